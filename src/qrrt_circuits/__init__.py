@@ -1,0 +1,1 @@
+"""qrrt_circuits: quantum-search sampling-based motion planners (q-RRT, Pq-RRT, QDA)."""

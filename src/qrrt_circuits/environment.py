@@ -1,0 +1,236 @@
+"""The world: an axis-aligned bounding box with axis-aligned box obstacles, in any dimension d >= 2.
+
+Obstacles are closed boxes: a point on a box's boundary is in collision. The workspace is the
+closed box ``bounds``. Environments round-trip through a documented JSON format::
+
+    {
+      "format": "qrrt-environment", "version": 1, "name": "paper_clutter",
+      "bounds": [[low_0, high_0], ..., [low_{d-1}, high_{d-1}]],
+      "boxes": [[[lower_0, ..., lower_{d-1}], [upper_0, ..., upper_{d-1}]], ...],
+      "start": [..] | null, "goal": [..] | null, "goal_radius": float | null,
+      "metadata": {...}
+    }
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+FORMAT_NAME = "qrrt-environment"
+FORMAT_VERSION = 1
+
+
+def _as_float_array(value: Any, name: str) -> np.ndarray:
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be numeric, got {value!r}") from exc
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must contain only finite numbers (no NaN or inf)")
+    return array
+
+
+@dataclass(frozen=True, eq=False)
+class Environment:
+    """Workspace ``bounds`` (d, 2) and box obstacles ``boxes`` (k, 2, d).
+
+    ``boxes[i, 0]`` is the lower corner of box i and ``boxes[i, 1]`` its upper corner.
+    ``start``, ``goal`` and ``goal_radius`` are optional: scenarios fill them in.
+    """
+
+    bounds: np.ndarray
+    boxes: np.ndarray
+    name: str = "custom"
+    start: np.ndarray | None = None
+    goal: np.ndarray | None = None
+    goal_radius: float | None = None
+    metadata: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        bounds = _as_float_array(self.bounds, "bounds")
+        if bounds.ndim != 2 or bounds.shape[1] != 2 or bounds.shape[0] < 2:
+            raise ValueError(f"bounds must have shape (d, 2) with d >= 2, got {bounds.shape}")
+        if np.any(bounds[:, 0] >= bounds[:, 1]):
+            axis = int(np.argmax(bounds[:, 0] >= bounds[:, 1]))
+            raise ValueError(
+                f"bounds[{axis}]: low must be < high, got low={bounds[axis, 0]}, "
+                f"high={bounds[axis, 1]}"
+            )
+        d = bounds.shape[0]
+        boxes = _as_float_array(self.boxes if len(self.boxes) else np.zeros((0, 2, d)), "boxes")
+        if boxes.ndim != 3 or boxes.shape[1:] != (2, d):
+            raise ValueError(f"boxes must have shape (k, 2, {d}), got {boxes.shape}")
+        bad = np.any(boxes[:, 0] > boxes[:, 1], axis=1)
+        if np.any(bad):
+            i = int(np.argmax(bad))
+            raise ValueError(
+                f"boxes[{i}]: lower corner must be <= upper corner on every axis, got "
+                f"lower={boxes[i, 0].tolist()}, upper={boxes[i, 1].tolist()}"
+            )
+        bounds.setflags(write=False)
+        boxes = np.ascontiguousarray(boxes)
+        boxes.setflags(write=False)
+        object.__setattr__(self, "bounds", bounds)
+        object.__setattr__(self, "boxes", boxes)
+        for key in ("start", "goal"):
+            value = getattr(self, key)
+            if value is not None:
+                point = _as_float_array(value, key).reshape(-1)
+                if point.shape != (d,):
+                    raise ValueError(f"{key} must have {d} coordinates, got {point.shape[0]}")
+                point.setflags(write=False)
+                object.__setattr__(self, key, point)
+        if self.goal_radius is not None:
+            radius = float(self.goal_radius)
+            if not math.isfinite(radius) or radius <= 0:
+                raise ValueError(f"goal_radius must be a finite number > 0, got {self.goal_radius}")
+            object.__setattr__(self, "goal_radius", radius)
+
+    @property
+    def dim(self) -> int:
+        """Dimension d of the configuration space."""
+        return int(self.bounds.shape[0])
+
+    @property
+    def num_boxes(self) -> int:
+        return int(self.boxes.shape[0])
+
+    @property
+    def volume(self) -> float:
+        return float(np.prod(self.bounds[:, 1] - self.bounds[:, 0]))
+
+    def in_bounds(self, points: np.ndarray) -> np.ndarray:
+        """True where ``points`` (..., d) lie in the closed workspace box."""
+        points = self._check_points(points)
+        return np.all((points >= self.bounds[:, 0]) & (points <= self.bounds[:, 1]), axis=-1)
+
+    def is_free(self, points: np.ndarray) -> np.ndarray:
+        """True where ``points`` (..., d) are inside the bounds and outside every (closed) box."""
+        from .collision import points_free
+
+        points = self._check_points(points)
+        shape = points.shape[:-1]
+        flat = np.ascontiguousarray(points.reshape(-1, self.dim))
+        index = self.grid_index
+        out = np.zeros(flat.shape[0], dtype=np.bool_)
+        points_free(flat, self.bounds, self._lower, self._upper, index.origin, index.cell_size,
+                    index.shape, index.cell_start, index.cell_items, out)
+        return out.reshape(shape)
+
+    @property
+    def grid_index(self):
+        """Uniform-grid spatial index of the boxes (built once, on first use)."""
+        from .collision import GridIndex
+
+        index = self.__dict__.get("_grid_index")
+        if index is None:
+            index = GridIndex.build(self.bounds, self.boxes)
+            object.__setattr__(self, "_grid_index", index)
+            object.__setattr__(self, "_lower", np.ascontiguousarray(self.boxes[:, 0]))
+            object.__setattr__(self, "_upper", np.ascontiguousarray(self.boxes[:, 1]))
+        return index
+
+    def sample_uniform(self, count: int, rng: np.random.Generator) -> np.ndarray:
+        """``count`` points uniform in the workspace box (obstacles ignored)."""
+        low, high = self.bounds[:, 0], self.bounds[:, 1]
+        return low + (high - low) * rng.random((count, self.dim))
+
+    def sample_free(
+        self, count: int, rng: np.random.Generator, max_attempts: int = 1000
+    ) -> np.ndarray:
+        """``count`` points uniform over free space, by rejection sampling."""
+        if int(count) != count or count < 0:
+            raise ValueError(f"count must be an integer >= 0, got {count}")
+        if not isinstance(rng, np.random.Generator):
+            raise ValueError("rng must be a numpy.random.Generator (use np.random.default_rng)")
+        count = int(count)
+        found: list[np.ndarray] = []
+        have = 0
+        for _ in range(max_attempts):
+            if have >= count:
+                break
+            batch = self.sample_uniform(max(2 * (count - have), 16), rng)
+            batch = batch[self.is_free(batch)]
+            found.append(batch)
+            have += len(batch)
+        if have < count:
+            raise RuntimeError(
+                f"could not draw {count} free points in {max_attempts} batches: "
+                "the free space is (nearly) empty"
+            )
+        return np.concatenate(found)[:count] if found else np.zeros((0, self.dim))
+
+    def free_fraction(self, samples: int = 20000, seed: int = 0) -> float:
+        """Monte-Carlo estimate of the free fraction of the workspace."""
+        rng = np.random.default_rng(seed)
+        return float(np.mean(self.is_free(self.sample_uniform(samples, rng))))
+
+    def _check_points(self, points: np.ndarray) -> np.ndarray:
+        points = np.asarray(points, dtype=float)
+        if points.shape[-1:] != (self.dim,):
+            raise ValueError(
+                f"points must have last dimension {self.dim} (the environment's d), "
+                f"got shape {points.shape}"
+            )
+        return points
+
+    # ------------------------------------------------------------------ JSON
+    def to_dict(self) -> dict:
+        return {
+            "format": FORMAT_NAME,
+            "version": FORMAT_VERSION,
+            "name": self.name,
+            "bounds": self.bounds.tolist(),
+            "boxes": self.boxes.tolist(),
+            "start": None if self.start is None else self.start.tolist(),
+            "goal": None if self.goal is None else self.goal.tolist(),
+            "goal_radius": self.goal_radius,
+            "metadata": dict(self.metadata),
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict) -> Environment:
+        if not isinstance(data, dict):
+            raise ValueError("environment JSON must be an object")
+        if data.get("format") != FORMAT_NAME:
+            raise ValueError(f"'format' must be {FORMAT_NAME!r}, got {data.get('format')!r}")
+        if data.get("version") != FORMAT_VERSION:
+            raise ValueError(f"'version' must be {FORMAT_VERSION}, got {data.get('version')!r}")
+        for key in ("bounds", "boxes"):
+            if key not in data:
+                raise ValueError(f"environment JSON is missing {key!r}")
+        bounds = _as_float_array(data["bounds"], "bounds")
+        boxes = data["boxes"]
+        if len(boxes) == 0:
+            boxes = np.zeros((0, 2, bounds.shape[0] if bounds.ndim == 2 else 2))
+        return cls(
+            bounds=bounds,
+            boxes=boxes,
+            name=str(data.get("name", "custom")),
+            start=data.get("start"),
+            goal=data.get("goal"),
+            goal_radius=data.get("goal_radius"),
+            metadata=dict(data.get("metadata") or {}),
+        )
+
+    def save(self, path: str | Path) -> Path:
+        path = Path(path)
+        path.write_text(json.dumps(self.to_dict(), indent=1))
+        return path
+
+    @classmethod
+    def load(cls, path: str | Path) -> Environment:
+        try:
+            data = json.loads(Path(path).read_text())
+        except json.JSONDecodeError as exc:
+            raise ValueError(f"{path}: not valid JSON ({exc})") from exc
+        return cls.from_dict(data)
+
+    def __repr__(self) -> str:
+        return f"Environment(name={self.name!r}, d={self.dim}, boxes={self.num_boxes})"

@@ -1,0 +1,181 @@
+"""Seeded scenarios of DESIGN §4. Each returns an ``Environment`` with ``start``, ``goal`` and
+``goal_radius`` filled in. Same seed, same world."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import ndimage
+
+from .environment import Environment
+
+CLUTTER_SIZE = 20.0
+CLUTTER_BOXES = 525
+SIDE_RANGE = (0.25, 0.85)
+GOAL_RADIUS = 0.75
+
+
+def _random_boxes(rng: np.random.Generator, count: int, low: np.ndarray, high: np.ndarray,
+                  side_range: tuple[float, float] = SIDE_RANGE) -> np.ndarray:
+    """``count`` boxes with independent side lengths U(side_range), lying inside [low, high]."""
+    d = low.shape[0]
+    sides = rng.uniform(side_range[0], side_range[1], size=(count, d))
+    lower = low + rng.random((count, d)) * (high - low - sides)
+    return np.stack([lower, lower + sides], axis=1)
+
+
+def _start_goal(env: Environment, rng: np.random.Generator, min_separation: float,
+                radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """Free start and goal at least ``min_separation`` apart, each with ``radius`` clearance from
+    obstacles along the axes (so the goal ball is not hidden inside an obstacle)."""
+    for _ in range(10000):
+        start, goal = env.sample_free(2, rng)
+        if np.linalg.norm(goal - start) >= min_separation and _clearance_ok(env, start, radius) \
+                and _clearance_ok(env, goal, radius):
+            return start, goal
+    raise RuntimeError("could not place start and goal")
+
+
+def _clearance_ok(env: Environment, point: np.ndarray, radius: float) -> bool:
+    offsets = np.concatenate([np.eye(env.dim), -np.eye(env.dim)]) * radius * 0.25
+    return bool(np.all(env.is_free(point + offsets)))
+
+
+def _check_seed(seed: int | None) -> int | None:
+    if seed is not None and (int(seed) != seed or seed < 0):
+        raise ValueError(f"seed must be a non-negative integer or None, got {seed}")
+    return seed
+
+
+def paper_clutter(seed: int | None = 0, num_boxes: int = CLUTTER_BOXES,
+                  size: float = CLUTTER_SIZE) -> Environment:
+    """[0, 20]^2 with 525 boxes of sides U(0.25, 0.85) (the authors' comparison world).
+
+    Start and goal are uniform free points at least half the side apart; goal radius 0.75.
+    """
+    _check_seed(seed)
+    if num_boxes < 0:
+        raise ValueError(f"num_boxes must be >= 0, got {num_boxes}")
+    if size <= 2 * SIDE_RANGE[1]:
+        raise ValueError(f"size must be > {2 * SIDE_RANGE[1]}, got {size}")
+    rng = np.random.default_rng(seed)
+    bounds = np.array([[0.0, size], [0.0, size]])
+    boxes = _random_boxes(rng, num_boxes, bounds[:, 0], bounds[:, 1])
+    env = Environment(bounds, boxes, name="paper_clutter")
+    start, goal = _start_goal(env, rng, size / 2, GOAL_RADIUS)
+    return Environment(bounds, boxes, name="paper_clutter", start=start, goal=goal,
+                       goal_radius=GOAL_RADIUS,
+                       metadata={"seed": seed, "num_boxes": num_boxes, "side_range": SIDE_RANGE})
+
+
+def narrow_corridor(seed: int | None = 0, width: float = 0.4, length: float = 4.0,
+                    clutter: int = 120) -> Environment:
+    """[0, 20]^2 split by two large blocks leaving one horizontal channel ``width`` wide and
+    ``length`` long through the middle (paper §V.C); small random boxes on both sides, kept out of
+    the channel's mouths. Start on the left, goal on the right."""
+    _check_seed(seed)
+    if not (0 < width < 10):
+        raise ValueError(f"width must be in (0, 10), got {width}")
+    if not (0 < length < 18):
+        raise ValueError(f"length must be in (0, 18), got {length}")
+    rng = np.random.default_rng(seed)
+    size = CLUTTER_SIZE
+    x0, x1 = (size - length) / 2, (size + length) / 2
+    y0, y1 = (size - width) / 2, (size + width) / 2
+    blocks = np.array([[[x0, 0.0], [x1, y0]], [[x0, y1], [x1, size]]])
+    keep_out = 1.5  # free margin around the channel mouths
+    small = []
+    while len(small) < clutter:
+        box = _random_boxes(rng, 1, np.zeros(2), np.full(2, size))[0]
+        if box[1, 0] > x0 - 0.3 and box[0, 0] < x1 + 0.3:
+            continue  # overlaps the wall's columns: keep the wall's faces clean
+        near_mouth_y = box[1, 1] > y0 - keep_out and box[0, 1] < y1 + keep_out
+        near_mouth_x = box[1, 0] > x0 - keep_out and box[0, 0] < x1 + keep_out
+        if near_mouth_y and near_mouth_x:
+            continue
+        small.append(box)
+    boxes = np.concatenate([blocks, np.array(small).reshape(-1, 2, 2)])
+    env = Environment(np.array([[0.0, size], [0.0, size]]), boxes, name="narrow_corridor")
+    for _ in range(10000):
+        start = np.array([rng.uniform(1.0, x0 - 3.0), rng.uniform(2.0, size - 2.0)])
+        goal = np.array([rng.uniform(x1 + 3.0, size - 1.0), rng.uniform(2.0, size - 2.0)])
+        if env.is_free(start) and env.is_free(goal) and _clearance_ok(env, goal, GOAL_RADIUS) \
+                and _clearance_ok(env, start, GOAL_RADIUS):
+            break
+    return Environment(env.bounds, boxes, name="narrow_corridor", start=start, goal=goal,
+                       goal_radius=GOAL_RADIUS,
+                       metadata={"seed": seed, "channel": [[x0, y0], [x1, y1]],
+                                 "width": width, "length": length, "clutter": clutter})
+
+
+def annealing_field(seed: int | None = 0, num_boxes: int = 6025) -> Environment:
+    """6025 boxes with paper_clutter's sides on a square whose side keeps paper_clutter's box
+    density (20 * sqrt(6025 / 525) ~ 67.75), so the free fraction matches (paper §V.D)."""
+    _check_seed(seed)
+    size = CLUTTER_SIZE * math.sqrt(num_boxes / CLUTTER_BOXES)
+    rng = np.random.default_rng(seed)
+    bounds = np.array([[0.0, size], [0.0, size]])
+    boxes = _random_boxes(rng, num_boxes, bounds[:, 0], bounds[:, 1])
+    env = Environment(bounds, boxes, name="annealing_field")
+    start, goal = _start_goal(env, rng, size / 2, GOAL_RADIUS)
+    return Environment(bounds, boxes, name="annealing_field", start=start, goal=goal,
+                       goal_radius=GOAL_RADIUS, metadata={"seed": seed, "num_boxes": num_boxes})
+
+
+def lattice(seed: int | None = 0, size: int = 72, blocked_fraction: float = 0.5) -> Environment:
+    """``size`` x ``size`` unit cells, a fraction ``blocked_fraction`` blocked at random (blocked
+    cells along a row are merged into one box). Start and goal are centres of cells of the largest
+    4-connected free component, drawn far apart."""
+    _check_seed(seed)
+    if int(size) != size or size < 2:
+        raise ValueError(f"size must be an integer >= 2, got {size}")
+    if not (0.0 <= blocked_fraction < 1.0):
+        raise ValueError(f"blocked_fraction must be in [0, 1), got {blocked_fraction}")
+    size = int(size)
+    rng = np.random.default_rng(seed)
+    blocked = np.zeros(size * size, dtype=bool)
+    blocked[rng.choice(size * size, int(round(blocked_fraction * size * size)), replace=False)] = True
+    blocked = blocked.reshape(size, size)  # blocked[ix, iy]
+    boxes = []
+    for iy in range(size):
+        ix = 0
+        while ix < size:
+            if blocked[ix, iy]:
+                end = ix
+                while end + 1 < size and blocked[end + 1, iy]:
+                    end += 1
+                boxes.append([[ix, iy], [end + 1, iy + 1]])
+                ix = end + 1
+            else:
+                ix += 1
+    labels, count = ndimage.label(~blocked)
+    if count == 0:
+        raise ValueError("the lattice has no free cell")
+    sizes = ndimage.sum(np.ones_like(labels), labels, index=np.arange(1, count + 1))
+    largest = int(np.argmax(sizes)) + 1
+    cells = np.argwhere(labels == largest)
+    first = cells[rng.integers(len(cells))]
+    distances = np.linalg.norm(cells - first, axis=1)
+    far = cells[distances >= np.quantile(distances, 0.9)]
+    second = far[rng.integers(len(far))]
+    bounds = np.array([[0.0, size], [0.0, size]])
+    return Environment(bounds, np.array(boxes, dtype=float).reshape(-1, 2, 2), name="lattice",
+                       start=first + 0.5, goal=second + 0.5, goal_radius=0.45,
+                       metadata={"seed": seed, "size": size, "blocked_fraction": blocked_fraction,
+                                 "component_cells": int(sizes[largest - 1])})
+
+
+SCENARIOS = {
+    "paper_clutter": paper_clutter,
+    "narrow_corridor": narrow_corridor,
+    "annealing_field": annealing_field,
+    "lattice": lattice,
+}
+
+
+def by_name(name: str, seed: int | None = 0) -> Environment:
+    """Build a scenario from its name (one of ``SCENARIOS``)."""
+    if name not in SCENARIOS:
+        raise ValueError(f"unknown scenario {name!r}; choose one of {sorted(SCENARIOS)}")
+    return SCENARIOS[name](seed=seed)
