@@ -1,1 +1,36 @@
-"""qrrt_circuits: quantum-search sampling-based motion planners (q-RRT, Pq-RRT, QDA)."""
+"""qrrt_circuits: quantum-search sampling-based motion planners.
+
+q-RRT, parallel Pq-RRT (shared and unshared databases) and Quantum Database Annealing from
+Lathrop, Boardman and Martinez, "Parallel Quantum Rapidly-Exploring Random Trees" (IEEE Access
+2024), with Grover search as real Qiskit circuits on Aer or on an exact statevector.
+"""
+
+from . import probability, scenarios
+from .dynamics import LinearTrackingDynamics
+from .environment import Environment
+from .oracle import OracleErrorModel, ReachabilityOracle
+from .search import (
+    AerBackend,
+    QuantumSearchBackend,
+    SamplerBackend,
+    SearchResult,
+    StatevectorBackend,
+    circuits,
+)
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "AerBackend",
+    "Environment",
+    "LinearTrackingDynamics",
+    "OracleErrorModel",
+    "QuantumSearchBackend",
+    "ReachabilityOracle",
+    "SamplerBackend",
+    "SearchResult",
+    "StatevectorBackend",
+    "circuits",
+    "probability",
+    "scenarios",
+]

@@ -168,7 +168,7 @@ class Environment:
 
     def free_fraction(self, samples: int = 20000, seed: int = 0) -> float:
         """Monte-Carlo estimate of the free fraction of the workspace."""
-        rng = np.random.default_rng(seed)
+        rng = np.random.default_rng([0xF4EE, seed])
         return float(np.mean(self.is_free(self.sample_uniform(samples, rng))))
 
     def _check_points(self, points: np.ndarray) -> np.ndarray:

@@ -48,6 +48,17 @@ def _check_seed(seed: int | None) -> int | None:
     return seed
 
 
+_STREAMS = {"paper_clutter": 1, "narrow_corridor": 2, "annealing_field": 3, "lattice": 4}
+
+
+def _world_rng(name: str, seed: int | None) -> np.random.Generator:
+    """The world's own stream: keyed by scenario, so ``default_rng(seed)`` in user code never
+    replays the numbers that placed the obstacles."""
+    if seed is None:
+        return np.random.default_rng()
+    return np.random.default_rng([0x51A7E, _STREAMS[name], int(seed)])
+
+
 def paper_clutter(seed: int | None = 0, num_boxes: int = CLUTTER_BOXES,
                   size: float = CLUTTER_SIZE) -> Environment:
     """[0, 20]^2 with 525 boxes of sides U(0.25, 0.85) (the authors' comparison world).
@@ -59,7 +70,7 @@ def paper_clutter(seed: int | None = 0, num_boxes: int = CLUTTER_BOXES,
         raise ValueError(f"num_boxes must be >= 0, got {num_boxes}")
     if size <= 2 * SIDE_RANGE[1]:
         raise ValueError(f"size must be > {2 * SIDE_RANGE[1]}, got {size}")
-    rng = np.random.default_rng(seed)
+    rng = _world_rng("paper_clutter", seed)
     bounds = np.array([[0.0, size], [0.0, size]])
     boxes = _random_boxes(rng, num_boxes, bounds[:, 0], bounds[:, 1])
     env = Environment(bounds, boxes, name="paper_clutter")
@@ -79,7 +90,7 @@ def narrow_corridor(seed: int | None = 0, width: float = 0.4, length: float = 4.
         raise ValueError(f"width must be in (0, 10), got {width}")
     if not (0 < length < 18):
         raise ValueError(f"length must be in (0, 18), got {length}")
-    rng = np.random.default_rng(seed)
+    rng = _world_rng("narrow_corridor", seed)
     size = CLUTTER_SIZE
     x0, x1 = (size - length) / 2, (size + length) / 2
     y0, y1 = (size - width) / 2, (size + width) / 2
@@ -114,7 +125,7 @@ def annealing_field(seed: int | None = 0, num_boxes: int = 6025) -> Environment:
     density (20 * sqrt(6025 / 525) ~ 67.75), so the free fraction matches (paper §V.D)."""
     _check_seed(seed)
     size = CLUTTER_SIZE * math.sqrt(num_boxes / CLUTTER_BOXES)
-    rng = np.random.default_rng(seed)
+    rng = _world_rng("annealing_field", seed)
     bounds = np.array([[0.0, size], [0.0, size]])
     boxes = _random_boxes(rng, num_boxes, bounds[:, 0], bounds[:, 1])
     env = Environment(bounds, boxes, name="annealing_field")
@@ -133,7 +144,7 @@ def lattice(seed: int | None = 0, size: int = 72, blocked_fraction: float = 0.5)
     if not (0.0 <= blocked_fraction < 1.0):
         raise ValueError(f"blocked_fraction must be in [0, 1), got {blocked_fraction}")
     size = int(size)
-    rng = np.random.default_rng(seed)
+    rng = _world_rng("lattice", seed)
     blocked = np.zeros(size * size, dtype=bool)
     blocked[rng.choice(size * size, int(round(blocked_fraction * size * size)), replace=False)] = True
     blocked = blocked.reshape(size, size)  # blocked[ix, iy]

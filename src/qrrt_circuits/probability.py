@@ -1,0 +1,155 @@
+"""The paper's probability results for p quantum workers on a shared database (§III.C).
+
+Notation: N = 2^n database entries, m of them marked by the oracle, P(G) the probability that one
+worker measures a marked entry after its Grover iterations. With oracle errors, m1 <= m marked
+entries are truly good and m2 truly good entries were marked bad.
+"""
+
+from __future__ import annotations
+
+import math
+
+from .search.statevector import good_probability
+
+
+def _count(value, name: str, minimum: int = 0) -> int:
+    if isinstance(value, bool) or int(value) != value or value < minimum:
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
+    return int(value)
+
+
+def _probability(value, name: str) -> float:
+    value = float(value)
+    if not (0.0 <= value <= 1.0):
+        raise ValueError(f"{name} must be a probability in [0, 1], got {value!r}")
+    return value
+
+
+def _marked(num_items, num_marked) -> tuple[int, int]:
+    num_items = _count(num_items, "num_items", 1)
+    num_marked = _count(num_marked, "num_marked", 0)
+    if num_marked > num_items:
+        raise ValueError(f"num_marked must be in [0, num_items = {num_items}], got {num_marked}")
+    return num_items, num_marked
+
+
+def harmonic(k: int) -> float:
+    """H_k = 1 + 1/2 + ... + 1/k (H_0 = 0)."""
+    return math.fsum(1.0 / i for i in range(1, _count(k, "k") + 1))
+
+
+def success_probability(num_items: int, num_marked: int, iterations: int) -> float:
+    """P(G) = sin^2((2k+1) theta), sin^2 theta = m/N (Lemma 1; Boyer et al. 1998)."""
+    num_items, num_marked = _marked(num_items, num_marked)
+    return good_probability(num_items, num_marked, _count(iterations, "iterations"))
+
+
+def optimal_iterations(num_items: int, num_marked: int) -> int:
+    """floor(pi / (4 theta)) with sin^2 theta = m/N, and 0 for m = 0 (Eq. 1, DESIGN §2)."""
+    num_items, num_marked = _marked(num_items, num_marked)
+    if num_marked == 0:
+        return 0
+    theta = math.asin(math.sqrt(num_marked / num_items))
+    return int(math.floor(math.pi / (4.0 * theta)))
+
+
+def prob_all_same(workers: int, num_marked: int, p_good: float) -> float:
+    """Lemma 1: P(all p workers measure the same solution) = P(G)^p m^(1-p) (0 if m = 0)."""
+    workers = _count(workers, "workers", 1)
+    num_marked = _count(num_marked, "num_marked")
+    p_good = _probability(p_good, "p_good")
+    if num_marked == 0:
+        return 0.0
+    return p_good**workers * float(num_marked) ** (1 - workers)
+
+
+def prob_all_different(workers: int, num_marked: int, p_good: float) -> float:
+    """Lemma 2: P(all p workers measure different solutions) = P(G)^p m! / (m^p (m-p)!).
+
+    Stated for m >= p; for p > m it is 0 (pigeonhole), which the formula's (m-p)! cannot say.
+    """
+    workers = _count(workers, "workers", 1)
+    num_marked = _count(num_marked, "num_marked")
+    p_good = _probability(p_good, "p_good")
+    if workers > num_marked:
+        return 0.0
+    falling = math.prod(range(num_marked - workers + 1, num_marked + 1))  # m! / (m-p)!
+    return p_good**workers * falling / float(num_marked) ** workers
+
+
+def expected_workers_all_found(num_marked: int, p_good: float) -> float:
+    """Lemma 3: expected workers (draws) to find all m solutions, E(p) = m H_m / P(G).
+
+    Coupon collection where each draw fails with probability 1 - P(G). Infinite if P(G) = 0 < m.
+    """
+    num_marked = _count(num_marked, "num_marked")
+    p_good = _probability(p_good, "p_good")
+    if num_marked == 0:
+        return 0.0
+    if p_good == 0.0:
+        return math.inf
+    return num_marked * harmonic(num_marked) / p_good
+
+
+def _error_counts(num_items, num_marked, true_marked, missed_good) -> tuple[int, int, int, int]:
+    num_items, num_marked = _marked(num_items, num_marked)
+    true_marked = _count(true_marked, "true_marked")
+    missed_good = _count(missed_good, "missed_good")
+    if true_marked > num_marked:
+        raise ValueError(f"true_marked must be in [0, num_marked = {num_marked}], got {true_marked}")
+    if missed_good > num_items - num_marked:
+        raise ValueError(
+            f"missed_good must be in [0, num_items - num_marked = {num_items - num_marked}], "
+            f"got {missed_good}"
+        )
+    return num_items, num_marked, true_marked, missed_good
+
+
+def prob_true_solution(num_items: int, num_marked: int, true_marked: int, missed_good: int,
+                       p_good: float) -> float:
+    """Lemma 4: P(G*) = (m1/m) P(G) + (m2/(N-m)) (1 - P(G)), a truly good entry is measured."""
+    n_items, m, m1, m2 = _error_counts(num_items, num_marked, true_marked, missed_good)
+    p_good = _probability(p_good, "p_good")
+    marked_part = m1 / m * p_good if m else 0.0
+    unmarked_part = m2 / (n_items - m) * (1.0 - p_good) if n_items > m else 0.0
+    return marked_part + unmarked_part
+
+
+def prob_all_same_with_errors(workers: int, num_items: int, num_marked: int, true_marked: int,
+                              missed_good: int, p_good: float) -> float:
+    """Lemma 5: P(all p workers measure the same truly good entry)
+    = m1 (P(G)/m)^p + m2 ((1 - P(G))/(N - m))^p."""
+    workers = _count(workers, "workers", 1)
+    n_items, m, m1, m2 = _error_counts(num_items, num_marked, true_marked, missed_good)
+    p_good = _probability(p_good, "p_good")
+    marked_part = m1 * (p_good / m) ** workers if m else 0.0
+    unmarked_part = m2 * ((1.0 - p_good) / (n_items - m)) ** workers if n_items > m else 0.0
+    return marked_part + unmarked_part
+
+
+def expected_workers_with_errors(num_marked: int, true_marked: int, p_good: float) -> float:
+    """Lemma 6: expected workers to find all m1 truly good marked entries,
+    E(p*) = m1 H_{m1} / ((m1/m) P(G)) = m H_{m1} / P(G)."""
+    num_marked = _count(num_marked, "num_marked")
+    true_marked = _count(true_marked, "true_marked")
+    if true_marked > num_marked:
+        raise ValueError(f"true_marked must be in [0, num_marked = {num_marked}], got {true_marked}")
+    p_good = _probability(p_good, "p_good")
+    if true_marked == 0:
+        return 0.0
+    if p_good == 0.0:
+        return math.inf
+    return true_marked * harmonic(true_marked) / (true_marked / num_marked * p_good)
+
+
+__all__ = [
+    "expected_workers_all_found",
+    "expected_workers_with_errors",
+    "harmonic",
+    "optimal_iterations",
+    "prob_all_different",
+    "prob_all_same",
+    "prob_all_same_with_errors",
+    "prob_true_solution",
+    "success_probability",
+]

@@ -1,0 +1,108 @@
+"""The ``QuantumSearchBackend`` interface and its result type.
+
+A backend Grover-searches a database of N = 2^n entries given the oracle's marks (a bool array of
+length N): it prepares the uniform superposition, applies ``iterations`` Grover iterations and
+measures, once per shot. Each shot is an independent preparation and measurement, so one call with
+``shots = p`` stands for p workers searching copies of one shared database (the simulation
+shortcut of Pq-RRT: on hardware each worker would run its own circuit).
+
+Oracle calls are counted as DESIGN §2 says: one per Grover iteration per preparation, so
+``oracle_calls = iterations * shots``.
+"""
+
+from __future__ import annotations
+
+import abc
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class SearchResult:
+    """Measured database indices (one per shot) and the oracle calls they cost."""
+
+    indices: np.ndarray
+    iterations: int
+    shots: int
+    oracle_calls: int
+
+    def __post_init__(self) -> None:
+        indices = np.asarray(self.indices, dtype=np.int64)
+        indices.setflags(write=False)
+        object.__setattr__(self, "indices", indices)
+
+
+def validate_marks(marks: np.ndarray) -> tuple[np.ndarray, int]:
+    """Return (marks as bool array, n) or raise a ValueError naming the problem."""
+    array = np.asarray(marks)
+    if array.ndim != 1:
+        raise ValueError(f"marks must be a 1-D array of length 2**n, got shape {array.shape}")
+    size = array.shape[0]
+    if size < 2 or size & (size - 1):
+        raise ValueError(
+            f"marks must have length 2**n with n >= 1 (a power of two >= 2), got length {size}"
+        )
+    if array.dtype != np.bool_:
+        if not np.all(np.isin(array, (0, 1))):
+            raise ValueError("marks must be booleans (or 0/1)")
+        array = array.astype(bool)
+    return array, size.bit_length() - 1
+
+
+def validate_iterations(iterations: int) -> int:
+    if isinstance(iterations, bool) or int(iterations) != iterations or iterations < 0:
+        raise ValueError(f"iterations must be an integer >= 0, got {iterations!r}")
+    return int(iterations)
+
+
+def validate_shots(shots: int) -> int:
+    if isinstance(shots, bool) or int(shots) != shots or shots < 1:
+        raise ValueError(f"shots must be an integer >= 1, got {shots!r}")
+    return int(shots)
+
+
+def seed_stream(seed: int | np.random.Generator | None) -> np.random.Generator:
+    """A numpy Generator from a seed, a Generator (used as is) or None (fresh entropy)."""
+    if isinstance(seed, np.random.Generator):
+        return seed
+    if seed is not None and (isinstance(seed, bool) or int(seed) != seed or seed < 0):
+        raise ValueError(f"seed must be a non-negative integer, a numpy Generator or None, got {seed!r}")
+    return np.random.default_rng(seed)
+
+
+class QuantumSearchBackend(abc.ABC):
+    """Runs Grover search on a marked database; subclasses differ in how (gates, exact, hardware)."""
+
+    #: short name used in outputs and the CLI
+    name: str = "backend"
+    #: a label for every output that depends on this backend's simulation shortcuts
+    shortcuts: tuple[str, ...] = (
+        "phase oracle built from a classical lookup of all 2^n entries (simulation_checks)",
+        "one circuit with p shots stands for p workers on a shared database",
+    )
+
+    @property
+    @abc.abstractmethod
+    def max_qubits(self) -> int:
+        """The largest n this backend accepts (memory-limited)."""
+
+    def search(self, marks: np.ndarray, iterations: int, shots: int = 1) -> SearchResult:
+        """Grover-search ``marks`` with ``iterations`` iterations; measure ``shots`` times."""
+        marks, num_qubits = validate_marks(marks)
+        iterations = validate_iterations(iterations)
+        shots = validate_shots(shots)
+        self.check_qubits(num_qubits)
+        indices = self._sample(marks, num_qubits, iterations, shots)
+        return SearchResult(indices, iterations, shots, iterations * shots)
+
+    def check_qubits(self, num_qubits: int) -> None:
+        if num_qubits < 1 or num_qubits > self.max_qubits:
+            raise ValueError(
+                f"num_qubits = {num_qubits} is outside the range this backend supports "
+                f"({self.name}: 1..{self.max_qubits} qubits, set by available memory)"
+            )
+
+    @abc.abstractmethod
+    def _sample(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int) -> np.ndarray:
+        """Return ``shots`` measured indices (validated inputs)."""

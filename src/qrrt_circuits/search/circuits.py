@@ -1,0 +1,182 @@
+"""Grover-search circuits over an n-qubit index register (paper Alg. 2, lines 4-8).
+
+Index i of the database is the computational basis state |i> in Qiskit's little-endian order
+(qubit 0 is the least significant bit), so a measured bitstring b reads as i = int(b, 2).
+
+- ``phase_oracle(marks)``: the unitary diag((-1)^marks) (the oracle X of the paper).
+- ``grover_circuit(marks, k)``: W = H^n on |0>, then k applications of
+  Q = grover_operator(oracle, W), then measurement. After k iterations the probability of a
+  marked index is sin^2((2k+1) theta), sin^2 theta = m / 2^n (Lemma 1).
+- ``aer_grover_circuit(marks, k)``: the same unitary (up to a global phase) written only with
+  gates AerSimulator executes natively (h, x, diagonal, mcphase), so no transpile is needed.
+- ``resource_estimate(marks, k)``: qubits, CX count and depth in the basis [cx, rz, sx, x].
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from qiskit import QuantumCircuit, transpile
+from qiskit.circuit.library import DiagonalGate, grover_operator
+
+from .backend import validate_iterations, validate_marks
+
+SYNTHESES = ("auto", "diagonal", "mcz")
+BASIS_GATES = ("cx", "rz", "sx", "x")
+
+
+def phase_oracle(marks: np.ndarray, synthesis: str = "auto") -> QuantumCircuit:
+    """Circuit on n qubits equal to diag((-1)^marks).
+
+    ``"diagonal"``: one ``DiagonalGate`` (about 2^n - 2 CX once synthesised);
+    ``"mcz"``: one multi-controlled Z per marked index, conjugated by X on its zero bits;
+    ``"auto"``: whichever has the smaller estimated CX count (``oracle_cx_estimate``).
+    """
+    marks, n = validate_marks(marks)
+    if synthesis not in SYNTHESES:
+        raise ValueError(f"synthesis must be one of {SYNTHESES}, got {synthesis!r}")
+    if synthesis == "auto":
+        synthesis = choose_synthesis(marks)
+    circuit = QuantumCircuit(n, name="oracle")
+    if synthesis == "diagonal":
+        circuit.append(DiagonalGate(np.where(marks, -1.0, 1.0).tolist()), range(n))
+        return circuit
+    full = (1 << n) - 1
+    flipped = 0  # qubits currently conjugated by X
+    for index in np.flatnonzero(marks):
+        wanted = ~int(index) & full  # X on the zero bits maps |index> to |1...1>
+        _flip(circuit, flipped ^ wanted)
+        flipped = wanted
+        _mcz(circuit, n)
+    _flip(circuit, flipped)
+    return circuit
+
+
+def _flip(circuit: QuantumCircuit, mask: int) -> None:
+    for qubit in range(circuit.num_qubits):
+        if mask >> qubit & 1:
+            circuit.x(qubit)
+
+
+def _mcz(circuit: QuantumCircuit, n: int) -> None:
+    """Phase -1 on |1...1> (an MCPhase(pi), which Aer runs natively)."""
+    if n == 1:
+        circuit.p(math.pi, 0)
+    else:
+        circuit.mcp(math.pi, list(range(n - 1)), n - 1)
+
+
+@functools.lru_cache(maxsize=64)
+def _mcz_cx_count(n: int) -> int:
+    circuit = QuantumCircuit(n)
+    _mcz(circuit, n)
+    compiled = transpile(circuit, basis_gates=list(BASIS_GATES), optimization_level=1)
+    return int(compiled.count_ops().get("cx", 0))
+
+
+def oracle_cx_estimate(num_qubits: int, num_marked: int) -> dict[str, int]:
+    """Estimated CX count of each synthesis: ``diagonal`` 2^n - 2 (uniformly controlled Rz
+    network), ``mcz`` = m x (CX of one transpiled n-qubit MCZ, counted once per n and cached)."""
+    diagonal = max((1 << num_qubits) - 2, 0)
+    return {"diagonal": diagonal, "mcz": num_marked * _mcz_cx_count(num_qubits)}
+
+
+def choose_synthesis(marks: np.ndarray) -> str:
+    marks, n = validate_marks(marks)
+    estimate = oracle_cx_estimate(n, int(np.count_nonzero(marks)))
+    return "mcz" if estimate["mcz"] < estimate["diagonal"] else "diagonal"
+
+
+def uniform_preparation(num_qubits: int) -> QuantumCircuit:
+    """W = H^n, the paper's Walsh-Hadamard state preparation."""
+    circuit = QuantumCircuit(num_qubits, name="W")
+    circuit.h(range(num_qubits))
+    return circuit
+
+
+def grover_circuit(
+    marks: np.ndarray, iterations: int, measure: bool = True, synthesis: str = "auto"
+) -> QuantumCircuit:
+    """W|0>, then ``iterations`` x Q with Q = grover_operator(phase_oracle(marks), W); measured
+    into a classical register named ``meas`` if ``measure``."""
+    marks, n = validate_marks(marks)
+    iterations = validate_iterations(iterations)
+    preparation = uniform_preparation(n)
+    circuit = QuantumCircuit(n, name="grover")
+    circuit.compose(preparation, inplace=True)
+    if iterations:
+        q = grover_operator(phase_oracle(marks, synthesis), state_preparation=preparation)
+        for _ in range(iterations):
+            circuit.compose(q, inplace=True)
+    if measure:
+        circuit.measure_all()
+    return circuit
+
+
+def aer_grover_circuit(
+    marks: np.ndarray, iterations: int, measure: bool = True, synthesis: str = "auto"
+) -> QuantumCircuit:
+    """The Grover circuit from Aer-native gates only: H^n, then per iteration the oracle followed by
+    the diffuser H^n X^n MCZ X^n H^n (= -(2|s><s| - I)); equal to ``grover_circuit`` up to a
+    global phase."""
+    marks, n = validate_marks(marks)
+    iterations = validate_iterations(iterations)
+    oracle = phase_oracle(marks, synthesis)
+    circuit = QuantumCircuit(n, name="grover_aer")
+    qubits = list(range(n))
+    circuit.h(qubits)
+    for _ in range(iterations):
+        circuit.compose(oracle, qubits, inplace=True)
+        circuit.h(qubits)
+        circuit.x(qubits)
+        _mcz(circuit, n)
+        circuit.x(qubits)
+        circuit.h(qubits)
+    if measure:
+        circuit.measure_all()
+    return circuit
+
+
+@dataclass(frozen=True)
+class ResourceCount:
+    qubits: int
+    cx: int
+    depth: int
+    size: int
+
+
+@dataclass(frozen=True)
+class ResourceEstimate:
+    """Cost of ``iterations`` Grover iterations after transpiling to [cx, rz, sx, x]."""
+
+    num_qubits: int
+    num_marked: int
+    iterations: int
+    synthesis: str
+    no_ancilla: ResourceCount
+    one_ancilla: ResourceCount
+
+
+def resource_estimate(
+    marks: np.ndarray, iterations: int, synthesis: str = "auto", optimization_level: int = 1
+) -> ResourceEstimate:
+    """Qubits, CX count and depth of the Grover circuit in the basis [cx, rz, sx, x], without and
+    with one extra (clean) ancilla qubit that the multi-controlled gates may use."""
+    marks, n = validate_marks(marks)
+    iterations = validate_iterations(iterations)
+    if n > 14:
+        raise ValueError(f"resource_estimate transpiles the full circuit: n must be <= 14, got {n}")
+    chosen = choose_synthesis(marks) if synthesis == "auto" else synthesis
+    circuit = grover_circuit(marks, iterations, measure=False, synthesis=chosen)
+    counts = []
+    for ancillas in (0, 1):
+        wide = QuantumCircuit(n + ancillas)
+        wide.compose(circuit, range(n), inplace=True)
+        compiled = transpile(wide, basis_gates=list(BASIS_GATES),
+                             optimization_level=optimization_level, seed_transpiler=0)
+        counts.append(ResourceCount(n + ancillas, int(compiled.count_ops().get("cx", 0)),
+                                    int(compiled.depth()), int(compiled.size())))
+    return ResourceEstimate(n, int(np.count_nonzero(marks)), iterations, chosen, *counts)

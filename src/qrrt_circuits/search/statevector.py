@@ -1,0 +1,98 @@
+"""Ideal Grover search on an exact numpy statevector.
+
+Starting from the uniform state, k Grover iterations leave every marked index with amplitude
+sin((2k+1)theta)/sqrt(m) and every unmarked one with cos((2k+1)theta)/sqrt(N-m), where
+sin^2 theta = m/N (Boyer, Brassard, Hoyer, Tapp 1998). Sampling uses this closed form (fast path,
+O(N) only to list the marked indices); ``amplitudes`` runs the O(N)-per-iteration statevector
+update, which the tests check against the closed form.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+from .backend import QuantumSearchBackend, seed_stream, validate_iterations, validate_marks
+
+BYTES_PER_ENTRY = 32  # amplitudes (8) + probabilities (8) + index lists (8) + marks, with slack
+
+
+def _memory_bytes() -> int:
+    try:
+        return int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        return 8 << 30
+
+
+def good_probability(num_items: int, num_marked: int, iterations: int) -> float:
+    """sin^2((2k+1) theta) with sin^2 theta = m/N."""
+    if num_marked == 0:
+        return 0.0
+    theta = math.asin(math.sqrt(num_marked / num_items))
+    return math.sin((2 * iterations + 1) * theta) ** 2
+
+
+class StatevectorBackend(QuantumSearchBackend):
+    """Exact (noise-free) Grover search; ``closed_form=False`` samples from the iterated vector."""
+
+    name = "statevector"
+
+    def __init__(
+        self,
+        seed: int | np.random.Generator | None = None,
+        closed_form: bool = True,
+        max_qubits: int | None = None,
+    ) -> None:
+        self._rng = seed_stream(seed)
+        self.closed_form = bool(closed_form)
+        memory_limit = int(math.log2(max(_memory_bytes() // 2 // BYTES_PER_ENTRY, 2)))
+        if max_qubits is not None and (int(max_qubits) != max_qubits or max_qubits < 1):
+            raise ValueError(f"max_qubits must be an integer >= 1, got {max_qubits}")
+        self._max_qubits = memory_limit if max_qubits is None else min(int(max_qubits), memory_limit)
+
+    @property
+    def max_qubits(self) -> int:
+        return self._max_qubits
+
+    @staticmethod
+    def amplitudes(marks: np.ndarray, iterations: int) -> np.ndarray:
+        """Real amplitudes after ``iterations`` x (oracle, then inversion about the mean)."""
+        marks, _ = validate_marks(marks)
+        iterations = validate_iterations(iterations)
+        state = np.full(marks.shape[0], 1.0 / math.sqrt(marks.shape[0]))
+        for _ in range(iterations):
+            state[marks] *= -1.0
+            state = 2.0 * state.mean() - state
+        return state
+
+    def _sample(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int) -> np.ndarray:
+        rng = self._rng
+        if not self.closed_form:
+            probabilities = self.amplitudes(marks, iterations) ** 2
+            cumulative = np.cumsum(probabilities)
+            draws = rng.random(shots) * cumulative[-1]
+            return np.minimum(np.searchsorted(cumulative, draws, side="right"), marks.shape[0] - 1)
+        size = marks.shape[0]
+        marked = np.flatnonzero(marks)
+        num_marked = marked.shape[0]
+        p_good = good_probability(size, num_marked, iterations)
+        good = rng.random(shots) < p_good
+        out = np.empty(shots, dtype=np.int64)
+        num_good = int(np.count_nonzero(good))
+        if num_good:
+            out[good] = marked[rng.integers(0, num_marked, num_good)]
+        if num_good < shots:
+            unmarked_count = size - num_marked
+            # k-th unmarked index without listing them all: rank among the complement
+            ranks = rng.integers(0, unmarked_count, shots - num_good)
+            out[~good] = _kth_unmarked(marked, ranks)
+        return out
+
+
+def _kth_unmarked(marked_sorted: np.ndarray, ranks: np.ndarray) -> np.ndarray:
+    """The ranks[j]-th index (0-based) not in ``marked_sorted``."""
+    # index = rank + (number of marked indices <= index); solve by searching marked - arange
+    shifted = marked_sorted - np.arange(marked_sorted.shape[0])
+    return ranks + np.searchsorted(shifted, ranks, side="right")

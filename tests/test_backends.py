@@ -1,0 +1,130 @@
+import math
+
+import numpy as np
+import pytest
+from conftest import ALL_BACKENDS, BACKENDS, make_backend, random_marks
+from scipy import stats
+
+import qrrt_circuits as qc
+from qrrt_circuits.probability import success_probability
+
+
+@pytest.mark.parametrize("backend_name", ALL_BACKENDS)
+@pytest.mark.parametrize("n, m, k", [(5, 3, 1), (5, 3, 2), (6, 1, 6), (4, 5, 1)])
+def test_success_frequency_matches_theory(backend_name, n, m, k):
+    backend = make_backend(backend_name, seed=17)
+    marks = random_marks(np.random.default_rng(n * 100 + m), n, m)
+    shots = 3000
+    result = backend.search(marks, k, shots=shots)
+    assert result.indices.shape == (shots,)
+    assert result.oracle_calls == k * shots
+    p = success_probability(2**n, m, k)
+    sigma = math.sqrt(p * (1 - p) / shots)
+    assert abs(marks[result.indices].mean() - p) <= 5 * sigma + 1e-12
+
+
+@pytest.mark.parametrize("backend_name", ALL_BACKENDS)
+def test_marked_outcomes_are_uniform(backend_name):
+    backend = make_backend(backend_name, seed=5)
+    marks = random_marks(np.random.default_rng(1), 6, 8)
+    result = backend.search(marks, 2, shots=4000)
+    hits = result.indices[marks[result.indices]]
+    counts = np.bincount(hits, minlength=64)[marks]
+    assert stats.chisquare(counts).pvalue > 1e-4
+
+
+@pytest.mark.parametrize("backend_name", ALL_BACKENDS)
+def test_no_marked_and_all_marked(backend_name):
+    backend = make_backend(backend_name, seed=2)
+    none = np.zeros(16, dtype=bool)
+    result = backend.search(none, 3, shots=1600)
+    counts = np.bincount(result.indices, minlength=16)
+    assert stats.chisquare(counts).pvalue > 1e-4  # uniform: Grover does nothing when m = 0
+    every = np.ones(16, dtype=bool)
+    assert every[backend.search(every, 3, shots=200).indices].all()
+
+
+@pytest.mark.parametrize("backend_name", BACKENDS + ["statevector-iterated"])
+def test_same_seed_same_indices(backend_name):
+    marks = random_marks(np.random.default_rng(0), 5, 4)
+    a = make_backend(backend_name, seed=42)
+    b = make_backend(backend_name, seed=42)
+    c = make_backend(backend_name, seed=43)
+    first = [a.search(marks, 1, shots=64).indices for _ in range(3)]
+    second = [b.search(marks, 1, shots=64).indices for _ in range(3)]
+    assert all(np.array_equal(x, y) for x, y in zip(first, second, strict=True))
+    assert not np.array_equal(first[0], c.search(marks, 1, shots=64).indices)
+
+
+def test_statevector_closed_form_equals_iteration():
+    rng = np.random.default_rng(9)
+    for n in (1, 3, 7):
+        for m in (0, 1, 2**n // 3, 2**n):
+            marks = random_marks(rng, n, m)
+            for k in (0, 1, 4):
+                amps = qc.StatevectorBackend.amplitudes(marks, k)
+                p = success_probability(2**n, m, k)
+                assert np.sum(amps[marks] ** 2) == pytest.approx(p, abs=1e-12)
+                assert np.sum(amps**2) == pytest.approx(1.0)
+
+
+def test_kth_unmarked_ranks():
+    from qrrt_circuits.search.statevector import _kth_unmarked
+
+    marks = np.zeros(32, dtype=bool)
+    marks[[0, 3, 4, 5, 20, 31]] = True
+    unmarked = np.flatnonzero(~marks)
+    ranks = np.arange(len(unmarked))
+    assert np.array_equal(_kth_unmarked(np.flatnonzero(marks), ranks), unmarked)
+
+
+@pytest.mark.parametrize("backend_name", ALL_BACKENDS)
+def test_bad_input(backend_name):
+    backend = make_backend(backend_name, seed=0)
+    with pytest.raises(ValueError, match="power of two"):
+        backend.search(np.zeros(12, bool), 1, 1)
+    with pytest.raises(ValueError, match="iterations"):
+        backend.search(np.zeros(8, bool), -1, 1)
+    with pytest.raises(ValueError, match="shots"):
+        backend.search(np.zeros(8, bool), 1, 0)
+    with pytest.raises(ValueError, match="num_qubits"):
+        backend.check_qubits(backend.max_qubits + 1)
+
+
+def test_statevector_memory_limit_is_checked_before_allocating():
+    backend = qc.StatevectorBackend(seed=0, max_qubits=10)
+    assert backend.max_qubits == 10
+    with pytest.raises(ValueError, match=r"num_qubits = 11 .*1\.\.10"):
+        backend.search(np.zeros(2**11, bool), 1, 1)
+
+
+def test_twenty_qubit_ideal_search():
+    backend = qc.StatevectorBackend(seed=1)
+    marks = random_marks(np.random.default_rng(0), 20, 50)
+    k = qc.probability.optimal_iterations(2**20, 50)
+    result = backend.search(marks, k, shots=400)
+    p = success_probability(2**20, 50, k)
+    assert abs(marks[result.indices].mean() - p) <= 5 * math.sqrt(p * (1 - p) / 400) + 1e-3
+
+
+def test_noisy_aer_backend_loses_amplification():
+    from qiskit_aer.noise import NoiseModel, depolarizing_error
+
+    noise = NoiseModel()
+    noise.add_all_qubit_quantum_error(depolarizing_error(0.05, 1), ["h", "x"])
+    marks = random_marks(np.random.default_rng(2), 5, 1)
+    ideal = qc.AerBackend(seed=1).search(marks, 4, shots=2000)
+    noisy = qc.AerBackend(seed=1, noise_model=noise).search(marks, 4, shots=2000)
+    assert marks[noisy.indices].mean() < marks[ideal.indices].mean() - 0.1
+
+
+def test_sampler_backend_transpiles_once_per_shape():
+    from qiskit_aer.primitives import SamplerV2
+
+    backend = qc.SamplerBackend(SamplerV2(seed=1))
+    marks = random_marks(np.random.default_rng(0), 4, 2)
+    backend.search(marks, 1, 10)
+    backend.search(marks, 1, 10)
+    assert backend.transpile_count == 1
+    backend.search(marks, 2, 10)
+    assert backend.transpile_count == 2

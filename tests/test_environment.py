@@ -1,0 +1,145 @@
+import json
+
+import numpy as np
+import pytest
+
+import qrrt_circuits as qc
+from qrrt_circuits.environment import Environment
+
+
+def test_is_free_matches_brute_force(clutter):
+    rng = np.random.default_rng(123)
+    points = clutter.sample_uniform(3000, rng)
+    lo, hi = clutter.boxes[:, 0], clutter.boxes[:, 1]
+    inside = np.any(np.all((points[:, None] >= lo) & (points[:, None] <= hi), axis=2), axis=1)
+    assert np.array_equal(clutter.is_free(points), ~inside)
+
+
+def test_is_free_keeps_leading_shape_and_rejects_out_of_bounds(clutter):
+    points = np.zeros((3, 4, 2)) - 1.0
+    assert clutter.is_free(points).shape == (3, 4)
+    assert not clutter.is_free(points).any()
+
+
+def test_box_boundary_is_in_collision():
+    env = Environment(np.array([[0, 10], [0, 10]]), np.array([[[2, 2], [4, 4]]]))
+    assert not env.is_free(np.array([4.0, 3.0]))
+    assert env.is_free(np.array([4.0 + 1e-9, 3.0]))
+
+
+def test_sample_free_is_free_and_seeded(clutter):
+    a = clutter.sample_free(500, np.random.default_rng(5))
+    b = clutter.sample_free(500, np.random.default_rng(5))
+    assert a.shape == (500, 2)
+    assert clutter.is_free(a).all()
+    assert np.array_equal(a, b)
+
+
+def test_json_round_trip(tmp_path, clutter):
+    path = clutter.save(tmp_path / "world.json")
+    loaded = Environment.load(path)
+    assert np.array_equal(loaded.bounds, clutter.bounds)
+    assert np.array_equal(loaded.boxes, clutter.boxes)
+    assert np.array_equal(loaded.start, clutter.start)
+    assert loaded.goal_radius == clutter.goal_radius
+    assert loaded.name == "paper_clutter"
+
+
+def _write(tmp_path, data):
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(data))
+    return path
+
+
+@pytest.mark.parametrize(
+    "patch, message",
+    [
+        ({"boxes": [[[3, 3], [1, 4]]]}, r"boxes\[0\]: lower corner must be <= upper"),
+        ({"bounds": [[0, 10], [5, 1]]}, r"bounds\[1\]: low must be < high"),
+        ({"bounds": [[0, float("nan")], [0, 1]]}, "finite"),
+        ({"boxes": [[[0, float("nan")], [1, 1]]]}, "finite"),
+        ({"format": "other"}, "'format' must be"),
+        ({"boxes": [[[0, 0, 0], [1, 1, 1]]]}, r"boxes must have shape \(k, 2, 2\)"),
+    ],
+)
+def test_bad_scenario_files_are_rejected(tmp_path, patch, message):
+    data = Environment(np.array([[0, 10], [0, 10]]), np.zeros((0, 2, 2))).to_dict()
+    data.update(patch)
+    with pytest.raises(ValueError, match=message):
+        Environment.load(_write(tmp_path, data))
+
+
+def test_not_json_is_rejected(tmp_path):
+    path = tmp_path / "x.json"
+    path.write_text("{not json")
+    with pytest.raises(ValueError, match="not valid JSON"):
+        Environment.load(path)
+
+
+def test_higher_dimension_environment():
+    env = Environment(np.array([[0, 1]] * 4), np.array([[[0.2] * 4, [0.4] * 4]]))
+    assert env.dim == 4
+    assert not env.is_free(np.full(4, 0.3))
+    assert env.is_free(np.full(4, 0.5))
+
+
+def test_paper_clutter_matches_design():
+    env = qc.scenarios.paper_clutter(seed=3)
+    sides = env.boxes[:, 1] - env.boxes[:, 0]
+    assert env.num_boxes == 525
+    assert np.all((sides >= 0.25) & (sides <= 0.85))
+    assert np.all(env.boxes[:, 0] >= 0) and np.all(env.boxes[:, 1] <= 20)
+    assert env.is_free(env.start) and env.is_free(env.goal)
+    assert env.goal_radius == 0.75
+    assert 0.6 < env.free_fraction() < 0.75
+
+
+def test_scenarios_are_seeded():
+    for name in qc.scenarios.SCENARIOS:
+        a = qc.scenarios.by_name(name, seed=7)
+        b = qc.scenarios.by_name(name, seed=7)
+        c = qc.scenarios.by_name(name, seed=8)
+        assert np.array_equal(a.boxes, b.boxes) and np.array_equal(a.start, b.start)
+        assert not np.array_equal(a.boxes, c.boxes)
+
+
+def test_annealing_field_matches_clutter_density():
+    field = qc.scenarios.annealing_field(seed=0)
+    clutter = qc.scenarios.paper_clutter(seed=0)
+    assert field.num_boxes == 6025
+    assert 67 < field.bounds[0, 1] < 69
+    assert abs(field.free_fraction() - clutter.free_fraction()) < 0.03
+
+
+def test_narrow_corridor_channel():
+    env = qc.scenarios.narrow_corridor(seed=1)
+    (x0, y0), (x1, y1) = env.metadata["channel"]
+    assert y1 - y0 == pytest.approx(0.4) and x1 - x0 == pytest.approx(4.0)
+    xs = np.linspace(x0 - 0.5, x1 + 0.5, 200)
+    assert env.is_free(np.stack([xs, np.full_like(xs, (y0 + y1) / 2)], axis=1)).all()
+    # the channel is the only way through the wall
+    ys = np.linspace(0, 20, 2001)
+    wall = env.is_free(np.stack([np.full_like(ys, 10.0), ys], axis=1))
+    assert np.all(wall == ((ys > y0) & (ys < y1)))
+    assert env.start[0] < x0 and env.goal[0] > x1
+
+
+def test_lattice_start_goal_connected():
+    from scipy import ndimage
+
+    env = qc.scenarios.lattice(seed=2, size=30)
+    cells = np.stack(np.meshgrid(np.arange(30) + 0.5, np.arange(30) + 0.5, indexing="ij"), -1)
+    free = env.is_free(cells)
+    labels, _ = ndimage.label(free)
+    s = labels[int(env.start[0]), int(env.start[1])]
+    assert s > 0 and s == labels[int(env.goal[0]), int(env.goal[1])]
+    assert abs(free.mean() - 0.5) < 0.01
+
+
+def test_bad_scenario_arguments():
+    with pytest.raises(ValueError, match="seed"):
+        qc.scenarios.paper_clutter(seed=-1)
+    with pytest.raises(ValueError, match="blocked_fraction"):
+        qc.scenarios.lattice(blocked_fraction=1.5)
+    with pytest.raises(ValueError, match="unknown scenario"):
+        qc.scenarios.by_name("nope")

@@ -1,0 +1,93 @@
+import numpy as np
+import pytest
+from reference import dense_trajectory, penetration_and_clearance
+
+import qrrt_circuits as qc
+from qrrt_circuits.environment import Environment
+
+
+def _check_against_reference(env, dyn, parents, children, resolution):
+    oracle = qc.ReachabilityOracle(env, dyn, resolution=resolution)
+    verdict = oracle.reachable(parents, children)
+    assert oracle.evaluations == len(parents)
+    for p, c, ok in zip(parents, children, verdict, strict=True):
+        points = dense_trajectory(dyn.A, dyn.B, dyn.K, p, c, dyn.horizon, spacing=resolution / 5)
+        depth, clearance = penetration_and_clearance(points, env.bounds, env.boxes)
+        if ok:
+            # never called reachable if the trajectory penetrates deeper than the resolution
+            assert depth <= resolution / 5, (p, c, depth)
+        else:
+            # only rejected if it collides or passes within the resolution of an obstacle
+            assert clearance <= resolution * 1.01, (p, c, clearance)
+    return verdict
+
+
+def test_oracle_agrees_with_dense_reference_on_clutter(clutter):
+    rng = np.random.default_rng(11)
+    parents = clutter.sample_free(300, rng)
+    children = np.clip(parents + rng.normal(scale=2.0, size=parents.shape), 0.01, 19.99)
+    verdict = _check_against_reference(clutter, qc.LinearTrackingDynamics.paper(), parents,
+                                       children, 0.01)
+    assert 0.15 < verdict.mean() < 0.85  # the sample exercises both outcomes
+
+
+def test_oracle_in_three_dimensions_with_non_normal_closed_loop():
+    rng = np.random.default_rng(4)
+    bounds = np.array([[0.0, 6.0]] * 3)
+    lower = rng.uniform(0, 5.4, size=(40, 3))
+    env = Environment(bounds, np.stack([lower, lower + rng.uniform(0.2, 0.6, (40, 3))], axis=1))
+    A = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, -2.0, -1.0]])
+    B = np.eye(3)
+    K = A + np.array([[1.5, -2.0, 0.0], [0.5, 1.0, 0.3], [0.0, 0.0, 2.0]])
+    dyn = qc.LinearTrackingDynamics(A, B, K)
+    parents = env.sample_free(120, rng)
+    children = np.clip(parents + rng.normal(scale=1.5, size=parents.shape), 0.05, 5.95)
+    verdict = _check_against_reference(env, dyn, parents, children, 0.02)
+    assert 0.1 < verdict.mean() < 0.9
+
+
+def test_wall_crossing_is_rejected_and_free_motion_accepted():
+    env = Environment(np.array([[0, 10], [0, 10]]), np.array([[[4.9, 0.0], [5.1, 10.0]]]))
+    oracle = qc.ReachabilityOracle(env)
+    verdict = oracle.reachable(np.array([[2.0, 5.0], [2.0, 5.0]]), np.array([[8.0, 5.0], [3.0, 3.0]]))
+    assert verdict.tolist() == [False, True]
+
+
+def test_thin_obstacle_between_samples_is_caught():
+    # an obstacle thinner than any fixed time step: evenly spaced samples would jump over it
+    env = Environment(np.array([[0, 100], [0, 100]]), np.array([[[50.0, 0.0], [50.02, 100.0]]]))
+    oracle = qc.ReachabilityOracle(env)
+    assert not oracle.reachable(np.array([[1.0, 50.0]]), np.array([[99.0, 50.0]]))[0]
+
+
+def test_endpoint_in_collision_is_rejected(clutter):
+    box = clutter.boxes[0]
+    centre = box.mean(axis=0)
+    start = clutter.sample_free(1, np.random.default_rng(0))[0]
+    oracle = qc.ReachabilityOracle(clutter)
+    assert not oracle.reachable(start[None], centre[None])[0]
+
+
+def test_oracle_rejects_bad_shapes(clutter):
+    oracle = qc.ReachabilityOracle(clutter)
+    with pytest.raises(ValueError, match=r"shape \(M, 2\)"):
+        oracle.reachable(np.zeros((3, 3)), np.zeros((3, 3)))
+    with pytest.raises(ValueError, match="same shape"):
+        oracle.reachable(np.zeros((3, 2)), np.zeros((4, 2)))
+    with pytest.raises(ValueError, match="resolution"):
+        qc.ReachabilityOracle(clutter, resolution=0)
+    with pytest.raises(ValueError, match="dimension"):
+        qc.ReachabilityOracle(clutter, qc.LinearTrackingDynamics(-np.eye(3), np.eye(3), np.zeros((3, 3))))
+
+
+def test_error_model_rates():
+    truth = np.zeros(20000, dtype=bool)
+    truth[:10000] = True
+    model = qc.OracleErrorModel(false_positive=0.1, false_negative=0.2, seed=0)
+    marks = model.apply(truth)
+    n = 10000
+    for rate, observed in ((0.2, 1 - marks[:10000].mean()), (0.1, marks[10000:].mean())):
+        assert abs(observed - rate) < 5 * np.sqrt(rate * (1 - rate) / n)
+    assert np.array_equal(qc.OracleErrorModel(0.1, 0.2, seed=0).apply(truth), marks)
+    with pytest.raises(ValueError, match="false_positive"):
+        qc.OracleErrorModel(false_positive=1.5)
