@@ -128,8 +128,12 @@ def aer_grover_circuit(
     circuit = QuantumCircuit(n, name="grover_aer")
     qubits = list(range(n))
     circuit.h(qubits)
+    # append the oracle's operations without copying them (a DiagonalGate carries 2^n phases)
+    oracle_ops = [(inst.operation, [oracle.find_bit(q).index for q in inst.qubits])
+                  for inst in oracle.data]
     for _ in range(iterations):
-        circuit.compose(oracle, qubits, inplace=True)
+        for operation, targets in oracle_ops:
+            circuit.append(operation, targets, copy=False)
         circuit.h(qubits)
         circuit.x(qubits)
         _mcz(circuit, n)

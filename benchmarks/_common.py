@@ -1,0 +1,45 @@
+"""Shared helpers for the benchmark scripts: timing and JSON output."""
+
+from __future__ import annotations
+
+import json
+import platform
+import time
+from pathlib import Path
+
+import numpy as np
+
+RESULTS = Path(__file__).resolve().parent / "results"
+
+
+def median_time(func, repeats: int, warmup: int = 1) -> tuple[float, float, float]:
+    """(median, min, max) wall time in seconds of ``func()`` over ``repeats`` runs."""
+    for _ in range(warmup):
+        func()
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        func()
+        times.append(time.perf_counter() - start)
+    return float(np.median(times)), float(np.min(times)), float(np.max(times))
+
+
+def machine() -> dict:
+    import qiskit
+    import qiskit_aer
+
+    return {
+        "python": platform.python_version(),
+        "machine": platform.machine(),
+        "processor": platform.processor(),
+        "qiskit": qiskit.__version__,
+        "qiskit_aer": qiskit_aer.__version__,
+        "numpy": np.__version__,
+    }
+
+
+def write_json(name: str, payload: dict, out: str | None = None) -> Path:
+    path = Path(out) if out else RESULTS / f"{name}.json"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(payload, indent=1))
+    return path
