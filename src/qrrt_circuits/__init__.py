@@ -6,9 +6,11 @@ Lathrop, Boardman and Martinez, "Parallel Quantum Rapidly-Exploring Random Trees
 """
 
 from . import probability, scenarios
+from .database import AnnealingSchedule
 from .dynamics import LinearTrackingDynamics
 from .environment import Environment
 from .oracle import OracleErrorModel, ReachabilityOracle
+from .planners import PQRRT, QRRT, RRT, Metrics, ParallelRRT, PlanResult
 from .search import (
     AerBackend,
     QuantumSearchBackend,
@@ -17,11 +19,24 @@ from .search import (
     StatevectorBackend,
     circuits,
 )
+from .search.schedules import BBHT, Adaptive, FixedIterations, KnownOptimal, PaperSchedule
 
 __version__ = "0.1.0"
 
 __all__ = [
+    "BBHT",
+    "PQRRT",
+    "QRRT",
+    "RRT",
+    "Adaptive",
     "AerBackend",
+    "AnnealingSchedule",
+    "FixedIterations",
+    "KnownOptimal",
+    "Metrics",
+    "PaperSchedule",
+    "ParallelRRT",
+    "PlanResult",
     "Environment",
     "LinearTrackingDynamics",
     "OracleErrorModel",

@@ -71,6 +71,77 @@ def cmd_search(args: argparse.Namespace) -> int:
     return 0
 
 
+PLANNERS = ("rrt", "prrt", "qrrt", "pqrrt", "pqrrt-unshared")
+
+
+def make_planner(args: argparse.Namespace, env):
+    from . import planners
+    from .search.schedules import parse_policy
+
+    common = {"goal_bias": args.goal_bias, "seed": args.seed}
+    if args.planner == "rrt":
+        return planners.RRT(env, **common)
+    if args.planner == "prrt":
+        return planners.ParallelRRT(env, workers=args.workers, **common)
+    backend = make_backend(args.backend, args.seed)
+    policy = parse_policy(args.schedule)
+    if args.planner == "qrrt":
+        return planners.QRRT(env, backend=backend, num_qubits=args.qubits, iterations=policy, **common)
+    return planners.PQRRT(env, backend=backend, num_qubits=args.qubits, workers=args.workers,
+                          shared_database=args.planner == "pqrrt", iterations=policy, **common)
+
+
+def cmd_plan(args: argparse.Namespace) -> int:
+    import json
+    from pathlib import Path
+
+    from . import scenarios
+
+    if args.scenario_file:
+        from .environment import Environment
+
+        env = Environment.load(args.scenario_file)
+    else:
+        env = scenarios.by_name(args.scenario, seed=args.scenario_seed)
+    planner = make_planner(args, env)
+    result = planner.plan(max_nodes=args.max_nodes, max_oracle_calls=args.max_oracle_calls,
+                          max_rounds=args.max_rounds)
+    metrics = result.metrics
+    print(f"{result.planner} on {env.name} (seed {args.seed}): {result.status}")
+    for key, value in result.settings.items():
+        if key in ("start", "goal", "budgets", "oracle_errors"):
+            continue
+        print(f"  {key:24s} {value}")
+    print("metrics:")
+    for key, value in metrics.as_dict().items():
+        shown = f"{value:.3f}" if isinstance(value, float) else str(value)
+        print(f"  {key:28s} {shown:>12s}")
+    if metrics.nodes:
+        print(f"  {'oracle_calls per node':28s} {metrics.oracle_calls / metrics.nodes:12.2f}")
+        print(f"  {'wall ms per node':28s} {metrics.wall_time_s * 1e3 / metrics.nodes:12.2f}")
+    if result.path is not None:
+        print(f"path: {len(result.path)} nodes")
+    for label in result.labels:
+        print(f"note: {label}")
+    if args.json:
+        Path(args.json).write_text(json.dumps(result.to_dict(), indent=1))
+        print(f"wrote {args.json}")
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        from .plotting import plot_tree
+
+        fig, ax = plt.subplots(figsize=(7, 7))
+        plot_tree(env, result, ax=ax)
+        fig.savefig(args.plot, dpi=130, bbox_inches="tight")
+        plt.close(fig)
+        print(f"wrote {args.plot}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="qrrt", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -84,6 +155,26 @@ def build_parser() -> argparse.ArgumentParser:
     search.add_argument("--seed", type=_nonnegative_int, default=0)
     search.add_argument("--top", type=_positive_int, default=10)
     search.set_defaults(func=cmd_search)
+
+    plan = sub.add_parser("plan", help="plan a path with one planner and print its metrics")
+    plan.add_argument("--scenario", default="paper_clutter",
+                      choices=["paper_clutter", "narrow_corridor", "annealing_field", "lattice"])
+    plan.add_argument("--scenario-file", default=None, help="an environment JSON file instead")
+    plan.add_argument("--scenario-seed", type=_nonnegative_int, default=0)
+    plan.add_argument("--planner", choices=PLANNERS, default="pqrrt")
+    plan.add_argument("--backend", choices=sorted(BACKENDS), default="aer")
+    plan.add_argument("--qubits", type=_positive_int, default=8)
+    plan.add_argument("--workers", type=_positive_int, default=8)
+    plan.add_argument("--schedule", default="paper",
+                      help="paper | optimal | bbht | adaptive | fixed:K (default paper)")
+    plan.add_argument("--goal-bias", type=float, default=0.0)
+    plan.add_argument("--seed", type=_nonnegative_int, default=0)
+    plan.add_argument("--max-nodes", type=_positive_int, default=None)
+    plan.add_argument("--max-oracle-calls", type=_positive_int, default=None)
+    plan.add_argument("--max-rounds", type=_positive_int, default=None)
+    plan.add_argument("--plot", default=None, help="write a PNG of the tree")
+    plan.add_argument("--json", default=None, help="write the result as JSON")
+    plan.set_defaults(func=cmd_plan)
     return parser
 
 

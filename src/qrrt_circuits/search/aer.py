@@ -63,9 +63,9 @@ class AerBackend(QuantumSearchBackend):
             limit //= 2
         return limit
 
-    def _sample(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int) -> np.ndarray:
+    def _sample(self, marks, num_qubits, iterations, shots, rng) -> np.ndarray:
         circuit = aer_grover_circuit(marks, iterations, measure=True, synthesis=self.synthesis)
-        seed = int(self._rng.integers(0, 2**31 - 1))
+        seed = int(rng.integers(0, 2**31 - 1))
         result = self.simulator.run(circuit, shots=shots, seed_simulator=seed, memory=True).result()
         if not result.success:
             raise RuntimeError(f"AerSimulator failed: {result.status}")

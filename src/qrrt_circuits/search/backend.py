@@ -87,13 +87,20 @@ class QuantumSearchBackend(abc.ABC):
     def max_qubits(self) -> int:
         """The largest n this backend accepts (memory-limited)."""
 
-    def search(self, marks: np.ndarray, iterations: int, shots: int = 1) -> SearchResult:
-        """Grover-search ``marks`` with ``iterations`` iterations; measure ``shots`` times."""
+    def search(
+        self, marks: np.ndarray, iterations: int, shots: int = 1, seed: int | None = None
+    ) -> SearchResult:
+        """Grover-search ``marks`` with ``iterations`` iterations; measure ``shots`` times.
+
+        ``seed`` seeds this call only (planners pass one per round and worker, so their results do
+        not depend on the order of calls); by default the backend's own stream is used.
+        """
         marks, num_qubits = validate_marks(marks)
         iterations = validate_iterations(iterations)
         shots = validate_shots(shots)
         self.check_qubits(num_qubits)
-        indices = self._sample(marks, num_qubits, iterations, shots)
+        rng = self._rng if seed is None else seed_stream(seed)
+        indices = self._sample(marks, num_qubits, iterations, shots, rng)
         return SearchResult(indices, iterations, shots, iterations * shots)
 
     def check_qubits(self, num_qubits: int) -> None:
@@ -103,6 +110,10 @@ class QuantumSearchBackend(abc.ABC):
                 f"({self.name}: 1..{self.max_qubits} qubits, set by available memory)"
             )
 
+    _rng: np.random.Generator
+
     @abc.abstractmethod
-    def _sample(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int) -> np.ndarray:
-        """Return ``shots`` measured indices (validated inputs)."""
+    def _sample(
+        self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int, rng: np.random.Generator
+    ) -> np.ndarray:
+        """Return ``shots`` measured indices (validated inputs), drawing randomness from ``rng``."""

@@ -47,6 +47,7 @@ class SamplerBackend(QuantumSearchBackend):
         self._cache: OrderedDict[tuple, object] = OrderedDict()
         self._cache_size = int(cache_size)
         self.transpile_count = 0
+        self._rng = np.random.default_rng(0)  # unused: the sampler owns its randomness
 
     @property
     def max_qubits(self) -> int:
@@ -65,7 +66,8 @@ class SamplerBackend(QuantumSearchBackend):
             self._cache.move_to_end(key)
         return circuit
 
-    def _sample(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int) -> np.ndarray:
+    def _sample(self, marks, num_qubits, iterations, shots, rng) -> np.ndarray:
+        # the sampler seeds itself; ``rng`` cannot reach it
         circuit = self.compiled(marks, iterations)
         result = self.sampler.run([circuit], shots=shots).result()[0]
         bitstrings = result.data.meas.get_bitstrings()

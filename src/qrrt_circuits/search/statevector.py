@@ -67,8 +67,7 @@ class StatevectorBackend(QuantumSearchBackend):
             state = 2.0 * state.mean() - state
         return state
 
-    def _sample(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int) -> np.ndarray:
-        rng = self._rng
+    def _sample(self, marks, num_qubits, iterations, shots, rng) -> np.ndarray:
         if not self.closed_form:
             probabilities = self.amplitudes(marks, iterations) ** 2
             cumulative = np.cumsum(probabilities)

@@ -1,0 +1,167 @@
+"""Candidate generation: the database of (sample, nearest parent) pairs (Alg. 1, lines 4-8) and
+Quantum Database Annealing (Alg. 4).
+
+``Tree`` stores the growing tree and answers nearest-node queries (a scipy KD-tree rebuilt as the
+tree doubles, plus brute force over the nodes added since). ``build_database`` draws 2^n samples,
+uniform over the workspace (a fraction ``goal_bias`` uniform in the goal ball instead), and pairs
+each with its nearest tree node. With an ``AnnealingSchedule`` each candidate keeps the direction
+from its parent to the sample but is moved to a distance drawn uniformly in the current band
+[r_min, r_max] (DESIGN §1).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .environment import Environment
+
+
+class Tree:
+    """Growable arrays of node positions and parent indices; node 0 is the root."""
+
+    def __init__(self, root: np.ndarray, capacity: int = 256) -> None:
+        root = np.asarray(root, dtype=float)
+        self.dim = root.shape[0]
+        self._nodes = np.empty((capacity, self.dim))
+        self._parents = np.empty(capacity, dtype=np.int64)
+        self._nodes[0] = root
+        self._parents[0] = -1
+        self.size = 1
+        self._kdtree: cKDTree | None = None
+        self._indexed = 0
+
+    @property
+    def nodes(self) -> np.ndarray:
+        return self._nodes[: self.size]
+
+    @property
+    def parents(self) -> np.ndarray:
+        return self._parents[: self.size]
+
+    def add(self, position: np.ndarray, parent: int) -> int:
+        if self.size == self._nodes.shape[0]:
+            self._nodes = np.concatenate([self._nodes, np.empty_like(self._nodes)])
+            self._parents = np.concatenate([self._parents, np.empty_like(self._parents)])
+        self._nodes[self.size] = position
+        self._parents[self.size] = parent
+        self.size += 1
+        return self.size - 1
+
+    def nearest(self, points: np.ndarray) -> np.ndarray:
+        """Index of the nearest node (Euclidean) to each of ``points`` (M, d)."""
+        points = np.atleast_2d(points)
+        if self.size >= 64 and self.size >= 2 * max(self._indexed, 32):
+            self._kdtree = cKDTree(self.nodes.copy())
+            self._indexed = self.size
+        if self._kdtree is None:
+            return _brute_nearest(points, self.nodes, 0)
+        dist, index = self._kdtree.query(points)
+        if self._indexed < self.size:
+            recent = _brute_nearest(points, self._nodes[self._indexed : self.size], self._indexed)
+            recent_dist = np.linalg.norm(points - self._nodes[recent], axis=1)
+            closer = recent_dist < dist
+            index = np.where(closer, recent, index)
+        return np.asarray(index, dtype=np.int64)
+
+
+def _brute_nearest(points: np.ndarray, nodes: np.ndarray, offset: int) -> np.ndarray:
+    squared = np.sum(points**2, axis=1)[:, None] - 2 * points @ nodes.T + np.sum(nodes**2, axis=1)
+    return np.argmin(squared, axis=1).astype(np.int64) + offset
+
+
+@dataclass(frozen=True)
+class AnnealingSchedule:
+    """Quantum Database Annealing (Alg. 4): the temperature array H as distance bands.
+
+    ``bands[h]`` = (r_min, r_max) is used for databases h with ``switch_at[h-1] <= h < switch_at[h]``
+    (the index h counts databases built, i.e. rounds); the last band stays in force.
+    """
+
+    bands: tuple[tuple[float, float], ...]
+    switch_at: tuple[int, ...] = ()
+
+    def __post_init__(self) -> None:
+        bands = tuple((float(lo), float(hi)) for lo, hi in self.bands)
+        if not bands:
+            raise ValueError("bands must hold at least one (r_min, r_max) pair")
+        for i, (lo, hi) in enumerate(bands):
+            if not (math.isfinite(lo) and math.isfinite(hi)) or lo < 0:
+                raise ValueError(f"bands[{i}] = ({lo}, {hi}): distances must be finite and >= 0")
+            if lo > hi:
+                raise ValueError(f"bands[{i}] = ({lo}, {hi}): r_min must be <= r_max")
+            if hi == 0:
+                raise ValueError(f"bands[{i}]: r_max must be > 0")
+        switch_at = tuple(int(s) for s in self.switch_at)
+        if len(switch_at) != len(bands) - 1:
+            raise ValueError(
+                f"switch_at must have len(bands) - 1 = {len(bands) - 1} entries, got {len(switch_at)}"
+            )
+        if any(s <= 0 for s in switch_at) or any(b <= a for a, b in zip(switch_at, switch_at[1:])):
+            raise ValueError(f"switch_at must be strictly increasing positive integers, got {switch_at}")
+        object.__setattr__(self, "bands", bands)
+        object.__setattr__(self, "switch_at", switch_at)
+
+    @classmethod
+    def paper(cls, switch_at: int = 8) -> AnnealingSchedule:
+        """The paper's §V.D bands: [2.7, 4.2], then [0.8, 2.0] (the switch point is ours)."""
+        return cls(bands=((2.7, 4.2), (0.8, 2.0)), switch_at=(switch_at,))
+
+    def band(self, h: int) -> tuple[float, float]:
+        """The band in force for the h-th database (h = 0, 1, ...)."""
+        index = int(np.searchsorted(np.asarray(self.switch_at), h, side="right"))
+        return self.bands[index]
+
+
+@dataclass(frozen=True)
+class Database:
+    """2^n candidates: ``children`` (N, d) and their ``parents`` (N,) as tree indices."""
+
+    children: np.ndarray
+    parents: np.ndarray
+    band: tuple[float, float] | None = None
+
+
+def build_database(
+    tree: Tree,
+    size: int,
+    env: Environment,
+    rng: np.random.Generator,
+    goal: np.ndarray | None = None,
+    goal_radius: float = 0.0,
+    goal_bias: float = 0.0,
+    annealing: AnnealingSchedule | None = None,
+    h: int = 0,
+) -> Database:
+    """Alg. 1 lines 4-8 (and Alg. 4 line 7 with ``annealing``)."""
+    samples = env.sample_uniform(size, rng)
+    if goal_bias > 0 and goal is not None:
+        biased = rng.random(size) < goal_bias
+        count = int(biased.sum())
+        if count:
+            samples[biased] = sample_ball(goal, goal_radius, count, rng)
+    parents = tree.nearest(samples)
+    band = None
+    if annealing is not None:
+        band = annealing.band(h)
+        origin = tree.nodes[parents]
+        offset = samples - origin
+        norm = np.linalg.norm(offset, axis=1)
+        zero = norm == 0
+        if np.any(zero):  # a sample on its parent: any direction will do
+            offset[zero] = rng.normal(size=(int(zero.sum()), tree.dim))
+            norm[zero] = np.linalg.norm(offset[zero], axis=1)
+        distance = rng.uniform(band[0], band[1], size)
+        samples = origin + offset / norm[:, None] * distance[:, None]
+    return Database(samples, parents, band)
+
+
+def sample_ball(centre: np.ndarray, radius: float, count: int, rng: np.random.Generator) -> np.ndarray:
+    """``count`` points uniform in the d-ball of ``radius`` around ``centre``."""
+    d = centre.shape[0]
+    direction = rng.normal(size=(count, d))
+    direction /= np.linalg.norm(direction, axis=1, keepdims=True)
+    return centre + direction * radius * rng.random(count)[:, None] ** (1.0 / d)

@@ -1,0 +1,82 @@
+"""Figures: the tree drawn along its closed-loop trajectories, obstacles, path, start and goal.
+
+Only this module imports matplotlib's pyplot; planners never plot. In d > 2 the first two axes are
+drawn.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .dynamics import LinearTrackingDynamics
+from .environment import Environment
+
+
+def _axes(ax):
+    if ax is None:
+        import matplotlib.pyplot as plt
+
+        _, ax = plt.subplots(figsize=(6, 6))
+    return ax
+
+
+def plot_environment(env: Environment, ax=None, color: str = "0.15"):
+    """Obstacles as filled rectangles inside the workspace outline."""
+    from matplotlib.collections import PatchCollection
+    from matplotlib.patches import Rectangle
+
+    ax = _axes(ax)
+    boxes = env.boxes[:, :, :2]
+    patches = [Rectangle(lo, *(hi - lo)) for lo, hi in boxes]
+    ax.add_collection(PatchCollection(patches, facecolor=color, edgecolor="none"))
+    (x0, x1), (y0, y1) = env.bounds[0], env.bounds[1]
+    ax.plot([x0, x1, x1, x0, x0], [y0, y0, y1, y1, y0], color="0.3", lw=0.8)
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    ax.set_aspect("equal")
+    return ax
+
+
+def edge_curves(nodes: np.ndarray, parents: np.ndarray, dynamics: LinearTrackingDynamics,
+                samples: int = 24) -> np.ndarray:
+    """(E, samples, d) points along each edge's trajectory x(t) = c + expm(Mt)(p - c)."""
+    children = np.flatnonzero(parents >= 0)
+    if children.size == 0:
+        return np.zeros((0, samples, nodes.shape[1]))
+    times = np.concatenate([[0.0], np.geomspace(1e-3, dynamics.horizon, samples - 1)])
+    phis = dynamics.propagators(times)  # (S, d, d)
+    errors = nodes[parents[children]] - nodes[children]  # (E, d)
+    return nodes[children][:, None, :] + np.einsum("sij,ej->esi", phis, errors)
+
+
+def plot_tree(env: Environment, result, ax=None, dynamics: LinearTrackingDynamics | None = None,
+              edge_color: str = "tab:blue", path_color: str = "tab:red", title: str | None = None):
+    """Obstacles, tree edges along their trajectories, the path, the start and the goal ball."""
+    from matplotlib.collections import LineCollection
+    from matplotlib.patches import Circle
+
+    dynamics = LinearTrackingDynamics.paper() if dynamics is None else dynamics
+    ax = plot_environment(env, ax)
+    curves = edge_curves(result.nodes, result.parents, dynamics)
+    ax.add_collection(LineCollection(curves[:, :, :2], colors=edge_color, linewidths=0.7, alpha=0.8))
+    ax.plot(result.nodes[1:, 0], result.nodes[1:, 1], ".", color=edge_color, ms=2.5)
+    if result.path is not None:
+        index = [result.goal_node]
+        while result.parents[index[-1]] >= 0:
+            index.append(int(result.parents[index[-1]]))
+        path_parents = np.full(len(result.nodes), -1)
+        for child, parent in zip(index[:-1], index[1:], strict=True):
+            path_parents[child] = parent
+        path_curves = edge_curves(result.nodes, path_parents, dynamics)
+        ax.add_collection(LineCollection(path_curves[:, :, :2], colors=path_color, linewidths=2.0))
+    settings = getattr(result, "settings", {})
+    start = result.nodes[0]
+    ax.plot(*start[:2], "o", color="tab:green", ms=8, label="start")
+    goal = settings.get("goal")
+    if goal is not None:
+        ax.add_patch(Circle(goal[:2], settings.get("goal_radius", 0.75), fill=False,
+                            color=path_color, lw=2, label="goal"))
+    metrics = result.metrics
+    ax.set_title(title or f"{result.planner}: {metrics.nodes} nodes, {metrics.oracle_calls} oracle "
+                          f"calls ({result.status})", fontsize=10)
+    return ax
