@@ -100,7 +100,8 @@ class AnnealingSchedule:
             raise ValueError(
                 f"switch_at must have len(bands) - 1 = {len(bands) - 1} entries, got {len(switch_at)}"
             )
-        if any(s <= 0 for s in switch_at) or any(b <= a for a, b in zip(switch_at, switch_at[1:])):
+        steps = np.diff(np.asarray(switch_at, dtype=np.int64))
+        if any(s <= 0 for s in switch_at) or np.any(steps <= 0):
             raise ValueError(f"switch_at must be strictly increasing positive integers, got {switch_at}")
         object.__setattr__(self, "bands", bands)
         object.__setattr__(self, "switch_at", switch_at)

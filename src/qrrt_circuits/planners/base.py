@@ -4,8 +4,9 @@ Oracle calls are counted as DESIGN §2 says: classical planners 1 per reachabili
 planners 1 per Grover iteration per worker plus 1 per classical verification of a measured
 candidate. Every classical check of one candidate (the finalizer of the quantum planners, the
 reachability test of the classical ones) is a ``verification_call``, so
-``oracle_calls == quantum_oracle_calls + verification_calls`` for every planner. Evaluating all 2^n entries to build the phase oracle in simulation is reported as
-``simulation_checks``, not as oracle calls.
+``oracle_calls == quantum_oracle_calls + verification_calls`` for every planner. Evaluating all 2^n
+entries to build the phase oracle in simulation is reported as ``simulation_checks``, not as oracle
+calls.
 
 Budgets are checked before each round: a round starts only while no budget is reached, so the
 last round may overshoot ``max_oracle_calls`` by less than one round's cost and ``max_nodes`` by
@@ -173,7 +174,8 @@ class Planner:
     # ----------------------------------------------------------------- randomness
     def rng(self, round_index: int, worker: int = 0, stream: int = 0) -> np.random.Generator:
         """The generator of one (round, worker, purpose): independent of call order and executor."""
-        return np.random.default_rng(np.random.SeedSequence(self._entropy, spawn_key=(round_index, worker, stream)))
+        sequence = np.random.SeedSequence(self._entropy, spawn_key=(round_index, worker, stream))
+        return np.random.default_rng(sequence)
 
     def call_seed(self, round_index: int, worker: int = 0, stream: int = 7) -> int:
         return int(self.rng(round_index, worker, stream).integers(0, 2**62))
@@ -193,7 +195,9 @@ class Planner:
         budget is reached. ``start``, ``goal`` and ``goal_radius`` default to the environment's."""
         start, goal, goal_radius = self._check_problem(start, goal, goal_radius)
         budgets = {
-            "max_oracle_calls": None if max_oracle_calls is None else _check_count(max_oracle_calls, "max_oracle_calls"),
+            "max_oracle_calls": (
+                None if max_oracle_calls is None else _check_count(max_oracle_calls, "max_oracle_calls")
+            ),
             "max_nodes": None if max_nodes is None else _check_count(max_nodes, "max_nodes"),
             "max_rounds": None if max_rounds is None else _check_count(max_rounds, "max_rounds"),
             "max_time_s": None,
