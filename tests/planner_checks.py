@@ -1,0 +1,35 @@
+"""Independent re-checks of planner output used by the planner tests."""
+
+from __future__ import annotations
+
+import numpy as np
+from reference import dense_trajectory, penetration_and_clearance
+
+
+def assert_tree_edges_valid(env, dynamics, result, resolution=0.01, spacing=0.004):
+    """Every edge of the tree re-checked by the dense trajectory check: no edge may penetrate an
+    obstacle (or leave the workspace) by more than the resolution."""
+    nodes, parents = result.nodes, result.parents
+    assert parents[0] == -1
+    assert np.all(parents[1:] >= 0) and np.all(parents[1:] < np.arange(1, len(parents)))
+    assert env.is_free(nodes).all()
+    for child in range(1, len(nodes)):
+        points = dense_trajectory(dynamics.A, dynamics.B, dynamics.K, nodes[parents[child]],
+                                  nodes[child], dynamics.horizon, spacing=spacing)
+        depth, _ = penetration_and_clearance(points, env.bounds, env.boxes)
+        assert depth <= resolution, f"edge {parents[child]} -> {child} penetrates by {depth}"
+
+
+def assert_path_valid(result):
+    if result.status == "reached":
+        goal = np.asarray(result.settings["goal"])
+        assert np.linalg.norm(result.path[-1] - goal) <= result.settings["goal_radius"] + 1e-12
+        assert np.array_equal(result.path[0], result.nodes[0])
+        index = result.goal_node
+        chain = []
+        while index >= 0:
+            chain.append(index)
+            index = result.parents[index]
+        assert np.array_equal(result.path, result.nodes[chain[::-1]])
+    else:
+        assert result.path is None

@@ -1,0 +1,245 @@
+import math
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+import pytest
+from planner_checks import assert_path_valid, assert_tree_edges_valid
+
+import qrrt_circuits as qc
+from qrrt_circuits.environment import Environment
+
+METRIC_KEYS = {"oracle_calls", "quantum_oracle_calls", "verification_calls",
+               "critical_path_oracle_calls", "simulation_checks", "nodes", "rounds", "databases",
+               "duplicates", "rejected", "wall_time_s"}
+
+
+def make(name, env, seed, **kw):
+    sv = qc.StatevectorBackend(seed=seed)
+    if name == "RRT":
+        return qc.RRT(env, seed=seed, **kw)
+    if name == "ParallelRRT":
+        return qc.ParallelRRT(env, workers=8, seed=seed, **kw)
+    if name == "QRRT":
+        return qc.QRRT(env, backend=sv, seed=seed, **kw)
+    if name == "PQRRT":
+        return qc.PQRRT(env, backend=sv, seed=seed, **kw)
+    if name == "PQRRT-unshared":
+        return qc.PQRRT(env, backend=sv, shared_database=False, seed=seed, **kw)
+    raise ValueError(name)
+
+
+PLANNERS = ["RRT", "ParallelRRT", "QRRT", "PQRRT", "PQRRT-unshared"]
+
+
+@pytest.mark.parametrize("name", PLANNERS)
+def test_metrics_identities_and_every_edge_rechecked(name, clutter):
+    result = make(name, clutter, seed=3).plan(max_nodes=60)
+    m = result.metrics
+    assert set(m.keys()) == METRIC_KEYS
+    assert m.oracle_calls == m.quantum_oracle_calls + m.verification_calls
+    assert m.nodes == len(result.nodes) - 1 and result.parents[0] == -1
+    assert m.rounds == len(result.history["oracle_calls"])
+    assert m.critical_path_oracle_calls <= m.oracle_calls
+    assert_tree_edges_valid(clutter, qc.LinearTrackingDynamics.paper(), result)
+    assert_path_valid(result)
+    graph = result.tree
+    assert graph.number_of_nodes() == m.nodes + 1 and graph.number_of_edges() == m.nodes
+    assert graph.nodes[0]["pos"] == tuple(result.nodes[0])
+
+
+def test_rrt_oracle_calls_are_its_reachability_tests(clutter):
+    planner = qc.RRT(clutter, seed=1)
+    result = planner.plan(max_rounds=300)
+    assert result.metrics.oracle_calls == 300 == result.metrics.rounds
+    assert planner.oracle.evaluations == 300
+    assert result.metrics.quantum_oracle_calls == 0 and result.metrics.simulation_checks == 0
+
+
+def test_parallel_rrt_counts_per_worker_and_critical_path(clutter):
+    result = qc.ParallelRRT(clutter, workers=5, seed=2).plan(max_rounds=40)
+    assert result.metrics.oracle_calls == 200
+    assert result.metrics.critical_path_oracle_calls == 40
+
+
+def test_quantum_counting_with_fixed_iterations(clutter):
+    k, p, rounds = 3, 4, 25
+    result = qc.PQRRT(clutter, backend=qc.StatevectorBackend(seed=0), workers=p,
+                      iterations=qc.FixedIterations(k), seed=0).plan(max_rounds=rounds)
+    m = result.metrics
+    assert m.quantum_oracle_calls == rounds * p * k
+    assert m.verification_calls == rounds * p
+    assert m.critical_path_oracle_calls == rounds * (k + 1)
+    assert m.simulation_checks == rounds * 256 and m.databases == rounds
+    assert m.nodes + m.duplicates + m.rejected == rounds * p
+    unshared = qc.PQRRT(clutter, backend=qc.StatevectorBackend(seed=0), workers=p,
+                        shared_database=False, iterations=qc.FixedIterations(k),
+                        seed=0).plan(max_rounds=rounds)
+    assert unshared.metrics.databases == rounds * p
+    assert unshared.metrics.simulation_checks == rounds * p * 256
+    assert unshared.metrics.duplicates == 0
+
+
+def test_pqrrt_with_one_worker_matches_qrrt_statistics(clutter):
+    def per_node(planner_cls, **kw):
+        calls, nodes = 0, 0
+        for seed in range(12):
+            r = planner_cls(clutter, backend=qc.StatevectorBackend(seed=seed), seed=seed,
+                            iterations=qc.FixedIterations(2), **kw).plan(max_rounds=80)
+            calls += r.metrics.oracle_calls
+            nodes += r.metrics.nodes
+        return nodes / (calls / 3)  # success fraction per round (3 calls a round)
+
+    q = per_node(qc.QRRT)
+    p = per_node(qc.PQRRT, workers=1)
+    rounds = 12 * 80
+    sigma = math.sqrt(q * (1 - q) / rounds)
+    assert abs(q - p) <= 5 * math.sqrt(2) * sigma
+    # same seed, same planner: identical (PQRRT with p = 1 *is* q-RRT)
+    a = qc.QRRT(clutter, backend=qc.StatevectorBackend(0), seed=5).plan(max_rounds=30)
+    b = qc.PQRRT(clutter, backend=qc.StatevectorBackend(0), workers=1, seed=5).plan(max_rounds=30)
+    assert np.array_equal(a.nodes, b.nodes)
+
+
+def test_shared_database_duplicates_are_dropped(clutter):
+    # 32 workers on a 16-entry database: many measure the same solution
+    result = qc.PQRRT(clutter, backend=qc.StatevectorBackend(seed=0), num_qubits=4, workers=32,
+                      iterations=qc.FixedIterations(1), seed=0).plan(max_rounds=20)
+    assert result.metrics.duplicates > 0
+    rows = {tuple(row) for row in result.nodes}
+    assert len(rows) == len(result.nodes)
+
+
+@pytest.mark.parametrize("backend_name", ["aer", "statevector"])
+def test_same_seed_same_tree(backend_name, clutter):
+    def run():
+        backend = qc.AerBackend() if backend_name == "aer" else qc.StatevectorBackend()
+        return qc.PQRRT(clutter, backend=backend, workers=4, seed=9).plan(max_rounds=15)
+
+    a, b = run(), run()
+    assert np.array_equal(a.nodes, b.nodes) and np.array_equal(a.parents, b.parents)
+    assert a.metrics.oracle_calls == b.metrics.oracle_calls
+
+
+@pytest.mark.parametrize("name", ["ParallelRRT", "PQRRT-unshared"])
+def test_executor_does_not_change_the_result(name, clutter):
+    serial = make(name, clutter, seed=4).plan(max_rounds=12)
+    with ThreadPoolExecutor(max_workers=3) as pool:
+        threaded = make(name, clutter, seed=4, executor=pool).plan(max_rounds=12)
+    assert np.array_equal(serial.nodes, threaded.nodes)
+    assert serial.metrics.oracle_calls == threaded.metrics.oracle_calls
+
+
+def test_unreachable_goal_ends_with_budget_exhausted():
+    # the goal is walled in: no plan can reach it
+    boxes = np.array([[[14, 14], [18, 14.5]], [[14, 17.5], [18, 18]], [[14, 14], [14.5, 18]],
+                      [[17.5, 14], [18, 18]]], dtype=float)
+    env = Environment(np.array([[0, 20], [0, 20]]), boxes)
+    for planner in (qc.RRT(env, seed=0), qc.QRRT(env, backend=qc.StatevectorBackend(0), seed=0)):
+        result = planner.plan([2, 2], [16, 16], 0.5, max_oracle_calls=400)
+        assert result.status == "budget_exhausted" and result.path is None
+        assert 400 <= result.metrics.oracle_calls < 400 + 7
+
+
+def test_default_budget_applies(monkeypatch):
+    from qrrt_circuits.planners import base
+
+    monkeypatch.setattr(base, "DEFAULT_MAX_ROUNDS", 17)
+    env = Environment(np.array([[0, 20], [0, 20]]), np.array([[[14, 14], [18, 18]]], dtype=float))
+    result = qc.RRT(env, seed=0).plan([1, 1], [19.5, 19.5], 0.1)
+    assert result.metrics.rounds == 17 or result.status == "reached"
+
+
+def test_bbht_terminates_with_no_solution_and_respects_its_bound():
+    policy = qc.BBHT()
+    backend = qc.StatevectorBackend(seed=0)
+    rng = np.random.default_rng(0)
+    size = 256
+    none = np.zeros(size, dtype=bool)
+    out = policy.run(lambda j: int(backend.search(none, j, 1).indices[0]), lambda i: False, size, rng)
+    assert out.index is None and out.iterations <= policy.cap(size)
+    for m in (1, 4, 16):
+        marks = np.zeros(size, dtype=bool)
+        marks[rng.choice(size, m, replace=False)] = True
+        costs = []
+        for _ in range(300):
+            out = policy.run(lambda j, mk=marks: int(backend.search(mk, j, 1).indices[0]),
+                             lambda i, mk=marks: bool(mk[i]), size, rng)
+            costs.append(out.iterations)
+        costs = np.array(costs)
+        bound = 9 / 4 * math.sqrt(size / m)
+        assert costs.mean() <= bound + 5 * costs.std() / math.sqrt(len(costs)) + 1
+
+
+def test_known_optimal_is_labelled_and_adaptive_is_not(clutter):
+    known = qc.QRRT(clutter, backend=qc.StatevectorBackend(0), iterations=qc.KnownOptimal(),
+                    seed=0).plan(max_rounds=5)
+    assert any("true marked count" in label for label in known.labels)
+    adaptive = qc.QRRT(clutter, backend=qc.StatevectorBackend(0), iterations=qc.Adaptive(),
+                       seed=0).plan(max_rounds=5)
+    assert not any("true marked count" in label for label in adaptive.labels)
+    assert any("classical lookup" in label for label in adaptive.labels)
+
+
+@pytest.mark.parametrize("marked", [3, 25, 90])
+def test_adaptive_learns_a_good_iteration_count(marked):
+    """From verified outcomes alone, Adaptive settles on a k whose success probability for the
+    (hidden) marked fraction is close to the best achievable per oracle call."""
+    state = qc.Adaptive().start(256)
+    rng = np.random.default_rng(marked)
+    for _ in range(150):
+        k = state.iterations(tree_nodes=50)
+        p = qc.probability.success_probability(256, marked, k)
+        state.observe(k, bool(rng.random() < p))
+    k = state.iterations(50)
+    best = max(qc.probability.success_probability(256, marked, j) / (j + 1) for j in range(13))
+    chosen = qc.probability.success_probability(256, marked, k) / (k + 1)
+    assert chosen >= 0.8 * best
+
+
+def test_annealing_first_band_distance(clutter):
+    schedule = qc.AnnealingSchedule(bands=[(2.7, 4.2), (0.8, 2.0)], switch_at=[1000])
+    planner = qc.QRRT(clutter, backend=qc.StatevectorBackend(0), iterations=qc.FixedIterations(2),
+                      annealing=schedule, seed=0)
+    result = planner.plan(max_nodes=25)
+    distances = np.linalg.norm(result.nodes[1:] - result.nodes[result.parents[1:]], axis=1)
+    assert 2.7 <= distances.min() and distances.max() <= 4.2
+    assert abs(distances.mean() - 3.45) < 5 * (1.5 / math.sqrt(12)) / math.sqrt(len(distances))
+    assert schedule.band(999) == (2.7, 4.2) and schedule.band(1000) == (0.8, 2.0)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"start": [-1, 5]}, r"start \[-1.0, 5.0\] is out of bounds"),
+    ({"goal": [30, 5]}, "goal .* is out of bounds"),
+    ({"goal_radius": 0}, "goal_radius must be"),
+    ({"goal_radius": -2}, "goal_radius must be"),
+    ({"start": [1, 2, 3]}, "dimension mismatch: start has 3 coordinates"),
+    ({"max_nodes": 0}, "max_nodes must be an integer >= 1"),
+])
+def test_bad_plan_input(kwargs, message, clutter):
+    with pytest.raises(ValueError, match=message):
+        qc.RRT(clutter, seed=0).plan(**kwargs)
+
+
+def test_start_or_goal_in_collision_names_which(clutter):
+    inside = clutter.boxes[0].mean(axis=0)
+    with pytest.raises(ValueError, match="start .* is in collision"):
+        qc.RRT(clutter).plan(start=inside)
+    with pytest.raises(ValueError, match="goal .* is in collision"):
+        qc.QRRT(clutter, backend=qc.StatevectorBackend(0)).plan(goal=inside)
+
+
+def test_bad_planner_settings(clutter):
+    with pytest.raises(ValueError, match="workers must be an integer >= 1"):
+        qc.PQRRT(clutter, backend=qc.StatevectorBackend(0), workers=0)
+    with pytest.raises(ValueError, match="workers must be an integer >= 1"):
+        qc.ParallelRRT(clutter, workers=0)
+    with pytest.raises(ValueError, match="num_qubits = 40 is outside"):
+        qc.QRRT(clutter, backend=qc.StatevectorBackend(0), num_qubits=40)
+    with pytest.raises(ValueError, match=r"r_min must be <= r_max"):
+        qc.AnnealingSchedule(bands=[(3.0, 1.0)])
+    with pytest.raises(ValueError, match="switch_at"):
+        qc.AnnealingSchedule(bands=[(1.0, 2.0), (0.5, 1.0)], switch_at=[])
+    with pytest.raises(ValueError, match="dimension mismatch"):
+        qc.RRT(clutter, dynamics=qc.LinearTrackingDynamics(-np.eye(3), np.eye(3), np.zeros((3, 3))))
+    with pytest.raises(ValueError, match="k must be an integer"):
+        qc.FixedIterations(-1)
