@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
-from reference import dense_trajectory, penetration_and_clearance
+from reference import dense_trajectory, diagonal_edge_hits, penetration_and_clearance
 
 
 def assert_tree_edges_valid(env, dynamics, result, resolution=0.01, spacing=0.004):
@@ -13,6 +13,15 @@ def assert_tree_edges_valid(env, dynamics, result, resolution=0.01, spacing=0.00
     assert parents[0] == -1
     assert np.all(parents[1:] >= 0) and np.all(parents[1:] < np.arange(1, len(parents)))
     assert env.is_free(nodes).all()
+    closed = dynamics.closed_loop
+    if np.allclose(closed, np.diag(np.diag(closed))):
+        # exact interval check: no contact at all, with any obstacle, along the whole edge
+        rates = np.diag(closed)
+        for child in range(1, len(nodes)):
+            assert not diagonal_edge_hits(nodes[parents[child]], nodes[child], rates,
+                                          dynamics.horizon, env.bounds, env.boxes), \
+                f"edge {parents[child]} -> {child} touches an obstacle"
+        return
     for child in range(1, len(nodes)):
         points = dense_trajectory(dynamics.A, dynamics.B, dynamics.K, nodes[parents[child]],
                                   nodes[child], dynamics.horizon, spacing=spacing)

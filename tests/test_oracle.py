@@ -91,3 +91,28 @@ def test_error_model_rates():
     assert np.array_equal(qc.OracleErrorModel(0.1, 0.2, seed=0).apply(truth), marks)
     with pytest.raises(ValueError, match="false_positive"):
         qc.OracleErrorModel(false_positive=1.5)
+
+
+def test_oracle_agrees_with_exact_diagonal_check(clutter):
+    """For the paper's diagonal closed loop the exact interval check is the truth: the oracle
+    never accepts a touching trajectory, and rejects a free one only within the resolution."""
+    from reference import diagonal_edge_hits
+
+    dyn = qc.LinearTrackingDynamics.paper()
+    oracle = qc.ReachabilityOracle(clutter, dyn)
+    rng = np.random.default_rng(21)
+    parents = clutter.sample_free(3000, rng)
+    children = np.clip(parents + rng.normal(scale=2.5, size=parents.shape), 0.0, 20.0)
+    verdict = oracle.reachable(parents, children)
+    rates = np.diag(dyn.closed_loop)
+    for p, c, ok in zip(parents, children, verdict, strict=True):
+        touches = diagonal_edge_hits(p, c, rates, dyn.horizon, clutter.bounds, clutter.boxes)
+        if ok:
+            assert not touches
+        elif not touches:
+            # a false rejection must come within the resolution of an obstacle: shrinking every
+            # obstacle by that margin... is tested the other way: grow them by the resolution
+            grown = clutter.boxes + np.array([-0.0101, 0.0101])[None, :, None]
+            inner = clutter.bounds + np.array([0.0101, -0.0101])
+            assert diagonal_edge_hits(p, c, rates, dyn.horizon, inner, grown, shrink=0.0)
+    assert 0.1 < verdict.mean() < 0.9
