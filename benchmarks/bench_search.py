@@ -57,7 +57,8 @@ def bench_reachability(quick: bool) -> list[dict]:
         }
         oracle.reachable(parents[:10], pairs["uniform"][:10])  # compile
         for kind, children in pairs.items():
-            med, lo, hi = median_time(lambda o=oracle, c=children: o.reachable(parents, c), 3 if quick else 5)
+            med, lo, hi = median_time(lambda o=oracle, c=children, p=parents: o.reachable(p, c),
+                                      3 if quick else 5)
             reach = float(oracle.reachable(parents, children).mean())
             rows.append({"scenario": scenario, "pairs": kind, "count": count,
                          "pairs_per_s": count / med, "reachable_fraction": reach,
