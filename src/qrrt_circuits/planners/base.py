@@ -115,7 +115,10 @@ class RunState:
         self.databases = 0
         self.duplicates = 0
         self.rejected = 0
-        self.history: dict[str, list] = {"oracle_calls": [], "critical_path": [], "nodes": []}
+        self.history: dict[str, list] = {"oracle_calls": [], "critical_path": [], "nodes": [],
+                                         "entries": [], "reachable": []}
+        self.round_entries = 0
+        self.round_reachable = 0
 
     @property
     def oracle_calls(self) -> int:
@@ -220,6 +223,9 @@ class Planner:
             state.history["oracle_calls"].append(state.oracle_calls)
             state.history["critical_path"].append(state.critical_path)
             state.history["nodes"].append(state.tree.size - 1)
+            state.history["entries"].append(state.round_entries)
+            state.history["reachable"].append(state.round_reachable)
+            state.round_entries = state.round_reachable = 0
         elapsed = time.perf_counter() - began
         return self._result(state, elapsed, start, goal, goal_radius, budgets)
 

@@ -49,6 +49,8 @@ class ParallelRRT(Planner):
         longest = 1
         for outcome in outcomes:
             state.verification_calls += 1
+            state.round_entries += 1
+            state.round_reachable += int(outcome.truth)
             if not outcome.answer:
                 continue
             if self.oracle_errors is not None:

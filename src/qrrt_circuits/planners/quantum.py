@@ -145,6 +145,8 @@ class PQRRT(Planner):
         db, truth, marks = self.make_database(tree, state.goal, state.goal_radius, r, 0, r)
         state.databases += 1
         state.simulation_checks += truth.shape[0]
+        state.round_entries += truth.shape[0]
+        state.round_reachable += int(np.count_nonzero(truth))
         outcomes = self.search_database(marks, truth, r, 0, self.workers, self._round_iterations(state))
         added: set[int] = set()
         longest = 0
@@ -178,6 +180,8 @@ class PQRRT(Planner):
         for outcome in outcomes:
             state.databases += 1
             state.simulation_checks += outcome.simulation_checks
+            state.round_entries += outcome.simulation_checks
+            state.round_reachable += outcome.reachable_entries
             state.quantum_calls += outcome.quantum_calls
             state.verification_calls += outcome.verifications
             longest = max(longest, outcome.quantum_calls + outcome.verifications)

@@ -44,6 +44,7 @@ class QuantumOutcome:
     quantum_calls: int
     verifications: int
     simulation_checks: int
+    reachable_entries: int
     observations: tuple[tuple[int, bool], ...]
 
 
@@ -62,5 +63,6 @@ def unshared_worker(planner, tree: Tree, goal, goal_radius, round_index: int, wo
         quantum_calls=spent,
         verifications=verifications,
         simulation_checks=truth.shape[0],
+        reachable_entries=int(np.count_nonzero(truth)),
         observations=observations,
     )
