@@ -142,6 +142,25 @@ def cmd_plan(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_reproduce(args: argparse.Namespace) -> int:
+    from .experiments import EXPERIMENTS, run_experiment
+
+    names = sorted(EXPERIMENTS) if args.experiment == "all" else [args.experiment]
+    if args.experiment != "all" and args.experiment not in EXPERIMENTS:
+        raise ValueError(f"EXPERIMENT must be one of {sorted(EXPERIMENTS)} or 'all', got {args.experiment!r}")
+    for name in names:
+        summary = run_experiment(name, out=args.out, quick=args.quick, trials=args.trials, seed=args.seed,
+                                 progress=not args.no_progress)
+        print(f"== {name}: {summary.get('title', '')}")
+        print(f"   ours : {summary['ours']}")
+        print(f"   paper: {summary['paper']}")
+        for key in ("ordering_reproduced", "ratio_qda_over_uniform", "speedup_over_paper_per_node"):
+            if key in summary:
+                print(f"   {key}: {summary[key]}")
+        print(f"   wrote {args.out}/{name}/ (records.csv, summary.json, {', '.join(summary['figures'])})")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="qrrt", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -175,6 +194,15 @@ def build_parser() -> argparse.ArgumentParser:
     plan.add_argument("--plot", default=None, help="write a PNG of the tree")
     plan.add_argument("--json", default=None, help="write the result as JSON")
     plan.set_defaults(func=cmd_plan)
+
+    reproduce = sub.add_parser("reproduce", help="reproduce the paper's figures and tables")
+    reproduce.add_argument("experiment", help="an experiment name or 'all'")
+    reproduce.add_argument("--quick", action="store_true", help="small settings (each < 2 min)")
+    reproduce.add_argument("--trials", type=_positive_int, default=None, help="override the trial count")
+    reproduce.add_argument("--out", default="results", help="output directory (default results/)")
+    reproduce.add_argument("--seed", type=_nonnegative_int, default=0)
+    reproduce.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    reproduce.set_defaults(func=cmd_reproduce)
     return parser
 
 

@@ -77,12 +77,16 @@ def _brute_nearest(points: np.ndarray, nodes: np.ndarray, offset: int) -> np.nda
 class AnnealingSchedule:
     """Quantum Database Annealing (Alg. 4): the temperature array H as distance bands.
 
-    ``bands[h]`` = (r_min, r_max) is used for databases h with ``switch_at[h-1] <= h < switch_at[h]``
-    (the index h counts databases built, i.e. rounds); the last band stays in force.
+    Band i = (r_min, r_max) is in force while ``switch_at[i-1] <= h < switch_at[i]``; the last band
+    stays in force. The index h counts databases built (``counter="databases"``, Alg. 4's h++ per
+    loop) or nodes in the tree (``counter="nodes"``). In Alg. 4 every database adds a node, so the
+    two coincide; with the classical verification a database can add none, and counting nodes
+    keeps the hot phase for the tree's first ``switch_at[0]`` nodes.
     """
 
     bands: tuple[tuple[float, float], ...]
     switch_at: tuple[int, ...] = ()
+    counter: str = "databases"
 
     def __post_init__(self) -> None:
         bands = tuple((float(lo), float(hi)) for lo, hi in self.bands)
@@ -103,6 +107,8 @@ class AnnealingSchedule:
         steps = np.diff(np.asarray(switch_at, dtype=np.int64))
         if any(s <= 0 for s in switch_at) or np.any(steps <= 0):
             raise ValueError(f"switch_at must be strictly increasing positive integers, got {switch_at}")
+        if self.counter not in ("databases", "nodes"):
+            raise ValueError(f"counter must be 'databases' or 'nodes', got {self.counter!r}")
         object.__setattr__(self, "bands", bands)
         object.__setattr__(self, "switch_at", switch_at)
 

@@ -84,7 +84,7 @@ def narrow_corridor(seed: int | None = 0, width: float = 0.4, length: float = 4.
                     clutter: int = 120) -> Environment:
     """[0, 20]^2 split by two large blocks leaving one horizontal channel ``width`` wide and
     ``length`` long through the middle (paper §V.C); small random boxes on both sides, kept out of
-    the channel's mouths. Start on the left, goal on the right."""
+    the channel's mouths. Start in front of the left mouth (0.5 to 1.5 before it, on its axis), goal on the right."""
     _check_seed(seed)
     if not (0 < width < 10):
         raise ValueError(f"width must be in (0, 10), got {width}")
@@ -109,7 +109,8 @@ def narrow_corridor(seed: int | None = 0, width: float = 0.4, length: float = 4.
     boxes = np.concatenate([blocks, np.array(small).reshape(-1, 2, 2)])
     env = Environment(np.array([[0.0, size], [0.0, size]]), boxes, name="narrow_corridor")
     for _ in range(10000):
-        start = np.array([rng.uniform(1.0, x0 - 3.0), rng.uniform(2.0, size - 2.0)])
+        # start in front of the channel's left mouth, on its axis; goal anywhere on the far side
+        start = np.array([rng.uniform(x0 - keep_out, x0 - 0.5), (y0 + y1) / 2 + rng.uniform(-0.1, 0.1) * width])
         goal = np.array([rng.uniform(x1 + 3.0, size - 1.0), rng.uniform(2.0, size - 2.0)])
         if env.is_free(start) and env.is_free(goal) and _clearance_ok(env, goal, GOAL_RADIUS) \
                 and _clearance_ok(env, start, GOAL_RADIUS):

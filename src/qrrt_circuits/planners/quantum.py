@@ -134,6 +134,12 @@ class PQRRT(Planner):
             return None
         return state.policy_state.iterations(state.tree.size - 1)
 
+    def _temperature_index(self, state: RunState) -> int:
+        """QDA's h: databases built so far (= rounds) or nodes in the tree, per the schedule."""
+        if self.annealing is not None and self.annealing.counter == "nodes":
+            return state.tree.size - 1
+        return state.rounds
+
     def _round(self, state: RunState) -> None:
         if self.shared_database:
             self._shared_round(state)
@@ -142,7 +148,7 @@ class PQRRT(Planner):
 
     def _shared_round(self, state: RunState) -> None:
         tree, r = state.tree, state.rounds
-        db, truth, marks = self.make_database(tree, state.goal, state.goal_radius, r, 0, r)
+        db, truth, marks = self.make_database(tree, state.goal, state.goal_radius, r, 0, self._temperature_index(state))
         state.databases += 1
         state.simulation_checks += truth.shape[0]
         state.round_entries += truth.shape[0]
@@ -171,7 +177,8 @@ class PQRRT(Planner):
     def _unshared_round(self, state: RunState) -> None:
         tree, r = state.tree, state.rounds
         k = self._round_iterations(state)
-        args = [(self, tree, state.goal, state.goal_radius, r, w, k, r) for w in range(self.workers)]
+        h = self._temperature_index(state)
+        args = [(self, tree, state.goal, state.goal_radius, r, w, k, h) for w in range(self.workers)]
         if self.executor is None:
             outcomes = [unshared_worker(*a) for a in args]
         else:
@@ -203,7 +210,7 @@ class PQRRT(Planner):
             "iterations": self.iterations_policy.describe(),
             "annealing": None if self.annealing is None else {
                 "bands": [list(b) for b in self.annealing.bands],
-                "switch_at": list(self.annealing.switch_at)},
+                "switch_at": list(self.annealing.switch_at), "counter": self.annealing.counter},
         }
 
     def labels(self) -> tuple[str, ...]:

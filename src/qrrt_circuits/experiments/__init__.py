@@ -1,0 +1,19 @@
+"""Reproductions of the paper's figures and tables, one module per experiment, and a runner that
+writes records.csv (one row per trial), summary.json and figures, and resumes interrupted runs."""
+
+from .annealing import Annealing
+from .corridor import Corridor
+from .heatmaps import Heatmaps
+from .lemmas import Lemmas
+from .oracle_efficiency import OracleEfficiency
+from .runner import read_records, run_experiment
+from .scaling import Scaling
+from .wallclock import Wallclock
+
+EXPERIMENTS = {
+    experiment.name: experiment
+    for experiment in (OracleEfficiency(), Wallclock(), Heatmaps(), Corridor(), Annealing(), Lemmas(),
+                       Scaling())
+}
+
+__all__ = ["EXPERIMENTS", "read_records", "run_experiment"]

@@ -1,0 +1,121 @@
+"""Paper Figs. 15-17: Quantum Database Annealing against uniform q-RRT databases.
+
+annealing_field (6025 boxes), databases of 2^9, 2 Grover iterations (Alg. 4). QDA uses the band
+[2.7, 4.2] while the tree has fewer than 16 nodes, then [0.8, 2.0] (h counts nodes: in Alg. 4 each
+database adds one node; here a database whose measured entry fails verification adds none). Trees
+of 16 and 48 nodes; the mean distance from a node to its parent, and tree figures.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..database import AnnealingSchedule
+from ..plotting import plot_tree
+from ..search.schedules import FixedIterations
+from .base import Experiment, Trial, replicate_seed
+from .common import dumps, loads, make_planner, new_figure, rounded, save, world
+
+METHODS = ("QDA", "QRRT")
+SIZES = (16, 48)
+
+
+class _TreeView:
+    """Just enough of a PlanResult for plot_tree."""
+
+    def __init__(self, nodes, parents, label, settings):
+        self.nodes = nodes
+        self.parents = parents
+        self.path = None
+        self.goal_node = None
+        self.planner = label
+        self.status = "grown"
+        self.settings = settings
+
+        class _M:
+            pass
+
+        self.metrics = _M()
+        self.metrics.nodes = len(nodes) - 1
+        self.metrics.oracle_calls = 0
+
+
+class Annealing(Experiment):
+    name = "annealing"
+    title = "Quantum Database Annealing vs uniform databases (paper Figs. 15-17)"
+    paper = {"QDA": 3.68, "QRRT": 1.70}
+
+    def settings(self, quick, trials, seed):
+        return {"trials": trials or (3 if quick else 20), "num_qubits": 9, "iterations": 2,
+                "bands": [[2.7, 4.2], [0.8, 2.0]], "switch_at": 16, "sizes": list(SIZES),
+                "backend": "aer", "scenario": "annealing_field", "seed": seed, "quick": quick}
+
+    def trials(self, settings):
+        out = []
+        for replicate in range(settings["trials"]):
+            world_seed = replicate_seed(settings["seed"], replicate, 5)
+            for method in METHODS:
+                out.append(Trial(f"{method}-{replicate}", {"method": method, "replicate": replicate,
+                                                            "world_seed": world_seed},
+                                 replicate_seed(settings["seed"], replicate, 6)))
+        return out
+
+    def run_trial(self, trial, settings):
+        env = world(settings["scenario"], trial.params["world_seed"])
+        annealing = None
+        if trial.params["method"] == "QDA":
+            annealing = AnnealingSchedule(bands=[tuple(b) for b in settings["bands"]],
+                                          switch_at=(settings["switch_at"],), counter="nodes")
+        planner = make_planner("QRRT", env, trial.seed, settings["backend"],
+                               num_qubits=settings["num_qubits"],
+                               iterations=FixedIterations(settings["iterations"]), annealing=annealing)
+        result = planner.plan(max_nodes=max(settings["sizes"]))
+        distances = np.linalg.norm(result.nodes[1:] - result.nodes[result.parents[1:]], axis=1)
+        record = {"nodes": result.metrics.nodes, "oracle_calls": result.metrics.oracle_calls,
+                  "rounds": result.metrics.rounds}
+        for size in settings["sizes"]:
+            part = distances[:size]
+            record[f"mean_parent_distance_{size}"] = float(part.mean()) if part.size else None
+        record["positions_json"] = dumps(rounded(result.nodes))
+        record["parents_json"] = dumps(result.parents.tolist())
+        return record
+
+    def summarize(self, records, settings):
+        ours = {}
+        for method in METHODS:
+            rows = [r for r in records if r["method"] == method]
+            ours[method] = {str(size): round(float(np.mean([r[f"mean_parent_distance_{size}"] for r in rows
+                                                            if r[f"mean_parent_distance_{size}"] is not None])), 3)
+                            for size in settings["sizes"]}
+        ratio = {str(s): round(ours["QDA"][str(s)] / ours["QRRT"][str(s)], 2) for s in settings["sizes"]}
+        return {"ours": ours, "paper": self.paper, "ratio_qda_over_uniform": ratio,
+                "target_2x_reached": bool(ratio[str(min(settings["sizes"]))] >= 2.0),
+                "note": "mean distance from node to parent over the first 16 and all 48 nodes"}
+
+    def plot(self, records, settings, summary, out_dir: Path):
+        first = {r["method"]: r for r in records if r["replicate"] == 0}
+        env = world(settings["scenario"], first["QDA"]["world_seed"])
+        sizes = settings["sizes"]
+        fig, axes = new_figure(len(METHODS), len(sizes) + 1, (4.8 * (len(sizes) + 1), 4.6 * len(METHODS)))
+        for row, method in enumerate(METHODS):
+            nodes = np.array(loads(first[method]["positions_json"]))
+            parents = np.array(loads(first[method]["parents_json"]))
+            for col, size in enumerate(sizes):
+                view = _TreeView(nodes[: size + 1], parents[: size + 1], method, {})
+                ax = axes[row, col]
+                plot_tree(env, view, ax=ax, title=f"{method}, {min(size, len(nodes) - 1)}-node tree")
+                span = np.ptp(nodes[: size + 1], axis=0).max() + 8
+                centre = nodes[0]
+                ax.set_xlim(centre[0] - span / 2, centre[0] + span / 2)
+                ax.set_ylim(centre[1] - span / 2, centre[1] + span / 2)
+            ax = axes[row, len(sizes)]
+            distances = [np.linalg.norm(np.array(loads(r["positions_json"]))[1:] -
+                                        np.array(loads(r["positions_json"]))[np.array(loads(r["parents_json"]))[1:]],
+                                        axis=1) for r in records if r["method"] == method]
+            ax.hist(np.concatenate(distances), bins=30, color="tab:blue" if method == "QRRT" else "tab:red")
+            ax.set_xlabel("distance to parent")
+            ax.set_title(f"{method}: mean {summary['ours'][method][str(sizes[0])]} (16 nodes), "
+                         f"paper {self.paper[method]}", fontsize=9)
+        return [save(fig, out_dir / "annealing.png")]

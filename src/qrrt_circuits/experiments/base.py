@@ -1,0 +1,58 @@
+"""The experiment interface and its trial type.
+
+An experiment is a list of independent trials (the unit of work), a function that runs one trial
+and returns a flat record (one CSV row), a summary of all records against the paper's numbers,
+and its figures. Trials carry parameters and a seed, never circuits or planners, so any executor
+can run them. Per-trial seeds come from one ``numpy.random.SeedSequence``: trial seeds depend on
+the root seed and the trial's replicate index only, never on the order trials run in.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+#: record columns that measure time: excluded when records are compared across executors
+TIMING_SUFFIX = "_s"
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One unit of work: a unique id, its parameters (JSON-able scalars) and its seed."""
+
+    id: str
+    params: dict = field(default_factory=dict)
+    seed: int = 0
+
+
+def replicate_seed(root_seed: int, replicate: int, stream: int = 0) -> int:
+    """The seed of replicate ``replicate``: SeedSequence(root_seed) spawned at (stream, replicate)."""
+    sequence = np.random.SeedSequence(int(root_seed), spawn_key=(int(stream), int(replicate)))
+    return int(sequence.generate_state(1, dtype=np.uint32)[0])
+
+
+class Experiment:
+    """Base class; subclasses define the five methods below (and ``name``, ``title``)."""
+
+    name = "experiment"
+    title = ""
+    #: what the paper reports (filled by subclasses)
+    paper: dict = {}
+
+    def settings(self, quick: bool, trials: int | None, seed: int) -> dict:
+        raise NotImplementedError
+
+    def trials(self, settings: dict) -> list[Trial]:
+        raise NotImplementedError
+
+    def run_trial(self, trial: Trial, settings: dict) -> dict:
+        raise NotImplementedError
+
+    def summarize(self, records: list[dict], settings: dict) -> dict:
+        """Return at least {"ours": ..., "paper": ...} (plus anything else worth keeping)."""
+        raise NotImplementedError
+
+    def plot(self, records: list[dict], settings: dict, summary: dict, out_dir: Path) -> list[Path]:
+        raise NotImplementedError

@@ -1,0 +1,73 @@
+"""Paper Figs. 13-14: narrow corridor. 50 trials per planner cut at 25 oracle calls in
+narrow_corridor (a channel 0.4 wide and 4 long); nodes inside the channel, nodes through it, and
+node heatmaps."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .base import Experiment, Trial, replicate_seed
+from .common import cut_at, dumps, loads, make_planner, new_figure, node_heatmap, rounded, save, world
+
+PLANNERS = ("RRT", "QRRT")
+
+
+def in_channel(points: np.ndarray, channel) -> np.ndarray:
+    (x0, y0), (x1, y1) = channel
+    return (points[:, 0] >= x0) & (points[:, 0] <= x1) & (points[:, 1] >= y0) & (points[:, 1] <= y1)
+
+
+class Corridor(Experiment):
+    name = "corridor"
+    title = "Narrow corridor at 25 oracle calls (paper Figs. 13-14)"
+    paper = {"QRRT": 47, "RRT": 14}
+
+    def settings(self, quick, trials, seed):
+        return {"trials": trials or (10 if quick else 50), "budget": 25, "num_qubits": 8,
+                "backend": "aer", "schedule": "paper", "scenario": "narrow_corridor", "world_seed": 0,
+                "seed": seed, "quick": quick}
+
+    def trials(self, settings):
+        return [Trial(f"{kind}-{i}", {"planner": kind, "replicate": i}, replicate_seed(settings["seed"], i, 4))
+                for kind in PLANNERS for i in range(settings["trials"])]
+
+    def run_trial(self, trial, settings):
+        env = world(settings["scenario"], settings["world_seed"])
+        planner = make_planner(trial.params["planner"], env, trial.seed, settings["backend"],
+                               num_qubits=settings["num_qubits"])
+        result = planner.plan(max_oracle_calls=settings["budget"])
+        nodes, calls = cut_at(result, settings["budget"])
+        positions = result.nodes[1 : nodes + 1]
+        channel = env.metadata["channel"]
+        entries = int(result.history["entries"].sum())
+        return {"reachable_fraction": int(result.history["reachable"].sum()) / entries if entries else 0.0,
+                "nodes": nodes, "oracle_calls": calls,
+                "in_channel": int(in_channel(positions, channel).sum()),
+                "through_channel": int((positions[:, 0] > channel[1][0]).sum()),
+                "positions_json": dumps(rounded(positions))}
+
+    def summarize(self, records, settings):
+        ours = {kind: sum(r["in_channel"] for r in records if r["planner"] == kind) for kind in PLANNERS}
+        return {"ours": ours, "paper": self.paper,
+                "through_channel": {k: sum(r["through_channel"] for r in records if r["planner"] == k)
+                                    for k in PLANNERS},
+                "nodes": {k: sum(r["nodes"] for r in records if r["planner"] == k) for k in PLANNERS},
+                "mean_reachable_fraction": {
+                    k: round(float(np.mean([r["reachable_fraction"] for r in records if r["planner"] == k])), 4)
+                    for k in PLANNERS},
+                "note": "nodes inside the channel rectangle, summed over the trials; reachable_fraction is "
+                        "the share of candidates (RRT tests, q-RRT database entries) that were reachable"}
+
+    def plot(self, records, settings, summary, out_dir: Path):
+        env = world(settings["scenario"], settings["world_seed"])
+        fig, axes = new_figure(1, len(PLANNERS), (5.2 * len(PLANNERS), 4.6))
+        for col, kind in enumerate(PLANNERS):
+            points = [np.array(loads(r["positions_json"])).reshape(-1, 2) for r in records if r["planner"] == kind]
+            points = np.concatenate(points) if points else np.zeros((0, 2))
+            node_heatmap(axes[0, col], env, points,
+                         f"{kind}: {summary['ours'][kind]} nodes in the channel (paper {self.paper[kind]})",
+                         goal=env.goal, radius=env.goal_radius)
+            axes[0, col].plot(*env.start, "o", color="tab:green")
+        return [save(fig, out_dir / "corridor.png")]

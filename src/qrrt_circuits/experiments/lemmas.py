@@ -1,0 +1,161 @@
+"""Lemmas 1-6 against shot frequencies on AerBackend, over a grid of workers p, marked m and
+qubits n, with and without oracle errors.
+
+Each trial runs one Aer search of a random database with p x R shots (R groups of p workers; the
+shots are independent preparations) and reads off: all p on the same solution (Lemma 1), all
+different (Lemma 2), a truly good entry measured (Lemma 4), all p on the same truly good entry
+(Lemma 5). Reading the shots in order as draws of a coupon collector gives the number of workers
+needed to find all m (Lemma 3) or all m1 truly good marked entries (Lemma 6). k is the optimal
+count for the oracle's m. Standard errors are binomial (or the sample standard deviation of the
+collection times).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .. import probability as pr
+from ..oracle import OracleErrorModel
+from .base import Experiment, Trial, replicate_seed
+from .common import make_backend, new_figure, save
+
+GRID_QUBITS = (4, 6)
+GRID_MARKED = (1, 2, 4, 8)
+GRID_WORKERS = (2, 4, 8)
+ERRORS = ((0.0, 0.0), (0.05, 0.2))
+
+
+def _collection_times(indices: np.ndarray, targets: np.ndarray) -> list[int]:
+    """Draws needed to see every target index, restarting after each completed collection."""
+    wanted = set(int(t) for t in targets)
+    if not wanted:
+        return []
+    times, seen, count = [], set(), 0
+    for index in indices:
+        count += 1
+        if int(index) in wanted:
+            seen.add(int(index))
+            if len(seen) == len(wanted):
+                times.append(count)
+                seen, count = set(), 0
+    return times
+
+
+class Lemmas(Experiment):
+    name = "lemmas"
+    title = "Lemmas 1-6 against Aer shot frequencies"
+    paper = {"lemma1": "P(G)^p m^(1-p)", "lemma2": "P(G)^p m! / (m^p (m-p)!)",
+             "lemma3": "m H_m / P(G)", "lemma4": "(m1/m) P(G) + (m2/(N-m)) (1-P(G))",
+             "lemma5": "m1 (P(G)/m)^p + m2 ((1-P(G))/(N-m))^p", "lemma6": "m1 H_m1 / ((m1/m) P(G))"}
+
+    def settings(self, quick, trials, seed):
+        grid = [[n, m, p, fp, fn] for n in GRID_QUBITS for m in GRID_MARKED for p in GRID_WORKERS
+                for fp, fn in ERRORS if m <= 2**n]
+        if quick:
+            grid = grid[:: max(len(grid) // 8, 1)]
+        return {"repeats": trials or (400 if quick else 3000), "grid": grid, "backend": "aer",
+                "seed": seed, "quick": quick}
+
+    def trials(self, settings):
+        return [Trial(f"n{n}-m{m}-p{p}-fp{fp}-fn{fn}", {"qubits": n, "marked": m, "workers": p,
+                                                         "false_positive": fp, "false_negative": fn},
+                      replicate_seed(settings["seed"], i, 7))
+                for i, (n, m, p, fp, fn) in enumerate(settings["grid"])]
+
+    def run_trial(self, trial, settings):
+        n, m, p = trial.params["qubits"], trial.params["marked"], trial.params["workers"]
+        size = 2**n
+        rng = np.random.default_rng(trial.seed)
+        truth = np.zeros(size, dtype=bool)
+        truth[rng.choice(size, m, replace=False)] = True
+        errors = OracleErrorModel(trial.params["false_positive"], trial.params["false_negative"])
+        marks = errors.apply(truth, rng)
+        m_oracle = int(marks.sum())
+        m1 = int((marks & truth).sum())
+        m2 = int((~marks & truth).sum())
+        k = pr.optimal_iterations(size, m_oracle)
+        p_good = pr.success_probability(size, m_oracle, k)
+        repeats = settings["repeats"]
+        backend = make_backend(settings["backend"])
+        indices = backend.search(marks, k, shots=p * repeats, seed=int(rng.integers(2**62))).indices
+        groups = indices.reshape(repeats, p)
+        good = marks[groups].all(axis=1)
+        same = good & (groups == groups[:, :1]).all(axis=1)
+        different = good & np.array([len(set(row)) == p for row in groups])
+        true_hit = truth[groups[:, 0]]
+        same_true = truth[groups].all(axis=1) & (groups == groups[:, :1]).all(axis=1)
+        record = {"iterations": k, "oracle_marked": m_oracle, "true_marked": m1, "missed_good": m2,
+                  "p_good": p_good, "repeats": repeats}
+
+        def put(name, observed, theory, stderr):
+            record[f"{name}_observed"] = float(observed)
+            record[f"{name}_theory"] = float(theory)
+            record[f"{name}_stderr"] = float(stderr)
+
+        def binomial(observed, theory):
+            return math.sqrt(max(theory * (1 - theory), 1.0 / repeats) / repeats)
+
+        lemma1 = pr.prob_all_same(p, m_oracle, p_good) if m_oracle else 0.0
+        lemma2 = pr.prob_all_different(p, m_oracle, p_good) if m_oracle else 0.0
+        put("lemma1", same.mean(), lemma1, binomial(same.mean(), lemma1))
+        put("lemma2", different.mean(), lemma2, binomial(different.mean(), lemma2))
+        lemma4 = pr.prob_true_solution(size, m_oracle, m1, m2, p_good)
+        put("lemma4", true_hit.mean(), lemma4, binomial(true_hit.mean(), lemma4))
+        lemma5 = pr.prob_all_same_with_errors(p, size, m_oracle, m1, m2, p_good)
+        put("lemma5", same_true.mean(), lemma5, binomial(same_true.mean(), lemma5))
+        # coupon collection over the shot sequence (Lemma 3: all m marked; Lemma 6: all m1 truly good)
+        for name, targets, theory in (
+            ("lemma3", np.flatnonzero(marks), pr.expected_workers_all_found(m_oracle, p_good)),
+            ("lemma6", np.flatnonzero(marks & truth), pr.expected_workers_with_errors(m_oracle, m1, p_good)),
+        ):
+            times = _collection_times(indices, targets)
+            if len(times) >= 5 and math.isfinite(theory):
+                put(name, np.mean(times), theory, np.std(times, ddof=1) / math.sqrt(len(times)))
+            else:
+                put(name, float("nan"), theory, float("nan"))
+        return record
+
+    def summarize(self, records, settings):
+        ours = {}
+        for lemma in ("lemma1", "lemma2", "lemma3", "lemma4", "lemma5", "lemma6"):
+            z = []
+            for r in records:
+                observed, theory, stderr = r[f"{lemma}_observed"], r[f"{lemma}_theory"], r[f"{lemma}_stderr"]
+                if observed is None or not np.isfinite(observed) or not stderr:
+                    continue
+                z.append((observed - theory) / stderr)
+            z = np.abs(np.array(z))
+            ours[lemma] = {"points": int(z.size), "max_abs_z": round(float(z.max()), 2) if z.size else None,
+                           "within_3_sigma": round(float(np.mean(z <= 3)), 3) if z.size else None}
+        return {"ours": ours, "paper": self.paper,
+                "note": "z = (observed - lemma) / standard error; the lemmas are exact for these "
+                        "events, so about 99.7% of points should lie within 3 sigma"}
+
+    def plot(self, records, settings, summary, out_dir: Path):
+        lemmas = ("lemma1", "lemma2", "lemma3", "lemma4", "lemma5", "lemma6")
+        fig, axes = new_figure(2, 3, (14, 8.5))
+        for ax, lemma in zip(axes.ravel(), lemmas, strict=True):
+            rows = [r for r in records if r[f"{lemma}_observed"] is not None
+                    and np.isfinite(r[f"{lemma}_observed"])]
+            theory = np.array([r[f"{lemma}_theory"] for r in rows])
+            observed = np.array([r[f"{lemma}_observed"] for r in rows])
+            stderr = np.array([r[f"{lemma}_stderr"] for r in rows])
+            errors = np.array([r["false_positive"] > 0 for r in rows])
+            for mask, color, label in ((~errors, "tab:blue", "exact oracle"), (errors, "tab:red", "oracle errors")):
+                if mask.any():
+                    ax.errorbar(theory[mask], observed[mask], yerr=stderr[mask], fmt="o", ms=3,
+                                color=color, label=label, capsize=2)
+            if theory.size:
+                lim = [min(theory.min(), observed.min()), max(theory.max(), observed.max())]
+                ax.plot(lim, lim, "k--", lw=0.8)
+            stats = summary["ours"][lemma]
+            ax.set_title(f"{lemma.title().replace('a', 'a ', 0)}: {self.paper[lemma]}\n"
+                         f"{stats['within_3_sigma']} within 3 sigma", fontsize=9)
+            ax.set_xlabel("lemma")
+            ax.set_ylabel("Aer shots")
+            ax.legend(fontsize=7)
+            ax.grid(alpha=0.3)
+        return [save(fig, out_dir / "lemmas.png")]

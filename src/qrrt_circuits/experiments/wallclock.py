@@ -1,0 +1,106 @@
+"""Paper Figs. 6-8: wall-clock seconds per oracle call and per node.
+
+Same trees as oracle-efficiency (30 nodes, paper_clutter), timed for RRT, parallel RRT, and
+q-RRT / Pq-RRT on both backends. Slopes are least-squares fits through the origin of seconds
+against oracle calls (or nodes) over the trials. The paper's numbers come from MATLAB on an
+8-core M2; ours from this machine, with everything in one process (the shared Pq-RRT shortcut —
+one search with p shots — is the same one the paper's simulation used).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .base import Experiment, Trial, replicate_seed
+from .common import make_planner, new_figure, save, world
+from .fitting import slope_through_origin
+
+CONFIGS = (("RRT", "none"), ("ParallelRRT", "none"), ("QRRT", "aer"), ("QRRT", "statevector"),
+           ("PQRRT", "aer"), ("PQRRT", "statevector"))
+
+
+def label(planner: str, backend: str) -> str:
+    return planner if backend == "none" else f"{planner} ({backend})"
+
+
+class Wallclock(Experiment):
+    name = "wallclock"
+    title = "Wall-clock seconds per oracle call and per node (paper Figs. 6-8)"
+    paper = {"seconds_per_oracle_call": {"QRRT": 3.52, "PQRRT": 0.20},
+             "seconds_per_node": {"RRT": 1.23, "ParallelRRT": 0.58, "QRRT": 25.3, "PQRRT": 3.17}}
+
+    def settings(self, quick, trials, seed):
+        return {"trials": trials or (3 if quick else 20), "nodes": 30, "workers": 8, "num_qubits": 8,
+                "scenario": "paper_clutter", "seed": seed, "quick": quick}
+
+    def trials(self, settings):
+        out = []
+        for replicate in range(settings["trials"]):
+            world_seed = replicate_seed(settings["seed"], replicate, 1)
+            for planner, backend in CONFIGS:
+                out.append(Trial(f"{label(planner, backend)}-{replicate}",
+                                 {"planner": planner, "backend": backend, "replicate": replicate,
+                                  "world_seed": world_seed},
+                                 replicate_seed(settings["seed"], replicate, 2)))
+        return out
+
+    def run_trial(self, trial, settings):
+        env = world(settings["scenario"], trial.params["world_seed"])
+        backend = trial.params["backend"]
+        planner = make_planner(trial.params["planner"], env, trial.seed,
+                               "statevector" if backend == "none" else backend,
+                               settings["workers"], settings["num_qubits"])
+        planner.plan(max_rounds=2)  # warm-up: compile kernels, build simulators
+        result = planner.plan(max_nodes=settings["nodes"])
+        m = result.metrics
+        return {"status": result.status, "nodes": m.nodes, "oracle_calls": m.oracle_calls,
+                "critical_path_oracle_calls": m.critical_path_oracle_calls,
+                "wall_time_s": m.wall_time_s}
+
+    def summarize(self, records, settings):
+        per_call, per_node, ms_node = {}, {}, {}
+        for planner, backend in CONFIGS:
+            rows = [r for r in records if r["planner"] == planner and r["backend"] == backend]
+            times = np.array([r["wall_time_s"] for r in rows])
+            name = label(planner, backend)
+            per_node[name] = slope_through_origin([r["nodes"] for r in rows], times)
+            ms_node[name] = round(per_node[name] * 1e3, 4)
+            if backend != "none":
+                per_call[name] = slope_through_origin([r["oracle_calls"] for r in rows], times)
+        speedup = {}
+        for name, value in per_node.items():
+            base = name.split(" ")[0]
+            speedup[name] = round(self.paper["seconds_per_node"][base] / value, 1)
+        return {"ours": {"seconds_per_oracle_call": per_call, "seconds_per_node": per_node},
+                "paper": self.paper, "ms_per_node": ms_node,
+                "speedup_over_paper_per_node": speedup,
+                "note": "the paper's times are MATLAB on an 8-core M2; ours one process on this machine"}
+
+    def plot(self, records, settings, summary, out_dir: Path):
+        fig, axes = new_figure(1, 2, (11, 4.4))
+        colors = dict(zip([label(*c) for c in CONFIGS],
+                          ["tab:gray", "tab:brown", "tab:blue", "tab:cyan", "tab:orange", "gold"], strict=True))
+        for ax, key, xcol in ((axes[0, 0], "seconds_per_node", "nodes"),
+                              (axes[0, 1], "seconds_per_oracle_call", "oracle_calls")):
+            for planner, backend in CONFIGS:
+                name = label(planner, backend)
+                if name not in summary["ours"][key]:
+                    continue
+                rows = [r for r in records if r["planner"] == planner and r["backend"] == backend]
+                x = np.array([r[xcol] for r in rows])
+                y = np.array([r["wall_time_s"] for r in rows])
+                slope = summary["ours"][key][name]
+                paper = self.paper[key].get(planner)
+                ax.scatter(x, y, s=10, color=colors[name], alpha=0.6)
+                ax.plot([0, x.max()], [0, slope * x.max()], color=colors[name],
+                        label=f"{name}: {slope * 1e3:.3g} ms (paper {paper} s)")
+            ax.set_yscale("log")
+            ax.set_xlabel(xcol.replace("_", " "))
+            ax.set_ylabel("wall-clock seconds")
+            ax.legend(fontsize=7)
+            ax.grid(alpha=0.3)
+        axes[0, 0].set_title("Seconds vs nodes (Figs. 7-8)", fontsize=10)
+        axes[0, 1].set_title("Seconds vs oracle calls (Fig. 6)", fontsize=10)
+        return [save(fig, out_dir / "wallclock.png")]
