@@ -108,8 +108,9 @@ class Annealing(Experiment):
                 plot_tree(env, view, ax=ax, title=f"{method}, {min(size, len(nodes) - 1)}-node tree")
                 span = np.ptp(nodes[: size + 1], axis=0).max() + 8
                 centre = nodes[0]
-                ax.set_xlim(centre[0] - span / 2, centre[0] + span / 2)
-                ax.set_ylim(centre[1] - span / 2, centre[1] + span / 2)
+                low = np.clip(centre - span / 2, env.bounds[:, 0], env.bounds[:, 1] - span)
+                ax.set_xlim(low[0], low[0] + span)
+                ax.set_ylim(low[1], low[1] + span)
             ax = axes[row, len(sizes)]
             distances = [np.linalg.norm(np.array(loads(r["positions_json"]))[1:] -
                                         np.array(loads(r["positions_json"]))[np.array(loads(r["parents_json"]))[1:]],

@@ -117,10 +117,13 @@ def node_heatmap(ax, env, points: np.ndarray, title: str, bins: int = 50, goal=N
     if len(points):
         counts, xe, ye = np.histogram2d(points[:, 0], points[:, 1], bins=bins,
                                         range=[[x0, x1], [y0, y1]])
-        image = ax.imshow(counts.T, origin="lower", extent=(x0, x1, y0, y1), cmap="hot_r",
-                          norm=LogNorm(vmin=1, vmax=max(counts.max(), 2)), interpolation="nearest")
+        masked = np.ma.masked_equal(counts.T, 0)
+        image = ax.imshow(masked, origin="lower", extent=(x0, x1, y0, y1), cmap="plasma",
+                          norm=LogNorm(vmin=1, vmax=max(counts.max(), 2)), interpolation="nearest", zorder=3)
         ax.figure.colorbar(image, ax=ax, fraction=0.046, pad=0.03, label="nodes")
     plot_environment(env, ax, color="0.35")
+    if env.start is not None:
+        ax.plot(*env.start[:2], "o", color="tab:green", ms=6, zorder=4)
     if goal is not None:
-        ax.add_patch(Circle(goal[:2], radius, fill=False, color="tab:red", lw=2))
+        ax.add_patch(Circle(goal[:2], radius, fill=False, color="tab:red", lw=2, zorder=4))
     ax.set_title(title, fontsize=9)

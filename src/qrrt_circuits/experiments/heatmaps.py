@@ -100,7 +100,8 @@ class Heatmaps(Experiment):
                 points = np.concatenate([p.reshape(-1, 2) for p in points]) if points else np.zeros((0, 2))
                 stats = summary["ours"][kind][str(cut)]
                 paper = self.paper.get(kind, {}).get(str(cut))
-                text = f"{kind}, {cut} calls: {stats['nodes']} nodes, eff. {stats['efficiency']:.1%}"
+                unit = "critical-path calls" if kind == "PQRRT" else "calls"
+                text = f"{kind}, {cut} {unit}: {stats['nodes']} nodes, eff. {stats['efficiency']:.1%}"
                 if paper:
                     text += f"\npaper: {paper['nodes']} nodes, {paper['efficiency']:.1%}"
                 node_heatmap(axes[row, col], env, points, text, goal=env.goal, radius=env.goal_radius)
