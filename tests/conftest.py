@@ -1,4 +1,8 @@
+import os
+import tempfile
+
 import numpy as np
+import psutil
 import pytest
 from qiskit_aer.primitives import SamplerV2
 
@@ -30,3 +34,22 @@ def random_marks(rng: np.random.Generator, num_qubits: int, num_marked: int) -> 
     marks = np.zeros(1 << num_qubits, dtype=bool)
     marks[rng.choice(1 << num_qubits, num_marked, replace=False)] = True
     return marks
+
+
+@pytest.fixture(scope="session", autouse=True)
+def no_leftovers():
+    """After the whole run: no child processes and no Dask scratch files left behind."""
+    prefixes = ("dask-scratch", "qrrt-dask-")
+    scratch = {name for name in os.listdir(tempfile.gettempdir()) if name.startswith(prefixes)}
+    yield
+    children = []
+    for process in psutil.Process().children(recursive=True):
+        try:
+            if not any("resource_tracker" in part for part in process.cmdline()):  # stdlib, exits with us
+                children.append(process)
+        except psutil.NoSuchProcess:
+            pass
+    gone, alive = psutil.wait_procs(children, timeout=30)
+    assert not alive, f"processes left running: {[p.pid for p in alive]}"
+    left = {name for name in os.listdir(tempfile.gettempdir()) if name.startswith(prefixes)}
+    assert left <= scratch, f"Dask scratch files left in {tempfile.gettempdir()}: {left - scratch}"

@@ -150,7 +150,8 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         raise ValueError(f"EXPERIMENT must be one of {sorted(EXPERIMENTS)} or 'all', got {args.experiment!r}")
     for name in names:
         summary = run_experiment(name, out=args.out, quick=args.quick, trials=args.trials, seed=args.seed,
-                                 progress=not args.no_progress)
+                                 progress=not args.no_progress, executor=args.executor, jobs=args.jobs,
+                                 scheduler=args.scheduler)
         print(f"== {name}: {summary.get('title', '')}")
         print(f"   ours : {summary['ours']}")
         print(f"   paper: {summary['paper']}")
@@ -202,6 +203,11 @@ def build_parser() -> argparse.ArgumentParser:
     reproduce.add_argument("--out", default="results", help="output directory (default results/)")
     reproduce.add_argument("--seed", type=_nonnegative_int, default=0)
     reproduce.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    reproduce.add_argument("--executor", choices=["serial", "process", "dask"], default="serial",
+                           help="where trials run (dask needs the [dask] extra)")
+    reproduce.add_argument("--jobs", type=_positive_int, default=None, help="worker processes (default: cores)")
+    reproduce.add_argument("--scheduler", default=None,
+                           help="address of an existing Dask scheduler (with --executor dask)")
     reproduce.set_defaults(func=cmd_reproduce)
     return parser
 

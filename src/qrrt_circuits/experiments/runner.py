@@ -14,7 +14,7 @@ import csv
 import json
 import os
 from collections.abc import Callable
-from concurrent.futures import Executor, as_completed
+from concurrent.futures import BrokenExecutor, Executor, as_completed
 from pathlib import Path
 
 from tqdm.auto import tqdm
@@ -100,21 +100,40 @@ class RecordWriter:
             os.fsync(handle.fileno())
 
 
+def _run_on(executor: Executor, name: str, trials: list[Trial], settings: dict, record_one) -> None:
+    futures = [executor.submit(execute_trial, name, trial, settings) for trial in trials]
+    try:
+        for future in as_completed(futures):
+            record_one(future.result())
+    finally:
+        for future in futures:
+            future.cancel()
+
+
 def run_experiment(
     name: str,
     out: str | Path = "results",
     quick: bool = False,
     trials: int | None = None,
     seed: int = 0,
-    executor: Executor | None = None,
+    executor: str | Executor | None = None,
+    jobs: int | None = None,
+    scheduler: str | None = None,
     progress: bool = True,
     stop_after: int | None = None,
     on_record: Callable[[dict], None] | None = None,
+    max_restarts: int = 3,
 ) -> dict:
     """Run (or resume) experiment ``name`` into ``out/name``; returns the summary.
 
-    ``stop_after`` stops after that many new trials (for tests of resuming).
+    ``executor``: ``"serial"`` (default), ``"process"``, ``"dask"`` (built here with ``jobs`` and
+    ``scheduler``, see ``qrrt_circuits.execution``) or any ``concurrent.futures.Executor``.
+    Records are written as trials finish, in whatever order. If a local process pool breaks (a
+    worker died), a new pool is started and the unfinished trials resubmitted, up to
+    ``max_restarts`` times; Dask reschedules a dead worker's tasks itself. ``stop_after`` stops
+    after that many new trials (for tests of resuming).
     """
+    from ..execution import check_executor_args, get_executor
     from . import EXPERIMENTS
 
     if name not in EXPERIMENTS:
@@ -123,6 +142,11 @@ def run_experiment(
         raise ValueError(f"trials must be an integer >= 1, got {trials}")
     if int(seed) != seed or seed < 0:
         raise ValueError(f"seed must be a non-negative integer, got {seed}")
+    if isinstance(executor, str) or executor is None:
+        kind = executor or "serial"
+        check_executor_args(kind, jobs, scheduler)
+    else:
+        kind = None
     experiment = EXPERIMENTS[name]
     settings = experiment.settings(quick, trials, int(seed))
     settings = json.loads(json.dumps(settings))  # plain JSON types, as stored
@@ -148,22 +172,30 @@ def run_experiment(
         todo = todo[:stop_after]
     writer = RecordWriter(records_path)
     bar = tqdm(total=len(all_trials), initial=len(done), desc=name, disable=not progress, unit="trial")
+    def record_one(record: dict) -> None:
+        writer.write(record)
+        if on_record:
+            on_record(record)
+        bar.update()
+
     try:
-        if executor is None:
+        if kind == "serial":
             for trial in todo:
-                record = execute_trial(name, trial, settings)
-                writer.write(record)
-                if on_record:
-                    on_record(record)
-                bar.update()
+                record_one(execute_trial(name, trial, settings))
+        elif kind is None:
+            _run_on(executor, name, todo, settings, record_one)
         else:
-            futures = [executor.submit(execute_trial, name, trial, settings) for trial in todo]
-            for future in as_completed(futures):
-                record = future.result()
-                writer.write(record)
-                if on_record:
-                    on_record(record)
-                bar.update()
+            remaining = list(todo)
+            for attempt in range(max_restarts + 1):
+                with get_executor(kind, jobs, scheduler) as pool:
+                    try:
+                        _run_on(pool, name, remaining, settings, record_one)
+                        break
+                    except BrokenExecutor:
+                        if attempt == max_restarts:
+                            raise
+                done_now = {r["trial_id"] for r in read_records(records_path)}
+                remaining = [t for t in remaining if t.id not in done_now]
     finally:
         bar.close()
     records = read_records(records_path)

@@ -1,0 +1,121 @@
+"""Scale-out: identical results on every executor, and faults that lose nothing."""
+
+import os
+import signal
+
+import psutil
+import pytest
+
+from qrrt_circuits.execution import get_executor
+from qrrt_circuits.experiments import read_records, run_experiment
+
+pytestmark = pytest.mark.xdist_group("dask")
+
+
+@pytest.fixture(scope="session")
+def dask_client(tmp_path_factory):
+    """One LocalCluster (2 single-threaded worker processes, no dashboard) for the whole run."""
+    from distributed import Client, LocalCluster
+
+    scratch = tmp_path_factory.mktemp("dask")
+    from qrrt_circuits.execution import NO_DASHBOARD
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address=NO_DASHBOARD, local_directory=str(scratch)) as cluster, \
+            Client(cluster) as client:
+        yield client
+
+
+def _records(directory, name):
+    rows = read_records(directory / name / "records.csv")
+    return sorted(({k: v for k, v in r.items() if not k.endswith("_s")} for r in rows),
+                  key=lambda r: r["trial_id"])
+
+
+def test_serial_process_and_dask_give_identical_results(dask_client, tmp_path):
+    name, trials = "heatmaps", 2
+    summaries = {
+        "serial": run_experiment(name, out=tmp_path / "serial", quick=True, trials=trials, progress=False),
+        "process": run_experiment(name, out=tmp_path / "process", quick=True, trials=trials, progress=False,
+                                  executor="process", jobs=2),
+        "dask": run_experiment(name, out=tmp_path / "dask", quick=True, trials=trials, progress=False,
+                               executor=dask_client.get_executor(retries=2, pure=False)),
+    }
+    reference = summaries["serial"]
+    for kind, summary in summaries.items():
+        assert summary["ours"] == reference["ours"], kind
+        assert _records(tmp_path / kind, name) == _records(tmp_path / "serial", name), kind
+
+
+def test_killed_dask_worker_is_rescheduled(dask_client, tmp_path):
+    pids = list(dask_client.run(os.getpid).values())
+    killed = []
+
+    def kill_one_worker(_record):
+        if not killed:
+            os.kill(pids[0], signal.SIGKILL)
+            killed.append(pids[0])
+
+    summary = run_experiment("oracle-efficiency", out=tmp_path / "dask", quick=True, trials=3, progress=False,
+                             executor=dask_client.get_executor(retries=2, pure=False), on_record=kill_one_worker)
+    assert killed and summary["complete"]
+    rows = read_records(tmp_path / "dask" / "oracle-efficiency" / "records.csv")
+    assert len(rows) == len({r["trial_id"] for r in rows}) == 12
+    serial = run_experiment("oracle-efficiency", out=tmp_path / "serial", quick=True, trials=3, progress=False)
+    assert summary["ours"] == serial["ours"]
+    dask_client.wait_for_workers(2, timeout=60)
+
+
+def test_killed_process_pool_worker_is_replaced(tmp_path):
+    before = {p.pid for p in psutil.Process().children(recursive=True)}
+    killed = []
+
+    def kill_one_worker(_record):
+        if not killed:
+            fresh = [p for p in psutil.Process().children(recursive=True) if p.pid not in before]
+            if fresh:
+                fresh[0].kill()
+                killed.append(fresh[0].pid)
+
+    summary = run_experiment("oracle-efficiency", out=tmp_path, quick=True, trials=3, progress=False,
+                             executor="process", jobs=2, on_record=kill_one_worker)
+    assert killed and summary["complete"]
+    rows = read_records(tmp_path / "oracle-efficiency" / "records.csv")
+    assert len(rows) == len({r["trial_id"] for r in rows}) == 12
+
+
+def _children():
+    """Child processes, except the standard library's resource tracker (it lives until exit)."""
+    out = set()
+    for process in psutil.Process().children(recursive=True):
+        try:
+            if not any("resource_tracker" in part for part in process.cmdline()):
+                out.add(process.pid)
+        except psutil.NoSuchProcess:
+            pass
+    return out
+
+
+def test_get_executor_cleans_up():
+    import tempfile
+
+    before = _children()
+    temp = set(os.listdir(tempfile.gettempdir()))
+    with get_executor("dask", jobs=1) as executor:
+        assert executor.submit(pow, 2, 5).result() == 32
+    with get_executor("process", jobs=1) as executor:
+        assert executor.submit(pow, 3, 2).result() == 9
+    psutil.wait_procs([psutil.Process(pid) for pid in _children() - before], timeout=20)
+    assert _children() <= before
+    leftovers = set(os.listdir(tempfile.gettempdir())) - temp
+    assert not leftovers, leftovers
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"executor": "gpu"}, "executor must be one of"),
+    ({"executor": "process", "jobs": 0}, "jobs must be an integer >= 1"),
+    ({"executor": "process", "scheduler": "tcp://127.0.0.1:8786"}, "scheduler is only used"),
+])
+def test_bad_executor_arguments(kwargs, message, tmp_path):
+    with pytest.raises(ValueError, match=message):
+        run_experiment("lemmas", out=tmp_path, quick=True, trials=20, progress=False, **kwargs)

@@ -1,0 +1,82 @@
+"""Execute the tutorial notebooks in notebooks/ and check they run cleanly and draw figures.
+
+Each notebook runs in a fresh kernel of the interpreter running the tests: the kernel spec
+manager is given no kernel directories, so "python3" resolves to ipykernel's built-in spec
+(``sys.executable -m ipykernel_launcher``) and never to a user- or system-level kernelspec that
+may point at another Python. A cell appended to the in-memory copy checks that.
+"""
+
+import os
+import sys
+from pathlib import Path
+
+import pytest
+
+nbformat = pytest.importorskip("nbformat")
+nbclient = pytest.importorskip("nbclient")
+pytest.importorskip("ipykernel")
+
+from jupyter_client.kernelspec import KernelSpecManager  # noqa: E402
+from jupyter_client.manager import AsyncKernelManager  # noqa: E402
+from traitlets import default  # noqa: E402
+
+NOTEBOOKS_DIR = Path(__file__).resolve().parent.parent / "notebooks"
+NOTEBOOKS = [
+    "01_grover_search_on_aer.ipynb",
+    "02_qrrt_planning.ipynb",
+    "03_parallel_workers_and_lemmas.ipynb",
+    "04_quantum_database_annealing.ipynb",
+]
+INTERPRETER_MARK = "kernel interpreter: "
+
+
+class ThisInterpreterKernelManager(AsyncKernelManager):
+    """Resolves "python3" to ipykernel's built-in spec, i.e. ``sys.executable``: no kernel
+    directories are searched. Passed as ``kernel_manager_class`` so that the NotebookClient owns
+    the manager and shuts the kernel down after the run."""
+
+    @default("kernel_spec_manager")
+    def _kernel_spec_manager_default(self) -> KernelSpecManager:
+        return KernelSpecManager(kernel_dirs=[])
+
+
+def test_notebook_list_is_complete():
+    assert sorted(p.name for p in NOTEBOOKS_DIR.glob("*.ipynb")) == sorted(NOTEBOOKS)
+
+
+def _stream_text(cell) -> str:
+    return "".join(out.get("text", "") for out in cell.get("outputs", []) if out.output_type == "stream")
+
+
+@pytest.mark.parametrize("name", NOTEBOOKS)
+def test_notebook_executes(name):
+    nb = nbformat.read(NOTEBOOKS_DIR / name, as_version=4)
+    assert all(not cell.get("outputs") for cell in nb.cells if cell.cell_type == "code"), (
+        f"{name} is stored with outputs; clear them before committing"
+    )
+    nb.cells.append(nbformat.v4.new_code_cell(f"import sys; print({INTERPRETER_MARK!r} + sys.executable)"))
+
+    client = nbclient.NotebookClient(
+        nb,
+        kernel_manager_class=ThisInterpreterKernelManager,
+        timeout=120,
+        kernel_name="python3",
+        resources={"metadata": {"path": str(NOTEBOOKS_DIR)}},
+    )
+    client.execute()  # raises CellExecutionError on the first failing cell
+
+    reported = _stream_text(nb.cells[-1]).strip()
+    assert reported.startswith(INTERPRETER_MARK), reported
+    kernel_python = reported.removeprefix(INTERPRETER_MARK)
+    assert os.path.realpath(kernel_python) == os.path.realpath(sys.executable)
+
+    errors = [out for cell in nb.cells for out in cell.get("outputs", []) if out.output_type == "error"]
+    assert not errors, errors
+    images = [
+        out
+        for cell in nb.cells
+        if cell.cell_type == "code"
+        for out in cell.get("outputs", [])
+        if "image/png" in out.get("data", {})
+    ]
+    assert images, f"{name} produced no image/png output"
