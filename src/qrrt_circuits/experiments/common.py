@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import json
 from pathlib import Path
 
@@ -45,8 +46,14 @@ def make_planner(kind: str, env, seed: int, backend: str = "aer", workers: int =
     raise ValueError(f"planner must be one of {PLANNER_KINDS}, got {kind!r}")
 
 
+@functools.lru_cache(maxsize=16)
+def _cached_world(name: str, seed: int, options: tuple):
+    return scenarios.SCENARIOS[name](seed=seed, **dict(options))
+
+
 def world(name: str, seed: int, **options):
-    return scenarios.SCENARIOS[name](seed=int(seed) % (2**31), **options)
+    """The scenario (cached per process: environments are immutable)."""
+    return _cached_world(name, int(seed) % (2**31), tuple(sorted(options.items())))
 
 
 def growth_curve(result) -> list[list[int]]:

@@ -43,7 +43,7 @@ class Heatmaps(Experiment):
                      "40": {"nodes": 526, "efficiency": 0.132}}}
 
     def settings(self, quick, trials, seed):
-        return {"trials": trials or (12 if quick else 100), "cuts": list(CUTS), "workers": 8,
+        return {"trials": trials or (50 if quick else 100), "cuts": list(CUTS), "workers": 8,
                 "num_qubits": 8, "backend": "aer", "schedule": "paper", "scenario": "paper_clutter",
                 "world_seed": 0, "seed": seed, "quick": quick}
 

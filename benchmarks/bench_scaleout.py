@@ -1,0 +1,62 @@
+"""Speed-up of ``qrrt reproduce EXPERIMENT --quick`` on 2 jobs over serial.
+
+    python benchmarks/bench_scaleout.py [--experiment heatmaps] [--repeats 3] [--jobs 2]
+
+Runs the real command line (a fresh ``--out`` each time, so nothing is resumed), end to end
+including interpreter start, cluster start and worker imports, and reports median wall seconds
+and the ratio serial / parallel measured in the same run. Writes JSON.
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from _common import machine, write_json
+
+
+def time_command(args: list[str]) -> float:
+    start = time.perf_counter()
+    subprocess.run(args, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return time.perf_counter() - start
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--experiment", default="heatmaps")
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--out", default=None)
+    args = parser.parse_args()
+    qrrt = str(Path(sys.executable).with_name("qrrt"))
+    rows = {}
+    for kind in ("serial", "process", "dask"):
+        times = []
+        for _ in range(args.repeats):
+            out = tempfile.mkdtemp(prefix="qrrt-bench-")
+            try:
+                command = [qrrt, "reproduce", args.experiment, "--quick", "--out", out, "--no-progress",
+                           "--executor", kind]
+                if kind != "serial":
+                    command += ["--jobs", str(args.jobs)]
+                times.append(time_command(command))
+            finally:
+                shutil.rmtree(out, ignore_errors=True)
+        rows[kind] = {"median_s": float(np.median(times)), "times_s": times}
+        print(f"  {kind:8s} median {np.median(times):6.2f} s  {[round(t, 2) for t in times]}")
+    speedup = {kind: rows["serial"]["median_s"] / rows[kind]["median_s"] for kind in ("process", "dask")}
+    print("speed-up over serial:", {k: round(v, 2) for k, v in speedup.items()})
+    path = write_json(f"bench_scaleout_{args.experiment}",
+                      {"machine": machine(), "experiment": args.experiment, "jobs": args.jobs,
+                       "repeats": args.repeats, "runs": rows, "speedup": speedup}, args.out)
+    print(f"wrote {path}")
+
+
+if __name__ == "__main__":
+    main()
