@@ -8,7 +8,7 @@ from qrrt_circuits.experiments import EXPERIMENTS, read_records, run_experiment
 from qrrt_circuits.experiments.fitting import linear_fit, power_law_exponent, slope_through_origin
 
 TINY = {"oracle-efficiency": 1, "wallclock": 1, "heatmaps": 2, "corridor": 2, "annealing": 1,
-        "lemmas": 60, "scaling": 1}
+        "lemmas": 60, "scaling": 1, "oracle-check": 1}
 
 
 def _is_png(path):

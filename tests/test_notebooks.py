@@ -3,22 +3,19 @@
 Each notebook runs in a fresh kernel of the interpreter running the tests: the kernel spec
 manager is given no kernel directories, so "python3" resolves to ipykernel's built-in spec
 (``sys.executable -m ipykernel_launcher``) and never to a user- or system-level kernelspec that
-may point at another Python. A cell appended to the in-memory copy checks that.
+may point at another Python. A cell appended to the in-memory copy checks that the kernel runs
+in this environment (same ``sys.prefix``, e.g. the project's .venv).
 """
 
-import os
 import sys
 from pathlib import Path
 
+import nbclient
+import nbformat
 import pytest
-
-nbformat = pytest.importorskip("nbformat")
-nbclient = pytest.importorskip("nbclient")
-pytest.importorskip("ipykernel")
-
-from jupyter_client.kernelspec import KernelSpecManager  # noqa: E402
-from jupyter_client.manager import AsyncKernelManager  # noqa: E402
-from traitlets import default  # noqa: E402
+from jupyter_client.kernelspec import KernelSpecManager
+from jupyter_client.manager import AsyncKernelManager
+from traitlets import default
 
 NOTEBOOKS_DIR = Path(__file__).resolve().parent.parent / "notebooks"
 NOTEBOOKS = [
@@ -54,7 +51,7 @@ def test_notebook_executes(name):
     assert all(not cell.get("outputs") for cell in nb.cells if cell.cell_type == "code"), (
         f"{name} is stored with outputs; clear them before committing"
     )
-    nb.cells.append(nbformat.v4.new_code_cell(f"import sys; print({INTERPRETER_MARK!r} + sys.executable)"))
+    nb.cells.append(nbformat.v4.new_code_cell(f"import sys; print({INTERPRETER_MARK!r} + sys.prefix)"))
 
     client = nbclient.NotebookClient(
         nb,
@@ -67,8 +64,7 @@ def test_notebook_executes(name):
 
     reported = _stream_text(nb.cells[-1]).strip()
     assert reported.startswith(INTERPRETER_MARK), reported
-    kernel_python = reported.removeprefix(INTERPRETER_MARK)
-    assert os.path.realpath(kernel_python) == os.path.realpath(sys.executable)
+    assert Path(reported.removeprefix(INTERPRETER_MARK)) == Path(sys.prefix), "kernel runs another Python"
 
     errors = [out for cell in nb.cells for out in cell.get("outputs", []) if out.output_type == "error"]
     assert not errors, errors

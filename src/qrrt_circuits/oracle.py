@@ -1,5 +1,8 @@
 """The reachability predicate (the oracle's truth) and the optional oracle error model (DESIGN §2).
 
+``check="time_samples"`` replaces the sound check by one that tests only evenly spaced time
+samples (like the output of the authors' ODE solver); it is unsound and exists to measure that.
+
 Candidate (c, p) is reachable iff the closed-loop trajectory x(t) = c + expm(M t)(p - c),
 t in [0, T], stays in the workspace and outside every obstacle. The check is conservative at a
 documented ``resolution`` (default 0.01 length units): any trajectory that touches an obstacle is
@@ -30,6 +33,8 @@ class ReachabilityOracle:
         env: Environment,
         dynamics: LinearTrackingDynamics | None = None,
         resolution: float = 0.01,
+        check: str = "exact",
+        time_samples: int = 50,
     ) -> None:
         dynamics = LinearTrackingDynamics.paper() if dynamics is None else dynamics
         if dynamics.dim != env.dim:
@@ -38,6 +43,12 @@ class ReachabilityOracle:
             )
         if not (np.isfinite(resolution) and resolution > 0):
             raise ValueError(f"resolution must be a finite number > 0, got {resolution}")
+        if check not in ("exact", "time_samples"):
+            raise ValueError(f"check must be 'exact' or 'time_samples', got {check!r}")
+        if int(time_samples) != time_samples or time_samples < 2:
+            raise ValueError(f"time_samples must be an integer >= 2, got {time_samples}")
+        self.check = check
+        self.time_samples = int(time_samples)
         self.env = env
         self.dynamics = dynamics
         self.resolution = float(resolution)
@@ -74,6 +85,9 @@ class ReachabilityOracle:
             )
         if not (np.all(np.isfinite(parents)) and np.all(np.isfinite(children))):
             raise ValueError("parents and children must be finite")
+        if self.check == "time_samples":
+            self.evaluations += int(parents.shape[0])
+            return self._time_sample_check(parents, children)
         out = np.zeros(parents.shape[0], dtype=np.bool_)
         index = self._index
         trajectories_free(
@@ -83,6 +97,17 @@ class ReachabilityOracle:
         )
         self.evaluations += int(parents.shape[0])
         return out
+
+
+    def _time_sample_check(self, parents: np.ndarray, children: np.ndarray) -> np.ndarray:
+        """Only x(t_j) at ``time_samples`` evenly spaced times in [0, T] are tested, as an ODE
+        solver's output would be: NOT a sound check (it steps over corners and thin obstacles).
+        Offered to study how much such a check accepts; see the oracle-check experiment."""
+        times = np.linspace(0.0, self.dynamics.horizon, self.time_samples)
+        phis = self.dynamics.propagators(times)  # (K, d, d)
+        points = children[:, None, :] + np.einsum("kij,mj->mki", phis, parents - children)
+        free = self.env.is_free(points.reshape(-1, self.env.dim)).reshape(points.shape[:2])
+        return free.all(axis=1) & self.env.is_free(children)
 
 
 @dataclass(frozen=True)

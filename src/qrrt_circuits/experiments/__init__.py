@@ -5,6 +5,7 @@ from .annealing import Annealing
 from .corridor import Corridor
 from .heatmaps import Heatmaps
 from .lemmas import Lemmas
+from .oracle_check import OracleCheck
 from .oracle_efficiency import OracleEfficiency
 from .runner import read_records, run_experiment
 from .scaling import Scaling
@@ -13,7 +14,7 @@ from .wallclock import Wallclock
 EXPERIMENTS = {
     experiment.name: experiment
     for experiment in (OracleEfficiency(), Wallclock(), Heatmaps(), Corridor(), Annealing(), Lemmas(),
-                       Scaling())
+                       Scaling(), OracleCheck())
 }
 
 __all__ = ["EXPERIMENTS", "read_records", "run_experiment"]

@@ -151,9 +151,16 @@ class Planner:
         goal_bias: float = 0.0,
         resolution: float = 0.01,
         seed: int | None = None,
+        oracle: ReachabilityOracle | None = None,
     ) -> None:
         if not isinstance(env, Environment):
             raise ValueError(f"env must be an Environment, got {type(env).__name__}")
+        if oracle is not None:
+            if not isinstance(oracle, ReachabilityOracle) or oracle.env is not env:
+                raise ValueError("oracle must be a ReachabilityOracle built on this planner's environment")
+            if dynamics is not None and dynamics is not oracle.dynamics:
+                raise ValueError("give dynamics= or oracle=, not both (the oracle carries its dynamics)")
+            dynamics = oracle.dynamics
         dynamics = LinearTrackingDynamics.paper() if dynamics is None else dynamics
         if dynamics.dim != env.dim:
             raise ValueError(
@@ -168,7 +175,7 @@ class Planner:
             raise ValueError(f"seed must be a non-negative integer or None, got {seed!r}")
         self.env = env
         self.dynamics = dynamics
-        self.oracle = ReachabilityOracle(env, dynamics, resolution=resolution)
+        self.oracle = oracle if oracle is not None else ReachabilityOracle(env, dynamics, resolution=resolution)
         self.oracle_errors = oracle_errors
         self.goal_bias = float(goal_bias)
         self.seed = seed
@@ -276,7 +283,7 @@ class Planner:
     # ----------------------------------------------------------------- reporting
     def settings(self) -> dict:
         return {"planner": self.name, "seed": self.seed, "goal_bias": self.goal_bias,
-                "resolution": self.oracle.resolution,
+                "resolution": self.oracle.resolution, "check": self.oracle.check,
                 "oracle_errors": None if self.oracle_errors is None else {
                     "false_positive": self.oracle_errors.false_positive,
                     "false_negative": self.oracle_errors.false_negative}}

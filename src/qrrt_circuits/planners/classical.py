@@ -14,7 +14,7 @@ from concurrent.futures import Executor
 
 from ..dynamics import LinearTrackingDynamics
 from ..environment import Environment
-from ..oracle import OracleErrorModel
+from ..oracle import OracleErrorModel, ReachabilityOracle
 from .base import Planner, RunState, _check_count
 from .workers import classical_extension
 
@@ -34,9 +34,10 @@ class ParallelRRT(Planner):
         resolution: float = 0.01,
         executor: Executor | None = None,
         seed: int | None = None,
+        oracle: ReachabilityOracle | None = None,
     ) -> None:
         self.workers = _check_count(workers, "workers")
-        super().__init__(env, dynamics, oracle_errors, goal_bias, resolution, seed)
+        super().__init__(env, dynamics, oracle_errors, goal_bias, resolution, seed, oracle)
         self.executor = executor
 
     def _round(self, state: RunState) -> None:
@@ -79,5 +80,6 @@ class RRT(ParallelRRT):
         goal_bias: float = 0.0,
         resolution: float = 0.01,
         seed: int | None = None,
+        oracle: ReachabilityOracle | None = None,
     ) -> None:
-        super().__init__(env, 1, dynamics, oracle_errors, goal_bias, resolution, None, seed)
+        super().__init__(env, 1, dynamics, oracle_errors, goal_bias, resolution, None, seed, oracle)

@@ -27,7 +27,7 @@ import numpy as np
 from ..database import AnnealingSchedule, Tree, build_database
 from ..dynamics import LinearTrackingDynamics
 from ..environment import Environment
-from ..oracle import OracleErrorModel
+from ..oracle import OracleErrorModel, ReachabilityOracle
 from ..probability import optimal_iterations
 from ..search.aer import AerBackend
 from ..search.backend import QuantumSearchBackend
@@ -62,6 +62,7 @@ class PQRRT(Planner):
         resolution: float = 0.01,
         executor: Executor | None = None,
         seed: int | None = None,
+        oracle: ReachabilityOracle | None = None,
     ) -> None:
         self.num_qubits = _check_count(num_qubits, "num_qubits")
         self.workers = _check_count(workers, "workers")
@@ -75,7 +76,7 @@ class PQRRT(Planner):
                              "FixedIterations(k), KnownOptimal(), BBHT(), Adaptive())")
         if annealing is not None and not isinstance(annealing, AnnealingSchedule):
             raise ValueError("annealing must be an AnnealingSchedule or None")
-        super().__init__(env, dynamics, oracle_errors, goal_bias, resolution, seed)
+        super().__init__(env, dynamics, oracle_errors, goal_bias, resolution, seed, oracle)
         self.backend = backend
         self.shared_database = bool(shared_database)
         self.iterations_policy = iterations
@@ -243,6 +244,7 @@ class QRRT(PQRRT):
         goal_bias: float = 0.0,
         resolution: float = 0.01,
         seed: int | None = None,
+        oracle: ReachabilityOracle | None = None,
     ) -> None:
         super().__init__(env, backend, num_qubits, 1, True, iterations, annealing, dynamics,
-                         oracle_errors, goal_bias, resolution, None, seed)
+                         oracle_errors, goal_bias, resolution, None, seed, oracle)
