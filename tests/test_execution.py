@@ -68,18 +68,24 @@ def test_killed_dask_worker_is_rescheduled(dask_client, tmp_path):
 
 def test_killed_process_pool_worker_is_replaced(tmp_path):
     before = {p.pid for p in psutil.Process().children(recursive=True)}
-    killed = []
+    killed, restarts = [], []
 
     def kill_one_worker(_record):
-        if not killed:
-            fresh = [p for p in psutil.Process().children(recursive=True) if p.pid not in before]
-            if fresh:
-                fresh[0].kill()
-                killed.append(fresh[0].pid)
+        if killed:
+            return
+        for process in psutil.Process().children(recursive=True):
+            try:
+                is_worker = any("spawn_main" in part for part in process.cmdline())
+            except psutil.NoSuchProcess:
+                continue
+            if process.pid not in before and is_worker:
+                process.kill()
+                killed.append(process.pid)
+                return
 
     summary = run_experiment("oracle-efficiency", out=tmp_path, quick=True, trials=3, progress=False,
-                             executor="process", jobs=2, on_record=kill_one_worker)
-    assert killed and summary["complete"]
+                             executor="process", jobs=2, on_record=kill_one_worker, on_restart=restarts.append)
+    assert killed and restarts == [1] and summary["complete"]
     rows = read_records(tmp_path / "oracle-efficiency" / "records.csv")
     assert len(rows) == len({r["trial_id"] for r in rows}) == 12
 

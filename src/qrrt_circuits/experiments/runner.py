@@ -123,6 +123,7 @@ def run_experiment(
     stop_after: int | None = None,
     on_record: Callable[[dict], None] | None = None,
     max_restarts: int = 3,
+    on_restart: Callable[[int], None] | None = None,
 ) -> dict:
     """Run (or resume) experiment ``name`` into ``out/name``; returns the summary.
 
@@ -194,6 +195,8 @@ def run_experiment(
                     except BrokenExecutor:
                         if attempt == max_restarts:
                             raise
+                        if on_restart:
+                            on_restart(attempt + 1)
                 done_now = {r["trial_id"] for r in read_records(records_path)}
                 remaining = [t for t in remaining if t.id not in done_now]
     finally:
