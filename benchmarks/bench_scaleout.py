@@ -1,6 +1,6 @@
 """Speed-up of ``qrrt reproduce EXPERIMENT --quick`` on 2 jobs over serial.
 
-    python benchmarks/bench_scaleout.py [--experiment heatmaps] [--repeats 3] [--jobs 2]
+    python benchmarks/bench_scaleout.py [--experiment heatmaps] [--repeats 3] [--jobs 2] [--full]
 
 Runs the real command line (a fresh ``--out`` each time, so nothing is resumed), end to end
 including interpreter start, cluster start and worker imports, and reports median wall seconds
@@ -32,6 +32,7 @@ def main() -> None:
     parser.add_argument("--experiment", default="heatmaps")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--full", action="store_true", help="the full settings instead of --quick")
     parser.add_argument("--out", default=None)
     args = parser.parse_args()
     qrrt = str(Path(sys.executable).with_name("qrrt"))
@@ -41,8 +42,9 @@ def main() -> None:
         for _ in range(args.repeats):
             out = tempfile.mkdtemp(prefix="qrrt-bench-")
             try:
-                command = [qrrt, "reproduce", args.experiment, "--quick", "--out", out, "--no-progress",
-                           "--executor", kind]
+                command = [qrrt, "reproduce", args.experiment, "--out", out, "--no-progress", "--executor", kind]
+                if not args.full:
+                    command.append("--quick")
                 if kind != "serial":
                     command += ["--jobs", str(args.jobs)]
                 times.append(time_command(command))
@@ -52,8 +54,8 @@ def main() -> None:
         print(f"  {kind:8s} median {np.median(times):6.2f} s  {[round(t, 2) for t in times]}")
     speedup = {kind: rows["serial"]["median_s"] / rows[kind]["median_s"] for kind in ("process", "dask")}
     print("speed-up over serial:", {k: round(v, 2) for k, v in speedup.items()})
-    path = write_json(f"bench_scaleout_{args.experiment}",
-                      {"machine": machine(), "experiment": args.experiment, "jobs": args.jobs,
+    path = write_json(f"bench_scaleout_{args.experiment}{'_full' if args.full else ''}",
+                      {"machine": machine(), "experiment": args.experiment, "jobs": args.jobs, "full": args.full,
                        "repeats": args.repeats, "runs": rows, "speedup": speedup}, args.out)
     print(f"wrote {path}")
 

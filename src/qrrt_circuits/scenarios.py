@@ -6,7 +6,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import ndimage
 
 from .environment import Environment
 
@@ -161,6 +160,8 @@ def lattice(seed: int | None = 0, size: int = 72, blocked_fraction: float = 0.5)
                 ix = end + 1
             else:
                 ix += 1
+    from scipy import ndimage  # only the lattice needs it (a slow import)
+
     labels, count = ndimage.label(~blocked)
     if count == 0:
         raise ValueError("the lattice has no free cell")
