@@ -23,3 +23,30 @@ def test_search_command_rejects_bad_input(capsys):
     assert "--marked must be in [0, 2**qubits = 16]" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         main(["search", "--shots", "0"])
+
+
+def test_plan_command_writes_json_and_plot(tmp_path, capsys):
+    import json
+
+    out_json, out_png = tmp_path / "r.json", tmp_path / "t.png"
+    assert main(["plan", "--planner", "qrrt", "--backend", "statevector", "--schedule", "adaptive",
+                 "--max-nodes", "15", "--seed", "2", "--json", str(out_json), "--plot", str(out_png)]) == 0
+    out = capsys.readouterr().out
+    assert "oracle_calls" in out and "classical lookup" in out
+    data = json.loads(out_json.read_text())
+    assert data["planner"] == "QRRT" and data["metrics"]["nodes"] == len(data["nodes"]) - 1
+    assert data["metrics"]["oracle_calls"] == data["metrics"]["quantum_oracle_calls"] + \
+        data["metrics"]["verification_calls"]
+    assert out_png.read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["plan", "--schedule", "fixed:abc"], "fixed:K needs an integer"),
+    (["plan", "--schedule", "magic"], "schedule must be one of"),
+    (["plan", "--planner", "qrrt", "--backend", "statevector", "--qubits", "40"], "num_qubits = 40 is outside"),
+])
+def test_plan_command_rejects_bad_input(argv, message, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    assert message in capsys.readouterr().err
