@@ -128,3 +128,23 @@ def test_sampler_backend_transpiles_once_per_shape():
     assert backend.transpile_count == 1
     backend.search(marks, 2, 10)
     assert backend.transpile_count == 2
+
+
+def test_sampler_backend_on_a_noisy_fake_backend():
+    """A fake device (GenericBackendV2: its basis, coupling map and noise) through BackendSamplerV2:
+    the circuit is transpiled to the device's basis and noise lowers, but does not erase, the
+    amplification."""
+    from qiskit.primitives import BackendSamplerV2
+    from qiskit.providers.fake_provider import GenericBackendV2
+    from qiskit_aer import AerSimulator
+
+    fake = GenericBackendV2(num_qubits=5, seed=3)
+    backend = qc.SamplerBackend(BackendSamplerV2(backend=AerSimulator.from_backend(fake, seed_simulator=5)),
+                                backend=fake)
+    marks = np.zeros(8, dtype=bool)
+    marks[[2, 5]] = True  # k = 1 is exact here: sin^2(3 theta) = 1
+    compiled = backend.compiled(marks, 1)
+    assert set(compiled.count_ops()) <= set(fake.operation_names) | {"measure", "barrier"}
+    shots = 2000
+    rate = marks[backend.search(marks, 1, shots=shots).indices].mean()
+    assert 0.25 + 10 * math.sqrt(0.25 * 0.75 / shots) < rate < 1.0
