@@ -27,14 +27,61 @@ def time_command(args: list[str]) -> float:
     return time.perf_counter() - start
 
 
+def warm_throughput(experiment: str, jobs: int, repeats: int) -> dict:
+    """Seconds for the experiment's last 50 quick trials (heatmaps: the Pq-RRT ones) on workers that
+    have already run 4 trials (imports, world, simulators warm); serial runs them in this process."""
+    from concurrent.futures import as_completed
+
+    from qrrt_circuits.execution import get_executor
+    from qrrt_circuits.experiments import EXPERIMENTS
+    from qrrt_circuits.experiments.runner import execute_trial
+
+    exp = EXPERIMENTS[experiment]
+    settings = exp.settings(True, None, 0)
+    trials = exp.trials(settings)
+    warm, timed = trials[:4], trials[-50:]
+    out = {}
+    for kind in ("serial", "process", "dask"):
+        times = []
+        with get_executor(kind, jobs if kind != "serial" else None) as pool:
+            for _ in range(repeats):
+                if pool is None:
+                    for trial in warm:
+                        execute_trial(experiment, trial, settings)
+                    start = time.perf_counter()
+                    for trial in timed:
+                        execute_trial(experiment, trial, settings)
+                else:
+                    for future in [pool.submit(execute_trial, experiment, t, settings) for t in warm]:
+                        future.result()
+                    start = time.perf_counter()
+                    for future in as_completed([pool.submit(execute_trial, experiment, t, settings) for t in timed]):
+                        future.result()
+                times.append(time.perf_counter() - start)
+        out[kind] = {"median_s": float(np.median(times)), "times_s": times}
+        print(f"  warm {kind:8s} median {np.median(times):6.2f} s")
+    return out
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--experiment", default="heatmaps")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--full", action="store_true", help="the full settings instead of --quick")
+    parser.add_argument("--warm", action="store_true",
+                        help="time the last 50 quick trials on already-warm workers instead of whole commands")
     parser.add_argument("--out", default=None)
     args = parser.parse_args()
+    if args.warm:
+        rows = warm_throughput(args.experiment, args.jobs, args.repeats)
+        speedup = {kind: rows["serial"]["median_s"] / rows[kind]["median_s"] for kind in ("process", "dask")}
+        print("speed-up over serial (warm):", {k: round(v, 2) for k, v in speedup.items()})
+        path = write_json(f"bench_scaleout_{args.experiment}_warm",
+                          {"machine": machine(), "experiment": args.experiment, "jobs": args.jobs, "warm": True,
+                           "repeats": args.repeats, "runs": rows, "speedup": speedup}, args.out)
+        print(f"wrote {path}")
+        return
     qrrt = str(Path(sys.executable).with_name("qrrt"))
     rows = {}
     for kind in ("serial", "process", "dask"):

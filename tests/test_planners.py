@@ -129,6 +129,18 @@ def test_executor_does_not_change_the_result(name, clutter):
     assert serial.metrics.oracle_calls == threaded.metrics.oracle_calls
 
 
+@pytest.mark.parametrize("name", ["ParallelRRT", "PQRRT-unshared"])
+def test_process_pool_executor_gives_the_serial_result(name, clutter):
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    serial = make(name, clutter, seed=6).plan(max_rounds=4)
+    with ProcessPoolExecutor(max_workers=2, mp_context=multiprocessing.get_context("spawn")) as pool:
+        parallel = make(name, clutter, seed=6, executor=pool).plan(max_rounds=4)
+    assert np.array_equal(serial.nodes, parallel.nodes)
+    assert serial.metrics.oracle_calls == parallel.metrics.oracle_calls
+
+
 def test_unreachable_goal_ends_with_budget_exhausted():
     # the goal is walled in: no plan can reach it
     boxes = np.array([[[14, 14], [18, 14.5]], [[14, 17.5], [18, 18]], [[14, 14], [14.5, 18]],

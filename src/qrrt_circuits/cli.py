@@ -91,12 +91,23 @@ def make_planner(args: argparse.Namespace, env):
                           shared_database=args.planner == "pqrrt", iterations=policy, **common)
 
 
+def _check_output_file(path: str | None, option: str) -> None:
+    from pathlib import Path
+
+    if path is not None and not Path(path).resolve().parent.is_dir():
+        raise ValueError(f"{option}: the folder of {path!r} does not exist")
+
+
 def cmd_plan(args: argparse.Namespace) -> int:
     import json
     from pathlib import Path
 
     from . import scenarios
 
+    _check_output_file(args.json, "--json")
+    _check_output_file(args.plot, "--plot")
+    if args.scenario_file and not Path(args.scenario_file).is_file():
+        raise ValueError(f"--scenario-file: no such file {args.scenario_file!r}")
     if args.scenario_file:
         from .environment import Environment
 
@@ -143,7 +154,12 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
     from .experiments import EXPERIMENTS, run_experiment
+
+    if Path(args.out).exists() and not Path(args.out).is_dir():
+        raise ValueError(f"--out: {args.out!r} exists and is not a folder")
 
     names = sorted(EXPERIMENTS) if args.experiment == "all" else [args.experiment]
     if args.experiment != "all" and args.experiment not in EXPERIMENTS:
@@ -165,7 +181,8 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="qrrt", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
-    search = sub.add_parser("search", help="Grover-search a random marked database")
+    formatter = argparse.ArgumentDefaultsHelpFormatter
+    search = sub.add_parser("search", help="Grover-search a random marked database", formatter_class=formatter)
     search.add_argument("--qubits", type=_positive_int, default=8)
     search.add_argument("--marked", type=_nonnegative_int, default=12)
     search.add_argument("--shots", type=_positive_int, default=2000)
@@ -176,15 +193,16 @@ def build_parser() -> argparse.ArgumentParser:
     search.add_argument("--top", type=_positive_int, default=10)
     search.set_defaults(func=cmd_search)
 
-    plan = sub.add_parser("plan", help="plan a path with one planner and print its metrics")
+    plan = sub.add_parser("plan", help="plan a path with one planner and print its metrics",
+                          formatter_class=formatter)
     plan.add_argument("--scenario", default="paper_clutter",
                       choices=["paper_clutter", "narrow_corridor", "annealing_field", "lattice"])
     plan.add_argument("--scenario-file", default=None, help="an environment JSON file instead")
     plan.add_argument("--scenario-seed", type=_nonnegative_int, default=0)
     plan.add_argument("--planner", choices=PLANNERS, default="pqrrt")
     plan.add_argument("--backend", choices=sorted(BACKENDS), default="aer")
-    plan.add_argument("--qubits", type=_positive_int, default=8)
-    plan.add_argument("--workers", type=_positive_int, default=8)
+    plan.add_argument("--qubits", type=_positive_int, default=8, help="database of 2^qubits (quantum planners)")
+    plan.add_argument("--workers", type=_positive_int, default=8, help="workers (prrt, pqrrt, pqrrt-unshared)")
     plan.add_argument("--schedule", default="paper",
                       help="paper | optimal | bbht | adaptive | fixed:K (default paper)")
     plan.add_argument("--goal-bias", type=float, default=0.0)
@@ -196,7 +214,8 @@ def build_parser() -> argparse.ArgumentParser:
     plan.add_argument("--json", default=None, help="write the result as JSON")
     plan.set_defaults(func=cmd_plan)
 
-    reproduce = sub.add_parser("reproduce", help="reproduce the paper's figures and tables")
+    reproduce = sub.add_parser("reproduce", help="reproduce the paper's figures and tables",
+                               formatter_class=formatter)
     reproduce.add_argument("experiment", help="an experiment name or 'all'")
     reproduce.add_argument("--quick", action="store_true", help="small settings (each < 2 min)")
     reproduce.add_argument("--trials", type=_positive_int, default=None, help="override the trial count")
@@ -219,6 +238,8 @@ def main(argv: list[str] | None = None) -> int:
         return args.func(args)
     except ValueError as exc:
         parser.exit(2, f"qrrt {args.command}: error: {exc}\n")
+    except OSError as exc:  # unreadable files, an unreachable Dask scheduler, a full disk
+        parser.exit(1, f"qrrt {args.command}: error: {type(exc).__name__}: {exc}\n")
 
 
 if __name__ == "__main__":

@@ -181,6 +181,12 @@ class Planner:
         self.seed = seed
         self._entropy = np.random.SeedSequence(seed).entropy
 
+    def __getstate__(self) -> dict:
+        """Planners travel to worker processes with their tasks; the executor stays behind."""
+        state = self.__dict__.copy()
+        state["executor"] = None
+        return state
+
     # ----------------------------------------------------------------- randomness
     def rng(self, round_index: int, worker: int = 0, stream: int = 0) -> np.random.Generator:
         """The generator of one (round, worker, purpose): independent of call order and executor."""
