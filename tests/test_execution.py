@@ -8,6 +8,7 @@ import pytest
 
 from qrrt_circuits.execution import get_executor
 from qrrt_circuits.experiments import read_records, run_experiment
+from qrrt_circuits.experiments.base import TIMING_SUFFIX
 
 pytestmark = pytest.mark.xdist_group("dask")
 
@@ -28,7 +29,7 @@ def dask_client(tmp_path_factory):
 
 def _records(directory, name):
     rows = read_records(directory / name / "records.csv")
-    return sorted(({k: v for k, v in r.items() if not k.endswith("_s")} for r in rows),
+    return sorted(({k: v for k, v in r.items() if not k.endswith(TIMING_SUFFIX)} for r in rows),
                   key=lambda r: r["trial_id"])
 
 

@@ -5,6 +5,7 @@ import pytest
 
 from qrrt_circuits.cli import main
 from qrrt_circuits.experiments import EXPERIMENTS, read_records, run_experiment
+from qrrt_circuits.experiments.base import TIMING_SUFFIX
 from qrrt_circuits.experiments.fitting import linear_fit, power_law_exponent, slope_through_origin
 
 TINY = {"oracle-efficiency": 1, "wallclock": 1, "heatmaps": 2, "corridor": 2, "annealing": 1,
@@ -33,7 +34,7 @@ def test_quick_path_writes_summary_records_and_figure(name, tmp_path):
 
 
 def _comparable(records):
-    return sorted(({k: v for k, v in r.items() if not k.endswith("_s")} for r in records),
+    return sorted(({k: v for k, v in r.items() if not k.endswith(TIMING_SUFFIX)} for r in records),
                   key=lambda r: r["trial_id"])
 
 

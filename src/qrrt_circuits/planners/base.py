@@ -141,7 +141,6 @@ class Planner:
     """Base planner: validates the problem, runs rounds until the goal or a budget, reports."""
 
     name = "planner"
-    quantum = False
 
     def __init__(
         self,

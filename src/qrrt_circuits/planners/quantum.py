@@ -45,7 +45,6 @@ class PQRRT(Planner):
     """Parallel q-RRT with ``workers`` quantum workers on a shared or unshared database."""
 
     name = "PQRRT"
-    quantum = True
 
     def __init__(
         self,

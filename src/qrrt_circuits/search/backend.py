@@ -76,11 +76,6 @@ class QuantumSearchBackend(abc.ABC):
 
     #: short name used in outputs and the CLI
     name: str = "backend"
-    #: a label for every output that depends on this backend's simulation shortcuts
-    shortcuts: tuple[str, ...] = (
-        "phase oracle built from a classical lookup of all 2^n entries (simulation_checks)",
-        "one circuit with p shots stands for p workers on a shared database",
-    )
 
     @property
     @abc.abstractmethod
