@@ -13,8 +13,8 @@ uses, so a policy object can be shared between planners and runs.
   terminates). Expected cost O(sqrt(N/m)).
 - ``Adaptive()``: a Bayesian estimate of the marked fraction f = m/N from the planner's own
   verified outcomes only: each measurement after k iterations succeeded with probability
-  sin^2((2k+1) asin(sqrt f)); a grid posterior over log f (with forgetting, since f drifts as the
-  tree grows) picks the k with the largest expected success per oracle call, (P(k) / (k + 1)).
+  sin^2((2k+1) asin(sqrt f)); a grid posterior over f (flat prior, with forgetting, since f drifts
+  as the tree grows) picks the k with the largest expected success per oracle call, P(k) / (k + 1).
 """
 
 from __future__ import annotations
@@ -165,10 +165,18 @@ class BBHTOutcome:
 
 @dataclass(frozen=True)
 class Adaptive(IterationPolicy):
-    """Chooses k from a posterior over the marked fraction built from verified outcomes only."""
+    """Chooses k from a posterior over the marked fraction built from verified outcomes only.
+
+    ``prior``: ``"uniform"`` (flat in f on [1/N, 1], the default) or ``"log-uniform"`` (flat in
+    log f). ``forgetting``: each new observation multiplies the old log-likelihood by this factor
+    (an effective memory of about 1 / (1 - forgetting) measurements, as f drifts with the tree).
+    The defaults (uniform, 0.9) were chosen on 20 paper_clutter worlds plus sparse (100 boxes) and
+    dense (1000 boxes) ones, against log-uniform and 0.97.
+    """
 
     grid_size: int = 200
-    forgetting: float = 0.97
+    forgetting: float = 0.9
+    prior: str = "uniform"
     max_iterations: int | None = None
     name = "adaptive"
 
@@ -177,6 +185,8 @@ class Adaptive(IterationPolicy):
             raise ValueError(f"grid_size must be an integer >= 10, got {self.grid_size}")
         if not (0.0 < self.forgetting <= 1.0):
             raise ValueError(f"forgetting must be in (0, 1], got {self.forgetting}")
+        if self.prior not in ("uniform", "log-uniform"):
+            raise ValueError(f"prior must be 'uniform' or 'log-uniform', got {self.prior!r}")
 
     def start(self, num_items: int) -> AdaptiveState:
         return AdaptiveState(self, num_items)
@@ -189,15 +199,22 @@ class AdaptiveState(PolicyState):
     def __init__(self, policy: Adaptive, num_items: int) -> None:
         super().__init__(policy, num_items)
         self.fractions = np.geomspace(1.0 / num_items, 1.0, policy.grid_size)
-        self.log_posterior = np.zeros(policy.grid_size)  # flat prior in log f
+        # the grid is geometric: weight f per point is a flat density in f, weight 1 flat in log f
+        self.log_prior = np.log(self.fractions) if policy.prior == "uniform" else np.zeros(policy.grid_size)
+        self.log_likelihood = np.zeros(policy.grid_size)
         top = policy.max_iterations or optimal_iterations(num_items, 1)
         self.candidates = np.arange(0, top + 1)
         theta = np.arcsin(np.sqrt(self.fractions))
         # success[k, f] = sin^2((2k+1) theta(f))
         self.success = np.sin(np.outer(2 * self.candidates + 1, theta)) ** 2
 
+    @property
+    def log_posterior(self) -> np.ndarray:
+        return self.log_prior + self.log_likelihood
+
     def iterations(self, tree_nodes: int, num_marked: int | None = None) -> int:
-        weights = np.exp(self.log_posterior - self.log_posterior.max())
+        log_posterior = self.log_posterior
+        weights = np.exp(log_posterior - log_posterior.max())
         weights /= weights.sum()
         expected = self.success @ weights
         return int(self.candidates[np.argmax(expected / (self.candidates + 1))])
@@ -205,12 +222,13 @@ class AdaptiveState(PolicyState):
     def observe(self, iterations: int, success: bool) -> None:
         theta = np.arcsin(np.sqrt(self.fractions))
         p = np.clip(np.sin((2 * iterations + 1) * theta) ** 2, 1e-9, 1 - 1e-9)
-        self.log_posterior *= self.policy.forgetting
-        self.log_posterior += np.log(p if success else 1 - p)
+        self.log_likelihood *= self.policy.forgetting
+        self.log_likelihood += np.log(p if success else 1 - p)
 
     def estimate(self) -> float:
         """Posterior mean of the marked fraction."""
-        weights = np.exp(self.log_posterior - self.log_posterior.max())
+        log_posterior = self.log_posterior
+        weights = np.exp(log_posterior - log_posterior.max())
         return float(np.sum(weights * self.fractions) / weights.sum())
 
 
