@@ -152,7 +152,7 @@ class Lemmas(Experiment):
                 lim = [min(theory.min(), observed.min()), max(theory.max(), observed.max())]
                 ax.plot(lim, lim, "k--", lw=0.8)
             stats = summary["ours"][lemma]
-            ax.set_title(f"{lemma.title().replace('a', 'a ', 0)}: {self.paper[lemma]}\n"
+            ax.set_title(f"Lemma {lemma[-1]}: {self.paper[lemma]}\n"
                          f"{stats['within_3_sigma']} within 3 sigma", fontsize=9)
             ax.set_xlabel("lemma")
             ax.set_ylabel("Aer shots")
