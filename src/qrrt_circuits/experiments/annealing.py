@@ -15,7 +15,7 @@ import numpy as np
 from ..database import AnnealingSchedule
 from ..plotting import plot_tree
 from ..search.schedules import FixedIterations
-from .base import Experiment, Trial, replicate_seed
+from .base import Experiment, paired_trials
 from .common import dumps, loads, make_planner, new_figure, rounded, save, world
 
 METHODS = ("QDA", "QRRT")
@@ -53,14 +53,7 @@ class Annealing(Experiment):
                 "backend": "aer", "scenario": "annealing_field", "seed": seed, "quick": quick}
 
     def trials(self, settings):
-        out = []
-        for replicate in range(settings["trials"]):
-            world_seed = replicate_seed(settings["seed"], replicate, 5)
-            for method in METHODS:
-                out.append(Trial(f"{method}-{replicate}", {"method": method, "replicate": replicate,
-                                                            "world_seed": world_seed},
-                                 replicate_seed(settings["seed"], replicate, 6)))
-        return out
+        return paired_trials(settings, [(method, {"method": method}) for method in METHODS], 5, 6)
 
     def run_trial(self, trial, settings):
         env = world(settings["scenario"], trial.params["world_seed"])

@@ -33,6 +33,21 @@ def replicate_seed(root_seed: int, replicate: int, stream: int = 0) -> int:
     return int(sequence.generate_state(1, dtype=np.uint32)[0])
 
 
+def paired_trials(settings: dict, variants: list[tuple[str, dict]], world_stream: int,
+                  seed_stream: int) -> list[Trial]:
+    """One world per replicate, shared by every variant (so variants are compared on the same
+    worlds): trial ``f"{label}-{replicate}"`` with ``params`` plus ``replicate`` and ``world_seed``;
+    all variants of a replicate share its seed too."""
+    trials = []
+    for replicate in range(settings["trials"]):
+        world_seed = replicate_seed(settings["seed"], replicate, world_stream)
+        seed = replicate_seed(settings["seed"], replicate, seed_stream)
+        for label, params in variants:
+            trials.append(Trial(f"{label}-{replicate}",
+                                {**params, "replicate": replicate, "world_seed": world_seed}, seed))
+    return trials
+
+
 class Experiment:
     """Base class; subclasses define the five methods below (and ``name``, ``title``)."""
 

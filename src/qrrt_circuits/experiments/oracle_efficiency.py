@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .base import Experiment, Trial, replicate_seed
+from .base import Experiment, paired_trials
 from .common import BACKEND_LABEL, dumps, growth_curve, loads, make_planner, new_figure, save, world
 from .fitting import linear_fit
 
@@ -32,14 +32,7 @@ class OracleEfficiency(Experiment):
                 "quick": quick}
 
     def trials(self, settings):
-        out = []
-        for replicate in range(settings["trials"]):
-            world_seed = replicate_seed(settings["seed"], replicate, 1)
-            for kind in PLANNERS:
-                out.append(Trial(f"{kind}-{replicate}", {"planner": kind, "replicate": replicate,
-                                                          "world_seed": world_seed},
-                                 replicate_seed(settings["seed"], replicate, 2)))
-        return out
+        return paired_trials(settings, [(kind, {"planner": kind}) for kind in PLANNERS], 1, 2)
 
     def run_trial(self, trial, settings):
         env = world(settings["scenario"], trial.params["world_seed"])

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .base import Experiment, Trial, replicate_seed
+from .base import Experiment, paired_trials
 from .common import make_planner, new_figure, save, world
 from .fitting import slope_through_origin
 
@@ -36,15 +36,8 @@ class Wallclock(Experiment):
                 "scenario": "paper_clutter", "seed": seed, "quick": quick}
 
     def trials(self, settings):
-        out = []
-        for replicate in range(settings["trials"]):
-            world_seed = replicate_seed(settings["seed"], replicate, 1)
-            for planner, backend in CONFIGS:
-                out.append(Trial(f"{label(planner, backend)}-{replicate}",
-                                 {"planner": planner, "backend": backend, "replicate": replicate,
-                                  "world_seed": world_seed},
-                                 replicate_seed(settings["seed"], replicate, 2)))
-        return out
+        variants = [(label(planner, backend), {"planner": planner, "backend": backend}) for planner, backend in CONFIGS]
+        return paired_trials(settings, variants, 1, 2)
 
     def run_trial(self, trial, settings):
         env = world(settings["scenario"], trial.params["world_seed"])
