@@ -5,23 +5,47 @@ Lathrop, Boardman and Martinez, "Parallel Quantum Rapidly-Exploring Random Trees
 2024), with Grover search as real Qiskit circuits on Aer or on an exact statevector.
 """
 
-from . import probability, scenarios
+from . import probability, registry, scenarios, termination
 from .database import AnnealingSchedule
 from .dynamics import LinearTrackingDynamics
 from .environment import Environment
-from .oracle import OracleErrorModel, ReachabilityOracle
+from .oracle import ReachabilityOracle
+from .oracle_errors import OracleErrorModel
 from .planners import PQRRT, QRRT, RRT, Metrics, ParallelRRT, PlanResult
+from .predicate import ReachabilityPredicate
 from .search import (
     AerBackend,
+    DatabaseSearch,
     QuantumSearchBackend,
     SamplerBackend,
+    SearchOutcome,
     SearchResult,
     StatevectorBackend,
     circuits,
 )
-from .search.schedules import BBHT, Adaptive, FixedIterations, KnownOptimal, PaperSchedule
+from .search.policies import (
+    BBHT,
+    Adaptive,
+    FixedIterations,
+    IterationPolicy,
+    KnownOptimal,
+    PaperSchedule,
+    SearchPolicy,
+)
+from .termination import (
+    AnyOf,
+    MaxCriticalPathCalls,
+    MaxNodes,
+    MaxOracleCalls,
+    MaxRounds,
+    MaxWallTime,
+    PlanStatus,
+    Stall,
+    TerminationCondition,
+)
+from .time_sampled import TimeSampledCheck
 
-__version__ = "0.1.0"
+__version__ = "0.2.0.dev0"
 
 __all__ = [
     "BBHT",
@@ -31,21 +55,38 @@ __all__ = [
     "Adaptive",
     "AerBackend",
     "AnnealingSchedule",
+    "AnyOf",
+    "DatabaseSearch",
+    "Environment",
     "FixedIterations",
+    "IterationPolicy",
     "KnownOptimal",
+    "LinearTrackingDynamics",
+    "MaxCriticalPathCalls",
+    "MaxNodes",
+    "MaxOracleCalls",
+    "MaxRounds",
+    "MaxWallTime",
     "Metrics",
+    "OracleErrorModel",
     "PaperSchedule",
     "ParallelRRT",
     "PlanResult",
-    "Environment",
-    "LinearTrackingDynamics",
-    "OracleErrorModel",
+    "PlanStatus",
     "QuantumSearchBackend",
     "ReachabilityOracle",
+    "ReachabilityPredicate",
     "SamplerBackend",
+    "SearchOutcome",
+    "SearchPolicy",
     "SearchResult",
+    "Stall",
     "StatevectorBackend",
+    "TerminationCondition",
+    "TimeSampledCheck",
     "circuits",
     "probability",
+    "registry",
     "scenarios",
+    "termination",
 ]

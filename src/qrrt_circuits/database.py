@@ -1,8 +1,7 @@
 """Candidate generation: the database of (sample, nearest parent) pairs (Alg. 1, lines 4-8) and
 Quantum Database Annealing (Alg. 4).
 
-``Tree`` stores the growing tree and answers nearest-node queries (a scipy KD-tree rebuilt as the
-tree doubles, plus brute force over the nodes added since). ``build_database`` draws 2^n samples,
+``build_database`` draws 2^n samples,
 uniform over the workspace (a fraction ``goal_bias`` uniform in the goal ball instead), and pairs
 each with its nearest tree node. With an ``AnnealingSchedule`` each candidate keeps the direction
 from its parent to the sample but is moved to a distance drawn uniformly in the current band
@@ -15,62 +14,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from .environment import Environment
-
-
-class Tree:
-    """Growable arrays of node positions and parent indices; node 0 is the root."""
-
-    def __init__(self, root: np.ndarray, capacity: int = 256) -> None:
-        root = np.asarray(root, dtype=float)
-        self.dim = root.shape[0]
-        self._nodes = np.empty((capacity, self.dim))
-        self._parents = np.empty(capacity, dtype=np.int64)
-        self._nodes[0] = root
-        self._parents[0] = -1
-        self.size = 1
-        self._kdtree: cKDTree | None = None
-        self._indexed = 0
-
-    @property
-    def nodes(self) -> np.ndarray:
-        return self._nodes[: self.size]
-
-    @property
-    def parents(self) -> np.ndarray:
-        return self._parents[: self.size]
-
-    def add(self, position: np.ndarray, parent: int) -> int:
-        if self.size == self._nodes.shape[0]:
-            self._nodes = np.concatenate([self._nodes, np.empty_like(self._nodes)])
-            self._parents = np.concatenate([self._parents, np.empty_like(self._parents)])
-        self._nodes[self.size] = position
-        self._parents[self.size] = parent
-        self.size += 1
-        return self.size - 1
-
-    def nearest(self, points: np.ndarray) -> np.ndarray:
-        """Index of the nearest node (Euclidean) to each of ``points`` (M, d)."""
-        points = np.atleast_2d(points)
-        if self.size >= 64 and self.size >= 2 * max(self._indexed, 32):
-            self._kdtree = cKDTree(self.nodes.copy())
-            self._indexed = self.size
-        if self._kdtree is None:
-            return _brute_nearest(points, self.nodes, 0)
-        dist, index = self._kdtree.query(points)
-        if self._indexed < self.size:
-            recent = _brute_nearest(points, self._nodes[self._indexed : self.size], self._indexed)
-            recent_dist = np.linalg.norm(points - self._nodes[recent], axis=1)
-            closer = recent_dist < dist
-            index = np.where(closer, recent, index)
-        return np.asarray(index, dtype=np.int64)
-
-
-def _brute_nearest(points: np.ndarray, nodes: np.ndarray, offset: int) -> np.ndarray:
-    squared = np.sum(points**2, axis=1)[:, None] - 2 * points @ nodes.T + np.sum(nodes**2, axis=1)
-    return np.argmin(squared, axis=1).astype(np.int64) + offset
+from .tree import Tree
+from .validation import check_choice, check_int
 
 
 @dataclass(frozen=True)
@@ -78,8 +25,8 @@ class AnnealingSchedule:
     """Quantum Database Annealing (Alg. 4): the temperature array H as distance bands.
 
     Band i = (r_min, r_max) is in force while ``switch_at[i-1] <= h < switch_at[i]``; the last band
-    stays in force. The index h counts databases built (``counter="databases"``, Alg. 4's h++ per
-    loop) or nodes in the tree (``counter="nodes"``). In Alg. 4 every database adds a node, so the
+    stays in force. The temperature index h (Alg. 4's ``h``) counts databases built
+    (``counter="databases"``, Alg. 4's h++ per loop) or nodes in the tree (``counter="nodes"``). In Alg. 4 every database adds a node, so the
     two coincide; with the classical verification a database can add none, and counting nodes
     keeps the hot phase for the tree's first ``switch_at[0]`` nodes.
     """
@@ -99,7 +46,7 @@ class AnnealingSchedule:
                 raise ValueError(f"bands[{i}] = ({lo}, {hi}): r_min must be <= r_max")
             if hi == 0:
                 raise ValueError(f"bands[{i}]: r_max must be > 0")
-        switch_at = tuple(int(s) for s in self.switch_at)
+        switch_at = tuple(check_int(s, f"switch_at[{i}]", 1) for i, s in enumerate(self.switch_at))
         if len(switch_at) != len(bands) - 1:
             raise ValueError(
                 f"switch_at must have len(bands) - 1 = {len(bands) - 1} entries, got {len(switch_at)}"
@@ -107,8 +54,7 @@ class AnnealingSchedule:
         steps = np.diff(np.asarray(switch_at, dtype=np.int64))
         if any(s <= 0 for s in switch_at) or np.any(steps <= 0):
             raise ValueError(f"switch_at must be strictly increasing positive integers, got {switch_at}")
-        if self.counter not in ("databases", "nodes"):
-            raise ValueError(f"counter must be 'databases' or 'nodes', got {self.counter!r}")
+        check_choice(self.counter, "counter", ("databases", "nodes"))
         object.__setattr__(self, "bands", bands)
         object.__setattr__(self, "switch_at", switch_at)
 
@@ -117,9 +63,17 @@ class AnnealingSchedule:
         """The paper's §V.D bands: [2.7, 4.2], then [0.8, 2.0] (the switch point is ours)."""
         return cls(bands=((2.7, 4.2), (0.8, 2.0)), switch_at=(switch_at,))
 
-    def band(self, h: int) -> tuple[float, float]:
-        """The band in force for the h-th database (h = 0, 1, ...)."""
-        index = int(np.searchsorted(np.asarray(self.switch_at), h, side="right"))
+    def temperature_index(self, databases: int, nodes: int) -> int:
+        """Alg. 4's h: databases built so far or nodes in the tree, per ``counter``."""
+        return nodes if self.counter == "nodes" else databases
+
+    def describe(self) -> dict:
+        return {"bands": [list(band) for band in self.bands], "switch_at": list(self.switch_at),
+                "counter": self.counter}
+
+    def band(self, temperature_index: int) -> tuple[float, float]:
+        """The band in force at temperature index h (h = 0, 1, ...)."""
+        index = int(np.searchsorted(np.asarray(self.switch_at), temperature_index, side="right"))
         return self.bands[index]
 
 
@@ -141,7 +95,7 @@ def build_database(
     goal_radius: float = 0.0,
     goal_bias: float = 0.0,
     annealing: AnnealingSchedule | None = None,
-    h: int = 0,
+    temperature_index: int = 0,
 ) -> Database:
     """Alg. 1 lines 4-8 (and Alg. 4 line 7 with ``annealing``)."""
     samples = env.sample_uniform(size, rng)
@@ -153,7 +107,7 @@ def build_database(
     parents = tree.nearest(samples)
     band = None
     if annealing is not None:
-        band = annealing.band(h)
+        band = annealing.band(temperature_index)
         origin = tree.nodes[parents]
         offset = samples - origin
         norm = np.linalg.norm(offset, axis=1)

@@ -68,6 +68,16 @@ class LinearTrackingDynamics:
     def dim(self) -> int:
         return int(self.A.shape[0])
 
+    def describe(self) -> dict:
+        """A, B, K and the horizon as plain lists (recorded in every plan's settings)."""
+        return {"A": self.A.tolist(), "B": self.B.tolist(), "K": self.K.tolist(), "horizon": self.horizon}
+
+    @classmethod
+    def from_description(cls, description: dict) -> LinearTrackingDynamics:
+        """The inverse of ``describe``."""
+        return cls(np.array(description["A"]), np.array(description["B"]), np.array(description["K"]),
+                   horizon=description["horizon"])
+
     @property
     def closed_loop(self) -> np.ndarray:
         """M = A - B K."""

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import math
 
-from .search.statevector import good_probability
 
 
 def _count(value, name: str, minimum: int = 0) -> int:
@@ -36,6 +35,15 @@ def _marked(num_items, num_marked) -> tuple[int, int]:
 def harmonic(k: int) -> float:
     """H_k = 1 + 1/2 + ... + 1/k (H_0 = 0)."""
     return math.fsum(1.0 / i for i in range(1, _count(k, "k") + 1))
+
+
+def good_probability(num_items: int, num_marked: int, iterations: int) -> float:
+    """sin^2((2k+1) theta) with sin^2 theta = m/N, unvalidated (Boyer et al. 1998, Eq. 1 of the
+    paper): the probability that one measurement after k Grover iterations is marked."""
+    if num_marked == 0:
+        return 0.0
+    theta = math.asin(math.sqrt(num_marked / num_items))
+    return math.sin((2 * iterations + 1) * theta) ** 2
 
 
 def success_probability(num_items: int, num_marked: int, iterations: int) -> float:

@@ -14,9 +14,15 @@ from concurrent.futures import Executor
 
 from ..dynamics import LinearTrackingDynamics
 from ..environment import Environment
-from ..oracle import OracleErrorModel, ReachabilityOracle
-from .base import Planner, RunState, _check_count
+from ..oracle_errors import OracleErrorModel
+from ..predicate import ReachabilityPredicate
+from ..validation import check_int
+from .base import Planner
+from .context import map_tasks
+from .run_state import RunState
 from .workers import classical_extension
+
+MAX_WORKERS = 4096
 
 
 class ParallelRRT(Planner):
@@ -27,26 +33,25 @@ class ParallelRRT(Planner):
     def __init__(
         self,
         env: Environment,
+        *,
         workers: int = 8,
+        predicate: ReachabilityPredicate | None = None,
         dynamics: LinearTrackingDynamics | None = None,
         oracle_errors: OracleErrorModel | None = None,
         goal_bias: float = 0.0,
         resolution: float = 0.01,
         executor: Executor | None = None,
         seed: int | None = None,
-        oracle: ReachabilityOracle | None = None,
+        oracle: ReachabilityPredicate | None = None,
     ) -> None:
-        self.workers = _check_count(workers, "workers")
-        super().__init__(env, dynamics, oracle_errors, goal_bias, resolution, seed, oracle)
-        self.executor = executor
+        self.workers = check_int(workers, "workers", 1, MAX_WORKERS)
+        super().__init__(env, predicate=predicate, dynamics=dynamics, oracle_errors=oracle_errors,
+                         goal_bias=goal_bias, resolution=resolution, seed=seed, oracle=oracle,
+                         executor=executor)
 
     def _round(self, state: RunState) -> None:
-        tree, r = state.tree, state.rounds
-        args = [(self, tree, state.goal, state.goal_radius, r, w) for w in range(self.workers)]
-        if self.executor is None:
-            outcomes = [classical_extension(*a) for a in args]
-        else:
-            outcomes = list(self.executor.map(classical_extension, *zip(*args, strict=True)))
+        outcomes = map_tasks(self.executor, classical_extension, self._context(), self._view(state),
+                             range(self.workers))
         longest = 1
         for outcome in outcomes:
             state.verification_calls += 1
@@ -75,11 +80,14 @@ class RRT(ParallelRRT):
     def __init__(
         self,
         env: Environment,
+        *,
+        predicate: ReachabilityPredicate | None = None,
         dynamics: LinearTrackingDynamics | None = None,
         oracle_errors: OracleErrorModel | None = None,
         goal_bias: float = 0.0,
         resolution: float = 0.01,
         seed: int | None = None,
-        oracle: ReachabilityOracle | None = None,
+        oracle: ReachabilityPredicate | None = None,
     ) -> None:
-        super().__init__(env, 1, dynamics, oracle_errors, goal_bias, resolution, None, seed, oracle)
+        super().__init__(env, workers=1, predicate=predicate, dynamics=dynamics, oracle_errors=oracle_errors,
+                         goal_bias=goal_bias, resolution=resolution, seed=seed, oracle=oracle)

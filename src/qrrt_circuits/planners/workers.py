@@ -1,6 +1,14 @@
 """Work one worker does in one round, as module-level functions so any executor (threads,
-processes, Dask) can run them. Every task carries its own seeds, so results never depend on which
-executor ran it or in what order."""
+processes, Dask) can run them. Each takes ``(WorkerContext, RoundView, task)`` and draws its
+randomness from the streams keyed by (round, worker), so results never depend on which executor
+ran it or in what order.
+
+- ``classical_extension``: one RRT step (Alg. 1 with a 1-entry database): sample, nearest node,
+  one reachability test.
+- ``search_database``: build one database of 2^n candidates, evaluate the predicate on all of them
+  to build the phase oracle (``simulation_checks``), and let the search policy run the workers that
+  share it (Alg. 1 lines 4-12; Alg. 2 for p workers).
+"""
 
 from __future__ import annotations
 
@@ -8,7 +16,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..database import Tree, build_database
+from ..database import build_database
+from ..randomness import Stream
+from ..search.problem import DatabaseSearch, SearchOutcome
+from .context import RoundView, WorkerContext
 
 
 @dataclass(frozen=True)
@@ -21,48 +32,49 @@ class ExtensionOutcome:
     truth: bool
 
 
-def classical_extension(planner, tree: Tree, goal, goal_radius, round_index: int, worker: int):
-    """Sample (with goal bias), nearest node, one reachability test (Alg. 1 with a 1-entry database)."""
-    rng = planner.rng(round_index, worker, 1)
-    db = build_database(tree, 1, planner.env, rng, goal, goal_radius, planner.goal_bias)
+def classical_extension(context: WorkerContext, view: RoundView, worker: int) -> ExtensionOutcome:
+    """Sample (with goal bias), nearest node, one reachability test."""
+    rng = context.streams.generator(view.round_index, worker, Stream.CANDIDATES)
+    db = build_database(view.tree, 1, context.env, rng, view.goal, view.goal_radius, context.goal_bias)
     child, parent = db.children[0], int(db.parents[0])
-    truth = bool(planner.oracle.reachable(tree.nodes[parent][None], child[None])[0])
+    truth = bool(context.predicate.reachable(view.tree.nodes[parent][None], child[None])[0])
     answer = truth
-    if planner.oracle_errors is not None:
-        answer = bool(planner.oracle_errors.apply(np.array([truth]), planner.rng(round_index, worker, 2))[0])
+    if context.oracle_errors is not None:
+        flips = context.streams.generator(view.round_index, worker, Stream.ORACLE_ERRORS)
+        answer = bool(context.oracle_errors.apply(np.array([truth]), flips)[0])
     return ExtensionOutcome(child, parent, answer, truth)
 
 
 @dataclass(frozen=True)
-class QuantumOutcome:
-    """One quantum worker on its own database (unshared Pq-RRT)."""
+class DatabaseOutcome:
+    """One database's statistics and, per worker that searched it, its outcome and the candidate
+    it found (child position and parent index) or None. Only found candidates travel back."""
 
-    child: np.ndarray | None
-    parent: int
-    verified: bool
-    iterations: int
-    quantum_calls: int
-    verifications: int
-    simulation_checks: int
+    entries: int
     reachable_entries: int
-    observations: tuple[tuple[int, bool], ...]
+    outcomes: tuple[SearchOutcome, ...]
+    found: tuple[tuple[np.ndarray, int] | None, ...]
 
 
-def unshared_worker(planner, tree: Tree, goal, goal_radius, round_index: int, worker: int,
-                    iterations: int | None, h: int) -> QuantumOutcome:
-    """Build a database, search it, measure one index and verify it (Alg. 2 run by one worker)."""
-    db, truth, marks = planner.make_database(tree, goal, goal_radius, round_index, worker, h)
-    index, spent, verifications, observations, used = planner.search_database(
-        marks, truth, round_index, worker, shots=1, iterations=iterations)[0]
-    verified = index is not None and bool(truth[index])
-    return QuantumOutcome(
-        child=None if index is None else db.children[index],
-        parent=-1 if index is None else int(db.parents[index]),
-        verified=verified,
-        iterations=used,
-        quantum_calls=spent,
-        verifications=verifications,
-        simulation_checks=truth.shape[0],
-        reachable_entries=int(np.count_nonzero(truth)),
-        observations=observations,
-    )
+def make_database(context: WorkerContext, view: RoundView, worker: int):
+    """Alg. 1 lines 4-8: the database, the true predicate on it, and the oracle's marks."""
+    rng = context.streams.generator(view.round_index, worker, Stream.CANDIDATES)
+    db = build_database(view.tree, context.database_size, context.env, rng, view.goal, view.goal_radius,
+                        context.goal_bias, context.annealing, view.temperature_index)
+    truth = context.predicate.reachable(view.tree.nodes[db.parents], db.children)
+    marks = truth
+    if context.oracle_errors is not None:
+        marks = context.oracle_errors.apply(
+            truth, context.streams.generator(view.round_index, worker, Stream.ORACLE_ERRORS))
+    return db, truth, marks
+
+
+def search_database(context: WorkerContext, view: RoundView, group: tuple[int, int]) -> DatabaseOutcome:
+    """Workers ``first, ..., first + count - 1`` search one database built by worker ``first``."""
+    first, count = group
+    db, truth, marks = make_database(context, view, first)
+    problem = DatabaseSearch(marks, truth, context.backend, context.streams, view.round_index, first)
+    outcomes = view.policy_state.run(problem, count, view.tree_nodes)
+    found = tuple(None if outcome.index is None else (db.children[outcome.index], int(db.parents[outcome.index]))
+                  for outcome in outcomes)
+    return DatabaseOutcome(int(truth.shape[0]), int(np.count_nonzero(truth)), outcomes, found)

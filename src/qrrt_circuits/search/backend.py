@@ -98,6 +98,13 @@ class QuantumSearchBackend(abc.ABC):
         indices = self._sample(marks, num_qubits, iterations, shots, rng)
         return SearchResult(indices, iterations, shots, iterations * shots)
 
+    def labels(self) -> tuple[str, ...]:
+        """Caveats every result that depends on this backend must carry (none by default)."""
+        return ()
+
+    def describe(self) -> str:
+        return self.name
+
     def check_qubits(self, num_qubits: int) -> None:
         if num_qubits < 1 or num_qubits > self.max_qubits:
             raise ValueError(

@@ -1,5 +1,11 @@
 """Grover search through any Qiskit ``BaseSamplerV2`` (a noisy fake backend, real hardware).
 
+Seeding: a ``BaseSamplerV2`` has no per-call seed. For qiskit-aer's ``SamplerV2`` built without a
+seed of its own, each search passes its seed as the simulator's ``seed_simulator`` run option, so a
+plan depends on the planner's seed only. Any other sampler (or an Aer sampler with a fixed seed,
+which then repeats the same draws on every call) seeds itself: ``labels()`` says so, and the
+planners copy that label into their results.
+
 The logical circuit is ``grover_circuit`` (built with ``grover_operator``). It is transpiled by one
 pass manager made once per backend object (``generate_preset_pass_manager``), and each transpiled
 circuit is cached by its shape (marks, iterations), so a repeated search transpiles nothing.
@@ -12,20 +18,21 @@ from collections import OrderedDict
 import numpy as np
 from qiskit.transpiler import generate_preset_pass_manager
 
-from .backend import QuantumSearchBackend
+from .backend import QuantumSearchBackend, seed_stream
 from .circuits import BASIS_GATES, SYNTHESES, grover_circuit
 
 
 class SamplerBackend(QuantumSearchBackend):
     """Wraps a ``BaseSamplerV2``; ``backend`` (a ``BackendV2``) sets the transpile target.
 
-    Seeding is the sampler's (e.g. ``qiskit_aer.primitives.SamplerV2(seed=...)``).
+    ``seed`` is the backend's own stream for direct ``search`` calls without a seed.
     """
 
     name = "sampler"
 
     def __init__(self, sampler, backend=None, optimization_level: int = 1,
-                 synthesis: str = "auto", cache_size: int = 128, max_qubits: int | None = None):
+                 synthesis: str = "auto", cache_size: int = 128, max_qubits: int | None = None,
+                 seed: int | np.random.Generator | None = None):
         if not hasattr(sampler, "run"):
             raise ValueError("sampler must be a qiskit BaseSamplerV2 (an object with .run(pubs, shots=...))")
         if synthesis not in SYNTHESES:
@@ -47,7 +54,8 @@ class SamplerBackend(QuantumSearchBackend):
         self._cache: OrderedDict[tuple, object] = OrderedDict()
         self._cache_size = int(cache_size)
         self.transpile_count = 0
-        self._rng = np.random.default_rng(0)  # unused: the sampler owns its randomness
+        self._rng = seed_stream(seed)
+        self.per_call_seed = _accepts_run_seed(sampler)
 
     @property
     def max_qubits(self) -> int:
@@ -66,10 +74,27 @@ class SamplerBackend(QuantumSearchBackend):
             self._cache.move_to_end(key)
         return circuit
 
+    def labels(self) -> tuple[str, ...]:
+        if self.per_call_seed:
+            return ()
+        return (f"randomness: the sampler ({type(self.sampler).__name__}) seeds itself, so results "
+                "depend on it and not only on the planner's seed",)
+
     def _sample(self, marks, num_qubits, iterations, shots, rng) -> np.ndarray:
-        # the sampler seeds itself; ``rng`` cannot reach it
         circuit = self.compiled(marks, iterations)
+        if self.per_call_seed:
+            self.sampler.options.run_options["seed_simulator"] = int(rng.integers(0, 2**31 - 1))
         result = self.sampler.run([circuit], shots=shots).result()[0]
         bitstrings = result.data.meas.get_bitstrings()
         return np.fromiter((int(bits, 2) for bits in bitstrings), dtype=np.int64,
                            count=len(bitstrings))
+
+
+def _accepts_run_seed(sampler) -> bool:
+    """True for qiskit-aer's SamplerV2 without a fixed seed: its ``seed_simulator`` run option
+    then seeds each run."""
+    try:
+        from qiskit_aer.primitives import SamplerV2 as AerSamplerV2
+    except ImportError:  # pragma: no cover - qiskit-aer is a core dependency
+        return False
+    return isinstance(sampler, AerSamplerV2) and sampler.seed is None

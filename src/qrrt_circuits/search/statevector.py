@@ -14,6 +14,7 @@ import os
 
 import numpy as np
 
+from ..probability import good_probability
 from .backend import QuantumSearchBackend, seed_stream, validate_iterations, validate_marks
 
 BYTES_PER_ENTRY = 32  # amplitudes (8) + probabilities (8) + index lists (8) + marks, with slack
@@ -24,14 +25,6 @@ def _memory_bytes() -> int:
         return int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
     except (ValueError, OSError, AttributeError):
         return 8 << 30
-
-
-def good_probability(num_items: int, num_marked: int, iterations: int) -> float:
-    """sin^2((2k+1) theta) with sin^2 theta = m/N."""
-    if num_marked == 0:
-        return 0.0
-    theta = math.asin(math.sqrt(num_marked / num_items))
-    return math.sin((2 * iterations + 1) * theta) ** 2
 
 
 class StatevectorBackend(QuantumSearchBackend):

@@ -1,0 +1,79 @@
+"""The reachability predicate: the one question every planner asks of the world (DESIGN §2, §7).
+
+A predicate answers, for a batch of (parent, child) pairs, whether the robot can move from each
+parent to its child without collision; it is what the paper's oracle evaluates. The protocol is
+OMPL's motion validator (``ompl::base::MotionValidator::checkMotion``), batched:
+
+- ``reachable(parents (M, d), children (M, d)) -> bool (M,)``;
+- ``dim``: the dimension d of the states;
+- ``name``: a short name recorded in every result;
+- ``describe() -> dict``: the settings that fix its answers (recorded in ``PlanResult.settings``);
+  a predicate that follows closed-loop dynamics puts them under the key ``"dynamics"``
+  (``LinearTrackingDynamics.describe()``), so figures draw edges along the motion actually used.
+
+Implementations here: ``ReachabilityOracle`` (sound, exact up to a resolution), ``TimeSampledCheck``
+(tests time samples only; unsound, for study) and, with the ``ompl`` extra,
+``qrrt_circuits.adapters.ompl.OMPLMotionPredicate``. Any object with these four members works:
+planners, experiments and plotting never ask which class it is.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+REQUIRED_MEMBERS = ("reachable", "dim", "name", "describe")
+
+
+@runtime_checkable
+class ReachabilityPredicate(Protocol):
+    """Batch motion validator (see the module docstring)."""
+
+    @property
+    def dim(self) -> int: ...
+
+    @property
+    def name(self) -> str: ...
+
+    def reachable(self, parents: np.ndarray, children: np.ndarray) -> np.ndarray: ...
+
+    def describe(self) -> dict: ...
+
+
+def check_predicate(predicate: object, dim: int, name: str = "predicate") -> ReachabilityPredicate:
+    """Return ``predicate`` if it implements the protocol in dimension ``dim``; else raise a
+    ``TypeError`` naming the missing members or a ``ValueError`` naming the dimension mismatch."""
+    missing = [member for member in REQUIRED_MEMBERS if not hasattr(predicate, member)]
+    if missing:
+        raise TypeError(
+            f"{name} must implement the ReachabilityPredicate protocol (reachable(parents, children), "
+            f"dim, name, describe()); {type(predicate).__name__} lacks {', '.join(missing)}")
+    if predicate.dim != dim:
+        raise ValueError(f"dimension mismatch: the {name} works in d = {predicate.dim}, the environment "
+                         f"has d = {dim}")
+    return predicate
+
+
+def as_pairs(parents: np.ndarray, children: np.ndarray, dim: int) -> tuple[np.ndarray, np.ndarray]:
+    """Validate and broadcast a batch of pairs to two C-contiguous float arrays of shape (M, d).
+
+    A single parent (shape (d,) or (1, d)) is broadcast against M children. Non-finite
+    coordinates are refused."""
+    parents = np.ascontiguousarray(parents, dtype=float)
+    children = np.ascontiguousarray(children, dtype=float)
+    if parents.ndim == 1:
+        parents = parents.reshape(1, -1)
+    if children.ndim == 1:
+        children = children.reshape(1, -1)
+    if parents.shape[-1] != dim or children.shape[-1] != dim or parents.ndim != 2 or children.ndim != 2:
+        raise ValueError(f"parents and children must have shape (M, {dim}), got {parents.shape} and "
+                         f"{children.shape}")
+    if parents.shape[0] != children.shape[0] and parents.shape[0] == 1:
+        parents = np.ascontiguousarray(np.broadcast_to(parents, children.shape))
+    if parents.shape != children.shape:
+        raise ValueError(f"parents and children must have the same shape, got {parents.shape} and "
+                         f"{children.shape}")
+    if not (np.all(np.isfinite(parents)) and np.all(np.isfinite(children))):
+        raise ValueError("parents and children must be finite")
+    return parents, children

@@ -1,0 +1,267 @@
+"""One registry of everything that is chosen by name: planners, backends, search policies,
+scenarios and reachability predicates.
+
+The CLI's choices and help text, the experiments, the benchmarks and the tests all build objects
+through these registries, so a name means the same thing everywhere. An unknown name is refused
+with the list of choices. Planner names are lower case (``rrt``, ``prrt``, ``qrrt``, ``pqrrt``,
+``pqrrt-unshared``); the class names used in 0.1's records (``RRT``, ``ParallelRRT``, ``QRRT``,
+``PQRRT``, ``PQRRT-unshared``) are aliases. A parametric entry is written ``name:VALUE``
+(``fixed:2``, ``time-samples:50``).
+"""
+
+from __future__ import annotations
+
+import functools
+import inspect
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from typing import Any
+
+
+@dataclass(frozen=True)
+class Entry:
+    """One named choice: ``factory(**options)`` builds it (``factory(value, **options)`` for a
+    parametric entry written ``name:VALUE``)."""
+
+    name: str
+    factory: Callable[..., Any]
+    help: str
+    aliases: tuple[str, ...] = ()
+    parameter: str | None = None  # e.g. "K" for "fixed:K"
+    tags: frozenset[str] = field(default_factory=frozenset)
+
+    @property
+    def label(self) -> str:
+        return self.name if self.parameter is None else f"{self.name}:{self.parameter}"
+
+    def options(self) -> frozenset[str]:
+        """The keyword options the factory accepts."""
+        target = self.factory
+        while isinstance(target, functools.partial):
+            target = target.func
+        parameters = inspect.signature(target).parameters.values()
+        return frozenset(p.name for p in parameters if p.kind in (p.KEYWORD_ONLY, p.POSITIONAL_OR_KEYWORD))
+
+
+class Registry:
+    """Named factories of one kind (``kind`` is used in error messages: "planner", ...)."""
+
+    def __init__(self, kind: str) -> None:
+        self.kind = kind
+        self._entries: dict[str, Entry] = {}
+        self._lookup: dict[str, str] = {}
+
+    def register(self, name: str, factory: Callable[..., Any], help: str, *, aliases: tuple[str, ...] = (),
+                 parameter: str | None = None, tags: tuple[str, ...] = ()) -> Entry:
+        entry = Entry(name, factory, help, tuple(aliases), parameter, frozenset(tags))
+        for key in (name, *aliases):
+            if key in self._lookup:
+                raise ValueError(f"{self.kind} name {key!r} is registered twice")
+            self._lookup[key] = name
+        self._entries[name] = entry
+        return entry
+
+    def names(self) -> tuple[str, ...]:
+        """Canonical names, in registration order."""
+        return tuple(self._entries)
+
+    def labels(self) -> tuple[str, ...]:
+        """Names as a user types them (``fixed:K`` for a parametric entry)."""
+        return tuple(entry.label for entry in self._entries.values())
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._entries)
+
+    def __contains__(self, name: object) -> bool:
+        try:
+            self.resolve(name)  # type: ignore[arg-type]
+        except (ValueError, TypeError):
+            return False
+        return True
+
+    def __len__(self) -> int:
+        return len(self._entries)
+
+    def _split(self, name: str) -> tuple[str, str | None]:
+        if not isinstance(name, str):
+            raise TypeError(f"{self.kind} must be a name (one of {', '.join(self.labels())}), got {name!r}")
+        base, _, value = name.partition(":")
+        return base, (value if _ else None)
+
+    def resolve(self, name: str) -> Entry:
+        """The entry for ``name`` (canonical, alias, or ``name:VALUE``); ValueError listing the
+        choices if there is none."""
+        base, value = self._split(name)
+        key = self._lookup.get(base)
+        entry = None if key is None else self._entries[key]
+        if entry is None or (entry.parameter is None) != (value is None):
+            raise ValueError(f"unknown {self.kind} {name!r}; choose one of {', '.join(self.labels())}")
+        return entry
+
+    def canonical(self, name: str) -> str:
+        """The canonical spelling of ``name`` (aliases resolved, a parameter kept)."""
+        entry = self.resolve(name)
+        _, value = self._split(name)
+        return entry.name if value is None else f"{entry.name}:{value}"
+
+    def create(self, name: str, /, **options: Any) -> Any:
+        """Build the object ``name`` stands for, with ``options``; an option the entry does not
+        take is refused (use ``applicable`` to keep only the ones that apply)."""
+        entry = self.resolve(name)
+        unknown = set(options) - entry.options()
+        if unknown:
+            raise ValueError(f"option(s) {sorted(unknown)} do not apply to {self.kind} {entry.name!r} "
+                             f"(it takes {sorted(entry.options())})")
+        _, value = self._split(name)
+        if entry.parameter is not None:
+            return entry.factory(value, **options)
+        return entry.factory(**options)
+
+    def applicable(self, name: str, options: dict[str, Any]) -> dict[str, Any]:
+        """The subset of ``options`` that ``name`` takes."""
+        accepted = self.resolve(name).options()
+        return {key: value for key, value in options.items() if key in accepted}
+
+    def help_text(self) -> str:
+        """``name: help`` for every entry (CLI help)."""
+        return "; ".join(f"{entry.label}: {entry.help}" for entry in self._entries.values())
+
+
+# ----------------------------------------------------------------------------------------- planners
+def _planners() -> Registry:
+    from .planners import PQRRT, QRRT, RRT, ParallelRRT
+
+    registry = Registry("planner")
+    registry.register("rrt", RRT, "classical RRT, 1 reachability test a round", aliases=("RRT",),
+                      tags=("classical",))
+    registry.register("prrt", ParallelRRT, "manager-worker parallel RRT (workers tests a round)",
+                      aliases=("ParallelRRT", "parallel-rrt"), tags=("classical", "parallel"))
+    registry.register("qrrt", QRRT, "q-RRT: Grover search of one database a round", aliases=("QRRT",),
+                      tags=("quantum",))
+    registry.register("pqrrt", functools.partial(PQRRT, shared_database=True),
+                      "Pq-RRT: workers measure one shared database", aliases=("PQRRT", "pqrrt-shared"),
+                      tags=("quantum", "parallel"))
+    registry.register("pqrrt-unshared", functools.partial(PQRRT, shared_database=False),
+                      "Pq-RRT: each worker builds and searches its own database",
+                      aliases=("PQRRT-unshared",), tags=("quantum", "parallel"))
+    return registry
+
+
+# ----------------------------------------------------------------------------------------- backends
+def _aer(seed=None, max_parallel_threads: int = 0, method: str = "statevector", noise_model=None,
+         device: str = "CPU"):
+    from .search import AerBackend
+
+    return AerBackend(seed=seed, method=method, noise_model=noise_model, device=device,
+                      max_parallel_threads=max_parallel_threads)
+
+
+def _statevector(seed=None, closed_form: bool = True):
+    from .search import StatevectorBackend
+
+    return StatevectorBackend(seed=seed, closed_form=closed_form)
+
+
+def _aer_sampler(seed=None):
+    from qiskit_aer.primitives import SamplerV2
+
+    from .search import SamplerBackend
+
+    return SamplerBackend(SamplerV2(), seed=seed)
+
+
+def _backends() -> Registry:
+    registry = Registry("backend")
+    registry.register("aer", _aer, "Grover circuits on qiskit-aer's AerSimulator (gate level)")
+    registry.register("statevector", _statevector, "exact statevector (ideal; same statistics as Aer)")
+    registry.register("sampler", _aer_sampler, "the grover_operator circuit, transpiled, through Aer's SamplerV2")
+    return registry
+
+
+# ----------------------------------------------------------------------------------------- policies
+def _fixed(value: str):
+    from .search.policies import FixedIterations
+
+    try:
+        k = int(value)
+    except ValueError:
+        raise ValueError(f"policy fixed:K needs an integer K >= 0, got 'fixed:{value}'") from None
+    return FixedIterations(k)
+
+
+def _policies() -> Registry:
+    from .search.policies import BBHT, Adaptive, KnownOptimal, PaperSchedule
+
+    registry = Registry("search policy")
+    registry.register("paper", PaperSchedule, "5 iterations, 3 after 10 nodes (the authors' code)")
+    registry.register("optimal", KnownOptimal, "optimal k for the true m (simulation knowledge)")
+    registry.register("bbht", BBHT, "Boyer-Brassard-Hoyer-Tapp for unknown m")
+    registry.register("adaptive", Adaptive, "k from a posterior over m/N learned from verified outcomes")
+    registry.register("fixed", _fixed, "always K iterations", parameter="K")
+    return registry
+
+
+# ----------------------------------------------------------------------------------------- scenarios
+def _scenarios() -> Registry:
+    from . import scenarios
+
+    registry = Registry("scenario")
+    registry.register("paper_clutter", scenarios.paper_clutter, "20 x 20, 525 boxes (paper Fig. 9-12)")
+    registry.register("narrow_corridor", scenarios.narrow_corridor, "a 0.4 x 4 channel (paper §V.C)")
+    registry.register("annealing_field", scenarios.annealing_field, "about 68 x 68, 6025 boxes (paper §V.D)")
+    registry.register("lattice", scenarios.lattice, "72 x 72 cells, half blocked (predecessor paper)")
+    return registry
+
+
+# ----------------------------------------------------------------------------------------- predicates
+def _exact(env, dynamics=None, resolution: float = 0.01):
+    from .oracle import ReachabilityOracle
+
+    return ReachabilityOracle(env, dynamics, resolution=resolution)
+
+
+def _time_samples(value: str, env, dynamics=None):
+    from .time_sampled import TimeSampledCheck
+
+    try:
+        count = int(value)
+    except ValueError:
+        raise ValueError(f"predicate time-samples:K needs an integer K >= 2, got 'time-samples:{value}'") from None
+    return TimeSampledCheck(env, dynamics, time_samples=count)
+
+
+def _predicates() -> Registry:
+    registry = Registry("predicate")
+    registry.register("exact", _exact, "sound check, exact up to the resolution (ours)")
+    registry.register("time-samples", _time_samples, "K evenly spaced time samples only (unsound; for study)",
+                      parameter="K")
+    return registry
+
+
+class _Lazy:
+    """A registry built on first use (the planners import the registry's users)."""
+
+    def __init__(self, build: Callable[[], Registry]) -> None:
+        self._build = build
+        self._registry: Registry | None = None
+
+    def __getattr__(self, name: str) -> Any:
+        if self._registry is None:
+            self._registry = self._build()
+        return getattr(self._registry, name)
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.__getattr__("names")())
+
+    def __contains__(self, name: object) -> bool:
+        return self.__getattr__("__contains__")(name)
+
+    def __len__(self) -> int:
+        return len(self.__getattr__("names")())
+
+
+PLANNERS: Registry = _Lazy(_planners)  # type: ignore[assignment]
+BACKENDS: Registry = _Lazy(_backends)  # type: ignore[assignment]
+POLICIES: Registry = _Lazy(_policies)  # type: ignore[assignment]
+SCENARIOS: Registry = _Lazy(_scenarios)  # type: ignore[assignment]
+PREDICATES: Registry = _Lazy(_predicates)  # type: ignore[assignment]

@@ -1,0 +1,50 @@
+"""A check of evenly spaced time samples only: NOT sound, offered to study what such a check does.
+
+``TimeSampledCheck`` tests x(t_j) at ``time_samples`` evenly spaced times in [0, T], as a naive
+reading of an ODE solver's output would: it steps over corners and thin obstacles between samples.
+It is the "points-only" variant the ``oracle-check`` experiment measures. (The authors' own
+``dynamicscheck.m`` also rasterizes the segments between its solver's outputs, which makes it
+nearly exact; see DESIGN §2.)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .dynamics import LinearTrackingDynamics
+from .environment import Environment
+from .predicate import as_pairs
+from .validation import check_int
+
+
+class TimeSampledCheck:
+    """Reachability predicate testing only ``time_samples`` evenly spaced samples of x(t)."""
+
+    name = "time-samples"
+
+    def __init__(self, env: Environment, dynamics: LinearTrackingDynamics | None = None, *,
+                 time_samples: int = 50) -> None:
+        dynamics = LinearTrackingDynamics.paper() if dynamics is None else dynamics
+        if dynamics.dim != env.dim:
+            raise ValueError(f"dynamics dimension {dynamics.dim} does not match the environment's d = {env.dim}")
+        self.env = env
+        self.dynamics = dynamics
+        self.time_samples = check_int(time_samples, "time_samples", 2, 1_000_000)
+        self.evaluations = 0
+        times = np.linspace(0.0, dynamics.horizon, self.time_samples)
+        self._phis = dynamics.propagators(times)  # (K, d, d)
+
+    @property
+    def dim(self) -> int:
+        return self.env.dim
+
+    def describe(self) -> dict:
+        return {"name": self.name, "time_samples": self.time_samples, "sound": False,
+                "dynamics": self.dynamics.describe()}
+
+    def reachable(self, parents: np.ndarray, children: np.ndarray) -> np.ndarray:
+        parents, children = as_pairs(parents, children, self.dim)
+        points = children[:, None, :] + np.einsum("kij,mj->mki", self._phis, parents - children)
+        free = self.env.is_free(points.reshape(-1, self.dim)).reshape(points.shape[:2])
+        self.evaluations += int(parents.shape[0])
+        return free.all(axis=1) & self.env.is_free(children)
