@@ -1,17 +1,21 @@
-"""The ``qrrt`` command line."""
+"""The ``qrrt`` command line: ``search``, ``plan`` and ``reproduce``.
+
+Every choice (planners, backends, search policies, scenarios, predicates) and its help text comes
+from ``qrrt_circuits.registry``, so the command line and the library mean the same thing by a name.
+"""
 
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import sys
+from pathlib import Path
 
 import numpy as np
 
 from . import probability
-from .search import AerBackend, StatevectorBackend
-
-BACKENDS = {"aer": AerBackend, "statevector": StatevectorBackend}
+from .registry import BACKENDS, PLANNERS, POLICIES, PREDICATES, SCENARIOS
 
 
 def _positive_int(text: str) -> int:
@@ -28,17 +32,23 @@ def _nonnegative_int(text: str) -> int:
     return value
 
 
-def make_backend(name: str, seed: int | None):
-    if name not in BACKENDS:
-        raise ValueError(f"--backend must be one of {sorted(BACKENDS)}, got {name!r}")
-    return BACKENDS[name](seed=seed)
+def _registered(registry):
+    """argparse type: a name the registry knows, canonicalised (aliases accepted)."""
+    def parse(text: str) -> str:
+        try:
+            return registry.canonical(text)
+        except (ValueError, TypeError) as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+    parse.__name__ = registry.kind
+    return parse
 
 
+# ----------------------------------------------------------------------------------------- search
 def cmd_search(args: argparse.Namespace) -> int:
     num_items = 1 << args.qubits
     if args.marked > num_items:
         raise ValueError(f"--marked must be in [0, 2**qubits = {num_items}], got {args.marked}")
-    backend = make_backend(args.backend, args.seed)
+    backend = BACKENDS.create(args.backend, seed=args.seed)
     backend.check_qubits(args.qubits)
     rng = np.random.default_rng(args.seed)
     marks = np.zeros(num_items, dtype=bool)
@@ -46,8 +56,13 @@ def cmd_search(args: argparse.Namespace) -> int:
     iterations = (probability.optimal_iterations(num_items, args.marked)
                   if args.iterations is None else args.iterations)
     result = backend.search(marks, iterations, shots=args.shots)
-    hits = marks[result.indices]
-    rate = float(hits.mean())
+    _print_search(args, marks, iterations, result)
+    return 0
+
+
+def _print_search(args: argparse.Namespace, marks: np.ndarray, iterations: int, result) -> None:
+    num_items = marks.shape[0]
+    rate = float(marks[result.indices].mean())
     theory = probability.success_probability(num_items, args.marked, iterations)
     sigma = math.sqrt(max(theory * (1 - theory), 1e-300) / args.shots)
     print(f"Grover search on {args.backend}: n = {args.qubits} qubits (N = {num_items}), "
@@ -68,60 +83,42 @@ def cmd_search(args: argparse.Namespace) -> int:
               f"{counts[j]:5d}  {'yes' if marks[index] else 'no'}")
     print("note: the phase oracle is built from a classical lookup of the marks "
           "(a simulation shortcut); m is known here")
-    return 0
 
 
-PLANNERS = ("rrt", "prrt", "qrrt", "pqrrt", "pqrrt-unshared")
-
-
-def make_planner(args: argparse.Namespace, env):
-    from . import planners
-    from .search.schedules import parse_policy
-
-    common = {"goal_bias": args.goal_bias, "seed": args.seed}
-    if args.planner == "rrt":
-        return planners.RRT(env, **common)
-    if args.planner == "prrt":
-        return planners.ParallelRRT(env, workers=args.workers, **common)
-    backend = make_backend(args.backend, args.seed)
-    policy = parse_policy(args.schedule)
-    if args.planner == "qrrt":
-        return planners.QRRT(env, backend=backend, num_qubits=args.qubits, iterations=policy, **common)
-    return planners.PQRRT(env, backend=backend, num_qubits=args.qubits, workers=args.workers,
-                          shared_database=args.planner == "pqrrt", iterations=policy, **common)
-
-
+# ----------------------------------------------------------------------------------------- plan
 def _check_output_file(path: str | None, option: str) -> None:
-    from pathlib import Path
-
     if path is not None and not Path(path).resolve().parent.is_dir():
         raise ValueError(f"{option}: the folder of {path!r} does not exist")
 
 
-def cmd_plan(args: argparse.Namespace) -> int:
-    import json
-    from pathlib import Path
-
-    from . import scenarios
-
-    _check_output_file(args.json, "--json")
-    _check_output_file(args.plot, "--plot")
-    if args.scenario_file and not Path(args.scenario_file).is_file():
-        raise ValueError(f"--scenario-file: no such file {args.scenario_file!r}")
+def _load_environment(args: argparse.Namespace):
     if args.scenario_file:
         from .environment import Environment
 
-        env = Environment.load(args.scenario_file)
-    else:
-        env = scenarios.by_name(args.scenario, seed=args.scenario_seed)
-    planner = make_planner(args, env)
-    result = planner.plan(max_nodes=args.max_nodes, max_oracle_calls=args.max_oracle_calls,
-                          max_rounds=args.max_rounds)
+        if not Path(args.scenario_file).is_file():
+            raise ValueError(f"--scenario-file: no such file {args.scenario_file!r}")
+        return Environment.load(args.scenario_file)
+    return SCENARIOS.create(args.scenario, seed=args.scenario_seed)
+
+
+def build_planner(args: argparse.Namespace, env):
+    """The planner the arguments name, with only the options that apply to it."""
+    options = {"goal_bias": args.goal_bias, "seed": args.seed, "workers": args.workers,
+               "num_qubits": args.qubits, "predicate": PREDICATES.create(args.predicate, env=env)}
+    if "quantum" in PLANNERS.resolve(args.planner).tags:
+        options["backend"] = BACKENDS.create(args.backend, seed=args.seed)
+        options["search_policy"] = POLICIES.create(args.policy)
+    return PLANNERS.create(args.planner, env=env, **PLANNERS.applicable(args.planner, options))
+
+
+def _print_plan(result, env, seed: int) -> None:
     metrics = result.metrics
-    print(f"{result.planner} on {env.name} (seed {args.seed}): {result.status}")
+    print(f"{result.planner} on {env.name} (seed {seed}): {result.status}")
     for key, value in result.settings.items():
-        if key in ("start", "goal", "budgets", "oracle_errors"):
+        if key in ("start", "goal", "termination", "oracle_errors", "dynamics"):
             continue
+        if isinstance(value, dict):  # the predicate: its settings without the dynamics matrices
+            value = ", ".join(f"{k}={v}" for k, v in value.items() if k != "dynamics")
         print(f"  {key:24s} {value}")
     print("metrics:")
     for key, value in metrics.as_dict().items():
@@ -134,6 +131,9 @@ def cmd_plan(args: argparse.Namespace) -> int:
         print(f"path: {len(result.path)} nodes")
     for label in result.labels:
         print(f"note: {label}")
+
+
+def _write_plan_outputs(args: argparse.Namespace, result, env) -> None:
     if args.json:
         Path(args.json).write_text(json.dumps(result.to_dict(), indent=1))
         print(f"wrote {args.json}")
@@ -150,20 +150,30 @@ def cmd_plan(args: argparse.Namespace) -> int:
         fig.savefig(args.plot, dpi=130, bbox_inches="tight")
         plt.close(fig)
         print(f"wrote {args.plot}")
+
+
+def cmd_plan(args: argparse.Namespace) -> int:
+    _check_output_file(args.json, "--json")
+    _check_output_file(args.plot, "--plot")
+    env = _load_environment(args)
+    planner = build_planner(args, env)
+    result = planner.plan(max_nodes=args.max_nodes, max_oracle_calls=args.max_oracle_calls,
+                          max_rounds=args.max_rounds, max_critical_path_calls=args.max_critical_path_calls,
+                          stall_rounds=args.stall_rounds)
+    _print_plan(result, env, args.seed)
+    _write_plan_outputs(args, result, env)
     return 0
 
 
+# ----------------------------------------------------------------------------------------- reproduce
 def cmd_reproduce(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
     from .experiments import EXPERIMENTS, run_experiment
 
     if Path(args.out).exists() and not Path(args.out).is_dir():
         raise ValueError(f"--out: {args.out!r} exists and is not a folder")
-
-    names = sorted(EXPERIMENTS) if args.experiment == "all" else [args.experiment]
     if args.experiment != "all" and args.experiment not in EXPERIMENTS:
         raise ValueError(f"EXPERIMENT must be one of {sorted(EXPERIMENTS)} or 'all', got {args.experiment!r}")
+    names = sorted(EXPERIMENTS) if args.experiment == "all" else [args.experiment]
     for name in names:
         summary = run_experiment(name, out=args.out, quick=args.quick, trials=args.trials, seed=args.seed,
                                  progress=not args.no_progress, executor=args.executor, jobs=args.jobs,
@@ -178,42 +188,55 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     return 0
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="qrrt", description=__doc__)
-    sub = parser.add_subparsers(dest="command", required=True)
-    formatter = argparse.ArgumentDefaultsHelpFormatter
+# ----------------------------------------------------------------------------------------- parser
+def _add_search_parser(sub, formatter) -> None:
     search = sub.add_parser("search", help="Grover-search a random marked database", formatter_class=formatter)
     search.add_argument("--qubits", type=_positive_int, default=8)
     search.add_argument("--marked", type=_nonnegative_int, default=12)
     search.add_argument("--shots", type=_positive_int, default=2000)
     search.add_argument("--iterations", type=_nonnegative_int, default=None,
                         help="Grover iterations (default: optimal for the known m)")
-    search.add_argument("--backend", choices=sorted(BACKENDS), default="aer")
+    search.add_argument("--backend", type=_registered(BACKENDS), choices=BACKENDS.names(), default="aer",
+                        help=BACKENDS.help_text())
     search.add_argument("--seed", type=_nonnegative_int, default=0)
     search.add_argument("--top", type=_positive_int, default=10)
     search.set_defaults(func=cmd_search)
 
+
+def _add_plan_parser(sub, formatter) -> None:
     plan = sub.add_parser("plan", help="plan a path with one planner and print its metrics",
                           formatter_class=formatter)
-    plan.add_argument("--scenario", default="paper_clutter",
-                      choices=["paper_clutter", "narrow_corridor", "annealing_field", "lattice"])
+    plan.add_argument("--scenario", type=_registered(SCENARIOS), choices=SCENARIOS.names(),
+                      default="paper_clutter", help=SCENARIOS.help_text())
     plan.add_argument("--scenario-file", default=None, help="an environment JSON file instead")
     plan.add_argument("--scenario-seed", type=_nonnegative_int, default=0)
-    plan.add_argument("--planner", choices=PLANNERS, default="pqrrt")
-    plan.add_argument("--backend", choices=sorted(BACKENDS), default="aer")
+    plan.add_argument("--planner", type=_registered(PLANNERS), choices=PLANNERS.names(), default="pqrrt",
+                      help=PLANNERS.help_text())
+    plan.add_argument("--backend", type=_registered(BACKENDS), choices=BACKENDS.names(), default="aer",
+                      help=f"(quantum planners) {BACKENDS.help_text()}")
     plan.add_argument("--qubits", type=_positive_int, default=8, help="database of 2^qubits (quantum planners)")
     plan.add_argument("--workers", type=_positive_int, default=8, help="workers (prrt, pqrrt, pqrrt-unshared)")
-    plan.add_argument("--schedule", default="paper",
-                      help="paper | optimal | bbht | adaptive | fixed:K (default paper)")
+    plan.add_argument("--policy", "--schedule", dest="policy", type=_registered(POLICIES), default="paper",
+                      metavar="|".join(POLICIES.labels()),
+                      help=f"search policy (quantum planners; --schedule is its old name): {POLICIES.help_text()}")
+    plan.add_argument("--predicate", type=_registered(PREDICATES), default="exact",
+                      metavar="|".join(PREDICATES.labels()), help=f"reachability check: {PREDICATES.help_text()}")
     plan.add_argument("--goal-bias", type=float, default=0.0)
     plan.add_argument("--seed", type=_nonnegative_int, default=0)
     plan.add_argument("--max-nodes", type=_positive_int, default=None)
     plan.add_argument("--max-oracle-calls", type=_positive_int, default=None)
-    plan.add_argument("--max-rounds", type=_positive_int, default=None)
+    plan.add_argument("--max-critical-path-calls", type=_positive_int, default=None,
+                      help="stop on the critical path (the time of p parallel devices)")
+    plan.add_argument("--max-rounds", type=_positive_int, default=None,
+                      help="round limit (default: 20000 rounds are always in force)")
+    plan.add_argument("--stall-rounds", type=_positive_int, default=None,
+                      help="stop after this many consecutive rounds without a new node")
     plan.add_argument("--plot", default=None, help="write a PNG of the tree")
     plan.add_argument("--json", default=None, help="write the result as JSON")
     plan.set_defaults(func=cmd_plan)
 
+
+def _add_reproduce_parser(sub, formatter) -> None:
     reproduce = sub.add_parser("reproduce", help="reproduce the paper's figures and tables",
                                formatter_class=formatter)
     reproduce.add_argument("experiment", help="an experiment name or 'all'")
@@ -228,6 +251,15 @@ def build_parser() -> argparse.ArgumentParser:
     reproduce.add_argument("--scheduler", default=None,
                            help="address of an existing Dask scheduler (with --executor dask)")
     reproduce.set_defaults(func=cmd_reproduce)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="qrrt", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    formatter = argparse.ArgumentDefaultsHelpFormatter
+    _add_search_parser(sub, formatter)
+    _add_plan_parser(sub, formatter)
+    _add_reproduce_parser(sub, formatter)
     return parser
 
 
@@ -236,7 +268,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         return args.func(args)
-    except ValueError as exc:
+    except (ValueError, TypeError) as exc:
         parser.exit(2, f"qrrt {args.command}: error: {exc}\n")
     except OSError as exc:  # unreadable files, an unreachable Dask scheduler, a full disk
         parser.exit(1, f"qrrt {args.command}: error: {type(exc).__name__}: {exc}\n")

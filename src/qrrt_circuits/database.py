@@ -26,9 +26,9 @@ class AnnealingSchedule:
 
     Band i = (r_min, r_max) is in force while ``switch_at[i-1] <= h < switch_at[i]``; the last band
     stays in force. The temperature index h (Alg. 4's ``h``) counts databases built
-    (``counter="databases"``, Alg. 4's h++ per loop) or nodes in the tree (``counter="nodes"``). In Alg. 4 every database adds a node, so the
-    two coincide; with the classical verification a database can add none, and counting nodes
-    keeps the hot phase for the tree's first ``switch_at[0]`` nodes.
+    (``counter="databases"``, Alg. 4's h++ per loop) or nodes in the tree (``counter="nodes"``).
+    In Alg. 4 every database adds a node, so the two coincide; with the classical verification a
+    database can add none, and counting nodes keeps the hot phase for the tree's first ``switch_at[0]`` nodes.
     """
 
     bands: tuple[tuple[float, float], ...]

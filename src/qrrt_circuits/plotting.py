@@ -37,29 +37,52 @@ def plot_environment(env: Environment, ax=None, color: str = "0.15"):
     return ax
 
 
-def edge_curves(nodes: np.ndarray, parents: np.ndarray, dynamics: LinearTrackingDynamics,
+def edge_curves(nodes: np.ndarray, parents: np.ndarray, dynamics: LinearTrackingDynamics | None,
                 samples: int = 24) -> np.ndarray:
-    """(E, samples, d) points along each edge's trajectory x(t) = c + expm(Mt)(p - c)."""
+    """(E, samples, d) points along each edge: the closed-loop trajectory
+    x(t) = c + expm(Mt)(p - c) of ``dynamics``, or the straight segment when ``dynamics`` is None
+    (a predicate without closed-loop dynamics)."""
     children = np.flatnonzero(parents >= 0)
     if children.size == 0:
         return np.zeros((0, samples, nodes.shape[1]))
+    errors = nodes[parents[children]] - nodes[children]  # (E, d)
+    if dynamics is None:
+        weights = np.linspace(1.0, 0.0, samples)
+        return nodes[children][:, None, :] + weights[None, :, None] * errors[:, None, :]
     times = np.concatenate([[0.0], np.geomspace(1e-3, dynamics.horizon, samples - 1)])
     phis = dynamics.propagators(times)  # (S, d, d)
-    errors = nodes[parents[children]] - nodes[children]  # (E, d)
     return nodes[children][:, None, :] + np.einsum("sij,ej->esi", phis, errors)
+
+
+def plan_dynamics(result) -> LinearTrackingDynamics | None:
+    """The dynamics a plan's predicate followed, from ``result.settings["dynamics"]`` (None: the
+    predicate describes none, and edges are drawn straight)."""
+    description = result.settings.get("dynamics")
+    return None if description is None else LinearTrackingDynamics.from_description(description)
+
+
+def plot_edges(env: Environment, nodes: np.ndarray, parents: np.ndarray,
+               dynamics: LinearTrackingDynamics | None, ax=None, edge_color: str = "tab:blue"):
+    """Obstacles, the tree's edges along their motion (see ``edge_curves``), nodes and the root."""
+    from matplotlib.collections import LineCollection
+
+    ax = plot_environment(env, ax)
+    curves = edge_curves(nodes, parents, dynamics)
+    ax.add_collection(LineCollection(curves[:, :, :2], colors=edge_color, linewidths=0.7, alpha=0.8))
+    ax.plot(nodes[1:, 0], nodes[1:, 1], ".", color=edge_color, ms=2.5)
+    ax.plot(*nodes[0, :2], "o", color="tab:green", ms=8, label="start")
+    return ax
 
 
 def plot_tree(env: Environment, result, ax=None, dynamics: LinearTrackingDynamics | None = None,
               edge_color: str = "tab:blue", path_color: str = "tab:red", title: str | None = None):
-    """Obstacles, tree edges along their trajectories, the path, the start and the goal ball."""
+    """Obstacles, tree edges along the motion the plan's predicate used (``dynamics`` overrides
+    what ``result.settings`` records), the path, the start and the goal ball."""
     from matplotlib.collections import LineCollection
     from matplotlib.patches import Circle
 
-    dynamics = LinearTrackingDynamics.paper() if dynamics is None else dynamics
-    ax = plot_environment(env, ax)
-    curves = edge_curves(result.nodes, result.parents, dynamics)
-    ax.add_collection(LineCollection(curves[:, :, :2], colors=edge_color, linewidths=0.7, alpha=0.8))
-    ax.plot(result.nodes[1:, 0], result.nodes[1:, 1], ".", color=edge_color, ms=2.5)
+    dynamics = plan_dynamics(result) if dynamics is None else dynamics
+    ax = plot_edges(env, result.nodes, result.parents, dynamics, ax, edge_color)
     if result.path is not None:
         index = [result.goal_node]
         while result.parents[index[-1]] >= 0:
@@ -69,12 +92,9 @@ def plot_tree(env: Environment, result, ax=None, dynamics: LinearTrackingDynamic
             path_parents[child] = parent
         path_curves = edge_curves(result.nodes, path_parents, dynamics)
         ax.add_collection(LineCollection(path_curves[:, :, :2], colors=path_color, linewidths=2.0))
-    settings = getattr(result, "settings", {})
-    start = result.nodes[0]
-    ax.plot(*start[:2], "o", color="tab:green", ms=8, label="start")
-    goal = settings.get("goal")
+    goal = result.settings.get("goal")
     if goal is not None:
-        ax.add_patch(Circle(goal[:2], settings.get("goal_radius", 0.75), fill=False,
+        ax.add_patch(Circle(goal[:2], result.settings.get("goal_radius", 0.75), fill=False,
                             color=path_color, lw=2, label="goal"))
     metrics = result.metrics
     ax.set_title(title or f"{result.planner}: {metrics.nodes} nodes, {metrics.oracle_calls} oracle "

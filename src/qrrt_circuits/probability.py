@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 
 
-
 def _count(value, name: str, minimum: int = 0) -> int:
     if isinstance(value, bool) or int(value) != value or value < minimum:
         raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")

@@ -13,33 +13,17 @@ from pathlib import Path
 import numpy as np
 
 from ..database import AnnealingSchedule
-from ..plotting import plot_tree
-from ..search.schedules import FixedIterations
-from .base import Experiment, paired_trials
-from .common import dumps, loads, make_planner, new_figure, rounded, save, world
+from ..dynamics import LinearTrackingDynamics
+from ..plotting import plot_edges
+from ..search.policies import FixedIterations
+from .base import Experiment, TrialStream, paired_trials
+from .figures import new_figure, save
+from .measures import dumps, loads, rounded
+from .planners import make_planner
+from .worlds import world
 
 METHODS = ("QDA", "QRRT")
 SIZES = (16, 48)
-
-
-class _TreeView:
-    """Just enough of a PlanResult for plot_tree."""
-
-    def __init__(self, nodes, parents, label, settings):
-        self.nodes = nodes
-        self.parents = parents
-        self.path = None
-        self.goal_node = None
-        self.planner = label
-        self.status = "grown"
-        self.settings = settings
-
-        class _M:
-            pass
-
-        self.metrics = _M()
-        self.metrics.nodes = len(nodes) - 1
-        self.metrics.oracle_calls = 0
 
 
 class Annealing(Experiment):
@@ -53,7 +37,8 @@ class Annealing(Experiment):
                 "backend": "aer", "scenario": "annealing_field", "seed": seed, "quick": quick}
 
     def trials(self, settings):
-        return paired_trials(settings, [(method, {"method": method}) for method in METHODS], 5, 6)
+        return paired_trials(settings, [(method, {"method": method}) for method in METHODS],
+                             TrialStream.ANNEALING_WORLDS, TrialStream.ANNEALING_PLANNERS)
 
     def run_trial(self, trial, settings):
         env = world(settings["scenario"], trial.params["world_seed"])
@@ -63,7 +48,7 @@ class Annealing(Experiment):
                                           switch_at=(settings["switch_at"],), counter="nodes")
         planner = make_planner("QRRT", env, trial.seed, settings["backend"],
                                num_qubits=settings["num_qubits"],
-                               iterations=FixedIterations(settings["iterations"]), annealing=annealing)
+                               search_policy=FixedIterations(settings["iterations"]), annealing=annealing)
         result = planner.plan(max_nodes=max(settings["sizes"]))
         distances = np.linalg.norm(result.nodes[1:] - result.nodes[result.parents[1:]], axis=1)
         record = {"nodes": result.metrics.nodes, "oracle_calls": result.metrics.oracle_calls,
@@ -96,9 +81,9 @@ class Annealing(Experiment):
             nodes = np.array(loads(first[method]["positions_json"]))
             parents = np.array(loads(first[method]["parents_json"]))
             for col, size in enumerate(sizes):
-                view = _TreeView(nodes[: size + 1], parents[: size + 1], method, {})
                 ax = axes[row, col]
-                plot_tree(env, view, ax=ax, title=f"{method}, {min(size, len(nodes) - 1)}-node tree")
+                plot_edges(env, nodes[: size + 1], parents[: size + 1], LinearTrackingDynamics.paper(), ax=ax)
+                ax.set_title(f"{method}, {min(size, len(nodes) - 1)}-node tree", fontsize=10)
                 span = np.ptp(nodes[: size + 1], axis=0).max() + 8
                 centre = nodes[0]
                 low = np.clip(centre - span / 2, env.bounds[:, 0], env.bounds[:, 1] - span)

@@ -10,12 +10,29 @@ the root seed and the trial's replicate index only, never on the order trials ru
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from enum import IntEnum
 from pathlib import Path
 
 import numpy as np
 
 #: record columns that measure time: excluded when records are compared across executors
 TIMING_SUFFIX = "_s"
+
+
+class TrialStream(IntEnum):
+    """The seed streams of the experiments' trials (``SeedSequence(root).spawn_key[0]``). They are
+    part of the reproducibility contract: changing one changes the published results."""
+
+    PAPER_WORLDS = 1  # oracle-efficiency and wallclock share their worlds ...
+    PAPER_PLANNERS = 2  # ... and their planner seeds
+    HEATMAPS = 3
+    CORRIDOR = 4
+    ANNEALING_WORLDS = 5
+    ANNEALING_PLANNERS = 6
+    LEMMAS = 7
+    SCALING_WORLDS = 8
+    SCALING_PLANNERS = 9
+    ORACLE_CHECK = 10
 
 
 @dataclass(frozen=True)

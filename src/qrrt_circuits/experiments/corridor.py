@@ -8,8 +8,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .base import Experiment, Trial, replicate_seed
-from .common import cut_at, dumps, loads, make_planner, new_figure, node_heatmap, rounded, save, world
+from .base import Experiment, Trial, TrialStream, replicate_seed
+from .figures import new_figure, node_heatmap, save
+from .measures import cut_at, dumps, loads, reachable_fraction, rounded
+from .planners import make_planner
+from .worlds import world
 
 PLANNERS = ("RRT", "QRRT")
 
@@ -30,7 +33,8 @@ class Corridor(Experiment):
                 "seed": seed, "quick": quick}
 
     def trials(self, settings):
-        return [Trial(f"{kind}-{i}", {"planner": kind, "replicate": i}, replicate_seed(settings["seed"], i, 4))
+        return [Trial(f"{kind}-{i}", {"planner": kind, "replicate": i},
+                      replicate_seed(settings["seed"], i, TrialStream.CORRIDOR))
                 for kind in PLANNERS for i in range(settings["trials"])]
 
     def run_trial(self, trial, settings):
@@ -41,8 +45,7 @@ class Corridor(Experiment):
         nodes, calls = cut_at(result, settings["budget"])
         positions = result.nodes[1 : nodes + 1]
         channel = env.metadata["channel"]
-        entries = int(result.history["entries"].sum())
-        return {"reachable_fraction": int(result.history["reachable"].sum()) / entries if entries else 0.0,
+        return {"reachable_fraction": reachable_fraction(result),
                 "nodes": nodes, "oracle_calls": calls,
                 "in_channel": int(in_channel(positions, channel).sum()),
                 "through_channel": int((positions[:, 0] > channel[1][0]).sum()),

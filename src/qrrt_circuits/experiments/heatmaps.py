@@ -3,10 +3,11 @@ cut at 10, 20 and 40 oracle calls; node-density heatmaps; total nodes placed and
 (nodes / oracle calls) at each cut.
 
 Pq-RRT's workers call the oracle simultaneously (one round costs 8 x (k + 1) calls), so it is cut
-on critical-path oracle calls, the time of 8 parallel devices, and labelled so.
+on critical-path oracle calls (``max_critical_path_calls``), the time of 8 parallel devices, and
+labelled so.
 
 Each trial runs once to 40 calls and the 10- and 20-call cuts are read from its round history:
-budgets are checked before each round, so a run stopped at 10 calls is exactly the prefix of the
+conditions are checked before each round, so a run stopped at 10 calls is exactly the prefix of the
 same run that ends after the first round reaching 10 calls.
 """
 
@@ -16,19 +17,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .base import Experiment, Trial, replicate_seed
-from .common import (
-    BACKEND_LABEL,
-    cut_at,
-    dumps,
-    loads,
-    make_planner,
-    new_figure,
-    node_heatmap,
-    rounded,
-    save,
-    world,
-)
+from .base import Experiment, Trial, TrialStream, replicate_seed
+from .figures import new_figure, node_heatmap, save
+from .measures import cut_at, dumps, loads, reachable_fraction, rounded
+from .planners import BACKEND_LABEL, make_planner
+from .worlds import world
 
 PLANNERS = ("RRT", "QRRT", "PQRRT")
 CUTS = (10, 20, 40)
@@ -48,7 +41,8 @@ class Heatmaps(Experiment):
                 "world_seed": 0, "seed": seed, "quick": quick}
 
     def trials(self, settings):
-        return [Trial(f"{kind}-{i}", {"planner": kind, "replicate": i}, replicate_seed(settings["seed"], i, 3))
+        return [Trial(f"{kind}-{i}", {"planner": kind, "replicate": i},
+                      replicate_seed(settings["seed"], i, TrialStream.HEATMAPS))
                 for kind in PLANNERS for i in range(settings["trials"])]
 
     def run_trial(self, trial, settings):
@@ -57,7 +51,7 @@ class Heatmaps(Experiment):
                                settings["workers"], settings["num_qubits"])
         critical = trial.params["planner"] == "PQRRT"
         if critical:
-            result = planner.plan(max_rounds=max(settings["cuts"]))  # critical path: k + 1 <= 6 a round
+            result = planner.plan(max_critical_path_calls=max(settings["cuts"]))
         else:
             result = planner.plan(max_oracle_calls=max(settings["cuts"]))
         record = {"cut_on": "critical_path" if critical else "oracle_calls"}
@@ -65,9 +59,8 @@ class Heatmaps(Experiment):
             nodes, calls = cut_at(result, cut, "critical_path" if critical else "oracle_calls")
             record[f"nodes_at_{cut}"] = nodes
             record[f"calls_at_{cut}"] = calls
-        entries = int(result.history["entries"].sum())
-        record["reachable_fraction"] = int(result.history["reachable"].sum()) / entries if entries else 0.0
-        record["status"] = result.status
+        record["reachable_fraction"] = reachable_fraction(result)
+        record["status"] = str(result.status)
         record["positions_json"] = dumps(rounded(result.nodes[1:]))
         return record
 

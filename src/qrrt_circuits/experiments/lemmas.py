@@ -19,8 +19,9 @@ import numpy as np
 
 from .. import probability as pr
 from ..oracle import OracleErrorModel
-from .base import Experiment, Trial, replicate_seed
-from .common import make_backend, new_figure, save
+from .base import Experiment, Trial, TrialStream, replicate_seed
+from .figures import new_figure, save
+from .planners import make_backend
 
 GRID_QUBITS = (4, 6)
 GRID_MARKED = (1, 2, 4, 8)
@@ -62,7 +63,7 @@ class Lemmas(Experiment):
     def trials(self, settings):
         return [Trial(f"n{n}-m{m}-p{p}-fp{fp}-fn{fn}", {"qubits": n, "marked": m, "workers": p,
                                                          "false_positive": fp, "false_negative": fn},
-                      replicate_seed(settings["seed"], i, 7))
+                      replicate_seed(settings["seed"], i, TrialStream.LEMMAS))
                 for i, (n, m, p, fp, fn) in enumerate(settings["grid"])]
 
     def run_trial(self, trial, settings):

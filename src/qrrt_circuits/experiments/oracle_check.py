@@ -14,17 +14,21 @@ from pathlib import Path
 import numpy as np
 
 from ..oracle import ReachabilityOracle
-from .base import Experiment, Trial, replicate_seed
-from .common import cut_at, make_planner, new_figure, save, world
+from ..registry import PREDICATES
+from .base import Experiment, Trial, TrialStream, replicate_seed
+from .figures import new_figure, save
+from .measures import cut_at, reachable_fraction
+from .planners import make_planner
+from .worlds import world
 
 PLANNERS = ("RRT", "QRRT")
 CHECKS = ("exact", "samples-200", "samples-50", "samples-20")
 
 
-def make_oracle(env, check: str) -> ReachabilityOracle:
-    if check == "exact":
-        return ReachabilityOracle(env)
-    return ReachabilityOracle(env, check="time_samples", time_samples=int(check.split("-")[1]))
+def make_predicate(env, check: str):
+    """``exact`` or ``samples-K`` (the registry's ``time-samples:K``)."""
+    name = "exact" if check == "exact" else f"time-samples:{check.split('-')[1]}"
+    return PREDICATES.create(name, env=env)
 
 
 class OracleCheck(Experiment):
@@ -39,22 +43,21 @@ class OracleCheck(Experiment):
 
     def trials(self, settings):
         return [Trial(f"{check}-{kind}-{i}", {"check": check, "planner": kind, "replicate": i},
-                      replicate_seed(settings["seed"], i, 10))
+                      replicate_seed(settings["seed"], i, TrialStream.ORACLE_CHECK))
                 for check in settings["checks"] for kind in PLANNERS for i in range(settings["trials"])]
 
     def run_trial(self, trial, settings):
         env = world(settings["scenario"], settings["world_seed"])
-        oracle = make_oracle(env, trial.params["check"])
+        predicate = make_predicate(env, trial.params["check"])
         planner = make_planner(trial.params["planner"], env, trial.seed, settings["backend"],
-                               num_qubits=settings["num_qubits"], oracle=oracle)
+                               num_qubits=settings["num_qubits"], predicate=predicate)
         result = planner.plan(max_oracle_calls=settings["budget"])
         nodes, calls = cut_at(result, settings["budget"])
         exact = ReachabilityOracle(env)
         children = np.arange(1, nodes + 1)
         valid = exact.reachable(result.nodes[result.parents[children]], result.nodes[children]) if nodes else []
-        entries = int(result.history["entries"].sum())
         return {"nodes": nodes, "oracle_calls": calls, "invalid_edges": int(nodes - np.sum(valid)),
-                "reachable_fraction": int(result.history["reachable"].sum()) / entries if entries else 0.0}
+                "reachable_fraction": reachable_fraction(result)}
 
     def summarize(self, records, settings):
         ours, invalid, fraction = {}, {}, {}

@@ -13,9 +13,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .base import Experiment, paired_trials
-from .common import BACKEND_LABEL, dumps, growth_curve, loads, make_planner, new_figure, save, world
+from .base import Experiment, TrialStream, paired_trials
+from .figures import new_figure, save
 from .fitting import linear_fit
+from .measures import dumps, growth_curve, loads
+from .planners import BACKEND_LABEL, make_planner
+from .worlds import world
 
 PLANNERS = ("RRT", "ParallelRRT", "QRRT", "PQRRT")
 COLORS = {"RRT": "tab:gray", "ParallelRRT": "tab:brown", "QRRT": "tab:blue", "PQRRT": "tab:orange"}
@@ -32,7 +35,8 @@ class OracleEfficiency(Experiment):
                 "quick": quick}
 
     def trials(self, settings):
-        return paired_trials(settings, [(kind, {"planner": kind}) for kind in PLANNERS], 1, 2)
+        return paired_trials(settings, [(kind, {"planner": kind}) for kind in PLANNERS],
+                             TrialStream.PAPER_WORLDS, TrialStream.PAPER_PLANNERS)
 
     def run_trial(self, trial, settings):
         env = world(settings["scenario"], trial.params["world_seed"])

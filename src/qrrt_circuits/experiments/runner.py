@@ -10,16 +10,18 @@ from all records at the end.
 
 from __future__ import annotations
 
-import csv
 import json
-import os
 from collections.abc import Callable
 from concurrent.futures import BrokenExecutor, Executor, as_completed
 from pathlib import Path
 
 from tqdm.auto import tqdm
 
+from ..validation import check_int, check_optional_int
 from .base import Trial
+from .records import RecordWriter, read_records
+
+__all__ = ["execute_trial", "read_records", "run_experiment"]
 
 RECORDS = "records.csv"
 SUMMARY = "summary.json"
@@ -36,70 +38,6 @@ def execute_trial(experiment_name: str, trial: Trial, settings: dict) -> dict:
     return record
 
 
-def _convert(value: str):
-    if value == "":
-        return None
-    for kind in (int, float):
-        try:
-            return kind(value)
-        except ValueError:
-            pass
-    if value in ("True", "False"):
-        return value == "True"
-    return value
-
-
-def read_records(path: Path) -> list[dict]:
-    """Rows of a records.csv (numbers converted). A torn last line (no newline: the writer was
-    killed mid-write) or a row of the wrong width is dropped and the file rewritten without it."""
-    if not path.exists():
-        return []
-    text = path.read_text()
-    lines = text.split("\n")
-    torn = bool(lines and lines[-1])  # text does not end with a newline
-    lines = lines[:-1]
-    rows = list(csv.reader(lines))
-    if not rows:
-        return []
-    header, body = rows[0], rows[1:]
-    good = [row for row in body if len(row) == len(header)]
-    if torn or len(good) != len(body):
-        _rewrite(path, header, good)
-    return [{key: _convert(value) for key, value in zip(header, row, strict=True)} for row in good]
-
-
-def _rewrite(path: Path, header: list[str], rows: list[list[str]]) -> None:
-    temporary = path.with_suffix(".tmp")
-    with temporary.open("w", newline="") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(header)
-        writer.writerows(rows)
-    os.replace(temporary, path)
-
-
-class RecordWriter:
-    """Appends records to records.csv, one flushed line per trial."""
-
-    def __init__(self, path: Path) -> None:
-        self.path = path
-        self.header: list[str] | None = None
-        if path.exists() and path.stat().st_size:
-            with path.open(newline="") as handle:
-                self.header = next(csv.reader(handle), None)
-
-    def write(self, record: dict) -> None:
-        if self.header is None:
-            self.header = list(record)
-            with self.path.open("w", newline="") as handle:
-                csv.writer(handle).writerow(self.header)
-        if set(record) != set(self.header):
-            raise ValueError(f"record columns {sorted(record)} differ from the file's {sorted(self.header)}")
-        with self.path.open("a", newline="") as handle:
-            csv.writer(handle).writerow(["" if record[key] is None else record[key] for key in self.header])
-            handle.flush()
-            os.fsync(handle.fileno())
-
-
 def _run_on(executor: Executor, name: str, trials: list[Trial], settings: dict, record_one) -> None:
     futures = [executor.submit(execute_trial, name, trial, settings) for trial in trials]
     try:
@@ -108,6 +46,83 @@ def _run_on(executor: Executor, name: str, trials: list[Trial], settings: dict, 
     finally:
         for future in futures:
             future.cancel()
+
+
+def _check_arguments(name: str, trials, seed, executor, jobs, scheduler) -> str | None:
+    """Refuse bad arguments before any work; returns the executor kind (None for an object)."""
+    from ..execution import check_executor_args
+    from . import EXPERIMENTS
+
+    if name not in EXPERIMENTS:
+        raise ValueError(f"unknown experiment {name!r}; choose one of {sorted(EXPERIMENTS)} or 'all'")
+    check_optional_int(trials, "trials", 1)
+    check_int(seed, "seed", 0)
+    if isinstance(executor, str) or executor is None:
+        kind = executor or "serial"
+        check_executor_args(kind, jobs, scheduler)
+        return kind
+    return None
+
+
+def _claim_directory(directory: Path, settings: dict) -> None:
+    """Create ``directory`` for ``settings``, or accept it if it holds results for the same settings."""
+    directory.mkdir(parents=True, exist_ok=True)
+    settings_path = directory / SETTINGS
+    if settings_path.exists():
+        stored = json.loads(settings_path.read_text())
+        if stored != settings:
+            raise ValueError(
+                f"{directory} holds results for other settings ({stored}); use another --out or "
+                "delete it")
+    else:
+        settings_path.write_text(json.dumps(settings, indent=1))
+
+
+def _execute(kind: str | None, executor, name: str, todo: list[Trial], settings: dict, record_one,
+             records_path: Path, jobs, scheduler, max_restarts: int, on_restart) -> None:
+    """Run ``todo`` serially, on a given executor, or on one built here (restarted if it breaks)."""
+    from ..execution import get_executor
+
+    if kind == "serial":
+        for trial in todo:
+            record_one(execute_trial(name, trial, settings))
+        return
+    if kind is None:
+        _run_on(executor, name, todo, settings, record_one)
+        return
+    remaining = list(todo)
+    for attempt in range(max_restarts + 1):
+        with get_executor(kind, jobs, scheduler) as pool:
+            try:
+                _run_on(pool, name, remaining, settings, record_one)
+                return
+            except BrokenExecutor:
+                if attempt == max_restarts:
+                    raise
+                if on_restart:
+                    on_restart(attempt + 1)
+        done_now = {r["trial_id"] for r in read_records(records_path)}
+        remaining = [t for t in remaining if t.id not in done_now]
+
+
+def _summarize(experiment, name: str, directory: Path, settings: dict, all_trials: list[Trial]) -> dict:
+    """summary.json and the figures from all records (or a partial summary if trials are missing)."""
+    ids = [trial.id for trial in all_trials]
+    order = {trial_id: index for index, trial_id in enumerate(ids)}
+    records = read_records(directory / RECORDS)
+    records = sorted((r for r in records if r["trial_id"] in order), key=lambda r: order[r["trial_id"]])
+    if len(records) < len(all_trials):
+        return {"experiment": name, "settings": settings, "complete": False,
+                "finished_trials": len(records), "total_trials": len(all_trials)}
+    result = experiment.summarize(records, settings)
+    summary = {"experiment": name, "title": experiment.title, "settings": settings,
+               "ours": result.pop("ours"), "paper": result.pop("paper"), **result,
+               "complete": True}
+    (directory / SUMMARY).write_text(json.dumps(summary, indent=1, default=float))
+    figures = experiment.plot(records, settings, summary, directory)
+    summary["figures"] = [str(path.name) for path in figures]
+    (directory / SUMMARY).write_text(json.dumps(summary, indent=1, default=float))
+    return summary
 
 
 def run_experiment(
@@ -134,37 +149,15 @@ def run_experiment(
     ``max_restarts`` times; Dask reschedules a dead worker's tasks itself. ``stop_after`` stops
     after that many new trials (for tests of resuming).
     """
-    from ..execution import check_executor_args, get_executor
     from . import EXPERIMENTS
 
-    if name not in EXPERIMENTS:
-        raise ValueError(f"unknown experiment {name!r}; choose one of {sorted(EXPERIMENTS)} or 'all'")
-    if trials is not None and (int(trials) != trials or trials < 1):
-        raise ValueError(f"trials must be an integer >= 1, got {trials}")
-    if int(seed) != seed or seed < 0:
-        raise ValueError(f"seed must be a non-negative integer, got {seed}")
-    if isinstance(executor, str) or executor is None:
-        kind = executor or "serial"
-        check_executor_args(kind, jobs, scheduler)
-    else:
-        kind = None
+    kind = _check_arguments(name, trials, seed, executor, jobs, scheduler)
     experiment = EXPERIMENTS[name]
-    settings = experiment.settings(quick, trials, int(seed))
-    settings = json.loads(json.dumps(settings))  # plain JSON types, as stored
+    settings = json.loads(json.dumps(experiment.settings(quick, trials, int(seed))))  # as stored
     directory = Path(out) / name
-    directory.mkdir(parents=True, exist_ok=True)
-    settings_path = directory / SETTINGS
-    if settings_path.exists():
-        stored = json.loads(settings_path.read_text())
-        if stored != settings:
-            raise ValueError(
-                f"{directory} holds results for other settings ({stored}); use another --out or "
-                "delete it")
-    else:
-        settings_path.write_text(json.dumps(settings, indent=1))
+    _claim_directory(directory, settings)
     all_trials = experiment.trials(settings)
-    ids = [trial.id for trial in all_trials]
-    if len(set(ids)) != len(ids):
+    if len({trial.id for trial in all_trials}) != len(all_trials):
         raise RuntimeError(f"experiment {name} produced duplicate trial ids")
     records_path = directory / RECORDS
     done = {record["trial_id"] for record in read_records(records_path)}
@@ -173,6 +166,7 @@ def run_experiment(
         todo = todo[:stop_after]
     writer = RecordWriter(records_path)
     bar = tqdm(total=len(all_trials), initial=len(done), desc=name, disable=not progress, unit="trial")
+
     def record_one(record: dict) -> None:
         writer.write(record)
         if on_record:
@@ -180,40 +174,8 @@ def run_experiment(
         bar.update()
 
     try:
-        if kind == "serial":
-            for trial in todo:
-                record_one(execute_trial(name, trial, settings))
-        elif kind is None:
-            _run_on(executor, name, todo, settings, record_one)
-        else:
-            remaining = list(todo)
-            for attempt in range(max_restarts + 1):
-                with get_executor(kind, jobs, scheduler) as pool:
-                    try:
-                        _run_on(pool, name, remaining, settings, record_one)
-                        break
-                    except BrokenExecutor:
-                        if attempt == max_restarts:
-                            raise
-                        if on_restart:
-                            on_restart(attempt + 1)
-                done_now = {r["trial_id"] for r in read_records(records_path)}
-                remaining = [t for t in remaining if t.id not in done_now]
+        _execute(kind, executor, name, todo, settings, record_one, records_path, jobs, scheduler,
+                 max_restarts, on_restart)
     finally:
         bar.close()
-    records = read_records(records_path)
-    order = {trial_id: index for index, trial_id in enumerate(ids)}
-    records = sorted((r for r in records if r["trial_id"] in order), key=lambda r: order[r["trial_id"]])
-    if len(records) < len(all_trials):
-        summary = {"experiment": name, "settings": settings, "complete": False,
-                   "finished_trials": len(records), "total_trials": len(all_trials)}
-        return summary
-    result = experiment.summarize(records, settings)
-    summary = {"experiment": name, "title": experiment.title, "settings": settings,
-               "ours": result.pop("ours"), "paper": result.pop("paper"), **result,
-               "complete": True}
-    (directory / SUMMARY).write_text(json.dumps(summary, indent=1, default=float))
-    figures = experiment.plot(records, settings, summary, directory)
-    summary["figures"] = [str(path.name) for path in figures]
-    (directory / SUMMARY).write_text(json.dumps(summary, indent=1, default=float))
-    return summary
+    return _summarize(experiment, name, directory, settings, all_trials)

@@ -13,10 +13,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..search.schedules import BBHT, Adaptive, KnownOptimal
-from .base import Experiment, Trial, replicate_seed
-from .common import BACKEND_LABEL, make_planner, new_figure, save, world
+from ..search.policies import BBHT, Adaptive, KnownOptimal
+from .base import Experiment, Trial, TrialStream, replicate_seed
+from .figures import new_figure, save
 from .fitting import power_law_exponent
+from .measures import reachable_fraction
+from .planners import BACKEND_LABEL, make_planner
+from .worlds import world
 
 CONFIGS = {"RRT": None, "QRRT optimal": KnownOptimal, "QRRT bbht": BBHT, "QRRT adaptive": Adaptive}
 DENSITIES = (100, 250, 400, 550, 700, 850, 1000)
@@ -36,12 +39,13 @@ class Scaling(Experiment):
         out = []
         for density in settings["densities"]:
             for replicate in range(settings["trials"]):
-                world_seed = replicate_seed(settings["seed"], replicate * 1000 + density, 8)
+                world_seed = replicate_seed(settings["seed"], replicate * 1000 + density, TrialStream.SCALING_WORLDS)
                 for name in CONFIGS:
                     out.append(Trial(f"{name}-{density}-{replicate}",
                                      {"config": name, "boxes": density, "replicate": replicate,
                                       "world_seed": world_seed},
-                                     replicate_seed(settings["seed"], replicate * 1000 + density, 9)))
+                                     replicate_seed(settings["seed"], replicate * 1000 + density,
+                                                    TrialStream.SCALING_PLANNERS)))
         return out
 
     def run_trial(self, trial, settings):
@@ -51,14 +55,12 @@ class Scaling(Experiment):
             planner = make_planner("RRT", env, trial.seed)
         else:
             planner = make_planner("QRRT", env, trial.seed, settings["backend"],
-                                   num_qubits=settings["num_qubits"], iterations=CONFIGS[name]())
+                                   num_qubits=settings["num_qubits"], search_policy=CONFIGS[name]())
         result = planner.plan(max_nodes=settings["nodes"])
-        entries = int(result.history["entries"].sum())
-        reachable = int(result.history["reachable"].sum())
         m = result.metrics
         return {"nodes": m.nodes, "oracle_calls": m.oracle_calls,
                 "calls_per_node": m.oracle_calls / max(m.nodes, 1),
-                "reachable_fraction": reachable / entries if entries else 0.0}
+                "reachable_fraction": reachable_fraction(result)}
 
     def summarize(self, records, settings):
         ours, fits = {}, {}

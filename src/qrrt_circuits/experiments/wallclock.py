@@ -13,9 +13,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .base import Experiment, paired_trials
-from .common import make_planner, new_figure, save, world
+from .base import Experiment, TrialStream, paired_trials
+from .figures import new_figure, save
 from .fitting import slope_through_origin
+from .planners import make_planner
+from .worlds import world
 
 CONFIGS = (("RRT", "none"), ("ParallelRRT", "none"), ("QRRT", "aer"), ("QRRT", "statevector"),
            ("PQRRT", "aer"), ("PQRRT", "statevector"))
@@ -37,7 +39,7 @@ class Wallclock(Experiment):
 
     def trials(self, settings):
         variants = [(label(planner, backend), {"planner": planner, "backend": backend}) for planner, backend in CONFIGS]
-        return paired_trials(settings, variants, 1, 2)
+        return paired_trials(settings, variants, TrialStream.PAPER_WORLDS, TrialStream.PAPER_PLANNERS)
 
     def run_trial(self, trial, settings):
         env = world(settings["scenario"], trial.params["world_seed"])
