@@ -22,7 +22,7 @@ def make_backend(name: str, seed: int):
     if name == "statevector-iterated":
         return qc.StatevectorBackend(seed=seed, closed_form=False)
     if name == "sampler":
-        return qc.SamplerBackend(SamplerV2(seed=seed))
+        return qc.SamplerBackend(SamplerV2(), seed=seed)  # seeded per call through seed_simulator
     raise ValueError(name)
 
 

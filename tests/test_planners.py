@@ -3,10 +3,13 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
+from conftest import BACKENDS, make_backend
 from planner_checks import assert_path_valid, assert_tree_edges_valid
+from tolerances import binomial_counts, z_bound
 
 import qrrt_circuits as qc
 from qrrt_circuits.environment import Environment
+from qrrt_circuits.registry import PLANNERS
 
 METRIC_KEYS = {"oracle_calls", "quantum_oracle_calls", "verification_calls",
                "critical_path_oracle_calls", "simulation_checks", "nodes", "rounds", "databases",
@@ -14,24 +17,15 @@ METRIC_KEYS = {"oracle_calls", "quantum_oracle_calls", "verification_calls",
 
 
 def make(name, env, seed, **kw):
-    sv = qc.StatevectorBackend(seed=seed)
-    if name == "RRT":
-        return qc.RRT(env, seed=seed, **kw)
-    if name == "ParallelRRT":
-        return qc.ParallelRRT(env, workers=8, seed=seed, **kw)
-    if name == "QRRT":
-        return qc.QRRT(env, backend=sv, seed=seed, **kw)
-    if name == "PQRRT":
-        return qc.PQRRT(env, backend=sv, seed=seed, **kw)
-    if name == "PQRRT-unshared":
-        return qc.PQRRT(env, backend=sv, shared_database=False, seed=seed, **kw)
-    raise ValueError(name)
+    """The registry's planner ``name`` on the exact statevector, 8 workers where it has workers."""
+    defaults = {"seed": seed, "workers": 8, "backend": qc.StatevectorBackend(seed=seed)}
+    return PLANNERS.create(name, env=env, **PLANNERS.applicable(name, defaults), **kw)
 
 
-PLANNERS = ["RRT", "ParallelRRT", "QRRT", "PQRRT", "PQRRT-unshared"]
+PLANNER_NAMES = list(PLANNERS)  # every registered planner
 
 
-@pytest.mark.parametrize("name", PLANNERS)
+@pytest.mark.parametrize("name", PLANNER_NAMES)
 def test_metrics_identities_and_every_edge_rechecked(name, clutter):
     result = make(name, clutter, seed=3).plan(max_nodes=60)
     m = result.metrics
@@ -79,25 +73,21 @@ def test_quantum_counting_with_fixed_iterations(clutter):
     assert unshared.metrics.duplicates == 0
 
 
-def test_pqrrt_with_one_worker_matches_qrrt_statistics(clutter):
-    def per_node(planner_cls, **kw):
-        calls, nodes = 0, 0
-        for seed in range(12):
-            r = planner_cls(clutter, backend=qc.StatevectorBackend(seed=seed), seed=seed,
-                            iterations=qc.FixedIterations(2), **kw).plan(max_rounds=80)
-            calls += r.metrics.oracle_calls
-            nodes += r.metrics.nodes
-        return nodes / (calls / 3)  # success fraction per round (3 calls a round)
-
-    q = per_node(qc.QRRT)
-    p = per_node(qc.PQRRT, workers=1)
-    rounds = 12 * 80
-    sigma = math.sqrt(q * (1 - q) / rounds)
-    assert abs(q - p) <= 5 * math.sqrt(2) * sigma
-    # same seed, same planner: identical (PQRRT with p = 1 *is* q-RRT)
-    a = qc.QRRT(clutter, backend=qc.StatevectorBackend(0), seed=5).plan(max_rounds=30)
-    b = qc.PQRRT(clutter, backend=qc.StatevectorBackend(0), workers=1, seed=5).plan(max_rounds=30)
-    assert np.array_equal(a.nodes, b.nodes)
+@pytest.mark.parametrize("backend_name", BACKENDS)
+def test_qrrt_adds_nodes_at_the_grover_rate(backend_name, clutter):
+    """Each q-RRT round adds a node with probability sin^2((2k+1) theta_r), sin^2 theta_r = m_r/N,
+    m_r the round's reachable entries (from the history): the node count must lie in the Poisson-
+    binomial interval of the rounds' probabilities (normal bound with the exact variance)."""
+    k, rounds, observed, mean, variance = 2, 120, 0, 0.0, 0.0
+    for seed in range(3):
+        result = qc.QRRT(clutter, backend=make_backend(backend_name, seed), search_policy=qc.FixedIterations(k),
+                         seed=seed).plan(max_rounds=rounds)
+        p = np.array([qc.probability.success_probability(256, int(m), k) for m in result.history["reachable"]])
+        observed += result.metrics.nodes
+        mean += p.sum()
+        variance += (p * (1 - p)).sum()
+        assert result.metrics.rejected == rounds - result.metrics.nodes
+    assert abs(observed - mean) <= z_bound() * math.sqrt(variance)
 
 
 def test_shared_database_duplicates_are_dropped(clutter):
@@ -148,17 +138,23 @@ def test_unreachable_goal_ends_with_budget_exhausted():
     env = Environment(np.array([[0, 20], [0, 20]]), boxes)
     for planner in (qc.RRT(env, seed=0), qc.QRRT(env, backend=qc.StatevectorBackend(0), seed=0)):
         result = planner.plan([2, 2], [16, 16], 0.5, max_oracle_calls=400)
-        assert result.status == "budget_exhausted" and result.path is None
+        assert result.status == qc.PlanStatus.MAX_ORACLE_CALLS == "max_oracle_calls"
+        assert result.path is None and result.budget_exhausted and not result.reached
         assert 400 <= result.metrics.oracle_calls < 400 + 7
 
 
-def test_default_budget_applies(monkeypatch):
-    from qrrt_circuits.planners import base
+def test_default_round_limit_ends_a_plan_with_no_budget(monkeypatch):
+    """With no budget at all the plan still ends, after DEFAULT_MAX_ROUNDS rounds (the goal is
+    walled in, so only the round limit can end it)."""
+    from qrrt_circuits import termination
 
-    monkeypatch.setattr(base, "DEFAULT_MAX_ROUNDS", 17)
-    env = Environment(np.array([[0, 20], [0, 20]]), np.array([[[14, 14], [18, 18]]], dtype=float))
-    result = qc.RRT(env, seed=0).plan([1, 1], [19.5, 19.5], 0.1)
-    assert result.metrics.rounds == 17 or result.status == "reached"
+    monkeypatch.setattr(termination, "DEFAULT_MAX_ROUNDS", 17)
+    boxes = np.array([[[14, 14], [18, 14.5]], [[14, 17.5], [18, 18]], [[14, 14], [14.5, 18]],
+                      [[17.5, 14], [18, 18]]], dtype=float)
+    env = Environment(np.array([[0, 20], [0, 20]]), boxes)
+    result = qc.RRT(env, seed=0).plan([1, 1], [16, 16], 0.5)
+    assert result.status == "max_rounds" and result.metrics.rounds == 17
+    assert result.settings["termination"] == {"max_rounds": 17}
 
 
 def test_bbht_terminates_with_no_solution_and_respects_its_bound():
@@ -193,19 +189,26 @@ def test_known_optimal_is_labelled_and_adaptive_is_not(clutter):
 
 
 @pytest.mark.parametrize("marked", [3, 25, 90])
-def test_adaptive_learns_a_good_iteration_count(marked):
-    """From verified outcomes alone, Adaptive settles on a k whose success probability for the
-    (hidden) marked fraction is close to the best achievable per oracle call."""
-    state = qc.Adaptive().start(256)
-    rng = np.random.default_rng(marked)
-    for _ in range(150):
-        k = state.iterations(tree_nodes=50)
-        p = qc.probability.success_probability(256, marked, k)
-        state.observe(k, bool(rng.random() < p))
-    k = state.iterations(50)
-    best = max(qc.probability.success_probability(256, marked, j) / (j + 1) for j in range(13))
-    chosen = qc.probability.success_probability(256, marked, k) / (k + 1)
-    assert chosen >= 0.8 * best
+def test_adaptive_posterior_covers_the_hidden_fraction_and_picks_its_argmax(marked):
+    """From verified outcomes alone, Adaptive's posterior over f = m/N contains the hidden f in its
+    central 99 % credible interval at least as often as a calibrated posterior would (its forgetting
+    only widens it), and the k it picks maximises expected success per oracle call under it."""
+    runs, covered = 40, 0
+    for run in range(runs):
+        state = qc.Adaptive().start(256)
+        rng = np.random.default_rng([marked, run])
+        for _ in range(150):
+            k = state.choose_iterations(tree_nodes=50)
+            state.observe(k, bool(rng.random() < qc.probability.success_probability(256, marked, k)))
+        weights = np.exp(state.log_posterior - state.log_posterior.max())
+        cdf = np.cumsum(weights) / weights.sum()
+        low, high = state.fractions[np.searchsorted(cdf, 0.005)], state.fractions[np.searchsorted(cdf, 0.995)]
+        covered += int(low <= marked / 256 <= high)
+        theta = np.arcsin(np.sqrt(state.fractions))
+        expected = [np.sum(weights * np.sin((2 * j + 1) * theta) ** 2) / weights.sum() / (j + 1)
+                    for j in state.candidates]
+        assert state.choose_iterations(50) == int(np.argmax(expected))
+    assert covered >= binomial_counts(runs, 0.99)[0]
 
 
 def test_annealing_first_band_distance(clutter):
@@ -241,10 +244,12 @@ def test_start_or_goal_in_collision_names_which(clutter):
 
 
 def test_bad_planner_settings(clutter):
-    with pytest.raises(ValueError, match="workers must be an integer >= 1"):
+    with pytest.raises(ValueError, match=r"workers must be an integer in \[1, 4096\], got 0"):
         qc.PQRRT(clutter, backend=qc.StatevectorBackend(0), workers=0)
-    with pytest.raises(ValueError, match="workers must be an integer >= 1"):
+    with pytest.raises(ValueError, match=r"workers must be an integer in \[1, 4096\], got 0"):
         qc.ParallelRRT(clutter, workers=0)
+    with pytest.raises(TypeError, match="workers must be an integer"):
+        qc.ParallelRRT(clutter, workers=2.5)
     with pytest.raises(ValueError, match="num_qubits = 40 is outside"):
         qc.QRRT(clutter, backend=qc.StatevectorBackend(0), num_qubits=40)
     with pytest.raises(ValueError, match=r"r_min must be <= r_max"):

@@ -1,0 +1,175 @@
+"""OMPL's motion validation as a reachability predicate (needs the ``ompl`` extra, OMPL >= 2.0).
+
+``OMPLMotionPredicate`` wraps an OMPL ``SpaceInformation`` on a ``RealVectorStateSpace``:
+``reachable(parents, children)`` answers, for each pair, ``si.checkMotion(parent, child)``, that
+is whatever motion validator the ``SpaceInformation`` holds (OMPL's default, the
+``DiscreteMotionValidator``, tests the child state and then the straight segment at interpolated
+states no further apart than the space's longest valid segment length). Any planner of this library
+then plans with OMPL's notion of a valid motion::
+
+    import qrrt_circuits as qc
+    from qrrt_circuits.adapters.ompl import OMPLMotionPredicate, from_environment
+
+    predicate = OMPLMotionPredicate(si)          # an ob.SpaceInformation you built and set up
+    predicate = from_environment(env)            # or: OMPL checks for a qc.Environment
+    result = qc.RRT(env, predicate=predicate, seed=0).plan(max_nodes=100)
+
+Notes:
+
+* ``reachable`` is a Python loop calling ``si.checkMotion`` once per pair, and the validity checker
+  built by ``from_environment`` is a Python callback called once per interpolated state, so this
+  predicate is much slower than the library's vectorized, compiled checks (``ReachabilityOracle``,
+  ``TimeSampledCheck``). It is for interoperability, not speed.
+* Soundness is OMPL's: the ``DiscreteMotionValidator`` tests states at most one longest valid
+  segment length L apart, so an obstacle thinner than L can be stepped over (and the parent state
+  itself is assumed valid, not tested). ``describe()`` records L and reports ``"sound": None``.
+* A predicate holds OMPL objects, which do not pickle: use planners in-process or with a thread
+  executor, not a process pool.
+* OMPL 2.0's Python states are owned by Python: never pass them to ``si.freeState`` (double free).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..environment import Environment
+from ..predicate import as_pairs
+from ..validation import check_float, check_instance
+
+INSTALL_HINT = 'pip install "qrrt-circuits[ompl]"'
+
+try:
+    from ompl import base as ob
+except ImportError as exc:  # pragma: no cover - exercised by a test that hides ompl
+    raise ImportError(
+        "qrrt_circuits.adapters.ompl needs the OMPL Python bindings (OMPL >= 2.0); install them with "
+        f"{INSTALL_HINT}") from exc
+
+__all__ = ["INSTALL_HINT", "OMPLMotionPredicate", "from_environment"]
+
+#: OMPL's default motion validator for a real-vector space, a C++ class OMPL 2.0 does not bind:
+#: Python sees it as a plain ``ob.MotionValidator``
+DEFAULT_VALIDATOR = "DiscreteMotionValidator"
+
+
+class OMPLMotionPredicate:
+    """Reachability predicate answering ``si.checkMotion(parent, child)`` for each pair.
+
+    ``space_information`` must be an ``ompl.base.SpaceInformation`` whose state space is an
+    ``ompl.base.RealVectorStateSpace`` (its dimension is ``dim``). It is set up here if it is not
+    yet (``si.setup()``, as OMPL's planners do); its validity checker and motion validator are used
+    as they are. ``evaluations`` counts the pairs checked through this object.
+    """
+
+    def __init__(self, space_information, name: str = "ompl") -> None:
+        if not isinstance(space_information, ob.SpaceInformation):
+            raise TypeError("space_information must be an ompl.base.SpaceInformation, got "
+                            f"{type(space_information).__name__}")
+        if not isinstance(name, str) or not name:
+            raise TypeError(f"name must be a non-empty string, got {name!r}")
+        space = space_information.getStateSpace()
+        if not isinstance(space, ob.RealVectorStateSpace):
+            raise ValueError(
+                "OMPLMotionPredicate needs a SpaceInformation on an ompl.base.RealVectorStateSpace (states "
+                f"are d real coordinates, as the planners' (M, d) arrays are); got a {type(space).__name__} "
+                f"({space.getName()!r})")
+        if not space_information.isSetup():
+            try:
+                space_information.setup()
+            except RuntimeError as exc:
+                raise ValueError(f"OMPL could not set up the SpaceInformation (are the space's bounds set?): "
+                                 f"{exc}") from exc
+        self.si = space_information
+        self.space = space
+        self.name = name
+        self.environment: Environment | None = None  # set by from_environment, for describe()
+        self.evaluations = 0
+        self._dim = int(space.getDimension())
+
+    @property
+    def dim(self) -> int:
+        return self._dim
+
+    def bounds(self) -> np.ndarray:
+        """(d, 2) array of the state space's [low, high] per axis."""
+        bounds = self.space.getBounds()
+        return np.column_stack([np.asarray(bounds.low, dtype=float), np.asarray(bounds.high, dtype=float)])
+
+    def motion_validator(self) -> str:
+        """The class of the ``SpaceInformation``'s motion validator (a Python subclass by its name;
+        OMPL's unbound C++ default by ``DEFAULT_VALIDATOR``)."""
+        validator = self.si.getMotionValidator()
+        if type(validator) is ob.MotionValidator:
+            return DEFAULT_VALIDATOR
+        return f"{type(validator).__module__}.{type(validator).__qualname__}"
+
+    def describe(self) -> dict:
+        """Name, space bounds and OMPL's motion-checking resolution; soundness unknown (None)."""
+        space = self.space
+        description = {
+            "name": self.name,
+            "library": "ompl",
+            "state_space": type(space).__name__,  # not getName(): OMPL numbers unnamed spaces per process
+            "dim": self._dim,
+            "bounds": self.bounds().tolist(),
+            "motion_validator": self.motion_validator(),
+            "longest_valid_segment_fraction": float(space.getLongestValidSegmentFraction()),
+            "longest_valid_segment_length": float(space.getLongestValidSegmentLength()),
+            "valid_segment_count_factor": int(space.getValidSegmentCountFactor()),
+            "sound": None,
+        }
+        if self.environment is not None:
+            description["environment"] = self.environment.name
+            description["validity_checker"] = "Environment.is_free"
+        return description
+
+    def reachable(self, parents: np.ndarray, children: np.ndarray) -> np.ndarray:
+        """Bool (M,): ``si.checkMotion(parent, child)`` for each pair (a Python loop; see the
+        module docstring). A single parent is broadcast against M children."""
+        parents, children = as_pairs(parents, children, self._dim)
+        si, axes = self.si, range(self._dim)
+        parent_state, child_state = si.allocState(), si.allocState()  # owned by Python: no freeState
+        out = np.empty(parents.shape[0], dtype=np.bool_)
+        for m, (parent, child) in enumerate(zip(parents.tolist(), children.tolist(), strict=True)):
+            for axis in axes:
+                parent_state[axis] = parent[axis]
+                child_state[axis] = child[axis]
+            out[m] = si.checkMotion(parent_state, child_state)
+        self.evaluations += int(parents.shape[0])
+        return out
+
+    def __repr__(self) -> str:
+        return (f"OMPLMotionPredicate(name={self.name!r}, d={self._dim}, "
+                f"longest_valid_segment_length={self.space.getLongestValidSegmentLength():.4g})")
+
+
+def from_environment(env: Environment, resolution: float = 0.01, name: str = "ompl") -> OMPLMotionPredicate:
+    """An ``OMPLMotionPredicate`` checking straight-line motions in ``env`` with OMPL.
+
+    Builds a ``RealVectorStateSpace`` with the environment's bounds, a ``SpaceInformation`` whose
+    state validity checker is ``env.is_free`` on one state, and OMPL's default motion validator for
+    such a space, the ``DiscreteMotionValidator`` (installed by ``SpaceInformation``'s constructor;
+    OMPL 2.0 does not bind the class itself), with ``resolution`` as the longest valid segment
+    fraction (``si.setStateValidityCheckingResolution``): states along a segment are tested at most
+    ``resolution * space.getMaximumExtent()`` apart (the workspace diagonal times ``resolution``).
+    """
+    check_instance(env, "env", Environment, "an Environment")
+    resolution = check_float(resolution, "resolution", 0.0, 1.0, open_minimum=True)
+    d = env.dim
+    space = ob.RealVectorStateSpace(d)
+    bounds = ob.RealVectorBounds(d)
+    for axis in range(d):
+        bounds.setLow(axis, float(env.bounds[axis, 0]))
+        bounds.setHigh(axis, float(env.bounds[axis, 1]))
+    space.setBounds(bounds)
+    si = ob.SpaceInformation(space)
+
+    def is_valid(state) -> bool:
+        return bool(env.is_free(np.array(state[0:d])))
+
+    si.setStateValidityChecker(is_valid)
+    si.setStateValidityCheckingResolution(resolution)
+    si.setup()
+    predicate = OMPLMotionPredicate(si, name=name)
+    predicate.environment = env
+    return predicate
