@@ -1,0 +1,127 @@
+"""Reachability predicates: any object with the protocol plans with every planner and backend;
+the built-in ones describe themselves; bad predicates are refused with the reason."""
+
+import numpy as np
+import pytest
+from conftest import BACKENDS, make_backend
+
+import qrrt_circuits as qc
+from qrrt_circuits.plotting import edge_curves, plan_dynamics
+from qrrt_circuits.predicate import check_predicate
+from qrrt_circuits.registry import PLANNERS
+
+
+class StraightLine:
+    """A user's predicate (not a ReachabilityOracle): straight-line motion, sampled every
+    ``spacing`` along the segment, in any dimension."""
+
+    name = "straight-line"
+
+    def __init__(self, env, spacing=0.01):
+        self.env = env
+        self.spacing = spacing
+        self.calls = 0
+
+    @property
+    def dim(self):
+        return self.env.dim
+
+    def describe(self):
+        return {"name": self.name, "spacing": self.spacing}
+
+    def reachable(self, parents, children):
+        parents, children = np.atleast_2d(parents), np.atleast_2d(children)
+        self.calls += len(children)
+        steps = int(np.ceil(np.max(np.linalg.norm(children - parents, axis=1)) / self.spacing)) + 1
+        t = np.linspace(0.0, 1.0, max(steps, 2))
+        points = parents[:, None, :] + t[None, :, None] * (children - parents)[:, None, :]
+        return self.env.is_free(points.reshape(-1, self.dim)).reshape(points.shape[:2]).all(axis=1)
+
+
+def dense_segment_free(env, parent, child, spacing=0.002):
+    steps = int(np.ceil(np.linalg.norm(child - parent) / spacing)) + 2
+    t = np.linspace(0.0, 1.0, steps)[:, None]
+    return bool(env.is_free(parent + t * (child - parent)).all())
+
+
+@pytest.mark.parametrize("backend_name", BACKENDS)
+@pytest.mark.parametrize("planner_name", list(PLANNERS))
+def test_a_user_predicate_plans_with_every_planner_and_backend(planner_name, backend_name, clutter):
+    predicate = StraightLine(clutter)
+    options = {"seed": 4, "workers": 3, "num_qubits": 6, "backend": make_backend(backend_name, 4),
+               "predicate": predicate}
+    planner = PLANNERS.create(planner_name, env=clutter, **PLANNERS.applicable(planner_name, options))
+    result = planner.plan(max_nodes=15)
+    assert result.metrics.nodes >= 15 and result.settings["predicate"] == predicate.describe()
+    assert result.settings["dynamics"] is None and plan_dynamics(result) is None
+    # classical planners evaluate the predicate once per test; quantum ones once per database entry
+    # (simulation_checks), their verifications reading those evaluations
+    quantum = "quantum" in PLANNERS.resolve(planner_name).tags
+    assert predicate.calls == (result.metrics.simulation_checks if quantum else result.metrics.verification_calls)
+    children = np.arange(1, len(result.nodes))
+    parents = result.parents[children]
+    # every edge re-checked with the plan's own predicate and with a denser independent check
+    assert predicate.reachable(result.nodes[parents], result.nodes[children]).all()
+    for child, parent in zip(children, parents, strict=True):
+        assert dense_segment_free(clutter, result.nodes[parent], result.nodes[child]), (parent, child)
+
+
+def test_a_user_predicate_in_three_dimensions():
+    rng = np.random.default_rng(0)
+    lower = rng.uniform(0, 9, size=(40, 3))
+    env = qc.Environment(np.array([[0, 10]] * 3, dtype=float), np.stack([lower, lower + 0.8], axis=1))
+    start, goal = env.sample_free(2, rng)
+    result = qc.QRRT(env, backend=qc.StatevectorBackend(0), num_qubits=6, predicate=StraightLine(env),
+                     seed=0).plan(start, goal, 1.0, max_nodes=25)
+    assert result.nodes.shape[1] == 3 and result.metrics.nodes >= 1
+    curves = edge_curves(result.nodes, result.parents, None, samples=5)
+    # straight edges: the middle sample is the midpoint of parent and child
+    child = 1
+    middle = (result.nodes[child] + result.nodes[result.parents[child]]) / 2
+    assert np.allclose(curves[0, 2], middle)
+
+
+def test_builtin_predicates_describe_themselves(clutter):
+    exact = qc.ReachabilityOracle(clutter)
+    assert check_predicate(exact, 2) is exact
+    description = exact.describe()
+    assert description["name"] == "exact" and description["resolution"] == 0.01 and description["sound"]
+    assert qc.LinearTrackingDynamics.from_description(description["dynamics"]).describe() == \
+        qc.LinearTrackingDynamics.paper().describe()
+    sampled = qc.TimeSampledCheck(clutter, time_samples=30)
+    assert sampled.describe()["sound"] is False and sampled.describe()["time_samples"] == 30
+    # 0.1's spelling returns the same kind of object
+    alias = qc.ReachabilityOracle(clutter, check="time_samples", time_samples=30)
+    assert isinstance(alias, qc.TimeSampledCheck) and isinstance(alias, qc.ReachabilityPredicate)
+    rng = np.random.default_rng(1)
+    parents, children = clutter.sample_free(200, rng), clutter.sample_uniform(200, rng)
+    assert np.array_equal(alias.reachable(parents, children), sampled.reachable(parents, children))
+
+
+def test_planner_records_the_dynamics_its_predicate_follows(clutter):
+    dynamics = qc.LinearTrackingDynamics(np.diag([-1.0, -2.0]), np.eye(2), np.zeros((2, 2)))
+    result = qc.RRT(clutter, dynamics=dynamics, seed=0).plan(max_nodes=3)
+    assert plan_dynamics(result).describe() == dynamics.describe()
+    # oracle= is an alias of predicate=
+    oracle = qc.ReachabilityOracle(clutter)
+    planner = qc.RRT(clutter, oracle=oracle, seed=0)
+    assert planner.predicate is oracle and planner.oracle is oracle
+
+
+class NoName:
+    dim = 2
+
+    def reachable(self, parents, children):
+        return np.ones(len(children), bool)
+
+
+def test_bad_predicates_are_refused_with_the_reason(clutter):
+    with pytest.raises(TypeError, match="lacks name, describe"):
+        qc.RRT(clutter, predicate=NoName())
+    env3 = qc.Environment(np.array([[0, 1]] * 3, dtype=float), np.zeros((0, 2, 3)))
+    with pytest.raises(ValueError, match="dimension mismatch: the predicate works in d = 3"):
+        qc.RRT(clutter, predicate=StraightLine(env3))
+    with pytest.raises(ValueError, match="give dynamics= or predicate=, not both"):
+        qc.RRT(clutter, predicate=StraightLine(clutter), dynamics=qc.LinearTrackingDynamics.paper())
+    with pytest.raises(ValueError, match="give predicate= or its alias oracle=, not both"):
+        qc.RRT(clutter, predicate=StraightLine(clutter), oracle=qc.ReachabilityOracle(clutter))

@@ -1,0 +1,102 @@
+"""One registry of planners, backends, search policies, scenarios and predicates: every CLI choice
+resolves through it, aliases mean the same object, unknown names list the choices."""
+
+import argparse
+
+import pytest
+
+import qrrt_circuits as qc
+from qrrt_circuits.cli import build_parser, main
+from qrrt_circuits.registry import BACKENDS, PLANNERS, POLICIES, PREDICATES, SCENARIOS, Registry
+
+EXPECTED_PLANNERS = {"rrt": qc.RRT, "prrt": qc.ParallelRRT, "qrrt": qc.QRRT, "pqrrt": qc.PQRRT,
+                     "pqrrt-unshared": qc.PQRRT}
+
+
+def _cli_choices(command: str, option: str) -> tuple[str, ...]:
+    parser = build_parser()
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices[command]
+    return tuple(next(a for a in sub._actions if option in a.option_strings).choices)
+
+
+def test_every_cli_choice_comes_from_the_registry():
+    assert _cli_choices("plan", "--planner") == PLANNERS.names()
+    assert _cli_choices("plan", "--backend") == BACKENDS.names() == _cli_choices("search", "--backend")
+    assert _cli_choices("plan", "--scenario") == SCENARIOS.names()
+    help_text = build_parser()._subparsers._group_actions[0].choices["plan"].format_help()
+    for label in POLICIES.labels() + PREDICATES.labels():
+        assert label in help_text
+
+
+@pytest.mark.parametrize("name", list(PLANNERS))
+def test_every_planner_name_builds_its_class_and_plans(name, clutter):
+    options = {"seed": 1, "workers": 3, "num_qubits": 5, "backend": qc.StatevectorBackend(1)}
+    planner = PLANNERS.create(name, env=clutter, **PLANNERS.applicable(name, options))
+    assert type(planner) is EXPECTED_PLANNERS[name]
+    assert getattr(planner, "shared_database", None) == {"qrrt": True, "pqrrt": True, "pqrrt-unshared": False}.get(name)
+    assert planner.plan(max_rounds=2).metrics.rounds == 2
+
+
+@pytest.mark.parametrize("name", list(PLANNERS))
+def test_every_planner_runs_from_the_cli(name, capsys):
+    assert main(["plan", "--planner", name, "--backend", "statevector", "--qubits", "5", "--workers", "2",
+                 "--max-rounds", "2"]) == 0
+    assert "max_rounds" in capsys.readouterr().out
+
+
+def test_aliases_resolve_to_the_same_entry():
+    for alias, name in {"RRT": "rrt", "ParallelRRT": "prrt", "QRRT": "qrrt", "PQRRT": "pqrrt",
+                        "PQRRT-unshared": "pqrrt-unshared"}.items():
+        assert PLANNERS.resolve(alias) is PLANNERS.resolve(name)
+        assert PLANNERS.canonical(alias) == name
+
+
+@pytest.mark.parametrize("name", list(BACKENDS))
+def test_every_backend_name_searches(name):
+    backend = BACKENDS.create(name, seed=3)
+    assert isinstance(backend, qc.QuantumSearchBackend)
+    marks = [False] * 15 + [True]
+    assert backend.search(marks, 2, shots=4, seed=5).indices.shape == (4,)
+
+
+def test_policies_including_parametric_ones():
+    assert POLICIES.create("paper") == qc.PaperSchedule()
+    assert POLICIES.create("fixed:3") == qc.FixedIterations(3)
+    assert isinstance(POLICIES.create("bbht"), qc.BBHT)
+    assert POLICIES.labels() == ("paper", "optimal", "bbht", "adaptive", "fixed:K")
+    with pytest.raises(ValueError, match="policy fixed:K needs an integer K >= 0, got 'fixed:x'"):
+        POLICIES.create("fixed:x")
+    with pytest.raises(ValueError, match="unknown search policy 'fixed'"):
+        POLICIES.create("fixed")  # the parameter is required
+
+
+def test_scenarios_and_predicates(clutter):
+    assert SCENARIOS.create("paper_clutter", seed=0).boxes.tobytes() == clutter.boxes.tobytes()
+    assert isinstance(PREDICATES.create("exact", env=clutter), qc.ReachabilityOracle)
+    sampled = PREDICATES.create("time-samples:20", env=clutter)
+    assert isinstance(sampled, qc.TimeSampledCheck) and sampled.time_samples == 20
+
+
+@pytest.mark.parametrize("registry, kind", [(PLANNERS, "planner"), (BACKENDS, "backend"),
+                                            (POLICIES, "search policy"), (SCENARIOS, "scenario"),
+                                            (PREDICATES, "predicate")])
+def test_unknown_names_list_the_choices(registry, kind):
+    with pytest.raises(ValueError) as error:
+        registry.create("nope")
+    assert str(error.value) == f"unknown {kind} 'nope'; choose one of {', '.join(registry.labels())}"
+    assert "nope" not in registry
+    with pytest.raises(TypeError, match=f"{kind} must be a name"):
+        registry.resolve(3)
+
+
+def test_options_that_do_not_apply_are_refused(clutter):
+    with pytest.raises(ValueError, match=r"option\(s\) \['backend'\] do not apply to planner 'rrt'"):
+        PLANNERS.create("rrt", env=clutter, backend=qc.StatevectorBackend())
+    assert PLANNERS.applicable("qrrt", {"workers": 4, "num_qubits": 5}) == {"num_qubits": 5}
+
+
+def test_a_name_is_registered_once():
+    registry = Registry("thing")
+    registry.register("a", dict, "first", aliases=("b",))
+    with pytest.raises(ValueError, match="thing name 'b' is registered twice"):
+        registry.register("b", dict, "second")

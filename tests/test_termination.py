@@ -1,0 +1,159 @@
+"""Termination conditions alone and combined, on planners and on progress snapshots; the status
+names the condition that ended the plan."""
+
+import math
+
+import numpy as np
+import pytest
+
+import qrrt_circuits as qc
+from qrrt_circuits.environment import Environment
+from qrrt_circuits.termination import Progress, from_budgets, with_round_limit
+
+WALLED_GOAL = np.array([[[14, 14], [18, 14.5]], [[14, 17.5], [18, 18]], [[14, 14], [14.5, 18]],
+                        [[17.5, 14], [18, 18]]], dtype=float)
+
+
+@pytest.fixture(scope="module")
+def walled():
+    """The goal (16, 16) is walled in: no plan reaches it, so only a condition ends a plan."""
+    return Environment(np.array([[0, 20], [0, 20]]), WALLED_GOAL)
+
+
+@pytest.fixture(scope="module")
+def boxed_in():
+    """The start (5, 5) sits in a 0.02-wide pocket inside a 2 x 2 block: no trajectory leaves it."""
+    gap = 0.01
+    boxes = [[[4, 4], [6, 5 - gap]], [[4, 5 + gap], [6, 6]], [[4, 5 - gap], [5 - gap, 5 + gap]],
+             [[5 + gap, 5 - gap], [6, 5 + gap]]]
+    return Environment(np.array([[0, 20], [0, 20]]), np.array(boxes, dtype=float))
+
+
+def progress(**values):
+    base = {"oracle_calls": 0, "critical_path_oracle_calls": 0, "nodes": 0, "rounds": 0,
+            "rounds_without_new_node": 0, "elapsed_s": 0.0}
+    return Progress(**(base | values))
+
+
+@pytest.mark.parametrize("condition, field, status", [
+    (qc.MaxOracleCalls(10), "oracle_calls", "max_oracle_calls"),
+    (qc.MaxCriticalPathCalls(10), "critical_path_oracle_calls", "max_critical_path_calls"),
+    (qc.MaxNodes(10), "nodes", "max_nodes"),
+    (qc.MaxRounds(10), "rounds", "max_rounds"),
+    (qc.Stall(10), "rounds_without_new_node", "stalled"),
+])
+def test_each_limit_fires_exactly_at_its_limit(condition, field, status):
+    assert condition.ended_by(progress(**{field: 9})) is None
+    assert condition.ended_by(progress(**{field: 10})) == status
+    assert condition.ended_by(progress(**{field: 11})) == status
+
+
+def test_wall_time_condition_on_progress_and_on_a_plan(walled):
+    condition = qc.MaxWallTime(0.5)
+    assert condition.ended_by(progress(elapsed_s=0.49)) is None
+    assert condition.ended_by(progress(elapsed_s=0.5)) == "max_time_s"
+    # a limit far below one round's time ends the plan before its first round
+    result = qc.RRT(walled, seed=0).plan([1, 1], [16, 16], 0.5, max_time_s=1e-12)
+    assert result.status == "max_time_s" and result.metrics.rounds == 0
+
+
+def test_combined_conditions_name_the_first_that_fires():
+    combined = qc.MaxNodes(5) | qc.MaxRounds(7) | qc.Stall(3)
+    assert isinstance(combined, qc.AnyOf) and len(combined.conditions) == 3  # flattened
+    assert combined.ended_by(progress(nodes=4, rounds=6, rounds_without_new_node=2)) is None
+    assert combined.ended_by(progress(nodes=5, rounds=7)) == "max_nodes"  # order decides ties
+    assert combined.ended_by(progress(nodes=1, rounds=7)) == "max_rounds"
+    assert combined.ended_by(progress(rounds_without_new_node=3)) == "stalled"
+    assert combined.describe() == {"max_nodes": 5, "max_rounds": 7, "stall_rounds": 3}
+    assert combined.limits_rounds and not (qc.MaxNodes(5) | qc.Stall(3)).limits_rounds
+
+
+@pytest.mark.parametrize("budget", [400, 401])
+def test_oracle_call_budget_on_a_plan(budget, walled):
+    for planner in (qc.RRT(walled, seed=0), qc.QRRT(walled, backend=qc.StatevectorBackend(0), seed=0,
+                                                     search_policy=qc.FixedIterations(2))):
+        result = planner.plan([2, 2], [16, 16], 0.5, max_oracle_calls=budget)
+        calls = result.history["oracle_calls"]
+        assert result.status == "max_oracle_calls"
+        # the plan stops after the first round that reaches the budget, and not before
+        assert calls[-1] >= budget and (len(calls) == 1 or calls[-2] < budget)
+
+
+def test_critical_path_budget_stops_parallel_workers_on_their_own_time(walled):
+    """Pq-RRT with p = 8 workers and k = 2: each round costs 8 x 3 calls but 3 on the critical path,
+    so a critical-path budget of 40 ends the plan after ceil(40 / 3) = 14 rounds."""
+    k, p, budget = 2, 8, 40
+    result = qc.PQRRT(walled, backend=qc.StatevectorBackend(0), workers=p, search_policy=qc.FixedIterations(k),
+                      seed=1).plan([2, 2], [16, 16], 0.5, max_critical_path_calls=budget)
+    rounds = math.ceil(budget / (k + 1))
+    assert result.status == "max_critical_path_calls"
+    assert result.metrics.rounds == rounds
+    assert result.metrics.critical_path_oracle_calls == rounds * (k + 1)
+    assert result.metrics.oracle_calls == rounds * p * (k + 1)
+
+
+def test_max_nodes_and_rounds_on_a_plan(clutter):
+    result = qc.ParallelRRT(clutter, workers=4, seed=3).plan(max_nodes=12)
+    assert result.status == "max_nodes" and 12 <= result.metrics.nodes < 12 + 4
+    assert result.history["nodes"][-2] < 12
+    result = qc.RRT(clutter, seed=3).plan(max_rounds=25)
+    assert result.status == "max_rounds" and result.metrics.rounds == 25
+
+
+@pytest.mark.parametrize("planner_name", ["rrt", "prrt", "qrrt", "pqrrt", "pqrrt-unshared"])
+def test_stall_ends_a_plan_that_cannot_add_nodes(planner_name, boxed_in):
+    from qrrt_circuits.registry import PLANNERS
+
+    options = {"seed": 0, "workers": 3, "num_qubits": 5, "backend": qc.StatevectorBackend(0)}
+    planner = PLANNERS.create(planner_name, env=boxed_in, **PLANNERS.applicable(planner_name, options))
+    result = planner.plan([5, 5], [15, 15], 0.5, stall_rounds=9, max_nodes=50)
+    assert result.status == qc.PlanStatus.STALLED
+    assert result.metrics.nodes == 0 and result.metrics.rounds == 9
+
+
+def test_stall_counts_consecutive_rounds_only(clutter):
+    """Stall counts rounds since the last new node, not all empty rounds."""
+    result = qc.RRT(clutter, seed=5).plan(max_nodes=30, stall_rounds=10_000)
+    empty = int(np.sum(np.diff(np.concatenate([[0], result.history["nodes"]])) == 0))
+    assert result.status == "max_nodes" and empty > 10  # many empty rounds, never 10 000 in a row
+
+
+def test_termination_argument_combines_with_the_shorthands(walled):
+    result = qc.RRT(walled, seed=0).plan([1, 1], [16, 16], 0.5, termination=qc.MaxRounds(30),
+                                         max_oracle_calls=12)
+    assert result.status == "max_oracle_calls" and result.metrics.rounds == 12
+    assert result.settings["termination"] == {"max_rounds": 30, "max_oracle_calls": 12}
+    with pytest.raises(TypeError, match="termination must be a TerminationCondition"):
+        qc.RRT(walled).plan([1, 1], [16, 16], 0.5, termination=30)
+
+
+def test_a_round_limit_is_always_in_force():
+    from qrrt_circuits import termination
+
+    assert with_round_limit(None) == qc.MaxRounds(termination.DEFAULT_MAX_ROUNDS)
+    nodes_only = with_round_limit(qc.MaxNodes(5))
+    assert nodes_only.describe() == {"max_nodes": 5, "max_rounds": termination.DEFAULT_MAX_ROUNDS}
+    assert with_round_limit(qc.MaxRounds(3)) == qc.MaxRounds(3)
+    assert from_budgets() is None
+
+
+def test_start_inside_the_goal_ball_is_reached_at_once(clutter):
+    start = clutter.start
+    result = qc.RRT(clutter, seed=0).plan(start, start, 0.5, max_rounds=10)
+    assert result.status == "reached" and result.metrics.rounds == 0 and result.goal_node == 0
+    assert np.array_equal(result.path, start[None])
+
+
+@pytest.mark.parametrize("kwargs, error, message", [
+    ({"max_nodes": 0}, ValueError, r"max_nodes must be an integer >= 1, got 0"),
+    ({"max_rounds": 2.5}, TypeError, r"max_rounds must be an integer >= 1, got 2.5"),
+    ({"max_critical_path_calls": -1}, ValueError, "max_critical_path_calls must be an integer >= 1"),
+    ({"stall_rounds": 0}, ValueError, "stall_rounds must be an integer >= 1"),
+    ({"max_time_s": float("nan")}, ValueError, "max_time_s must be a finite number > 0"),
+    ({"max_time_s": True}, TypeError, "max_time_s must be a real number"),
+])
+def test_bad_limits_are_refused_before_any_work(kwargs, error, message, clutter):
+    planner = qc.RRT(clutter, seed=0)
+    with pytest.raises(error, match=message):
+        planner.plan(**kwargs)
+    assert planner.predicate.evaluations == 0
