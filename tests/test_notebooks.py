@@ -23,6 +23,7 @@ NOTEBOOKS = [
     "02_qrrt_planning.ipynb",
     "03_parallel_workers_and_lemmas.ipynb",
     "04_quantum_database_annealing.ipynb",
+    "05_custom_predicate.ipynb",
 ]
 INTERPRETER_MARK = "kernel interpreter: "
 
