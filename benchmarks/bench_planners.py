@@ -23,24 +23,30 @@ import qrrt_circuits as qc
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
+#: (label, registry planner, registry backend, registry search policy); workers 8 where a planner has them
+CONFIGURATIONS = (
+    ("RRT", "rrt", None, None),
+    ("ParallelRRT (8)", "prrt", None, None),
+    ("QRRT statevector", "qrrt", "statevector", "paper"),
+    ("QRRT aer", "qrrt", "aer", "paper"),
+    ("PQRRT shared statevector", "pqrrt", "statevector", "paper"),
+    ("PQRRT shared aer", "pqrrt", "aer", "paper"),
+    ("PQRRT unshared statevector", "pqrrt-unshared", "statevector", "paper"),
+    ("QRRT adaptive statevector", "qrrt", "statevector", "adaptive"),
+    ("QRRT bbht statevector", "qrrt", "statevector", "bbht"),
+    ("QRRT known-optimal statevector", "qrrt", "statevector", "optimal"),
+)
+
+
 def configurations():
-    sv = qc.StatevectorBackend
-    return {
-        "RRT": lambda env, s: qc.RRT(env, seed=s),
-        "ParallelRRT (8)": lambda env, s: qc.ParallelRRT(env, workers=8, seed=s),
-        "QRRT statevector": lambda env, s: qc.QRRT(env, backend=sv(), seed=s),
-        "QRRT aer": lambda env, s: qc.QRRT(env, backend=qc.AerBackend(max_parallel_threads=1), seed=s),
-        "PQRRT shared statevector": lambda env, s: qc.PQRRT(env, backend=sv(), seed=s),
-        "PQRRT shared aer": lambda env, s: qc.PQRRT(
-            env, backend=qc.AerBackend(max_parallel_threads=1), seed=s),
-        "PQRRT unshared statevector": lambda env, s: qc.PQRRT(env, backend=sv(), shared_database=False,
-                                                              seed=s),
-        "QRRT adaptive statevector": lambda env, s: qc.QRRT(env, backend=sv(), iterations=qc.Adaptive(),
-                                                            seed=s),
-        "QRRT bbht statevector": lambda env, s: qc.QRRT(env, backend=sv(), iterations=qc.BBHT(), seed=s),
-        "QRRT known-optimal statevector": lambda env, s: qc.QRRT(env, backend=sv(),
-                                                                 iterations=qc.KnownOptimal(), seed=s),
-    }
+    """label -> planner factory (env, seed), every planner built through the registry."""
+    from qrrt_circuits.experiments.planners import make_planner
+
+    def factory(planner, backend, policy):
+        return lambda env, seed: make_planner(planner, env, seed, backend or "statevector",
+                                              search_policy=policy)
+
+    return {label: factory(planner, backend, policy) for label, planner, backend, policy in CONFIGURATIONS}
 
 
 def summarize(values: list[float]) -> dict:

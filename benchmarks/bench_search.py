@@ -20,16 +20,16 @@ import numpy as np
 from _common import machine, median_time, write_json
 
 import qrrt_circuits as qc
+from qrrt_circuits.registry import BACKENDS
 
 
 def bench_search(quick: bool) -> list[dict]:
     rows = []
     rng = np.random.default_rng(0)
-    for name, factory, top in (("aer", lambda: qc.AerBackend(seed=1, max_parallel_threads=1), 16),
-                               ("statevector", lambda: qc.StatevectorBackend(seed=1), 20),
-                               ("statevector-iterated",
-                                lambda: qc.StatevectorBackend(seed=1, closed_form=False), 20)):
-        backend = factory()
+    for name, registered, options, top in (("aer", "aer", {"max_parallel_threads": 1}, 16),
+                                           ("statevector", "statevector", {}, 20),
+                                           ("statevector-iterated", "statevector", {"closed_form": False}, 20)):
+        backend = BACKENDS.create(registered, seed=1, **options)
         for n in range(4, (12 if quick else top) + 1, 2 if quick else 1):
             m = min(12, 2 ** n // 4)
             marks = np.zeros(2**n, dtype=bool)

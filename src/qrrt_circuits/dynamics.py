@@ -17,6 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import expm
 
+from .validation import check_int
+
 PAPER_A = ((-1.5, -2.0), (1.0, 3.0))
 PAPER_B = ((0.5, 0.25), (0.0, 1.0))
 PAPER_K = ((1.9, -7.5), (1.0, 7.0))
@@ -102,8 +104,7 @@ class LinearTrackingDynamics:
         Arc length is integrated on ``dense`` time samples (geometric near t = 0, where the motion
         is fastest) and inverted by linear interpolation.
         """
-        if int(num) != num or num < 2:
-            raise ValueError(f"num must be an integer >= 2, got {num}")
+        check_int(num, "num", 2, 10_000_000)
         times = self.dense_times(dense)
         points = self.positions(parent, child, times)
         steps = np.linalg.norm(np.diff(points, axis=0), axis=1)

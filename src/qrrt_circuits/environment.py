@@ -22,6 +22,8 @@ from typing import Any
 
 import numpy as np
 
+from .validation import check_int
+
 FORMAT_NAME = "qrrt-environment"
 FORMAT_VERSION = 1
 
@@ -145,8 +147,7 @@ class Environment:
         self, count: int, rng: np.random.Generator, max_attempts: int = 1000
     ) -> np.ndarray:
         """``count`` points uniform over free space, by rejection sampling."""
-        if int(count) != count or count < 0:
-            raise ValueError(f"count must be an integer >= 0, got {count}")
+        check_int(count, "count", 0)
         if not isinstance(rng, np.random.Generator):
             raise ValueError("rng must be a numpy.random.Generator (use np.random.default_rng)")
         count = int(count)

@@ -19,6 +19,8 @@ import os
 from collections.abc import Iterator
 from concurrent.futures import Executor, ProcessPoolExecutor
 
+from .validation import check_optional_int
+
 EXECUTORS = ("serial", "process", "dask")
 
 #: no Bokeh dashboard is served (bokeh is not a dependency); ``dashboard_address=None`` does not stop
@@ -37,8 +39,7 @@ def _worker_init() -> None:
 def check_executor_args(kind: str, jobs: int | None, scheduler: str | None) -> int:
     if kind not in EXECUTORS:
         raise ValueError(f"executor must be one of {EXECUTORS}, got {kind!r}")
-    if jobs is not None and (isinstance(jobs, bool) or int(jobs) != jobs or jobs < 1):
-        raise ValueError(f"jobs must be an integer >= 1, got {jobs!r}")
+    check_optional_int(jobs, "jobs", 1)
     if scheduler is not None and kind != "dask":
         raise ValueError("scheduler is only used with executor='dask'")
     if kind == "dask":

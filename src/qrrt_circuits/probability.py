@@ -9,18 +9,15 @@ from __future__ import annotations
 
 import math
 
+from .validation import check_int, check_probability
+
 
 def _count(value, name: str, minimum: int = 0) -> int:
-    if isinstance(value, bool) or int(value) != value or value < minimum:
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
-    return int(value)
+    return check_int(value, name, minimum)
 
 
 def _probability(value, name: str) -> float:
-    value = float(value)
-    if not (0.0 <= value <= 1.0):
-        raise ValueError(f"{name} must be a probability in [0, 1], got {value!r}")
-    return value
+    return check_probability(value, name)
 
 
 def _marked(num_items, num_marked) -> tuple[int, int]:

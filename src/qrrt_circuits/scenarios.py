@@ -8,6 +8,7 @@ import math
 import numpy as np
 
 from .environment import Environment
+from .validation import check_int, check_seed
 
 CLUTTER_SIZE = 20.0
 CLUTTER_BOXES = 525
@@ -42,9 +43,7 @@ def _clearance_ok(env: Environment, point: np.ndarray, radius: float) -> bool:
 
 
 def _check_seed(seed: int | None) -> int | None:
-    if seed is not None and (int(seed) != seed or seed < 0):
-        raise ValueError(f"seed must be a non-negative integer or None, got {seed}")
-    return seed
+    return check_seed(seed)
 
 
 _STREAMS = {"paper_clutter": 1, "narrow_corridor": 2, "annealing_field": 3, "lattice": 4}
@@ -139,8 +138,7 @@ def lattice(seed: int | None = 0, size: int = 72, blocked_fraction: float = 0.5)
     cells along a row are merged into one box). Start and goal are centres of cells of the largest
     4-connected free component, drawn far apart."""
     _check_seed(seed)
-    if int(size) != size or size < 2:
-        raise ValueError(f"size must be an integer >= 2, got {size}")
+    check_int(size, "size", 2, 4096)
     if not (0.0 <= blocked_fraction < 1.0):
         raise ValueError(f"blocked_fraction must be in [0, 1), got {blocked_fraction}")
     size = int(size)

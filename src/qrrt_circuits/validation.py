@@ -63,7 +63,13 @@ def check_positive_float(value: Any, name: str) -> float:
 
 
 def check_probability(value: Any, name: str) -> float:
-    return check_float(value, name, 0.0, 1.0)
+    """A probability: a finite real number in [0, 1]."""
+    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name} must be a probability in [0, 1], got {value!r}")
+    value = float(value)
+    if not (0.0 <= value <= 1.0):
+        raise ValueError(f"{name} must be a probability in [0, 1], got {value!r}")
+    return value
 
 
 def check_seed(value: Any, name: str = "seed") -> int | None:

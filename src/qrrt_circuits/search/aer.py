@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 from qiskit_aer import AerSimulator
 
+from ..validation import check_int
 from .backend import QuantumSearchBackend, seed_stream
 from .circuits import SYNTHESES, aer_grover_circuit
 
@@ -38,8 +39,7 @@ class AerBackend(QuantumSearchBackend):
             raise ValueError(f"method must be one of {METHODS}, got {method!r}")
         if synthesis not in SYNTHESES:
             raise ValueError(f"synthesis must be one of {SYNTHESES}, got {synthesis!r}")
-        if int(max_parallel_threads) != max_parallel_threads or max_parallel_threads < 0:
-            raise ValueError(f"max_parallel_threads must be an integer >= 0, got {max_parallel_threads}")
+        check_int(max_parallel_threads, "max_parallel_threads", 0, 4096)
         self._rng = seed_stream(seed)
         self.method = method
         self.synthesis = synthesis

@@ -17,6 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..validation import check_int, check_seed
+
 
 @dataclass(frozen=True)
 class SearchResult:
@@ -51,24 +53,18 @@ def validate_marks(marks: np.ndarray) -> tuple[np.ndarray, int]:
 
 
 def validate_iterations(iterations: int) -> int:
-    if isinstance(iterations, bool) or int(iterations) != iterations or iterations < 0:
-        raise ValueError(f"iterations must be an integer >= 0, got {iterations!r}")
-    return int(iterations)
+    return check_int(iterations, "iterations", 0)
 
 
 def validate_shots(shots: int) -> int:
-    if isinstance(shots, bool) or int(shots) != shots or shots < 1:
-        raise ValueError(f"shots must be an integer >= 1, got {shots!r}")
-    return int(shots)
+    return check_int(shots, "shots", 1)
 
 
 def seed_stream(seed: int | np.random.Generator | None) -> np.random.Generator:
     """A numpy Generator from a seed, a Generator (used as is) or None (fresh entropy)."""
     if isinstance(seed, np.random.Generator):
         return seed
-    if seed is not None and (isinstance(seed, bool) or int(seed) != seed or seed < 0):
-        raise ValueError(f"seed must be a non-negative integer, a numpy Generator or None, got {seed!r}")
-    return np.random.default_rng(seed)
+    return np.random.default_rng(check_seed(seed))
 
 
 class QuantumSearchBackend(abc.ABC):
