@@ -152,3 +152,25 @@ def test_sampler_backend_on_a_noisy_fake_backend():
     shots = 2000
     rate = marks[backend.search(marks, 1, shots=shots).indices].mean()
     assert 0.25 + 10 * math.sqrt(0.25 * 0.75 / shots) < rate < 1.0
+
+
+def test_sampler_backend_is_seeded_per_search_when_the_sampler_allows_it(clutter):
+    """Aer's SamplerV2 without a seed of its own takes each search's seed: two plans with one
+    planner seed are identical. A sampler with a fixed seed seeds itself, and results say so."""
+    from qiskit_aer.primitives import SamplerV2
+
+    def plan(sampler):
+        return qc.PQRRT(clutter, backend=qc.SamplerBackend(sampler), num_qubits=5, workers=3,
+                        seed=11).plan(max_rounds=8)
+
+    a, b = plan(SamplerV2()), plan(SamplerV2())
+    assert np.array_equal(a.nodes, b.nodes) and a.metrics.oracle_calls == b.metrics.oracle_calls
+    assert not any("seeds itself" in label for label in a.labels)
+    fixed = plan(SamplerV2(seed=3))
+    assert any("the sampler (SamplerV2) seeds itself" in label for label in fixed.labels)
+    # the per-search seeds reach the simulator: two different planner seeds give different draws
+    marks = random_marks(np.random.default_rng(0), 6, 20)
+    backend = qc.SamplerBackend(SamplerV2())
+    first = backend.search(marks, 1, shots=64, seed=1).indices
+    assert np.array_equal(first, backend.search(marks, 1, shots=64, seed=1).indices)
+    assert not np.array_equal(first, backend.search(marks, 1, shots=64, seed=2).indices)

@@ -140,6 +140,7 @@ class Planner:
         self._check_ready()
         state = RunState(start, goal, goal_radius)
         state.policy_state = self._start_policy()
+        state.context = self._context()
         began = time.perf_counter()
         status = PlanStatus.REACHED
         while state.goal_node is None:

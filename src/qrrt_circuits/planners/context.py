@@ -1,8 +1,10 @@
 """What a worker receives: a small picklable context, never the planner.
 
 ``WorkerContext`` holds what stays fixed for a whole plan (the world, the predicate, the error
-model, the backend, the annealing schedule, the random streams); ``RoundView`` what one round
-adds (a snapshot of the tree, the goal, the round and temperature indices, the search policy's
+model, the backend, the annealing schedule, the random streams). It is built once per plan and
+pickled once: every task carries the same bytes, and a worker process unpickles them only the
+first time it sees that plan (a small per-process cache keyed by a random token). ``RoundView``
+what one round adds (a snapshot of the tree, the goal, the round and temperature indices, the search policy's
 state). ``map_tasks`` runs one worker function over a round's tasks, serially or on any
 ``concurrent.futures.Executor`` (threads, processes, Dask), in task order, so results never depend
 on the executor: every task draws its randomness from streams keyed by (round, worker).
@@ -12,7 +14,10 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from concurrent.futures import Executor
-from dataclasses import dataclass
+import pickle
+import uuid
+from collections import OrderedDict
+from dataclasses import dataclass, field
 from itertools import repeat
 from typing import TypeVar
 
@@ -43,6 +48,30 @@ class WorkerContext:
     backend: QuantumSearchBackend | None = None
     annealing: AnnealingSchedule | None = None
     database_size: int = 1
+    token: str = field(default_factory=lambda: uuid.uuid4().hex, compare=False)
+
+    def __reduce__(self):
+        payload = self.__dict__.get("_payload")
+        if payload is None:
+            state = {key: value for key, value in self.__dict__.items() if key != "_payload"}
+            payload = pickle.dumps(state, protocol=pickle.HIGHEST_PROTOCOL)
+            object.__setattr__(self, "_payload", payload)
+        return _restore_context, (self.token, payload)
+
+
+#: contexts a worker process has already unpickled, by token (a few plans at a time)
+_CONTEXTS: OrderedDict[str, WorkerContext] = OrderedDict()
+_CONTEXTS_KEPT = 8
+
+
+def _restore_context(token: str, payload: bytes) -> WorkerContext:
+    context = _CONTEXTS.get(token)
+    if context is None:
+        context = WorkerContext(**pickle.loads(payload))
+        _CONTEXTS[token] = context
+        if len(_CONTEXTS) > _CONTEXTS_KEPT:
+            _CONTEXTS.popitem(last=False)
+    return context
 
 
 @dataclass(frozen=True, eq=False)

@@ -124,7 +124,7 @@ class PQRRT(Planner):
 
     def _round(self, state: RunState) -> None:
         view = self._view(state, self._temperature_index(state))
-        results = map_tasks(self.executor, search_database, self._context(), view, self._worker_groups())
+        results = map_tasks(self.executor, search_database, state.context, view, self._worker_groups())
         longest = 0
         for result in results:
             longest = max(longest, self._integrate(state, result))

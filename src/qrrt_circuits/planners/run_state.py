@@ -32,6 +32,7 @@ class RunState:
         self.round_reachable = 0
         self._nodes_at_round_start = 0
         self.policy_state = None
+        self.context = None  # the plan's WorkerContext, built once
 
     @property
     def oracle_calls(self) -> int:
