@@ -12,11 +12,11 @@ on the executor: every task draws its randomness from streams keyed by (round, w
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from concurrent.futures import Executor
 import pickle
 import uuid
 from collections import OrderedDict
+from collections.abc import Callable, Sequence
+from concurrent.futures import Executor
 from dataclasses import dataclass, field
 from itertools import repeat
 from typing import TypeVar
