@@ -3,8 +3,9 @@
 Candidate (c, p) is reachable iff the closed-loop trajectory x(t) = c + expm(M t)(p - c),
 t in [0, T], stays in the workspace and outside every obstacle. The check is conservative at a
 documented ``resolution`` (default 0.01 length units): any trajectory that touches an obstacle is
-rejected, and a collision-free one is only rejected if it passes within ``resolution`` of an
-obstacle or of the workspace boundary (see ``qrrt_circuits.collision``).
+rejected, and a collision-free one is only rejected if it passes within
+(1 + sqrt(d)) * ``resolution`` of an obstacle or 2 * ``resolution`` of the workspace boundary
+(``ReachabilityOracle.false_rejection_bound``; the derivation is in ``qrrt_circuits.collision``).
 
 ``ReachabilityOracle`` implements the ``ReachabilityPredicate`` protocol
 (``qrrt_circuits.predicate``). ``OracleErrorModel`` lives in ``qrrt_circuits.oracle_errors`` and is
@@ -81,8 +82,15 @@ class ReachabilityOracle:
     def dim(self) -> int:
         return self.env.dim
 
+    @property
+    def false_rejection_bound(self) -> dict[str, float]:
+        """How close a free trajectory must pass to be rejected: (1 + sqrt(d)) * resolution to an
+        obstacle, 2 * resolution to the workspace boundary. Farther, a free trajectory is accepted."""
+        return {"obstacle": (1.0 + float(np.sqrt(self.dim))) * self.resolution, "boundary": 2.0 * self.resolution}
+
     def describe(self) -> dict:
         return {"name": self.name, "resolution": self.resolution, "sound": True,
+                "false_rejection_bound": self.false_rejection_bound,
                 "dynamics": self.dynamics.describe()}
 
     def reachable(self, parents: np.ndarray, children: np.ndarray) -> np.ndarray:
