@@ -65,14 +65,10 @@ def run_ompl_rrt(env: Environment, start: np.ndarray, goal: np.ndarray, goal_rad
     ou.RNG.setSeed(int(seed) + 1)
     ou.setLogLevel(ou.LogLevel.LOG_WARN)
 
-    space = ob.RealVectorStateSpace(d)
-    bounds = ob.RealVectorBounds(d)
-    for axis in range(d):
-        bounds.setLow(axis, float(env.bounds[axis, 0]))
-        bounds.setHigh(axis, float(env.bounds[axis, 1]))
-    space.setBounds(bounds)
-    si = ob.SpaceInformation(space)
-    si.setStateValidityChecker(lambda s: bool(env.is_free(np.array(s[0:d]))))
+    from qrrt_circuits.adapters.ompl import environment_space_information
+
+    si = environment_space_information(env)
+    space = si.getStateSpace()
 
     class Validator(ob.MotionValidator):
         """Directed closed-loop motion s1 (parent) -> s2 (child) checked by our oracle."""

@@ -143,18 +143,10 @@ class OMPLMotionPredicate:
                 f"longest_valid_segment_length={self.space.getLongestValidSegmentLength():.4g})")
 
 
-def from_environment(env: Environment, resolution: float = 0.01, name: str = "ompl") -> OMPLMotionPredicate:
-    """An ``OMPLMotionPredicate`` checking straight-line motions in ``env`` with OMPL.
-
-    Builds a ``RealVectorStateSpace`` with the environment's bounds, a ``SpaceInformation`` whose
-    state validity checker is ``env.is_free`` on one state, and OMPL's default motion validator for
-    such a space, the ``DiscreteMotionValidator`` (installed by ``SpaceInformation``'s constructor;
-    OMPL 2.0 does not bind the class itself), with ``resolution`` as the longest valid segment
-    fraction (``si.setStateValidityCheckingResolution``): states along a segment are tested at most
-    ``resolution * space.getMaximumExtent()`` apart (the workspace diagonal times ``resolution``).
-    """
-    check_instance(env, "env", Environment, "an Environment")
-    resolution = check_float(resolution, "resolution", 0.0, 1.0, open_minimum=True)
+def environment_space_information(env: Environment) -> ob.SpaceInformation:
+    """An OMPL ``SpaceInformation`` for ``env``: a ``RealVectorStateSpace`` with its bounds and a
+    state validity checker that is ``env.is_free`` on one state (motion validation left to OMPL's
+    default, or to whatever the caller installs)."""
     d = env.dim
     space = ob.RealVectorStateSpace(d)
     bounds = ob.RealVectorBounds(d)
@@ -168,6 +160,22 @@ def from_environment(env: Environment, resolution: float = 0.01, name: str = "om
         return bool(env.is_free(np.array(state[0:d])))
 
     si.setStateValidityChecker(is_valid)
+    return si
+
+
+def from_environment(env: Environment, resolution: float = 0.01, name: str = "ompl") -> OMPLMotionPredicate:
+    """An ``OMPLMotionPredicate`` checking straight-line motions in ``env`` with OMPL.
+
+    Builds a ``RealVectorStateSpace`` with the environment's bounds, a ``SpaceInformation`` whose
+    state validity checker is ``env.is_free`` on one state, and OMPL's default motion validator for
+    such a space, the ``DiscreteMotionValidator`` (installed by ``SpaceInformation``'s constructor;
+    OMPL 2.0 does not bind the class itself), with ``resolution`` as the longest valid segment
+    fraction (``si.setStateValidityCheckingResolution``): states along a segment are tested at most
+    ``resolution * space.getMaximumExtent()`` apart (the workspace diagonal times ``resolution``).
+    """
+    check_instance(env, "env", Environment, "an Environment")
+    resolution = check_float(resolution, "resolution", 0.0, 1.0, open_minimum=True)
+    si = environment_space_information(env)
     si.setStateValidityCheckingResolution(resolution)
     si.setup()
     predicate = OMPLMotionPredicate(si, name=name)
