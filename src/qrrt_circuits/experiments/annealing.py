@@ -18,6 +18,7 @@ from ..plotting import plot_edges
 from ..search.policies import FixedIterations
 from .base import Experiment, TrialStream, paired_trials
 from .figures import new_figure, save
+from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import dumps, loads, rounded
 from .planners import make_planner
 from .worlds import world
@@ -68,7 +69,18 @@ class Annealing(Experiment):
                                                             if r[f"mean_parent_distance_{size}"] is not None])), 3)
                             for size in settings["sizes"]}
         ratio = {str(s): round(ours["QDA"][str(s)] / ours["QRRT"][str(s)], 2) for s in settings["sizes"]}
+        interval = {}
+        for method in METHODS:
+            rows = [r for r in records if r["method"] == method]
+            interval[method] = {
+                str(size): rounded_interval(bootstrap_interval(rows, lambda sample, size=size: float(np.mean(
+                    [r[f"mean_parent_distance_{size}"] for r in sample
+                     if r[f"mean_parent_distance_{size}"] is not None])), settings["seed"]), 3)
+                for size in settings["sizes"]}
+        smallest = str(min(settings["sizes"]))
         return {"ours": ours, "paper": self.paper, "ratio_qda_over_uniform": ratio,
+                "interval_95": interval,
+                "differs_from_paper": {m: differs(self.paper[m], interval[m][smallest]) for m in METHODS},
                 "target_2x_reached": bool(ratio[str(min(settings["sizes"]))] >= 2.0),
                 "note": "mean distance from node to parent over the first 16 and all 48 nodes"}
 

@@ -10,6 +10,7 @@ import numpy as np
 
 from .base import Experiment, Trial, TrialStream, replicate_seed
 from .figures import new_figure, node_heatmap, save
+from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import cut_at, dumps, loads, reachable_fraction, rounded
 from .planners import make_planner
 from .worlds import world
@@ -53,7 +54,11 @@ class Corridor(Experiment):
 
     def summarize(self, records, settings):
         ours = {kind: sum(r["in_channel"] for r in records if r["planner"] == kind) for kind in PLANNERS}
-        return {"ours": ours, "paper": self.paper,
+        interval = {kind: rounded_interval(bootstrap_interval(
+            [r for r in records if r["planner"] == kind], lambda rows: sum(r["in_channel"] for r in rows),
+            settings["seed"]), 1) for kind in PLANNERS}
+        return {"ours": ours, "paper": self.paper, "interval_95": interval,
+                "differs_from_paper": {kind: differs(self.paper[kind], interval[kind]) for kind in PLANNERS},
                 "through_channel": {k: sum(r["through_channel"] for r in records if r["planner"] == k)
                                     for k in PLANNERS},
                 "nodes": {k: sum(r["nodes"] for r in records if r["planner"] == k) for k in PLANNERS},

@@ -19,6 +19,7 @@ import numpy as np
 
 from .base import Experiment, Trial, TrialStream, replicate_seed
 from .figures import new_figure, node_heatmap, save
+from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import cut_at, dumps, loads, reachable_fraction, rounded
 from .planners import BACKEND_LABEL, make_planner
 from .worlds import world
@@ -76,7 +77,26 @@ class Heatmaps(Experiment):
                                         "efficiency": round(nodes / calls, 4) if calls else None}
         fractions = {k: round(float(np.mean([r["reachable_fraction"] for r in records if r["planner"] == k])), 4)
                      for k in PLANNERS}
+        interval, differs_from_paper = {}, {}
+        for kind in PLANNERS:
+            rows = [r for r in records if r["planner"] == kind]
+            interval[kind], differs_from_paper[kind] = {}, {}
+            for cut in settings["cuts"]:
+                def nodes(sample, cut=cut):
+                    return sum(r[f"nodes_at_{cut}"] for r in sample)
+
+                def efficiency(sample, cut=cut):
+                    calls = sum(r[f"calls_at_{cut}"] for r in sample)
+                    return sum(r[f"nodes_at_{cut}"] for r in sample) / calls if calls else float("nan")
+
+                span = {"nodes": rounded_interval(bootstrap_interval(rows, nodes, settings["seed"]), 1),
+                        "efficiency": rounded_interval(bootstrap_interval(rows, efficiency, settings["seed"]))}
+                interval[kind][str(cut)] = span
+                paper = self.paper.get(kind, {}).get(str(cut))
+                if paper:
+                    differs_from_paper[kind][str(cut)] = {key: differs(paper[key], span[key]) for key in span}
         return {"ours": ours, "paper": self.paper, "mean_reachable_fraction": fractions,
+                "interval_95": interval, "differs_from_paper": differs_from_paper,
                 "note": f"totals over {settings['trials']} trials per planner; the paper used 100. "
                         "PQRRT is cut on critical-path calls (8 parallel devices); its 'calls' are those.",
                 "labels": ["phase oracle from a classical lookup of all 2^8 entries",

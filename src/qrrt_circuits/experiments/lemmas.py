@@ -21,6 +21,7 @@ from .. import probability as pr
 from ..oracle import OracleErrorModel
 from .base import Experiment, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
+from .intervals import binomial_interval, rounded_interval
 from .planners import make_backend
 
 GRID_QUBITS = (4, 6)
@@ -130,7 +131,9 @@ class Lemmas(Experiment):
                 z.append((observed - theory) / stderr)
             z = np.abs(np.array(z))
             ours[lemma] = {"points": int(z.size), "max_abs_z": round(float(z.max()), 2) if z.size else None,
-                           "within_3_sigma": round(float(np.mean(z <= 3)), 3) if z.size else None}
+                           "within_3_sigma": round(float(np.mean(z <= 3)), 3) if z.size else None,
+                           "within_3_sigma_interval_95": rounded_interval(
+                               binomial_interval(int(np.sum(z <= 3)), int(z.size)), 3)}
         return {"ours": ours, "paper": self.paper,
                 "note": "z = (observed - lemma) / standard error; the lemmas are exact for these "
                         "events, so about 99.7% of points should lie within 3 sigma"}

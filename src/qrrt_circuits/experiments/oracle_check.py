@@ -17,6 +17,7 @@ from ..oracle import ReachabilityOracle
 from ..registry import PREDICATES
 from .base import Experiment, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
+from .intervals import bootstrap_interval, rounded_interval
 from .measures import cut_at, reachable_fraction
 from .planners import make_planner
 from .worlds import world
@@ -29,6 +30,11 @@ def make_predicate(env, check: str):
     """``exact`` or ``samples-K`` (the registry's ``time-samples:K``)."""
     name = "exact" if check == "exact" else f"time-samples:{check.split('-')[1]}"
     return PREDICATES.create(name, env=env)
+
+
+def efficiency(rows) -> float:
+    """Nodes per oracle call over ``rows`` (the paper's oracle efficiency)."""
+    return sum(r["nodes"] for r in rows) / max(sum(r["oracle_calls"] for r in rows), 1)
 
 
 class OracleCheck(Experiment):
@@ -60,16 +66,17 @@ class OracleCheck(Experiment):
                 "reachable_fraction": reachable_fraction(result)}
 
     def summarize(self, records, settings):
-        ours, invalid, fraction = {}, {}, {}
+        ours, invalid, fraction, interval = {}, {}, {}, {}
         for check in settings["checks"]:
-            ours[check], invalid[check], fraction[check] = {}, {}, {}
+            ours[check], invalid[check], fraction[check], interval[check] = {}, {}, {}, {}
             for kind in PLANNERS:
                 rows = [r for r in records if r["check"] == check and r["planner"] == kind]
                 nodes = sum(r["nodes"] for r in rows)
-                ours[check][kind] = round(nodes / max(sum(r["oracle_calls"] for r in rows), 1), 4)
+                ours[check][kind] = round(efficiency(rows), 4)
+                interval[check][kind] = rounded_interval(bootstrap_interval(rows, efficiency, settings["seed"]))
                 invalid[check][kind] = round(sum(r["invalid_edges"] for r in rows) / max(nodes, 1), 4)
                 fraction[check][kind] = round(float(np.mean([r["reachable_fraction"] for r in rows])), 4)
-        return {"ours": ours, "paper": {"efficiency_at_40_calls": self.paper},
+        return {"ours": ours, "paper": {"efficiency_at_40_calls": self.paper}, "interval_95": interval,
                 "invalid_edge_fraction": invalid, "reachable_fraction": fraction,
                 "note": "efficiency = nodes / oracle calls at the 40-call cut; invalid edges are tree edges the "
                         "exact check rejects (they pass through an obstacle)"}

@@ -16,6 +16,7 @@ import numpy as np
 from .base import Experiment, TrialStream, paired_trials
 from .figures import new_figure, save
 from .fitting import linear_fit
+from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import dumps, growth_curve, loads
 from .planners import BACKEND_LABEL, make_planner
 from .worlds import world
@@ -61,7 +62,16 @@ class OracleEfficiency(Experiment):
             rows = [r for r in records if r["planner"] == kind]
             per_node[kind] = round(sum(r["oracle_calls"] for r in rows) / max(sum(r["nodes"] for r in rows), 1), 3)
         quantum_first = max(slopes["QRRT"], slopes["PQRRT"]) < min(slopes["RRT"], slopes["ParallelRRT"])
+
+        def slope(rows, column=1):
+            points = np.array([p for r in rows for p in loads(r["curve_json"])])
+            return linear_fit(points[:, 0], points[:, column]).slope if len(points) > 1 else float("nan")
+
+        interval = {kind: rounded_interval(bootstrap_interval([r for r in records if r["planner"] == kind], slope,
+                                                              settings["seed"]), 3) for kind in PLANNERS}
         return {"ours": slopes, "paper": dict(self.paper),
+                "interval_95": interval,
+                "differs_from_paper": {kind: differs(self.paper[kind], interval[kind]) for kind in PLANNERS},
                 "critical_path_slope": critical, "pooled_calls_per_node": per_node,
                 "ordering_reproduced": bool(quantum_first and slopes["QRRT"] < slopes["PQRRT"]),
                 "labels": ["phase oracle from a classical lookup of all 2^8 entries",

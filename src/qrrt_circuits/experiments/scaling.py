@@ -17,6 +17,7 @@ from ..search.policies import BBHT, Adaptive, KnownOptimal
 from .base import Experiment, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .fitting import power_law_exponent
+from .intervals import bootstrap_interval, rounded_interval
 from .measures import reachable_fraction
 from .planners import BACKEND_LABEL, make_planner
 from .worlds import world
@@ -69,7 +70,10 @@ class Scaling(Experiment):
             fit = power_law_exponent([r["reachable_fraction"] for r in rows], [r["calls_per_node"] for r in rows])
             ours[name] = round(fit.slope, 3)
             fits[name] = {"exponent": fit.slope, "stderr": fit.slope_stderr, "prefactor": float(np.exp(fit.intercept)),
-                          "points": fit.points}
+                          "points": fit.points,
+                          "interval_95": rounded_interval(bootstrap_interval(rows, lambda sample: power_law_exponent(
+                              [r["reachable_fraction"] for r in sample], [r["calls_per_node"] for r in sample]).slope,
+                              settings["seed"]), 3)}
         return {"ours": ours, "paper": self.paper, "fits": fits,
                 "note": "'paper' holds the theoretical exponents (-1 classical, -1/2 Grover); the "
                         "paper itself does not run this experiment",

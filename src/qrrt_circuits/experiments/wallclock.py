@@ -16,6 +16,7 @@ import numpy as np
 from .base import Experiment, TrialStream, paired_trials
 from .figures import new_figure, save
 from .fitting import slope_through_origin
+from .intervals import bootstrap_interval, rounded_interval
 from .planners import make_planner
 from .worlds import world
 
@@ -55,13 +56,15 @@ class Wallclock(Experiment):
                 "wall_time_s": m.wall_time_s}
 
     def summarize(self, records, settings):
-        per_call, per_node, ms_node = {}, {}, {}
+        per_call, per_node, ms_node, ms_interval = {}, {}, {}, {}
         for planner, backend in CONFIGS:
             rows = [r for r in records if r["planner"] == planner and r["backend"] == backend]
             times = np.array([r["wall_time_s"] for r in rows])
             name = label(planner, backend)
             per_node[name] = slope_through_origin([r["nodes"] for r in rows], times)
             ms_node[name] = round(per_node[name] * 1e3, 4)
+            ms_interval[name] = rounded_interval(bootstrap_interval(rows, lambda sample: 1e3 * slope_through_origin(
+                [r["nodes"] for r in sample], [r["wall_time_s"] for r in sample]), settings["seed"]))
             if backend != "none":
                 per_call[name] = slope_through_origin([r["oracle_calls"] for r in rows], times)
         speedup = {}
@@ -69,7 +72,7 @@ class Wallclock(Experiment):
             base = name.split(" ")[0]
             speedup[name] = round(self.paper["seconds_per_node"][base] / value, 1)
         return {"ours": {"seconds_per_oracle_call": per_call, "seconds_per_node": per_node},
-                "paper": self.paper, "ms_per_node": ms_node,
+                "paper": self.paper, "ms_per_node": ms_node, "ms_per_node_interval_95": ms_interval,
                 "speedup_over_paper_per_node": speedup,
                 "note": "the paper's times are MATLAB on an 8-core M2; ours one process on this machine"}
 

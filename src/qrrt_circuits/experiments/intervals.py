@@ -1,0 +1,54 @@
+"""95 % intervals on reproduced numbers: a percentile bootstrap over trials for any statistic of
+the records, and the exact (Clopper-Pearson) interval for a binomial rate.
+
+A number "differs from the paper" when the paper's value lies outside our interval. The bootstrap
+resamples whole trials (a trial is the independent unit: one tree, one world), with a generator
+seeded from the experiment's seed, so a summary is reproducible.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+from scipy.stats import binomtest
+
+LEVEL = 0.95
+RESAMPLES = 2000
+
+
+def bootstrap_interval(trials: Sequence[Any], statistic: Callable[[list], float], seed: int,
+                       resamples: int = RESAMPLES, level: float = LEVEL) -> tuple[float, float]:
+    """Percentile bootstrap interval of ``statistic(trials)``, resampling whole trials."""
+    trials = list(trials)
+    if len(trials) < 2:
+        value = float(statistic(trials)) if trials else float("nan")
+        return value, value
+    rng = np.random.default_rng(seed)
+    values = np.array([statistic([trials[i] for i in rng.integers(0, len(trials), len(trials))])
+                       for _ in range(resamples)], dtype=float)
+    values = values[np.isfinite(values)]
+    if values.size == 0:
+        return float("nan"), float("nan")
+    tail = (1.0 - level) / 2.0
+    return float(np.quantile(values, tail)), float(np.quantile(values, 1.0 - tail))
+
+
+def binomial_interval(successes: int, trials: int, level: float = LEVEL) -> tuple[float, float]:
+    """Exact (Clopper-Pearson) interval of a success rate."""
+    if trials <= 0:
+        return float("nan"), float("nan")
+    interval = binomtest(int(successes), int(trials)).proportion_ci(confidence_level=level, method="exact")
+    return float(interval.low), float(interval.high)
+
+
+def rounded_interval(interval: tuple[float, float], digits: int = 4) -> list[float]:
+    return [round(interval[0], digits), round(interval[1], digits)]
+
+
+def differs(paper: float | None, interval: Sequence[float]) -> bool | None:
+    """True if the paper's value lies outside our interval (None if there is nothing to compare)."""
+    if paper is None or not np.all(np.isfinite(interval)):
+        return None
+    return bool(paper < interval[0] or paper > interval[1])
