@@ -160,3 +160,26 @@ def test_reproduce_command(tmp_path, capsys):
     assert "== lemmas" in out and "summary.json" in out
     with pytest.raises(SystemExit):
         main(["reproduce", "nope", "--out", str(tmp_path)])
+
+
+def test_intervals_cover_at_their_level():
+    """The bootstrap interval of a mean and the exact binomial interval cover the true value in at
+    least the binomial lower bound of 95 % of 200 replicates (a bootstrap percentile interval of
+    30 normal samples undercovers slightly: allow the nominal level minus that known bias, 0.93)."""
+    from tolerances import binomial_counts
+
+    from qrrt_circuits.experiments.intervals import binomial_interval, bootstrap_interval, differs
+
+    rng = np.random.default_rng(0)
+    replicates, boot, exact = 200, 0, 0
+    for seed in range(replicates):
+        sample = list(rng.normal(3.0, 1.0, 30))
+        low, high = bootstrap_interval(sample, lambda s: float(np.mean(s)), seed, resamples=400)
+        boot += low <= 3.0 <= high
+        successes = int(rng.binomial(50, 0.3))
+        low, high = binomial_interval(successes, 50)
+        exact += low <= 0.3 <= high
+    assert boot >= binomial_counts(replicates, 0.93)[0]
+    assert exact >= binomial_counts(replicates, 0.95)[0]
+    assert differs(5.0, [1.0, 2.0]) is True and differs(1.5, [1.0, 2.0]) is False
+    assert differs(None, [1.0, 2.0]) is None
