@@ -183,3 +183,32 @@ def test_intervals_cover_at_their_level():
     assert exact >= binomial_counts(replicates, 0.95)[0]
     assert differs(5.0, [1.0, 2.0]) is True and differs(1.5, [1.0, 2.0]) is False
     assert differs(None, [1.0, 2.0]) is None
+
+
+def _predicate_names():
+    from qrrt_circuits.registry import PREDICATES
+
+    return [label.replace(":K", ":50") for label in PREDICATES.labels() if label != "exact"]
+
+
+@pytest.mark.parametrize("predicate", _predicate_names())
+@pytest.mark.parametrize("name", sorted(n for n in EXPERIMENTS if EXPERIMENTS[n].uses_predicate))
+def test_quick_path_under_each_predicate(name, predicate, tmp_path):
+    summary = run_experiment(name, out=tmp_path, quick=True, trials=TINY[name], progress=False,
+                             predicate=predicate)
+    assert summary["complete"] and summary["settings"]["predicate"] == predicate
+    records = read_records(tmp_path / name / "records.csv")
+    assert len(records) == len(EXPERIMENTS[name].trials(summary["settings"]))
+
+
+def test_settings_written_before_predicates_existed_mean_the_exact_check(tmp_path):
+    run_experiment("corridor", out=tmp_path, quick=True, trials=1, progress=False)
+    path = tmp_path / "corridor" / "settings.json"
+    old = json.loads(path.read_text())
+    del old["predicate"]
+    path.write_text(json.dumps(old))
+    assert run_experiment("corridor", out=tmp_path, quick=True, trials=1, progress=False)["complete"]
+    with pytest.raises(ValueError, match="holds results for other settings"):
+        run_experiment("corridor", out=tmp_path, quick=True, trials=1, progress=False, predicate="time-samples:20")
+    with pytest.raises(ValueError, match="experiment 'lemmas' does not take a predicate"):
+        run_experiment("lemmas", out=tmp_path, predicate="time-samples:20")

@@ -174,10 +174,12 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     if args.experiment != "all" and args.experiment not in EXPERIMENTS:
         raise ValueError(f"EXPERIMENT must be one of {sorted(EXPERIMENTS)} or 'all', got {args.experiment!r}")
     names = sorted(EXPERIMENTS) if args.experiment == "all" else [args.experiment]
+    if args.predicate != "exact":  # 'all' with another check: the experiments that plan with one
+        names = [name for name in names if EXPERIMENTS[name].uses_predicate or args.experiment != "all"]
     for name in names:
         summary = run_experiment(name, out=args.out, quick=args.quick, trials=args.trials, seed=args.seed,
                                  progress=not args.no_progress, executor=args.executor, jobs=args.jobs,
-                                 scheduler=args.scheduler)
+                                 scheduler=args.scheduler, predicate=args.predicate)
         print(f"== {name}: {summary.get('title', '')}")
         print(f"   ours : {summary['ours']}")
         print(f"   paper: {summary['paper']}")
@@ -250,6 +252,9 @@ def _add_reproduce_parser(sub, formatter) -> None:
     reproduce.add_argument("--jobs", type=_positive_int, default=None, help="worker processes (default: cores)")
     reproduce.add_argument("--scheduler", default=None,
                            help="address of an existing Dask scheduler (with --executor dask)")
+    reproduce.add_argument("--predicate", type=_registered(PREDICATES), default="exact",
+                           metavar="|".join(PREDICATES.labels()),
+                           help=f"the planners' reachability check: {PREDICATES.help_text()}")
     reproduce.set_defaults(func=cmd_reproduce)
 
 

@@ -20,7 +20,7 @@ from .base import Experiment, TrialStream, paired_trials
 from .figures import new_figure, save
 from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import dumps, loads, rounded
-from .planners import make_planner
+from .planners import planner_for
 from .worlds import world
 
 METHODS = ("QDA", "QRRT")
@@ -47,7 +47,7 @@ class Annealing(Experiment):
         if trial.params["method"] == "QDA":
             annealing = AnnealingSchedule(bands=[tuple(b) for b in settings["bands"]],
                                           switch_at=(settings["switch_at"],), counter="nodes")
-        planner = make_planner("QRRT", env, trial.seed, settings["backend"],
+        planner = planner_for(settings, "QRRT", env, trial.seed, settings["backend"],
                                num_qubits=settings["num_qubits"],
                                search_policy=FixedIterations(settings["iterations"]), annealing=annealing)
         result = planner.plan(max_nodes=max(settings["sizes"]))

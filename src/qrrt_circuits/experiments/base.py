@@ -70,6 +70,8 @@ class Experiment:
 
     name = "experiment"
     title = ""
+    #: whether the experiment's planners take the reachability predicate chosen by ``--predicate``
+    uses_predicate = True
     #: what the paper reports (filled by subclasses)
     paper: dict = {}
 

@@ -12,7 +12,7 @@ from .base import Experiment, Trial, TrialStream, replicate_seed
 from .figures import new_figure, node_heatmap, save
 from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import cut_at, dumps, loads, reachable_fraction, rounded
-from .planners import make_planner
+from .planners import planner_for
 from .worlds import world
 
 PLANNERS = ("RRT", "QRRT")
@@ -40,7 +40,7 @@ class Corridor(Experiment):
 
     def run_trial(self, trial, settings):
         env = world(settings["scenario"], settings["world_seed"])
-        planner = make_planner(trial.params["planner"], env, trial.seed, settings["backend"],
+        planner = planner_for(settings, trial.params["planner"], env, trial.seed, settings["backend"],
                                num_qubits=settings["num_qubits"])
         result = planner.plan(max_oracle_calls=settings["budget"])
         nodes, calls = cut_at(result, settings["budget"])

@@ -21,7 +21,7 @@ from .base import Experiment, Trial, TrialStream, replicate_seed
 from .figures import new_figure, node_heatmap, save
 from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import cut_at, dumps, loads, reachable_fraction, rounded
-from .planners import BACKEND_LABEL, make_planner
+from .planners import BACKEND_LABEL, planner_for
 from .worlds import world
 
 PLANNERS = ("RRT", "QRRT", "PQRRT")
@@ -48,7 +48,7 @@ class Heatmaps(Experiment):
 
     def run_trial(self, trial, settings):
         env = world(settings["scenario"], settings["world_seed"])
-        planner = make_planner(trial.params["planner"], env, trial.seed, settings["backend"],
+        planner = planner_for(settings, trial.params["planner"], env, trial.seed, settings["backend"],
                                settings["workers"], settings["num_qubits"])
         critical = trial.params["planner"] == "PQRRT"
         if critical:

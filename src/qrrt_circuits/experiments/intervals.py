@@ -26,13 +26,22 @@ def bootstrap_interval(trials: Sequence[Any], statistic: Callable[[list], float]
         value = float(statistic(trials)) if trials else float("nan")
         return value, value
     rng = np.random.default_rng(seed)
-    values = np.array([statistic([trials[i] for i in rng.integers(0, len(trials), len(trials))])
+    values = np.array([_defined(statistic, [trials[i] for i in rng.integers(0, len(trials), len(trials))])
                        for _ in range(resamples)], dtype=float)
     values = values[np.isfinite(values)]
     if values.size == 0:
         return float("nan"), float("nan")
     tail = (1.0 - level) / 2.0
     return float(np.quantile(values, tail)), float(np.quantile(values, 1.0 - tail))
+
+
+def _defined(statistic: Callable[[list], float], sample: list) -> float:
+    """The statistic of one resample, or NaN where it is undefined there (a line fit through one
+    distinct x, say): such resamples are left out of the percentiles."""
+    try:
+        return float(statistic(sample))
+    except (ValueError, ZeroDivisionError):
+        return float("nan")
 
 
 def binomial_interval(successes: int, trials: int, level: float = LEVEL) -> tuple[float, float]:

@@ -48,6 +48,7 @@ def _collection_times(indices: np.ndarray, targets: np.ndarray) -> list[int]:
 
 class Lemmas(Experiment):
     name = "lemmas"
+    uses_predicate = False  # no planner: random marked databases
     title = "Lemmas 1-6 against Aer shot frequencies"
     paper = {"lemma1": "P(G)^p m^(1-p)", "lemma2": "P(G)^p m! / (m^p (m-p)!)",
              "lemma3": "m H_m / P(G)", "lemma4": "(m1/m) P(G) + (m2/(N-m)) (1-P(G))",

@@ -18,7 +18,7 @@ from .figures import new_figure, save
 from .fitting import linear_fit
 from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import dumps, growth_curve, loads
-from .planners import BACKEND_LABEL, make_planner
+from .planners import BACKEND_LABEL, planner_for
 from .worlds import world
 
 PLANNERS = ("RRT", "ParallelRRT", "QRRT", "PQRRT")
@@ -41,7 +41,7 @@ class OracleEfficiency(Experiment):
 
     def run_trial(self, trial, settings):
         env = world(settings["scenario"], trial.params["world_seed"])
-        planner = make_planner(trial.params["planner"], env, trial.seed, settings["backend"],
+        planner = planner_for(settings, trial.params["planner"], env, trial.seed, settings["backend"],
                                settings["workers"], settings["num_qubits"])
         result = planner.plan(max_nodes=settings["nodes"])
         m = result.metrics

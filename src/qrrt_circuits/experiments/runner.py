@@ -48,15 +48,20 @@ def _run_on(executor: Executor, name: str, trials: list[Trial], settings: dict, 
             future.cancel()
 
 
-def _check_arguments(name: str, trials, seed, executor, jobs, scheduler) -> str | None:
+def _check_arguments(name: str, trials, seed, executor, jobs, scheduler, predicate: str) -> str | None:
     """Refuse bad arguments before any work; returns the executor kind (None for an object)."""
     from ..execution import check_executor_args
+    from ..registry import PREDICATES
     from . import EXPERIMENTS
 
     if name not in EXPERIMENTS:
         raise ValueError(f"unknown experiment {name!r}; choose one of {sorted(EXPERIMENTS)} or 'all'")
     check_optional_int(trials, "trials", 1)
     check_int(seed, "seed", 0)
+    PREDICATES.resolve(predicate)
+    if not EXPERIMENTS[name].uses_predicate and PREDICATES.canonical(predicate) != "exact":
+        raise ValueError(f"experiment {name!r} does not take a predicate (it plans nothing with one); "
+                         "run it without --predicate")
     if isinstance(executor, str) or executor is None:
         kind = executor or "serial"
         check_executor_args(kind, jobs, scheduler)
@@ -70,6 +75,9 @@ def _claim_directory(directory: Path, settings: dict) -> None:
     settings_path = directory / SETTINGS
     if settings_path.exists():
         stored = json.loads(settings_path.read_text())
+        if "predicate" not in stored and settings.get("predicate") == "exact":
+            stored["predicate"] = "exact"  # written by 0.1, whose experiments always used the exact check
+            settings_path.write_text(json.dumps(stored, indent=1))
         if stored != settings:
             raise ValueError(
                 f"{directory} holds results for other settings ({stored}); use another --out or "
@@ -139,6 +147,7 @@ def run_experiment(
     on_record: Callable[[dict], None] | None = None,
     max_restarts: int = 3,
     on_restart: Callable[[int], None] | None = None,
+    predicate: str = "exact",
 ) -> dict:
     """Run (or resume) experiment ``name`` into ``out/name``; returns the summary.
 
@@ -147,13 +156,18 @@ def run_experiment(
     Records are written as trials finish, in whatever order. If a local process pool breaks (a
     worker died), a new pool is started and the unfinished trials resubmitted, up to
     ``max_restarts`` times; Dask reschedules a dead worker's tasks itself. ``stop_after`` stops
-    after that many new trials (for tests of resuming).
+    after that many new trials (for tests of resuming). ``predicate`` (a ``PREDICATES`` name) is
+    the reachability check the experiment's planners use, recorded in the settings.
     """
+    from ..registry import PREDICATES
     from . import EXPERIMENTS
 
-    kind = _check_arguments(name, trials, seed, executor, jobs, scheduler)
+    kind = _check_arguments(name, trials, seed, executor, jobs, scheduler, predicate)
     experiment = EXPERIMENTS[name]
-    settings = json.loads(json.dumps(experiment.settings(quick, trials, int(seed))))  # as stored
+    settings = experiment.settings(quick, trials, int(seed))
+    if experiment.uses_predicate:
+        settings["predicate"] = PREDICATES.canonical(predicate)
+    settings = json.loads(json.dumps(settings))  # as stored
     directory = Path(out) / name
     _claim_directory(directory, settings)
     all_trials = experiment.trials(settings)

@@ -19,7 +19,7 @@ from .figures import new_figure, save
 from .fitting import power_law_exponent
 from .intervals import bootstrap_interval, rounded_interval
 from .measures import reachable_fraction
-from .planners import BACKEND_LABEL, make_planner
+from .planners import BACKEND_LABEL, planner_for
 from .worlds import world
 
 CONFIGS = {"RRT": None, "QRRT optimal": KnownOptimal, "QRRT bbht": BBHT, "QRRT adaptive": Adaptive}
@@ -53,9 +53,9 @@ class Scaling(Experiment):
         env = world("paper_clutter", trial.params["world_seed"], num_boxes=trial.params["boxes"])
         name = trial.params["config"]
         if name == "RRT":
-            planner = make_planner("RRT", env, trial.seed)
+            planner = planner_for(settings, "RRT", env, trial.seed)
         else:
-            planner = make_planner("QRRT", env, trial.seed, settings["backend"],
+            planner = planner_for(settings, "QRRT", env, trial.seed, settings["backend"],
                                    num_qubits=settings["num_qubits"], search_policy=CONFIGS[name]())
         result = planner.plan(max_nodes=settings["nodes"])
         m = result.metrics

@@ -17,7 +17,7 @@ from .base import Experiment, TrialStream, paired_trials
 from .figures import new_figure, save
 from .fitting import slope_through_origin
 from .intervals import bootstrap_interval, rounded_interval
-from .planners import make_planner
+from .planners import planner_for
 from .worlds import world
 
 CONFIGS = (("RRT", "none"), ("ParallelRRT", "none"), ("QRRT", "aer"), ("QRRT", "statevector"),
@@ -45,7 +45,7 @@ class Wallclock(Experiment):
     def run_trial(self, trial, settings):
         env = world(settings["scenario"], trial.params["world_seed"])
         backend = trial.params["backend"]
-        planner = make_planner(trial.params["planner"], env, trial.seed,
+        planner = planner_for(settings, trial.params["planner"], env, trial.seed,
                                "statevector" if backend == "none" else backend,
                                settings["workers"], settings["num_qubits"])
         planner.plan(max_rounds=2)  # warm-up: compile kernels, build simulators
