@@ -9,7 +9,8 @@ from qrrt_circuits.experiments.base import TIMING_SUFFIX
 from qrrt_circuits.experiments.fitting import linear_fit, power_law_exponent, slope_through_origin
 
 TINY = {"oracle-efficiency": 1, "wallclock": 1, "heatmaps": 2, "corridor": 2, "annealing": 1,
-        "lemmas": 60, "scaling": 1, "oracle-check": 1}
+        "lemmas": 60, "scaling": 1, "oracle-check": 1,
+        "tree-size": 1}
 
 
 def _is_png(path):
@@ -95,9 +96,21 @@ def _check_oracle_check(summary, records):
     assert all(r["invalid_edges"] == 0 for r in records if r["check"] == "exact")
 
 
+def _check_tree_size(summary, records):
+    sizes = summary["settings"]["sizes"]
+    for r in records:  # cumulative calls at each size never decrease, and each size was reached
+        points = json.loads(r["points_json"])
+        assert [p[0] for p in points] == sizes
+        assert all(a[1] <= b[1] and a[2] <= b[2] <= b[1] for a, b in zip(points, points[1:], strict=False))
+    for label, windows in summary["ours"].items():
+        low, high = next(iter(summary["interval_95"][label].values()))
+        assert low <= next(iter(windows.values())) <= high or low == high
+
+
 CHECKS = {"oracle-efficiency": _check_oracle_efficiency, "wallclock": _check_wallclock,
           "heatmaps": _check_heatmaps, "corridor": _check_corridor, "annealing": _check_annealing,
-          "lemmas": _check_lemmas, "scaling": _check_scaling, "oracle-check": _check_oracle_check}
+          "lemmas": _check_lemmas, "scaling": _check_scaling, "oracle-check": _check_oracle_check,
+          "tree-size": _check_tree_size}
 
 
 def _comparable(records):

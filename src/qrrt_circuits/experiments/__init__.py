@@ -9,12 +9,13 @@ from .oracle_check import OracleCheck
 from .oracle_efficiency import OracleEfficiency
 from .runner import read_records, run_experiment
 from .scaling import Scaling
+from .tree_size import TreeSize
 from .wallclock import Wallclock
 
 EXPERIMENTS = {
     experiment.name: experiment
     for experiment in (OracleEfficiency(), Wallclock(), Heatmaps(), Corridor(), Annealing(), Lemmas(),
-                       Scaling(), OracleCheck())
+                       Scaling(), OracleCheck(), TreeSize())
 }
 
 __all__ = ["EXPERIMENTS", "read_records", "run_experiment"]

@@ -33,6 +33,8 @@ class TrialStream(IntEnum):
     SCALING_WORLDS = 8
     SCALING_PLANNERS = 9
     ORACLE_CHECK = 10
+    TREE_SIZE_WORLDS = 11
+    TREE_SIZE_PLANNERS = 12
 
 
 @dataclass(frozen=True)
