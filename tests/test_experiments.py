@@ -10,7 +10,7 @@ from qrrt_circuits.experiments.fitting import linear_fit, power_law_exponent, sl
 
 TINY = {"oracle-efficiency": 1, "wallclock": 1, "heatmaps": 2, "corridor": 2, "annealing": 1,
         "lemmas": 60, "scaling": 1, "oracle-check": 1,
-        "tree-size": 1}
+        "tree-size": 1, "heatmap-hypotheses": 3}
 
 
 def _is_png(path):
@@ -107,10 +107,23 @@ def _check_tree_size(summary, records):
         assert low <= next(iter(windows.values())) <= high or low == high
 
 
+def _check_heatmap_hypotheses(summary, records):
+    from qrrt_circuits.experiments.heatmap_hypotheses import calibrate, max_nodes_within
+
+    # the arithmetic that rules out the paper schedule: 6 calls a round, at most 2 rounds by 10 calls
+    assert summary["arithmetic"]["paper_schedule_max_nodes_at_10_calls"] == 200 < 372
+    assert max_nodes_within(10, 3, 100) == 400 and calibrate([100, 200], [0.2, 0.1], 0.15) == 150
+    assert calibrate([100, 200], [0.2, 0.1], 0.5) is None
+    for variant, by_count in summary["table"].items():
+        for boxes, by_cut in by_count.items():
+            rows = [r for r in records if r["variant"] == variant and r["boxes"] == int(boxes)]
+            assert by_cut["10"]["nodes"] == round(100 * sum(r["nodes_at_10"] for r in rows) / len(rows), 1)
+
+
 CHECKS = {"oracle-efficiency": _check_oracle_efficiency, "wallclock": _check_wallclock,
           "heatmaps": _check_heatmaps, "corridor": _check_corridor, "annealing": _check_annealing,
           "lemmas": _check_lemmas, "scaling": _check_scaling, "oracle-check": _check_oracle_check,
-          "tree-size": _check_tree_size}
+          "tree-size": _check_tree_size, "heatmap-hypotheses": _check_heatmap_hypotheses}
 
 
 def _comparable(records):

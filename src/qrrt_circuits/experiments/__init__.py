@@ -3,6 +3,7 @@ writes records.csv (one row per trial), summary.json and figures, and resumes in
 
 from .annealing import Annealing
 from .corridor import Corridor
+from .heatmap_hypotheses import HeatmapHypotheses
 from .heatmaps import Heatmaps
 from .lemmas import Lemmas
 from .oracle_check import OracleCheck
@@ -15,7 +16,7 @@ from .wallclock import Wallclock
 EXPERIMENTS = {
     experiment.name: experiment
     for experiment in (OracleEfficiency(), Wallclock(), Heatmaps(), Corridor(), Annealing(), Lemmas(),
-                       Scaling(), OracleCheck(), TreeSize())
+                       Scaling(), OracleCheck(), TreeSize(), HeatmapHypotheses())
 }
 
 __all__ = ["EXPERIMENTS", "read_records", "run_experiment"]

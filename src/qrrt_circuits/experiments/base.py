@@ -35,6 +35,7 @@ class TrialStream(IntEnum):
     ORACLE_CHECK = 10
     TREE_SIZE_WORLDS = 11
     TREE_SIZE_PLANNERS = 12
+    HEATMAP_HYPOTHESES = 13
 
 
 @dataclass(frozen=True)
