@@ -10,7 +10,8 @@ from qrrt_circuits.experiments.fitting import linear_fit, power_law_exponent, sl
 
 TINY = {"oracle-efficiency": 1, "wallclock": 1, "heatmaps": 2, "corridor": 2, "annealing": 1,
         "lemmas": 60, "scaling": 1, "oracle-check": 1,
-        "tree-size": 1, "heatmap-hypotheses": 3}
+        "tree-size": 1, "heatmap-hypotheses": 3,
+        "corridor-sensitivity": 2}
 
 
 def _is_png(path):
@@ -120,10 +121,21 @@ def _check_heatmap_hypotheses(summary, records):
             assert by_cut["10"]["nodes"] == round(100 * sum(r["nodes_at_10"] for r in rows) / len(rows), 1)
 
 
+def _check_corridor_sensitivity(summary, records):
+    from qrrt_circuits.experiments.corridor_sensitivity import BASE, cell_id, cells
+
+    assert summary["base"] == cell_id(BASE) and set(summary["ours"]) == {cell_id(c) for c in
+                                                                         cells(summary["settings"]["factors"])}
+    for r in records:
+        assert 0 <= r["in_channel"] <= r["nodes"] and r["start_distance"] >= r["distance"]
+        assert r["oracle_calls"] >= summary["settings"]["budget"]
+
+
 CHECKS = {"oracle-efficiency": _check_oracle_efficiency, "wallclock": _check_wallclock,
           "heatmaps": _check_heatmaps, "corridor": _check_corridor, "annealing": _check_annealing,
           "lemmas": _check_lemmas, "scaling": _check_scaling, "oracle-check": _check_oracle_check,
-          "tree-size": _check_tree_size, "heatmap-hypotheses": _check_heatmap_hypotheses}
+          "tree-size": _check_tree_size, "heatmap-hypotheses": _check_heatmap_hypotheses,
+          "corridor-sensitivity": _check_corridor_sensitivity}
 
 
 def _comparable(records):

@@ -79,15 +79,18 @@ def paper_clutter(seed: int | None = 0, num_boxes: int = CLUTTER_BOXES,
 
 
 def narrow_corridor(seed: int | None = 0, width: float = 0.4, length: float = 4.0,
-                    clutter: int = 120) -> Environment:
+                    clutter: int = 120, mouth_clearance: float = 1.5) -> Environment:
     """[0, 20]^2 split by two large blocks leaving one horizontal channel ``width`` wide and
-    ``length`` long through the middle (paper §V.C); small random boxes on both sides, kept out of
-    the channel's mouths. Start in front of the left mouth (0.5 to 1.5 before it, on its axis), goal on the right."""
+    ``length`` long through the middle (paper §V.C); small random boxes on both sides, kept
+    ``mouth_clearance`` away from the channel's mouths (smaller: denser clutter beside the mouth).
+    Start in front of the left mouth (0.5 to 1.5 before it, on its axis), goal on the right."""
     _check_seed(seed)
     if not (0 < width < 10):
         raise ValueError(f"width must be in (0, 10), got {width}")
     if not (0 < length < 18):
         raise ValueError(f"length must be in (0, 18), got {length}")
+    if not (0 <= mouth_clearance <= 5):
+        raise ValueError(f"mouth_clearance must be in [0, 5], got {mouth_clearance}")
     rng = _world_rng("narrow_corridor", seed)
     size = CLUTTER_SIZE
     x0, x1 = (size - length) / 2, (size + length) / 2
@@ -99,8 +102,8 @@ def narrow_corridor(seed: int | None = 0, width: float = 0.4, length: float = 4.
         box = _random_boxes(rng, 1, np.zeros(2), np.full(2, size))[0]
         if box[1, 0] > x0 - 0.3 and box[0, 0] < x1 + 0.3:
             continue  # overlaps the wall's columns: keep the wall's faces clean
-        near_mouth_y = box[1, 1] > y0 - keep_out and box[0, 1] < y1 + keep_out
-        near_mouth_x = box[1, 0] > x0 - keep_out and box[0, 0] < x1 + keep_out
+        near_mouth_y = box[1, 1] > y0 - mouth_clearance and box[0, 1] < y1 + mouth_clearance
+        near_mouth_x = box[1, 0] > x0 - mouth_clearance and box[0, 0] < x1 + mouth_clearance
         if near_mouth_y and near_mouth_x:
             continue
         small.append(box)
@@ -116,7 +119,8 @@ def narrow_corridor(seed: int | None = 0, width: float = 0.4, length: float = 4.
     return Environment(env.bounds, boxes, name="narrow_corridor", start=start, goal=goal,
                        goal_radius=GOAL_RADIUS,
                        metadata={"seed": seed, "channel": [[x0, y0], [x1, y1]],
-                                 "width": width, "length": length, "clutter": clutter})
+                                 "width": width, "length": length, "clutter": clutter,
+                                 "mouth_clearance": mouth_clearance})
 
 
 def annealing_field(seed: int | None = 0, num_boxes: int = 6025) -> Environment:

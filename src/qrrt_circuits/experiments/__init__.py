@@ -3,6 +3,7 @@ writes records.csv (one row per trial), summary.json and figures, and resumes in
 
 from .annealing import Annealing
 from .corridor import Corridor
+from .corridor_sensitivity import CorridorSensitivity
 from .heatmap_hypotheses import HeatmapHypotheses
 from .heatmaps import Heatmaps
 from .lemmas import Lemmas
@@ -16,7 +17,8 @@ from .wallclock import Wallclock
 EXPERIMENTS = {
     experiment.name: experiment
     for experiment in (OracleEfficiency(), Wallclock(), Heatmaps(), Corridor(), Annealing(), Lemmas(),
-                       Scaling(), OracleCheck(), TreeSize(), HeatmapHypotheses())
+                       Scaling(), OracleCheck(), TreeSize(), HeatmapHypotheses(),
+                       CorridorSensitivity())
 }
 
 __all__ = ["EXPERIMENTS", "read_records", "run_experiment"]

@@ -36,6 +36,7 @@ class TrialStream(IntEnum):
     TREE_SIZE_WORLDS = 11
     TREE_SIZE_PLANNERS = 12
     HEATMAP_HYPOTHESES = 13
+    CORRIDOR_SENSITIVITY = 14
 
 
 @dataclass(frozen=True)
