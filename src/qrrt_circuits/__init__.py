@@ -6,6 +6,7 @@ Lathrop, Boardman and Martinez, "Parallel Quantum Rapidly-Exploring Random Trees
 """
 
 from . import probability, registry, scenarios, termination
+from .authors_check import AuthorsCheck
 from .database import AnnealingSchedule
 from .dynamics import LinearTrackingDynamics
 from .environment import Environment
@@ -56,6 +57,7 @@ __all__ = [
     "AerBackend",
     "AnnealingSchedule",
     "AnyOf",
+    "AuthorsCheck",
     "DatabaseSearch",
     "Environment",
     "FixedIterations",

@@ -230,9 +230,25 @@ def _time_samples(value: str, env, dynamics=None):
     return TimeSampledCheck(env, dynamics, time_samples=count)
 
 
+def _authors(env, dynamics=None):
+    from .authors_check import AuthorsCheck
+
+    return AuthorsCheck(env, dynamics, refine=4)
+
+
+def _authors_octave(env, dynamics=None):
+    from .authors_check import AuthorsCheck
+
+    return AuthorsCheck(env, dynamics, refine=1)
+
+
 def _predicates() -> Registry:
     registry = Registry("predicate")
     registry.register("exact", _exact, "sound check, exact up to the resolution (ours)")
+    registry.register("authors", _authors,
+                      "the authors' dynamicscheck.m under MATLAB's ode45 (Refine 4; unsound, tail untested)")
+    registry.register("authors-octave", _authors_octave,
+                      "the authors' dynamicscheck.m under Octave's ode45 (1 output a step; unsound, nearly exact)")
     registry.register("time-samples", _time_samples, "K evenly spaced time samples only (unsound; for study)",
                       parameter="K")
     return registry
