@@ -54,6 +54,20 @@ def calls_at_sizes(result, sizes) -> list[list[int]]:
     return out
 
 
+def reachable_fraction_by_window(result, sizes) -> dict[str, float]:
+    """The truly reachable share of the candidates evaluated while the tree grew through each window
+    of sizes (RRT: its tests; q-RRT: its database entries): what sets Grover's success
+    probability sin^2((2k+1) theta), sin^2 theta = f."""
+    nodes = result.history["nodes"]
+    out = {}
+    for low, high in zip(sizes[:-1], sizes[1:], strict=True):
+        rounds = (nodes >= low) & (np.concatenate([[0], nodes[:-1]]) < high)
+        entries = int(result.history["entries"][rounds].sum())
+        if entries and np.any(nodes >= high):
+            out[f"{low}-{high}"] = int(result.history["reachable"][rounds].sum()) / entries
+    return out
+
+
 def marginal(points: list[list[int]], column: int = 1) -> dict[str, float]:
     """Calls added per node added between consecutive sizes: {"30-100": ..., ...}."""
     out = {}
@@ -84,7 +98,8 @@ class TreeSize(Experiment):
         result = planner.plan(env.start, env.goal, 1e-9, max_nodes=max(settings["sizes"]))
         return {"status": str(result.status), "nodes": result.metrics.nodes, "rounds": result.metrics.rounds,
                 "oracle_calls": result.metrics.oracle_calls,
-                "points_json": dumps(calls_at_sizes(result, settings["sizes"]))}
+                "points_json": dumps(calls_at_sizes(result, settings["sizes"])),
+                "fractions_json": dumps(reachable_fraction_by_window(result, settings["sizes"]))}
 
     def summarize(self, records, settings):
         sizes = settings["sizes"]
@@ -108,6 +123,10 @@ class TreeSize(Experiment):
             interval[label] = {w: rounded_interval(bootstrap_interval(rows, lambda s, w=w: pooled(s, w),
                                                                       settings["seed"]), 3) for w in windows}
             critical[label] = {w: round(pooled(rows, w, 2), 3) for w in windows}
+        fractions = {label: {w: round(float(np.mean([loads(r["fractions_json"])[w] for r in records
+                                                     if r["config"] == label and w in loads(r["fractions_json"])]
+                                                    or [np.nan])), 4) for w in windows}
+                     for label in settings["configs"]}
         crossover = {}
         for label in settings["configs"]:
             if label == "RRT":
@@ -117,6 +136,7 @@ class TreeSize(Experiment):
             crossover[label] = worse[0] if worse else None
         return {"ours": ours, "paper": self.paper, "interval_95": interval,
                 "critical_path_per_node": critical, "crossover_window": crossover,
+                "mean_reachable_fraction": fractions,
                 "note": "marginal oracle calls per node added in each window of tree sizes, pooled over "
                         "worlds; crossover_window: the first window where the planner is no longer "
                         "cheaper per node than RRT (Pq-RRT compared on its critical path)",
