@@ -107,6 +107,7 @@ class Annealing(Experiment):
                                         axis=1) for r in records if r["method"] == method]
             ax.hist(np.concatenate(distances), bins=30, color="tab:blue" if method == "QRRT" else "tab:red")
             ax.set_xlabel("distance to parent")
-            ax.set_title(f"{method}: mean {summary['ours'][method][str(sizes[0])]} (16 nodes), "
+            low, high = summary["interval_95"][method][str(sizes[0])]
+            ax.set_title(f"{method}: mean {summary['ours'][method][str(sizes[0])]} [{low}, {high}] (16 nodes), "
                          f"paper {self.paper[method]}", fontsize=9)
         return [save(fig, out_dir / "annealing.png")]

@@ -75,7 +75,8 @@ class Corridor(Experiment):
             points = [np.array(loads(r["positions_json"])).reshape(-1, 2) for r in records if r["planner"] == kind]
             points = np.concatenate(points) if points else np.zeros((0, 2))
             node_heatmap(axes[0, col], env, points,
-                         f"{kind}: {summary['ours'][kind]} nodes in the channel (paper {self.paper[kind]})",
+                         f"{kind}: {summary['ours'][kind]} nodes in the channel "
+                         f"{summary['interval_95'][kind]} (paper {self.paper[kind]})",
                          goal=env.goal, radius=env.goal_radius)
             axes[0, col].plot(*env.start, "o", color="tab:green")
         return [save(fig, out_dir / "corridor.png")]

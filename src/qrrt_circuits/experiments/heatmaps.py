@@ -114,7 +114,9 @@ class Heatmaps(Experiment):
                 stats = summary["ours"][kind][str(cut)]
                 paper = self.paper.get(kind, {}).get(str(cut))
                 unit = "critical-path calls" if kind == "PQRRT" else "calls"
-                text = f"{kind}, {cut} {unit}: {stats['nodes']} nodes, eff. {stats['efficiency']:.1%}"
+                low, high = summary["interval_95"][kind][str(cut)]["efficiency"]
+                text = (f"{kind}, {cut} {unit}: {stats['nodes']} nodes, eff. {stats['efficiency']:.1%} "
+                        f"[{low:.1%}, {high:.1%}]")
                 if paper:
                     text += f"\npaper: {paper['nodes']} nodes, {paper['efficiency']:.1%}"
                 node_heatmap(axes[row, col], env, points, text, goal=env.goal, radius=env.goal_radius)

@@ -86,7 +86,8 @@ class OracleEfficiency(Experiment):
                 fit = linear_fit(points[:, 0], points[:, column])
                 ax.scatter(points[:, 0], points[:, column], s=6, alpha=0.35, color=COLORS[kind])
                 xs = np.array([0, points[:, 0].max()])
-                extra = f", paper {self.paper[kind]}" if column == 1 else ""
+                low, high = summary["interval_95"][kind]
+                extra = f" [{low:.1f}, {high:.1f}], paper {self.paper[kind]}" if column == 1 else ""
                 ax.plot(xs, fit.slope * xs + fit.intercept, color=COLORS[kind],
                         label=f"{kind}: {fit.slope:.1f}/node{extra}")
             ax.set_xlabel("nodes")
