@@ -15,27 +15,41 @@ closed box ``bounds``. Environments round-trip through a documented JSON format:
 from __future__ import annotations
 
 import json
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .validation import check_int
+from .validation import check_float, check_int
 
 FORMAT_NAME = "qrrt-environment"
 FORMAT_VERSION = 1
 
 
+#: the largest workspace extent accepted on any axis (beyond it extents and distances overflow)
+MAX_EXTENT = 1e12
+
+
 def _as_float_array(value: Any, name: str) -> np.ndarray:
+    if value is None or isinstance(value, str | bytes):
+        raise ValueError(f"{name} must be an array of numbers, got {value!r}")
     try:
         array = np.asarray(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be numeric, got {value!r}") from exc
+    except (TypeError, ValueError, OverflowError) as exc:
+        shown = repr(value)
+        raise ValueError(f"{name} must be numeric, got {shown[:80]}{'...' if len(shown) > 80 else ''}") from exc
     if not np.all(np.isfinite(array)):
         raise ValueError(f"{name} must contain only finite numbers (no NaN or inf)")
     return array
+
+
+def _metadata(value: Any) -> dict:
+    if value is None:
+        return {}
+    if not isinstance(value, dict):
+        raise ValueError(f"'metadata' must be an object, got {value!r}")
+    return dict(value)
 
 
 @dataclass(frozen=True, eq=False)
@@ -64,7 +78,12 @@ class Environment:
                 f"bounds[{axis}]: low must be < high, got low={bounds[axis, 0]}, "
                 f"high={bounds[axis, 1]}"
             )
+        if np.any(np.abs(bounds) > MAX_EXTENT):
+            raise ValueError(f"bounds must lie within [-{MAX_EXTENT:g}, {MAX_EXTENT:g}] on every axis, got "
+                             f"{bounds.tolist()}")
         d = bounds.shape[0]
+        if self.boxes is None:
+            raise ValueError("boxes must be an array of shape (k, 2, d), got None")
         boxes = _as_float_array(self.boxes if len(self.boxes) else np.zeros((0, 2, d)), "boxes")
         if boxes.ndim != 3 or boxes.shape[1:] != (2, d):
             raise ValueError(f"boxes must have shape (k, 2, {d}), got {boxes.shape}")
@@ -89,10 +108,8 @@ class Environment:
                 point.setflags(write=False)
                 object.__setattr__(self, key, point)
         if self.goal_radius is not None:
-            radius = float(self.goal_radius)
-            if not math.isfinite(radius) or radius <= 0:
-                raise ValueError(f"goal_radius must be a finite number > 0, got {self.goal_radius}")
-            object.__setattr__(self, "goal_radius", radius)
+            object.__setattr__(self, "goal_radius", check_float(self.goal_radius, "goal_radius", 0.0,
+                                                                open_minimum=True))
 
     @property
     def dim(self) -> int:
@@ -110,7 +127,7 @@ class Environment:
     def in_bounds(self, points: np.ndarray) -> np.ndarray:
         """True where ``points`` (..., d) lie in the closed workspace box."""
         points = self._check_points(points)
-        return np.all((points >= self.bounds[:, 0]) & (points <= self.bounds[:, 1]), axis=-1)
+        return np.all((points >= self.bounds[:, 0]) & (points <= self.bounds[:, 1]), axis=-1)  # NaN: False
 
     def is_free(self, points: np.ndarray) -> np.ndarray:
         """True where ``points`` (..., d) are inside the bounds and outside every (closed) box."""
@@ -123,6 +140,7 @@ class Environment:
         out = np.zeros(flat.shape[0], dtype=np.bool_)
         points_free(flat, self.bounds, self._lower, self._upper, index.origin, index.cell_size,
                     index.shape, index.cell_start, index.cell_items, out)
+        out &= np.all(np.isfinite(flat), axis=1)  # a non-finite point is never free
         return out.reshape(shape)
 
     @property
@@ -173,6 +191,8 @@ class Environment:
         return float(np.mean(self.is_free(self.sample_uniform(samples, rng))))
 
     def _check_points(self, points: np.ndarray) -> np.ndarray:
+        """Points as a float array (..., d). Non-finite coordinates are allowed here and are never
+        in bounds or free."""
         points = np.asarray(points, dtype=float)
         if points.shape[-1:] != (self.dim,):
             raise ValueError(
@@ -208,16 +228,18 @@ class Environment:
                 raise ValueError(f"environment JSON is missing {key!r}")
         bounds = _as_float_array(data["bounds"], "bounds")
         boxes = data["boxes"]
+        if not isinstance(boxes, list):
+            raise ValueError(f"'boxes' must be a list of [[lower...], [upper...]] pairs, got {boxes!r}")
         if len(boxes) == 0:
             boxes = np.zeros((0, 2, bounds.shape[0] if bounds.ndim == 2 else 2))
         return cls(
             bounds=bounds,
             boxes=boxes,
-            name=str(data.get("name", "custom")),
+            name=str(data.get("name", "custom"))[:200],
             start=data.get("start"),
             goal=data.get("goal"),
             goal_radius=data.get("goal_radius"),
-            metadata=dict(data.get("metadata") or {}),
+            metadata=_metadata(data.get("metadata")),
         )
 
     def save(self, path: str | Path) -> Path:
@@ -228,10 +250,15 @@ class Environment:
     @classmethod
     def load(cls, path: str | Path) -> Environment:
         try:
-            data = json.loads(Path(path).read_text())
-        except json.JSONDecodeError as exc:
+            data = json.loads(Path(path).read_text(encoding="utf-8"))
+        except UnicodeDecodeError as exc:
+            raise ValueError(f"{path}: not a UTF-8 text file ({exc.reason} at byte {exc.start})") from exc
+        except (json.JSONDecodeError, ValueError) as exc:
             raise ValueError(f"{path}: not valid JSON ({exc})") from exc
-        return cls.from_dict(data)
+        try:
+            return cls.from_dict(data)
+        except ValueError as exc:
+            raise ValueError(f"{path}: {exc}") from exc
 
     def __repr__(self) -> str:
         return f"Environment(name={self.name!r}, d={self.dim}, boxes={self.num_boxes})"
