@@ -8,7 +8,7 @@ import pytest
 
 import qrrt_circuits as qc
 from qrrt_circuits.environment import Environment
-from qrrt_circuits.termination import Progress, from_budgets, with_round_limit
+from qrrt_circuits.termination import DEFAULT_STALL_ROUNDS, Progress, from_budgets, with_defaults, with_round_limit
 
 WALLED_GOAL = np.array([[[14, 14], [18, 14.5]], [[14, 17.5], [18, 18]], [[14, 14], [14.5, 18]],
                         [[17.5, 14], [18, 18]]], dtype=float)
@@ -122,7 +122,8 @@ def test_termination_argument_combines_with_the_shorthands(walled):
     result = qc.RRT(walled, seed=0).plan([1, 1], [16, 16], 0.5, termination=qc.MaxRounds(30),
                                          max_oracle_calls=12)
     assert result.status == "max_oracle_calls" and result.metrics.rounds == 12
-    assert result.settings["termination"] == {"max_rounds": 30, "max_oracle_calls": 12}
+    assert result.settings["termination"] == {"max_rounds": 30, "max_oracle_calls": 12,
+                                              "stall_rounds": DEFAULT_STALL_ROUNDS}
     with pytest.raises(TypeError, match="termination must be a TerminationCondition"):
         qc.RRT(walled).plan([1, 1], [16, 16], 0.5, termination=30)
 
@@ -157,3 +158,15 @@ def test_bad_limits_are_refused_before_any_work(kwargs, error, message, clutter)
     with pytest.raises(error, match=message):
         planner.plan(**kwargs)
     assert planner.predicate.evaluations == 0
+
+
+def test_default_stall_ends_a_plan_given_only_a_node_budget(monkeypatch, boxed_in):
+    """A plan with only max_nodes that can add no node ends as "stalled" after the default stall
+    limit (0.1 looped forever here)."""
+    from qrrt_circuits import termination
+
+    monkeypatch.setattr(termination, "DEFAULT_STALL_ROUNDS", 25)
+    result = qc.RRT(boxed_in, seed=0).plan([5, 5], [15, 15], 0.5, max_nodes=5)
+    assert result.status == "stalled" and result.metrics.rounds == 25
+    assert with_defaults(qc.Stall(3)) == qc.Stall(3) | qc.MaxRounds(termination.DEFAULT_MAX_ROUNDS)
+    assert with_defaults(qc.MaxRounds(3)) == qc.MaxRounds(3) | qc.Stall(25)

@@ -10,7 +10,8 @@ calls.
 
 A plan runs rounds until the goal is reached or its termination condition ends it
 (``qrrt_circuits.termination``); the condition is checked before each round, and a round limit
-(``DEFAULT_MAX_ROUNDS`` unless the caller limits rounds) is always in force, so every plan ends.
+(``DEFAULT_MAX_ROUNDS``) and a stall limit (``DEFAULT_STALL_ROUNDS``) are always in force unless the
+caller gives their own, so every plan ends.
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ from ..oracle import ReachabilityOracle
 from ..oracle_errors import OracleErrorModel
 from ..predicate import ReachabilityPredicate, check_predicate
 from ..randomness import RandomStreams, Stream
-from ..termination import PlanStatus, TerminationCondition, from_budgets, with_round_limit
+from ..termination import PlanStatus, TerminationCondition, from_budgets, with_defaults
 from ..validation import check_float, check_instance, check_int, check_seed
 from .context import RoundView, WorkerContext
 from .result import Metrics, PlanResult
@@ -136,7 +137,7 @@ class Planner:
         if termination is not None:
             check_instance(termination, "termination", TerminationCondition, "a TerminationCondition")
             condition = termination if condition is None else termination | condition
-        condition = with_round_limit(condition, _termination.DEFAULT_MAX_ROUNDS)
+        condition = with_defaults(condition, _termination.DEFAULT_MAX_ROUNDS, _termination.DEFAULT_STALL_ROUNDS)
         self._check_ready()
         state = RunState(start, goal, goal_radius)
         state.policy_state = self._start_policy()
