@@ -174,3 +174,20 @@ def test_sampler_backend_is_seeded_per_search_when_the_sampler_allows_it(clutter
     first = backend.search(marks, 1, shots=64, seed=1).indices
     assert np.array_equal(first, backend.search(marks, 1, shots=64, seed=1).indices)
     assert not np.array_equal(first, backend.search(marks, 1, shots=64, seed=2).indices)
+
+
+@pytest.mark.parametrize("method", ["density_matrix", "matrix_product_state"])
+def test_unsupported_aer_methods_are_refused_with_the_reason(method):
+    with pytest.raises(ValueError, match=f"method='{method}' is not supported: .*mcphase"):
+        qc.AerBackend(method=method)
+
+
+def test_search_sizes_have_documented_limits():
+    backend = qc.StatevectorBackend(seed=0)
+    marks = np.zeros(16, dtype=bool)
+    with pytest.raises(ValueError, match=r"shots must be an integer in \[1, 10000000\]"):
+        backend.search(marks, 1, shots=10**9)
+    with pytest.raises(ValueError, match=r"iterations must be an integer in \[0, 100000\]"):
+        backend.search(marks, 10**6, shots=1)
+    with pytest.raises(ValueError, match="device must be one of"):
+        qc.AerBackend(device="TPU")

@@ -250,3 +250,27 @@ def test_settings_written_before_predicates_existed_mean_the_exact_check(tmp_pat
         run_experiment("corridor", out=tmp_path, quick=True, trials=1, progress=False, predicate="time-samples:20")
     with pytest.raises(ValueError, match="experiment 'lemmas' does not take a predicate"):
         run_experiment("lemmas", out=tmp_path, predicate="time-samples:20")
+
+
+def test_resume_never_counts_a_trial_twice_or_without_its_settings(tmp_path):
+    whole = run_experiment("corridor", out=tmp_path, quick=True, trials=2, progress=False)
+    path = tmp_path / "corridor" / "records.csv"
+    lines = path.read_text().splitlines(keepends=True)
+    path.write_text("".join(lines + [lines[1]]))  # a duplicated row
+    with pytest.warns(UserWarning, match="second record of trial"):
+        again = run_experiment("corridor", out=tmp_path, quick=True, trials=2, progress=False)
+    assert again["ours"] == whole["ours"] and again["nodes"] == whole["nodes"]
+    assert len(read_records(path)) == 4
+    settings = tmp_path / "corridor" / "settings.json"
+    settings.write_text("{not json")
+    with pytest.raises(ValueError, match=r"settings.json is corrupt"):
+        run_experiment("corridor", out=tmp_path, quick=True, trials=2, progress=False)
+    settings.unlink()
+    with pytest.raises(ValueError, match=r"records.csv has records but .*settings.json is missing"):
+        run_experiment("corridor", out=tmp_path, quick=True, trials=2, seed=1, progress=False)
+
+
+def test_trial_count_has_a_documented_limit(tmp_path):
+    with pytest.raises(ValueError, match=r"trials must be an integer in \[1, 100000\]"):
+        run_experiment("heatmaps", out=tmp_path, trials=10**9)
+    assert not (tmp_path / "heatmaps").exists()  # refused before any file is written

@@ -148,7 +148,7 @@ class Lemmas(Experiment):
             theory = np.array([r[f"{lemma}_theory"] for r in rows])
             observed = np.array([r[f"{lemma}_observed"] for r in rows])
             stderr = np.array([r[f"{lemma}_stderr"] for r in rows])
-            errors = np.array([r["false_positive"] > 0 for r in rows])
+            errors = np.array([r["false_positive"] > 0 for r in rows], dtype=bool)
             for mask, color, label in ((~errors, "tab:blue", "exact oracle"), (errors, "tab:red", "oracle errors")):
                 if mask.any():
                     ax.errorbar(theory[mask], observed[mask], yerr=stderr[mask], fmt="o", ms=3,

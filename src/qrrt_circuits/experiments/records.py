@@ -1,13 +1,16 @@
 """records.csv: one row per finished trial, appended and flushed as trials finish.
 
 A torn last line (the writer was killed mid-write) or a row of the wrong width is dropped and the
-file rewritten without it, so an interrupted run loses at most the trials in flight.
+file rewritten without it, so an interrupted run loses at most the trials in flight. Records are
+keyed by ``trial_id``: a second row with the same id (a file edited or concatenated by hand) is
+dropped with a warning, so no trial is ever counted twice.
 """
 
 from __future__ import annotations
 
 import csv
 import os
+import warnings
 from pathlib import Path
 
 
@@ -38,6 +41,16 @@ def read_records(path: Path) -> list[dict]:
         return []
     header, body = rows[0], rows[1:]
     good = [row for row in body if len(row) == len(header)]
+    if "trial_id" in header:
+        column, seen, unique = header.index("trial_id"), set(), []
+        for row in good:
+            if row[column] in seen:
+                warnings.warn(f"{path}: a second record of trial {row[column]!r} was dropped (each trial "
+                              "counts once)", stacklevel=2)
+                continue
+            seen.add(row[column])
+            unique.append(row)
+        good = unique
     if torn or len(good) != len(body):
         _rewrite(path, header, good)
     return [{key: _convert(value) for key, value in zip(header, row, strict=True)} for row in good]

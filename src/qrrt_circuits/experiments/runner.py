@@ -24,6 +24,8 @@ from .records import RecordWriter, read_records
 __all__ = ["execute_trial", "read_records", "run_experiment"]
 
 RECORDS = "records.csv"
+#: the most trials per variant ``--trials`` accepts (a trial list is built in memory)
+MAX_TRIALS = 100_000
 SUMMARY = "summary.json"
 SETTINGS = "settings.json"
 
@@ -56,7 +58,7 @@ def _check_arguments(name: str, trials, seed, executor, jobs, scheduler, predica
 
     if name not in EXPERIMENTS:
         raise ValueError(f"unknown experiment {name!r}; choose one of {sorted(EXPERIMENTS)} or 'all'")
-    check_optional_int(trials, "trials", 1)
+    check_optional_int(trials, "trials", 1, MAX_TRIALS)
     check_int(seed, "seed", 0)
     PREDICATES.resolve(predicate)
     if not EXPERIMENTS[name].uses_predicate and PREDICATES.canonical(predicate) != "exact":
@@ -73,8 +75,16 @@ def _claim_directory(directory: Path, settings: dict) -> None:
     """Create ``directory`` for ``settings``, or accept it if it holds results for the same settings."""
     directory.mkdir(parents=True, exist_ok=True)
     settings_path = directory / SETTINGS
+    if not settings_path.exists() and (directory / RECORDS).exists() and (directory / RECORDS).stat().st_size:
+        raise ValueError(f"{directory / RECORDS} has records but {settings_path} is missing: their settings "
+                         "(seed, trials, predicate) cannot be checked; use another --out or delete the folder")
     if settings_path.exists():
-        stored = json.loads(settings_path.read_text())
+        try:
+            stored = json.loads(settings_path.read_text())
+        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+            raise ValueError(f"{settings_path} is corrupt ({exc}); use another --out or delete the folder") from exc
+        if not isinstance(stored, dict):
+            raise ValueError(f"{settings_path} is corrupt (not a JSON object); use another --out or delete the folder")
         if "predicate" not in stored and settings.get("predicate") == "exact":
             stored["predicate"] = "exact"  # written by 0.1, whose experiments always used the exact check
             settings_path.write_text(json.dumps(stored, indent=1))

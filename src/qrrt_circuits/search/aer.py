@@ -14,7 +14,13 @@ from ..validation import check_int
 from .backend import QuantumSearchBackend, seed_stream
 from .circuits import SYNTHESES, aer_grover_circuit
 
-METHODS = ("statevector", "matrix_product_state", "density_matrix", "automatic")
+METHODS = ("statevector", "automatic")
+#: methods AerSimulator offers that these circuits cannot run, and why (refused at construction)
+UNSUPPORTED_METHODS = {
+    "density_matrix": "its instruction set lacks the mcphase gate of aer_grover_circuit (and it "
+                      "doubles the qubits); use method='statevector' with a noise_model",
+    "matrix_product_state": "its instruction set lacks the mcphase gate of aer_grover_circuit",
+}
 
 
 class AerBackend(QuantumSearchBackend):
@@ -35,8 +41,14 @@ class AerBackend(QuantumSearchBackend):
         device: str = "CPU",
         max_parallel_threads: int = 0,
     ) -> None:
+        if method in UNSUPPORTED_METHODS:
+            raise ValueError(f"method={method!r} is not supported: {UNSUPPORTED_METHODS[method]}")
         if method not in METHODS:
             raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+        available = AerSimulator().available_devices()
+        if device not in available:
+            raise ValueError(f"device must be one of {tuple(available)} for this qiskit-aer build, got {device!r} "
+                             "(device='GPU' needs qiskit-aer-gpu and an NVIDIA GPU)")
         if synthesis not in SYNTHESES:
             raise ValueError(f"synthesis must be one of {SYNTHESES}, got {synthesis!r}")
         check_int(max_parallel_threads, "max_parallel_threads", 0, 4096)
@@ -49,19 +61,11 @@ class AerBackend(QuantumSearchBackend):
             noise_model=noise_model,
             max_parallel_threads=int(max_parallel_threads),
         )
-        if device not in self.simulator.available_devices():
-            raise ValueError(
-                f"device must be one of {self.simulator.available_devices()} for this qiskit-aer "
-                f"build, got {device!r}"
-            )
         self.device = device
 
     @property
     def max_qubits(self) -> int:
-        limit = int(self.simulator.configuration().n_qubits)
-        if self.method == "density_matrix":
-            limit //= 2
-        return limit
+        return int(self.simulator.configuration().n_qubits)
 
     def _sample(self, marks, num_qubits, iterations, shots, rng) -> np.ndarray:
         circuit = aer_grover_circuit(marks, iterations, measure=True, synthesis=self.synthesis)

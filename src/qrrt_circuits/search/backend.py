@@ -52,12 +52,18 @@ def validate_marks(marks: np.ndarray) -> tuple[np.ndarray, int]:
     return array, size.bit_length() - 1
 
 
+#: generous upper limits: far beyond any useful search (the optimal k for N = 2^30 and m = 1 is
+#: 25 735), small enough that a circuit or a result never exhausts memory
+MAX_ITERATIONS = 100_000
+MAX_SHOTS = 10_000_000
+
+
 def validate_iterations(iterations: int) -> int:
-    return check_int(iterations, "iterations", 0)
+    return check_int(iterations, "iterations", 0, MAX_ITERATIONS)
 
 
 def validate_shots(shots: int) -> int:
-    return check_int(shots, "shots", 1)
+    return check_int(shots, "shots", 1, MAX_SHOTS)
 
 
 def seed_stream(seed: int | np.random.Generator | None) -> np.random.Generator:
