@@ -127,3 +127,30 @@ def test_get_executor_cleans_up():
 def test_bad_executor_arguments(kwargs, message, tmp_path):
     with pytest.raises(ValueError, match=message):
         run_experiment("lemmas", out=tmp_path, quick=True, trials=20, progress=False, **kwargs)
+
+
+def test_process_pool_workers_exit_when_the_client_is_killed(tmp_path):
+    """SIGKILL the client of --executor process mid-sweep: its pool workers notice their parent is
+    gone and exit within seconds (0.1 left them running for minutes)."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    import psutil
+
+    client = subprocess.Popen([sys.executable, "-m", "qrrt_circuits.cli", "reproduce", "heatmaps", "--quick",
+                               "--executor", "process", "--jobs", "2", "--out", str(tmp_path), "--no-progress"],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    workers = []
+    for _ in range(600):  # wait (up to 60 s) until the pool's workers have started
+        time.sleep(0.1)
+        workers = [p for p in psutil.Process(client.pid).children(recursive=True)
+                   if "resource_tracker" not in " ".join(p.cmdline())]
+        if len(workers) >= 2:
+            break
+    assert len(workers) >= 2, "the pool did not start"
+    client.send_signal(signal.SIGKILL)
+    client.wait()
+    gone, alive = psutil.wait_procs(workers, timeout=10)
+    assert not alive, f"workers still running 10 s after the client died: {[p.pid for p in alive]}"

@@ -86,9 +86,30 @@ def _print_search(args: argparse.Namespace, marks: np.ndarray, iterations: int, 
 
 
 # ----------------------------------------------------------------------------------------- plan
-def _check_output_file(path: str | None, option: str) -> None:
-    if path is not None and not Path(path).resolve().parent.is_dir():
+PLOT_FORMATS = (".png", ".pdf", ".svg", ".jpg", ".jpeg")
+
+
+def _check_output_file(path: str | None, option: str, suffixes: tuple[str, ...] | None = None) -> None:
+    """Refuse an output path that cannot be written, before any work is done."""
+    if path is None:
+        return
+    import os
+
+    target = Path(path)
+    if str(path) == "" or target.is_dir():
+        raise ValueError(f"{option}: {path!r} is a folder, not a file name")
+    if not target.resolve().parent.is_dir():
         raise ValueError(f"{option}: the folder of {path!r} does not exist")
+    existed = target.exists()
+    try:  # open it now, so an unwritable path fails before the work, not after
+        with target.open("a"):
+            pass
+    except OSError as exc:
+        raise ValueError(f"{option}: {path!r} cannot be written ({exc.strerror})") from None
+    if not existed:
+        os.remove(target)
+    if suffixes is not None and target.suffix.lower() not in suffixes:
+        raise ValueError(f"{option}: {path!r} must end in one of {', '.join(suffixes)}")
 
 
 def _load_environment(args: argparse.Namespace):
@@ -154,7 +175,7 @@ def _write_plan_outputs(args: argparse.Namespace, result, env) -> None:
 
 def cmd_plan(args: argparse.Namespace) -> int:
     _check_output_file(args.json, "--json")
-    _check_output_file(args.plot, "--plot")
+    _check_output_file(args.plot, "--plot", PLOT_FORMATS)
     env = _load_environment(args)
     planner = build_planner(args, env)
     result = planner.plan(max_nodes=args.max_nodes, max_oracle_calls=args.max_oracle_calls,
@@ -169,6 +190,8 @@ def cmd_plan(args: argparse.Namespace) -> int:
 def cmd_reproduce(args: argparse.Namespace) -> int:
     from .experiments import EXPERIMENTS, run_experiment
 
+    if str(args.out).strip() == "":
+        raise ValueError("--out must name a folder, got ''")
     if Path(args.out).exists() and not Path(args.out).is_dir():
         raise ValueError(f"--out: {args.out!r} exists and is not a folder")
     if args.experiment != "all" and args.experiment not in EXPERIMENTS:
@@ -186,7 +209,8 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         for key in ("ordering_reproduced", "ratio_qda_over_uniform", "speedup_over_paper_per_node"):
             if key in summary:
                 print(f"   {key}: {summary[key]}")
-        print(f"   wrote {args.out}/{name}/ (records.csv, summary.json, {', '.join(summary['figures'])})")
+        print(f"   wrote {Path(args.out).resolve() / name}/ (records.csv, summary.json, "
+              f"{', '.join(summary['figures'])})")
     return 0
 
 
@@ -273,6 +297,11 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         return args.func(args)
+    except KeyboardInterrupt:
+        kept = ("finished trials are kept in records.csv; run the same command again to resume"
+                if args.command == "reproduce" else "nothing was written")
+        print(f"qrrt {args.command}: interrupted; {kept}", file=sys.stderr)
+        return 130
     except (ValueError, TypeError) as exc:
         parser.exit(2, f"qrrt {args.command}: error: {exc}\n")
     except OSError as exc:  # unreadable files, an unreachable Dask scheduler, a full disk

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import expm
 
-from .validation import check_int
+from .validation import check_float, check_int
 
 PAPER_A = ((-1.5, -2.0), (1.0, 3.0))
 PAPER_B = ((0.5, 0.25), (0.0, 1.0))
@@ -34,6 +34,10 @@ class LinearTrackingDynamics:
     horizon: float = 5.0
 
     def __post_init__(self) -> None:
+        for name in ("A", "B", "K"):
+            raw = np.asarray(getattr(self, name))
+            if raw.dtype.kind not in "biuf" or raw.dtype.kind == "b":
+                raise TypeError(f"{name} must be a real numeric matrix, got dtype {raw.dtype}")
         A = np.array(self.A, dtype=float)
         B = np.array(self.B, dtype=float)
         K = np.array(self.K, dtype=float)
@@ -47,8 +51,7 @@ class LinearTrackingDynamics:
         for name, mat in (("A", A), ("B", B), ("K", K)):
             if not np.all(np.isfinite(mat)):
                 raise ValueError(f"{name} must contain only finite numbers")
-        if not (np.isfinite(self.horizon) and self.horizon > 0):
-            raise ValueError(f"horizon must be a finite number > 0, got {self.horizon}")
+        check_float(self.horizon, "horizon", 0.0, open_minimum=True)
         closed = A - B @ K
         eigenvalues = np.linalg.eigvals(closed)
         if np.max(eigenvalues.real) >= 0:

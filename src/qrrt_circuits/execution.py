@@ -32,8 +32,30 @@ SINGLE_THREAD_ENV = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_N
                      "NUMBA_NUM_THREADS": "1"}
 
 
-def _worker_init() -> None:
+#: how often a pool worker checks that its parent is alive (seconds)
+PARENT_POLL_S = 0.5
+
+
+def _exit_when_orphaned(parent: int) -> None:
+    """Runs in a daemon thread of each pool worker: when the parent dies (killed with SIGKILL, say,
+    so it could not shut the pool down), the worker is re-parented and exits at once instead of
+    lingering with its memory."""
+    import time
+
+    while os.getppid() == parent:
+        time.sleep(PARENT_POLL_S)
+    os._exit(1)
+
+
+def _worker_init(parent: int | None = None) -> None:
+    """Pool worker start-up: one thread per native library, and a watch on ``parent`` (the pid of
+    the process that made the pool, passed in, since a worker still importing when its parent
+    dies would otherwise take its new parent for the real one)."""
+    import threading
+
     os.environ.update(SINGLE_THREAD_ENV)
+    parent = os.getppid() if parent is None else parent
+    threading.Thread(target=_exit_when_orphaned, args=(parent,), daemon=True, name="qrrt-orphan-watch").start()
 
 
 def check_executor_args(kind: str, jobs: int | None, scheduler: str | None) -> int:
@@ -63,7 +85,7 @@ def get_executor(kind: str = "serial", jobs: int | None = None, scheduler: str |
         import multiprocessing
 
         with ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("spawn"),
-                                 initializer=_worker_init) as pool:
+                                 initializer=_worker_init, initargs=(os.getpid(),)) as pool:
             yield pool
         return
     from distributed import Client, LocalCluster
