@@ -257,7 +257,7 @@ class Environment:
             raise ValueError(f"{path}: not valid JSON ({exc})") from exc
         try:
             return cls.from_dict(data)
-        except ValueError as exc:
+        except (ValueError, TypeError) as exc:
             raise ValueError(f"{path}: {exc}") from exc
 
     def __repr__(self) -> str:

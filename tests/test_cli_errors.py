@@ -1,0 +1,67 @@
+"""Every user error on the command line exits non-zero with one line on stderr and no traceback,
+before any work is done (a table of the cases the reliability review found)."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+
+def scenario_file(tmp_path, **fields):
+    data = {"format": "qrrt-environment", "version": 1, "bounds": [[0, 20], [0, 20]], "boxes": [],
+            "start": [1, 1], "goal": [19, 19], "goal_radius": 0.75} | fields
+    path = tmp_path / "world.json"
+    path.write_text(json.dumps(data))
+    return str(path)
+
+
+CASES = [
+    (["plan", "--json", "."], "is a folder"),
+    (["plan", "--json", "/proc/x"], "cannot be written"),
+    (["plan", "--plot", "t.xyz"], "must end in one of"),
+    (["plan", "--planner", "nope"], "unknown planner 'nope'"),
+    (["plan", "--policy", "fixed:abc"], "fixed:K needs an integer"),
+    (["plan", "--predicate", "time-samples:1"], "time_samples must be an integer"),
+    (["plan", "--planner", "qrrt", "--backend", "statevector", "--qubits", "40"], "num_qubits = 40"),
+    (["plan", "--goal-bias", "1.5"], "goal_bias must be"),
+    (["search", "--shots", "1000000000"], "shots must be an integer in [1, 10000000]"),
+    (["search", "--iterations", "1000000"], "iterations must be an integer in [0, 100000]"),
+    (["reproduce", "heatmaps", "--trials", "1000000000"], "trials must be an integer in [1, 100000]"),
+    (["reproduce", "lemmas", "--predicate", "authors"], "does not take a predicate"),
+    (["reproduce", "nope"], "EXPERIMENT must be one of"),
+    (["reproduce", "lemmas", "--out", ""], "--out must name a folder"),
+]
+
+
+@pytest.mark.parametrize("argv, message", CASES)
+def test_user_errors_give_one_line_and_no_traceback(argv, message, tmp_path):
+    run = subprocess.run([sys.executable, "-m", "qrrt_circuits.cli", *argv], capture_output=True, text=True,
+                         cwd=tmp_path, timeout=120)
+    assert run.returncode != 0
+    lines = [line for line in run.stderr.splitlines() if line.strip() and not line.startswith("usage:")
+             and not line.startswith(" ")]
+    assert "Traceback" not in run.stderr
+    assert len(lines) == 1 and message in lines[0], run.stderr
+
+
+@pytest.mark.parametrize("fields, message", [
+    ({"boxes": None}, "'boxes' must be a list"),
+    ({"goal_radius": [1, 2]}, "goal_radius must be a real number"),
+    ({"bounds": [[0, 10**400], [0, 20]]}, "bounds must be numeric"),
+    ({"bounds": [[-1e308, 1e308], [0, 20]]}, "bounds must lie within"),
+])
+def test_bad_scenario_files_name_the_field_and_the_file(fields, message, tmp_path):
+    path = scenario_file(tmp_path, **fields)
+    run = subprocess.run([sys.executable, "-m", "qrrt_circuits.cli", "plan", "--scenario-file", path],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 2 and "Traceback" not in run.stderr
+    assert message in run.stderr and "world.json" in run.stderr
+
+
+def test_non_utf8_scenario_file(tmp_path):
+    path = tmp_path / "world.json"
+    path.write_bytes(b"\xff\xfe\x00garbage")
+    run = subprocess.run([sys.executable, "-m", "qrrt_circuits.cli", "plan", "--scenario-file", str(path)],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 2 and "not a UTF-8 text file" in run.stderr and "Traceback" not in run.stderr
