@@ -88,7 +88,10 @@ class OracleCheck(Experiment):
         checks = settings["checks"]
         x = np.arange(len(checks))
         for offset, kind, color in ((-0.2, "RRT", "tab:gray"), (0.2, "QRRT", "tab:blue")):
-            axes[0, 0].bar(x + offset, [summary["ours"][c][kind] for c in checks], 0.4, color=color, label=kind)
+            values = np.array([summary["ours"][c][kind] for c in checks])
+            spans = np.array([summary["interval_95"][c][kind] for c in checks])
+            axes[0, 0].bar(x + offset, values, 0.4, color=color, label=f"{kind} (95 % interval)",
+                           yerr=[values - spans[:, 0], spans[:, 1] - values], capsize=3)
             axes[0, 0].axhline(self.paper[kind], color=color, ls="--", lw=1, label=f"paper {kind} (40 calls)")
             axes[0, 1].bar(x + offset, [summary["invalid_edge_fraction"][c][kind] for c in checks], 0.4,
                            color=color, label=kind)

@@ -92,7 +92,7 @@ class Scaling(Experiment):
             ax.scatter(f, y, s=12, color=colors[name], alpha=0.6)
             xs = np.geomspace(f.min(), f.max(), 20)
             ax.plot(xs, fit["prefactor"] * xs ** fit["exponent"], color=colors[name],
-                    label=f"{name}: exponent {fit['exponent']:.2f} (theory {self.paper[name]})")
+                    label=f"{name}: exponent {fit['exponent']:.2f} {fit['interval_95']} (theory {self.paper[name]})")
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel("reachable fraction of candidates f")

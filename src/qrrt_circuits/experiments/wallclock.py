@@ -76,6 +76,13 @@ class Wallclock(Experiment):
                 "speedup_over_paper_per_node": speedup,
                 "note": "the paper's times are MATLAB on an 8-core M2; ours one process on this machine"}
 
+    @staticmethod
+    def _interval(summary, key: str, name: str) -> str:
+        if key != "seconds_per_node":
+            return ""
+        low, high = summary["ms_per_node_interval_95"][name]
+        return f" [{low:.3g}, {high:.3g}]"
+
     def plot(self, records, settings, summary, out_dir: Path):
         fig, axes = new_figure(1, 2, (11, 4.4))
         colors = dict(zip([label(*c) for c in CONFIGS],
@@ -93,7 +100,7 @@ class Wallclock(Experiment):
                 paper = self.paper[key].get(planner)
                 ax.scatter(x, y, s=10, color=colors[name], alpha=0.6)
                 ax.plot([0, x.max()], [0, slope * x.max()], color=colors[name],
-                        label=f"{name}: {slope * 1e3:.3g} ms (paper {paper} s)")
+                        label=f"{name}: {slope * 1e3:.3g} ms{self._interval(summary, key, name)} (paper {paper} s)")
             ax.set_yscale("log")
             ax.set_xlabel(xcol.replace("_", " "))
             ax.set_ylabel("wall-clock seconds")
