@@ -132,3 +132,18 @@ def test_every_policy_inside_the_planners(name, shared, clutter):
         k = [expected_k(name, 256, 0, nodes) for nodes in np.concatenate([[0], result.history["nodes"][:-1]])]
         assert m.quantum_oracle_calls == workers * sum(k) and m.verification_calls == workers * rounds
         assert m.critical_path_oracle_calls == sum(k) + rounds
+
+
+@pytest.mark.parametrize("build, error, message", [
+    (lambda: qc.Adaptive(max_iterations=-3), ValueError, r"max_iterations must be an integer in \[0, 1000000\]"),
+    (lambda: qc.Adaptive(grid_size=10**9), ValueError, r"grid_size must be an integer in \[10, 100000\]"),
+    (lambda: qc.Adaptive(grid_size=float("nan")), TypeError, "grid_size must be an integer"),
+    (lambda: qc.BBHT(cap_factor=float("inf")), ValueError, "cap_factor must be a finite number"),
+    (lambda: qc.FixedIterations(True), TypeError, "k must be an integer"),
+    (lambda: qc.PaperSchedule(early=2.5), TypeError, "early must be an integer"),
+    (lambda: qc.AnnealingSchedule(bands=[(2.7, 4.2), (0.8, 2.0)], switch_at=[2.5]), TypeError,
+     r"switch_at\[0\] must be an integer"),
+])
+def test_policy_settings_are_checked_at_construction(build, error, message):
+    with pytest.raises(error, match=message):
+        build()
