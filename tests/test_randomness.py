@@ -1,0 +1,41 @@
+"""The compiled seed derivation gives numpy's SeedSequence generators bit for bit."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from qrrt_circuits.randomness import RandomStreams, Stream
+
+
+@pytest.mark.parametrize("seed", [0, 1, 7, 2**32 + 5, 2**70 + 3, 12345678901234567890123, None])
+def test_seed_words_equal_numpy_seed_sequence(seed):
+    streams = RandomStreams.from_seed(seed)
+    rng = np.random.default_rng(0 if seed is None else seed % 1000)
+    keys = np.column_stack([rng.integers(0, 10**6, 60), rng.integers(0, 5000, 60), rng.choice([1, 2, 3, 7], 60)])
+    keys[:5] = [[0, 0, 1], [0, 0, 0], [2**33, 1, 7], [2**40 + 1, 2**35, 3], [1, 2**32, 1]]
+    words = streams.seed_words(keys)
+    for key, got in zip(keys, words, strict=True):
+        expected = np.random.SeedSequence(streams.entropy, spawn_key=tuple(int(k) for k in key))
+        assert np.array_equal(got, expected.generate_state(4, np.uint64)), key
+
+
+def test_generators_draw_what_default_rng_draws():
+    streams = RandomStreams.from_seed(42)
+    batch = streams.generators(np.arange(10, 20), 3, Stream.CANDIDATES)
+    for round_index, generator in zip(range(10, 20), batch, strict=True):
+        single = streams.generator(round_index, 3, Stream.CANDIDATES)
+        reference = np.random.default_rng(np.random.SeedSequence(42, spawn_key=(round_index, 3, 1)))
+        expected = reference.random(5)
+        assert np.array_equal(generator.random(5), expected)
+        assert np.array_equal(single.random(5), expected)
+        assert streams.seed(round_index, 3) == int(
+            np.random.default_rng(np.random.SeedSequence(42, spawn_key=(round_index, 3, 7))).integers(0, 2**62))
+
+
+def test_negative_keys_refused():
+    streams = RandomStreams.from_seed(1)
+    with pytest.raises(ValueError, match="non-negative"):
+        streams.generator(-1, 0, Stream.CANDIDATES)
+    with pytest.raises(ValueError, match="non-negative"):
+        streams.seed_words(np.array([[0, -2, 1]]))
