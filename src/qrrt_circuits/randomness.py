@@ -182,3 +182,64 @@ class RandomStreams:
     def seed(self, round_index: int, worker: int, stream: Stream = Stream.SEARCH) -> int:
         """One integer seed (for a backend call) drawn from that generator."""
         return int(self.generator(round_index, worker, stream).integers(0, 2**62))
+
+
+# PCG64 (numpy's default bit generator, O'Neill 2014: 128-bit LCG, XSL-RR output) for the first
+# few doubles of many generators at once: numpy's pcg64.h, seeded as PCG64(seed_sequence) seeds it
+_PCG_MULT_HIGH = 0x2360ED051FC65DA4
+_PCG_MULT_LOW = 0x4385DF649FCCF645
+
+
+@njit(cache=True, nogil=True)
+def _mul64(a, b):
+    """The 128-bit product of two uint64 as (high, low)."""
+    mask = np.uint64(0xFFFFFFFF)
+    shift = np.uint64(32)
+    a_lo, a_hi = a & mask, a >> shift
+    b_lo, b_hi = b & mask, b >> shift
+    lo_lo = a_lo * b_lo
+    hi_lo = a_hi * b_lo
+    lo_hi = a_lo * b_hi
+    hi_hi = a_hi * b_hi
+    cross = (lo_lo >> shift) + (hi_lo & mask) + lo_hi
+    return hi_hi + (hi_lo >> shift) + (cross >> shift), (cross << shift) | (lo_lo & mask)
+
+
+@njit(cache=True, nogil=True)
+def _pcg_step(state_hi, state_lo, inc_hi, inc_lo):
+    """state * MULT + inc (mod 2^128)."""
+    mult_hi, mult_lo = np.uint64(_PCG_MULT_HIGH), np.uint64(_PCG_MULT_LOW)
+    high, low = _mul64(state_lo, mult_lo)
+    high = high + state_hi * mult_lo + state_lo * mult_hi
+    new_lo = low + inc_lo
+    carry = np.uint64(1) if new_lo < low else np.uint64(0)
+    return high + inc_hi + carry, new_lo
+
+
+@njit(cache=True, nogil=True)
+def _uniform_draws(words, count):
+    """(K, count): the first ``count`` values of ``Generator(PCG64(seed words)).random()``."""
+    out = np.empty((words.shape[0], count))
+    one = np.uint64(1)
+    for row in range(words.shape[0]):
+        # pcg64_set_seed: state seed = words[0]:words[1], increment (words[2]:words[3]) << 1 | 1
+        inc_hi = (words[row, 2] << one) | (words[row, 3] >> np.uint64(63))
+        inc_lo = (words[row, 3] << one) | one
+        state_hi, state_lo = _pcg_step(np.uint64(0), np.uint64(0), inc_hi, inc_lo)
+        state_lo_sum = state_lo + words[row, 1]
+        carry = one if state_lo_sum < state_lo else np.uint64(0)
+        state_hi, state_lo = state_hi + words[row, 0] + carry, state_lo_sum
+        state_hi, state_lo = _pcg_step(state_hi, state_lo, inc_hi, inc_lo)
+        for column in range(count):
+            state_hi, state_lo = _pcg_step(state_hi, state_lo, inc_hi, inc_lo)
+            rotation = state_hi >> np.uint64(58)
+            value = state_hi ^ state_lo
+            value = (value >> rotation) | (value << ((np.uint64(64) - rotation) & np.uint64(63)))
+            out[row, column] = np.float64(value >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+    return out
+
+
+def uniform_draws(streams: RandomStreams, keys: np.ndarray, count: int) -> np.ndarray:
+    """(K, count): the first ``count`` doubles ``generator(*key).random()`` would return, for each
+    key (round, worker, stream) of ``keys`` (K, 3), computed without building the generators."""
+    return _uniform_draws(streams.seed_words(keys), int(count))

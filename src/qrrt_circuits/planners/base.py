@@ -143,16 +143,21 @@ class Planner:
         state.policy_state = self._start_policy()
         state.context = self._context()
         began = time.perf_counter()
-        status = PlanStatus.REACHED
+        status = self._run(state, condition, began)
+        elapsed = time.perf_counter() - began
+        return self._result(state, status, elapsed, start, goal, goal_radius, condition)
+
+    def _run(self, state: RunState, condition: TerminationCondition, began: float) -> PlanStatus:
+        """The round loop: check the condition, run a round, record it; until the goal or the end.
+        Subclasses may run several rounds' work at once if every round's outcome, counters and
+        termination check stay exactly those of this loop."""
         while state.goal_node is None:
             ended = condition.ended_by(state.progress(time.perf_counter() - began))
             if ended is not None:
-                status = ended
-                break
+                return ended
             self._round(state)
             state.end_round()
-        elapsed = time.perf_counter() - began
-        return self._result(state, status, elapsed, start, goal, goal_radius, condition)
+        return PlanStatus.REACHED
 
     def _check_problem(self, start, goal, goal_radius):
         env = self.env
@@ -231,6 +236,7 @@ class Planner:
             duplicates=state.duplicates,
             rejected=state.rejected,
             wall_time_s=elapsed,
+            wasted_checks=state.wasted_checks,
         )
         settings = self.settings() | {"start": start.tolist(), "goal": goal.tolist(),
                                       "goal_radius": goal_radius, "termination": condition.describe(),

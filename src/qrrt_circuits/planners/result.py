@@ -18,7 +18,8 @@ class Metrics:
     ``oracle_calls == quantum_oracle_calls + verification_calls`` always holds;
     ``critical_path_oracle_calls`` sums, over rounds, the largest count of one worker (the time of
     p parallel quantum devices); ``simulation_checks`` are the 2^n predicate evaluations per
-    database the simulated phase oracle needs (not oracle calls)."""
+    database the simulated phase oracle needs (not oracle calls); ``wasted_checks`` the predicate
+    evaluations the batched classical planners made for rounds that never ran (not oracle calls)."""
 
     oracle_calls: int
     quantum_oracle_calls: int
@@ -31,6 +32,9 @@ class Metrics:
     duplicates: int
     rejected: int
     wall_time_s: float
+    #: predicate evaluations done ahead of time and thrown away (batched RRT: candidates of rounds
+    #: after the round that changed the tree); raw work, never oracle calls
+    wasted_checks: int = 0
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)

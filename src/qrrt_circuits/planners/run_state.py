@@ -26,6 +26,7 @@ class RunState:
         self.databases = 0
         self.duplicates = 0
         self.rejected = 0
+        self.wasted_checks = 0
         self.rounds_without_new_node = 0
         self.history: dict[str, list] = {key: [] for key in HISTORY_KEYS}
         self.round_entries = 0
