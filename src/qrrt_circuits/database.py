@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .environment import Environment
+from .randomness import RandomStreams, Stream, uniform_draws
 from .tree import Tree
 from .validation import check_choice, check_int
 
@@ -99,7 +100,48 @@ def build_database(
 ) -> Database:
     """Alg. 1 lines 4-8 (and Alg. 4 line 7 with ``annealing``)."""
     samples = env.sample_uniform(size, rng)
+    return _finish_database(samples, tree, size, lambda: rng, goal, goal_radius, goal_bias, annealing,
+                            temperature_index)
+
+
+def stream_database(
+    tree: Tree,
+    size: int,
+    env: Environment,
+    streams: RandomStreams,
+    round_index: int,
+    worker: int,
+    goal: np.ndarray | None = None,
+    goal_radius: float = 0.0,
+    goal_bias: float = 0.0,
+    annealing: AnnealingSchedule | None = None,
+    temperature_index: int = 0,
+) -> Database:
+    """``build_database`` with the generator of (round, worker, ``Stream.CANDIDATES``), without
+    building it unless needed: the uniform samples (``Environment.sample_uniform``: low + (high -
+    low) * u) come from the compiled PCG64 draws; only goal bias or annealing build the generator,
+    advanced past those draws (each double is one 64-bit output). Same database, bit for bit."""
+    dim = tree.dim
+    key = np.array([[round_index, worker, int(Stream.CANDIDATES)]], dtype=np.int64)
+    low, high = env.bounds[:, 0], env.bounds[:, 1]
+    samples = low + (high - low) * uniform_draws(streams, key, size * dim).reshape(size, dim)
+
+    def generator() -> np.random.Generator:
+        rng = streams.generator(round_index, worker, Stream.CANDIDATES)
+        rng.bit_generator.advance(size * dim)
+        return rng
+
+    return _finish_database(samples, tree, size, generator, goal, goal_radius, goal_bias, annealing,
+                            temperature_index)
+
+
+def _finish_database(samples, tree, size, generator, goal, goal_radius, goal_bias, annealing,
+                     temperature_index) -> Database:
+    """The rest of Alg. 1 lines 4-8 / Alg. 4 line 7 after the uniform samples; ``generator()``
+    gives the candidates' generator positioned after them (called only if more draws are needed)."""
+    rng = None
     if goal_bias > 0 and goal is not None:
+        rng = generator()
         biased = rng.random(size) < goal_bias
         count = int(biased.sum())
         if count:
@@ -107,6 +149,7 @@ def build_database(
     parents = tree.nearest(samples)
     band = None
     if annealing is not None:
+        rng = generator() if rng is None else rng
         band = annealing.band(temperature_index)
         origin = tree.nodes[parents]
         offset = samples - origin

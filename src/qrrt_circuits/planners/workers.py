@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..database import build_database
+from ..database import stream_database
 from ..randomness import Stream
 from ..search.problem import DatabaseSearch, SearchOutcome
 from .context import RoundView, WorkerContext
@@ -34,8 +34,8 @@ class ExtensionOutcome:
 
 def classical_extension(context: WorkerContext, view: RoundView, worker: int) -> ExtensionOutcome:
     """Sample (with goal bias), nearest node, one reachability test."""
-    rng = context.streams.generator(view.round_index, worker, Stream.CANDIDATES)
-    db = build_database(view.tree, 1, context.env, rng, view.goal, view.goal_radius, context.goal_bias)
+    db = stream_database(view.tree, 1, context.env, context.streams, view.round_index, worker, view.goal,
+                         view.goal_radius, context.goal_bias)
     child, parent = db.children[0], int(db.parents[0])
     truth = bool(context.predicate.reachable(view.tree.nodes[parent][None], child[None])[0])
     answer = truth
@@ -58,9 +58,9 @@ class DatabaseOutcome:
 
 def make_database(context: WorkerContext, view: RoundView, worker: int):
     """Alg. 1 lines 4-8: the database, the true predicate on it, and the oracle's marks."""
-    rng = context.streams.generator(view.round_index, worker, Stream.CANDIDATES)
-    db = build_database(view.tree, context.database_size, context.env, rng, view.goal, view.goal_radius,
-                        context.goal_bias, context.annealing, view.temperature_index)
+    db = stream_database(view.tree, context.database_size, context.env, context.streams, view.round_index,
+                         worker, view.goal, view.goal_radius, context.goal_bias, context.annealing,
+                         view.temperature_index)
     truth = context.predicate.reachable(view.tree.nodes[db.parents], db.children)
     marks = truth
     if context.oracle_errors is not None:

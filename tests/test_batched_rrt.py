@@ -1,0 +1,87 @@
+"""Batched RRT / ParallelRRT rounds are exactly the sequential rounds (issue 11, item 3).
+
+The sequential reference is the same planner with an executor: one task per worker per round, the
+loop of ``Planner._run`` (the code path every plan took before batching). Trees, counters, history
+and status must agree bit for bit; only ``wasted_checks`` (tests made ahead and dropped) differ.
+"""
+
+from __future__ import annotations
+
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+import pytest
+from planner_fingerprints import HISTORY_KEYS, METRIC_KEYS
+
+import qrrt_circuits as qc
+from qrrt_circuits.planners.classical import MAX_BATCH_ROUNDS, batch_rounds
+
+
+def _sequential(planner, executor):
+    planner.executor = executor
+    return planner
+
+
+def _same(batched, sequential):
+    assert np.array_equal(batched.nodes, sequential.nodes)
+    assert np.array_equal(batched.parents, sequential.parents)
+    for key in METRIC_KEYS:
+        assert batched.metrics[key] == sequential.metrics[key], key
+    for key in HISTORY_KEYS:
+        assert np.array_equal(batched.history[key], sequential.history[key]), key
+    assert batched.status == sequential.status and batched.goal_node == sequential.goal_node
+    assert sequential.metrics.wasted_checks == 0
+
+
+@pytest.fixture(scope="module")
+def executor():
+    with ThreadPoolExecutor(2) as pool:
+        yield pool
+
+
+BUDGETS = ({"max_nodes": 40}, {"max_oracle_calls": 73}, {"max_rounds": 31}, {"stall_rounds": 3, "max_nodes": 60},
+           {"max_critical_path_calls": 50, "max_nodes": 30})
+
+
+@pytest.mark.parametrize("seed", range(24))
+def test_batched_rrt_equals_sequential_rrt(seed, executor):
+    env = qc.scenarios.paper_clutter(seed=seed % 6)
+    budgets = BUDGETS[seed % len(BUDGETS)]
+    options = {"goal_bias": 0.15} if seed % 4 == 1 else {}
+    if seed % 4 == 2:
+        options["oracle_errors"] = qc.OracleErrorModel(false_positive=0.2, false_negative=0.1)
+    batched = qc.RRT(env, seed=seed, **options).plan(**budgets)
+    sequential = _sequential(qc.RRT(env, seed=seed, **options), executor).plan(**budgets)
+    _same(batched, sequential)
+    if "max_oracle_calls" in budgets and not batched.reached and not options:
+        assert batched.metrics.oracle_calls == budgets["max_oracle_calls"]  # stops exactly there
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_batched_parallel_rrt_equals_sequential(seed, executor):
+    env = qc.scenarios.paper_clutter(seed=seed % 3)
+    workers = (2, 3, 8)[seed % 3]
+    budgets = BUDGETS[seed % len(BUDGETS)]
+    options = {"oracle_errors": qc.OracleErrorModel(false_positive=0.1, false_negative=0.1)} if seed % 4 == 3 else {}
+    batched = qc.ParallelRRT(env, workers=workers, seed=seed, **options).plan(**budgets)
+    sequential = _sequential(qc.ParallelRRT(env, workers=workers, seed=seed, **options), executor).plan(**budgets)
+    _same(batched, sequential)
+
+
+def test_wasted_checks_are_the_tests_of_rounds_that_never_ran():
+    env = qc.scenarios.paper_clutter(seed=3)
+    result = qc.RRT(env, seed=3).plan(max_nodes=50)
+    metrics = result.metrics
+    assert metrics.oracle_calls == metrics.rounds == metrics.verification_calls
+    assert metrics.wasted_checks > 0
+    predicate = qc.ReachabilityOracle(env)  # counts every pair it evaluates
+    again = qc.RRT(env, seed=3, predicate=predicate).plan(max_nodes=50)
+    assert predicate.evaluations == again.metrics.oracle_calls + again.metrics.wasted_checks
+    assert again.metrics.wasted_checks == metrics.wasted_checks
+
+
+def test_batch_size_follows_the_success_rate():
+    assert batch_rounds(0, 0) == 2
+    assert batch_rounds(9, 98) == 10
+    assert batch_rounds(99, 98) == 1
+    assert batch_rounds(0, 10**6) == MAX_BATCH_ROUNDS
