@@ -56,7 +56,8 @@ class Tree:
         if self.size >= 2 * self._grid_built_at:
             self._build_grid()
         else:
-            _grid_insert(self._nodes, self._next, self._head, self._origin, self._cell, self._shape, index)
+            _grid_insert(self._nodes, self._next, self._head, self._origin, self._cell, self._shape, index,
+                         self._low, self._high)
         return index
 
     def nearest(self, points: np.ndarray) -> np.ndarray:
@@ -64,7 +65,7 @@ class Tree:
         points = np.ascontiguousarray(np.atleast_2d(points), dtype=float)
         out = np.empty(points.shape[0], dtype=np.int64)
         _grid_nearest(points, self._nodes, self._next, self._head, self._origin, self._cell, self._shape,
-                      self.size, out)
+                      self.size, self._low, self._high, out)
         return out
 
     def _build_grid(self) -> None:
@@ -82,8 +83,10 @@ class Tree:
         self._cell = cell
         self._shape = shape
         self._head = np.full(int(np.prod(shape)), -1, dtype=np.int64)
+        self._low, self._high = low.copy(), high.copy()  # the nodes' bounding box, kept up to date
         for index in range(self.size):
-            _grid_insert(self._nodes, self._next, self._head, self._origin, self._cell, self._shape, index)
+            _grid_insert(self._nodes, self._next, self._head, self._origin, self._cell, self._shape, index,
+                         self._low, self._high)
         self._grid_built_at = self.size
 
 
@@ -105,7 +108,10 @@ def _cell_of(point, origin, cell, shape, out):
 
 
 @njit(cache=True, nogil=True)
-def _grid_insert(nodes, next_node, head, origin, cell, shape, index):
+def _grid_insert(nodes, next_node, head, origin, cell, shape, index, low, high):
+    for axis in range(low.shape[0]):
+        low[axis] = min(low[axis], nodes[index, axis])
+        high[axis] = max(high[axis], nodes[index, axis])
     coordinates = np.empty(shape.shape[0], dtype=np.int64)
     flat = _cell_of(nodes[index], origin, cell, shape, coordinates)
     next_node[index] = head[flat]
@@ -113,45 +119,71 @@ def _grid_insert(nodes, next_node, head, origin, cell, shape, index):
 
 
 @njit(cache=True, nogil=True)
-def _grid_nearest(points, nodes, next_node, head, origin, cell, shape, size, out):
+def _visit_cell(point, nodes, next_node, head, flat, size, best, best_index):
+    node = head[flat]
+    while node >= 0:
+        if node < size:
+            squared = 0.0
+            for axis in range(point.shape[0]):
+                delta = point[axis] - nodes[node, axis]
+                squared += delta * delta
+            if squared < best or (squared == best and node < best_index):
+                best = squared
+                best_index = node
+        node = next_node[node]
+    return best, best_index
+
+
+@njit(cache=True, nogil=True)
+def _grid_nearest(points, nodes, next_node, head, origin, cell, shape, size, low, high, out):
     """Ring search: for each point, the node with the smallest (squared distance, index)."""
     dim = points.shape[1]
+    last = dim - 1
     centre = np.empty(dim, dtype=np.int64)
     current = np.empty(dim, dtype=np.int64)
     lower = np.empty(dim, dtype=np.int64)
     upper = np.empty(dim, dtype=np.int64)
+    outside = np.empty(dim)  # the point's distance to the nodes' bounding box along each axis
     for row in range(points.shape[0]):
         point = points[row]
         _cell_of(point, origin, cell, shape, centre)
+        outside_total = 0.0
+        for axis in range(dim):
+            below = low[axis] - point[axis]
+            above = point[axis] - high[axis]
+            outside[axis] = max(below, above, 0.0)
+            outside_total += outside[axis] * outside[axis]
         best = np.inf
         best_index = size
         ring = 0
         while True:
-            # visit the cells at Chebyshev distance ``ring`` from the centre (clipped to the grid)
+            # visit the cells at Chebyshev distance ``ring`` from the centre (clipped to the grid):
+            # an odometer over the first d - 1 axes; the last axis in full where the prefix is on
+            # the ring, else only its two ends
             for axis in range(dim):
                 lower[axis] = max(centre[axis] - ring, 0)
                 upper[axis] = min(centre[axis] + ring, shape[axis] - 1)
                 current[axis] = lower[axis]
             while True:
-                on_ring = False
-                flat = 0
-                for axis in range(dim):
+                on_ring = ring == 0
+                prefix = 0
+                for axis in range(last):
                     if abs(current[axis] - centre[axis]) == ring:
                         on_ring = True
-                    flat = flat * shape[axis] + current[axis]
-                if on_ring or ring == 0:
-                    node = head[flat]
-                    while node >= 0:
-                        if node < size:
-                            squared = 0.0
-                            for axis in range(dim):
-                                delta = point[axis] - nodes[node, axis]
-                                squared += delta * delta
-                            if squared < best or (squared == best and node < best_index):
-                                best = squared
-                                best_index = node
-                        node = next_node[node]
-                axis = dim - 1  # odometer step over the block
+                    prefix = prefix * shape[axis] + current[axis]
+                prefix *= shape[last]
+                if on_ring:
+                    for value in range(lower[last], upper[last] + 1):
+                        best, best_index = _visit_cell(point, nodes, next_node, head, prefix + value, size,
+                                                       best, best_index)
+                else:
+                    if centre[last] - ring >= 0:
+                        best, best_index = _visit_cell(point, nodes, next_node, head,
+                                                       prefix + centre[last] - ring, size, best, best_index)
+                    if centre[last] + ring <= shape[last] - 1:
+                        best, best_index = _visit_cell(point, nodes, next_node, head,
+                                                       prefix + centre[last] + ring, size, best, best_index)
+                axis = last - 1  # odometer step over the prefix
                 while axis >= 0:
                     current[axis] += 1
                     if current[axis] <= upper[axis]:
@@ -160,17 +192,20 @@ def _grid_nearest(points, nodes, next_node, head, origin, cell, shape, size, out
                     axis -= 1
                 if axis < 0:
                     break
-            # the distance from the point to any cell outside the visited block
+            # a lower bound on the squared distance from the point to any cell outside the visited
+            # block: beyond one side of one axis, the gap to that side plus, along the other axes,
+            # the point's distance to the nodes' bounding box (nodes outside the grid's box sit in
+            # its border cells, so the gaps hold for them too)
             bound = np.inf
-            covered = True
             for axis in range(dim):
+                others = outside_total - outside[axis] * outside[axis]
                 if centre[axis] - ring - 1 >= 0:
-                    covered = False
-                    bound = min(bound, point[axis] - (origin[axis] + (centre[axis] - ring) * cell))
+                    gap = max(point[axis] - (origin[axis] + (centre[axis] - ring) * cell), 0.0)
+                    bound = min(bound, gap * gap + others)
                 if centre[axis] + ring + 1 <= shape[axis] - 1:
-                    covered = False
-                    bound = min(bound, origin[axis] + (centre[axis] + ring + 1) * cell - point[axis])
-            if covered or (bound > 0.0 and bound * bound > best):
+                    gap = max(origin[axis] + (centre[axis] + ring + 1) * cell - point[axis], 0.0)
+                    bound = min(bound, gap * gap + others)
+            if bound > best:  # inf when the block covers the grid
                 break
             ring += 1
         out[row] = best_index
