@@ -1,18 +1,26 @@
-"""Oracle calls per node and milliseconds per node for every planner on paper_clutter.
+"""Oracle calls per node, milliseconds per node and the oracle's share of the time for every
+planner on paper_clutter.
 
-    python benchmarks/bench_planners.py [--quick] [--seeds 20] [--nodes 100] [--out FILE]
+    python benchmarks/bench_planners.py [--quick] [--seeds 20] [--nodes 100] [--big-nodes 3000]
+                                        [--big-seeds 3] [--out FILE]
 
 Each configuration plans on paper_clutter worlds seeds 0..S-1 (planner seed = world seed) until
-``--nodes`` nodes or the goal. Per run: oracle calls / node, critical-path calls / node and wall
-ms / node; the table gives the median and the 10th-90th percentile spread over seeds. If ``ompl``
-is importable (``pip install ".[ompl]"``), OMPL's RRT runs on the same worlds with our closed-loop
-motion check (a Python MotionValidator) for a time-per-node comparison. Writes JSON.
+``--nodes`` nodes or the goal. Per run: oracle calls / node, critical-path calls / node, wall
+ms / node, the oracle share (wall time inside the predicate's ``reachable`` calls / the plan's wall
+time; the predicate is the exact ``ReachabilityOracle`` wrapped in a timer) and the non-oracle
+microseconds per round; the table gives the median and the 10th-90th percentile spread over seeds.
+The "3000 nodes" rows grow q-RRT trees to ``--big-nodes`` nodes on the first ``--big-seeds`` worlds
+with the goal made unreachable (goal radius 1e-9), so the per-round cost can be compared at 100
+and 3000 nodes. If ``ompl`` is importable (``pip install ".[ompl]"``), OMPL's RRT runs on the same
+worlds with our closed-loop motion check (a Python MotionValidator) right after our RRT, and the
+ratio of their median ms per node is printed. Writes JSON.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -28,6 +36,7 @@ CONFIGURATIONS = (
     ("RRT", "rrt", None, None),
     ("ParallelRRT (8)", "prrt", None, None),
     ("QRRT statevector", "qrrt", "statevector", "paper"),
+    ("QRRT statevector 3000 nodes", "qrrt", "statevector", "paper"),
     ("QRRT aer", "qrrt", "aer", "paper"),
     ("PQRRT shared statevector", "pqrrt", "statevector", "paper"),
     ("PQRRT shared aer", "pqrrt", "aer", "paper"),
@@ -38,13 +47,44 @@ CONFIGURATIONS = (
 )
 
 
+#: the configurations grown to --big-nodes nodes with an unreachable goal
+BIG = ("QRRT statevector 3000 nodes",)
+
+
+class TimedPredicate:
+    """A predicate that times its delegate's ``reachable`` calls (the oracle share)."""
+
+    def __init__(self, delegate) -> None:
+        self.delegate = delegate
+        self.seconds = 0.0
+        self.pairs = 0
+
+    @property
+    def dim(self) -> int:
+        return self.delegate.dim
+
+    @property
+    def name(self) -> str:
+        return self.delegate.name
+
+    def describe(self) -> dict:
+        return self.delegate.describe()
+
+    def reachable(self, parents, children):
+        began = time.perf_counter()
+        out = self.delegate.reachable(parents, children)
+        self.seconds += time.perf_counter() - began
+        self.pairs += len(out)
+        return out
+
+
 def configurations():
-    """label -> planner factory (env, seed), every planner built through the registry."""
+    """label -> planner factory (env, seed, predicate), every planner built through the registry."""
     from qrrt_circuits.experiments.planners import make_planner
 
     def factory(planner, backend, policy):
-        return lambda env, seed: make_planner(planner, env, seed, backend or "statevector",
-                                              search_policy=policy)
+        return lambda env, seed, predicate: make_planner(planner, env, seed, backend or "statevector",
+                                                         search_policy=policy, predicate=predicate)
 
     return {label: factory(planner, backend, policy) for label, planner, backend, policy in CONFIGURATIONS}
 
@@ -55,62 +95,90 @@ def summarize(values: list[float]) -> dict:
             "p90": float(np.percentile(arr, 90)), "mean": float(arr.mean())}
 
 
+def run_one(make, env, seed: int, nodes: int, big: bool) -> dict:
+    predicate = TimedPredicate(qc.ReachabilityOracle(env))
+    planner = make(env, seed, predicate)
+    result = planner.plan(max_nodes=nodes, goal_radius=1e-9) if big else planner.plan(max_nodes=nodes)
+    m = result.metrics
+    count = max(m.nodes, 1)
+    other_s = max(m.wall_time_s - predicate.seconds, 0.0)
+    return {"seed": seed, "nodes": m.nodes, "rounds": m.rounds, "oracle_calls": m.oracle_calls,
+            "critical_path": m.critical_path_oracle_calls, "wasted_checks": m.wasted_checks,
+            "predicate_pairs": predicate.pairs,
+            "calls_per_node": m.oracle_calls / count,
+            "critical_per_node": m.critical_path_oracle_calls / count,
+            "ms_per_node": m.wall_time_s * 1e3 / count,
+            "ms_per_call": m.wall_time_s * 1e3 / max(m.oracle_calls, 1),
+            "oracle_share": predicate.seconds / m.wall_time_s if m.wall_time_s > 0 else float("nan"),
+            "other_us_per_round": other_s * 1e6 / max(m.rounds, 1),
+            "reached": result.status == "reached", "labels": list(result.labels)}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--seeds", type=int, default=20)
     parser.add_argument("--nodes", type=int, default=100)
+    parser.add_argument("--big-nodes", type=int, default=3000)
+    parser.add_argument("--big-seeds", type=int, default=3)
     parser.add_argument("--out", default=None)
     args = parser.parse_args()
     seeds = 4 if args.quick else args.seeds
     nodes = 30 if args.quick else args.nodes
+    big_nodes = 300 if args.quick else args.big_nodes
+    big_seeds = 1 if args.quick else args.big_seeds
     worlds = [qc.scenarios.paper_clutter(seed=s) for s in range(seeds)]
     qc.RRT(worlds[0], seed=0).plan(max_rounds=5)  # compile the oracle kernel
+    qc.QRRT(worlds[0], backend=qc.StatevectorBackend(), seed=0).plan(max_rounds=5)  # and the tree's
+    try:
+        from ompl_rrt import ompl_available, run_ompl_rrt
+    except ImportError:
+        ompl_available = None
+    with_ompl = ompl_available is not None and ompl_available()
     rows = {}
-    print(f"{'planner':32s} {'calls/node':>18s} {'critical/node':>14s} {'ms/node':>18s} {'reached':>8s}")
+    ompl_rows = None
+    print(f"{'planner':32s} {'calls/node':>18s} {'critical/node':>14s} {'ms/node':>18s} {'oracle':>7s} "
+          f"{'other us/rnd':>12s} {'reached':>8s}")
     for name, make in configurations().items():
-        runs = []
-        for seed, env in enumerate(worlds):
-            result = make(env, seed).plan(max_nodes=nodes)
-            m = result.metrics
-            count = max(m.nodes, 1)
-            runs.append({"seed": seed, "nodes": m.nodes, "oracle_calls": m.oracle_calls,
-                         "critical_path": m.critical_path_oracle_calls,
-                         "calls_per_node": m.oracle_calls / count,
-                         "critical_per_node": m.critical_path_oracle_calls / count,
-                         "ms_per_node": m.wall_time_s * 1e3 / count,
-                         "reached": result.status == "reached", "labels": list(result.labels)})
+        big = name in BIG
+        runs = [run_one(make, env, seed, big_nodes if big else nodes, big)
+                for seed, env in enumerate(worlds[:big_seeds] if big else worlds)]
         pooled = sum(r["oracle_calls"] for r in runs) / max(sum(r["nodes"] for r in runs), 1)
-        row = {"runs": runs,
+        row = {"runs": runs, "max_nodes": big_nodes if big else nodes,
+               "goal": "unreachable (goal radius 1e-9)" if big else "the world's",
                "calls_per_node": summarize([r["calls_per_node"] for r in runs]),
                "critical_per_node": summarize([r["critical_per_node"] for r in runs]),
                "ms_per_node": summarize([r["ms_per_node"] for r in runs]),
+               "ms_per_call": summarize([r["ms_per_call"] for r in runs]),
+               "oracle_share": summarize([r["oracle_share"] for r in runs]),
+               "other_us_per_round": summarize([r["other_us_per_round"] for r in runs]),
                "pooled_calls_per_node": pooled,
                "reached_fraction": float(np.mean([r["reached"] for r in runs]))}
         rows[name] = row
         c, k, t = row["calls_per_node"], row["critical_per_node"], row["ms_per_node"]
         print(f"{name:32s} {c['median']:6.2f} [{c['p10']:5.2f},{c['p90']:6.2f}] {k['median']:14.2f} "
-              f"{t['median']:7.2f} [{t['p10']:5.2f},{t['p90']:6.2f}] {row['reached_fraction']:8.2f}")
-    ompl_rows = None
-    try:
-        from ompl_rrt import ompl_available, run_ompl_rrt
-    except ImportError:
-        ompl_available = None
-    if ompl_available is not None and ompl_available():
-        runs = [run_ompl_rrt(env, env.start, env.goal, env.goal_radius, nodes, seed)
-                for seed, env in enumerate(worlds)]
-        ompl_rows = {"runs": runs, "ms_per_node": summarize([r["ms_per_node"] for r in runs])}
-        t = ompl_rows["ms_per_node"]
-        print(f"{'OMPL RRT (our motion check)':32s} {'':>18s} {'':>14s} "
-              f"{t['median']:7.2f} [{t['p10']:5.2f},{t['p90']:6.2f}]")
-    else:
+              f"{t['median']:7.3f} [{t['p10']:5.2f},{t['p90']:6.2f}] {row['oracle_share']['median']:7.2f} "
+              f"{row['other_us_per_round']['median']:12.1f} {row['reached_fraction']:8.2f}")
+        if name == "RRT" and with_ompl:  # side by side, right after ours
+            ompl_runs = [run_ompl_rrt(env, env.start, env.goal, env.goal_radius, nodes, seed)
+                         for seed, env in enumerate(worlds)]
+            ompl_rows = {"runs": ompl_runs, "ms_per_node": summarize([r["ms_per_node"] for r in ompl_runs])}
+            t = ompl_rows["ms_per_node"]
+            ompl_rows["ours_over_ompl"] = row["ms_per_node"]["median"] / t["median"]
+            print(f"{'OMPL RRT (our motion check)':32s} {'':>18s} {'':>14s} "
+                  f"{t['median']:7.3f} [{t['p10']:5.2f},{t['p90']:6.2f}]   (RRT / OMPL ms per node: "
+                  f"{ompl_rows['ours_over_ompl']:.2f})")
+    if not with_ompl:
         print("(ompl not importable: OMPL comparison skipped; pip install '.[ompl]')")
     path = write_json("bench_planners" + ("_quick" if args.quick else ""),
-                      {"machine": machine(), "seeds": seeds, "max_nodes": nodes, "planners": rows,
-                       "ompl_rrt": ompl_rows,
+                      {"machine": machine(), "seeds": seeds, "max_nodes": nodes, "big_nodes": big_nodes,
+                       "big_seeds": big_seeds, "planners": rows, "ompl_rrt": ompl_rows,
                        "note": "quantum planners: phase oracle built from a classical lookup of all "
                                "2^n entries (simulation_checks); shared Pq-RRT: one search with p "
-                               "shots stands for p workers; 'known-optimal' uses the true m"},
+                               "shots stands for p workers; 'known-optimal' uses the true m; "
+                               "oracle_share: wall time inside predicate.reachable / plan wall time; "
+                               "RRT and ParallelRRT test rounds in batches (wasted_checks: tests of "
+                               "rounds that never ran, not oracle calls)"},
                       args.out)
     print(f"wrote {path}")
 

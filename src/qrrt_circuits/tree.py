@@ -90,7 +90,7 @@ class Tree:
         self._grid_built_at = self.size
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _cell_of(point, origin, cell, shape, out):
     """The (clamped) integer cell coordinates of ``point`` into ``out``; returns the flat index."""
     flat = 0
@@ -118,7 +118,7 @@ def _grid_insert(nodes, next_node, head, origin, cell, shape, index, low, high):
     head[flat] = index
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _visit_cell(point, nodes, next_node, head, flat, size, best, best_index):
     node = head[flat]
     while node >= 0:
