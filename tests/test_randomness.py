@@ -39,3 +39,12 @@ def test_negative_keys_refused():
         streams.generator(-1, 0, Stream.CANDIDATES)
     with pytest.raises(ValueError, match="non-negative"):
         streams.seed_words(np.array([[0, -2, 1]]))
+
+
+@pytest.mark.parametrize("seed", [0, 99, None])
+def test_search_seeds_equal_numpy_integers(seed):
+    streams = RandomStreams.from_seed(seed)
+    for round_index in range(0, 4000, 13):
+        key = (round_index, round_index % 5, int(Stream.SEARCH))
+        expected = np.random.default_rng(np.random.SeedSequence(streams.entropy, spawn_key=key)).integers(0, 2**62)
+        assert streams.seed(*key) == int(expected)

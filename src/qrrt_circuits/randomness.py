@@ -180,8 +180,15 @@ class RandomStreams:
         return [np.random.Generator(np.random.PCG64(_SeedWords(words))) for words in self.seed_words(keys)]
 
     def seed(self, round_index: int, worker: int, stream: Stream = Stream.SEARCH) -> int:
-        """One integer seed (for a backend call) drawn from that generator."""
-        return int(self.generator(round_index, worker, stream).integers(0, 2**62))
+        """One integer seed (for a backend call) drawn from that generator: its
+        ``integers(0, 2**62)``, which for this range is the first 64-bit output shifted right by
+        2 (Lemire's bounded method with a power-of-two range never rejects), computed without
+        building the generator (tested against numpy)."""
+        key = (int(round_index), int(worker), int(stream))
+        if min(key) < 0:
+            raise ValueError(f"spawn keys must be non-negative, got {key}")
+        words = _seed_words(self._run_entropy, np.array([key], dtype=np.int64))
+        return int(_raw_outputs(words, 1)[0, 0] >> np.uint64(2))
 
 
 # PCG64 (numpy's default bit generator, O'Neill 2014: 128-bit LCG, XSL-RR output) for the first
@@ -217,9 +224,9 @@ def _pcg_step(state_hi, state_lo, inc_hi, inc_lo):
 
 
 @njit(cache=True, nogil=True)
-def _uniform_draws(words, count):
-    """(K, count): the first ``count`` values of ``Generator(PCG64(seed words)).random()``."""
-    out = np.empty((words.shape[0], count))
+def _raw_outputs(words, count):
+    """(K, count) uint64: the first ``count`` outputs of ``PCG64(seed words)`` (``random_raw``)."""
+    out = np.empty((words.shape[0], count), dtype=np.uint64)
     one = np.uint64(1)
     for row in range(words.shape[0]):
         # pcg64_set_seed: state seed = words[0]:words[1], increment (words[2]:words[3]) << 1 | 1
@@ -234,8 +241,19 @@ def _uniform_draws(words, count):
             state_hi, state_lo = _pcg_step(state_hi, state_lo, inc_hi, inc_lo)
             rotation = state_hi >> np.uint64(58)
             value = state_hi ^ state_lo
-            value = (value >> rotation) | (value << ((np.uint64(64) - rotation) & np.uint64(63)))
-            out[row, column] = np.float64(value >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+            out[row, column] = (value >> rotation) | (value << ((np.uint64(64) - rotation) & np.uint64(63)))
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _uniform_draws(words, count):
+    """(K, count): the first ``count`` values of ``Generator(PCG64(seed words)).random()``
+    (numpy's next_double: the top 53 bits of one output)."""
+    raw = _raw_outputs(words, count)
+    out = np.empty(raw.shape)
+    for row in range(raw.shape[0]):
+        for column in range(count):
+            out[row, column] = np.float64(raw[row, column] >> np.uint64(11)) * (1.0 / 9007199254740992.0)
     return out
 
 
