@@ -58,6 +58,18 @@ class Tree:
         return np.asarray(index, dtype=np.int64)
 
 
+#: brute-force distance blocks hold at most this many (point, node) pairs, so a query's scratch
+#: memory stays about 3 x 8 MiB whatever the database and tree sizes (unblocked, 2^22 points
+#: against 63 nodes took 1 KB per point: ``benchmarks/bench_memory.py``)
+BRUTE_BLOCK_PAIRS = 1 << 20
+
+
 def _brute_nearest(points: np.ndarray, nodes: np.ndarray, offset: int) -> np.ndarray:
-    squared = np.sum(points**2, axis=1)[:, None] - 2 * points @ nodes.T + np.sum(nodes**2, axis=1)
-    return np.argmin(squared, axis=1).astype(np.int64) + offset
+    out = np.empty(points.shape[0], dtype=np.int64)
+    node_norms = np.sum(nodes**2, axis=1)
+    block = max(1, BRUTE_BLOCK_PAIRS // max(nodes.shape[0], 1))
+    for first in range(0, points.shape[0], block):
+        chunk = points[first : first + block]
+        squared = np.sum(chunk**2, axis=1)[:, None] - 2 * chunk @ nodes.T + node_norms
+        out[first : first + block] = np.argmin(squared, axis=1)
+    return out + offset

@@ -51,6 +51,16 @@ class StatevectorBackend(QuantumSearchBackend):
     def max_qubits(self) -> int:
         return self._max_qubits
 
+    #: per shot: the uniform draws, the good/unmarked split, the ranks and the measured indices
+    BYTES_PER_SHOT = 64
+
+    def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1) -> int:
+        """Closed form: the marked indices and their rank table (at most 8 + 16 bytes per entry
+        when every entry is marked). ``closed_form=False``: the state, its update temporaries,
+        the probabilities and their cumulative sum (5 float64 arrays)."""
+        per_entry = 24 if self.closed_form else 40
+        return (per_entry << num_qubits) + self.BYTES_PER_SHOT * shots
+
     @staticmethod
     def amplitudes(marks: np.ndarray, iterations: int) -> np.ndarray:
         """Real amplitudes after ``iterations`` x (oracle, then inversion about the mean)."""
