@@ -15,7 +15,7 @@ import os
 import numpy as np
 
 from ..probability import good_probability
-from ..validation import check_int
+from ..validation import check_bool, check_int
 from .backend import QuantumSearchBackend, seed_stream, validate_iterations, validate_marks
 
 BYTES_PER_ENTRY = 32  # amplitudes (8) + probabilities (8) + index lists (8) + marks, with slack
@@ -40,7 +40,7 @@ class StatevectorBackend(QuantumSearchBackend):
         max_qubits: int | None = None,
     ) -> None:
         self._rng = seed_stream(seed)
-        self.closed_form = bool(closed_form)
+        self.closed_form = check_bool(closed_form, "closed_form")
         memory_limit = int(math.log2(max(_memory_bytes() // 2 // BYTES_PER_ENTRY, 2)))
         if max_qubits is not None and check_int(max_qubits, "max_qubits", 1) > memory_limit:
             raise ValueError(f"max_qubits must be an integer in [1, {memory_limit}] (the largest n whose "
