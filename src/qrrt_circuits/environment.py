@@ -82,8 +82,8 @@ class Environment:
             raise ValueError(f"bounds must lie within [-{MAX_EXTENT:g}, {MAX_EXTENT:g}] on every axis, got "
                              f"{bounds.tolist()}")
         d = bounds.shape[0]
-        if self.boxes is None:
-            raise ValueError("boxes must be an array of shape (k, 2, d), got None")
+        if self.boxes is None or not hasattr(self.boxes, "__len__") or isinstance(self.boxes, str | bytes):
+            raise ValueError(f"boxes must be an array of shape (k, 2, {d}), got {self.boxes!r}")
         boxes = _as_float_array(self.boxes if len(self.boxes) else np.zeros((0, 2, d)), "boxes")
         if boxes.ndim != 3 or boxes.shape[1:] != (2, d):
             raise ValueError(f"boxes must have shape (k, 2, {d}), got {boxes.shape}")
