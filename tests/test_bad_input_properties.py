@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 
 import qrrt_circuits as qc
 
-SETTINGS = settings(max_examples=20, deadline=None, derandomize=True,
+SETTINGS = settings(max_examples=12, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 
 ENV = qc.Environment(np.array([[0.0, 10.0], [0.0, 10.0]]), np.array([[[4.0, 4.0], [5.0, 5.0]]]),
