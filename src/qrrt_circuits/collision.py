@@ -64,13 +64,13 @@ class GridIndex:
                 buckets.setdefault(int(np.dot(cell, strides)), []).append(index)
         num_cells = int(np.prod(shape))
         sizes = np.zeros(num_cells, dtype=np.int64)
-        for cell, items in buckets.items():
-            sizes[cell] = len(items)
+        for cell_id, items in buckets.items():
+            sizes[cell_id] = len(items)
         cell_start = np.zeros(num_cells + 1, dtype=np.int64)
         np.cumsum(sizes, out=cell_start[1:])
         cell_items = np.zeros(int(cell_start[-1]), dtype=np.int64)
-        for cell, items in buckets.items():
-            cell_items[cell_start[cell] : cell_start[cell + 1]] = items
+        for cell_id, items in buckets.items():
+            cell_items[cell_start[cell_id] : cell_start[cell_id + 1]] = items
         return cls(bounds[:, 0].copy(), cell_size, shape, cell_start, cell_items)
 
 

@@ -68,7 +68,7 @@ def plot_edges(env: Environment, nodes: np.ndarray, parents: np.ndarray,
 
     ax = plot_environment(env, ax)
     curves = edge_curves(nodes, parents, dynamics)
-    ax.add_collection(LineCollection(curves[:, :, :2], colors=edge_color, linewidths=0.7, alpha=0.8))
+    ax.add_collection(LineCollection(list(curves[:, :, :2]), colors=edge_color, linewidths=0.7, alpha=0.8))
     ax.plot(nodes[1:, 0], nodes[1:, 1], ".", color=edge_color, ms=2.5)
     ax.plot(*nodes[0, :2], "o", color="tab:green", ms=8, label="start")
     return ax
@@ -91,7 +91,7 @@ def plot_tree(env: Environment, result, ax=None, dynamics: LinearTrackingDynamic
         for child, parent in zip(index[:-1], index[1:], strict=True):
             path_parents[child] = parent
         path_curves = edge_curves(result.nodes, path_parents, dynamics)
-        ax.add_collection(LineCollection(path_curves[:, :, :2], colors=path_color, linewidths=2.0))
+        ax.add_collection(LineCollection(list(path_curves[:, :, :2]), colors=path_color, linewidths=2.0))
     goal = result.settings.get("goal")
     if goal is not None:
         ax.add_patch(Circle(goal[:2], result.settings.get("goal_radius", 0.75), fill=False,

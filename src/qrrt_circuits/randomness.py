@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import IntEnum
+from typing import cast
 
 import numpy as np
 
@@ -35,7 +36,8 @@ class RandomStreams:
 
     @classmethod
     def from_seed(cls, seed: int | None) -> RandomStreams:
-        return cls(int(np.random.SeedSequence(seed).entropy))
+        entropy = np.random.SeedSequence(seed).entropy  # an int for an int or None seed
+        return cls(int(cast(int, entropy)))
 
     def generator(self, round_index: int, worker: int, stream: Stream) -> np.random.Generator:
         sequence = np.random.SeedSequence(self.entropy, spawn_key=(int(round_index), int(worker), int(stream)))
