@@ -113,17 +113,20 @@ def _write_if_changed(path: Path, text: str) -> None:
 
 
 def _public_names(module: types.ModuleType) -> list[str]:
-    """A module's public names: its ``__all__``, else the public classes and functions it defines."""
+    """A module's public names: its ``__all__``, else the public classes and functions it defines
+    and its UPPER_CASE constants (``registry.PLANNERS``, ``termination.DEFAULT_MAX_ROUNDS``)."""
     names = getattr(module, "__all__", None)
     if names is not None:
         return list(names)
-    return sorted(
-        name
-        for name, obj in vars(module).items()
-        if not name.startswith("_")
-        and (inspect.isclass(obj) or inspect.isfunction(obj))
-        and getattr(obj, "__module__", None) == module.__name__
-    )
+
+    def public(name: str, obj: object) -> bool:
+        if name.startswith("_") or isinstance(obj, types.ModuleType):
+            return False
+        if inspect.isclass(obj) or inspect.isfunction(obj):
+            return getattr(obj, "__module__", None) == module.__name__
+        return name.isupper()
+
+    return sorted(name for name, obj in vars(module).items() if public(name, obj))
 
 
 def _summary_line(module: types.ModuleType) -> str:
@@ -213,6 +216,19 @@ def write_gallery() -> None:
                   f"{'/authors' if predicate else ''}`", "",
                   f"![{rel.as_posix()}]({rel.as_posix()})", ""]
     _write_if_changed(GALLERY, "\n".join(lines))
+
+
+def drop_builtin_docstrings(app, what, name, obj, options, lines) -> None:
+    """Module constants (``registry.PLANNERS``, ``scenarios.SCENARIOS``) have no docstring of their
+    own; autodoc would show their type's (``dict``'s), so show none instead."""
+    if what in ("data", "attribute") and lines and type(obj).__module__ == "builtins":
+        doc = inspect.getdoc(type(obj)) or ""
+        if "\n".join(lines).strip() == doc.strip():
+            lines.clear()
+
+
+def setup(app) -> None:
+    app.connect("autodoc-process-docstring", drop_builtin_docstrings)
 
 
 write_api_pages()
