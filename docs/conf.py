@@ -20,6 +20,7 @@ the tutorials or the results change (all three land in git-ignored folders under
 from __future__ import annotations
 
 import inspect
+import os
 import shutil
 import sys
 import types
@@ -227,10 +228,26 @@ def drop_builtin_docstrings(app, what, name, obj, options, lines) -> None:
             lines.clear()
 
 
+def check_notebook_kernel() -> None:
+    """The tutorials must run in this interpreter (the one with qrrt_circuits installed). Kernel
+    "python3" resolves to the environment's own kernelspec first (JUPYTER_PREFER_ENV_PATH), whose
+    "python" jupyter_client replaces by ``sys.executable``; refuse a spec that names another one."""
+    os.environ.setdefault("JUPYTER_PREFER_ENV_PATH", "1")
+    from jupyter_client.kernelspec import KernelSpecManager
+
+    spec = KernelSpecManager().get_kernel_spec("python3")
+    program = spec.argv[0]
+    if program not in ("python", "python3", f"python{sys.version_info[0]}.{sys.version_info[1]}") and \
+            Path(program).resolve() != Path(sys.executable).resolve():
+        raise RuntimeError(f"the 'python3' Jupyter kernel ({spec.resource_dir}) runs {program}, not this "
+                           f"interpreter ({sys.executable}); the tutorials would run without qrrt_circuits")
+
+
 def setup(app) -> None:
     app.connect("autodoc-process-docstring", drop_builtin_docstrings)
 
 
+check_notebook_kernel()
 write_api_pages()
 copy_notebooks()
 write_gallery()

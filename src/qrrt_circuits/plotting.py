@@ -6,13 +6,20 @@ drawn.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from .dynamics import LinearTrackingDynamics
 from .environment import Environment
 
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
 
-def _axes(ax):
+    from .planners.result import PlanResult
+
+
+def _axes(ax: Axes | None) -> Axes:
     if ax is None:
         import matplotlib.pyplot as plt
 
@@ -20,7 +27,7 @@ def _axes(ax):
     return ax
 
 
-def plot_environment(env: Environment, ax=None, color: str = "0.15"):
+def plot_environment(env: Environment, ax: Axes | None = None, color: str = "0.15") -> Axes:
     """Obstacles as filled rectangles inside the workspace outline."""
     from matplotlib.collections import PatchCollection
     from matplotlib.patches import Rectangle
@@ -54,7 +61,7 @@ def edge_curves(nodes: np.ndarray, parents: np.ndarray, dynamics: LinearTracking
     return nodes[children][:, None, :] + np.einsum("sij,ej->esi", phis, errors)
 
 
-def plan_dynamics(result) -> LinearTrackingDynamics | None:
+def plan_dynamics(result: PlanResult) -> LinearTrackingDynamics | None:
     """The dynamics a plan's predicate followed, from ``result.settings["dynamics"]`` (None: the
     predicate describes none, and edges are drawn straight)."""
     description = result.settings.get("dynamics")
@@ -62,7 +69,8 @@ def plan_dynamics(result) -> LinearTrackingDynamics | None:
 
 
 def plot_edges(env: Environment, nodes: np.ndarray, parents: np.ndarray,
-               dynamics: LinearTrackingDynamics | None, ax=None, edge_color: str = "tab:blue"):
+               dynamics: LinearTrackingDynamics | None, ax: Axes | None = None,
+               edge_color: str = "tab:blue") -> Axes:
     """Obstacles, the tree's edges along their motion (see ``edge_curves``), nodes and the root."""
     from matplotlib.collections import LineCollection
 
@@ -74,8 +82,9 @@ def plot_edges(env: Environment, nodes: np.ndarray, parents: np.ndarray,
     return ax
 
 
-def plot_tree(env: Environment, result, ax=None, dynamics: LinearTrackingDynamics | None = None,
-              edge_color: str = "tab:blue", path_color: str = "tab:red", title: str | None = None):
+def plot_tree(env: Environment, result: PlanResult, ax: Axes | None = None,
+              dynamics: LinearTrackingDynamics | None = None, edge_color: str = "tab:blue",
+              path_color: str = "tab:red", title: str | None = None) -> Axes:
     """Obstacles, tree edges along the motion the plan's predicate used (``dynamics`` overrides
     what ``result.settings`` records), the path, the start and the goal ball."""
     from matplotlib.collections import LineCollection
