@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import probability
+from . import __version__, probability
 from .registry import BACKENDS, PLANNERS, POLICIES, PREDICATES, SCENARIOS
 
 
@@ -304,6 +304,7 @@ def _add_reproduce_parser(sub, formatter) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="qrrt", description=__doc__.splitlines()[0])
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     formatter = argparse.ArgumentDefaultsHelpFormatter
     _add_search_parser(sub, formatter)

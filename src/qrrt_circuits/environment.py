@@ -138,7 +138,8 @@ class Environment:
         flat = np.ascontiguousarray(points.reshape(-1, self.dim))
         index = self.grid_index
         out = np.zeros(flat.shape[0], dtype=np.bool_)
-        points_free(flat, self.bounds, self._lower, self._upper, index.origin, index.cell_size,
+        lower, upper = self.__dict__["_lower"], self.__dict__["_upper"]  # set with the grid index
+        points_free(flat, self.bounds, lower, upper, index.origin, index.cell_size,
                     index.shape, index.cell_start, index.cell_items, out)
         out &= np.all(np.isfinite(flat), axis=1)  # a non-finite point is never free
         return out.reshape(shape)

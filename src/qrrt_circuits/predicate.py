@@ -23,7 +23,7 @@ planners, experiments and plotting never ask which class it is.
 
 from __future__ import annotations
 
-from typing import Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -45,7 +45,7 @@ class ReachabilityPredicate(Protocol):
     def describe(self) -> dict: ...
 
 
-def check_predicate(predicate: object, dim: int, name: str = "predicate") -> ReachabilityPredicate:
+def check_predicate(predicate: Any, dim: int, name: str = "predicate") -> ReachabilityPredicate:
     """Return ``predicate`` if it implements the protocol in dimension ``dim``; else raise a
     ``TypeError`` naming the missing members or a ``ValueError`` naming the dimension mismatch."""
     missing = [member for member in REQUIRED_MEMBERS if not hasattr(predicate, member)]

@@ -20,6 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import IntEnum
 from functools import cached_property
+from typing import cast
 
 import numpy as np
 from numba import njit
@@ -148,7 +149,8 @@ class RandomStreams:
 
     @classmethod
     def from_seed(cls, seed: int | None) -> RandomStreams:
-        return cls(int(np.random.SeedSequence(seed).entropy))
+        entropy = np.random.SeedSequence(seed).entropy  # an int for an int or None seed
+        return cls(int(cast(int, entropy)))
 
     @cached_property
     def _run_entropy(self) -> np.ndarray:
