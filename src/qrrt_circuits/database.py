@@ -137,7 +137,7 @@ def stream_database(
 
     def generator() -> np.random.Generator:
         rng = streams.generator(round_index, worker, Stream.CANDIDATES)
-        rng.bit_generator.advance(size * dim)
+        rng.bit_generator.advance(size * dim)  # type: ignore[attr-defined]  # a PCG64
         return rng
 
     return _finish_database(samples, tree, size, generator, goal, goal_radius, goal_bias, annealing,

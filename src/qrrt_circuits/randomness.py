@@ -170,7 +170,7 @@ class RandomStreams:
         if min(key) < 0:
             raise ValueError(f"spawn keys must be non-negative, got {key}")
         words = _seed_words(self._run_entropy, np.array([key], dtype=np.int64))
-        return np.random.Generator(np.random.PCG64(_SeedWords(words[0])))
+        return np.random.Generator(np.random.PCG64(_SeedWords(words[0])))  # type: ignore[arg-type]  # an ISeedSequence
 
     def generators(self, rounds: np.ndarray, workers: np.ndarray, stream: Stream) -> list[np.random.Generator]:
         """The generators of many (round, worker) pairs of one stream, seeded in one compiled call."""
@@ -179,7 +179,8 @@ class RandomStreams:
         keys[:, 0] = rounds
         keys[:, 1] = workers
         keys[:, 2] = int(stream)
-        return [np.random.Generator(np.random.PCG64(_SeedWords(words))) for words in self.seed_words(keys)]
+        return [np.random.Generator(np.random.PCG64(_SeedWords(words)))  # type: ignore[arg-type]
+                for words in self.seed_words(keys)]
 
     def seed(self, round_index: int, worker: int, stream: Stream = Stream.SEARCH) -> int:
         """One integer seed (for a backend call) drawn from that generator: its
