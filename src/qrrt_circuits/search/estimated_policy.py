@@ -1,8 +1,9 @@
 """``EstimatedOptimal``: estimate the marked count of each database by amplitude estimation, then
 let every worker run the optimal number of Grover iterations for the estimate.
 
-For one database (shared by p workers in Pq-RRT), one ``IterativeAmplitudeEstimation`` from
-qiskit-algorithms (``search/estimation.py``) estimates a = m / N; every worker then runs
+For one database (shared by p workers in Pq-RRT), one amplitude estimation from qiskit-algorithms
+(``MaximumLikelihoodAmplitudeEstimation`` by default, or ``IterativeAmplitudeEstimation``;
+``search/estimation.py``) estimates a = m / N; every worker then runs
 k = floor(pi / (4 theta)), sin^2 theta = m_hat / N with m_hat = max(1, round(a_hat N)) (Eq. 1),
 measures once and verifies. The estimation is paid once per database and used by all p workers,
 which is where it can pay for itself.
@@ -21,7 +22,7 @@ from dataclasses import dataclass
 
 from ..probability import optimal_iterations
 from ..validation import check_choice, check_float, check_int
-from .estimation import AmplitudeEstimate, estimate_marked_fraction
+from .estimation import METHODS, AmplitudeEstimate, estimate_marked_fraction
 from .policies import IterationPolicy, PolicyState
 from .problem import DatabaseSearch, SearchOutcome
 
@@ -30,22 +31,26 @@ __all__ = ["EstimatedOptimal", "EstimatedOptimalState"]
 
 @dataclass(frozen=True)
 class EstimatedOptimal(IterationPolicy):
-    """One amplitude estimation per database (target half-width ``epsilon`` on m/N, confidence
-    1 - ``alpha``, ``shots`` per estimation circuit), then the optimal k for the estimate."""
+    """One amplitude estimation per database (confidence 1 - ``alpha``, ``shots`` per estimation
+    circuit), then the optimal k for the estimate. ``method="mlae"``: the powers [0, 1, ...,
+    2^(schedule-1)] of the Grover operator, likelihood-ratio interval; ``method="iae"``: iterative,
+    to a half-width ``epsilon`` on m/N (see ``search/estimation.py`` for why MLAE is the default)."""
 
-    epsilon: float = 0.05
-    alpha: float = 0.05
+    method: str = "mlae"
+    schedule: int = 3
     shots: int = 16
-    confidence_method: str = "beta"
+    alpha: float = 0.05
+    epsilon: float = 0.05
     name = "estimated"
 
     def __post_init__(self) -> None:
-        check_float(self.epsilon, "epsilon", 0.0, 0.5, open_minimum=True)
+        check_choice(self.method, "method", METHODS)
+        check_int(self.schedule, "schedule", 0, 20)
+        check_int(self.shots, "shots", 1, 1_000_000)
         check_float(self.alpha, "alpha", 0.0, 1.0, open_minimum=True)
         if self.alpha >= 1.0:
             raise ValueError(f"alpha must be in (0, 1), got {self.alpha}")
-        check_int(self.shots, "shots", 1, 1_000_000)
-        check_choice(self.confidence_method, "confidence_method", ("beta", "chernoff"))
+        check_float(self.epsilon, "epsilon", 0.0, 0.5, open_minimum=True)
 
     def start(self, num_items: int) -> EstimatedOptimalState:
         return EstimatedOptimalState(self, num_items)
@@ -53,13 +58,15 @@ class EstimatedOptimal(IterationPolicy):
     def estimate(self, problem: DatabaseSearch) -> AmplitudeEstimate:
         """One amplitude estimation of ``problem``'s marked fraction, seeded from the policy
         stream of its first worker."""
-        return estimate_marked_fraction(problem.marks, epsilon=self.epsilon, alpha=self.alpha,
-                                        shots=self.shots, rng=problem.worker_generator(0),
-                                        confidence_method=self.confidence_method)
+        return estimate_marked_fraction(problem.marks, alpha=self.alpha, shots=self.shots,
+                                        rng=problem.worker_generator(0), method=self.method,
+                                        schedule=self.schedule, epsilon=self.epsilon)
 
     def describe(self) -> str:
-        return (f"estimated (iterative amplitude estimation, epsilon {self.epsilon}, alpha {self.alpha}, "
-                f"{self.shots} shots a circuit, then the optimal k for the estimate)")
+        top = 2 ** (self.schedule - 1) if self.schedule else 0
+        how = (f"maximum-likelihood amplitude estimation, powers 0..{top}" if self.method == "mlae"
+               else f"iterative amplitude estimation to epsilon {self.epsilon}")
+        return f"estimated ({how}, {self.shots} shots a circuit, then the optimal k for the estimate)"
 
     def labels(self) -> tuple[str, ...]:
         return ("EstimatedOptimal: amplitude-estimation shots are counted as quantum oracle calls "
