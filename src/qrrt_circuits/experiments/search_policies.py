@@ -156,17 +156,23 @@ class SearchPolicies(Experiment):
                            "estimation_share_of_calls": round(sum(r["estimation_calls"] for r in rows)
                                                               / sum(r["oracle_calls"] for r in rows), 4)}
         single = [r for r in records if r["config"] == "QRRT estimated"]
-        adaptive = [r for r in records if r["config"] == "QRRT adaptive"]
-        if single and adaptive:
+        if single:
             searches = sum(r["verification_calls"] for r in single)
             estimation = sum(r["estimation_calls"] for r in single) / searches
             search_cost = (sum(r["quantum_oracle_calls"] - r["estimation_calls"] for r in single) + searches) / searches
             rate = sum(r["nodes"] for r in single) / searches
-            adaptive_per_node = sum(r["oracle_calls"] for r in adaptive) / sum(r["nodes"] for r in adaptive)
-            margin = rate * adaptive_per_node - search_cost
-            out["break_even_workers"] = None if margin <= 0 else round(estimation / margin, 1)
-            out["break_even_note"] = ("p* = E / (r x Adaptive's calls per node - s) from q-RRT runs; None: the "
-                                      "searches after an estimate cost more per node than Adaptive's, so no p pays")
+            out["break_even_workers"] = {}
+            for rival in ("adaptive", "bbht", "paper"):
+                rows = [r for r in records if r["config"] == f"QRRT {rival}"]
+                if not rows:
+                    continue
+                per_node = sum(r["oracle_calls"] for r in rows) / sum(r["nodes"] for r in rows)
+                margin = rate * per_node - search_cost
+                out["break_even_workers"][rival] = None if margin <= 0 else round(estimation / margin, 1)
+            out["break_even_note"] = ("p* = E / (r x rival's calls per node - s) from the q-RRT runs (E: estimation "
+                                      "calls per database, s: search calls per worker, r: nodes per worker search); "
+                                      "None: the searches after an estimate cost more per node than the rival's, so "
+                                      "no number of workers pays")
         return out
 
     def plot(self, records, settings, summary, out_dir: Path):
