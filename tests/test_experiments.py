@@ -11,7 +11,7 @@ from qrrt_circuits.experiments.fitting import linear_fit, power_law_exponent, sl
 TINY = {"oracle-efficiency": 1, "wallclock": 1, "heatmaps": 2, "corridor": 2, "annealing": 1,
         "lemmas": 60, "scaling": 1, "oracle-check": 1,
         "tree-size": 1, "heatmap-hypotheses": 3,
-        "corridor-sensitivity": 2}
+        "corridor-sensitivity": 2, "search-policies": 1}
 
 
 def _is_png(path):
@@ -131,11 +131,25 @@ def _check_corridor_sensitivity(summary, records):
         assert r["oracle_calls"] >= summary["settings"]["budget"]
 
 
+def _check_search_policies(summary, records):
+    from qrrt_circuits.experiments.search_policies import CONFIGS
+
+    assert set(summary["ours"]) == set(CONFIGS)
+    for r in records:
+        assert r["oracle_calls"] == r["quantum_oracle_calls"] + r["verification_calls"]
+        assert r["critical_path_calls"] <= r["oracle_calls"]
+        assert (r["estimation_calls"] > 0) == r["config"].endswith("estimated")
+        assert r["estimation_calls"] <= r["quantum_oracle_calls"]
+    for label, row in summary["whole_run"].items():
+        if label.startswith("QRRT") or label == "RRT":  # one worker: the critical path is every call
+            assert row["critical_path_per_node"] == row["calls_per_node"]
+
+
 CHECKS = {"oracle-efficiency": _check_oracle_efficiency, "wallclock": _check_wallclock,
           "heatmaps": _check_heatmaps, "corridor": _check_corridor, "annealing": _check_annealing,
           "lemmas": _check_lemmas, "scaling": _check_scaling, "oracle-check": _check_oracle_check,
           "tree-size": _check_tree_size, "heatmap-hypotheses": _check_heatmap_hypotheses,
-          "corridor-sensitivity": _check_corridor_sensitivity}
+          "corridor-sensitivity": _check_corridor_sensitivity, "search-policies": _check_search_policies}
 
 
 def _comparable(records):

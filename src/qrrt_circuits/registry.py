@@ -29,10 +29,20 @@ class Entry:
     aliases: tuple[str, ...] = ()
     parameter: str | None = None  # e.g. "K" for "fixed:K"
     tags: frozenset[str] = field(default_factory=frozenset)
+    #: the parameter may be left out (``fixed-point`` or ``fixed-point:0.3``); the factory gets None
+    parameter_optional: bool = False
 
     @property
     def label(self) -> str:
-        return self.name if self.parameter is None else f"{self.name}:{self.parameter}"
+        if self.parameter is None:
+            return self.name
+        return f"{self.name}[:{self.parameter}]" if self.parameter_optional else f"{self.name}:{self.parameter}"
+
+    def accepts(self, value: str | None) -> bool:
+        """Whether ``name:VALUE`` (or the bare name, for value None) is this entry's form."""
+        if self.parameter is None:
+            return value is None
+        return value is not None or self.parameter_optional
 
     def options(self) -> frozenset[str]:
         """The keyword options the factory accepts."""
@@ -52,8 +62,9 @@ class Registry:
         self._lookup: dict[str, str] = {}
 
     def register(self, name: str, factory: Callable[..., Any], help: str, *, aliases: tuple[str, ...] = (),
-                 parameter: str | None = None, tags: tuple[str, ...] = ()) -> Entry:
-        entry = Entry(name, factory, help, tuple(aliases), parameter, frozenset(tags))
+                 parameter: str | None = None, tags: tuple[str, ...] = (),
+                 parameter_optional: bool = False) -> Entry:
+        entry = Entry(name, factory, help, tuple(aliases), parameter, frozenset(tags), parameter_optional)
         for key in (name, *aliases):
             if key in self._lookup:
                 raise ValueError(f"{self.kind} name {key!r} is registered twice")
@@ -94,7 +105,7 @@ class Registry:
         base, value = self._split(name)
         key = self._lookup.get(base)
         entry = None if key is None else self._entries[key]
-        if entry is None or (entry.parameter is None) != (value is None):
+        if entry is None or not entry.accepts(value):
             raise ValueError(f"unknown {self.kind} {name!r}; choose one of {', '.join(self.labels())}")
         return entry
 
@@ -189,6 +200,25 @@ def _fixed(value: str):
     return FixedIterations(k)
 
 
+def _fixed_point(value: str | None):
+    from .search.fixed_point_policy import FixedPointAmplification
+
+    if value is None:
+        return FixedPointAmplification()
+    try:
+        delta = float(value)
+    except ValueError:
+        raise ValueError(f"policy fixed-point:DELTA needs a number DELTA in (0, 1), "
+                         f"got 'fixed-point:{value}'") from None
+    return FixedPointAmplification(delta=delta)
+
+
+def _estimated():
+    from .search.estimated_policy import EstimatedOptimal
+
+    return EstimatedOptimal()
+
+
 def _policies() -> Registry:
     from .search.policies import BBHT, Adaptive, KnownOptimal, PaperSchedule
 
@@ -198,6 +228,12 @@ def _policies() -> Registry:
     registry.register("bbht", BBHT, "Boyer-Brassard-Hoyer-Tapp for unknown m")
     registry.register("adaptive", Adaptive, "k from a posterior over m/N learned from verified outcomes")
     registry.register("fixed", _fixed, "always K iterations", parameter="K")
+    registry.register("fixed-point", _fixed_point,
+                      "fixed-point amplitude amplification (Yoder et al. 2014), P >= 1 - DELTA^2 for "
+                      "marked fractions >= 0.05 (DELTA 0.5 by default)", parameter="DELTA", parameter_optional=True)
+    registry.register("estimated", _estimated,
+                      "amplitude estimation of m per database (its shots counted as oracle calls), "
+                      "then the optimal k")
     return registry
 
 

@@ -11,6 +11,7 @@ from .oracle_check import OracleCheck
 from .oracle_efficiency import OracleEfficiency
 from .runner import read_records, run_experiment
 from .scaling import Scaling
+from .search_policies import SearchPolicies
 from .tree_size import TreeSize
 from .wallclock import Wallclock
 
@@ -18,7 +19,7 @@ EXPERIMENTS = {
     experiment.name: experiment
     for experiment in (OracleEfficiency(), Wallclock(), Heatmaps(), Corridor(), Annealing(), Lemmas(),
                        Scaling(), OracleCheck(), TreeSize(), HeatmapHypotheses(),
-                       CorridorSensitivity())
+                       CorridorSensitivity(), SearchPolicies())
 }
 
 __all__ = ["EXPERIMENTS", "read_records", "run_experiment"]

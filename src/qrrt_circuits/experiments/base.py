@@ -37,6 +37,9 @@ class TrialStream(IntEnum):
     TREE_SIZE_PLANNERS = 12
     HEATMAP_HYPOTHESES = 13
     CORRIDOR_SENSITIVITY = 14
+    # search-policies (numbered apart from the others so that parallel additions cannot collide)
+    SEARCH_POLICIES_WORLDS = 31
+    SEARCH_POLICIES_PLANNERS = 32
 
 
 @dataclass(frozen=True)

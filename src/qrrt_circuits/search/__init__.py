@@ -3,6 +3,9 @@
 from . import circuits
 from .aer import AerBackend
 from .backend import QuantumSearchBackend, SearchResult
+from .estimated_policy import EstimatedOptimal
+from .fixed_point import IterateSequence
+from .fixed_point_policy import FixedPointAmplification
 from .problem import DatabaseSearch, SearchOutcome
 from .sampler import SamplerBackend
 from .statevector import StatevectorBackend
@@ -10,6 +13,9 @@ from .statevector import StatevectorBackend
 __all__ = [
     "AerBackend",
     "DatabaseSearch",
+    "EstimatedOptimal",
+    "FixedPointAmplification",
+    "IterateSequence",
     "QuantumSearchBackend",
     "SamplerBackend",
     "SearchOutcome",

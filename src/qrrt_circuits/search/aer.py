@@ -13,6 +13,7 @@ from qiskit_aer import AerSimulator
 from ..validation import check_int
 from .backend import QuantumSearchBackend, seed_stream
 from .circuits import SYNTHESES, aer_grover_circuit
+from .fixed_point import generalized_grover_circuit
 
 METHODS = ("statevector", "automatic")
 #: methods AerSimulator offers that these circuits cannot run, and why (refused at construction)
@@ -87,6 +88,13 @@ class AerBackend(QuantumSearchBackend):
 
     def _sample(self, marks, num_qubits, iterations, shots, rng) -> np.ndarray:
         circuit = aer_grover_circuit(marks, iterations, measure=True, synthesis=self.synthesis)
+        return self._execute(circuit, shots, rng)
+
+    def _sample_sequence(self, marks, num_qubits, sequence, shots, rng) -> np.ndarray:
+        circuit = generalized_grover_circuit(marks, sequence, measure=True, synthesis=self.synthesis)
+        return self._execute(circuit, shots, rng)
+
+    def _execute(self, circuit, shots, rng) -> np.ndarray:
         seed = int(rng.integers(0, 2**31 - 1))
         result = self.simulator.run(circuit, shots=shots, seed_simulator=seed, memory=True).result()
         if not result.success:

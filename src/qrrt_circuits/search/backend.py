@@ -8,6 +8,10 @@ shortcut of Pq-RRT: on hardware each worker would run its own circuit).
 
 Oracle calls are counted as DESIGN §2 says: one per Grover iteration per preparation, so
 ``oracle_calls = iterations * shots``.
+
+``search_sequence(marks, sequence, shots, seed)`` runs generalized iterates G(alpha_j, beta_j)
+instead (an ``IterateSequence``, ``search/fixed_point.py``: fixed-point amplitude amplification);
+each iterate queries the oracle once, so ``oracle_calls = len(sequence) * shots`` as well.
 """
 
 from __future__ import annotations
@@ -121,6 +125,29 @@ class QuantumSearchBackend(abc.ABC):
         """Refuse a search whose estimated peak exceeds the available memory (before allocating)."""
         check_fits(lambda n: self.memory_estimate(n, shots, iterations), num_qubits,
                    f"this {self.name} search ({shots} shots, {iterations} iterations)")
+
+    def search_sequence(self, marks: np.ndarray, sequence, shots: int = 1,
+                        seed: int | None = None) -> SearchResult:
+        """Apply the generalized Grover iterates of ``sequence`` (an ``IterateSequence``) to the
+        uniform state and measure ``shots`` times; ``iterations`` of the result = len(sequence)."""
+        from .fixed_point import IterateSequence
+
+        marks, num_qubits = validate_marks(marks)
+        if not isinstance(sequence, IterateSequence):
+            raise TypeError(f"sequence must be an IterateSequence, got {type(sequence).__name__}")
+        shots = validate_shots(shots)
+        self.check_qubits(num_qubits)
+        self.check_memory(num_qubits, shots, len(sequence))
+        rng = self._rng if seed is None else seed_stream(seed)
+        indices = self._sample_sequence(marks, num_qubits, sequence, shots, rng)
+        return SearchResult(indices, len(sequence), shots, sequence.oracle_calls * shots)
+
+    def _sample_sequence(self, marks: np.ndarray, num_qubits: int, sequence, shots: int,
+                         rng: np.random.Generator) -> np.ndarray:
+        """``shots`` measured indices after ``sequence`` (validated inputs); backends that can run
+        generalized iterates override this."""
+        raise NotImplementedError(f"backend {self.name!r} does not run generalized Grover iterates "
+                                  "(search_sequence); use the aer, statevector or sampler backend")
 
     def labels(self) -> tuple[str, ...]:
         """Caveats every result that depends on this backend must carry (none by default)."""

@@ -2,7 +2,8 @@
 
 A ``DatabaseSearch`` gives a policy three things and nothing else: ``search(iterations, shots,
 seed)`` (prepare the uniform superposition, apply Grover iterations, measure ``shots`` times: each
-shot one worker's independent preparation), ``verify(index)`` (the classical finalizer: the true
+shot one worker's independent preparation; ``search_sequence(sequence, shots, seed)`` applies
+generalized iterates instead, for fixed-point amplification), ``verify(index)`` (the classical finalizer: the true
 predicate on one entry, 1 oracle call), and the database size. ``marked_count()`` is simulation
 knowledge a quantum device does not have (only ``KnownOptimal`` uses it, and it is labelled).
 Seeds come from the plan's random streams, keyed by round and worker, so a search never depends on
@@ -67,6 +68,11 @@ class DatabaseSearch:
     def search(self, iterations: int, shots: int, seed: int) -> np.ndarray:
         """Measured indices (one per shot) after ``iterations`` Grover iterations."""
         return self.backend.search(self.marks, iterations, shots, seed=seed).indices
+
+    def search_sequence(self, sequence, shots: int, seed: int) -> np.ndarray:
+        """Measured indices (one per shot) after the generalized iterates of ``sequence`` (an
+        ``IterateSequence``: fixed-point amplification), len(sequence) oracle calls per shot."""
+        return self.backend.search_sequence(self.marks, sequence, shots, seed=seed).indices
 
     def verify(self, index: int) -> bool:
         """The classical finalizer: is entry ``index`` truly reachable? (1 oracle call.)"""

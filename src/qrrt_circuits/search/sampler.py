@@ -20,6 +20,7 @@ from qiskit.transpiler import generate_preset_pass_manager
 
 from .backend import QuantumSearchBackend, seed_stream
 from .circuits import BASIS_GATES, SYNTHESES, grover_circuit
+from .fixed_point import generalized_grover_circuit
 
 
 class SamplerBackend(QuantumSearchBackend):
@@ -74,6 +75,20 @@ class SamplerBackend(QuantumSearchBackend):
             self._cache.move_to_end(key)
         return circuit
 
+    def compiled_sequence(self, marks: np.ndarray, sequence):
+        """The transpiled ``generalized_grover_circuit`` (cached by marks and phases)."""
+        key = (marks.shape[0], np.packbits(marks).tobytes(), "sequence", sequence.key())
+        circuit = self._cache.get(key)
+        if circuit is None:
+            circuit = self.pass_manager.run(generalized_grover_circuit(marks, sequence, synthesis=self.synthesis))
+            self.transpile_count += 1
+            self._cache[key] = circuit
+            if len(self._cache) > self._cache_size:
+                self._cache.popitem(last=False)
+        else:
+            self._cache.move_to_end(key)
+        return circuit
+
     def labels(self) -> tuple[str, ...]:
         if self.per_call_seed:
             return ()
@@ -81,7 +96,12 @@ class SamplerBackend(QuantumSearchBackend):
                 "depend on it and not only on the planner's seed",)
 
     def _sample(self, marks, num_qubits, iterations, shots, rng) -> np.ndarray:
-        circuit = self.compiled(marks, iterations)
+        return self._execute(self.compiled(marks, iterations), shots, rng)
+
+    def _sample_sequence(self, marks, num_qubits, sequence, shots, rng) -> np.ndarray:
+        return self._execute(self.compiled_sequence(marks, sequence), shots, rng)
+
+    def _execute(self, circuit, shots, rng) -> np.ndarray:
         if self.per_call_seed:
             self.sampler.options.run_options["seed_simulator"] = int(rng.integers(0, 2**31 - 1))
         result = self.sampler.run([circuit], shots=shots).result()[0]

@@ -17,6 +17,7 @@ import numpy as np
 from ..probability import good_probability
 from ..validation import check_bool, check_int
 from .backend import QuantumSearchBackend, seed_stream, validate_iterations, validate_marks
+from .fixed_point import statevector_after
 
 BYTES_PER_ENTRY = 32  # amplitudes (8) + probabilities (8) + index lists (8) + marks, with slack
 
@@ -74,25 +75,45 @@ class StatevectorBackend(QuantumSearchBackend):
 
     def _sample(self, marks, num_qubits, iterations, shots, rng) -> np.ndarray:
         if not self.closed_form:
-            probabilities = self.amplitudes(marks, iterations) ** 2
-            cumulative = np.cumsum(probabilities)
-            draws = rng.random(shots) * cumulative[-1]
-            return np.minimum(np.searchsorted(cumulative, draws, side="right"), marks.shape[0] - 1)
-        size = marks.shape[0]
-        marked = np.flatnonzero(marks)
-        num_marked = marked.shape[0]
-        p_good = good_probability(size, num_marked, iterations)
-        good = rng.random(shots) < p_good
-        out = np.empty(shots, dtype=np.int64)
-        num_good = int(np.count_nonzero(good))
-        if num_good:
-            out[good] = marked[rng.integers(0, num_marked, num_good)]
-        if num_good < shots:
-            unmarked_count = size - num_marked
-            # k-th unmarked index without listing them all: rank among the complement
-            ranks = rng.integers(0, unmarked_count, shots - num_good)
-            out[~good] = _kth_unmarked(marked, ranks)
-        return out
+            return _draw(self.amplitudes(marks, iterations) ** 2, shots, rng)
+        p_good = good_probability(marks.shape[0], int(np.count_nonzero(marks)), iterations)
+        return _draw_two_level(marks, p_good, shots, rng)
+
+    def _sample_sequence(self, marks, num_qubits, sequence, shots, rng) -> np.ndarray:
+        """Generalized iterates: the exact 2-dimensional evolution (closed form; every marked index
+        keeps the same amplitude) or, with ``closed_form=False``, the full iterated vector."""
+        if not self.closed_form:
+            return _draw(np.abs(statevector_after(marks, sequence)) ** 2, shots, rng)
+        num_marked = int(np.count_nonzero(marks))
+        p_good = sequence.good_probability(num_marked / marks.shape[0]) if num_marked else 0.0
+        return _draw_two_level(marks, min(max(p_good, 0.0), 1.0), shots, rng)
+
+
+def _draw(probabilities: np.ndarray, shots: int, rng: np.random.Generator) -> np.ndarray:
+    cumulative = np.cumsum(probabilities)
+    draws = rng.random(shots) * cumulative[-1]
+    return np.minimum(np.searchsorted(cumulative, draws, side="right"), probabilities.shape[0] - 1)
+
+
+def _draw_two_level(marks: np.ndarray, p_good: float, shots: int, rng: np.random.Generator) -> np.ndarray:
+    """``shots`` indices: marked (uniformly among the marked) with probability ``p_good``, else
+    uniformly among the unmarked (Grover-type states are uniform within each class)."""
+    size = marks.shape[0]
+    marked = np.flatnonzero(marks)
+    num_marked = marked.shape[0]
+    if num_marked in (0, size):  # nothing to amplify: the class probabilities are exact
+        p_good = float(num_marked == size)
+    good = rng.random(shots) < p_good
+    out = np.empty(shots, dtype=np.int64)
+    num_good = int(np.count_nonzero(good))
+    if num_good:
+        out[good] = marked[rng.integers(0, num_marked, num_good)]
+    if num_good < shots:
+        unmarked_count = size - num_marked
+        # k-th unmarked index without listing them all: rank among the complement
+        ranks = rng.integers(0, unmarked_count, shots - num_good)
+        out[~good] = _kth_unmarked(marked, ranks)
+    return out
 
 
 def _kth_unmarked(marked_sorted: np.ndarray, ranks: np.ndarray) -> np.ndarray:

@@ -1,0 +1,200 @@
+"""Beyond the paper: search policies that cannot overshoot, or that estimate m first, against the
+paper's schedule, BBHT, Adaptive and KnownOptimal, as the tree grows.
+
+Every planner grows one tree per world in ``paper_clutter`` toward a goal it cannot reach (goal
+radius 1e-9), as in ``tree-size``, and the cumulative oracle calls (total and critical path) are
+read at tree sizes 30, 100, 300 and 1000; the marginal cost of each window is calls added / nodes
+added. Each policy is run in q-RRT (1 worker) and in Pq-RRT with 8 workers on a shared database,
+where ``EstimatedOptimal``'s amplitude estimation is paid once per database and used by the 8
+workers (its shots are shared among them, so its critical path is one worker's share).
+
+For ``EstimatedOptimal`` the trial also records the estimation's oracle calls separately from the
+search's, and the summary derives, from the q-RRT runs, the number of workers p* at which one
+estimation per database would make its calls per node equal Adaptive's:
+calls per node(p) = (E + p s) / (p r) with E the estimation calls per database, s the search calls
+(k + 1) per worker and r the success rate per worker; Adaptive's is s_a / r_a. Duplicate finds on a
+shared database are ignored in that formula (they only make sharing worse), so p* is a lower bound.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..registry import POLICIES
+from ..search.estimated_policy import EstimatedOptimal
+from .base import Experiment, TrialStream, paired_trials
+from .figures import new_figure, save
+from .intervals import bootstrap_interval, rounded_interval
+from .measures import dumps, loads
+from .planners import planner_for
+from .tree_size import calls_at_sizes, reachable_fraction_by_window
+from .worlds import world
+
+SIZES = (30, 100, 300, 1000)
+POLICY_NAMES = ("paper", "bbht", "adaptive", "fixed-point", "estimated", "optimal")
+#: label -> (registry planner, search policy name or None)
+CONFIGS = {"RRT": ("rrt", None)} | {
+    f"{prefix} {policy}": (planner, policy)
+    for prefix, planner in (("QRRT", "qrrt"), ("PQRRT", "pqrrt")) for policy in POLICY_NAMES}
+COLORS = {"paper": "tab:blue", "bbht": "tab:green", "adaptive": "tab:orange", "fixed-point": "tab:red",
+          "estimated": "tab:cyan", "optimal": "tab:purple"}
+
+
+class _LoggedEstimatedOptimal(EstimatedOptimal):
+    """EstimatedOptimal whose plan state is kept, to read its per-database (estimate, k) history."""
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        object.__setattr__(self, "states", [])  # a frozen dataclass; the list is this trial's log
+
+    def start(self, num_items):
+        state = super().start(num_items)
+        self.states.append(state)
+        return state
+
+
+def _policy(name: str | None):
+    if name == "estimated":
+        return _LoggedEstimatedOptimal()
+    return None if name is None else POLICIES.create(name)
+
+
+class SearchPolicies(Experiment):
+    name = "search-policies"
+    title = "Search that cannot overshoot: fixed-point amplification and estimated m (beyond the paper)"
+    paper = {"note": "the paper uses a fixed schedule (5 then 3 iterations) and reports 30-node trees only"}
+
+    def settings(self, quick, trials, seed):
+        return {"trials": trials or (2 if quick else 3), "sizes": list(SIZES[:2] if quick else SIZES),
+                "workers": 8, "num_qubits": 8, "backend": "statevector", "scenario": "paper_clutter",
+                "configs": list(CONFIGS), "policies": {name: POLICIES.create(name).describe()
+                                                       for name in POLICY_NAMES},
+                "seed": seed, "quick": quick}
+
+    def trials(self, settings):
+        variants = [(label, {"config": label}) for label in settings["configs"]]
+        return paired_trials(settings, variants, TrialStream.SEARCH_POLICIES_WORLDS,
+                             TrialStream.SEARCH_POLICIES_PLANNERS)
+
+    def run_trial(self, trial, settings):
+        env = world(settings["scenario"], trial.params["world_seed"])
+        planner_name, policy_name = CONFIGS[trial.params["config"]]
+        policy = _policy(policy_name)
+        planner = planner_for(settings, planner_name, env, trial.seed, settings["backend"], settings["workers"],
+                              settings["num_qubits"], search_policy=policy)
+        result = planner.plan(env.start, env.goal, 1e-9, max_nodes=max(settings["sizes"]))
+        m = result.metrics
+        estimation = k_total = 0
+        if isinstance(policy, _LoggedEstimatedOptimal):
+            history = policy.states[-1].history
+            estimation = sum(est.oracle_calls for est, _ in history)
+            k_total = sum(k for _, k in history)
+        return {"status": str(result.status), "nodes": m.nodes, "rounds": m.rounds,
+                "oracle_calls": m.oracle_calls, "quantum_oracle_calls": m.quantum_oracle_calls,
+                "verification_calls": m.verification_calls, "critical_path_calls": m.critical_path_oracle_calls,
+                "databases": m.databases, "duplicates": m.duplicates,
+                "estimation_calls": estimation, "estimated_k_total": k_total,
+                "points_json": dumps(calls_at_sizes(result, settings["sizes"])),
+                "fractions_json": dumps(reachable_fraction_by_window(result, settings["sizes"]))}
+
+    def summarize(self, records, settings):
+        sizes = settings["sizes"]
+        windows = [f"{a}-{b}" for a, b in zip(sizes[:-1], sizes[1:], strict=True)]
+
+        def pooled(rows, window, column=1):
+            low, high = (int(v) for v in window.split("-"))
+            calls = nodes = 0
+            for r in rows:
+                points = {p[0]: p for p in loads(r["points_json"])}
+                if low in points and high in points:
+                    calls += points[high][column] - points[low][column]
+                    nodes += high - low
+            return calls / nodes if nodes else float("nan")
+
+        ours, interval, critical, whole = {}, {}, {}, {}
+        for label in settings["configs"]:
+            rows = [r for r in records if r["config"] == label]
+            ours[label] = {w: round(pooled(rows, w), 3) for w in windows}
+            interval[label] = {w: rounded_interval(bootstrap_interval(rows, lambda s, w=w: pooled(s, w),
+                                                                      settings["seed"]), 3) for w in windows}
+            critical[label] = {w: round(pooled(rows, w, 2), 3) for w in windows}
+            nodes = sum(r["nodes"] for r in rows)
+            whole[label] = {"calls_per_node": round(sum(r["oracle_calls"] for r in rows) / nodes, 3),
+                            "critical_path_per_node": round(sum(r["critical_path_calls"] for r in rows) / nodes, 3)}
+        fractions = {w: round(float(np.mean([loads(r["fractions_json"])[w] for r in records
+                                             if w in loads(r["fractions_json"])] or [np.nan])), 4)
+                     for w in windows}
+        return {"ours": ours, "paper": self.paper, "interval_95": interval, "critical_path_per_node": critical,
+                "whole_run": whole, "mean_reachable_fraction": fractions,
+                "estimation": self._estimation_summary(records),
+                "note": "marginal oracle calls per node added in each window of tree sizes, pooled over worlds "
+                        "(critical_path_per_node: the same for the critical path, the time of 8 parallel devices); "
+                        "whole_run: all calls / all nodes up to the largest size",
+                "labels": ["QRRT/PQRRT optimal use the true m of each database (simulation knowledge)",
+                           "estimated: amplitude-estimation shots are counted as quantum oracle calls (k + 1 per "
+                           "shot of Q^k A|0>), run on qiskit-aer's SamplerV2; the searches on the exact statevector",
+                           "phase oracle from a classical lookup of all 2^8 entries",
+                           "backend: exact statevector (ideal; same statistics as Aer)"]}
+
+    @staticmethod
+    def _estimation_summary(records) -> dict:
+        """Estimation vs search calls of EstimatedOptimal, and the workers p* at which one estimation
+        per database would match Adaptive's calls per node (from the q-RRT runs)."""
+        out = {}
+        for prefix in ("QRRT", "PQRRT"):
+            rows = [r for r in records if r["config"] == f"{prefix} estimated"]
+            databases = sum(r["databases"] for r in rows)
+            searches = sum(r["verification_calls"] for r in rows)
+            if not databases or not searches:
+                continue
+            out[prefix] = {"estimation_calls_per_database": round(sum(r["estimation_calls"] for r in rows)
+                                                                  / databases, 2),
+                           "search_calls_per_worker": round((sum(r["quantum_oracle_calls"] - r["estimation_calls"]
+                                                                 for r in rows) + searches) / searches, 3),
+                           "estimation_share_of_calls": round(sum(r["estimation_calls"] for r in rows)
+                                                              / sum(r["oracle_calls"] for r in rows), 4)}
+        single = [r for r in records if r["config"] == "QRRT estimated"]
+        if single:
+            searches = sum(r["verification_calls"] for r in single)
+            estimation = sum(r["estimation_calls"] for r in single) / searches
+            search_cost = (sum(r["quantum_oracle_calls"] - r["estimation_calls"] for r in single) + searches) / searches
+            rate = sum(r["nodes"] for r in single) / searches
+            out["break_even_workers"] = {}
+            for rival in ("adaptive", "bbht", "paper"):
+                rows = [r for r in records if r["config"] == f"QRRT {rival}"]
+                if not rows:
+                    continue
+                per_node = sum(r["oracle_calls"] for r in rows) / sum(r["nodes"] for r in rows)
+                margin = rate * per_node - search_cost
+                out["break_even_workers"][rival] = None if margin <= 0 else round(estimation / margin, 1)
+            out["break_even_note"] = ("p* = E / (r x rival's calls per node - s) from the q-RRT runs (E: estimation "
+                                      "calls per database, s: search calls per worker, r: nodes per worker search); "
+                                      "None: the searches after an estimate cost more per node than the rival's, so "
+                                      "no number of workers pays")
+        return out
+
+    def plot(self, records, settings, summary, out_dir: Path):
+        fig, axes = new_figure(1, 2, (12, 5))
+        sizes = settings["sizes"]
+        windows = list(summary["ours"]["RRT"])
+        centres = [np.sqrt(a * b) for a, b in zip(sizes[:-1], sizes[1:], strict=True)]
+        for ax, prefix, column in ((axes[0, 0], "QRRT", "ours"), (axes[0, 1], "PQRRT", "critical_path_per_node")):
+            ax.plot(centres, [summary["ours"]["RRT"][w] for w in windows], "o-", color="tab:gray", label="RRT")
+            for policy in POLICY_NAMES:
+                label = f"{prefix} {policy}"
+                values = [summary[column][label][w] for w in windows]
+                ax.plot(centres, values, "o-", color=COLORS[policy], ms=4, label=label)
+                if prefix == "PQRRT":
+                    ax.plot(centres, [summary["ours"][label][w] for w in windows], ":", color=COLORS[policy])
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            ax.set_xlabel("tree size (nodes, window centre)")
+            ax.grid(alpha=0.3, which="both")
+            ax.legend(fontsize=7)
+        axes[0, 0].set_ylabel("oracle calls per node added")
+        axes[0, 0].set_title(f"q-RRT: calls per node ({settings['trials']} worlds)", fontsize=10)
+        axes[0, 1].set_title("Pq-RRT, 8 workers, shared database: critical path (solid), total (dotted)",
+                             fontsize=10)
+        return [save(fig, out_dir / "search_policies.png")]

@@ -1,0 +1,101 @@
+"""``EstimatedOptimal``: estimate the marked count of each database by amplitude estimation, then
+let every worker run the optimal number of Grover iterations for the estimate.
+
+For one database (shared by p workers in Pq-RRT), one amplitude estimation from qiskit-algorithms
+(``MaximumLikelihoodAmplitudeEstimation`` by default, or ``IterativeAmplitudeEstimation``;
+``search/estimation.py``) estimates a = m / N; every worker then runs
+k = floor(pi / (4 theta)), sin^2 theta = m_hat / N with m_hat = max(1, round(a_hat N)) (Eq. 1),
+measures once and verifies. The estimation is paid once per database and used by all p workers,
+which is where it can pay for itself.
+
+Oracle calls (DESIGN §2): the estimation costs sum_i shots_i (k_i + 1) quantum oracle calls (k_i
+inside Q^{k_i}, 1 to decide whether the measured index is good: see ``search/estimation.py``);
+its shots are shared by the p workers round by round (worker w takes shots // p, one more for
+w < shots % p), so the estimation's critical path is worker 0's share. Each worker adds k quantum
+calls and 1 verification. Estimation shots are labelled in every output as counted oracle calls.
+The estimation runs on qiskit-aer's SamplerV2 whatever the planner's backend (labelled too).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..probability import optimal_iterations
+from ..validation import check_choice, check_float, check_int
+from .estimation import METHODS, AmplitudeEstimate, estimate_marked_fraction
+from .policies import IterationPolicy, PolicyState
+from .problem import DatabaseSearch, SearchOutcome
+
+__all__ = ["EstimatedOptimal", "EstimatedOptimalState"]
+
+
+@dataclass(frozen=True)
+class EstimatedOptimal(IterationPolicy):
+    """One amplitude estimation per database (confidence 1 - ``alpha``, ``shots`` per estimation
+    circuit), then the optimal k for the estimate. ``method="mlae"``: the powers [0, 1, ...,
+    2^(schedule-1)] of the Grover operator, likelihood-ratio interval; ``method="iae"``: iterative,
+    to a half-width ``epsilon`` on m/N (see ``search/estimation.py`` for why MLAE is the default)."""
+
+    method: str = "mlae"
+    schedule: int = 3
+    shots: int = 16
+    alpha: float = 0.05
+    epsilon: float = 0.05
+    name = "estimated"
+
+    def __post_init__(self) -> None:
+        check_choice(self.method, "method", METHODS)
+        check_int(self.schedule, "schedule", 0, 20)
+        check_int(self.shots, "shots", 1, 1_000_000)
+        check_float(self.alpha, "alpha", 0.0, 1.0, open_minimum=True)
+        if self.alpha >= 1.0:
+            raise ValueError(f"alpha must be in (0, 1), got {self.alpha}")
+        check_float(self.epsilon, "epsilon", 0.0, 0.5, open_minimum=True)
+
+    def start(self, num_items: int) -> EstimatedOptimalState:
+        return EstimatedOptimalState(self, num_items)
+
+    def estimate(self, problem: DatabaseSearch) -> AmplitudeEstimate:
+        """One amplitude estimation of ``problem``'s marked fraction, seeded from the policy
+        stream of its first worker."""
+        return estimate_marked_fraction(problem.marks, alpha=self.alpha, shots=self.shots,
+                                        rng=problem.worker_generator(0), method=self.method,
+                                        schedule=self.schedule, epsilon=self.epsilon)
+
+    def describe(self) -> str:
+        top = 2 ** (self.schedule - 1) if self.schedule else 0
+        how = (f"maximum-likelihood amplitude estimation, powers 0..{top}" if self.method == "mlae"
+               else f"iterative amplitude estimation to epsilon {self.epsilon}")
+        return f"estimated ({how}, {self.shots} shots a circuit, then the optimal k for the estimate)"
+
+    def labels(self) -> tuple[str, ...]:
+        return ("EstimatedOptimal: amplitude-estimation shots are counted as quantum oracle calls "
+                "(k + 1 per shot of Q^k A|0>), shared by the workers of a database; they run on "
+                "qiskit-aer's SamplerV2 whatever the search backend",)
+
+
+class EstimatedOptimalState(PolicyState):
+    """Per database: one estimation, then every worker searches with the optimal k for it.
+    ``history`` keeps (estimate, k) per database, in the order they were run."""
+
+    policy: EstimatedOptimal
+
+    def __init__(self, policy: EstimatedOptimal, num_items: int) -> None:
+        super().__init__(policy, num_items)
+        self.history: list[tuple[AmplitudeEstimate, int]] = []
+
+    def choose_iterations(self, tree_nodes: int, num_marked: int | None = None) -> int:
+        raise TypeError("EstimatedOptimal chooses k per database from its estimate (see run)")
+
+    iterations = choose_iterations
+
+    def run(self, problem: DatabaseSearch, workers: int, tree_nodes: int) -> tuple[SearchOutcome, ...]:
+        estimate = self.policy.estimate(problem)
+        k = optimal_iterations(problem.num_items, estimate.marked_count(problem.num_items))
+        self.history.append((estimate, k))
+        shares = estimate.calls_per_worker(workers)
+        outcomes = []
+        for share, measured in zip(shares, problem.search(k, workers, problem.shared_seed()), strict=True):
+            good = problem.verify(int(measured))
+            outcomes.append(SearchOutcome(int(measured) if good else None, share + k, 1, ((k, good),)))
+        return tuple(outcomes)

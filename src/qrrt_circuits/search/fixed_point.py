@@ -1,0 +1,252 @@
+"""Fixed-point amplitude amplification (Yoder, Low and Chuang, PRL 113, 210501, 2014): phases,
+success probability and the generalized Grover circuits that apply them.
+
+Generalized Grover iterate (Yoder et al., Eq. 1 and the text around it)::
+
+    G(alpha, beta) = -S_s(alpha) S_t(beta),
+    S_t(beta)  = I - (1 - e^{+i beta})  |T><T|    (phase oracle diag(e^{i beta marks}))
+    S_s(alpha) = I - (1 - e^{-i alpha}) |s><s|    (|s> = H^n |0>, the uniform state)
+
+With alpha = beta = pi, G is the standard Grover iterate (oracle, then inversion about the mean).
+The sequence applies G(alpha_1, beta_1) first and G(alpha_l, beta_l) last to |s>. For a target
+error delta and L = 2l + 1, the paper's closed form is::
+
+    1 / gamma = T_{1/L}(1 / delta),
+    alpha_j = -beta_{l - j + 1} = 2 cot^{-1}( tan(2 pi j / L) sqrt(1 - gamma^2) ),   j = 1..l
+
+and the probability of measuring a marked index, for a marked fraction f = m / N, is::
+
+    P_L(f) = 1 - delta^2 T_L( T_{1/L}(1/delta) sqrt(1 - f) )^2,
+
+which is >= 1 - delta^2 for every f >= w whenever sqrt(1 - w) T_{1/L}(1/delta) <= 1, i.e.
+w >= 1 - gamma^2 (|T_L| <= 1 on [-1, 1]). The paper's sufficient length is
+L >= log(2 / delta) / sqrt(w) (``length_rule="paper"``); ``"tight"`` takes the smallest L with
+1 - gamma^2 <= w, which carries the same guarantee with fewer queries. The sign conventions were
+checked numerically (tests/test_fixed_point.py): flipping the sign of alpha or of beta alone
+breaks P_L.
+
+Counting (DESIGN §2): each iterate queries the oracle once, so a sequence of l iterates costs l
+quantum oracle calls per preparation; the paper's L = 2l + 1 counts the applications of the state
+preparation H^n (and its inverse), exactly as k Grover iterations reach sin^2((2k + 1) theta).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from qiskit import QuantumCircuit
+from qiskit.circuit.library import DiagonalGate
+
+from ..validation import check_float, check_int
+from .backend import MAX_ITERATIONS, validate_marks
+
+LENGTH_RULES = ("paper", "tight")
+
+
+def chebyshev(order: float, x: float) -> float:
+    """T_order(x) = cos(order acos x) on [-1, 1] and cosh(order acosh x) for x > 1 (real order)."""
+    if abs(x) <= 1.0:
+        return math.cos(order * math.acos(x))
+    if x > 1.0:
+        return math.cosh(order * math.acosh(x))
+    raise ValueError(f"chebyshev is used here for x > -1 only, got x = {x}")
+
+
+def gamma(delta: float, length: int) -> float:
+    """gamma with 1 / gamma = T_{1/L}(1 / delta) (Yoder et al.)."""
+    return 1.0 / chebyshev(1.0 / length, 1.0 / delta)
+
+
+def check_delta(delta) -> float:
+    """The target error delta in (0, 1) (delta = 1 would promise nothing)."""
+    value = check_float(delta, "delta", 0.0, 1.0, open_minimum=True)
+    if value == 1.0:
+        raise ValueError("delta must be in (0, 1) (the guarantee is P >= 1 - delta^2), got 1.0")
+    return value
+
+
+def check_fraction(fraction, name: str = "min_fraction") -> float:
+    return check_float(fraction, name, 0.0, 1.0, open_minimum=True)
+
+
+def fixed_point_iterates(delta: float, min_fraction: float, length_rule: str = "paper") -> int:
+    """The number l of generalized iterates (oracle calls) for error ``delta`` and marked fraction
+    >= ``min_fraction``: the smallest l with L = 2l + 1 >= log(2/delta)/sqrt(w) (``"paper"``), or the
+    smallest with 1 - gamma(L)^2 <= w (``"tight"``; never larger than the paper's)."""
+    delta = check_delta(delta)
+    w = check_fraction(min_fraction)
+    if length_rule not in LENGTH_RULES:
+        raise ValueError(f"length_rule must be one of {LENGTH_RULES}, got {length_rule!r}")
+    bound = math.log(2.0 / delta) / math.sqrt(w)
+    paper = max(0, math.ceil((bound - 1.0) / 2.0))
+    if length_rule == "paper":
+        return paper
+    for iterates in range(paper + 1):
+        if 1.0 - gamma(delta, 2 * iterates + 1) ** 2 <= w:
+            return iterates
+    return paper
+
+
+def fixed_point_phases(delta: float, iterates: int) -> tuple[np.ndarray, np.ndarray]:
+    """(alphas, betas) of length l for error ``delta`` (Yoder et al.'s closed form)."""
+    delta = check_delta(delta)
+    iterates = check_int(iterates, "iterates", 0, MAX_ITERATIONS)
+    length = 2 * iterates + 1
+    root = math.sqrt(max(0.0, 1.0 - gamma(delta, length) ** 2))
+    j = np.arange(1, iterates + 1)
+    # cot^{-1}(x) = atan2(1, x); another branch changes alpha by 2 pi (the same phase e^{i alpha})
+    alphas = 2.0 * np.arctan2(1.0, np.tan(2.0 * np.pi * j / length) * root)
+    betas = -alphas[::-1]
+    return alphas, betas
+
+
+def fixed_point_success_probability(delta: float, iterates: int, fraction: float) -> float:
+    """P_L(f) = 1 - delta^2 T_L(T_{1/L}(1/delta) sqrt(1 - f))^2, L = 2l + 1 (Yoder et al.)."""
+    delta = check_delta(delta)
+    fraction = check_float(fraction, "fraction", 0.0, 1.0)
+    length = 2 * check_int(iterates, "iterates", 0, MAX_ITERATIONS) + 1
+    x = chebyshev(1.0 / length, 1.0 / delta) * math.sqrt(1.0 - fraction)
+    return 1.0 - delta**2 * chebyshev(length, x) ** 2
+
+
+@dataclass(frozen=True, eq=False)
+class IterateSequence:
+    """Generalized Grover iterates G(alpha_j, beta_j), applied to |s> in order j = 1, 2, ...
+
+    ``oracle_calls`` = l per preparation (one phase oracle per iterate)."""
+
+    alphas: np.ndarray
+    betas: np.ndarray
+
+    def __post_init__(self) -> None:
+        alphas = np.array(self.alphas, dtype=float).reshape(-1)
+        betas = np.array(self.betas, dtype=float).reshape(-1)
+        if alphas.shape != betas.shape:
+            raise ValueError(f"alphas and betas must have the same length, got {alphas.size} and {betas.size}")
+        if alphas.size > MAX_ITERATIONS:
+            raise ValueError(f"an iterate sequence has at most {MAX_ITERATIONS} iterates, got {alphas.size}")
+        if not (np.all(np.isfinite(alphas)) and np.all(np.isfinite(betas))):
+            raise ValueError("alphas and betas must be finite")
+        alphas.setflags(write=False)
+        betas.setflags(write=False)
+        object.__setattr__(self, "alphas", alphas)
+        object.__setattr__(self, "betas", betas)
+
+    @classmethod
+    def grover(cls, iterations: int) -> IterateSequence:
+        """k standard Grover iterations: alpha = beta = pi."""
+        k = check_int(iterations, "iterations", 0, MAX_ITERATIONS)
+        return cls(np.full(k, math.pi), np.full(k, math.pi))
+
+    @classmethod
+    def fixed_point(cls, delta: float, iterates: int) -> IterateSequence:
+        return cls(*fixed_point_phases(delta, iterates))
+
+    @property
+    def oracle_calls(self) -> int:
+        return int(self.alphas.size)
+
+    def __len__(self) -> int:
+        return int(self.alphas.size)
+
+    def key(self) -> bytes:
+        """Hashable identity (for caches of compiled circuits)."""
+        return self.alphas.tobytes() + b"|" + self.betas.tobytes()
+
+    def marked_amplitude(self, fraction: float) -> tuple[complex, complex]:
+        """(amplitude on the normalized marked state, on the unmarked one) after the sequence, for
+        marked fraction ``fraction``: the exact 2-dimensional evolution (every operator keeps the
+        span of |T> and |s>)."""
+        f = check_float(fraction, "fraction", 0.0, 1.0)
+        s = np.array([math.sqrt(f), math.sqrt(1.0 - f)], dtype=complex)
+        psi = s.copy()
+        for alpha, beta in zip(self.alphas, self.betas, strict=True):
+            psi[0] *= np.exp(1j * beta)
+            psi = -(psi - (1.0 - np.exp(-1j * alpha)) * s * np.vdot(s, psi))
+        return complex(psi[0]), complex(psi[1])
+
+    def good_probability(self, fraction: float) -> float:
+        """Probability of measuring a marked index after the sequence (exact)."""
+        return float(abs(self.marked_amplitude(fraction)[0]) ** 2)
+
+
+def statevector_after(marks: np.ndarray, sequence: IterateSequence) -> np.ndarray:
+    """The full 2^n-dimensional statevector after ``sequence``, iterated operator by operator
+    (O(N) per iterate): S_t(beta) multiplies marked amplitudes by e^{i beta}, S_s(alpha) subtracts
+    (1 - e^{-i alpha}) <s|psi> |s>, then the sign of G."""
+    marks, _ = validate_marks(marks)
+    size = marks.shape[0]
+    state = np.full(size, 1.0 / math.sqrt(size), dtype=complex)
+    for alpha, beta in zip(sequence.alphas, sequence.betas, strict=True):
+        state[marks] *= np.exp(1j * beta)
+        overlap = state.sum() / math.sqrt(size)
+        state = -(state - (1.0 - np.exp(-1j * alpha)) * overlap / math.sqrt(size))
+    return state
+
+
+# ----------------------------------------------------------------------------------------- circuits
+def phase_oracle_beta(marks: np.ndarray, beta: float, synthesis: str = "diagonal") -> QuantumCircuit:
+    """S_t(beta) = diag(e^{i beta marks}) on n qubits. ``"diagonal"``: one ``DiagonalGate``;
+    ``"mcz"``: one multi-controlled phase(beta) per marked index, conjugated by X on its zero bits
+    (``"auto"`` picks the cheaper as ``circuits.choose_synthesis`` does)."""
+    from .circuits import SYNTHESES, _flip, choose_synthesis
+
+    marks, n = validate_marks(marks)
+    if synthesis not in SYNTHESES:
+        raise ValueError(f"synthesis must be one of {SYNTHESES}, got {synthesis!r}")
+    if synthesis == "auto":
+        synthesis = choose_synthesis(marks)
+    circuit = QuantumCircuit(n, name=f"oracle({beta:.3f})")
+    if synthesis == "diagonal":
+        circuit.append(DiagonalGate(np.where(marks, np.exp(1j * beta), 1.0).tolist()), range(n))
+        return circuit
+    full = (1 << n) - 1
+    flipped = 0
+    for index in np.flatnonzero(marks):
+        wanted = ~int(index) & full
+        _flip(circuit, flipped ^ wanted)
+        flipped = wanted
+        _mcphase(circuit, beta, n)
+    _flip(circuit, flipped)
+    return circuit
+
+
+def _mcphase(circuit: QuantumCircuit, angle: float, n: int) -> None:
+    """Phase e^{i angle} on |1...1> (an MCPhase, which Aer runs natively)."""
+    if n == 1:
+        circuit.p(angle, 0)
+    else:
+        circuit.mcp(angle, list(range(n - 1)), n - 1)
+
+
+def append_state_reflection(circuit: QuantumCircuit, alpha: float) -> None:
+    """S_s(alpha) = I - (1 - e^{-i alpha}) |s><s| = H^n X^n MCPhase(-alpha) X^n H^n: the phase
+    e^{-i alpha} on |1...1> is the phase on |s> once conjugated by X^n H^n."""
+    qubits = list(range(circuit.num_qubits))
+    circuit.h(qubits)
+    circuit.x(qubits)
+    _mcphase(circuit, -alpha, circuit.num_qubits)
+    circuit.x(qubits)
+    circuit.h(qubits)
+
+
+def generalized_grover_circuit(marks: np.ndarray, sequence: IterateSequence, measure: bool = True,
+                               synthesis: str = "auto") -> QuantumCircuit:
+    """H^n |0>, then G(alpha_j, beta_j) = -S_s(alpha_j) S_t(beta_j) for j = 1..l, from gates Aer runs
+    natively (h, x, diagonal, mcphase); the sign of each G is the circuit's global phase, so the
+    circuit's operator equals the product of the G's times H^n exactly. Measured into ``meas``."""
+    marks, n = validate_marks(marks)
+    if not isinstance(sequence, IterateSequence):
+        raise TypeError(f"sequence must be an IterateSequence, got {type(sequence).__name__}")
+    circuit = QuantumCircuit(n, name="fixed_point")
+    circuit.h(range(n))
+    for alpha, beta in zip(sequence.alphas, sequence.betas, strict=True):
+        oracle = phase_oracle_beta(marks, float(beta), synthesis)
+        circuit.compose(oracle, inplace=True)
+        append_state_reflection(circuit, float(alpha))
+        circuit.global_phase += math.pi
+    if measure:
+        circuit.measure_all()
+    return circuit
