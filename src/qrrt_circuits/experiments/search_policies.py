@@ -45,6 +45,8 @@ COLORS = {"paper": "tab:blue", "bbht": "tab:green", "adaptive": "tab:orange", "f
 class _LoggedEstimatedOptimal(EstimatedOptimal):
     """EstimatedOptimal whose plan state is kept, to read its per-database (estimate, k) history."""
 
+    states: list  # not a dataclass field: set in __post_init__
+
     def __post_init__(self) -> None:
         super().__post_init__()
         object.__setattr__(self, "states", [])  # a frozen dataclass; the list is this trial's log
