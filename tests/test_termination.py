@@ -170,3 +170,81 @@ def test_default_stall_ends_a_plan_given_only_a_node_budget(monkeypatch, boxed_i
     assert result.status == "stalled" and result.metrics.rounds == 25
     assert with_defaults(qc.Stall(3)) == qc.Stall(3) | qc.MaxRounds(termination.DEFAULT_MAX_ROUNDS)
     assert with_defaults(qc.MaxRounds(3)) == qc.MaxRounds(3) | qc.Stall(25)
+
+
+def _tiled(cells: int = 317, gap: float = 0.004) -> tuple[Environment, np.ndarray, np.ndarray]:
+    """A 20 x 20 world tiled by cells^2 (about 10^5) boxes with gaps of ``gap`` between them: every
+    motion is rejected (the gaps are narrower than the check's margin). Start and goal sit on gap
+    crossings, so both are free."""
+    pitch = 20.0 / cells
+    index = np.arange(cells)
+    x, y = (a.ravel() for a in np.meshgrid(index, index, indexing="ij"))
+    lower = np.stack([x * pitch + gap / 2, y * pitch + gap / 2], axis=1)
+    upper = np.stack([(x + 1) * pitch - gap / 2, (y + 1) * pitch - gap / 2], axis=1)
+    env = Environment(np.array([[0.0, 20.0], [0.0, 20.0]]), np.stack([lower, upper], axis=1))
+    return env, np.array([100 * pitch, 100 * pitch]), np.array([250 * pitch, 250 * pitch])
+
+
+@pytest.mark.parametrize("planner_name", ["rrt", "prrt", "qrrt", "pqrrt-unshared"])
+def test_a_world_of_1e5_boxes_where_nothing_can_be_added_stalls(planner_name):
+    from qrrt_circuits.registry import PLANNERS
+
+    env, start, goal = _tiled()
+    assert env.num_boxes > 100_000 and env.is_free(start) and env.is_free(goal)
+    options = {"seed": 0, "workers": 2, "num_qubits": 4, "backend": qc.StatevectorBackend(0)}
+    planner = PLANNERS.create(planner_name, env=env, **PLANNERS.applicable(planner_name, options))
+    result = planner.plan(start, goal, 0.5, max_nodes=3, stall_rounds=4)
+    assert result.status == "stalled" and result.metrics.nodes == 0 and result.metrics.rounds == 4
+
+
+def test_grid_index_of_1e5_boxes_lists_every_box_it_overlaps():
+    """The vectorized index build: every box appears in exactly the cells it overlaps."""
+    env, _, _ = _tiled(60)
+    index = env.grid_index
+    counts = np.bincount(index.cell_items, minlength=env.num_boxes)
+    lo = np.floor((env.boxes[:, 0] - index.origin) / index.cell_size).clip(0, index.shape - 1)
+    hi = np.floor((env.boxes[:, 1] - index.origin) / index.cell_size).clip(0, index.shape - 1)
+    assert np.array_equal(counts, np.prod(hi - lo + 1, axis=1).astype(int))
+    probes = np.random.default_rng(0).uniform(0, 20, (2000, 2))
+    inside = np.any(np.all((probes[:, None] >= env.boxes[None, :, 0]) & (probes[:, None] <= env.boxes[None, :, 1]),
+                           axis=2), axis=1)
+    assert np.array_equal(env.is_free(probes), ~inside)
+
+
+@pytest.mark.parametrize("planner_name", ["rrt", "prrt", "qrrt", "pqrrt"])
+@pytest.mark.parametrize("start", [[0.0, 5.0], [20.0, 7.5], [3.0, 0.0], [0.0, 20.0]])
+def test_a_start_on_the_boundary_is_refused_before_any_work(planner_name, start, walled):
+    """The exact check rejects every motion from a point on the workspace boundary (issue 10,
+    defect 1: the plan looped until the stall limit)."""
+    from qrrt_circuits.registry import PLANNERS
+
+    options = {"seed": 0, "workers": 2, "num_qubits": 4, "backend": qc.StatevectorBackend(0)}
+    planner = PLANNERS.create(planner_name, env=walled, **PLANNERS.applicable(planner_name, options))
+    with pytest.raises(ValueError, match=r"start \[.*\] lies on the workspace boundary .*rejects every motion"):
+        planner.plan(start, [10, 10], 0.5, max_nodes=5)
+    assert planner.predicate.evaluations == 0
+
+
+def test_boundary_refusal_follows_the_predicate_and_the_goal():
+    env = qc.scenarios.paper_clutter(seed=0)
+    with pytest.raises(ValueError, match=r"start \[0.0, 5.0\] lies on the workspace boundary"):
+        qc.RRT(env, seed=0).plan(start=[0.0, 5.0], max_nodes=5)  # the issue's reproduction
+    # the time-sampled check tests points only: a boundary start can leave it, so it is not refused
+    sampled = qc.RRT(env, seed=0, predicate=qc.TimeSampledCheck(env))
+    assert sampled.plan(start=[0.0, 5.0], max_nodes=2).status == "max_nodes"
+    # a boundary start inside the goal ball is reached at once, not refused
+    assert qc.RRT(env, seed=0).plan(start=[0.0, 5.0], goal=[0.2, 5.0], goal_radius=0.5).status == "reached"
+    with pytest.raises(ValueError, match=r"start \[2.0, 5.0\] is in collision with an obstacle"):
+        qc.RRT(env, seed=0).plan(start=[2.0, 5.0], max_nodes=5)
+
+
+@pytest.mark.parametrize("planner_name", ["rrt", "qrrt"])
+def test_a_start_just_inside_the_boundary_margin_ends_stalled(planner_name, walled):
+    """Off the boundary but inside its margin, leaving is possible in principle (a close enough
+    child passes) but not decidable: the stall limit ends the plan."""
+    from qrrt_circuits.registry import PLANNERS
+
+    options = {"seed": 0, "num_qubits": 4, "backend": qc.StatevectorBackend(0)}
+    planner = PLANNERS.create(planner_name, env=walled, **PLANNERS.applicable(planner_name, options))
+    result = planner.plan([1e-7, 5.0], [10, 10], 0.5, max_nodes=5, stall_rounds=20)
+    assert result.status == "stalled" and result.metrics.nodes == 0

@@ -5,6 +5,8 @@ Lathrop, Boardman and Martinez, "Parallel Quantum Rapidly-Exploring Random Trees
 2024), with Grover search as real Qiskit circuits on Aer or on an exact statevector.
 """
 
+from importlib import metadata as _metadata
+
 from . import probability, registry, scenarios, termination
 from .authors_check import AuthorsCheck
 from .database import AnnealingSchedule
@@ -46,7 +48,10 @@ from .termination import (
 )
 from .time_sampled import TimeSampledCheck
 
-__version__ = "0.2.0.dev0"
+try:  # one source of the version: ``version`` in pyproject.toml, read from the installed metadata
+    __version__ = _metadata.version("qrrt-circuits")
+except _metadata.PackageNotFoundError:  # a source tree on sys.path that was never installed
+    __version__ = "0+unknown"
 
 __all__ = [
     "BBHT",

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import probability
+from . import __version__, probability
 from .registry import BACKENDS, PLANNERS, POLICIES, PREDICATES, SCENARIOS
 
 
@@ -50,14 +50,34 @@ def cmd_search(args: argparse.Namespace) -> int:
         raise ValueError(f"--marked must be in [0, 2**qubits = {num_items}], got {args.marked}")
     backend = BACKENDS.create(args.backend, seed=args.seed)
     backend.check_qubits(args.qubits)
+    iterations = (probability.optimal_iterations(num_items, args.marked)
+                  if args.iterations is None else args.iterations)
+    from .search.backend import validate_iterations, validate_shots
+
+    _check_search_memory(backend, args.qubits, validate_shots(args.shots), validate_iterations(iterations))
     rng = np.random.default_rng(args.seed)
     marks = np.zeros(num_items, dtype=bool)
     marks[rng.choice(num_items, args.marked, replace=False)] = True
-    iterations = (probability.optimal_iterations(num_items, args.marked)
-                  if args.iterations is None else args.iterations)
     result = backend.search(marks, iterations, shots=args.shots)
     _print_search(args, marks, iterations, result)
     return 0
+
+
+#: the marks (1 byte per entry) and numpy's draw of the marked entries (a permutation, 8 bytes)
+SEARCH_MARKS_BYTES_PER_ENTRY = 9
+
+
+def _check_search_memory(backend, num_qubits: int, shots: int, iterations: int) -> None:
+    """Refuse before allocating the marks when the marks and the search would not fit."""
+    from dataclasses import replace
+
+    from .memory import check_fits
+
+    def estimate(n: int):
+        search = backend.memory_estimate(n, shots, iterations)
+        return replace(search, resident_bytes=SEARCH_MARKS_BYTES_PER_ENTRY << n)
+
+    check_fits(estimate, num_qubits, f"this {backend.name} search ({shots} shots, {iterations} iterations)")
 
 
 def _print_search(args: argparse.Namespace, marks: np.ndarray, iterations: int, result) -> None:
@@ -284,6 +304,7 @@ def _add_reproduce_parser(sub, formatter) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="qrrt", description=__doc__.splitlines()[0])
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     formatter = argparse.ArgumentDefaultsHelpFormatter
     _add_search_parser(sub, formatter)

@@ -18,7 +18,6 @@ near it, not all boxes. The inner loop is compiled with numba.
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -56,22 +55,33 @@ class GridIndex:
         strides = np.ones(d, dtype=np.int64)
         for axis in range(d - 2, -1, -1):
             strides[axis] = strides[axis + 1] * shape[axis + 1]
-        buckets: dict[int, list[int]] = {}
-        for index, box in enumerate(boxes):
-            lo = np.clip(np.floor((box[0] - bounds[:, 0]) / cell_size).astype(np.int64), 0, shape - 1)
-            hi = np.clip(np.floor((box[1] - bounds[:, 0]) / cell_size).astype(np.int64), 0, shape - 1)
-            for cell in itertools.product(*(range(a, b + 1) for a, b in zip(lo, hi, strict=True))):
-                buckets.setdefault(int(np.dot(cell, strides)), []).append(index)
         num_cells = int(np.prod(shape))
-        sizes = np.zeros(num_cells, dtype=np.int64)
-        for cell, items in buckets.items():
-            sizes[cell] = len(items)
+        cells, items = _box_cells(bounds, boxes, cell_size, shape, strides)
+        order = np.lexsort((items, cells))  # by cell, boxes in index order within a cell
         cell_start = np.zeros(num_cells + 1, dtype=np.int64)
-        np.cumsum(sizes, out=cell_start[1:])
-        cell_items = np.zeros(int(cell_start[-1]), dtype=np.int64)
-        for cell, items in buckets.items():
-            cell_items[cell_start[cell] : cell_start[cell + 1]] = items
+        np.cumsum(np.bincount(cells, minlength=num_cells), out=cell_start[1:])
+        cell_items = np.ascontiguousarray(items[order])
         return cls(bounds[:, 0].copy(), cell_size, shape, cell_start, cell_items)
+
+
+def _box_cells(bounds: np.ndarray, boxes: np.ndarray, cell_size: np.ndarray, shape: np.ndarray,
+               strides: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(cell, box) for every grid cell every box overlaps, vectorized (a 10^5-box world took 20 s
+    with a Python loop over boxes)."""
+    if len(boxes) == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    lo = np.clip(np.floor((boxes[:, 0] - bounds[:, 0]) / cell_size).astype(np.int64), 0, shape - 1)
+    hi = np.clip(np.floor((boxes[:, 1] - bounds[:, 0]) / cell_size).astype(np.int64), 0, shape - 1)
+    span = hi - lo + 1
+    counts = np.prod(span, axis=1)
+    items = np.repeat(np.arange(len(boxes), dtype=np.int64), counts)
+    remainder = np.arange(int(counts.sum()), dtype=np.int64) - np.repeat(np.cumsum(counts) - counts, counts)
+    cells = np.zeros_like(items)
+    for axis in range(bounds.shape[0] - 1, -1, -1):  # unravel the index within each box's cell range
+        axis_span = span[items, axis]
+        cells += (lo[items, axis] + remainder % axis_span) * strides[axis]
+        remainder //= axis_span
+    return cells, items
 
 
 @njit(cache=True, nogil=True)

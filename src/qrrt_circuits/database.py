@@ -10,7 +10,6 @@ from its parent to the sample but is moved to a distance drawn uniformly in the 
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -18,7 +17,19 @@ import numpy as np
 from .environment import Environment
 from .randomness import RandomStreams, Stream, uniform_draws
 from .tree import Tree
-from .validation import check_choice, check_int
+from .validation import check_choice, check_float, check_int
+
+
+def _check_bands(bands) -> tuple[tuple[float, float], ...]:
+    """(r_min, r_max) pairs of finite distances >= 0, as floats (strings are not coerced)."""
+    if not isinstance(bands, tuple | list) or not bands:
+        raise TypeError(f"bands must be a non-empty sequence of (r_min, r_max) pairs, got {bands!r}")
+    checked = []
+    for i, band in enumerate(bands):
+        if not isinstance(band, tuple | list | np.ndarray) or len(band) != 2:
+            raise TypeError(f"bands[{i}] must be an (r_min, r_max) pair, got {band!r}")
+        checked.append((check_float(band[0], f"bands[{i}] r_min", 0.0), check_float(band[1], f"bands[{i}] r_max", 0.0)))
+    return tuple(checked)
 
 
 @dataclass(frozen=True)
@@ -37,16 +48,14 @@ class AnnealingSchedule:
     counter: str = "databases"
 
     def __post_init__(self) -> None:
-        bands = tuple((float(lo), float(hi)) for lo, hi in self.bands)
-        if not bands:
-            raise ValueError("bands must hold at least one (r_min, r_max) pair")
+        bands = _check_bands(self.bands)
         for i, (lo, hi) in enumerate(bands):
-            if not (math.isfinite(lo) and math.isfinite(hi)) or lo < 0:
-                raise ValueError(f"bands[{i}] = ({lo}, {hi}): distances must be finite and >= 0")
             if lo > hi:
                 raise ValueError(f"bands[{i}] = ({lo}, {hi}): r_min must be <= r_max")
             if hi == 0:
                 raise ValueError(f"bands[{i}]: r_max must be > 0")
+        if not isinstance(self.switch_at, tuple | list):
+            raise TypeError(f"switch_at must be a tuple of increasing integers >= 1, got {self.switch_at!r}")
         switch_at = tuple(check_int(s, f"switch_at[{i}]", 1) for i, s in enumerate(self.switch_at))
         if len(switch_at) != len(bands) - 1:
             raise ValueError(
@@ -128,7 +137,7 @@ def stream_database(
 
     def generator() -> np.random.Generator:
         rng = streams.generator(round_index, worker, Stream.CANDIDATES)
-        rng.bit_generator.advance(size * dim)
+        rng.bit_generator.advance(size * dim)  # type: ignore[attr-defined]  # a PCG64
         return rng
 
     return _finish_database(samples, tree, size, generator, goal, goal_radius, goal_bias, annealing,

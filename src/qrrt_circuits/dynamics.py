@@ -132,10 +132,10 @@ class LinearTrackingDynamics:
     ) -> tuple[np.ndarray, np.ndarray]:
         """A time grid and per-interval bounds a_i >= max ||M^2 expm(M t)||_2 on [t_i, t_{i+1}].
 
-        On an interval of length h the curve stays within h^2/8 * |e| * a_i of its chord
-        (interpolation error bound with |x''(t)| = |M^2 expm(M t) e|). The grid is fine enough that
-        this is <= ``resolution`` for every |e| <= ``max_error``; callers merge intervals for
-        smaller |e|. The bound uses ||expm(M s)|| <= exp(mu s), mu the logarithmic norm of M.
+        On an interval of length h the curve stays within ``h^2/8 * |e| * a_i`` of its chord
+        (interpolation error bound with ``|x''(t)| = |M^2 expm(M t) e|``). The grid is fine enough
+        that this is <= ``resolution`` for every ``|e| <= max_error``; callers merge intervals for
+        smaller ``|e|``. The bound uses ||expm(M s)|| <= exp(mu s), mu the logarithmic norm of M.
         """
         closed = self.closed_loop
         mu = max(float(np.max(np.linalg.eigvalsh((closed + closed.T) / 2))), 0.0)

@@ -82,8 +82,8 @@ class Environment:
             raise ValueError(f"bounds must lie within [-{MAX_EXTENT:g}, {MAX_EXTENT:g}] on every axis, got "
                              f"{bounds.tolist()}")
         d = bounds.shape[0]
-        if self.boxes is None:
-            raise ValueError("boxes must be an array of shape (k, 2, d), got None")
+        if self.boxes is None or not hasattr(self.boxes, "__len__") or isinstance(self.boxes, str | bytes):
+            raise ValueError(f"boxes must be an array of shape (k, 2, {d}), got {self.boxes!r}")
         boxes = _as_float_array(self.boxes if len(self.boxes) else np.zeros((0, 2, d)), "boxes")
         if boxes.ndim != 3 or boxes.shape[1:] != (2, d):
             raise ValueError(f"boxes must have shape (k, 2, {d}), got {boxes.shape}")
@@ -138,7 +138,8 @@ class Environment:
         flat = np.ascontiguousarray(points.reshape(-1, self.dim))
         index = self.grid_index
         out = np.zeros(flat.shape[0], dtype=np.bool_)
-        points_free(flat, self.bounds, self._lower, self._upper, index.origin, index.cell_size,
+        lower, upper = self.__dict__["_lower"], self.__dict__["_upper"]  # set with the grid index
+        points_free(flat, self.bounds, lower, upper, index.origin, index.cell_size,
                     index.shape, index.cell_start, index.cell_items, out)
         out &= np.all(np.isfinite(flat), axis=1)  # a non-finite point is never free
         return out.reshape(shape)

@@ -93,6 +93,17 @@ class ReachabilityOracle:
                 "false_rejection_bound": self.false_rejection_bound,
                 "dynamics": self.dynamics.describe()}
 
+    def can_leave(self, point: np.ndarray) -> bool:
+        """False where it is certain that no motion from ``point`` can ever be accepted: a point on
+        the workspace boundary. Every chord of a trajectory to a child c != point is tested with
+        the box padded by its error bound delta > 0 (``collision.trajectories_free``), and the
+        bounds test is strict (x - delta < low rejects), so the first chord from a point with
+        x_i = low_i or x_i = high_i is always rejected. (Inside the margin but off the boundary,
+        a child close enough has a smaller delta and may pass: not decidable here; the planners'
+        stall limit ends such plans.)"""
+        point = np.asarray(point, dtype=float).reshape(-1)
+        return not bool(np.any((point == self._bounds[:, 0]) | (point == self._bounds[:, 1])))
+
     def reachable(self, parents: np.ndarray, children: np.ndarray) -> np.ndarray:
         """Bool (M,): may each child be reached from its parent without collision?"""
         parents, children = as_pairs(parents, children, self.dim)

@@ -6,13 +6,20 @@ drawn.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from .dynamics import LinearTrackingDynamics
 from .environment import Environment
 
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
 
-def _axes(ax):
+    from .planners.result import PlanResult
+
+
+def _axes(ax: Axes | None) -> Axes:
     if ax is None:
         import matplotlib.pyplot as plt
 
@@ -20,7 +27,7 @@ def _axes(ax):
     return ax
 
 
-def plot_environment(env: Environment, ax=None, color: str = "0.15"):
+def plot_environment(env: Environment, ax: Axes | None = None, color: str = "0.15") -> Axes:
     """Obstacles as filled rectangles inside the workspace outline."""
     from matplotlib.collections import PatchCollection
     from matplotlib.patches import Rectangle
@@ -54,7 +61,7 @@ def edge_curves(nodes: np.ndarray, parents: np.ndarray, dynamics: LinearTracking
     return nodes[children][:, None, :] + np.einsum("sij,ej->esi", phis, errors)
 
 
-def plan_dynamics(result) -> LinearTrackingDynamics | None:
+def plan_dynamics(result: PlanResult) -> LinearTrackingDynamics | None:
     """The dynamics a plan's predicate followed, from ``result.settings["dynamics"]`` (None: the
     predicate describes none, and edges are drawn straight)."""
     description = result.settings.get("dynamics")
@@ -62,20 +69,22 @@ def plan_dynamics(result) -> LinearTrackingDynamics | None:
 
 
 def plot_edges(env: Environment, nodes: np.ndarray, parents: np.ndarray,
-               dynamics: LinearTrackingDynamics | None, ax=None, edge_color: str = "tab:blue"):
+               dynamics: LinearTrackingDynamics | None, ax: Axes | None = None,
+               edge_color: str = "tab:blue") -> Axes:
     """Obstacles, the tree's edges along their motion (see ``edge_curves``), nodes and the root."""
     from matplotlib.collections import LineCollection
 
     ax = plot_environment(env, ax)
     curves = edge_curves(nodes, parents, dynamics)
-    ax.add_collection(LineCollection(curves[:, :, :2], colors=edge_color, linewidths=0.7, alpha=0.8))
+    ax.add_collection(LineCollection(list(curves[:, :, :2]), colors=edge_color, linewidths=0.7, alpha=0.8))
     ax.plot(nodes[1:, 0], nodes[1:, 1], ".", color=edge_color, ms=2.5)
     ax.plot(*nodes[0, :2], "o", color="tab:green", ms=8, label="start")
     return ax
 
 
-def plot_tree(env: Environment, result, ax=None, dynamics: LinearTrackingDynamics | None = None,
-              edge_color: str = "tab:blue", path_color: str = "tab:red", title: str | None = None):
+def plot_tree(env: Environment, result: PlanResult, ax: Axes | None = None,
+              dynamics: LinearTrackingDynamics | None = None, edge_color: str = "tab:blue",
+              path_color: str = "tab:red", title: str | None = None) -> Axes:
     """Obstacles, tree edges along the motion the plan's predicate used (``dynamics`` overrides
     what ``result.settings`` records), the path, the start and the goal ball."""
     from matplotlib.collections import LineCollection
@@ -91,7 +100,7 @@ def plot_tree(env: Environment, result, ax=None, dynamics: LinearTrackingDynamic
         for child, parent in zip(index[:-1], index[1:], strict=True):
             path_parents[child] = parent
         path_curves = edge_curves(result.nodes, path_parents, dynamics)
-        ax.add_collection(LineCollection(path_curves[:, :, :2], colors=path_color, linewidths=2.0))
+        ax.add_collection(LineCollection(list(path_curves[:, :, :2]), colors=path_color, linewidths=2.0))
     goal = result.settings.get("goal")
     if goal is not None:
         ax.add_patch(Circle(goal[:2], result.settings.get("goal_radius", 0.75), fill=False,

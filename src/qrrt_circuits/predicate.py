@@ -11,6 +11,10 @@ OMPL's motion validator (``ompl::base::MotionValidator::checkMotion``), batched:
   a predicate that follows closed-loop dynamics puts them under the key ``"dynamics"``
   (``LinearTrackingDynamics.describe()``), so figures draw edges along the motion actually used.
 
+A predicate may also offer ``can_leave(point) -> bool``: False where it is certain that it rejects
+every motion from ``point`` (the planners then refuse such a start before any work). Without it,
+every start is assumed able to leave (the stall limit ends a plan that cannot grow).
+
 Implementations here: ``ReachabilityOracle`` (sound, exact up to a resolution), ``TimeSampledCheck``
 (tests time samples only; unsound, for study) and, with the ``ompl`` extra,
 ``qrrt_circuits.adapters.ompl.OMPLMotionPredicate``. Any object with these four members works:
@@ -19,7 +23,7 @@ planners, experiments and plotting never ask which class it is.
 
 from __future__ import annotations
 
-from typing import Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -41,7 +45,7 @@ class ReachabilityPredicate(Protocol):
     def describe(self) -> dict: ...
 
 
-def check_predicate(predicate: object, dim: int, name: str = "predicate") -> ReachabilityPredicate:
+def check_predicate(predicate: Any, dim: int, name: str = "predicate") -> ReachabilityPredicate:
     """Return ``predicate`` if it implements the protocol in dimension ``dim``; else raise a
     ``TypeError`` naming the missing members or a ``ValueError`` naming the dimension mismatch."""
     missing = [member for member in REQUIRED_MEMBERS if not hasattr(predicate, member)]
@@ -77,3 +81,9 @@ def as_pairs(parents: np.ndarray, children: np.ndarray, dim: int) -> tuple[np.nd
     if not (np.all(np.isfinite(parents)) and np.all(np.isfinite(children))):
         raise ValueError("parents and children must be finite")
     return parents, children
+
+
+def can_leave(predicate: ReachabilityPredicate, point: np.ndarray) -> bool:
+    """The predicate's own ``can_leave(point)`` if it has one, else True (not decidable)."""
+    method = getattr(predicate, "can_leave", None)
+    return True if method is None else bool(method(point))

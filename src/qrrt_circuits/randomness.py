@@ -20,6 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import IntEnum
 from functools import cached_property
+from typing import cast
 
 import numpy as np
 from numba import njit
@@ -148,7 +149,8 @@ class RandomStreams:
 
     @classmethod
     def from_seed(cls, seed: int | None) -> RandomStreams:
-        return cls(int(np.random.SeedSequence(seed).entropy))
+        entropy = np.random.SeedSequence(seed).entropy  # an int for an int or None seed
+        return cls(int(cast(int, entropy)))
 
     @cached_property
     def _run_entropy(self) -> np.ndarray:
@@ -168,7 +170,7 @@ class RandomStreams:
         if min(key) < 0:
             raise ValueError(f"spawn keys must be non-negative, got {key}")
         words = _seed_words(self._run_entropy, np.array([key], dtype=np.int64))
-        return np.random.Generator(np.random.PCG64(_SeedWords(words[0])))
+        return np.random.Generator(np.random.PCG64(_SeedWords(words[0])))  # type: ignore[arg-type]  # an ISeedSequence
 
     def generators(self, rounds: np.ndarray, workers: np.ndarray, stream: Stream) -> list[np.random.Generator]:
         """The generators of many (round, worker) pairs of one stream, seeded in one compiled call."""
@@ -177,7 +179,8 @@ class RandomStreams:
         keys[:, 0] = rounds
         keys[:, 1] = workers
         keys[:, 2] = int(stream)
-        return [np.random.Generator(np.random.PCG64(_SeedWords(words))) for words in self.seed_words(keys)]
+        return [np.random.Generator(np.random.PCG64(_SeedWords(words)))  # type: ignore[arg-type]
+                for words in self.seed_words(keys)]
 
     def seed(self, round_index: int, worker: int, stream: Stream = Stream.SEARCH) -> int:
         """One integer seed (for a backend call) drawn from that generator: its

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -97,7 +98,7 @@ def narrow_corridor(seed: int | None = 0, width: float = 0.4, length: float = 4.
     y0, y1 = (size - width) / 2, (size + width) / 2
     blocks = np.array([[[x0, 0.0], [x1, y0]], [[x0, y1], [x1, size]]])
     keep_out = 1.5  # free margin around the channel mouths
-    small = []
+    small: list[np.ndarray] = []
     while len(small) < clutter:
         box = _random_boxes(rng, 1, np.zeros(2), np.full(2, size))[0]
         if box[1, 0] > x0 - 0.3 and box[0, 0] < x1 + 0.3:
@@ -147,9 +148,9 @@ def lattice(seed: int | None = 0, size: int = 72, blocked_fraction: float = 0.5)
         raise ValueError(f"blocked_fraction must be in [0, 1), got {blocked_fraction}")
     size = int(size)
     rng = _world_rng("lattice", seed)
-    blocked = np.zeros(size * size, dtype=bool)
-    blocked[rng.choice(size * size, int(round(blocked_fraction * size * size)), replace=False)] = True
-    blocked = blocked.reshape(size, size)  # blocked[ix, iy]
+    flat = np.zeros(size * size, dtype=bool)
+    flat[rng.choice(size * size, int(round(blocked_fraction * size * size)), replace=False)] = True
+    blocked = flat.reshape(size, size)  # blocked[ix, iy]
     boxes = []
     for iy in range(size):
         ix = 0
@@ -181,7 +182,7 @@ def lattice(seed: int | None = 0, size: int = 72, blocked_fraction: float = 0.5)
                                  "component_cells": int(sizes[largest - 1])})
 
 
-SCENARIOS = {
+SCENARIOS: dict[str, Callable[..., Environment]] = {
     "paper_clutter": paper_clutter,
     "narrow_corridor": narrow_corridor,
     "annealing_field": annealing_field,

@@ -26,7 +26,7 @@ from ..dynamics import LinearTrackingDynamics
 from ..environment import Environment
 from ..oracle import ReachabilityOracle
 from ..oracle_errors import OracleErrorModel
-from ..predicate import ReachabilityPredicate, check_predicate
+from ..predicate import ReachabilityPredicate, can_leave, check_predicate
 from ..randomness import RandomStreams, Stream
 from ..termination import PlanStatus, TerminationCondition, from_budgets, with_defaults
 from ..validation import check_float, check_instance, check_int, check_seed
@@ -185,6 +185,12 @@ class Planner:
                 raise ValueError(f"{name} {point.tolist()} is in collision with an obstacle")
             checked.append(point)
         goal_radius = check_float(goal_radius, "goal_radius", 0.0, open_minimum=True)
+        reached = np.linalg.norm(checked[0] - checked[1]) <= goal_radius  # a start in the goal ball ends at once
+        if not reached and not can_leave(self.predicate, checked[0]):
+            raise ValueError(
+                f"start {checked[0].tolist()} lies on the workspace boundary {env.bounds.tolist()}: the "
+                f"{self.predicate.name} check rejects every motion from it, so no node could ever be "
+                "added (move the start inside the workspace)")
         return checked[0], checked[1], goal_radius
 
     def _check_ready(self) -> None:

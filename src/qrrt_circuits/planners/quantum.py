@@ -26,6 +26,7 @@ from concurrent.futures import Executor
 from ..database import AnnealingSchedule
 from ..dynamics import LinearTrackingDynamics
 from ..environment import Environment
+from ..memory import MemoryEstimate, check_fits, database_bytes, database_resident_bytes
 from ..oracle_errors import OracleErrorModel
 from ..predicate import ReachabilityPredicate
 from ..search.aer import AerBackend
@@ -93,6 +94,25 @@ class PQRRT(Planner):
         self.shared_database = check_bool(shared_database, "shared_database")
         self.search_policy = policy
         self.annealing = annealing
+        check_fits(self.memory_estimate, self.num_qubits, "this plan")
+
+    def memory_estimate(self, num_qubits: int | None = None) -> MemoryEstimate:
+        """Estimated peak memory of one round (``qrrt_circuits.memory``), for this planner's
+        settings at ``num_qubits`` (default its own): the databases alive at once (one, or one per
+        worker when unshared databases run on an executor), each with its backend search at the
+        policy's largest iteration count, plus the policy's state. Checked at construction."""
+        n = self.num_qubits if num_qubits is None else num_qubits
+        size = 1 << n
+        concurrent = self.workers if (self.executor is not None and not self.shared_database) else 1
+        shots = self.workers if self.shared_database else 1
+        search = self.backend.peak_bytes(n, shots, self.search_policy.iterations_bound(size))
+        return MemoryEstimate(
+            n,
+            database_bytes=concurrent * database_bytes(n, self.env.dim, self.annealing is not None),
+            resident_bytes=concurrent * database_resident_bytes(n, self.env.dim),
+            search_bytes=concurrent * search,
+            policy_bytes=self.search_policy.state_bytes(size),
+        )
 
     @property
     def iterations_policy(self) -> IterationPolicy:

@@ -41,6 +41,9 @@ class AerBackend(QuantumSearchBackend):
         device: str = "CPU",
         max_parallel_threads: int = 0,
     ) -> None:
+        for name, value in (("method", method), ("synthesis", synthesis), ("device", device)):
+            if not isinstance(value, str):
+                raise TypeError(f"{name} must be a string, got {value!r}")
         if method in UNSUPPORTED_METHODS:
             raise ValueError(f"method={method!r} is not supported: {UNSUPPORTED_METHODS[method]}")
         if method not in METHODS:
@@ -66,6 +69,21 @@ class AerBackend(QuantumSearchBackend):
     @property
     def max_qubits(self) -> int:
         return int(self.simulator.configuration().n_qubits)
+
+    #: calibrated on ``benchmarks/bench_memory.py`` (peak RSS of a round with many marked entries,
+    #: so the oracle is one DiagonalGate): the gate's 2^n phases as Python objects, Aer's complex128
+    #: state and its converted copy of the phases, then per iteration Aer's own copy of the oracle's
+    #: phases (the circuit appends the same gate k times; Aer converts each instance).
+    AER_BYTES_PER_ENTRY = 240
+    AER_BYTES_PER_ENTRY_PER_ITERATION = 80
+    #: per shot: the measured bitstring kept by ``memory=True`` and its conversion to an index
+    BYTES_PER_SHOT = 200
+
+    def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1) -> int:
+        """Upper bound of one search with the diagonal-gate oracle (the larger of the two
+        syntheses: ``mcz`` is chosen only when it has fewer gates than the diagonal's 2^n - 2 CX)."""
+        per_entry = self.AER_BYTES_PER_ENTRY + self.AER_BYTES_PER_ENTRY_PER_ITERATION * iterations
+        return (per_entry << num_qubits) + self.BYTES_PER_SHOT * shots
 
     def _sample(self, marks, num_qubits, iterations, shots, rng) -> np.ndarray:
         circuit = aer_grover_circuit(marks, iterations, measure=True, synthesis=self.synthesis)

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..memory import MemoryEstimate, check_fits
 from ..validation import check_int, check_seed
 
 
@@ -96,9 +97,30 @@ class QuantumSearchBackend(abc.ABC):
         iterations = validate_iterations(iterations)
         shots = validate_shots(shots)
         self.check_qubits(num_qubits)
+        self.check_memory(num_qubits, shots, iterations)
         rng = self._rng if seed is None else seed_stream(seed)
         indices = self._sample(marks, num_qubits, iterations, shots, rng)
         return SearchResult(indices, iterations, shots, iterations * shots)
+
+    #: generic footprint of one search (subclasses report their own, calibrated): a complex128 state
+    #: vector and the measured indices
+    BYTES_PER_ENTRY: int = 16
+    BYTES_PER_SHOT: int = 64
+
+    def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1) -> int:
+        """Peak bytes one ``search`` of a 2^n-entry database adds to the process, beyond the marks
+        the caller holds (used by the memory guard, ``qrrt_circuits.memory``)."""
+        return (self.BYTES_PER_ENTRY << num_qubits) + self.BYTES_PER_SHOT * shots
+
+    def memory_estimate(self, num_qubits: int, shots: int = 1, iterations: int = 1) -> MemoryEstimate:
+        """This backend's search alone, as a ``MemoryEstimate``."""
+        return MemoryEstimate(num_qubits, search_bytes=self.peak_bytes(num_qubits, shots, iterations),
+                              scratch_bytes=0)
+
+    def check_memory(self, num_qubits: int, shots: int = 1, iterations: int = 1) -> None:
+        """Refuse a search whose estimated peak exceeds the available memory (before allocating)."""
+        check_fits(lambda n: self.memory_estimate(n, shots, iterations), num_qubits,
+                   f"this {self.name} search ({shots} shots, {iterations} iterations)")
 
     def labels(self) -> tuple[str, ...]:
         """Caveats every result that depends on this backend must carry (none by default)."""

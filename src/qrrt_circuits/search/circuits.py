@@ -1,10 +1,10 @@
 """Grover-search circuits over an n-qubit index register (paper Alg. 2, lines 4-8).
 
-Index i of the database is the computational basis state |i> in Qiskit's little-endian order
+Index i of the database is the computational basis state ``|i>`` in Qiskit's little-endian order
 (qubit 0 is the least significant bit), so a measured bitstring b reads as i = int(b, 2).
 
 - ``phase_oracle(marks)``: the unitary diag((-1)^marks) (the oracle X of the paper).
-- ``grover_circuit(marks, k)``: W = H^n on |0>, then k applications of
+- ``grover_circuit(marks, k)``: W = H^n on ``|0>``, then k applications of
   Q = grover_operator(oracle, W), then measurement. After k iterations the probability of a
   marked index is sin^2((2k+1) theta), sin^2 theta = m / 2^n (Lemma 1).
 - ``aer_grover_circuit(marks, k)``: the same unitary (up to a global phase) written only with

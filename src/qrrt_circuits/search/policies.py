@@ -83,6 +83,16 @@ class IterationPolicy:
         """The k for one database (policies that pick k before measuring)."""
         return self._iterations(problem.num_items, tree_nodes, None)
 
+    def iterations_bound(self, num_items: int) -> int:
+        """The most Grover iterations one search (one circuit) of this policy can run on a
+        database of ``num_items`` entries (the memory guard sizes a search by it). By default the
+        optimal k for one marked entry, floor(pi / (4 asin(1/sqrt(N)))) (Eq. 1)."""
+        return optimal_iterations(num_items, 1)
+
+    def state_bytes(self, num_items: int) -> int:
+        """Bytes the policy's per-plan state holds (the memory guard adds them)."""
+        return 0
+
     def _iterations(self, num_items: int, tree_nodes: int, num_marked: int | None) -> int:
         raise NotImplementedError
 
@@ -148,6 +158,9 @@ class PaperSchedule(IterationPolicy):
     def _iterations(self, num_items: int, tree_nodes: int, num_marked: int | None) -> int:
         return self.late if tree_nodes > self.switch_nodes else self.early
 
+    def iterations_bound(self, num_items: int) -> int:
+        return max(self.early, self.late)
+
     def describe(self) -> str:
         return f"paper ({self.early} iterations, {self.late} after {self.switch_nodes} nodes)"
 
@@ -163,6 +176,9 @@ class FixedIterations(IterationPolicy):
         _check_iteration_count(self.k, "k")
 
     def _iterations(self, num_items: int, tree_nodes: int, num_marked: int | None) -> int:
+        return int(self.k)
+
+    def iterations_bound(self, num_items: int) -> int:
         return int(self.k)
 
     def describe(self) -> str:
@@ -216,6 +232,10 @@ class BBHT(IterationPolicy):
 
     def start(self, num_items: int) -> BBHTState:
         return BBHTState(self, num_items)
+
+    def iterations_bound(self, num_items: int) -> int:
+        """One BBHT circuit runs j < M <= sqrt(N) iterations (the cap bounds their sum)."""
+        return min(math.isqrt(num_items), self.cap(num_items))
 
     def cap(self, num_items: int) -> int:
         """Iteration budget of one BBHT search: ``cap_factor * sqrt(N)``."""
@@ -296,6 +316,14 @@ class Adaptive(IterationPolicy):
 
     def start(self, num_items: int) -> AdaptiveState:
         return AdaptiveState(self, num_items)
+
+    def iterations_bound(self, num_items: int) -> int:
+        return optimal_iterations(num_items, 1) if self.max_iterations is None else int(self.max_iterations)
+
+    def state_bytes(self, num_items: int) -> int:
+        """The success table sin^2((2k+1) theta(f)), (k_max + 1) x grid_size float64, and the
+        temporaries that build it (3 tables)."""
+        return 3 * 8 * (self.iterations_bound(num_items) + 1) * int(self.grid_size)
 
     def describe(self) -> str:
         return "adaptive (estimates m/N from verified outcomes; no access to the true m)"

@@ -15,7 +15,7 @@ import os
 import numpy as np
 
 from ..probability import good_probability
-from ..validation import check_int
+from ..validation import check_bool, check_int
 from .backend import QuantumSearchBackend, seed_stream, validate_iterations, validate_marks
 
 BYTES_PER_ENTRY = 32  # amplitudes (8) + probabilities (8) + index lists (8) + marks, with slack
@@ -40,7 +40,7 @@ class StatevectorBackend(QuantumSearchBackend):
         max_qubits: int | None = None,
     ) -> None:
         self._rng = seed_stream(seed)
-        self.closed_form = bool(closed_form)
+        self.closed_form = check_bool(closed_form, "closed_form")
         memory_limit = int(math.log2(max(_memory_bytes() // 2 // BYTES_PER_ENTRY, 2)))
         if max_qubits is not None and check_int(max_qubits, "max_qubits", 1) > memory_limit:
             raise ValueError(f"max_qubits must be an integer in [1, {memory_limit}] (the largest n whose "
@@ -50,6 +50,16 @@ class StatevectorBackend(QuantumSearchBackend):
     @property
     def max_qubits(self) -> int:
         return self._max_qubits
+
+    #: per shot: the uniform draws, the good/unmarked split, the ranks and the measured indices
+    BYTES_PER_SHOT = 64
+
+    def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1) -> int:
+        """Closed form: the marked indices and their rank table (at most 8 + 16 bytes per entry
+        when every entry is marked). ``closed_form=False``: the state, its update temporaries,
+        the probabilities and their cumulative sum (5 float64 arrays)."""
+        per_entry = 24 if self.closed_form else 40
+        return (per_entry << num_qubits) + self.BYTES_PER_SHOT * shots
 
     @staticmethod
     def amplitudes(marks: np.ndarray, iterations: int) -> np.ndarray:

@@ -1,0 +1,137 @@
+"""The memory guard's estimate against the measured peak memory (issue 10, defect 2).
+
+Each case runs in a fresh subprocess: it imports the library, warms up (numba compilation, a tiny
+plan), reads its resident set (VmRSS), then runs the case and reads its peak resident set
+(``resource.getrusage(RUSAGE_SELF).ru_maxrss``). The measured figure is the peak minus that
+baseline: the bytes the run added, which is what ``qrrt_circuits.memory`` estimates.
+
+Cases:
+- ``plan``: one round of q-RRT (``QRRT``, paper_clutter, the paper's schedule: k = 5 on a new tree)
+  on each backend for several n; the estimate is ``QRRT.memory_estimate()``;
+- ``--database``: one database build and predicate evaluation alone, in d = 2, 4, 6, with and
+  without annealing, at n = 20 (the constants ``DATABASE_*`` / ``ANNEALING_*`` come from these);
+- ``--aer-iterations``: one Aer round at n = 18 for k = 1, 2, 5, 10 (the per-iteration constant).
+
+    python benchmarks/bench_memory.py            # n = 16, 18, 20, 22 on both backends (a few minutes)
+    python benchmarks/bench_memory.py --quick    # n = 16, 18, 20
+
+Writes ``benchmarks/results/bench_memory.json``. Memory figures do not depend on a busy CPU, but
+the allocator's behaviour makes them vary by a few MiB between runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+
+from _common import RESULTS, machine
+
+MIB = 1 << 20
+
+
+def _rss() -> int:
+    with open("/proc/self/status") as status:
+        for line in status:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) * 1024
+    raise RuntimeError("no VmRSS in /proc/self/status")
+
+
+def _peak() -> int:
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # KiB on Linux
+
+
+def run_plan_case(backend_name: str, n: int, k: int | None) -> dict:
+    import qrrt_circuits as qc
+
+    env = qc.scenarios.paper_clutter(seed=0)
+    backend = qc.AerBackend(seed=0) if backend_name == "aer" else qc.StatevectorBackend(seed=0)
+    policy = qc.PaperSchedule() if k is None else qc.FixedIterations(k)
+    qc.QRRT(env, backend=backend, num_qubits=4, seed=0, search_policy=policy).plan(max_rounds=2)  # warm up
+    base = _rss()
+    planner = qc.QRRT(env, backend=backend, num_qubits=n, seed=0, search_policy=policy)
+    estimate = planner.memory_estimate()
+    planner.plan(max_rounds=1)
+    return {"case": "plan", "backend": backend_name, "num_qubits": n,
+            "iterations": policy.iterations_bound(1 << n), "measured_bytes": _peak() - base,
+            "estimated_bytes": estimate.total_bytes, "estimate": estimate.describe()}
+
+
+def run_database_case(n: int, d: int, annealing: bool) -> dict:
+    import numpy as np
+
+    import qrrt_circuits as qc
+    from qrrt_circuits.database import AnnealingSchedule, build_database
+    from qrrt_circuits.memory import database_bytes
+    from qrrt_circuits.tree import Tree
+
+    env = qc.Environment(np.array([[0.0, 10.0]] * d), np.array([[[4.0] * d, [5.0] * d]]))
+    dynamics = None if d == 2 else qc.LinearTrackingDynamics(-np.eye(d), np.eye(d), np.eye(d))
+    oracle = qc.ReachabilityOracle(env, dynamics)
+    rng = np.random.default_rng(0)
+    tree = Tree(np.full(d, 1.0))
+    for point in env.sample_free(62, rng):  # a 63-node tree
+        tree.add(point, 0)
+    oracle.reachable(np.ones((1, d)), np.full((1, d), 2.0))  # warm up
+    base = _rss()
+    db = build_database(tree, 1 << n, env, rng, np.full(d, 9.0), 0.5, 0.1,
+                        AnnealingSchedule.paper() if annealing else None, 0)
+    oracle.reachable(tree.nodes[db.parents], db.children)
+    return {"case": "database", "num_qubits": n, "dim": d, "annealing": annealing,
+            "measured_bytes": _peak() - base, "estimated_bytes": database_bytes(n, d, annealing),
+            "measured_bytes_per_entry": (_peak() - base) / (1 << n)}
+
+
+def in_subprocess(*args: str) -> dict:
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    out = subprocess.run([sys.executable, __file__, "--case", *args], capture_output=True, text=True,
+                         check=True, env=env)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--database", action="store_true", help="also the database cases (d = 2, 4, 6)")
+    parser.add_argument("--aer-iterations", action="store_true", help="also Aer at n = 18 for k = 1..10")
+    parser.add_argument("--case", nargs="+", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.case:
+        kind, *rest = args.case
+        if kind == "plan":
+            result = run_plan_case(rest[0], int(rest[1]), None if rest[2] == "paper" else int(rest[2]))
+        else:
+            result = run_database_case(int(rest[0]), int(rest[1]), rest[2] == "1")
+        print(json.dumps(result))
+        return
+    sizes = (16, 18, 20) if args.quick else (16, 18, 20, 22)
+    cases = [("plan", backend, str(n), "paper") for backend in ("statevector", "aer") for n in sizes]
+    if args.aer_iterations:
+        cases += [("plan", "aer", "18", str(k)) for k in (1, 2, 5, 10)]
+    if args.database:
+        cases += [("database", "20", str(d), a) for d in (2, 4, 6) for a in ("0", "1")]
+    rows = []
+    print(f"{'case':9s} {'backend':12s} {'n':>3s} {'d':>2s} {'k':>3s} {'estimated MiB':>14s} "
+          f"{'measured MiB':>13s} {'est/meas':>9s}")
+    for case in cases:
+        row = in_subprocess(*case)
+        rows.append(row)
+        ratio = row["estimated_bytes"] / max(row["measured_bytes"], 1)
+        print(f"{row['case']:9s} {row.get('backend', '-'):12s} {row['num_qubits']:3d} {row.get('dim', 2):2d} "
+              f"{row.get('iterations', '-')!s:>3s} {row['estimated_bytes'] / MIB:14.1f} "
+              f"{row['measured_bytes'] / MIB:13.1f} {ratio:9.2f}", flush=True)
+    RESULTS.mkdir(exist_ok=True)
+    path = RESULTS / "bench_memory.json"
+    path.write_text(json.dumps({"machine": machine(), "rows": rows,
+                                "note": "peak RSS increment over a warmed-up baseline, one subprocess per case"},
+                               indent=1))
+    print(f"wrote {path}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,148 @@
+"""The memory guard: estimate a run's peak memory before anything large is allocated, and refuse a
+run that would not fit (issue 10, defect 2).
+
+A quantum planner's round holds, at its peak, one database of N = 2^n candidates (samples,
+nearest parents, the predicate's answers, the oracle's marks and the scratch arrays that build
+them), plus what one Grover search of it costs on the backend (``QuantumSearchBackend.peak_bytes``:
+each backend reports its own footprint) and the search policy's own state
+(``IterationPolicy.state_bytes``). The estimate is the sum, in bytes *added* to the running
+process (the interpreter and the imported libraries are already resident, so they are already
+missing from the available memory).
+
+Available memory is ``MemAvailable`` from ``/proc/meminfo`` (Linux: free memory plus the page cache
+and slabs the kernel can reclaim, i.e. what can be allocated without swapping); elsewhere
+``os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")`` (free pages only, a lower figure); if
+neither exists, no check is made. ``psutil`` is not a runtime dependency, so it is not used.
+
+The per-entry constants are calibrated, not derived: ``benchmarks/bench_memory.py`` measures the
+peak resident set of real runs (``resource.getrusage``, in a fresh subprocess per case) against
+this estimate for n = 16..22 on both backends; the constants below are the measured bytes per
+entry rounded up (d = 2, 4, 6 fitted linearly in d for the database).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from dataclasses import dataclass
+
+MIB = 1 << 20
+
+#: database of one round, bytes per entry: samples and their scratch, nearest-parent indices, the
+#: (parent, child) pairs handed to the predicate, its answers and the marks. Measured 57 / 89 /
+#: 120 B per entry for d = 2 / 4 / 6 at n = 20 (``bench_memory.py --database``): 26 + 16 d.
+DATABASE_BYTES_PER_ENTRY = 26
+DATABASE_BYTES_PER_COORDINATE = 16
+#: with Quantum Database Annealing (Alg. 4) candidates are moved along their parent's direction:
+#: measured 122 / 193 / 273 B per entry for d = 2 / 4 / 6: 46 + 38 d.
+ANNEALING_BYTES_PER_ENTRY = 46
+ANNEALING_BYTES_PER_COORDINATE = 38
+#: fixed allowance: the nearest-node grid of the tree (``tree.Tree``) and allocator slack
+SCRATCH_BYTES = 64 * MIB
+
+
+def available_memory_bytes() -> int | None:
+    """Memory that can still be allocated without swapping, in bytes (None if unknown)."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as meminfo:
+            for line in meminfo:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return int(os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def database_bytes(num_qubits: int, dim: int, annealing: bool = False) -> int:
+    """Peak bytes of building one database of 2^n candidates in d dimensions and evaluating the
+    predicate on it (Alg. 1 lines 4-8; Alg. 4 line 7 with ``annealing``)."""
+    if annealing:
+        per_entry = ANNEALING_BYTES_PER_ENTRY + ANNEALING_BYTES_PER_COORDINATE * dim
+    else:
+        per_entry = DATABASE_BYTES_PER_ENTRY + DATABASE_BYTES_PER_COORDINATE * dim
+    return per_entry << num_qubits
+
+
+def database_resident_bytes(num_qubits: int, dim: int) -> int:
+    """Bytes one built database keeps while it is searched: candidates (8 d), parent indices (8),
+    the predicate's answers and the marks (1 + 1)."""
+    return (10 + 8 * dim) << num_qubits
+
+
+@dataclass(frozen=True)
+class MemoryEstimate:
+    """A run's estimated peak memory, in bytes added to the running process, by part.
+
+    The database's build scratch is freed before the search starts, so the peak is the larger of
+    building the databases and searching them while they are kept:
+    ``max(database_bytes, resident_bytes + search_bytes) + policy_bytes + scratch_bytes``."""
+
+    num_qubits: int
+    database_bytes: int = 0
+    resident_bytes: int = 0
+    search_bytes: int = 0
+    policy_bytes: int = 0
+    scratch_bytes: int = SCRATCH_BYTES
+
+    @property
+    def total_bytes(self) -> int:
+        return (max(self.database_bytes, self.resident_bytes + self.search_bytes) + self.policy_bytes
+                + self.scratch_bytes)
+
+    def describe(self) -> dict:
+        return {"num_qubits": self.num_qubits, "database_bytes": self.database_bytes,
+                "resident_bytes": self.resident_bytes, "search_bytes": self.search_bytes,
+                "policy_bytes": self.policy_bytes, "scratch_bytes": self.scratch_bytes,
+                "total_bytes": self.total_bytes}
+
+    def breakdown(self) -> str:
+        parts = [("database build", self.database_bytes), ("database kept", self.resident_bytes),
+                 ("search", self.search_bytes), ("search policy", self.policy_bytes),
+                 ("scratch", self.scratch_bytes)]
+        return ", ".join(f"{name} {_size(value)}" for name, value in parts if value)
+
+
+def _size(value: float) -> str:
+    if value >= 1 << 30:
+        return f"{value / (1 << 30):.1f} GiB"
+    return f"{value / MIB:.0f} MiB"
+
+
+#: estimates up to this size are not checked (reading /proc/meminfo on every small search would
+#: cost as much as the search)
+ALWAYS_FITS_BYTES = 256 * MIB
+
+#: n is never tried beyond this when looking for the largest n that fits (2^64 entries)
+_LARGEST_TRIED = 64
+
+
+def largest_fitting(estimate_for: Callable[[int], MemoryEstimate], available: int, below: int) -> int:
+    """The largest n < ``below`` whose estimate fits in ``available`` bytes (0 if none does)."""
+    best = 0
+    for n in range(1, min(below, _LARGEST_TRIED)):
+        if estimate_for(n).total_bytes > available:
+            break
+        best = n
+    return best
+
+
+def check_fits(estimate_for: Callable[[int], MemoryEstimate], num_qubits: int, what: str,
+               available: int | None = None) -> MemoryEstimate:
+    """Refuse (``ValueError``) a run whose estimated peak exceeds the available memory, naming
+    ``num_qubits``, the estimate, the available memory and the largest n that fits. ``what`` names
+    the run ("this plan", "this search"). Returns the estimate when it fits."""
+    estimate = estimate_for(num_qubits)
+    if estimate.total_bytes <= ALWAYS_FITS_BYTES:
+        return estimate
+    available = available_memory_bytes() if available is None else available
+    if available is None or estimate.total_bytes <= available:
+        return estimate
+    largest = largest_fitting(estimate_for, available, num_qubits)
+    raise ValueError(
+        f"num_qubits = {num_qubits}: {what} needs about {_size(estimate.total_bytes)} at its peak "
+        f"({estimate.breakdown()}), more than the {_size(available)} of memory available "
+        f"(MemAvailable); the largest num_qubits that fits is {largest}"
+        f"{' (none does)' if largest == 0 else ''}")

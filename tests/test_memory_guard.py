@@ -1,0 +1,124 @@
+"""The memory guard (issue 10, defect 2): a run whose estimated peak exceeds the available memory is
+refused before anything large is allocated, naming num_qubits, the estimate, the available memory
+and the largest n that fits."""
+
+import re
+import resource
+
+import numpy as np
+import pytest
+
+import qrrt_circuits as qc
+from qrrt_circuits import cli, memory
+
+MIB = 1 << 20
+
+
+@pytest.fixture(scope="module")
+def env():
+    return qc.scenarios.paper_clutter(seed=0)
+
+
+@pytest.fixture
+def small_memory(monkeypatch):
+    """The machine reports 300 MiB available (machine-independent refusals)."""
+    monkeypatch.setattr(memory, "available_memory_bytes", lambda: 300 * MIB)
+    return 300 * MIB
+
+
+def _peak_rss() -> int:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
+def _largest(message: str) -> int:
+    return int(re.search(r"the largest num_qubits that fits is (\d+)", message).group(1))
+
+
+@pytest.mark.parametrize("make_backend", [lambda: qc.StatevectorBackend(0), lambda: qc.AerBackend(0)],
+                         ids=["statevector", "aer"])
+def test_planner_refused_at_construction_with_the_largest_fitting_n(env, small_memory, make_backend):
+    backend = make_backend()
+    before = _peak_rss()
+    with pytest.raises(ValueError, match=r"num_qubits = 28: this plan needs about .* at its peak .*more "
+                                         r"than the 300 MiB of memory available") as info:
+        qc.PQRRT(env, backend=backend, num_qubits=28, seed=0)
+    assert _peak_rss() - before < 64 * MIB  # refused before the 2^28-entry database was built
+    largest = _largest(str(info.value))
+    planner = qc.PQRRT(env, backend=backend, num_qubits=largest, seed=0)
+    assert planner.memory_estimate().total_bytes <= small_memory
+    assert planner.memory_estimate(largest + 1).total_bytes > small_memory
+
+
+def test_the_estimate_grows_with_what_the_run_holds(env):
+    sv = qc.StatevectorBackend(0)
+    base = qc.QRRT(env, backend=sv, num_qubits=10, seed=0).memory_estimate(24)
+    annealed = qc.QRRT(env, backend=sv, num_qubits=10, seed=0,
+                       annealing=qc.AnnealingSchedule.paper()).memory_estimate(24)
+    aer = qc.QRRT(env, backend=qc.AerBackend(0), num_qubits=10, seed=0).memory_estimate(24)
+    aer_more_k = qc.QRRT(env, backend=qc.AerBackend(0), num_qubits=10, seed=0,
+                         search_policy=qc.FixedIterations(20)).memory_estimate(24)
+    assert base.total_bytes < annealed.total_bytes
+    assert base.total_bytes < aer.total_bytes < aer_more_k.total_bytes
+    # the per-entry part doubles with one more qubit; shots add a per-shot part
+    shot = sv.peak_bytes(20, 2) - sv.peak_bytes(20, 1)
+    assert shot > 0 and sv.peak_bytes(21, 1) - shot == 2 * (sv.peak_bytes(20, 1) - shot)
+    assert qc.Adaptive(grid_size=100_000, max_iterations=1_000_000).state_bytes(1 << 10) > 1 << 40
+
+
+def test_adaptive_with_a_huge_table_is_refused_before_allocating_it(env):
+    policy = qc.Adaptive(grid_size=100_000, max_iterations=1_000_000)  # a 2.4 TB success table
+    with pytest.raises(ValueError, match=r"num_qubits = 8: this plan needs about .*search policy"):
+        qc.QRRT(env, backend=qc.StatevectorBackend(0), num_qubits=8, seed=0, search_policy=policy)
+
+
+@pytest.mark.parametrize("make_backend", [lambda: qc.StatevectorBackend(0, max_qubits=24),
+                                          lambda: qc.AerBackend(0)], ids=["statevector", "aer"])
+def test_direct_search_refused(small_memory, make_backend):
+    backend = make_backend()
+    marks = np.zeros(1 << 24, dtype=bool)
+    marks[::3] = True
+    with pytest.raises(ValueError, match=r"num_qubits = 24: this .* search \(1 shots, 5 iterations\) needs "
+                                         r"about .*the largest num_qubits that fits is \d+"):
+        backend.search(marks, 5)
+
+
+def test_cli_search_refused_before_the_marks(small_memory, capsys):
+    before = _peak_rss()
+    with pytest.raises(SystemExit) as info:
+        cli.main(["search", "--backend", "aer", "--qubits", "26", "--marked", "1"])
+    assert info.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "num_qubits = 26" in err and "largest num_qubits that fits" in err
+    assert _peak_rss() - before < 32 * MIB  # the 2^26 marks were never allocated
+
+
+def test_cli_plan_reproductions_refused(small_memory, capsys):
+    for argv in (["plan", "--planner", "qrrt", "--backend", "statevector", "--qubits", "28", "--max-rounds", "1"],
+                 ["plan", "--backend", "aer", "--qubits", "24"]):
+        with pytest.raises(SystemExit) as info:
+            cli.main(argv)
+        assert info.value.code == 2
+        err = capsys.readouterr().err
+        assert "this plan needs about" in err and "300 MiB of memory available" in err
+
+
+@pytest.mark.parametrize("argv_backend, qubits, planner", [("statevector", 28, qc.QRRT), ("aer", 24, qc.PQRRT)])
+def test_issue_reproductions_on_this_machine(env, argv_backend, qubits, planner):
+    """The issue's two runs, with this machine's real available memory: refused when their estimate
+    exceeds it (skipped on a machine that has the memory: they then run, as they should)."""
+    backend = qc.StatevectorBackend(0) if argv_backend == "statevector" else qc.AerBackend(0)
+    estimate = planner(env, backend=backend, num_qubits=12, seed=0).memory_estimate(qubits)
+    available = memory.available_memory_bytes()
+    if available is None or estimate.total_bytes <= available:
+        pytest.skip(f"this machine has {available} bytes available, enough for the estimated "
+                    f"{estimate.total_bytes}")
+    with pytest.raises(ValueError, match=f"num_qubits = {qubits}: this plan needs about"):
+        planner(env, backend=backend, num_qubits=qubits, seed=0)
+
+
+def test_available_memory_reads_meminfo():
+    available = memory.available_memory_bytes()
+    assert available is not None and available > 0
+    with open("/proc/meminfo") as meminfo:
+        total = next(int(line.split()[1]) * 1024 for line in meminfo if line.startswith("MemTotal:"))
+    assert available <= total
