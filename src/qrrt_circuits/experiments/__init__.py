@@ -7,6 +7,7 @@ from .corridor_sensitivity import CorridorSensitivity
 from .heatmap_hypotheses import HeatmapHypotheses
 from .heatmaps import Heatmaps
 from .lemmas import Lemmas
+from .noise import Noise
 from .oracle_check import OracleCheck
 from .oracle_efficiency import OracleEfficiency
 from .runner import read_records, run_experiment
@@ -18,7 +19,7 @@ EXPERIMENTS = {
     experiment.name: experiment
     for experiment in (OracleEfficiency(), Wallclock(), Heatmaps(), Corridor(), Annealing(), Lemmas(),
                        Scaling(), OracleCheck(), TreeSize(), HeatmapHypotheses(),
-                       CorridorSensitivity())
+                       CorridorSensitivity(), Noise())
 }
 
 __all__ = ["EXPERIMENTS", "read_records", "run_experiment"]

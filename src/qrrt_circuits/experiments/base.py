@@ -37,6 +37,12 @@ class TrialStream(IntEnum):
     TREE_SIZE_PLANNERS = 12
     HEATMAP_HYPOTHESES = 13
     CORRIDOR_SENSITIVITY = 14
+    # noise and resources (issue 12); numbered apart from the other streams added beside them
+    NOISE_SWEEP = 31
+    NOISE_WORLDS = 32
+    NOISE_PLANNERS = 33
+    RESOURCES_WORLDS = 34
+    RESOURCES_PLANNERS = 35
 
 
 @dataclass(frozen=True)
