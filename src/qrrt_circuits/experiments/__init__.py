@@ -10,6 +10,7 @@ from .lemmas import Lemmas
 from .noise import Noise
 from .oracle_check import OracleCheck
 from .oracle_efficiency import OracleEfficiency
+from .resources import Resources
 from .runner import read_records, run_experiment
 from .scaling import Scaling
 from .tree_size import TreeSize
@@ -19,7 +20,7 @@ EXPERIMENTS = {
     experiment.name: experiment
     for experiment in (OracleEfficiency(), Wallclock(), Heatmaps(), Corridor(), Annealing(), Lemmas(),
                        Scaling(), OracleCheck(), TreeSize(), HeatmapHypotheses(),
-                       CorridorSensitivity(), Noise())
+                       CorridorSensitivity(), Noise(), Resources())
 }
 
 __all__ = ["EXPERIMENTS", "read_records", "run_experiment"]
