@@ -90,23 +90,29 @@ def iteration_circuit(marks: np.ndarray, synthesis: str = "diagonal"):
 def near_term_counts(marks: np.ndarray, synthesis: str = "diagonal", connectivity: str = "all-to-all",
                      optimization_level: int = 1) -> NearTermCount:
     """Two-qubit gate count and depth of one iteration on ``connectivity`` (see the module text)."""
-    from qiskit.transpiler import generate_preset_pass_manager
-
     marks, n = validate_marks(marks)
     check_choice(synthesis, "synthesis", ("diagonal", "mcz"))
     connectivity = check_choice(connectivity, "connectivity", CONNECTIVITIES)
     check_int(optimization_level, "optimization_level", 0, 3)
     if n > 14:
         raise ValueError(f"near_term_counts transpiles the circuit: n must be <= 14, got {n}")
-    manager = generate_preset_pass_manager(optimization_level=optimization_level,
-                                           basis_gates=list(TWO_QUBIT_BASIS),
-                                           coupling_map=coupling_map(connectivity, n), seed_transpiler=0)
-    compiled = manager.run(iteration_circuit(marks, synthesis))
+    compiled = transpile_to(iteration_circuit(marks, synthesis), connectivity, optimization_level)
     used = {compiled.find_bit(q).index for inst in compiled.data for q in inst.qubits}
     return NearTermCount(n, int(marks.sum()), synthesis, connectivity,
                          int(compiled.count_ops().get("cx", 0)),
                          int(compiled.depth(lambda inst: inst.operation.num_qubits == 2)),
                          int(compiled.depth()), len(used))
+
+
+def transpile_to(circuit, connectivity: str = "all-to-all", optimization_level: int = 1):
+    """``circuit`` transpiled (fixed seed) to [cx, rz, sx, x] on ``connectivity``."""
+    from qiskit.transpiler import generate_preset_pass_manager
+
+    connectivity = check_choice(connectivity, "connectivity", CONNECTIVITIES)
+    manager = generate_preset_pass_manager(optimization_level=optimization_level, basis_gates=list(TWO_QUBIT_BASIS),
+                                           coupling_map=coupling_map(connectivity, circuit.num_qubits),
+                                           seed_transpiler=0)
+    return manager.run(circuit)
 
 
 # ---------------------------------------------------------------------------- fault tolerant
@@ -252,6 +258,7 @@ __all__ = [
     "iteration_circuit",
     "multi_controlled_z_toffolis",
     "near_term_counts",
+    "transpile_to",
     "plan_time_s",
     "qrom_toffolis",
 ]
