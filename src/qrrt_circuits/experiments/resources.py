@@ -170,6 +170,9 @@ class Resources(Experiment):
                                                                 v["test_s"])
             v["break_even_call_s"] = res.break_even_call_s(v["rrt_calls"], v["quantum_calls"], v["verifications"],
                                                            v["test_s"])
+            # machine-independent: the break-even in units of one classical test (measured timings cancel)
+            v["break_even_tests_per_call"] = v["break_even_call_s"] / v["test_s"]
+            v["table_checks_over_rrt_calls"] = v["table_checks"] / v["rrt_calls"]
             v["break_even_toffolis"] = v["break_even_call_s"] / settings["toffoli_s"]
             v["break_even_two_qubit_layers"] = v["break_even_call_s"] / settings["two_qubit_gate_s"]
             return v
