@@ -68,10 +68,11 @@ class Noise(Experiment):
         device = noise.available_fake_device() if noise.has_fake_devices() else None
         if quick:
             return {"trials": trials or 1, "seed": seed, "quick": True,
-                    "sweep_qubits": [4, 5], "sweep_iterations": [1, 3], "p2": [0.0, 1e-3, 1e-2],
-                    "p1_ratio": 0.1, "exact_max_qubits": 4, "shots": 200,
-                    "device": device, "device_qubits": [4], "device_iterations": [1], "device_shots": 200,
-                    "planning_p2": [0.0, 1e-2], "planning_qubits": 4, "nodes": 4,
+                    "sweep_qubits": [3, 4], "sweep_iterations": [1, 2], "p2": [0.0, 1e-2],
+                    "p1_ratio": 0.1, "exact_max_qubits": 3, "shots": 100,
+                    # the fake device's noise model takes seconds to build: tests/test_noise.py runs it
+                    "device": device, "device_qubits": [], "device_iterations": [1], "device_shots": 100,
+                    "planning_p2": [0.0, 1e-2], "planning_qubits": 4, "nodes": 3,
                     "planning_configs": ["QRRT adaptive"]}
         return {"trials": trials or 3, "seed": seed, "quick": False,
                 "sweep_qubits": [4, 5, 6, 7, 8, 9, 10], "sweep_iterations": [1, 2, 3],

@@ -53,10 +53,10 @@ class Resources(Experiment):
     def settings(self, quick, trials, seed):
         lookups = ["qrom", "select-swap"] if res.has_qualtran() else ["qrom"]
         return {"trials": trials or (1 if quick else 10), "seed": seed, "quick": quick,
-                "qubits": [4, 5] if quick else list(range(4, 13)), "syntheses": ["diagonal", "mcz"],
+                "qubits": [3, 4] if quick else list(range(4, 13)), "syntheses": ["diagonal", "mcz"],
                 "connectivities": list(res.CONNECTIVITIES), "lookups": lookups,
                 "ft_source": "qualtran" if res.has_qualtran() else "formula",
-                "plan_qubits": 4 if quick else 8, "nodes": 5 if quick else 30,
+                "plan_qubits": 4 if quick else 8, "nodes": 3 if quick else 30,
                 "toffoli_s": ASSUMPTIONS.toffoli_s, "two_qubit_gate_s": ASSUMPTIONS.two_qubit_gate_s}
 
     def trials(self, settings):
