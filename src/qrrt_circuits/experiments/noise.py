@@ -222,6 +222,7 @@ class Noise(Experiment):
             return rrt, quantum
 
         calls, break_even = {}, {}
+        beyond = 1e6 * max(levels)
         rrt_all, _ = stats(worlds, settings["planning_configs"][0])
         calls["RRT"] = {"mean": rrt_all, "interval_95": rounded_interval(bootstrap_interval(
             worlds, lambda s: stats(s, settings["planning_configs"][0])[0], settings["seed"]), 3)}
@@ -231,9 +232,11 @@ class Noise(Experiment):
                 worlds, lambda s, i=i, c=config: stats(s, c)[1][i], settings["seed"]), 3)}
                 for i, (p2, q) in enumerate(zip(levels, quantum, strict=True))}
             value = crossing(levels, quantum, rrt_all)
-            interval = bootstrap_interval(worlds, lambda s, c=config: _finite(crossing(levels, *stats(s, c)[::-1])),
-                                          settings["seed"])
-            break_even[config] = {"p2": value, "interval_95": [interval[0], interval[1]],
+            # a resample that never crosses counts as "beyond the largest level" (a finite stand-in, so
+            # that the bootstrap keeps it), and is reported as inf
+            interval = bootstrap_interval(
+                worlds, lambda s, c=config, b=beyond: min(crossing(levels, *stats(s, c)[::-1]), b), settings["seed"])
+            break_even[config] = {"p2": value, "interval_95": [_beyond(x, beyond) for x in interval],
                                   "meaning": _crossing_meaning(value, levels)}
         return {"calls_per_node": {c: (v["mean"] if c == "RRT" else {p: x["mean"] for p, x in v.items()})
                                    for c, v in calls.items()},
@@ -355,8 +358,8 @@ def _calls(rows, config, p2) -> float:
     return next(r["calls_per_node"] for r in rows if r["config"] == config and r["p2"] == p2)
 
 
-def _finite(value: float) -> float:
-    return value if np.isfinite(value) else math.nan
+def _beyond(value: float, beyond: float) -> float:
+    return math.inf if value >= beyond else float(value)
 
 
 def _mean(values) -> float:
