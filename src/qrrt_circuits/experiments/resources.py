@@ -181,7 +181,8 @@ class Resources(Experiment):
         intervals = {key: rounded_interval(bootstrap_interval(worlds, lambda s, k=key: derived(s)[k],
                                                               settings["seed"]), 9) for key in table}
         table.update(num_qubits=n, lookup=lookup, fault_tolerant_call_s=call_ft, near_term_call_s=call_nt,
-                     fault_tolerant_over_break_even=call_ft / table["break_even_call_s"])
+                     fault_tolerant_over_break_even=(call_ft / table["break_even_call_s"]
+                                                     if table["break_even_call_s"] > 0 else math.inf))
         return {"table": table, "interval_95": intervals}
 
     def plot(self, records, settings, summary, out_dir: Path):
