@@ -11,7 +11,7 @@ from qrrt_circuits.experiments.fitting import linear_fit, power_law_exponent, sl
 TINY = {"oracle-efficiency": 1, "wallclock": 1, "heatmaps": 2, "corridor": 2, "annealing": 1,
         "lemmas": 60, "scaling": 1, "oracle-check": 1,
         "tree-size": 1, "heatmap-hypotheses": 3,
-        "corridor-sensitivity": 2, "search-policies": 1}
+        "corridor-sensitivity": 2, "search-policies": 1, "noise": 1, "resources": 1}
 
 
 def _is_png(path):
@@ -145,11 +145,37 @@ def _check_search_policies(summary, records):
             assert row["critical_path_per_node"] == row["calls_per_node"]
 
 
+def _check_noise(summary, records):
+    for r in records:
+        if r["part"] == "sweep" and r["p2"] == 0 and r["shots"] == 0:  # zero noise: exactly the ideal
+            assert r["success"] == pytest.approx(r["ideal"], abs=1e-9)
+        if r["part"] == "sweep" and r["shots"] == 0:
+            assert 0.0 < r["fidelity"] <= 1.0 and r["collision"] >= r["collision_uniform"] - 1e-12
+        if r["part"] == "planning":
+            assert r["oracle_calls"] == r["quantum_oracle_calls"] + r["verification_calls"]
+            assert r["config"] != "RRT" or r["quantum_oracle_calls"] == 0
+    assert set(summary["ours"]["break_even_p2"]) == set(summary["settings"]["planning_configs"])
+    assert summary["device"]["name"] or "pip install" in summary["device"]["missing"]
+
+
+def _check_resources(summary, records):
+    for r in records:
+        if r["part"] == "fault-tolerant" and r["lookup"] == "qrom":  # Babbush et al.: 2 x (2^n - 2) + (n - 2)
+            assert r["oracle_ands"] + r["diffuser_ands"] == 2 * (2 ** r["n"] - 2) + r["n"] - 2
+        if r["part"] == "near-term" and r["synthesis"] == "diagonal" and r["connectivity"] == "all-to-all":
+            assert r["two_qubit_gates"] >= 2 ** r["n"] - 2  # the oracle alone has 2^n - 2 CX
+    plan = summary["plan"]["table"]
+    expected = (plan["rrt_calls"] - plan["verifications"]) * plan["test_s"] / plan["quantum_calls"]
+    assert plan["break_even_call_s"] == pytest.approx(expected)
+    assert plan["qrrt_fault_tolerant_with_table_s"] > plan["qrrt_fault_tolerant_s"]
+
+
 CHECKS = {"oracle-efficiency": _check_oracle_efficiency, "wallclock": _check_wallclock,
           "heatmaps": _check_heatmaps, "corridor": _check_corridor, "annealing": _check_annealing,
           "lemmas": _check_lemmas, "scaling": _check_scaling, "oracle-check": _check_oracle_check,
           "tree-size": _check_tree_size, "heatmap-hypotheses": _check_heatmap_hypotheses,
-          "corridor-sensitivity": _check_corridor_sensitivity, "search-policies": _check_search_policies}
+          "corridor-sensitivity": _check_corridor_sensitivity, "search-policies": _check_search_policies,
+          "noise": _check_noise, "resources": _check_resources}
 
 
 def _comparable(records):

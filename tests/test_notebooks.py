@@ -24,6 +24,7 @@ NOTEBOOKS = [
     "03_parallel_workers_and_lemmas.ipynb",
     "04_quantum_database_annealing.ipynb",
     "05_custom_predicate.ipynb",
+    "06_would_it_pay_off.ipynb",
 ]
 INTERPRETER_MARK = "kernel interpreter: "
 

@@ -7,8 +7,10 @@ from .corridor_sensitivity import CorridorSensitivity
 from .heatmap_hypotheses import HeatmapHypotheses
 from .heatmaps import Heatmaps
 from .lemmas import Lemmas
+from .noise import Noise
 from .oracle_check import OracleCheck
 from .oracle_efficiency import OracleEfficiency
+from .resources import Resources
 from .runner import read_records, run_experiment
 from .scaling import Scaling
 from .search_policies import SearchPolicies
@@ -19,7 +21,7 @@ EXPERIMENTS = {
     experiment.name: experiment
     for experiment in (OracleEfficiency(), Wallclock(), Heatmaps(), Corridor(), Annealing(), Lemmas(),
                        Scaling(), OracleCheck(), TreeSize(), HeatmapHypotheses(),
-                       CorridorSensitivity(), SearchPolicies())
+                       CorridorSensitivity(), SearchPolicies(), Noise(), Resources())
 }
 
 __all__ = ["EXPERIMENTS", "read_records", "run_experiment"]

@@ -37,9 +37,15 @@ class TrialStream(IntEnum):
     TREE_SIZE_PLANNERS = 12
     HEATMAP_HYPOTHESES = 13
     CORRIDOR_SENSITIVITY = 14
-    # search-policies (numbered apart from the others so that parallel additions cannot collide)
-    SEARCH_POLICIES_WORLDS = 31
-    SEARCH_POLICIES_PLANNERS = 32
+    # noise and resources (issue 12); numbered apart from the other streams added beside them
+    NOISE_SWEEP = 31
+    NOISE_WORLDS = 32
+    NOISE_PLANNERS = 33
+    RESOURCES_WORLDS = 34
+    RESOURCES_PLANNERS = 35
+    # search-policies (issue 12)
+    SEARCH_POLICIES_WORLDS = 36
+    SEARCH_POLICIES_PLANNERS = 37
 
 
 @dataclass(frozen=True)

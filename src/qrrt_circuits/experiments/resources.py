@@ -1,0 +1,242 @@
+"""Beyond the paper: what one oracle call and one plan would cost on a quantum computer.
+
+Three parts, one trial list (``qrrt_circuits.resources`` holds the counting and the assumptions):
+
+- ``near-term``: one Grover iteration (one oracle call) over N = 2^n entries with m = N / 16
+  random marks, each phase-oracle synthesis ("diagonal", "mcz"), transpiled to [cx, rz, sx, x] on
+  all-to-all, a line and heavy-hex: two-qubit gates and two-qubit depth, n = 4 ... 12.
+- ``fault-tolerant``: Toffoli (And) and T counts of one call with the oracle over a classical
+  lookup of the 2^n marks (QROM and select-swap QROM) plus the diffuser; Qualtran's bloqs when the
+  ``ft`` extra is installed, else the published formulas.
+- ``plan``: RRT and q-RRT (n = 8, the paper's schedule, exact statevector) grow 30-node trees in
+  the worlds of ``oracle-efficiency`` (same world seeds). RRT's wall time gives the classical time
+  of a plan and of one reachability test (busy-machine timings); q-RRT's quantum calls times the
+  time of one call gives its projected time. The break-even time per call is where the two meet.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .. import resources as res
+from ..registry import PLANNERS, PREDICATES
+from ..search.policies import PaperSchedule
+from .base import Experiment, Trial, TrialStream, replicate_seed
+from .figures import new_figure, save
+from .intervals import bootstrap_interval, rounded_interval
+from .worlds import world
+
+_NUMBERS = ("n", "m", "two_qubit_gates", "two_qubit_depth", "depth", "physical_qubits", "oracle_ands",
+            "oracle_t", "diffuser_ands", "t_count", "toffoli_equivalents", "nodes", "oracle_calls",
+            "quantum_oracle_calls", "verification_calls", "simulation_checks", "rounds", "wall_time_s",
+            "world_seed", "replicate")
+COLUMNS = {**dict.fromkeys(_NUMBERS, math.nan), "synthesis": "", "connectivity": "", "lookup": "", "source": "",
+           "planner": "", "status": ""}
+ASSUMPTIONS = res.ProjectionAssumptions()
+
+
+def database_marks(num_qubits: int, seed: int) -> np.ndarray:
+    size = 1 << num_qubits
+    marks = np.zeros(size, dtype=bool)
+    marks[np.random.default_rng(seed).choice(size, max(1, size >> 4), replace=False)] = True
+    return marks
+
+
+class Resources(Experiment):
+    name = "resources"
+    title = "Gates and time per oracle call and per plan, near term and fault tolerant (beyond the paper)"
+    paper = {"cost_model": "oracle calls only; the paper gives no gate counts or times"}
+
+    def settings(self, quick, trials, seed):
+        lookups = ["qrom", "select-swap"] if res.has_qualtran() else ["qrom"]
+        return {"trials": trials or (1 if quick else 10), "seed": seed, "quick": quick,
+                "qubits": [3, 4] if quick else list(range(4, 13)), "syntheses": ["diagonal", "mcz"],
+                "connectivities": list(res.CONNECTIVITIES), "lookups": lookups,
+                "ft_source": "qualtran" if res.has_qualtran() else "formula",
+                "plan_qubits": 4 if quick else 8, "nodes": 3 if quick else 30,
+                "toffoli_s": ASSUMPTIONS.toffoli_s, "two_qubit_gate_s": ASSUMPTIONS.two_qubit_gate_s}
+
+    def trials(self, settings):
+        out = []
+        root = settings["seed"]
+        for n in settings["qubits"]:
+            seed = replicate_seed(root, n, TrialStream.RESOURCES_WORLDS)
+            for synthesis in settings["syntheses"]:
+                for connectivity in settings["connectivities"]:
+                    out.append(Trial(f"near-term-n{n}-{synthesis}-{connectivity}",
+                                     {"part": "near-term", "n": n, "synthesis": synthesis,
+                                      "connectivity": connectivity}, seed))
+            for lookup in settings["lookups"]:
+                out.append(Trial(f"fault-tolerant-n{n}-{lookup}", {"part": "fault-tolerant", "n": n,
+                                                                    "lookup": lookup}, 0))
+        for replicate in range(settings["trials"]):  # the worlds and planner seeds of oracle-efficiency
+            world_seed = replicate_seed(root, replicate, TrialStream.PAPER_WORLDS)
+            seed = replicate_seed(root, replicate, TrialStream.PAPER_PLANNERS)
+            for planner in ("RRT", "QRRT"):
+                out.append(Trial(f"plan-{planner}-{replicate}", {"part": "plan", "planner": planner,
+                                                                 "replicate": replicate, "world_seed": world_seed},
+                                 seed))
+        return out
+
+    def run_trial(self, trial, settings):
+        part = trial.params["part"].replace("-", "_")
+        record = getattr(self, f"_run_{part}")(trial, settings)
+        return {key: value for key, value in COLUMNS.items() if key not in trial.params} | record
+
+    def _run_near_term(self, trial, settings):
+        p = trial.params
+        marks = database_marks(p["n"], trial.seed)
+        count = res.near_term_counts(marks, p["synthesis"], p["connectivity"])
+        return {"m": count.num_marked, "two_qubit_gates": count.two_qubit_gates,
+                "two_qubit_depth": count.two_qubit_depth, "depth": count.depth,
+                "physical_qubits": count.physical_qubits}
+
+    def _run_fault_tolerant(self, trial, settings):
+        count = res.fault_tolerant_counts(trial.params["n"], trial.params["lookup"],
+                                          use_qualtran=settings["ft_source"] == "qualtran")
+        return {"oracle_ands": count.oracle_ands, "oracle_t": count.oracle_t, "diffuser_ands": count.diffuser_ands,
+                "t_count": count.t_count, "toffoli_equivalents": count.toffoli_equivalents, "source": count.source}
+
+    def _run_plan(self, trial, settings):
+        env = world("paper_clutter", trial.params["world_seed"])
+        options = {"env": env, "seed": trial.seed, "predicate": PREDICATES.create(settings["predicate"], env=env)}
+        # compile the predicate's kernels before the timed plan (a first call in a process JIT-compiles)
+        options["predicate"].reachable(env.start[None, :], env.start[None, :])
+        if trial.params["planner"] == "RRT":
+            planner = PLANNERS.create("RRT", **options)
+        else:
+            planner = PLANNERS.create("QRRT", backend=plan_backend(), num_qubits=settings["plan_qubits"],
+                                      search_policy=PaperSchedule(), **options)
+        result = planner.plan(max_nodes=settings["nodes"])
+        m = result.metrics
+        return {"status": str(result.status), "nodes": m.nodes, "oracle_calls": m.oracle_calls,
+                "quantum_oracle_calls": m.quantum_oracle_calls, "verification_calls": m.verification_calls,
+                "simulation_checks": m.simulation_checks, "rounds": m.rounds, "wall_time_s": m.wall_time_s}
+
+    # ------------------------------------------------------------------ summary
+    def summarize(self, records, settings):
+        near = {}
+        for r in (r for r in records if r["part"] == "near-term"):
+            near.setdefault(str(r["n"]), {})[f"{r['synthesis']}/{r['connectivity']}"] = {
+                "two_qubit_gates": r["two_qubit_gates"], "two_qubit_depth": r["two_qubit_depth"]}
+        fault = {}
+        for r in (r for r in records if r["part"] == "fault-tolerant"):
+            fault.setdefault(str(r["n"]), {})[r["lookup"]] = {
+                "ands": r["oracle_ands"] + r["diffuser_ands"], "t_count": r["t_count"],
+                "toffoli_equivalents": r["toffoli_equivalents"],
+                "time_per_call_s": r["toffoli_equivalents"] * settings["toffoli_s"], "source": r["source"]}
+        plan = self._plan_summary(records, settings, near, fault)
+        return {"ours": {"per_call_near_term": near, "per_call_fault_tolerant": fault, "per_plan": plan["table"]},
+                "paper": self.paper, "plan": plan,
+                "assumptions": {"toffoli_s": settings["toffoli_s"], "two_qubit_gate_s": settings["two_qubit_gate_s"],
+                                "t_gate": "a quarter of a Toffoli time (4 T per And)", "cliffords": "free",
+                                "near_term_time": "two-qubit depth x two_qubit_gate_s, errors ignored (lower bound)"},
+                "labels": ["classical times measured on a busy machine (RRT wall time / its reachability tests)",
+                           "q-RRT plans on the exact statevector backend (same statistics as Aer)",
+                           f"fault-tolerant counts from {settings['ft_source']}"]}
+
+    def _plan_summary(self, records, settings, near, fault):
+        rows = [r for r in records if r["part"] == "plan"]
+        by_world = {}
+        for r in rows:
+            by_world.setdefault(r["replicate"], {})[r["planner"]] = r
+        worlds = sorted(by_world)
+        n = settings["plan_qubits"]
+        lookup = settings["lookups"][-1]  # the cheaper lookup where both are counted
+        call_ft = fault[str(n)][lookup]["time_per_call_s"] if str(n) in fault else math.nan
+        near_key = "diagonal/heavy-hex"
+        call_nt = (near[str(n)][near_key]["two_qubit_depth"] * settings["two_qubit_gate_s"]
+                   if str(n) in near else math.nan)
+
+        def means(sample):
+            rrt = [by_world[w]["RRT"] for w in sample]
+            q = [by_world[w]["QRRT"] for w in sample]
+            test_s = sum(r["wall_time_s"] for r in rrt) / sum(r["oracle_calls"] for r in rrt)
+            return {"rrt_calls": np.mean([r["oracle_calls"] for r in rrt]),
+                    "rrt_time_s": np.mean([r["wall_time_s"] for r in rrt]),
+                    "test_s": test_s,
+                    "quantum_calls": np.mean([r["quantum_oracle_calls"] for r in q]),
+                    "verifications": np.mean([r["verification_calls"] for r in q]),
+                    "table_checks": np.mean([r["simulation_checks"] for r in q])}
+
+        def derived(sample):
+            v = means(sample)
+            v["qrrt_fault_tolerant_s"] = res.plan_time_s(v["quantum_calls"], v["verifications"], call_ft, v["test_s"])
+            v["qrrt_fault_tolerant_with_table_s"] = v["qrrt_fault_tolerant_s"] + v["table_checks"] * v["test_s"]
+            v["qrrt_near_term_lower_bound_s"] = res.plan_time_s(v["quantum_calls"], v["verifications"], call_nt,
+                                                                v["test_s"])
+            v["break_even_call_s"] = res.break_even_call_s(v["rrt_calls"], v["quantum_calls"], v["verifications"],
+                                                           v["test_s"])
+            # machine-independent: the break-even in units of one classical test (measured timings cancel)
+            v["break_even_tests_per_call"] = v["break_even_call_s"] / v["test_s"]
+            v["table_checks_over_rrt_calls"] = v["table_checks"] / v["rrt_calls"]
+            v["break_even_toffolis"] = v["break_even_call_s"] / settings["toffoli_s"]
+            v["break_even_two_qubit_layers"] = v["break_even_call_s"] / settings["two_qubit_gate_s"]
+            return v
+
+        table = {key: float(value) for key, value in derived(worlds).items()}
+        intervals = {key: rounded_interval(bootstrap_interval(worlds, lambda s, k=key: derived(s)[k],
+                                                              settings["seed"]), 9) for key in table}
+        table.update(num_qubits=n, lookup=lookup, fault_tolerant_call_s=call_ft, near_term_call_s=call_nt,
+                     fault_tolerant_over_break_even=(call_ft / table["break_even_call_s"]
+                                                     if table["break_even_call_s"] > 0 else math.inf))
+        return {"table": table, "interval_95": intervals}
+
+    def plot(self, records, settings, summary, out_dir: Path):
+        fig, axes = new_figure(1, 3, (16, 4.8))
+        ax = axes[0, 0]
+        for synthesis, marker in zip(settings["syntheses"], "os", strict=False):
+            for connectivity in settings["connectivities"]:
+                rows = sorted((r for r in records if r["part"] == "near-term" and r["synthesis"] == synthesis
+                               and r["connectivity"] == connectivity), key=lambda r: r["n"])
+                ax.plot([r["n"] for r in rows], [r["two_qubit_gates"] for r in rows], marker=marker,
+                        label=f"{synthesis}, {connectivity}")
+        ax.set_yscale("log")
+        ax.set_xlabel("index qubits n (m = N/16)")
+        ax.set_ylabel("CX per oracle call (one Grover iteration)")
+        ax.set_title("Near term: [cx, rz, sx, x] after routing", fontsize=9)
+        ax.legend(fontsize=7)
+        ax.grid(alpha=0.3, which="both")
+
+        ax = axes[0, 1]
+        plan = summary["plan"]["table"]
+        for lookup in settings["lookups"]:
+            rows = sorted((r for r in records if r["part"] == "fault-tolerant" and r["lookup"] == lookup),
+                          key=lambda r: r["n"])
+            ax.plot([r["n"] for r in rows], [r["toffoli_equivalents"] for r in rows], "o-",
+                    label=f"lookup oracle ({lookup}) + diffuser")
+        ax.axhline(plan["break_even_toffolis"], color="tab:red", ls="--",
+                   label=f"break-even on the n={plan['num_qubits']} plans: {plan['break_even_toffolis']:.0f}")
+        ax.set_yscale("log")
+        ax.set_xlabel("index qubits n")
+        ax.set_ylabel("Toffoli equivalents per oracle call")
+        ax.set_title(f"Fault tolerant ({settings['ft_source']})", fontsize=9)
+        ax.legend(fontsize=7)
+        ax.grid(alpha=0.3, which="both")
+
+        ax = axes[0, 2]
+        labels = ["RRT (measured)", "q-RRT FT,\nquantum part", "q-RRT FT,\n+ lookup table",
+                  "q-RRT near term\n(lower bound)"]
+        keys = ["rrt_time_s", "qrrt_fault_tolerant_s", "qrrt_fault_tolerant_with_table_s",
+                "qrrt_near_term_lower_bound_s"]
+        values = [plan[k] for k in keys]
+        errors = np.array([[plan[k] - summary["plan"]["interval_95"][k][0],
+                            summary["plan"]["interval_95"][k][1] - plan[k]] for k in keys]).T
+        ax.bar(range(len(keys)), values, yerr=np.clip(errors, 0, None), capsize=4,
+               color=["tab:gray", "tab:blue", "tab:purple", "tab:orange"])
+        ax.set_xticks(range(len(keys)), labels, fontsize=7)
+        ax.set_yscale("log")
+        ax.set_ylabel(f"seconds per {settings['nodes']}-node plan")
+        ax.set_title(f"paper_clutter plans, n = {plan['num_qubits']}, paper schedule", fontsize=9)
+        ax.grid(alpha=0.3, axis="y", which="both")
+        return [save(fig, out_dir / "resources.png")]
+
+
+def plan_backend():
+    """The ideal backend of the plan part (only oracle calls are taken from q-RRT's plans)."""
+    from ..search.statevector import StatevectorBackend
+
+    return StatevectorBackend()

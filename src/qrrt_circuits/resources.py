@@ -1,0 +1,270 @@
+"""What one oracle call (one Grover iteration) costs in gates, near term and fault tolerant, and what
+a q-RRT plan would cost in time (beyond the paper, which counts oracle calls only).
+
+**Near term** (``near_term_counts``): the iteration Q = grover_operator(phase_oracle(marks), H^n)
+transpiled (optimization level 1, fixed seed) to the basis [cx, rz, sx, x] on all-to-all, a line,
+or IBM's heavy-hex lattice (``CouplingMap.from_heavy_hex``, the topology of the Eagle/Heron
+devices): two-qubit gate count, two-qubit depth, depth.
+
+**Fault tolerant** (``fault_tolerant_counts``): the oracle over a classical lookup of the 2^n marks
+d_i is QROM (load d_i into a clean qubit), Z on that qubit, QROM^dagger (unload):
+
+- unary-iteration QROM over L = 2^n entries (Babbush et al., "Encoding electronic spectra in
+  quantum circuits with linear T complexity", PRX 8, 041015 (2018), Sec. III.A): L - 1 Toffolis
+  (4L - 4 T) with a control qubit, L - 2 without one (the lookup here has none);
+- select-swap QROM (Low, Kliuchnikov, Schaeffer, "Trading T-gates for dirty qubits in state
+  preparation and unitary synthesis", arXiv:1812.00954 (2018)): about L / lambda Toffolis plus
+  lambda - 1 controlled swaps per output bit, with lambda extra qubits;
+- the diffuser's n-qubit controlled Z: n - 2 Toffolis (And gates) with n - 2 clean ancillas
+  (a compute-uncompute And ladder, Gidney, "Halving the cost of quantum addition", Quantum 2, 74
+  (2018): an And costs 4 T, its uncomputation is measurement based and costs none).
+
+With Qualtran installed (optional extra ``ft``) the counts are Qualtran's (``QROM``,
+``SelectSwapQROM``, ``MultiControlZ`` with ``QECGatesCost``); without it the formulas above.
+
+**Time** (``ProjectionAssumptions``): fault tolerant, one logical Toffoli (And) per 10 µs
+(reaction-limited surface code: 1 µs code cycle, 10 µs reaction time, as assumed by Gidney and
+Ekerå, "How to factor 2048 bit RSA integers in 8 hours", Quantum 5, 433 (2021)), a T gate a quarter
+of that (4 T per And), Cliffords free. A plan of q-RRT costs its quantum oracle calls times the time
+of one iteration plus its verifications at the classical time of one reachability test.
+
+**Break-even**: q-RRT beats RRT on the same plans only if one iteration costs less than
+(RRT's calls - q-RRT's verifications) x t_test / q-RRT's quantum calls.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .search.backend import validate_marks
+from .validation import check_choice, check_int, check_positive_float
+
+CONNECTIVITIES = ("all-to-all", "line", "heavy-hex")
+#: the heavy-hex lattice used (57 qubits, distance 5): enough room for n <= 12 plus routing
+HEAVY_HEX_DISTANCE = 5
+TWO_QUBIT_BASIS = ("cx", "rz", "sx", "x")
+QUALTRAN_HINT = "install the optional extra: pip install 'qrrt-circuits[ft]' (it adds qualtran)"
+
+
+@dataclass(frozen=True)
+class NearTermCount:
+    """One Grover iteration after transpiling to [cx, rz, sx, x] on ``connectivity``."""
+
+    num_qubits: int
+    num_marked: int
+    synthesis: str
+    connectivity: str
+    two_qubit_gates: int
+    two_qubit_depth: int
+    depth: int
+    physical_qubits: int
+
+
+@functools.lru_cache(maxsize=8)
+def coupling_map(connectivity: str, num_qubits: int):
+    """None (all-to-all), a line of n qubits, or the distance-5 heavy-hex lattice."""
+    from qiskit.transpiler import CouplingMap
+
+    connectivity = check_choice(connectivity, "connectivity", CONNECTIVITIES)
+    if connectivity == "all-to-all":
+        return None
+    if connectivity == "line":
+        return CouplingMap.from_line(num_qubits)
+    return CouplingMap.from_heavy_hex(HEAVY_HEX_DISTANCE)
+
+
+def iteration_circuit(marks: np.ndarray, synthesis: str = "diagonal"):
+    """One Grover iteration Q = grover_operator(phase_oracle(marks, synthesis), H^n): one oracle call."""
+    from qiskit.circuit.library import grover_operator
+
+    from .search.circuits import phase_oracle, uniform_preparation
+
+    marks, n = validate_marks(marks)
+    return grover_operator(phase_oracle(marks, synthesis), state_preparation=uniform_preparation(n))
+
+
+def near_term_counts(marks: np.ndarray, synthesis: str = "diagonal", connectivity: str = "all-to-all",
+                     optimization_level: int = 1) -> NearTermCount:
+    """Two-qubit gate count and depth of one iteration on ``connectivity`` (see the module text)."""
+    marks, n = validate_marks(marks)
+    check_choice(synthesis, "synthesis", ("diagonal", "mcz"))
+    connectivity = check_choice(connectivity, "connectivity", CONNECTIVITIES)
+    check_int(optimization_level, "optimization_level", 0, 3)
+    if n > 14:
+        raise ValueError(f"near_term_counts transpiles the circuit: n must be <= 14, got {n}")
+    compiled = transpile_to(iteration_circuit(marks, synthesis), connectivity, optimization_level)
+    used = {compiled.find_bit(q).index for inst in compiled.data for q in inst.qubits}
+    return NearTermCount(n, int(marks.sum()), synthesis, connectivity,
+                         int(compiled.count_ops().get("cx", 0)),
+                         int(compiled.depth(lambda inst: inst.operation.num_qubits == 2)),
+                         int(compiled.depth()), len(used))
+
+
+def transpile_to(circuit, connectivity: str = "all-to-all", optimization_level: int = 1):
+    """``circuit`` transpiled (fixed seed) to [cx, rz, sx, x] on ``connectivity``."""
+    from qiskit.transpiler import generate_preset_pass_manager
+
+    connectivity = check_choice(connectivity, "connectivity", CONNECTIVITIES)
+    manager = generate_preset_pass_manager(optimization_level=optimization_level, basis_gates=list(TWO_QUBIT_BASIS),
+                                           coupling_map=coupling_map(connectivity, circuit.num_qubits),
+                                           seed_transpiler=0)
+    return manager.run(circuit)
+
+
+# ---------------------------------------------------------------------------- fault tolerant
+def qrom_toffolis(num_qubits: int, controlled: bool = False) -> int:
+    """Unary-iteration QROM over L = 2^n entries: L - 1 Toffolis with a control, L - 2 without
+    (Babbush et al. 2018, Sec. III.A; each Toffoli an And of 4 T)."""
+    n = check_int(num_qubits, "num_qubits", 1, 60)
+    size = 1 << n
+    return max(size - (1 if controlled else 2), 0)
+
+
+def multi_controlled_z_toffolis(num_qubits: int) -> int:
+    """A Z controlled on n - 1 qubits (phase -1 on |1...1> of n qubits): n - 2 Ands with clean
+    ancillas (Gidney 2018); n <= 2 is a Z or CZ (Clifford, no Toffoli)."""
+    n = check_int(num_qubits, "num_qubits", 1, 10_000)
+    return max(n - 2, 0)
+
+
+@dataclass(frozen=True)
+class FaultTolerantCount:
+    """Logical non-Clifford cost of one oracle call (lookup oracle) and of one diffuser."""
+
+    num_qubits: int
+    lookup: str  # "qrom" or "select-swap"
+    oracle_ands: int
+    oracle_t: int
+    diffuser_ands: int
+    source: str  # "qualtran x.y" or "formula"
+
+    @property
+    def ands(self) -> int:
+        return self.oracle_ands + self.diffuser_ands
+
+    @property
+    def t_count(self) -> int:
+        """T gates with 4 T per And (Gidney 2018)."""
+        return 4 * self.ands + self.oracle_t
+
+    @property
+    def toffoli_equivalents(self) -> float:
+        """Ands plus T / 4: the units of one Toffoli time in ``ProjectionAssumptions``."""
+        return self.ands + self.oracle_t / 4
+
+
+def has_qualtran() -> bool:
+    try:
+        import qualtran  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def fault_tolerant_counts(num_qubits: int, lookup: str = "qrom", use_qualtran: bool | None = None
+                          ) -> FaultTolerantCount:
+    """Oracle = lookup + Z + lookup^dagger over the 2^n marks, diffuser = n-qubit controlled Z.
+
+    ``use_qualtran``: None uses Qualtran when installed; True requires it; False uses the formulas
+    (select-swap needs Qualtran: its block size is Qualtran's choice)."""
+    n = check_int(num_qubits, "num_qubits", 2, 30)
+    lookup = check_choice(lookup, "lookup", ("qrom", "select-swap"))
+    if use_qualtran is None:
+        use_qualtran = has_qualtran()
+    if use_qualtran:
+        return _qualtran_counts(n, lookup)
+    if lookup == "select-swap":
+        raise ValueError(f"the select-swap count needs Qualtran: {QUALTRAN_HINT}")
+    return FaultTolerantCount(n, lookup, 2 * qrom_toffolis(n), 0, multi_controlled_z_toffolis(n), "formula")
+
+
+@functools.lru_cache(maxsize=64)
+def _qualtran_counts(n: int, lookup: str) -> FaultTolerantCount:
+    try:
+
+        from qualtran.bloqs.data_loading.qrom import QROM
+        from qualtran.bloqs.data_loading.select_swap_qrom import SelectSwapQROM
+        from qualtran.bloqs.mcmt import MultiControlZ
+        from qualtran.resource_counting import QECGatesCost, get_cost_value
+    except ImportError as exc:
+        raise ImportError(f"qualtran is not installed: {QUALTRAN_HINT}") from exc
+    kind = QROM if lookup == "qrom" else SelectSwapQROM
+    bloq = kind.build_from_bitsize((1 << n,), (1,))  # any data: the worst case, no data-dependent pruning
+    forward = get_cost_value(bloq, QECGatesCost())
+    backward = get_cost_value(bloq.adjoint(), QECGatesCost())
+    diffuser = get_cost_value(MultiControlZ(cvs=(1,) * (n - 1)), QECGatesCost())
+    return FaultTolerantCount(n, lookup, _ands(forward) + _ands(backward), _ts(forward) + _ts(backward),
+                              _ands(diffuser) + _ts(diffuser) // 4, "qualtran " + _version("qualtran"))
+
+
+def _ands(cost) -> int:
+    return int(cost.and_bloq) + int(cost.toffoli) + int(cost.cswap)
+
+
+def _ts(cost) -> int:
+    if int(cost.rotation):
+        raise RuntimeError(f"unexpected arbitrary rotations in a lookup's cost: {cost}")
+    return int(cost.t)
+
+
+# ---------------------------------------------------------------------------- time
+@dataclass(frozen=True)
+class ProjectionAssumptions:
+    """Stated gate times. ``toffoli_s``: one logical And/Toffoli (10 µs, reaction-limited surface
+    code, Gidney and Ekerå 2021); T gates cost a quarter of it. ``two_qubit_gate_s``: one physical
+    two-qubit gate layer on a superconducting device (about 0.5 µs for IBM's ECR/CZ gates; a
+    lower bound on the run time of a near-term circuit, errors ignored)."""
+
+    toffoli_s: float = 10e-6
+    two_qubit_gate_s: float = 0.5e-6
+
+    def __post_init__(self) -> None:
+        check_positive_float(self.toffoli_s, "toffoli_s")
+        check_positive_float(self.two_qubit_gate_s, "two_qubit_gate_s")
+
+    def fault_tolerant_call_s(self, count: FaultTolerantCount) -> float:
+        return count.toffoli_equivalents * self.toffoli_s
+
+    def near_term_call_s(self, count: NearTermCount) -> float:
+        return count.two_qubit_depth * self.two_qubit_gate_s
+
+
+def plan_time_s(quantum_calls: float, verification_calls: float, call_s: float, test_s: float) -> float:
+    """q-RRT's time for a plan: quantum calls x one iteration + verifications x one classical test."""
+    return float(quantum_calls * call_s + verification_calls * test_s)
+
+
+def break_even_call_s(rrt_calls: float, quantum_calls: float, verification_calls: float, test_s: float) -> float:
+    """The largest time per oracle call (one Grover iteration) at which q-RRT is no slower than RRT
+    on the same plans: (rrt_calls - verifications) x t_test / quantum_calls (<= 0: never)."""
+    if quantum_calls <= 0:
+        return math.inf
+    return float((rrt_calls - verification_calls) * test_s / quantum_calls)
+
+
+__all__ = [
+    "CONNECTIVITIES",
+    "FaultTolerantCount",
+    "NearTermCount",
+    "ProjectionAssumptions",
+    "break_even_call_s",
+    "coupling_map",
+    "fault_tolerant_counts",
+    "has_qualtran",
+    "iteration_circuit",
+    "multi_controlled_z_toffolis",
+    "near_term_counts",
+    "transpile_to",
+    "plan_time_s",
+    "qrom_toffolis",
+]
+
+
+def _version(package: str) -> str:
+    from importlib.metadata import version
+
+    return version(package)
