@@ -1,8 +1,16 @@
 """Gate-level Grover search: real Qiskit circuits executed by qiskit-aer's ``AerSimulator``.
 
-The circuit (``aer_grover_circuit``) uses only instructions Aer executes natively (h, x, diagonal,
-mcphase, measure), so it is run without a per-call transpile. Each shot is an independent
-preparation, k Grover iterations and a measurement (``memory=True`` keeps them per shot).
+The circuit (``aer_grover_circuit``: Walsh-Hadamard blocks, the oracle as one ``diagonal`` or as
+``pauli`` + ``mcphase`` pairs, one ``mcphase`` per diffuser) uses only instructions Aer executes
+natively, so it is run without a per-call transpile; with a ``noise_model`` the gate-by-gate
+circuit (``aer_literal_grover_circuit``: h, x, mcphase) is run instead, so per-gate noise acts on
+the paper's gates. Each shot is an independent preparation, k Grover iterations and a measurement
+(``memory=True`` keeps them per shot).
+
+Threads: Aer parallelises a state update only from ``statevector_parallel_threshold`` (14) qubits
+on; below it, extra OpenMP threads only cost their start-up and synchronisation (measured: a
+1-qubit circuit took 40x longer with 2 threads than with 1 on a loaded 2-core machine), so circuits
+narrower than ``SERIAL_BELOW_QUBITS`` run on one thread whatever ``max_parallel_threads`` says.
 """
 
 from __future__ import annotations
@@ -12,9 +20,11 @@ from qiskit_aer import AerSimulator
 
 from ..validation import check_int
 from .backend import QuantumSearchBackend, seed_stream
-from .circuits import SYNTHESES, aer_grover_circuit
+from .circuits import SYNTHESES, aer_grover_circuit, aer_literal_grover_circuit
 
 METHODS = ("statevector", "automatic")
+#: circuits on fewer qubits run single-threaded (Aer's default statevector_parallel_threshold)
+SERIAL_BELOW_QUBITS = 14
 #: methods AerSimulator offers that these circuits cannot run, and why (refused at construction)
 UNSUPPORTED_METHODS = {
     "density_matrix": "its instruction set lacks the mcphase gate of aer_grover_circuit (and it "
@@ -26,8 +36,12 @@ UNSUPPORTED_METHODS = {
 class AerBackend(QuantumSearchBackend):
     """Grover search on ``AerSimulator(method=...)``; seeded through ``seed_simulator``.
 
-    ``noise_model`` (a ``qiskit_aer.noise.NoiseModel``) is passed to the simulator as is;
-    ``device="GPU"`` needs Aer's GPU build. ``max_parallel_threads`` = 0 lets Aer use all cores.
+    ``noise_model`` (a ``qiskit_aer.noise.NoiseModel``) is passed to the simulator as is (and
+    selects the gate-by-gate circuit); ``device="GPU"`` needs Aer's GPU build.
+    ``max_parallel_threads`` = 0 lets Aer use all cores for circuits of ``SERIAL_BELOW_QUBITS`` or
+    more qubits; narrower ones run on one thread. ``synthesis``: the oracle's form, ``"auto"``
+    (``simulation_synthesis``, or with a noise model the CX-based ``choose_synthesis``),
+    ``"diagonal"`` or ``"mcz"``.
     """
 
     name = "aer"
@@ -62,16 +76,29 @@ class AerBackend(QuantumSearchBackend):
             max_parallel_threads=int(max_parallel_threads),
         )
         self.device = device
+        self.max_parallel_threads = int(max_parallel_threads)
+        self._build = aer_grover_circuit if noise_model is None else aer_literal_grover_circuit
 
     @property
     def max_qubits(self) -> int:
         return int(self.simulator.configuration().n_qubits)
 
+    def threads_for(self, num_qubits: int) -> int:
+        """The ``max_parallel_threads`` a circuit on ``num_qubits`` qubits runs with."""
+        return 1 if num_qubits < SERIAL_BELOW_QUBITS else self.max_parallel_threads
+
     def _sample(self, marks, num_qubits, iterations, shots, rng) -> np.ndarray:
-        circuit = aer_grover_circuit(marks, iterations, measure=True, synthesis=self.synthesis)
+        circuit = self._build(marks, iterations, measure=True, synthesis=self.synthesis)
         seed = int(rng.integers(0, 2**31 - 1))
-        result = self.simulator.run(circuit, shots=shots, seed_simulator=seed, memory=True).result()
-        if not result.success:
-            raise RuntimeError(f"AerSimulator failed: {result.status}")
-        memory = result.get_memory(0)
-        return np.fromiter((int(bits, 2) for bits in memory), dtype=np.int64, count=len(memory))
+        result = self.simulator.run(circuit, shots=shots, seed_simulator=seed, memory=True,
+                                    max_parallel_threads=self.threads_for(num_qubits)).result()
+        return _measured_indices(result, 0)
+
+
+def _measured_indices(result, experiment: int) -> np.ndarray:
+    """The measured indices of one experiment, from Aer's per-shot memory (hexadecimal strings
+    of the classical register, so no bitstring formatting per shot)."""
+    if not result.success:
+        raise RuntimeError(f"AerSimulator failed: {result.status}")
+    memory = result.results[experiment].data.memory
+    return np.fromiter((int(word, 16) for word in memory), dtype=np.int64, count=len(memory))
