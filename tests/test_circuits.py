@@ -102,15 +102,17 @@ def test_simulation_synthesis_is_separate_from_the_cx_choice():
 
 def test_aer_circuit_instruction_count():
     """Per iteration: the oracle, two Walsh-Hadamard layers of ceil(n/3) blocks, one mcphase; the
-    mcz oracle is one pauli + one mcphase per flipped entry (plus one pauli)."""
+    mcz oracle is one mcphase per flipped entry and one pauli between two of them (the first and
+    the last pauli of the search cancel across the diffusers)."""
     n, k = 16, 12
     marks = np.zeros(2**n, dtype=bool)
     marks[np.random.default_rng(0).choice(2**n, 12, replace=False)] = True
     circuit = circuits.aer_grover_circuit(marks, k)
     blocks = -(-n // 3)
-    per_iteration = (2 * 12 + 1) + 2 * blocks + 1
-    # H^n, k iterations, Z^n folded: one pauli before the first oracle and one at the end, n measures
-    assert len(circuit.data) == blocks + k * per_iteration + 2 + n
+    per_iteration = (2 * 12 - 1) + 2 * blocks + 1
+    # H^n, k iterations, the Z^n folded in (one pauli before the first oracle, one at the end), the
+    # first and the last X-string of the search, n measures
+    assert len(circuit.data) == blocks + k * per_iteration + 2 + 2 + n
     assert circuit.count_ops()["mcphase"] == k * (12 + 1)
     dense = np.random.default_rng(1).random(2**6) < 0.5
     compact = circuits.aer_grover_circuit(dense, k, measure=False)

@@ -12,9 +12,10 @@ identities that leave the unitary unchanged up to a global phase:
   ``block`` qubits (Aer's own gate fusion builds blocks of the same kind; a ``unitary``
   instruction costs Aer's assembler about what one ``h`` costs).
 - The oracle diag((-1)^marks) has two forms. ``"diagonal"``: one Aer ``diagonal`` instruction of
-  2^n phases. ``"mcz"``: per marked index one ``pauli`` X-string (bringing that index to |1...1>,
-  XOR-ed with the previous one) and one ``mcphase``; when more than half of the entries are marked,
-  the unmarked ones are flipped instead, times the global phase -1.
+  2^n phases. ``"mcz"``: per marked index one ``mcphase`` on |1...1>, with ``pauli`` X-strings between them
+  that bring each index to |1...1> (consecutive ones merged; successive oracle calls visit the
+  indices in alternating order so the strings at their ends cancel); when more than half of the
+  entries are marked, the unmarked ones are flipped instead, times the global phase -1.
 
 Why these forms (measured, ``benchmarks/bench_search.py``): Aer's Python assembler costs a few
 microseconds per instruction, far more than the arithmetic of a small state vector, while a
@@ -117,30 +118,41 @@ def simulation_synthesis(marks: np.ndarray) -> str:
     return "diagonal" if marks.shape[0] <= ENTRIES_PER_INSTRUCTION * (2 * flipped + 1) else "mcz"
 
 
-def _sparse_oracle(parts: _Parts, marks: np.ndarray) -> tuple[list, float]:
-    """The ``mcz`` form: X-strings and ``mcphase`` per flipped index; (instructions, global phase)."""
+def _sparse_oracles(parts: _Parts, marks: np.ndarray, iterations: int) -> tuple[list[list], float]:
+    """The ``mcz`` form of the k oracles: per oracle call one ``mcphase`` per flipped index i,
+    conjugated by X on the zero bits of i (which maps |i> to |1...1>); returns the instructions
+    to put before each iteration's diffuser, and the global phase of one oracle call.
+
+    Consecutive X-strings are merged (X^a X^b = X^(a xor b)). An X-string commutes with the
+    diffuser W MCZ W (W X^a W = Z^a, diagonal like MCZ), so an oracle's last X-string cancels the
+    next oracle's first one when the next oracle visits the indices in reverse order: the oracles
+    alternate forward and backward, and only the first and the last X-string of the whole search
+    remain (m - 1 X-strings per call instead of m + 1)."""
     n = parts.num_qubits
     flip_marked = 2 * int(np.count_nonzero(marks)) <= marks.shape[0]
-    indices = np.flatnonzero(marks if flip_marked else ~marks)
-    instructions = []
+    indices = np.flatnonzero(marks if flip_marked else ~marks).tolist()
+    phase = 0.0 if flip_marked else math.pi
+    if not indices:
+        return [[] for _ in range(iterations)], phase
     full = (1 << n) - 1
-    previous = 0
-    for index in indices.tolist():
-        wanted = ~index & full  # X on the zero bits maps |index> to |1...1>
-        mask = previous ^ wanted
-        if mask:
-            instructions.append(_x_string(parts, mask))
-        instructions.append(parts.reflection)
-        previous = wanted
-    if previous:
-        instructions.append(_x_string(parts, previous))
-    return instructions, (0.0 if flip_marked else math.pi)
+    wanted = [~index & full for index in indices]  # X on the zero bits maps |index> to |1...1>
+    forward = [parts.reflection]
+    for previous, current in zip(wanted, wanted[1:], strict=False):
+        forward += [*_x_string(parts, previous ^ current), parts.reflection]
+    backward = forward[::-1]
+    calls = [list(forward if call % 2 == 0 else backward) for call in range(iterations)]
+    calls[0][:0] = _x_string(parts, wanted[0])
+    calls[-1] += _x_string(parts, wanted[-1] if (iterations - 1) % 2 == 0 else wanted[0])
+    return calls, phase
 
 
-def _x_string(parts: _Parts, mask: int) -> CircuitInstruction:
-    """X on the qubits whose bit is set in ``mask`` (a ``PauliGate``; its label is big-endian)."""
+def _x_string(parts: _Parts, mask: int) -> list[CircuitInstruction]:
+    """X on the qubits whose bit is set in ``mask`` (one ``PauliGate``, whose label is big-endian;
+    none for mask 0)."""
+    if not mask:
+        return []
     label = "".join("X" if mask >> qubit & 1 else "I" for qubit in reversed(range(parts.num_qubits)))
-    return CircuitInstruction(PauliGate(label), parts.qubits)
+    return [CircuitInstruction(PauliGate(label), parts.qubits)]
 
 
 def aer_grover_circuit(
@@ -169,14 +181,14 @@ def aer_grover_circuit(
     if iterations:
         if synthesis == "diagonal":
             signs = np.where(marks, -1.0, 1.0)
-            first = [CircuitInstruction(_diagonal_gate(signs * parts.signs), parts.qubits)]
-            rest = [CircuitInstruction(_diagonal_gate(signs), parts.qubits)] if iterations > 1 else []
-            phase = 0.0
+            first = CircuitInstruction(_diagonal_gate(signs * parts.signs), parts.qubits)
+            rest = CircuitInstruction(_diagonal_gate(signs), parts.qubits) if iterations > 1 else None
+            calls, phase = [[first]] + [[rest]] * (iterations - 1), 0.0
         else:
-            rest, phase = _sparse_oracle(parts, marks)
-            first = [parts.parity, *rest]
-        for iteration in range(iterations):
-            for instruction in first if iteration == 0 else rest:
+            calls, phase = _sparse_oracles(parts, marks, iterations)
+            calls[0].insert(0, parts.parity)
+        for oracle in calls:
+            for instruction in oracle:
                 append(instruction)
             for instruction in parts.walsh:
                 append(instruction)
