@@ -2,7 +2,7 @@
 
 from . import circuits
 from .aer import AerBackend
-from .backend import QuantumSearchBackend, SearchResult
+from .backend import QuantumSearchBackend, SearchRequest, SearchResult
 from .problem import DatabaseSearch, SearchOutcome
 from .sampler import SamplerBackend
 from .statevector import StatevectorBackend
@@ -13,6 +13,7 @@ __all__ = [
     "QuantumSearchBackend",
     "SamplerBackend",
     "SearchOutcome",
+    "SearchRequest",
     "SearchResult",
     "StatevectorBackend",
     "circuits",
