@@ -8,9 +8,10 @@ the paper's gates. Each shot is an independent preparation, k Grover iterations 
 (``memory=True`` keeps them per shot).
 
 Threads: Aer parallelises a state update only from ``statevector_parallel_threshold`` (14) qubits
-on; below it, extra OpenMP threads only cost their start-up and synchronisation (measured: a
-1-qubit circuit took 40x longer with 2 threads than with 1 on a loaded 2-core machine), so circuits
-narrower than ``SERIAL_BELOW_QUBITS`` run on one thread whatever ``max_parallel_threads`` says.
+on; below it, extra OpenMP threads only cost their start-up and synchronisation (on a loaded
+2-core machine a 1-qubit circuit took many times longer with all cores than with one:
+``floor_all_threads`` in ``benchmarks/bench_search.py``), so circuits narrower than
+``SERIAL_BELOW_QUBITS`` run on one thread whatever ``max_parallel_threads`` says.
 """
 
 from __future__ import annotations

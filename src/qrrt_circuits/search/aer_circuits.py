@@ -17,11 +17,13 @@ identities that leave the unitary unchanged up to a global phase:
   indices in alternating order so the strings at their ends cancel); when more than half of the
   entries are marked, the unmarked ones are flipped instead, times the global phase -1.
 
-Why these forms (measured, ``benchmarks/bench_search.py``): Aer's Python assembler costs a few
-microseconds per instruction, far more than the arithmetic of a small state vector, while a
-``diagonal`` instruction costs per entry (qiskit stores each of its 2^n phases as a separate
-parameter, and Aer converts each one). ``simulation_synthesis`` picks the oracle form by that cost,
-separately from ``circuits.choose_synthesis``, which counts CX gates for hardware and is what
+Why these forms (profiled with cProfile on qiskit 2.6 / qiskit-aer 0.18; the resulting speed is
+measured by ``benchmarks/bench_search.py``): for small n, Aer's Python assembler and its
+per-instruction binding cost far more than the arithmetic on the state vector, so the circuit has
+as few instructions as possible; a ``diagonal`` instruction is cheap to call but costs per entry
+(qiskit's circuit and Aer's assembler handle each of its 2^n phases as a parameter), so
+``simulation_synthesis`` weighs 2^n entries against 2m + 1 instructions. That choice is separate
+from ``circuits.choose_synthesis``, which counts CX gates for hardware and is what
 ``resource_estimate`` uses.
 
 The parts that depend only on n (the W blocks, the ``mcphase``, the ``pauli`` Z^n,
@@ -49,16 +51,17 @@ AER_SYNTHESES = ("auto", "diagonal", "mcz")
 WALSH_HADAMARD_BLOCK = 3
 
 #: cost model of ``simulation_synthesis``: one phase of a ``diagonal`` instruction costs about
-#: 1/ENTRIES_PER_INSTRUCTION of one extra instruction (qiskit 2.6 / Aer 0.18: both forms cost the
-#: same at 2^n / (2m + 1) between about 100 and 200; ``benchmarks/bench_search.py`` reports both)
+#: 1/ENTRIES_PER_INSTRUCTION of one extra instruction (qiskit 2.6 / Aer 0.18, timed on a busy
+#: 2-core machine for n = 6..12, m = 1..16: the forms crossed over at 2^n / (2m + 1) between about
+#: 100 and 200; ``benchmarks/bench_search.py`` times both forms at n = 8 and 12 with m = 12)
 ENTRIES_PER_INSTRUCTION = 128
 
 
 def _diagonal_gate(phases: np.ndarray) -> DiagonalGate:
     """A ``DiagonalGate`` of ``phases`` (entries +-1) without its per-entry Python validation.
 
-    ``DiagonalGate(list)`` checks every entry in Python (about 1 microsecond each); the entries here
-    are +-1 by construction, so the gate is made from the list directly."""
+    ``DiagonalGate(list)`` checks every entry in Python; the entries here are +-1 by construction,
+    so the gate is made from the list directly (``Operator`` and Aer read the same list)."""
     gate = DiagonalGate.__new__(DiagonalGate)
     Gate.__init__(gate, "diagonal", int(phases.shape[0]).bit_length() - 1, [])
     gate._params = phases.astype(complex).tolist()
