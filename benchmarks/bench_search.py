@@ -4,7 +4,8 @@
 
 Against Aer's floor (n = 4, 8, 12, 16; ``--quick``: 4, 8, 12), m = 12 marked entries (4 at n = 4),
 k = 12 iterations, 8 shots, Aer on one thread; in each repeat, one after the other:
-- ``floor``: Aer's own floor, a 1-qubit circuit (h, measure) run with 8 shots;
+- ``floor``: Aer's own floor, a 1-qubit circuit (h, measure) run with 8 shots (and
+  ``floor_all_threads``: the same with Aer's default thread count, all cores);
 - ``ours``: ``AerBackend.search`` (the compact circuit of ``aer_grover_circuit``), and
   ``build`` its circuit construction alone (its share of the search);
 - ``gate_by_gate``: the previous implementation (``aer_literal_grover_circuit`` with the CX-based
@@ -65,8 +66,12 @@ def _contenders(n: int, marks: np.ndarray) -> dict:
                                memory=True).result()
         return [int(bits, 2) for bits in result.get_memory(0)]
 
+    all_threads = AerSimulator(method="statevector", max_parallel_threads=0)
     runs = {
         "floor": lambda: simulator.run(floor, shots=8, seed_simulator=1, memory=True).result(),
+        # the same 1-qubit circuit with Aer's default thread count (all cores), as AerBackend ran
+        # every circuit before it kept circuits under 14 qubits on one thread
+        "floor_all_threads": lambda: all_threads.run(floor, shots=8, seed_simulator=1, memory=True).result(),
         "ours": lambda: ours.search(marks, 12, shots=8),
         "build": lambda: circuits.aer_grover_circuit(marks, 12),
         "gate_by_gate": gate_by_gate,
