@@ -82,3 +82,24 @@ def test_unshared_pqrrt_round_searched_together_equals_one_by_one(policy, seed, 
     assert np.array_equal(together.parents, one_by_one.parents)
     assert together.metrics.as_dict() | {"wall_time_s": 0} == one_by_one.metrics.as_dict() | {"wall_time_s": 0}
     assert together.metrics.quantum_oracle_calls > 0
+
+
+def test_a_state_overriding_run_keeps_its_run_in_run_many(clutter):
+    """A user's policy state that overrides ``run`` (not ``run_many``) is not bypassed."""
+    from qrrt_circuits.search.policies import PolicyState
+
+    class OneIterationState(PolicyState):
+        calls = 0
+
+        def run(self, problem, workers, tree_nodes):
+            OneIterationState.calls += 1
+            return super().run(problem, workers, tree_nodes)
+
+    class OneIteration(qc.FixedIterations):
+        def start(self, num_items):
+            return OneIterationState(self, num_items)
+
+    planner = qc.PQRRT(clutter, backend=qc.StatevectorBackend(), num_qubits=4, workers=3, shared_database=False,
+                       search_policy=OneIteration(1), seed=0)
+    result = planner.plan(max_rounds=2)
+    assert OneIterationState.calls == 3 * result.metrics.rounds

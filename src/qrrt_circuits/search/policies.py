@@ -121,7 +121,10 @@ class PolicyState:
                  tree_nodes: int) -> tuple[tuple[SearchOutcome, ...], ...]:
         """``run`` on each of several independent databases of one round (unshared Pq-RRT), with
         all their searches handed to the backend at once (``QuantumSearchBackend.search_many``);
-        the outcomes are those of calling ``run`` on each database in turn."""
+        the outcomes are those of calling ``run`` on each database in turn. A state class that
+        overrides ``run`` but not ``run_many`` gets its own ``run`` on each database."""
+        if type(self).run is not PolicyState.run:
+            return tuple(self.run(problem, workers, tree_nodes) for problem in problems)
         iterations = [self.iterations_for(problem, tree_nodes) for problem in problems]
         requests = [problem.request(k, workers, problem.shared_seed())
                     for problem, k in zip(problems, iterations, strict=True)]
