@@ -1,18 +1,34 @@
-"""Time per Grover search for each backend, and reachability pairs per second.
+"""Time per Grover search for each backend, against Aer's floor, and reachability pairs per second.
 
     python benchmarks/bench_search.py [--quick] [--out FILE]
 
-Search: m = 12 marked entries (fewer for tiny N), k = 12 iterations, 8 shots (one shared database,
-8 workers); Aer for n = 4..16, the exact statevector for n = 4..20. Reachability: one core, batches
-of pairs on paper_clutter and annealing_field, for two pair distributions (``uniform``: a free
-parent and a uniform child anywhere; ``local``: child = parent + N(0, 1.5^2) per axis, like a
-database entry near its nearest tree node). Prints a table and writes JSON.
+Against Aer's floor (n = 4, 8, 12, 16; ``--quick``: 4, 8, 12), m = 12 marked entries (4 at n = 4),
+k = 12 iterations, 8 shots, Aer on one thread; in each repeat, one after the other:
+- ``floor``: Aer's own floor, a 1-qubit circuit (h, measure) run with 8 shots (and
+  ``floor_all_threads``: the same with Aer's default thread count, all cores);
+- ``ours``: ``AerBackend.search`` (the compact circuit of ``aer_grover_circuit``), and
+  ``build`` its circuit construction alone (its share of the search);
+- ``gate_by_gate``: the previous implementation (``aer_literal_grover_circuit`` with the CX-based
+  synthesis choice, bitstring memory parsing), for before/after figures from one run;
+- ``qiskit_algorithms``: qiskit-algorithms' ``Grover`` (12 iterations) with qiskit-aer's
+  ``SamplerV2`` (8 shots, one thread) and a preset pass manager for AerSimulator (n <= 12);
+- ``ours_diagonal`` / ``ours_mcz``: both oracle forms at n = 8 and 12, to check
+  ``simulation_synthesis``'s choice.
+Medians over the repeats (and the fastest repeat of each); every figure is also given as a ratio
+to the floor of the same run.
+
+Search table: Aer for n = 4..16, the exact statevector for n = 4..20. Reachability: one core,
+batches of pairs on paper_clutter and annealing_field, for two pair distributions (``uniform``: a
+free parent and a uniform child anywhere; ``local``: child = parent + N(0, 1.5^2) per axis, like a
+database entry near its nearest tree node). Prints tables and writes JSON.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import time
+import warnings
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
@@ -21,6 +37,112 @@ from _common import machine, median_time, write_json
 
 import qrrt_circuits as qc
 from qrrt_circuits.registry import BACKENDS
+from qrrt_circuits.search import circuits
+
+FLOOR_QUBITS = (4, 8, 12, 16)
+
+
+def _marks(n: int, rng: np.random.Generator) -> np.ndarray:
+    marks = np.zeros(2**n, dtype=bool)
+    marks[rng.choice(2**n, min(12, 2**n // 4), replace=False)] = True
+    return marks
+
+
+def _contenders(n: int, marks: np.ndarray) -> dict:
+    """name -> function running one search (k = 12, 8 shots) of ``marks``."""
+    from qiskit import QuantumCircuit
+    from qiskit_aer import AerSimulator
+
+    simulator = AerSimulator(method="statevector", max_parallel_threads=1)
+    floor = QuantumCircuit(1, 1)
+    floor.h(0)
+    floor.measure(0, 0)
+    ours = qc.AerBackend(seed=1, max_parallel_threads=1)
+    seeds = np.random.default_rng(2)
+
+    def gate_by_gate():  # the implementation before this benchmark's figures (same seeds per call)
+        circuit = circuits.aer_literal_grover_circuit(marks, 12, synthesis="auto")
+        result = simulator.run(circuit, shots=8, seed_simulator=int(seeds.integers(2**31 - 1)),
+                               memory=True).result()
+        return [int(bits, 2) for bits in result.get_memory(0)]
+
+    all_threads = AerSimulator(method="statevector", max_parallel_threads=0)
+    runs = {
+        "floor": lambda: simulator.run(floor, shots=8, seed_simulator=1, memory=True).result(),
+        # the same 1-qubit circuit with Aer's default thread count (all cores), as AerBackend ran
+        # every circuit before it kept circuits under 14 qubits on one thread
+        "floor_all_threads": lambda: all_threads.run(floor, shots=8, seed_simulator=1, memory=True).result(),
+        "ours": lambda: ours.search(marks, 12, shots=8),
+        "build": lambda: circuits.aer_grover_circuit(marks, 12),
+        "gate_by_gate": gate_by_gate,
+    }
+    if n in (8, 12):
+        for form in ("diagonal", "mcz"):
+            backend = qc.AerBackend(seed=1, max_parallel_threads=1, synthesis=form)
+            runs[f"ours_{form}"] = lambda b=backend: b.search(marks, 12, shots=8)
+    if n <= 12:
+        runs["qiskit_algorithms"] = _qiskit_algorithms_grover(n, marks)
+    return runs
+
+
+def _qiskit_algorithms_grover(n: int, marks: np.ndarray):
+    from qiskit import QuantumCircuit
+    from qiskit.circuit.library import DiagonalGate
+    from qiskit.transpiler import generate_preset_pass_manager
+    from qiskit_aer import AerSimulator
+    from qiskit_aer.primitives import SamplerV2
+    from qiskit_algorithms import AmplificationProblem, Grover
+
+    oracle = QuantumCircuit(n)
+    oracle.append(DiagonalGate(np.where(marks, -1.0, 1.0).tolist()), range(n))
+    problem = AmplificationProblem(oracle, is_good_state=[format(i, f"0{n}b") for i in np.flatnonzero(marks)])
+    pass_manager = generate_preset_pass_manager(optimization_level=1, backend=AerSimulator())
+    sampler = SamplerV2(seed=1, default_shots=8, options={"backend_options": {"max_parallel_threads": 1}})
+    grover = Grover(iterations=12, sampler=sampler, transpiler=pass_manager)
+
+    def run():
+        with warnings.catch_warnings():  # qiskit-algorithms 0.4 builds the deprecated GroverOperator
+            warnings.simplefilter("ignore", DeprecationWarning)
+            return grover.amplify(problem)
+
+    return run
+
+
+def bench_floor(quick: bool) -> list[dict]:
+    """Each contender's median time and its ratio to Aer's floor, measured interleaved."""
+    rows = []
+    rng = np.random.default_rng(0)
+    for n in FLOOR_QUBITS[:3] if quick else FLOOR_QUBITS:
+        marks = _marks(n, rng)
+        runs = _contenders(n, marks)
+        for run in runs.values():  # warm-up (imports, caches, the pass manager)
+            run()
+        repeats = (5 if quick else 30) if n <= 8 else (3 if quick else (12 if n == 12 else 5))
+        times = {name: [] for name in runs}
+        for _ in range(repeats):
+            for name, run in runs.items():
+                start = time.perf_counter()
+                run()
+                times[name].append(time.perf_counter() - start)
+        medians = {name: float(np.median(values)) for name, values in times.items()}
+        minimums = {name: float(np.min(values)) for name, values in times.items()}
+        floor = medians["floor"]
+        row = {"qubits": n, "marked": int(marks.sum()), "iterations": 12, "shots": 8, "repeats": repeats,
+               "synthesis": circuits.simulation_synthesis(marks),
+               "instructions": len(circuits.aer_grover_circuit(marks, 12).data),
+               "instructions_gate_by_gate": len(circuits.aer_literal_grover_circuit(marks, 12).data),
+               "median_ms": {name: value * 1e3 for name, value in medians.items()},
+               "ratio_to_floor": {name: value / floor for name, value in medians.items()},
+               # the fastest repeat of each: less sensitive to other processes on a busy machine
+               "min_ms": {name: value * 1e3 for name, value in minimums.items()},
+               "ratio_of_minimums_to_floor": {name: value / minimums["floor"] for name, value in minimums.items()},
+               "build_share": medians["build"] / medians["ours"]}
+        rows.append(row)
+        text = "  ".join(f"{name} {value * 1e3:8.3f} ms ({value / floor:6.1f}x)" for name, value in medians.items())
+        print(f"  n={n:2d} m={row['marked']:2d}  {text}  build share {row['build_share']:.1%}")
+        text = "  ".join(f"{name} {value:6.1f}x" for name, value in row["ratio_of_minimums_to_floor"].items())
+        print(f"        fastest repeats over the fastest floor: {text}")
+    return rows
 
 
 def bench_search(quick: bool) -> list[dict]:
@@ -73,6 +195,8 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--out", default=None)
     args = parser.parse_args()
+    print("Grover search against Aer's floor (k = 12, 8 shots, medians, ratio to the floor):")
+    floor = bench_floor(args.quick)
     print("Grover search, time per search (k = 12, 8 shots):")
     search = bench_search(args.quick)
     print("Reachability (one core):")
@@ -83,9 +207,18 @@ def main() -> None:
                "statevector_speedup_n12": aer12 / sv12 if aer12 and sv12 else None}
     sv20 = next((r["median_s"] for r in search if r["backend"] == "statevector" and r["qubits"] == 20), None)
     summary["statevector_n20_ms"] = sv20 and sv20 * 1e3
+    for row in floor:
+        n = row["qubits"]
+        summary[f"aer_floor_ms_n{n}"] = row["median_ms"]["floor"]
+        for name in ("ours", "gate_by_gate", "qiskit_algorithms"):
+            if name in row["ratio_to_floor"]:
+                summary[f"{name}_over_floor_n{n}"] = row["ratio_to_floor"][name]
+                summary[f"{name}_min_over_floor_min_n{n}"] = row["ratio_of_minimums_to_floor"][name]
+        summary[f"ours_ms_n{n}"] = row["median_ms"]["ours"]
+        summary[f"build_share_n{n}"] = row["build_share"]
     print("summary:", {k: (round(v, 3) if isinstance(v, float) else v) for k, v in summary.items()})
     path = write_json("bench_search" + ("_quick" if args.quick else ""),
-                      {"machine": machine(), "quick": args.quick, "search": search,
+                      {"machine": machine(), "quick": args.quick, "against_floor": floor, "search": search,
                        "reachability": reach, "summary": summary,
                        "note": "phase oracle built from a classical lookup of all 2^n marks; "
                                "one circuit with 8 shots stands for 8 workers"}, args.out)

@@ -15,13 +15,18 @@ Pq-RRT, unshared: each of the p workers builds and searches its own database (op
 ``executor``); all verified candidates are added.
 
 Both are one function, ``workers.search_database``, applied to groups of workers: one group of p
-for a shared database, p groups of one for unshared ones. The critical path of a round is the
+for a shared database, p groups of one for unshared ones. Without an executor, a round's databases
+are built in turn and their searches handed to the backend together
+(``search_databases_together``: ``PolicyState.run_many``, ``backend.search_many``), with the same
+outcomes. The critical path of a round is the
 largest number of oracle calls one worker made in it: the time of p parallel quantum devices.
 """
 
 from __future__ import annotations
 
 from concurrent.futures import Executor
+
+import numpy as np
 
 from ..database import AnnealingSchedule
 from ..dynamics import LinearTrackingDynamics
@@ -32,17 +37,41 @@ from ..predicate import ReachabilityPredicate
 from ..search.aer import AerBackend
 from ..search.backend import QuantumSearchBackend
 from ..search.policies import IterationPolicy, PaperSchedule
+from ..search.problem import DatabaseSearch
 from ..validation import check_bool, check_instance, check_int
 from .base import Planner
 from .classical import MAX_WORKERS
-from .context import WorkerContext, map_tasks
+from .context import RoundView, WorkerContext, map_tasks
 from .run_state import RunState
-from .workers import DatabaseOutcome, search_database
+from .workers import DatabaseOutcome, make_database, search_database
 
 ORACLE_LOOKUP_LABEL = (
     "simulation: the phase oracle is built from a classical lookup of all 2^n database entries "
     "(reported as simulation_checks, not as oracle calls)"
 )
+
+
+def search_databases_together(context: WorkerContext, view: RoundView,
+                              groups: list[tuple[int, int]]) -> list[DatabaseOutcome]:
+    """``search_database`` for every group of one round, with the databases' searches handed to
+    the search policy at once (``PolicyState.run_many``, hence ``backend.search_many``): the same
+    outcomes as searching them one by one, since every search draws its seed from the streams
+    keyed by (round, worker). Groups are (first worker, workers) with one worker count."""
+    if not groups:
+        return []
+    built = [make_database(context, view, first) for first, _ in groups]
+    problems = [DatabaseSearch(marks, truth, context.backend, context.streams, view.round_index, first)
+                for (_, truth, marks), (first, _) in zip(built, groups, strict=True)]
+    workers = groups[0][1]
+    if any(count != workers for _, count in groups):
+        raise ValueError("search_databases_together needs groups of one size")
+    outcomes = view.policy_state.run_many(problems, workers, view.tree_nodes)
+    results = []
+    for (db, truth, _), found_by in zip(built, outcomes, strict=True):
+        found = tuple(None if outcome.index is None else (db.children[outcome.index], int(db.parents[outcome.index]))
+                      for outcome in found_by)
+        results.append(DatabaseOutcome(int(truth.shape[0]), int(np.count_nonzero(truth)), found_by, found))
+    return results
 
 
 class PQRRT(Planner):
@@ -144,7 +173,10 @@ class PQRRT(Planner):
 
     def _round(self, state: RunState) -> None:
         view = self._view(state, self._temperature_index(state))
-        results = map_tasks(self.executor, search_database, state.context, view, self._worker_groups())
+        if self.executor is None:  # the round's searches go to the backend together (same outcomes)
+            results = search_databases_together(state.context, view, self._worker_groups())
+        else:
+            results = map_tasks(self.executor, search_database, state.context, view, self._worker_groups())
         longest = 0
         for result in results:
             longest = max(longest, self._integrate(state, result))

@@ -2,7 +2,7 @@
 
 from . import circuits
 from .aer import AerBackend
-from .backend import QuantumSearchBackend, SearchResult
+from .backend import QuantumSearchBackend, SearchRequest, SearchResult
 from .estimated_policy import EstimatedOptimal
 from .fixed_point import IterateSequence
 from .fixed_point_policy import FixedPointAmplification
@@ -19,6 +19,7 @@ __all__ = [
     "QuantumSearchBackend",
     "SamplerBackend",
     "SearchOutcome",
+    "SearchRequest",
     "SearchResult",
     "StatevectorBackend",
     "circuits",

@@ -1,21 +1,34 @@
 """Gate-level Grover search: real Qiskit circuits executed by qiskit-aer's ``AerSimulator``.
 
-The circuit (``aer_grover_circuit``) uses only instructions Aer executes natively (h, x, diagonal,
-mcphase, measure), so it is run without a per-call transpile. Each shot is an independent
-preparation, k Grover iterations and a measurement (``memory=True`` keeps them per shot).
+The circuit (``aer_grover_circuit``: Walsh-Hadamard blocks, the oracle as one ``diagonal`` or as
+``pauli`` + ``mcphase`` pairs, one ``mcphase`` per diffuser) uses only instructions Aer executes
+natively, so it is run without a per-call transpile; with a ``noise_model`` the gate-by-gate
+circuit (``aer_literal_grover_circuit``: h, x, mcphase) is run instead, so per-gate noise acts on
+the paper's gates. Each shot is an independent preparation, k Grover iterations and a measurement
+(``memory=True`` keeps them per shot).
+
+Threads: Aer parallelises a state update only from ``statevector_parallel_threshold`` (14) qubits
+on; below it, extra OpenMP threads only cost their start-up and synchronisation (on a loaded
+2-core machine a 1-qubit circuit took many times longer with all cores than with one:
+``floor_all_threads`` in ``benchmarks/bench_search.py``), so circuits narrower than
+``SERIAL_BELOW_QUBITS`` run on one thread whatever ``max_parallel_threads`` says.
 """
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 import numpy as np
 from qiskit_aer import AerSimulator
 
 from ..validation import check_int
-from .backend import QuantumSearchBackend, seed_stream
-from .circuits import SYNTHESES, aer_grover_circuit
+from .backend import QuantumSearchBackend, SearchRequest, SearchResult, seed_stream
+from .circuits import SYNTHESES, aer_grover_circuit, aer_literal_grover_circuit
 from .fixed_point import generalized_grover_circuit
 
 METHODS = ("statevector", "automatic")
+#: circuits on fewer qubits run single-threaded (Aer's default statevector_parallel_threshold)
+SERIAL_BELOW_QUBITS = 14
 #: methods AerSimulator offers that these circuits cannot run, and why (refused at construction)
 UNSUPPORTED_METHODS = {
     "density_matrix": "its instruction set lacks the mcphase gate of aer_grover_circuit (and it "
@@ -27,8 +40,12 @@ UNSUPPORTED_METHODS = {
 class AerBackend(QuantumSearchBackend):
     """Grover search on ``AerSimulator(method=...)``; seeded through ``seed_simulator``.
 
-    ``noise_model`` (a ``qiskit_aer.noise.NoiseModel``) is passed to the simulator as is;
-    ``device="GPU"`` needs Aer's GPU build. ``max_parallel_threads`` = 0 lets Aer use all cores.
+    ``noise_model`` (a ``qiskit_aer.noise.NoiseModel``) is passed to the simulator as is (and
+    selects the gate-by-gate circuit); ``device="GPU"`` needs Aer's GPU build.
+    ``max_parallel_threads`` = 0 lets Aer use all cores for circuits of ``SERIAL_BELOW_QUBITS`` or
+    more qubits; narrower ones run on one thread. ``synthesis``: the oracle's form, ``"auto"``
+    (``simulation_synthesis``, or with a noise model the CX-based ``choose_synthesis``),
+    ``"diagonal"`` or ``"mcz"``.
     """
 
     name = "aer"
@@ -42,9 +59,6 @@ class AerBackend(QuantumSearchBackend):
         device: str = "CPU",
         max_parallel_threads: int = 0,
     ) -> None:
-        for name, value in (("method", method), ("synthesis", synthesis), ("device", device)):
-            if not isinstance(value, str):
-                raise TypeError(f"{name} must be a string, got {value!r}")
         if method in UNSUPPORTED_METHODS:
             raise ValueError(f"method={method!r} is not supported: {UNSUPPORTED_METHODS[method]}")
         if method not in METHODS:
@@ -66,38 +80,68 @@ class AerBackend(QuantumSearchBackend):
             max_parallel_threads=int(max_parallel_threads),
         )
         self.device = device
+        self.max_parallel_threads = int(max_parallel_threads)
+        self._build = aer_grover_circuit if noise_model is None else aer_literal_grover_circuit
 
     @property
     def max_qubits(self) -> int:
         return int(self.simulator.configuration().n_qubits)
 
     #: calibrated on ``benchmarks/bench_memory.py`` (peak RSS of a round with many marked entries,
-    #: so the oracle is one DiagonalGate): the gate's 2^n phases as Python objects, Aer's complex128
-    #: state and its converted copy of the phases, then per iteration Aer's own copy of the oracle's
-    #: phases (the circuit appends the same gate k times; Aer converts each instance).
+    #: so the oracle is one diagonal): the oracle's 2^n phases, Aer's complex128 state and its
+    #: converted copy of the phases, then per iteration Aer's own copy of the oracle's phases (the
+    #: circuit appends the same gate k times; Aer converts each instance).
     AER_BYTES_PER_ENTRY = 240
     AER_BYTES_PER_ENTRY_PER_ITERATION = 80
-    #: per shot: the measured bitstring kept by ``memory=True`` and its conversion to an index
+    #: per shot: the measured word kept by ``memory=True`` and its conversion to an index
     BYTES_PER_SHOT = 200
 
     def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1) -> int:
-        """Upper bound of one search with the diagonal-gate oracle (the larger of the two
-        syntheses: ``mcz`` is chosen only when it has fewer gates than the diagonal's 2^n - 2 CX)."""
+        """Upper bound of one search with the diagonal oracle (the larger of the oracle forms)."""
         per_entry = self.AER_BYTES_PER_ENTRY + self.AER_BYTES_PER_ENTRY_PER_ITERATION * iterations
         return (per_entry << num_qubits) + self.BYTES_PER_SHOT * shots
 
+    def threads_for(self, num_qubits: int) -> int:
+        """The ``max_parallel_threads`` a circuit on ``num_qubits`` qubits runs with."""
+        return 1 if num_qubits < SERIAL_BELOW_QUBITS else self.max_parallel_threads
+
+    def _submit(self, marks, num_qubits, iterations, shots, rng):
+        """Build the circuit and start its Aer job (Aer runs jobs on its own worker thread)."""
+        circuit = self._build(marks, iterations, measure=True, synthesis=self.synthesis)
+        seed = int(rng.integers(0, 2**31 - 1))
+        return self.simulator.run(circuit, shots=shots, seed_simulator=seed, memory=True,
+                                  max_parallel_threads=self.threads_for(num_qubits))
+
     def _sample(self, marks, num_qubits, iterations, shots, rng) -> np.ndarray:
-        circuit = aer_grover_circuit(marks, iterations, measure=True, synthesis=self.synthesis)
-        return self._execute(circuit, shots, rng)
+        return _measured_indices(self._submit(marks, num_qubits, iterations, shots, rng).result(), 0)
 
     def _sample_sequence(self, marks, num_qubits, sequence, shots, rng) -> np.ndarray:
+        """Fixed-point amplification: the generalized iterates of ``sequence`` as one circuit."""
         circuit = generalized_grover_circuit(marks, sequence, measure=True, synthesis=self.synthesis)
-        return self._execute(circuit, shots, rng)
-
-    def _execute(self, circuit, shots, rng) -> np.ndarray:
         seed = int(rng.integers(0, 2**31 - 1))
-        result = self.simulator.run(circuit, shots=shots, seed_simulator=seed, memory=True).result()
-        if not result.success:
-            raise RuntimeError(f"AerSimulator failed: {result.status}")
-        memory = result.get_memory(0)
-        return np.fromiter((int(bits, 2) for bits in memory), dtype=np.int64, count=len(memory))
+        job = self.simulator.run(circuit, shots=shots, seed_simulator=seed, memory=True,
+                                 max_parallel_threads=self.threads_for(num_qubits))
+        return _measured_indices(job.result(), 0)
+
+    def search_many(self, requests: Sequence[SearchRequest]) -> tuple[SearchResult, ...]:
+        """Submit every request's job before waiting for the first: Aer simulates job i on its
+        worker thread while this thread builds circuit i + 1. Results are identical to searching
+        one by one (each circuit keeps its own ``seed_simulator``).
+
+        Why not one job with all circuits: in a multi-circuit job Aer seeds circuit i with
+        ``seed_simulator + 2113 i`` (qiskit-aer 0.18.2, checked by ``test_backends``), and
+        ``seed_simulator`` takes one integer, so a single job cannot give each database the seed it
+        gets when searched alone: the planners' results would change."""
+        prepared = [self._prepare(request) for request in requests]
+        jobs = [self._submit(*item) for item in prepared]
+        return tuple(self._finish(item, _measured_indices(job.result(), 0))
+                     for item, job in zip(prepared, jobs, strict=True))
+
+
+def _measured_indices(result, experiment: int) -> np.ndarray:
+    """The measured indices of one experiment, from Aer's per-shot memory (hexadecimal strings
+    of the classical register, so no bitstring formatting per shot)."""
+    if not result.success:
+        raise RuntimeError(f"AerSimulator failed: {result.status}")
+    memory = result.results[experiment].data.memory
+    return np.fromiter((int(word, 16) for word in memory), dtype=np.int64, count=len(memory))

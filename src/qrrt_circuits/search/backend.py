@@ -17,6 +17,7 @@ each iterate queries the oracle once, so ``oracle_calls = len(sequence) * shots`
 from __future__ import annotations
 
 import abc
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -38,6 +39,16 @@ class SearchResult:
         indices = np.asarray(self.indices, dtype=np.int64)
         indices.setflags(write=False)
         object.__setattr__(self, "indices", indices)
+
+
+@dataclass(frozen=True, eq=False)
+class SearchRequest:
+    """One search of ``QuantumSearchBackend.search_many``: the arguments of one ``search`` call."""
+
+    marks: np.ndarray
+    iterations: int
+    shots: int = 1
+    seed: int | None = None
 
 
 def validate_marks(marks: np.ndarray) -> tuple[np.ndarray, int]:
@@ -97,13 +108,31 @@ class QuantumSearchBackend(abc.ABC):
         ``seed`` seeds this call only (planners pass one per round and worker, so their results do
         not depend on the order of calls); by default the backend's own stream is used.
         """
-        marks, num_qubits = validate_marks(marks)
-        iterations = validate_iterations(iterations)
-        shots = validate_shots(shots)
+        prepared = self._prepare(SearchRequest(marks, iterations, shots, seed))
+        return self._finish(prepared, self._sample(*prepared))
+
+    def search_many(self, requests: Sequence[SearchRequest]) -> tuple[SearchResult, ...]:
+        """Independent searches (the p databases of one unshared Pq-RRT round): result i is exactly
+        what ``search(marks, iterations, shots, seed)`` of request i returns when the requests are
+        searched one after the other (same seeds, same measured indices). Every request is
+        validated before any search runs. A backend may run them together (``AerBackend``)."""
+        prepared = [self._prepare(request) for request in requests]
+        return tuple(self._finish(item, self._sample(*item)) for item in prepared)
+
+    def _prepare(self, request: SearchRequest):
+        """(marks, n, iterations, shots, rng) of one validated request."""
+        if not isinstance(request, SearchRequest):
+            raise TypeError(f"requests must be SearchRequest objects, got {type(request).__name__}")
+        marks, num_qubits = validate_marks(request.marks)
+        iterations = validate_iterations(request.iterations)
+        shots = validate_shots(request.shots)
         self.check_qubits(num_qubits)
         self.check_memory(num_qubits, shots, iterations)
-        rng = self._rng if seed is None else seed_stream(seed)
-        indices = self._sample(marks, num_qubits, iterations, shots, rng)
+        return marks, num_qubits, iterations, shots, self._rng if request.seed is None else seed_stream(request.seed)
+
+    @staticmethod
+    def _finish(prepared, indices: np.ndarray) -> SearchResult:
+        _, _, iterations, shots, _ = prepared
         return SearchResult(indices, iterations, shots, iterations * shots)
 
     #: generic footprint of one search (subclasses report their own, calibrated): a complex128 state

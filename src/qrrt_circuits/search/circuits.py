@@ -7,8 +7,12 @@ Index i of the database is the computational basis state ``|i>`` in Qiskit's lit
 - ``grover_circuit(marks, k)``: W = H^n on ``|0>``, then k applications of
   Q = grover_operator(oracle, W), then measurement. After k iterations the probability of a
   marked index is sin^2((2k+1) theta), sin^2 theta = m / 2^n (Lemma 1).
-- ``aer_grover_circuit(marks, k)``: the same unitary (up to a global phase) written only with
-  gates AerSimulator executes natively (h, x, diagonal, mcphase), so no transpile is needed.
+- ``aer_grover_circuit(marks, k)`` (defined in ``aer_circuits``): the same unitary (up to a global
+  phase) written with few instructions AerSimulator executes natively (unitary Walsh-Hadamard
+  blocks, diagonal or pauli + mcphase oracles, mcphase), so no transpile is needed; its oracle form
+  is chosen for simulation speed (``simulation_synthesis``), not by CX count.
+- ``aer_literal_grover_circuit(marks, k)``: the same circuit gate by gate (h, x, mcphase and the
+  hardware oracle), for noisy simulation, where a noise model acts per gate.
 - ``resource_estimate(marks, k)``: qubits, CX count and depth in the basis [cx, rz, sx, x].
 """
 
@@ -22,7 +26,24 @@ import numpy as np
 from qiskit import QuantumCircuit, transpile
 from qiskit.circuit.library import DiagonalGate, grover_operator
 
+from .aer_circuits import aer_grover_circuit, simulation_synthesis
 from .backend import validate_iterations, validate_marks
+
+__all__ = [
+    "BASIS_GATES",
+    "SYNTHESES",
+    "ResourceCount",
+    "ResourceEstimate",
+    "aer_grover_circuit",
+    "aer_literal_grover_circuit",
+    "choose_synthesis",
+    "grover_circuit",
+    "oracle_cx_estimate",
+    "phase_oracle",
+    "resource_estimate",
+    "simulation_synthesis",
+    "uniform_preparation",
+]
 
 SYNTHESES = ("auto", "diagonal", "mcz")
 BASIS_GATES = ("cx", "rz", "sx", "x")
@@ -85,6 +106,8 @@ def oracle_cx_estimate(num_qubits: int, num_marked: int) -> dict[str, int]:
 
 
 def choose_synthesis(marks: np.ndarray) -> str:
+    """The synthesis with the fewer estimated CX gates (hardware cost; ``resource_estimate`` and
+    ``phase_oracle(synthesis="auto")`` use it). Aer's circuits use ``simulation_synthesis``."""
     marks, n = validate_marks(marks)
     estimate = oracle_cx_estimate(n, int(np.count_nonzero(marks)))
     return "mcz" if estimate["mcz"] < estimate["diagonal"] else "diagonal"
@@ -116,12 +139,15 @@ def grover_circuit(
     return circuit
 
 
-def aer_grover_circuit(
+def aer_literal_grover_circuit(
     marks: np.ndarray, iterations: int, measure: bool = True, synthesis: str = "auto"
 ) -> QuantumCircuit:
-    """The Grover circuit from Aer-native gates only: H^n, then per iteration the oracle followed by
-    the diffuser H^n X^n MCZ X^n H^n (= -(2|s><s| - I)); equal to ``grover_circuit`` up to a
-    global phase."""
+    """The Grover circuit gate by gate from Aer-native gates, for noisy simulation: H^n, then per
+    iteration the oracle (``phase_oracle``: CX-based ``synthesis`` choice, as on hardware) followed
+    by the diffuser H^n X^n MCZ X^n H^n (= -(2|s><s| - I)); equal to ``grover_circuit`` up to a
+    global phase. A noise model attached to h, x or mcphase acts on every such gate of the paper's
+    circuit (``aer_grover_circuit`` merges them into fewer instructions, which is faster but would
+    change where such noise applies)."""
     marks, n = validate_marks(marks)
     iterations = validate_iterations(iterations)
     oracle = phase_oracle(marks, synthesis)

@@ -10,6 +10,9 @@ given a database (its search, its verification and its size), run ``workers`` wo
 and return one frozen outcome per worker: the verified index or None, the quantum oracle calls and
 verifications spent, and observations for learning policies. After the round the planner hands
 all outcomes back with ``state.learn(outcomes)``. The planner never asks which policy it has.
+``state.run_many(problems, workers, tree_nodes)`` answers the same for the independent databases
+of one round (unshared Pq-RRT): by default their searches go to the backend together
+(``search_many``), with the outcomes ``run`` gives on each; ``BBHT`` runs them in turn.
 
 Policies that pick one k before measuring (``PaperSchedule``, ``FixedIterations``,
 ``KnownOptimal``, ``Adaptive``) share the default ``run``: one backend search with ``shots =
@@ -35,14 +38,14 @@ of a shared database, overrides ``run`` the same way.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..probability import optimal_iterations
 from ..validation import check_choice, check_float, check_int, check_optional_int
-from .problem import DatabaseSearch, SearchOutcome
+from .problem import DatabaseSearch, SearchOutcome, search_together
 
 __all__ = [
     "BBHT",
@@ -122,11 +125,22 @@ class PolicyState:
         """``workers`` workers search ``problem``: one backend search with ``shots = workers``,
         then each worker verifies its own measurement (k quantum calls + 1 verification each)."""
         k = self.iterations_for(problem, tree_nodes)
-        outcomes = []
-        for measured in problem.search(k, workers, problem.shared_seed()):
-            good = problem.verify(int(measured))
-            outcomes.append(SearchOutcome(int(measured) if good else None, k, 1, ((k, good),)))
-        return tuple(outcomes)
+        return _verified(problem, k, problem.search(k, workers, problem.shared_seed()))
+
+    def run_many(self, problems: Sequence[DatabaseSearch], workers: int,
+                 tree_nodes: int) -> tuple[tuple[SearchOutcome, ...], ...]:
+        """``run`` on each of several independent databases of one round (unshared Pq-RRT), with
+        all their searches handed to the backend at once (``QuantumSearchBackend.search_many``);
+        the outcomes are those of calling ``run`` on each database in turn. A state class that
+        overrides ``run`` but not ``run_many`` gets its own ``run`` on each database."""
+        if type(self).run is not PolicyState.run:
+            return tuple(self.run(problem, workers, tree_nodes) for problem in problems)
+        iterations = [self.iterations_for(problem, tree_nodes) for problem in problems]
+        requests = [problem.request(k, workers, problem.shared_seed())
+                    for problem, k in zip(problems, iterations, strict=True)]
+        results = search_together(problems, requests)
+        return tuple(_verified(problem, k, result.indices)
+                     for problem, k, result in zip(problems, iterations, results, strict=True))
 
     def observe(self, iterations: int, success: bool) -> None:
         """Record that a measurement after ``iterations`` iterations verified (or not)."""
@@ -136,6 +150,15 @@ class PolicyState:
         for outcome in outcomes:
             for iterations, success in outcome.observations:
                 self.observe(iterations, success)
+
+
+def _verified(problem: DatabaseSearch, k: int, measured: np.ndarray) -> tuple[SearchOutcome, ...]:
+    """Each worker verifies its own measured index (k quantum calls + 1 verification each)."""
+    outcomes = []
+    for index in measured:
+        good = problem.verify(int(index))
+        outcomes.append(SearchOutcome(int(index) if good else None, k, 1, ((k, good),)))
+    return tuple(outcomes)
 
 
 def _check_iteration_count(value, name: str) -> int:
@@ -289,6 +312,11 @@ class BBHTState(PolicyState):
             found = self.policy.run(search, problem.verify, problem.num_items, rng)
             outcomes.append(SearchOutcome(found.index, found.iterations, found.verifications, found.attempts))
         return tuple(outcomes)
+
+    def run_many(self, problems: Sequence[DatabaseSearch], workers: int,
+                 tree_nodes: int) -> tuple[tuple[SearchOutcome, ...], ...]:
+        """Each database in turn: a BBHT worker's next search depends on its previous outcome."""
+        return tuple(self.run(problem, workers, tree_nodes) for problem in problems)
 
 
 @dataclass(frozen=True)

@@ -16,12 +16,13 @@ observations ``(iterations, verified)`` for learning policies.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..randomness import RandomStreams, Stream
-from .backend import QuantumSearchBackend
+from .backend import QuantumSearchBackend, SearchRequest, SearchResult
 
 
 @dataclass(frozen=True)
@@ -74,6 +75,10 @@ class DatabaseSearch:
         ``IterateSequence``: fixed-point amplification), len(sequence) oracle calls per shot."""
         return self.backend.search_sequence(self.marks, sequence, shots, seed=seed).indices
 
+    def request(self, iterations: int, shots: int, seed: int) -> SearchRequest:
+        """``search``'s arguments as a request for ``search_together``."""
+        return SearchRequest(self.marks, iterations, shots, seed)
+
     def verify(self, index: int) -> bool:
         """The classical finalizer: is entry ``index`` truly reachable? (1 oracle call.)"""
         return bool(self.truth[index])
@@ -89,3 +94,13 @@ class DatabaseSearch:
     def worker_generator(self, offset: int) -> np.random.Generator:
         """The policy's own generator for worker ``first_worker + offset``."""
         return self.streams.generator(self.round_index, self.first_worker + offset, Stream.POLICY)
+
+
+def search_together(problems: Sequence[DatabaseSearch], requests: Sequence[SearchRequest]) -> tuple[SearchResult, ...]:
+    """One request per database, all handed to their (common) backend's ``search_many``."""
+    if not problems:
+        return ()
+    backend = problems[0].backend
+    if any(problem.backend is not backend for problem in problems):
+        raise ValueError("search_together needs databases searched by one backend")
+    return backend.search_many(requests)

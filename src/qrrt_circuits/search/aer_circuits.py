@@ -1,0 +1,206 @@
+"""The Grover circuit as AerSimulator runs it: few Aer-native instructions, cheap to build.
+
+What Aer is given is the circuit of ``grover_circuit`` (paper Alg. 2, lines 4-8), rewritten with
+identities that leave the unitary unchanged up to a global phase:
+
+- The diffuser D = H^n X^n MCZ X^n H^n equals Z^n D' Z^n with D' = H^n MCZ H^n (because
+  X H = H Z). Between two iterations the trailing Z^n of one diffuser, the next oracle O and the
+  leading Z^n of the next diffuser are all diagonal, so Z^n O Z^n = O: the X layers disappear,
+  one Z^n is folded into the first oracle and one Z^n (a single ``pauli`` instruction) is left at
+  the end. Per iteration Aer runs: the oracle, W, one ``mcphase``, W.
+- W = H^n is applied as Walsh-Hadamard blocks ``UnitaryGate(H^{(x)b})`` on groups of at most
+  ``block`` qubits (Aer's own gate fusion builds blocks of the same kind; a ``unitary``
+  instruction costs Aer's assembler about what one ``h`` costs).
+- The oracle diag((-1)^marks) has two forms. ``"diagonal"``: one Aer ``diagonal`` instruction of
+  2^n phases. ``"mcz"``: per marked index one ``mcphase`` on |1...1>, with ``pauli`` X-strings between them
+  that bring each index to |1...1> (consecutive ones merged; successive oracle calls visit the
+  indices in alternating order so the strings at their ends cancel); when more than half of the
+  entries are marked, the unmarked ones are flipped instead, times the global phase -1.
+
+Why these forms (profiled with cProfile on qiskit 2.6 / qiskit-aer 0.18; the resulting speed is
+measured by ``benchmarks/bench_search.py``): for small n, Aer's Python assembler and its
+per-instruction binding cost far more than the arithmetic on the state vector, so the circuit has
+as few instructions as possible; a ``diagonal`` instruction is cheap to call but costs per entry
+(qiskit's circuit and Aer's assembler handle each of its 2^n phases as a parameter), so
+``simulation_synthesis`` weighs 2^n entries against 2m + 1 instructions. That choice is separate
+from ``circuits.choose_synthesis``, which counts CX gates for hardware and is what
+``resource_estimate`` uses.
+
+The parts that depend only on n (the W blocks, the ``mcphase``, the ``pauli`` Z^n,
+the measurements, as ``CircuitInstruction`` objects) are built once per n and reused; per search
+only the oracle's instructions are new, built from numpy arrays without per-entry Python work.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+from qiskit import QuantumCircuit
+from qiskit.circuit import CircuitInstruction, Gate, Measure
+from qiskit.circuit.library import DiagonalGate, MCPhaseGate, PauliGate, PhaseGate, UnitaryGate
+
+from ..validation import check_int
+from .backend import validate_iterations, validate_marks
+
+AER_SYNTHESES = ("auto", "diagonal", "mcz")
+
+#: the largest group of qubits one Walsh-Hadamard block acts on: 3 was the fastest of 1..5 for
+#: n = 6..16 (wider blocks cost more arithmetic per amplitude, narrower more instructions)
+WALSH_HADAMARD_BLOCK = 3
+
+#: cost model of ``simulation_synthesis``: one phase of a ``diagonal`` instruction costs about
+#: 1/ENTRIES_PER_INSTRUCTION of one extra instruction (qiskit 2.6 / Aer 0.18, timed on a busy
+#: 2-core machine for n = 6..12, m = 1..16: the forms crossed over at 2^n / (2m + 1) between about
+#: 100 and 200; ``benchmarks/bench_search.py`` times both forms at n = 8 and 12 with m = 12)
+ENTRIES_PER_INSTRUCTION = 128
+
+
+def _diagonal_gate(phases: np.ndarray) -> DiagonalGate:
+    """A ``DiagonalGate`` of ``phases`` (entries +-1) without its per-entry Python validation.
+
+    ``DiagonalGate(list)`` checks every entry in Python; the entries here are +-1 by construction,
+    so the gate is made from the list directly (``Operator`` and Aer read the same list)."""
+    gate = DiagonalGate.__new__(DiagonalGate)
+    Gate.__init__(gate, "diagonal", int(phases.shape[0]).bit_length() - 1, [])
+    gate._params = phases.astype(complex).tolist()
+    return gate
+
+
+def parity_signs(num_qubits: int) -> np.ndarray:
+    """(-1)^popcount(i) for i = 0 .. 2^n - 1: the diagonal of Z^n."""
+    index = np.arange(1 << num_qubits, dtype=np.int64)
+    parity = np.zeros_like(index)
+    for bit in range(num_qubits):
+        parity ^= (index >> bit) & 1
+    return 1.0 - 2.0 * parity
+
+
+def _walsh_hadamard(size: int) -> UnitaryGate:
+    hadamard = np.array([[1.0, 1.0], [1.0, -1.0]]) / math.sqrt(2.0)
+    matrix = np.ones((1, 1))
+    for _ in range(size):
+        matrix = np.kron(matrix, hadamard)
+    return UnitaryGate(matrix, label=f"W{size}")
+
+
+class _Parts:
+    """The instructions of one register width n that no search changes (built once per n)."""
+
+    def __init__(self, num_qubits: int, block: int) -> None:
+        self.num_qubits = n = num_qubits
+        template = QuantumCircuit(n, n, name="grover_aer")
+        self.qubits = qubits = template.qubits
+        self.clbits = template.clbits
+        self.qregs, self.cregs = template.qregs, template.cregs
+        walsh = []
+        for start in range(0, n, block):
+            group = qubits[start:start + block]
+            walsh.append(CircuitInstruction(_walsh_hadamard(len(group)), group))
+        self.walsh = tuple(walsh)
+        reflection = PhaseGate(math.pi) if n == 1 else MCPhaseGate(math.pi, n - 1)
+        self.reflection = CircuitInstruction(reflection, qubits)
+        self.parity = CircuitInstruction(PauliGate("Z" * n), qubits)
+        self.measures = tuple(CircuitInstruction(Measure(), (qubit,), (clbit,))
+                              for qubit, clbit in zip(qubits, self.clbits, strict=True))
+        self.signs = parity_signs(n)
+
+
+@functools.lru_cache(maxsize=32)
+def _parts(num_qubits: int, block: int) -> _Parts:
+    return _Parts(num_qubits, block)
+
+
+def simulation_synthesis(marks: np.ndarray) -> str:
+    """The oracle form Aer runs fastest (``"diagonal"`` or ``"mcz"``): a ``diagonal`` costs its
+    2^n entries, the ``mcz`` form two instructions per flipped entry (min(m, N - m) of them)."""
+    marks, n = validate_marks(marks)
+    marked = int(np.count_nonzero(marks))
+    flipped = min(marked, marks.shape[0] - marked)
+    return "diagonal" if marks.shape[0] <= ENTRIES_PER_INSTRUCTION * (2 * flipped + 1) else "mcz"
+
+
+def _sparse_oracles(parts: _Parts, marks: np.ndarray, iterations: int) -> tuple[list[list], float]:
+    """The ``mcz`` form of the k oracles: per oracle call one ``mcphase`` per flipped index i,
+    conjugated by X on the zero bits of i (which maps |i> to |1...1>); returns the instructions
+    to put before each iteration's diffuser, and the global phase of one oracle call.
+
+    Consecutive X-strings are merged (X^a X^b = X^(a xor b)). An X-string commutes with the
+    diffuser W MCZ W (W X^a W = Z^a, diagonal like MCZ), so an oracle's last X-string cancels the
+    next oracle's first one when the next oracle visits the indices in reverse order: the oracles
+    alternate forward and backward, and only the first and the last X-string of the whole search
+    remain (m - 1 X-strings per call instead of m + 1)."""
+    n = parts.num_qubits
+    flip_marked = 2 * int(np.count_nonzero(marks)) <= marks.shape[0]
+    indices = np.flatnonzero(marks if flip_marked else ~marks).tolist()
+    phase = 0.0 if flip_marked else math.pi
+    if not indices:
+        return [[] for _ in range(iterations)], phase
+    full = (1 << n) - 1
+    wanted = [~index & full for index in indices]  # X on the zero bits maps |index> to |1...1>
+    forward = [parts.reflection]
+    for previous, current in zip(wanted, wanted[1:], strict=False):
+        forward += [*_x_string(parts, previous ^ current), parts.reflection]
+    backward = forward[::-1]
+    calls = [list(forward if call % 2 == 0 else backward) for call in range(iterations)]
+    calls[0][:0] = _x_string(parts, wanted[0])
+    calls[-1] += _x_string(parts, wanted[-1] if (iterations - 1) % 2 == 0 else wanted[0])
+    return calls, phase
+
+
+def _x_string(parts: _Parts, mask: int) -> list[CircuitInstruction]:
+    """X on the qubits whose bit is set in ``mask`` (one ``PauliGate``, whose label is big-endian;
+    none for mask 0)."""
+    if not mask:
+        return []
+    label = "".join("X" if mask >> qubit & 1 else "I" for qubit in reversed(range(parts.num_qubits)))
+    return [CircuitInstruction(PauliGate(label), parts.qubits)]
+
+
+def aer_grover_circuit(
+    marks: np.ndarray, iterations: int, measure: bool = True, synthesis: str = "auto",
+    block: int = WALSH_HADAMARD_BLOCK,
+) -> QuantumCircuit:
+    """W|0>, ``iterations`` Grover iterations and (if ``measure``) measurement into the classical
+    register ``c`` (n bits, little-endian as ``grover_circuit``'s ``meas``), from Aer-native
+    instructions only; the same unitary as ``grover_circuit`` up to a global phase.
+
+    ``synthesis``: the oracle's form, ``"diagonal"``, ``"mcz"`` or ``"auto"``
+    (``simulation_synthesis``); ``block``: the widest Walsh-Hadamard block (1 gives single-qubit
+    ones)."""
+    marks, n = validate_marks(marks)
+    iterations = validate_iterations(iterations)
+    if synthesis not in AER_SYNTHESES:
+        raise ValueError(f"synthesis must be one of {AER_SYNTHESES}, got {synthesis!r}")
+    block = check_int(block, "block", 1, 10)
+    if synthesis == "auto":
+        synthesis = simulation_synthesis(marks)
+    parts = _parts(n, block)
+    circuit = QuantumCircuit(*parts.qregs, *(parts.cregs if measure else ()), name="grover_aer")
+    append = circuit._append
+    for instruction in parts.walsh:
+        append(instruction)
+    if iterations:
+        if synthesis == "diagonal":
+            signs = np.where(marks, -1.0, 1.0)
+            first = CircuitInstruction(_diagonal_gate(signs * parts.signs), parts.qubits)
+            rest = CircuitInstruction(_diagonal_gate(signs), parts.qubits) if iterations > 1 else None
+            calls, phase = [[first]] + [[rest]] * (iterations - 1), 0.0
+        else:
+            calls, phase = _sparse_oracles(parts, marks, iterations)
+            calls[0].insert(0, parts.parity)
+        for oracle in calls:
+            for instruction in oracle:
+                append(instruction)
+            for instruction in parts.walsh:
+                append(instruction)
+            append(parts.reflection)
+            for instruction in parts.walsh:
+                append(instruction)
+        append(parts.parity)
+        circuit.global_phase = phase * iterations
+    if measure:
+        for instruction in parts.measures:
+            append(instruction)
+    return circuit
