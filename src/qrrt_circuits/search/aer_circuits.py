@@ -79,7 +79,7 @@ def parity_signs(num_qubits: int) -> np.ndarray:
 
 def _walsh_hadamard(size: int) -> UnitaryGate:
     hadamard = np.array([[1.0, 1.0], [1.0, -1.0]]) / math.sqrt(2.0)
-    matrix = np.ones((1, 1))
+    matrix: np.ndarray = np.ones((1, 1))
     for _ in range(size):
         matrix = np.kron(matrix, hadamard)
     return UnitaryGate(matrix, label=f"W{size}")
