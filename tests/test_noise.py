@@ -100,6 +100,10 @@ def test_bad_input_is_refused():
         depolarizing_backend(0.0, -0.1)
     with pytest.raises(ValueError, match="method"):
         depolarizing_backend(0.0, 0.0, method="mps")
+
+
+def test_unknown_fake_device_is_refused():
+    pytest.importorskip("qiskit_ibm_runtime")
     with pytest.raises(ValueError, match="device"):
         noise.fake_device("FakeMelbourne")
 

@@ -59,6 +59,9 @@ class AerBackend(QuantumSearchBackend):
         device: str = "CPU",
         max_parallel_threads: int = 0,
     ) -> None:
+        for name, value in (("method", method), ("synthesis", synthesis), ("device", device)):
+            if not isinstance(value, str):
+                raise TypeError(f"{name} must be a string, got {value!r}")
         if method in UNSUPPORTED_METHODS:
             raise ValueError(f"method={method!r} is not supported: {UNSUPPORTED_METHODS[method]}")
         if method not in METHODS:
