@@ -67,6 +67,14 @@ def test_killed_dask_worker_is_rescheduled(dask_client, tmp_path):
     dask_client.wait_for_workers(2, timeout=60)
 
 
+def _is_pool_worker(process) -> bool:
+    """A spawned worker, or one forked by the fork server (not the server itself)."""
+    if any("spawn_main" in part for part in process.cmdline()):
+        return True
+    parent = process.parent()
+    return parent is not None and any("forkserver" in part for part in parent.cmdline())
+
+
 def test_killed_process_pool_worker_is_replaced(tmp_path):
     before = {p.pid for p in psutil.Process().children(recursive=True)}
     killed, restarts = [], []
@@ -76,7 +84,7 @@ def test_killed_process_pool_worker_is_replaced(tmp_path):
             return
         for process in psutil.Process().children(recursive=True):
             try:
-                is_worker = any("spawn_main" in part for part in process.cmdline())
+                is_worker = _is_pool_worker(process)
             except psutil.NoSuchProcess:
                 continue
             if process.pid not in before and is_worker:
