@@ -1,15 +1,20 @@
 """Speed-up of ``qrrt reproduce EXPERIMENT --quick`` on 2 jobs over serial.
 
-    python benchmarks/bench_scaleout.py [--experiment heatmaps] [--repeats 3] [--jobs 2] [--full]
+    python benchmarks/bench_scaleout.py [--experiment heatmaps] [--repeats 3] [--jobs 2] [--full] [--quick]
 
 Runs the real command line (a fresh ``--out`` each time, so nothing is resumed), end to end
 including interpreter start, cluster start and worker imports, and reports median wall seconds
-and the ratio serial / parallel measured in the same run. Writes JSON.
+and the ratio serial / parallel measured in the same run, and the CPU seconds of the whole process
+tree (client, fork server, workers): on a machine shared with other work the wall-clock ratio
+moves with the load, the CPU seconds much less. ``--quick`` runs each command once. Writes JSON
+with flat ``figures`` for ``benchmarks/run.py``.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import resource
 import shutil
 import subprocess
 import sys
@@ -21,10 +26,17 @@ import numpy as np
 from _common import machine, write_json
 
 
-def time_command(args: list[str]) -> float:
+def _children_cpu_s() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def time_command(args: list[str]) -> tuple[float, float]:
+    """(wall seconds, CPU seconds of the command and every process it waited for)."""
+    cpu = _children_cpu_s()
     start = time.perf_counter()
     subprocess.run(args, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    return time.perf_counter() - start
+    return time.perf_counter() - start, _children_cpu_s() - cpu
 
 
 def warm_throughput(experiment: str, jobs: int, repeats: int) -> dict:
@@ -66,13 +78,15 @@ def warm_throughput(experiment: str, jobs: int, repeats: int) -> dict:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--experiment", default="heatmaps")
-    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--repeats", type=int, default=None, help="runs of each command (default 3; 1 with --quick)")
+    parser.add_argument("--quick", action="store_true", help="each command once")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--full", action="store_true", help="the full settings instead of --quick")
     parser.add_argument("--warm", action="store_true",
                         help="time the last 50 quick trials on already-warm workers instead of whole commands")
     parser.add_argument("--out", default=None)
     args = parser.parse_args()
+    args.repeats = args.repeats or (1 if args.quick else 3)
     if args.warm:
         rows = warm_throughput(args.experiment, args.jobs, args.repeats)
         speedup = {kind: rows["serial"]["median_s"] / rows[kind]["median_s"] for kind in ("process", "dask")}
@@ -85,7 +99,7 @@ def main() -> None:
     qrrt = str(Path(sys.executable).with_name("qrrt"))
     rows = {}
     for kind in ("serial", "process", "dask"):
-        times = []
+        times, cpus = [], []
         for _ in range(args.repeats):
             out = tempfile.mkdtemp(prefix="qrrt-bench-")
             try:
@@ -94,16 +108,25 @@ def main() -> None:
                     command.append("--quick")
                 if kind != "serial":
                     command += ["--jobs", str(args.jobs)]
-                times.append(time_command(command))
+                wall, cpu = time_command(command)
+                times.append(wall)
+                cpus.append(cpu)
             finally:
                 shutil.rmtree(out, ignore_errors=True)
-        rows[kind] = {"median_s": float(np.median(times)), "times_s": times}
-        print(f"  {kind:8s} median {np.median(times):6.2f} s  {[round(t, 2) for t in times]}")
+        rows[kind] = {"median_s": float(np.median(times)), "times_s": times,
+                      "cpu_median_s": float(np.median(cpus)), "cpu_s": cpus}
+        print(f"  {kind:8s} median {np.median(times):6.2f} s  {[round(t, 2) for t in times]}  "
+              f"CPU {np.median(cpus):6.2f} s")
     speedup = {kind: rows["serial"]["median_s"] / rows[kind]["median_s"] for kind in ("process", "dask")}
     print("speed-up over serial:", {k: round(v, 2) for k, v in speedup.items()})
-    path = write_json(f"bench_scaleout_{args.experiment}{'_full' if args.full else ''}",
+    sweep = f"{args.experiment}{'_full' if args.full else ''}"
+    figures = {f"{sweep}.{kind}.s": row["median_s"] for kind, row in rows.items()}
+    figures.update({f"{sweep}.{kind}.cpu_s": row["cpu_median_s"] for kind, row in rows.items()})
+    figures.update({f"{sweep}.{kind}.speedup": value for kind, value in speedup.items()})
+    path = write_json(f"bench_scaleout_{sweep}",
                       {"machine": machine(), "experiment": args.experiment, "jobs": args.jobs, "full": args.full,
-                       "repeats": args.repeats, "runs": rows, "speedup": speedup}, args.out)
+                       "repeats": args.repeats, "load_average": list(os.getloadavg()), "runs": rows,
+                       "speedup": speedup, "figures": figures}, args.out)
     print(f"wrote {path}")
 
 
