@@ -13,6 +13,7 @@ with flat ``figures`` for ``benchmarks/run.py``.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import resource
 import shutil
@@ -37,6 +38,41 @@ def time_command(args: list[str]) -> tuple[float, float]:
     start = time.perf_counter()
     subprocess.run(args, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     return time.perf_counter() - start, _children_cpu_s() - cpu
+
+
+PHASES_SCRIPT = """
+import json, pathlib, sys, tempfile, time
+clock = time.process_time
+start = clock()
+from qrrt_circuits.experiments import EXPERIMENTS
+from qrrt_circuits.experiments.runner import execute_trial
+imported = clock()
+name = sys.argv[1]
+experiment = EXPERIMENTS[name]
+settings = json.loads(json.dumps({**experiment.settings(sys.argv[2] == "quick", None, 0), "predicate": "exact"}))
+records = [execute_trial(name, trial, settings) for trial in experiment.trials(settings)]
+ran = clock()
+result = experiment.summarize(records, settings)
+summarized = clock()
+experiment.plot(records, settings, {**result, "ours": result["ours"]}, pathlib.Path(tempfile.mkdtemp()))
+plotted = clock()
+print(json.dumps({"import_s": imported - start, "trials_s": ran - imported, "summarize_s": summarized - ran,
+                  "plot_s": plotted - summarized}))
+"""
+
+
+def serial_phases(experiment: str, full: bool, jobs: int) -> dict:
+    """CPU seconds of each phase of a serial run in a fresh interpreter (imports, trials, summary,
+    figures), and the speed-up ``jobs`` workers could give at best if only the trials were shared
+    and nothing else cost anything (Amdahl): the import, summary and figures stay serial."""
+    done = subprocess.run([sys.executable, "-c", PHASES_SCRIPT, experiment, "full" if full else "quick"],
+                          check=True, capture_output=True, text=True)
+    phases = json.loads(done.stdout.strip().splitlines()[-1])
+    serial = sum(phases.values())
+    best = phases["import_s"] + phases["trials_s"] / jobs + phases["summarize_s"] + phases["plot_s"]
+    phases["serial_tail_share"] = (phases["summarize_s"] + phases["plot_s"]) / serial
+    phases["best_speedup"] = serial / best
+    return phases
 
 
 def warm_throughput(experiment: str, jobs: int, repeats: int) -> dict:
@@ -119,14 +155,17 @@ def main() -> None:
               f"CPU {np.median(cpus):6.2f} s")
     speedup = {kind: rows["serial"]["median_s"] / rows[kind]["median_s"] for kind in ("process", "dask")}
     print("speed-up over serial:", {k: round(v, 2) for k, v in speedup.items()})
+    phases = serial_phases(args.experiment, args.full, args.jobs)
+    print("serial phases (CPU s):", {k: round(v, 2) for k, v in phases.items()})
     sweep = f"{args.experiment}{'_full' if args.full else ''}"
     figures = {f"{sweep}.{kind}.s": row["median_s"] for kind, row in rows.items()}
     figures.update({f"{sweep}.{kind}.cpu_s": row["cpu_median_s"] for kind, row in rows.items()})
     figures.update({f"{sweep}.{kind}.speedup": value for kind, value in speedup.items()})
+    figures.update({f"{sweep}.serial_phase.{key}": value for key, value in phases.items()})
     path = write_json(f"bench_scaleout_{sweep}",
                       {"machine": machine(), "experiment": args.experiment, "jobs": args.jobs, "full": args.full,
                        "repeats": args.repeats, "load_average": list(os.getloadavg()), "runs": rows,
-                       "speedup": speedup, "figures": figures}, args.out)
+                       "speedup": speedup, "serial_phases_cpu_s": phases, "figures": figures}, args.out)
     print(f"wrote {path}")
 
 

@@ -3,9 +3,10 @@
 - ``serial``: none (trials run in this process, in order).
 - ``process``: local processes, standard library ``ProcessPoolExecutor``.
 - ``dask``: ``dask.distributed`` — a ``LocalCluster`` (``jobs`` single-threaded worker processes
-  under nannies, no dashboard) or an existing cluster at ``scheduler`` (e.g. one started with
-  dask-jobqueue on SLURM), used through ``Client.get_executor(retries=...)``: a task whose worker
-  dies is rescheduled by the scheduler and, if it fails, retried.
+  under nannies, no dashboard, no profiler: ``LOCAL_DASK_CONFIG``) or an existing cluster at
+  ``scheduler`` (e.g. one started with dask-jobqueue on SLURM), used through
+  ``Client.get_executor(retries=...)``: a task whose worker dies is rescheduled by the scheduler
+  and, if it fails, retried.
 
 **Warm workers.** Local workers (pool and ``LocalCluster``) are forked from one *fork server*
 (the ``forkserver`` start method) that has imported ``qrrt_circuits.worker_warmup`` once: every
@@ -42,6 +43,12 @@ NO_DASHBOARD = "127.0.0.1:0"
 #: environment for worker processes: one thread per native library
 SINGLE_THREAD_ENV = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
                      "NUMBA_NUM_THREADS": "1"}
+
+#: Dask settings for a ``LocalCluster`` of a few single-threaded workers: no statistical profiler
+#: sampling each running task every 10 ms, and the event-loop watchdog and system monitor ticking
+#: less often; each was CPU taken from the trials on 2 cores (measured: ``bench_scaleout.py``)
+LOCAL_DASK_CONFIG = {"distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "1s",
+                     "distributed.admin.system-monitor.interval": "5s"}
 
 #: modules the fork server imports before forking any worker (the warm-up is the import)
 WORKER_PRELOAD = ("qrrt_circuits.worker_warmup",)
@@ -191,7 +198,7 @@ def _local_dask(jobs: int, retries: int, local_directory: str | None) -> Iterato
     local_directory = local_directory if scratch is None else scratch.name
     try:
         with _warm_fork_server(("distributed",)) as method, \
-                dask.config.set({"distributed.worker.multiprocessing-method": method}), \
+                dask.config.set({**LOCAL_DASK_CONFIG, "distributed.worker.multiprocessing-method": method}), \
                 _single_thread_environment(), \
                 LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, host="127.0.0.1",
                              dashboard_address=NO_DASHBOARD, local_directory=local_directory) as cluster, \
