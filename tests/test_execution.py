@@ -111,6 +111,40 @@ def _children():
     return out
 
 
+#: evaluated in a worker: it was forked from the warm fork server (the warm-up module is imported
+#: by nothing else) and holds the default world already built
+WARM_CHECK = ("'qrrt_circuits.worker_warmup' in __import__('sys').modules and __import__("
+              "'qrrt_circuits.experiments.worlds', fromlist=['w'])._cached_world.cache_info().currsize >= 1")
+
+
+def _is_warm(executor) -> bool:
+    import multiprocessing
+
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        return True  # workers are spawned cold where there is no fork server
+    return executor.submit(eval, WARM_CHECK).result()
+
+
+def test_one_worker_pool_serves_several_sweeps_and_starts_only_when_needed(tmp_path):
+    from qrrt_circuits.execution import WorkerPool
+
+    serial = run_experiment("oracle-efficiency", out=tmp_path / "serial", quick=True, trials=2, progress=False)
+    with WorkerPool("process", jobs=1) as pool:
+        done = run_experiment("oracle-efficiency", out=tmp_path / "serial", quick=True, trials=2, progress=False,
+                              executor=pool)
+        assert done["ours"] == serial["ours"] and not pool.started  # nothing left to run: no workers
+        worker = pool.executor.submit(os.getpid).result()
+        first = run_experiment("oracle-efficiency", out=tmp_path / "pool", quick=True, trials=2, progress=False,
+                               executor=pool)
+        run_experiment("oracle-efficiency", out=tmp_path / "seed1", quick=True, trials=2, seed=1, progress=False,
+                       executor=pool)
+        assert pool.executor.submit(os.getpid).result() == worker  # the same worker throughout
+    assert first["ours"] == serial["ours"]
+    assert not pool.started
+    with pytest.raises(RuntimeError, match="not open"):
+        _ = pool.executor
+
+
 def test_get_executor_cleans_up():
     import tempfile
 
@@ -118,8 +152,10 @@ def test_get_executor_cleans_up():
     temp = set(os.listdir(tempfile.gettempdir()))
     with get_executor("dask", jobs=1) as executor:
         assert executor.submit(pow, 2, 5).result() == 32
+        assert _is_warm(executor)
     with get_executor("process", jobs=1) as executor:
         assert executor.submit(pow, 3, 2).result() == 9
+        assert _is_warm(executor)
     psutil.wait_procs([psutil.Process(pid) for pid in _children() - before], timeout=20)
     assert _children() <= before
     leftovers = {name for name in set(os.listdir(tempfile.gettempdir())) - temp
