@@ -1,6 +1,7 @@
 """Speed-up of ``qrrt reproduce EXPERIMENT --quick`` on 2 jobs over serial.
 
     python benchmarks/bench_scaleout.py [--experiment heatmaps] [--repeats 3] [--jobs 2] [--full] [--quick]
+                                        [--baseline-src OTHER_CHECKOUT/src]
 
 Runs the real command line (a fresh ``--out`` each time, so nothing is resumed), end to end
 including interpreter start, cluster start and worker imports, and reports median wall seconds
@@ -32,11 +33,13 @@ def _children_cpu_s() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
-def time_command(args: list[str]) -> tuple[float, float]:
-    """(wall seconds, CPU seconds of the command and every process it waited for)."""
+def time_command(args: list[str], source: str | None = None) -> tuple[float, float]:
+    """(wall seconds, CPU seconds of the command and every process it waited for); ``source``: a
+    ``src`` folder put first on ``PYTHONPATH`` (another checkout's code)."""
+    env = dict(os.environ, PYTHONPATH=source) if source else None
     cpu = _children_cpu_s()
     start = time.perf_counter()
-    subprocess.run(args, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    subprocess.run(args, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
     return time.perf_counter() - start, _children_cpu_s() - cpu
 
 
@@ -120,6 +123,9 @@ def main() -> None:
     parser.add_argument("--full", action="store_true", help="the full settings instead of --quick")
     parser.add_argument("--warm", action="store_true",
                         help="time the last 50 quick trials on already-warm workers instead of whole commands")
+    parser.add_argument("--baseline-src", default=None, metavar="SRC",
+                        help="also time process and Dask with the package from this src folder (e.g. a "
+                             "`git worktree` of an older commit), interleaved with ours")
     parser.add_argument("--out", default=None)
     args = parser.parse_args()
     args.repeats = args.repeats or (1 if args.quick else 3)
@@ -133,10 +139,13 @@ def main() -> None:
         print(f"wrote {path}")
         return
     qrrt = str(Path(sys.executable).with_name("qrrt"))
-    rows = {}
-    for kind in ("serial", "process", "dask"):
-        times, cpus = [], []
-        for _ in range(args.repeats):
+    variants = {"serial": ("serial", None), "process": ("process", None), "dask": ("dask", None)}
+    if args.baseline_src:  # the same commands on another checkout's code, interleaved with ours
+        variants.update({"baseline_process": ("process", args.baseline_src),
+                         "baseline_dask": ("dask", args.baseline_src)})
+    samples = {name: ([], []) for name in variants}
+    for _ in range(args.repeats):  # interleaved, so a change of load hits every variant alike
+        for name, (kind, source) in variants.items():
             out = tempfile.mkdtemp(prefix="qrrt-bench-")
             try:
                 command = [qrrt, "reproduce", args.experiment, "--out", out, "--no-progress", "--executor", kind]
@@ -144,22 +153,24 @@ def main() -> None:
                     command.append("--quick")
                 if kind != "serial":
                     command += ["--jobs", str(args.jobs)]
-                wall, cpu = time_command(command)
-                times.append(wall)
-                cpus.append(cpu)
+                wall, cpu = time_command(command, source)
+                samples[name][0].append(wall)
+                samples[name][1].append(cpu)
             finally:
                 shutil.rmtree(out, ignore_errors=True)
-        rows[kind] = {"median_s": float(np.median(times)), "times_s": times,
+    rows = {}
+    for name, (times, cpus) in samples.items():
+        rows[name] = {"median_s": float(np.median(times)), "times_s": times,
                       "cpu_median_s": float(np.median(cpus)), "cpu_s": cpus}
-        print(f"  {kind:8s} median {np.median(times):6.2f} s  {[round(t, 2) for t in times]}  "
+        print(f"  {name:17s} median {np.median(times):6.2f} s  {[round(t, 2) for t in times]}  "
               f"CPU {np.median(cpus):6.2f} s")
-    speedup = {kind: rows["serial"]["median_s"] / rows[kind]["median_s"] for kind in ("process", "dask")}
+    speedup = {name: rows["serial"]["median_s"] / rows[name]["median_s"] for name in rows if name != "serial"}
     print("speed-up over serial:", {k: round(v, 2) for k, v in speedup.items()})
     phases = serial_phases(args.experiment, args.full, args.jobs)
     print("serial phases (CPU s):", {k: round(v, 2) for k, v in phases.items()})
     sweep = f"{args.experiment}{'_full' if args.full else ''}"
-    figures = {f"{sweep}.{kind}.s": row["median_s"] for kind, row in rows.items()}
-    figures.update({f"{sweep}.{kind}.cpu_s": row["cpu_median_s"] for kind, row in rows.items()})
+    figures = {f"{sweep}.{name}.s": row["median_s"] for name, row in rows.items()}
+    figures.update({f"{sweep}.{name}.cpu_s": row["cpu_median_s"] for name, row in rows.items()})
     figures.update({f"{sweep}.{kind}.speedup": value for kind, value in speedup.items()})
     figures.update({f"{sweep}.serial_phase.{key}": value for key, value in phases.items()})
     path = write_json(f"bench_scaleout_{sweep}",
