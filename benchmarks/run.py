@@ -109,7 +109,8 @@ def run_one(script: Path, quick: bool, timeout: float | None) -> tuple[dict, dic
         except subprocess.TimeoutExpired as exc:
             returncode = None
             output = f"timed out after {timeout} s\n" + str(exc.stdout or "")
-        entry = {"command": " ".join([Path(sys.executable).name, *command[1:]]).replace(str(out), "OUT"),
+        shown = ["python", str(script.relative_to(HERE.parent)), *command[2:]]
+        entry = {"command": " ".join(shown).replace(str(out), "OUT"),
                  "returncode": returncode, "wall_s": round(time.perf_counter() - start, 2)}
         payload = None
         if returncode == 0 and out.exists():
