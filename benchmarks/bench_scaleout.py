@@ -1,15 +1,22 @@
 """Speed-up of ``qrrt reproduce EXPERIMENT --quick`` on 2 jobs over serial.
 
-    python benchmarks/bench_scaleout.py [--experiment heatmaps] [--repeats 3] [--jobs 2] [--full]
+    python benchmarks/bench_scaleout.py [--experiment heatmaps] [--repeats 3] [--jobs 2] [--full] [--quick]
+                                        [--baseline-src OTHER_CHECKOUT/src]
 
 Runs the real command line (a fresh ``--out`` each time, so nothing is resumed), end to end
 including interpreter start, cluster start and worker imports, and reports median wall seconds
-and the ratio serial / parallel measured in the same run. Writes JSON.
+and the ratio serial / parallel measured in the same run, and the CPU seconds of the whole process
+tree (client, fork server, workers): on a machine shared with other work the wall-clock ratio
+moves with the load, the CPU seconds much less. ``--quick`` runs each command once. Writes JSON
+with flat ``figures`` for ``benchmarks/run.py``.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import os
+import resource
 import shutil
 import subprocess
 import sys
@@ -21,10 +28,54 @@ import numpy as np
 from _common import machine, write_json
 
 
-def time_command(args: list[str]) -> float:
+def _children_cpu_s() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def time_command(args: list[str], source: str | None = None) -> tuple[float, float]:
+    """(wall seconds, CPU seconds of the command and every process it waited for); ``source``: a
+    ``src`` folder put first on ``PYTHONPATH`` (another checkout's code)."""
+    env = dict(os.environ, PYTHONPATH=source) if source else None
+    cpu = _children_cpu_s()
     start = time.perf_counter()
-    subprocess.run(args, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    return time.perf_counter() - start
+    subprocess.run(args, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
+    return time.perf_counter() - start, _children_cpu_s() - cpu
+
+
+PHASES_SCRIPT = """
+import json, pathlib, sys, tempfile, time
+clock = time.process_time
+start = clock()
+from qrrt_circuits.experiments import EXPERIMENTS
+from qrrt_circuits.experiments.runner import execute_trial
+imported = clock()
+name = sys.argv[1]
+experiment = EXPERIMENTS[name]
+settings = json.loads(json.dumps({**experiment.settings(sys.argv[2] == "quick", None, 0), "predicate": "exact"}))
+records = [execute_trial(name, trial, settings) for trial in experiment.trials(settings)]
+ran = clock()
+result = experiment.summarize(records, settings)
+summarized = clock()
+experiment.plot(records, settings, {**result, "ours": result["ours"]}, pathlib.Path(tempfile.mkdtemp()))
+plotted = clock()
+print(json.dumps({"import_s": imported - start, "trials_s": ran - imported, "summarize_s": summarized - ran,
+                  "plot_s": plotted - summarized}))
+"""
+
+
+def serial_phases(experiment: str, full: bool, jobs: int) -> dict:
+    """CPU seconds of each phase of a serial run in a fresh interpreter (imports, trials, summary,
+    figures), and the speed-up ``jobs`` workers could give at best if only the trials were shared
+    and nothing else cost anything (Amdahl): the import, summary and figures stay serial."""
+    done = subprocess.run([sys.executable, "-c", PHASES_SCRIPT, experiment, "full" if full else "quick"],
+                          check=True, capture_output=True, text=True)
+    phases = json.loads(done.stdout.strip().splitlines()[-1])
+    serial = sum(phases.values())
+    best = phases["import_s"] + phases["trials_s"] / jobs + phases["summarize_s"] + phases["plot_s"]
+    phases["serial_tail_share"] = (phases["summarize_s"] + phases["plot_s"]) / serial
+    phases["best_speedup"] = serial / best
+    return phases
 
 
 def warm_throughput(experiment: str, jobs: int, repeats: int) -> dict:
@@ -66,13 +117,18 @@ def warm_throughput(experiment: str, jobs: int, repeats: int) -> dict:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--experiment", default="heatmaps")
-    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--repeats", type=int, default=None, help="runs of each command (default 3; 1 with --quick)")
+    parser.add_argument("--quick", action="store_true", help="each command once")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--full", action="store_true", help="the full settings instead of --quick")
     parser.add_argument("--warm", action="store_true",
                         help="time the last 50 quick trials on already-warm workers instead of whole commands")
+    parser.add_argument("--baseline-src", default=None, metavar="SRC",
+                        help="also time process and Dask with the package from this src folder (e.g. a "
+                             "`git worktree` of an older commit), interleaved with ours")
     parser.add_argument("--out", default=None)
     args = parser.parse_args()
+    args.repeats = args.repeats or (1 if args.quick else 3)
     if args.warm:
         rows = warm_throughput(args.experiment, args.jobs, args.repeats)
         speedup = {kind: rows["serial"]["median_s"] / rows[kind]["median_s"] for kind in ("process", "dask")}
@@ -83,10 +139,13 @@ def main() -> None:
         print(f"wrote {path}")
         return
     qrrt = str(Path(sys.executable).with_name("qrrt"))
-    rows = {}
-    for kind in ("serial", "process", "dask"):
-        times = []
-        for _ in range(args.repeats):
+    variants = {"serial": ("serial", None), "process": ("process", None), "dask": ("dask", None)}
+    if args.baseline_src:  # the same commands on another checkout's code, interleaved with ours
+        variants.update({"baseline_process": ("process", args.baseline_src),
+                         "baseline_dask": ("dask", args.baseline_src)})
+    samples = {name: ([], []) for name in variants}
+    for _ in range(args.repeats):  # interleaved, so a change of load hits every variant alike
+        for name, (kind, source) in variants.items():
             out = tempfile.mkdtemp(prefix="qrrt-bench-")
             try:
                 command = [qrrt, "reproduce", args.experiment, "--out", out, "--no-progress", "--executor", kind]
@@ -94,16 +153,30 @@ def main() -> None:
                     command.append("--quick")
                 if kind != "serial":
                     command += ["--jobs", str(args.jobs)]
-                times.append(time_command(command))
+                wall, cpu = time_command(command, source)
+                samples[name][0].append(wall)
+                samples[name][1].append(cpu)
             finally:
                 shutil.rmtree(out, ignore_errors=True)
-        rows[kind] = {"median_s": float(np.median(times)), "times_s": times}
-        print(f"  {kind:8s} median {np.median(times):6.2f} s  {[round(t, 2) for t in times]}")
-    speedup = {kind: rows["serial"]["median_s"] / rows[kind]["median_s"] for kind in ("process", "dask")}
+    rows = {}
+    for name, (times, cpus) in samples.items():
+        rows[name] = {"median_s": float(np.median(times)), "times_s": times,
+                      "cpu_median_s": float(np.median(cpus)), "cpu_s": cpus}
+        print(f"  {name:17s} median {np.median(times):6.2f} s  {[round(t, 2) for t in times]}  "
+              f"CPU {np.median(cpus):6.2f} s")
+    speedup = {name: rows["serial"]["median_s"] / rows[name]["median_s"] for name in rows if name != "serial"}
     print("speed-up over serial:", {k: round(v, 2) for k, v in speedup.items()})
-    path = write_json(f"bench_scaleout_{args.experiment}{'_full' if args.full else ''}",
+    phases = serial_phases(args.experiment, args.full, args.jobs)
+    print("serial phases (CPU s):", {k: round(v, 2) for k, v in phases.items()})
+    sweep = f"{args.experiment}{'_full' if args.full else ''}"
+    figures = {f"{sweep}.{name}.s": row["median_s"] for name, row in rows.items()}
+    figures.update({f"{sweep}.{name}.cpu_s": row["cpu_median_s"] for name, row in rows.items()})
+    figures.update({f"{sweep}.{kind}.speedup": value for kind, value in speedup.items()})
+    figures.update({f"{sweep}.serial_phase.{key}": value for key, value in phases.items()})
+    path = write_json(f"bench_scaleout_{sweep}",
                       {"machine": machine(), "experiment": args.experiment, "jobs": args.jobs, "full": args.full,
-                       "repeats": args.repeats, "runs": rows, "speedup": speedup}, args.out)
+                       "repeats": args.repeats, "load_average": list(os.getloadavg()), "runs": rows,
+                       "speedup": speedup, "serial_phases_cpu_s": phases, "figures": figures}, args.out)
     print(f"wrote {path}")
 
 

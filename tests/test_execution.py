@@ -67,6 +67,14 @@ def test_killed_dask_worker_is_rescheduled(dask_client, tmp_path):
     dask_client.wait_for_workers(2, timeout=60)
 
 
+def _is_pool_worker(process) -> bool:
+    """A spawned worker, or one forked by the fork server (not the server itself)."""
+    if any("spawn_main" in part for part in process.cmdline()):
+        return True
+    parent = process.parent()
+    return parent is not None and any("forkserver" in part for part in parent.cmdline())
+
+
 def test_killed_process_pool_worker_is_replaced(tmp_path):
     before = {p.pid for p in psutil.Process().children(recursive=True)}
     killed, restarts = [], []
@@ -76,7 +84,7 @@ def test_killed_process_pool_worker_is_replaced(tmp_path):
             return
         for process in psutil.Process().children(recursive=True):
             try:
-                is_worker = any("spawn_main" in part for part in process.cmdline())
+                is_worker = _is_pool_worker(process)
             except psutil.NoSuchProcess:
                 continue
             if process.pid not in before and is_worker:
@@ -103,6 +111,40 @@ def _children():
     return out
 
 
+#: evaluated in a worker: it was forked from the warm fork server (the warm-up module is imported
+#: by nothing else) and holds the default world already built
+WARM_CHECK = ("'qrrt_circuits.worker_warmup' in __import__('sys').modules and __import__("
+              "'qrrt_circuits.experiments.worlds', fromlist=['w'])._cached_world.cache_info().currsize >= 1")
+
+
+def _is_warm(executor) -> bool:
+    import multiprocessing
+
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        return True  # workers are spawned cold where there is no fork server
+    return executor.submit(eval, WARM_CHECK).result()
+
+
+def test_one_worker_pool_serves_several_sweeps_and_starts_only_when_needed(tmp_path):
+    from qrrt_circuits.execution import WorkerPool
+
+    serial = run_experiment("oracle-efficiency", out=tmp_path / "serial", quick=True, trials=2, progress=False)
+    with WorkerPool("process", jobs=1) as pool:
+        done = run_experiment("oracle-efficiency", out=tmp_path / "serial", quick=True, trials=2, progress=False,
+                              executor=pool)
+        assert done["ours"] == serial["ours"] and not pool.started  # nothing left to run: no workers
+        worker = pool.executor.submit(os.getpid).result()
+        first = run_experiment("oracle-efficiency", out=tmp_path / "pool", quick=True, trials=2, progress=False,
+                               executor=pool)
+        run_experiment("oracle-efficiency", out=tmp_path / "seed1", quick=True, trials=2, seed=1, progress=False,
+                       executor=pool)
+        assert pool.executor.submit(os.getpid).result() == worker  # the same worker throughout
+    assert first["ours"] == serial["ours"]
+    assert not pool.started
+    with pytest.raises(RuntimeError, match="not open"):
+        _ = pool.executor
+
+
 def test_get_executor_cleans_up():
     import tempfile
 
@@ -110,8 +152,10 @@ def test_get_executor_cleans_up():
     temp = set(os.listdir(tempfile.gettempdir()))
     with get_executor("dask", jobs=1) as executor:
         assert executor.submit(pow, 2, 5).result() == 32
+        assert _is_warm(executor)
     with get_executor("process", jobs=1) as executor:
         assert executor.submit(pow, 3, 2).result() == 9
+        assert _is_warm(executor)
     psutil.wait_procs([psutil.Process(pid) for pid in _children() - before], timeout=20)
     assert _children() <= before
     leftovers = {name for name in set(os.listdir(tempfile.gettempdir())) - temp

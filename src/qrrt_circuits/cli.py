@@ -208,7 +208,9 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 # ----------------------------------------------------------------------------------------- reproduce
 def cmd_reproduce(args: argparse.Namespace) -> int:
+    from .execution import WorkerPool
     from .experiments import EXPERIMENTS, run_experiment
+    from .experiments.runner import check_experiment_arguments
 
     if str(args.out).strip() == "":
         raise ValueError("--out must name a folder, got ''")
@@ -219,19 +221,27 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     names = sorted(EXPERIMENTS) if args.experiment == "all" else [args.experiment]
     if args.predicate != "exact":  # 'all' with another check: the experiments that plan with one
         names = [name for name in names if EXPERIMENTS[name].uses_predicate or args.experiment != "all"]
-    for name in names:
-        summary = run_experiment(name, out=args.out, quick=args.quick, trials=args.trials, seed=args.seed,
-                                 progress=not args.no_progress, executor=args.executor, jobs=args.jobs,
-                                 scheduler=args.scheduler, predicate=args.predicate)
-        print(f"== {name}: {summary.get('title', '')}")
-        print(f"   ours : {summary['ours']}")
-        print(f"   paper: {summary['paper']}")
-        for key in ("ordering_reproduced", "ratio_qda_over_uniform", "speedup_over_paper_per_node"):
-            if key in summary:
-                print(f"   {key}: {summary[key]}")
-        print(f"   wrote {Path(args.out).resolve() / name}/ (records.csv, summary.json, "
-              f"{', '.join(summary['figures'])})")
+    for name in names:  # bad arguments are refused before any worker starts
+        check_experiment_arguments(name, trials=args.trials, seed=args.seed, executor=args.executor,
+                                   jobs=args.jobs, scheduler=args.scheduler, predicate=args.predicate)
+    # one pool or Dask cluster for every experiment, started when the first trial needs it
+    with WorkerPool(args.executor, args.jobs, args.scheduler) as pool:
+        for name in names:
+            summary = run_experiment(name, out=args.out, quick=args.quick, trials=args.trials, seed=args.seed,
+                                     progress=not args.no_progress, executor=pool, predicate=args.predicate)
+            _print_summary(name, summary, args.out)
     return 0
+
+
+def _print_summary(name: str, summary: dict, out: str) -> None:
+    print(f"== {name}: {summary.get('title', '')}")
+    print(f"   ours : {summary['ours']}")
+    print(f"   paper: {summary['paper']}")
+    for key in ("ordering_reproduced", "ratio_qda_over_uniform", "speedup_over_paper_per_node"):
+        if key in summary:
+            print(f"   {key}: {summary[key]}")
+    print(f"   wrote {Path(out).resolve() / name}/ (records.csv, summary.json, "
+          f"{', '.join(summary['figures'])})")
 
 
 # ----------------------------------------------------------------------------------------- parser

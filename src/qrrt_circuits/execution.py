@@ -1,15 +1,26 @@
 """Executors for sweeps: one way to get a ``concurrent.futures.Executor`` for each kind.
 
 - ``serial``: none (trials run in this process, in order).
-- ``process``: local processes, standard library ``ProcessPoolExecutor`` with the *spawn* start
-  method (no forked simulator or numba state); task functions are module-level.
-- ``dask``: ``dask.distributed`` — a ``LocalCluster`` (``jobs`` single-threaded worker processes,
-  no dashboard) or an existing cluster at ``scheduler`` (e.g. one started with dask-jobqueue on
-  SLURM), used through ``Client.get_executor(retries=...)``: a task whose worker dies is rescheduled
-  by the scheduler and, if it fails, retried.
+- ``process``: local processes, standard library ``ProcessPoolExecutor``.
+- ``dask``: ``dask.distributed`` — a ``LocalCluster`` (``jobs`` single-threaded worker processes
+  under nannies, no dashboard, no profiler: ``LOCAL_DASK_CONFIG``) or an existing cluster at
+  ``scheduler`` (e.g. one started with dask-jobqueue on SLURM), used through
+  ``Client.get_executor(retries=...)``: a task whose worker dies is rescheduled by the scheduler
+  and, if it fails, retried.
+
+**Warm workers.** Local workers (pool and ``LocalCluster``) are forked from one *fork server*
+(the ``forkserver`` start method) that has imported ``qrrt_circuits.worker_warmup`` once: every
+experiment, Qiskit, Aer, numba's compiled kernels and the default world. A worker then starts in
+milliseconds with all of that in memory, instead of each one being a fresh interpreter spending
+seconds of CPU on the same imports (which on 2 cores ate much of what 2 workers gain). The fork
+server is a fresh single-threaded interpreter that never runs a simulator, so nothing forked holds
+threads or OpenMP state. It is started with the single-thread environment below and stopped when
+the executor is shut down. Where the platform has no fork server, workers are spawned (cold).
 
 Workers build their own backends with one thread each (``max_parallel_threads=1`` for Aer), so
-``jobs`` processes use ``jobs`` cores. Install the Dask extra with ``pip install ".[dask]"``.
+``jobs`` processes use ``jobs`` cores. :class:`WorkerPool` keeps one executor for several sweeps
+(``qrrt reproduce all`` starts one pool or cluster, not one per experiment) and starts a new one
+when a local pool breaks. Install the Dask extra with ``pip install ".[dask]"``.
 """
 
 from __future__ import annotations
@@ -21,6 +32,8 @@ from concurrent.futures import Executor, ProcessPoolExecutor
 
 from .validation import check_optional_int
 
+__all__ = ["EXECUTORS", "WORKER_PRELOAD", "WorkerPool", "check_executor_args", "get_executor"]
+
 EXECUTORS = ("serial", "process", "dask")
 
 #: no Bokeh dashboard is served (bokeh is not a dependency); ``dashboard_address=None`` does not stop
@@ -31,31 +44,122 @@ NO_DASHBOARD = "127.0.0.1:0"
 SINGLE_THREAD_ENV = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
                      "NUMBA_NUM_THREADS": "1"}
 
+#: Dask settings for a ``LocalCluster`` of a few single-threaded workers: no statistical profiler
+#: sampling each running task every 10 ms, and the event-loop watchdog and system monitor ticking
+#: less often; each was CPU taken from the trials on 2 cores (measured: ``bench_scaleout.py``)
+LOCAL_DASK_CONFIG = {"distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "1s",
+                     "distributed.admin.system-monitor.interval": "5s"}
 
-#: how often a pool worker checks that its parent is alive (seconds)
+#: modules the fork server imports before forking any worker (the warm-up is the import)
+WORKER_PRELOAD = ("qrrt_circuits.worker_warmup",)
+
+#: how often a pool worker checks that its client is alive (seconds)
 PARENT_POLL_S = 0.5
 
 
-def _exit_when_orphaned(parent: int) -> None:
-    """Runs in a daemon thread of each pool worker: when the parent dies (killed with SIGKILL, say,
-    so it could not shut the pool down), the worker is re-parented and exits at once instead of
-    lingering with its memory."""
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, owned by someone else (the pid was reused): ours is gone
+        return False
+    return True
+
+
+def _exit_when_orphaned(client: int, parent: int) -> None:
+    """Runs in a daemon thread of each pool worker: when the client dies (killed with SIGKILL, say,
+    so it could not shut the pool down), the worker exits at once instead of lingering with its
+    memory. ``parent`` is the worker's parent at start (the client, or the fork server, which
+    outlives the client while any worker it forked is alive); a changed parent also means orphaned."""
     import time
 
-    while os.getppid() == parent:
+    while os.getppid() == parent and _alive(client):
         time.sleep(PARENT_POLL_S)
     os._exit(1)
 
 
-def _worker_init(parent: int | None = None) -> None:
-    """Pool worker start-up: one thread per native library, and a watch on ``parent`` (the pid of
-    the process that made the pool, passed in, since a worker still importing when its parent
-    dies would otherwise take its new parent for the real one)."""
+def _worker_init(client: int | None = None) -> None:
+    """Pool worker start-up: one thread per native library, and a watch on ``client`` (the pid of
+    the process that made the pool, passed in: a spawned worker still importing when its client
+    dies would otherwise take its new parent for the real one, and a forked one's parent is the
+    fork server)."""
     import threading
 
     os.environ.update(SINGLE_THREAD_ENV)
-    parent = os.getppid() if parent is None else parent
-    threading.Thread(target=_exit_when_orphaned, args=(parent,), daemon=True, name="qrrt-orphan-watch").start()
+    parent = os.getppid()
+    client = parent if client is None else client
+    threading.Thread(target=_exit_when_orphaned, args=(client, parent), daemon=True,
+                     name="qrrt-orphan-watch").start()
+
+
+@contextlib.contextmanager
+def _single_thread_environment() -> Iterator[None]:
+    """``SINGLE_THREAD_ENV`` in ``os.environ`` (inherited by processes started meanwhile), restored after."""
+    saved = {key: os.environ.get(key) for key in SINGLE_THREAD_ENV}
+    os.environ.update(SINGLE_THREAD_ENV)
+    try:
+        yield
+    finally:
+        for key, value in saved.items():
+            if value is None:
+                os.environ.pop(key, None)
+            else:
+                os.environ[key] = value
+
+
+def _fork_server_available() -> bool:
+    import multiprocessing
+
+    return "forkserver" in multiprocessing.get_all_start_methods()
+
+
+@contextlib.contextmanager
+def _warm_fork_server(extra_preload: tuple[str, ...] = ()) -> Iterator[str]:
+    """Start the fork server (preloading ``WORKER_PRELOAD``) unless one runs; yields the start method
+    for workers (``"spawn"`` where there is no fork server). A server started here is stopped on exit,
+    once the workers it forked are gone."""
+    if not _fork_server_available():
+        yield "spawn"
+        return
+    import multiprocessing
+    from multiprocessing import forkserver
+
+    server = forkserver._forkserver  # the standard library's one per process
+    started_here = server._forkserver_pid is None
+    if started_here:
+        multiprocessing.get_context("forkserver").set_forkserver_preload([*extra_preload, *WORKER_PRELOAD])
+        with _single_thread_environment():
+            forkserver.ensure_running()
+    try:
+        yield "forkserver"
+    finally:
+        if started_here:
+            _stop_fork_server(server)
+
+
+def _stop_fork_server(server) -> None:
+    """Close our end of the server's "alive" pipe (it exits when no worker holds one either) and
+    reap it; kill it if it has not gone after a few seconds."""
+    import signal
+    import time
+
+    pid, fd = server._forkserver_pid, server._forkserver_alive_fd
+    if pid is None:
+        return
+    with server._lock:
+        os.close(fd)
+        server._forkserver_alive_fd = server._forkserver_address = server._forkserver_pid = None
+    deadline = time.monotonic() + 5.0
+    while True:
+        done, _ = os.waitpid(pid, os.WNOHANG)
+        if done:
+            return
+        if time.monotonic() > deadline:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+            return
+        time.sleep(0.02)
 
 
 def check_executor_args(kind: str, jobs: int | None, scheduler: str | None) -> int:
@@ -73,44 +177,119 @@ def check_executor_args(kind: str, jobs: int | None, scheduler: str | None) -> i
 
 
 @contextlib.contextmanager
-def get_executor(kind: str = "serial", jobs: int | None = None, scheduler: str | None = None,
-                 retries: int = 2, local_directory: str | None = None) -> Iterator[Executor | None]:
-    """Context manager yielding an executor (``None`` for serial); everything it started is shut
-    down on exit."""
-    jobs = check_executor_args(kind, jobs, scheduler)
-    if kind == "serial":
-        yield None
-        return
-    if kind == "process":
-        import multiprocessing
+def _process_pool(jobs: int) -> Iterator[Executor]:
+    import multiprocessing
 
-        with ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("spawn"),
-                                 initializer=_worker_init, initargs=(os.getpid(),)) as pool:
-            yield pool
-        return
-    from distributed import Client, LocalCluster
+    with _warm_fork_server() as method, \
+            ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context(method),
+                                initializer=_worker_init, initargs=(os.getpid(),)) as pool:
+        yield pool
 
-    if scheduler is not None:
-        with Client(scheduler) as client:
-            yield client.get_executor(retries=retries, pure=False)
-        return
+
+@contextlib.contextmanager
+def _local_dask(jobs: int, retries: int, local_directory: str | None) -> Iterator[Executor]:
     import tempfile
 
-    saved = {key: os.environ.get(key) for key in SINGLE_THREAD_ENV}
-    os.environ.update(SINGLE_THREAD_ENV)  # inherited by the worker processes
+    import dask
+    from distributed import Client, LocalCluster
+
     # Dask leaves lock files in its scratch directory: give it one of ours and remove it after
     scratch = None if local_directory is not None else tempfile.TemporaryDirectory(prefix="qrrt-dask-")
     local_directory = local_directory if scratch is None else scratch.name
     try:
-        with LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, host="127.0.0.1",
-                          dashboard_address=NO_DASHBOARD, local_directory=local_directory) as cluster, \
+        with _warm_fork_server(("distributed",)) as method, \
+                dask.config.set({**LOCAL_DASK_CONFIG, "distributed.worker.multiprocessing-method": method}), \
+                _single_thread_environment(), \
+                LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, host="127.0.0.1",
+                             dashboard_address=NO_DASHBOARD, local_directory=local_directory) as cluster, \
                 Client(cluster) as client:
             yield client.get_executor(retries=retries, pure=False)
     finally:
         if scratch is not None:
             scratch.cleanup()
-        for key, value in saved.items():
-            if value is None:
-                os.environ.pop(key, None)
-            else:
-                os.environ[key] = value
+
+
+@contextlib.contextmanager
+def _open(kind: str, jobs: int, scheduler: str | None, retries: int,
+          local_directory: str | None) -> Iterator[Executor | None]:
+    if kind == "serial":
+        yield None
+    elif kind == "process":
+        with _process_pool(jobs) as pool:
+            yield pool
+    elif scheduler is not None:
+        from distributed import Client
+
+        with Client(scheduler) as client:
+            yield client.get_executor(retries=retries, pure=False)
+    else:
+        with _local_dask(jobs, retries, local_directory) as executor:
+            yield executor
+
+
+@contextlib.contextmanager
+def get_executor(kind: str = "serial", jobs: int | None = None, scheduler: str | None = None,
+                 retries: int = 2, local_directory: str | None = None) -> Iterator[Executor | None]:
+    """Context manager yielding an executor (``None`` for serial); everything it started is shut
+    down on exit."""
+    jobs = check_executor_args(kind, jobs, scheduler)
+    with _open(kind, jobs, scheduler, retries, local_directory) as executor:
+        yield executor
+
+
+class WorkerPool:
+    """One executor of ``kind`` kept open across several sweeps (a context manager).
+
+    ``executor`` is the live executor (``None`` for serial), started on first use, so a pool
+    whose sweeps are all finished already starts no workers; ``renew()`` shuts it down and starts
+    a new one (after a local pool broke because a worker died). ``run_experiment(executor=pool)``
+    uses it and renews it when it breaks, so ``qrrt reproduce all`` pays the start of workers once.
+    """
+
+    def __init__(self, kind: str = "serial", jobs: int | None = None, scheduler: str | None = None,
+                 retries: int = 2, local_directory: str | None = None) -> None:
+        self.kind = kind
+        self.jobs = check_executor_args(kind, jobs, scheduler)
+        self.scheduler = scheduler
+        self.retries = retries
+        self.local_directory = local_directory
+        self._open = False
+        self._stack: contextlib.ExitStack | None = None
+        self._executor: Executor | None = None
+
+    @property
+    def executor(self) -> Executor | None:
+        if not self._open:
+            raise RuntimeError("WorkerPool is not open: use it as a context manager")
+        if self._stack is None:
+            self._start()
+        return self._executor
+
+    @property
+    def started(self) -> bool:
+        """Whether workers (or a client) are running now."""
+        return self._stack is not None
+
+    def __enter__(self) -> WorkerPool:
+        self._open = True
+        return self
+
+    def __exit__(self, *exc_info) -> None:
+        self._shut_down()
+        self._open = False
+
+    def _start(self) -> None:
+        stack = contextlib.ExitStack()
+        with stack:
+            self._executor = stack.enter_context(
+                _open(self.kind, self.jobs, self.scheduler, self.retries, self.local_directory))
+            self._stack = stack.pop_all()
+
+    def renew(self) -> None:
+        """Shut the executor down (a broken one too); the next use starts a fresh one."""
+        self._shut_down()
+
+    def _shut_down(self) -> None:
+        stack, self._stack, self._executor = self._stack, None, None
+        if stack is not None:
+            stack.close()

@@ -10,10 +10,12 @@ from all records at the end.
 
 from __future__ import annotations
 
+import contextlib
 import json
 from collections.abc import Callable
 from concurrent.futures import BrokenExecutor, Executor, as_completed
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from tqdm.auto import tqdm
 
@@ -21,7 +23,10 @@ from ..validation import check_int, check_optional_int
 from .base import Trial
 from .records import RecordWriter, read_records
 
-__all__ = ["execute_trial", "read_records", "run_experiment"]
+if TYPE_CHECKING:
+    from ..execution import WorkerPool
+
+__all__ = ["check_experiment_arguments", "execute_trial", "read_records", "run_experiment"]
 
 RECORDS = "records.csv"
 #: the most trials per variant ``--trials`` accepts (a trial list is built in memory)
@@ -71,6 +76,14 @@ def _check_arguments(name: str, trials, seed, executor, jobs, scheduler, predica
     return None
 
 
+def check_experiment_arguments(name: str, trials: int | None = None, seed: int = 0,
+                               executor: str | Executor | WorkerPool | None = None, jobs: int | None = None,
+                               scheduler: str | None = None, predicate: str = "exact") -> None:
+    """Refuse the arguments ``run_experiment`` would refuse, without doing anything (so a caller
+    running several experiments can check them all before starting workers)."""
+    _check_arguments(name, trials, seed, executor, jobs, scheduler, predicate)
+
+
 def _claim_directory(directory: Path, settings: dict) -> None:
     """Create ``directory`` for ``settings``, or accept it if it holds results for the same settings."""
     directory.mkdir(parents=True, exist_ok=True)
@@ -98,29 +111,38 @@ def _claim_directory(directory: Path, settings: dict) -> None:
 
 def _execute(kind: str | None, executor, name: str, todo: list[Trial], settings: dict, record_one,
              records_path: Path, jobs, scheduler, max_restarts: int, on_restart) -> None:
-    """Run ``todo`` serially, on a given executor, or on one built here (restarted if it breaks)."""
-    from ..execution import get_executor
+    """Run ``todo`` serially, on a given executor or ``WorkerPool``, or on a pool built here; a
+    pool whose executor breaks is renewed and the unfinished trials resubmitted."""
+    from ..execution import WorkerPool
 
+    if not todo:
+        return
     if kind == "serial":
         for trial in todo:
             record_one(execute_trial(name, trial, settings))
         return
-    if kind is None:
+    if kind is None and not isinstance(executor, WorkerPool):
         _run_on(executor, name, todo, settings, record_one)
         return
+    opened = contextlib.nullcontext(executor) if kind is None else WorkerPool(kind, jobs, scheduler)
     remaining = list(todo)
-    for attempt in range(max_restarts + 1):
-        with get_executor(kind, jobs, scheduler) as pool:
+    with opened as pool:
+        for attempt in range(max_restarts + 1):
             try:
-                _run_on(pool, name, remaining, settings, record_one)
+                if pool.executor is None:  # a serial WorkerPool
+                    for trial in remaining:
+                        record_one(execute_trial(name, trial, settings))
+                else:
+                    _run_on(pool.executor, name, remaining, settings, record_one)
                 return
             except BrokenExecutor:
                 if attempt == max_restarts:
                     raise
                 if on_restart:
                     on_restart(attempt + 1)
-        done_now = {r["trial_id"] for r in read_records(records_path)}
-        remaining = [t for t in remaining if t.id not in done_now]
+            done_now = {r["trial_id"] for r in read_records(records_path)}
+            remaining = [t for t in remaining if t.id not in done_now]
+            pool.renew()
 
 
 def _summarize(experiment, name: str, directory: Path, settings: dict, all_trials: list[Trial]) -> dict:
@@ -149,7 +171,7 @@ def run_experiment(
     quick: bool = False,
     trials: int | None = None,
     seed: int = 0,
-    executor: str | Executor | None = None,
+    executor: str | Executor | WorkerPool | None = None,
     jobs: int | None = None,
     scheduler: str | None = None,
     progress: bool = True,
@@ -162,9 +184,10 @@ def run_experiment(
     """Run (or resume) experiment ``name`` into ``out/name``; returns the summary.
 
     ``executor``: ``"serial"`` (default), ``"process"``, ``"dask"`` (built here with ``jobs`` and
-    ``scheduler``, see ``qrrt_circuits.execution``) or any ``concurrent.futures.Executor``.
+    ``scheduler``, see ``qrrt_circuits.execution``), an open ``qrrt_circuits.execution.WorkerPool``
+    (kept across several experiments, renewed if it breaks) or any ``concurrent.futures.Executor``.
     Records are written as trials finish, in whatever order. If a local process pool breaks (a
-    worker died), a new pool is started and the unfinished trials resubmitted, up to
+    worker died), a new pool is started (a given ``WorkerPool`` is renewed) and the unfinished trials resubmitted, up to
     ``max_restarts`` times; Dask reschedules a dead worker's tasks itself. ``stop_after`` stops
     after that many new trials (for tests of resuming). ``predicate`` (a ``PREDICATES`` name) is
     the reachability check the experiment's planners use, recorded in the settings.

@@ -1,0 +1,85 @@
+"""The benchmark entry point and comparison tool: discovery, flat figures, regressions flagged.
+
+Only the tools are tested here (on tiny synthetic files); no benchmark is run."""
+
+import json
+import sys
+from pathlib import Path
+
+import pytest
+
+BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
+sys.path.insert(0, str(BENCHMARKS))
+
+import _figures  # noqa: E402
+import compare  # noqa: E402
+import run  # noqa: E402
+
+
+def test_discovery_finds_every_bench_script_and_nothing_else():
+    found = run.discover()
+    assert {"search", "planners", "scaleout", "authors_check"} <= set(found)
+    assert all(path.name.startswith("bench_") and path.suffix == ".py" for path in found.values())
+    assert set(found) == {p.stem.removeprefix("bench_") for p in BENCHMARKS.glob("bench_*.py")}
+    assert list(found) == sorted(found)
+
+
+def test_run_refuses_an_unknown_benchmark_before_running_any(capsys):
+    with pytest.raises(SystemExit):
+        run.main(["--only", "no_such_bench"])
+    assert "unknown benchmark" in capsys.readouterr().err
+
+
+def test_machine_description_names_what_the_figures_depend_on():
+    machine = run.machine_description()
+    assert machine["cores"] >= 1 and machine["python"] and machine["date"]
+    assert {"qiskit", "qiskit-aer", "numpy", "numba"} <= set(machine["packages"])
+
+
+@pytest.mark.parametrize("key, way", [
+    ("search.summary.aer_n12_ms", _figures.LOWER),
+    ("scaleout.heatmaps.dask.s", _figures.LOWER),
+    ("planners.RRT.ms_per_node.median", _figures.LOWER),
+    ("search.reachability.paper_clutter.random.pairs_per_s", _figures.HIGHER),
+    ("scaleout.heatmaps.dask.speedup", _figures.HIGHER),
+    ("planners.RRT.calls_per_node.median", _figures.INFO),
+    ("search.search.aer.qubits4.marked", _figures.INFO),
+])
+def test_direction_of_a_figure(key, way):
+    assert _figures.direction(key) == way
+
+
+def test_flatten_names_list_items_by_their_identity_and_skips_samples_and_machine():
+    payload = {"machine": {"cores": 2}, "search": [{"backend": "aer", "qubits": 4, "median_s": 0.5},
+                                                     {"backend": "aer", "qubits": 8, "median_s": 0.9}],
+               "times_s": [1.0, 2.0], "reached": True, "note": "text"}
+    assert _figures.flatten(payload) == {"search.aer.qubits4.median_s": 0.5, "search.aer.qubits8.median_s": 0.9}
+    assert _figures.flatten({"figures": {"n12.ms": 45}, "other": 1}) == {"n12.ms": 45.0}
+
+
+def _write(path, figures):
+    path.write_text(json.dumps({"machine": {"cpu": "test"}, "quick": True, "benchmarks": {}, "figures": figures}))
+    return str(path)
+
+
+def test_compare_flags_a_slower_time_and_a_lower_throughput_only(tmp_path, capsys):
+    old = _write(tmp_path / "old.json", {"search.n12.ms": 10.0, "search.pairs_per_s": 1000.0, "scaleout.x.s": 5.0,
+                                         "planners.calls_per_node": 3.0, "gone.ms": 1.0})
+    new = _write(tmp_path / "new.json", {"search.n12.ms": 13.0, "search.pairs_per_s": 700.0, "scaleout.x.s": 5.2,
+                                         "planners.calls_per_node": 30.0, "added.ms": 1.0})
+    assert compare.main([new, old, "--threshold", "0.2"]) == 1
+    printed = capsys.readouterr().out
+    regressions = printed.split("REGRESSIONS:")[1]
+    assert "search.n12.ms" in regressions and "search.pairs_per_s" in regressions
+    assert "scaleout.x.s" not in regressions and "calls_per_node" not in printed  # within 20 %; informational
+    rows = {row["key"]: row for row in compare.compare(compare.figures_of(json.loads(Path(new).read_text())),
+                                                       compare.figures_of(json.loads(Path(old).read_text())), 0.2)}
+    assert rows["search.n12.ms"]["worse"] == pytest.approx(1.3)
+    assert rows["search.pairs_per_s"]["worse"] == pytest.approx(1000 / 700)
+    assert set(rows) == {"search.n12.ms", "search.pairs_per_s", "scaleout.x.s"}
+
+
+def test_compare_of_a_faster_run_reports_no_regression(tmp_path):
+    old = _write(tmp_path / "old.json", {"search.n12.ms": 10.0, "search.pairs_per_s": 1000.0})
+    new = _write(tmp_path / "new.json", {"search.n12.ms": 5.0, "search.pairs_per_s": 1000.0})
+    assert compare.main([new, old]) == 0
