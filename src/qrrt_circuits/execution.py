@@ -126,7 +126,7 @@ def _warm_fork_server(extra_preload: tuple[str, ...] = ()) -> Iterator[str]:
     from multiprocessing import forkserver
 
     server = forkserver._forkserver  # the standard library's one per process
-    started_here = server._forkserver_pid is None
+    started_here = server._forkserver_pid is None  # type: ignore[attr-defined]  # private, see docstring
     if started_here:
         multiprocessing.get_context("forkserver").set_forkserver_preload([*extra_preload, *WORKER_PRELOAD])
         with _single_thread_environment():
