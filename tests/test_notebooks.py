@@ -5,6 +5,13 @@ manager is given no kernel directories, so "python3" resolves to ipykernel's bui
 (``sys.executable -m ipykernel_launcher``) and never to a user- or system-level kernelspec that
 may point at another Python. A cell appended to the in-memory copy checks that the kernel runs
 in this environment (same ``sys.prefix``, e.g. the project's .venv).
+
+The docs build (``python -m sphinx ... docs docs/_build/html``, myst-nb in cache mode) executes the
+same tutorials and keeps each executed copy in ``docs/_build/.jupyter_cache``, keyed by a hash of
+the notebook's code; jupyter-cache stores only executions that raised no error, and the build
+refuses a kernel that is not its own interpreter. When that cache holds this exact code (CI builds
+the docs just before the suite), the test checks the cached outputs instead of running the
+notebook a second time; otherwise it executes the notebook itself.
 """
 
 import sys
@@ -18,6 +25,7 @@ from jupyter_client.manager import AsyncKernelManager
 from traitlets import default
 
 NOTEBOOKS_DIR = Path(__file__).resolve().parent.parent / "notebooks"
+DOCS_EXECUTION_CACHE = NOTEBOOKS_DIR.parent / "docs" / "_build" / ".jupyter_cache"
 NOTEBOOKS = [
     "01_grover_search_on_aer.ipynb",
     "02_qrrt_planning.ipynb",
@@ -47,12 +55,35 @@ def _stream_text(cell) -> str:
     return "".join(out.get("text", "") for out in cell.get("outputs", []) if out.output_type == "stream")
 
 
+def executed_by_docs_build(nb):
+    """The docs build's executed copy of ``nb`` (same code), or None if it has none."""
+    if not DOCS_EXECUTION_CACHE.is_dir():
+        return None
+    try:
+        from jupyter_cache import get_cache
+    except ImportError:  # the docs extra is not installed
+        return None
+    cache = get_cache(DOCS_EXECUTION_CACHE)
+    try:
+        record = cache.match_cache_notebook(nb)
+    except KeyError:
+        return None
+    return cache.get_cache_bundle(record.pk).nb
+
+
 @pytest.mark.parametrize("name", NOTEBOOKS)
 def test_notebook_executes(name):
     nb = nbformat.read(NOTEBOOKS_DIR / name, as_version=4)
     assert all(not cell.get("outputs") for cell in nb.cells if cell.cell_type == "code"), (
         f"{name} is stored with outputs; clear them before committing"
     )
+    cached = executed_by_docs_build(nb)
+    if cached is not None:
+        unexecuted = [c.source[:60] for c in cached.cells if c.cell_type == "code" and c.source.strip()
+                      and not c.get("execution_count")]
+        assert not unexecuted, f"the docs build's copy of {name} has unexecuted cells: {unexecuted}"
+        check_outputs(name, cached)
+        return
     nb.cells.append(nbformat.v4.new_code_cell(f"import sys; print({INTERPRETER_MARK!r} + sys.prefix)"))
 
     client = nbclient.NotebookClient(
@@ -67,7 +98,11 @@ def test_notebook_executes(name):
     reported = _stream_text(nb.cells[-1]).strip()
     assert reported.startswith(INTERPRETER_MARK), reported
     assert Path(reported.removeprefix(INTERPRETER_MARK)) == Path(sys.prefix), "kernel runs another Python"
+    check_outputs(name, nb)
 
+
+def check_outputs(name, nb):
+    """No error output, and at least one figure."""
     errors = [out for cell in nb.cells for out in cell.get("outputs", []) if out.output_type == "error"]
     assert not errors, errors
     images = [

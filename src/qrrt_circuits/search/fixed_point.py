@@ -113,7 +113,7 @@ def fixed_point_success_probability(delta: float, iterates: int, fraction: float
 
 @dataclass(frozen=True, eq=False)
 class IterateSequence:
-    """Generalized Grover iterates G(alpha_j, beta_j), applied to |s> in order j = 1, 2, ...
+    """Generalized Grover iterates G(alpha_j, beta_j), applied to ``|s>`` in order j = 1, 2, ...
 
     ``oracle_calls`` = l per preparation (one phase oracle per iterate)."""
 
@@ -158,7 +158,7 @@ class IterateSequence:
     def marked_amplitude(self, fraction: float) -> tuple[complex, complex]:
         """(amplitude on the normalized marked state, on the unmarked one) after the sequence, for
         marked fraction ``fraction``: the exact 2-dimensional evolution (every operator keeps the
-        span of |T> and |s>)."""
+        span of ``|T>`` and ``|s>``)."""
         f = check_float(fraction, "fraction", 0.0, 1.0)
         s = np.array([math.sqrt(f), math.sqrt(1.0 - f)], dtype=complex)
         psi = s.copy()
