@@ -26,6 +26,7 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 from _common import RESULTS, machine
 
@@ -99,6 +100,7 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--database", action="store_true", help="also the database cases (d = 2, 4, 6)")
     parser.add_argument("--aer-iterations", action="store_true", help="also Aer at n = 18 for k = 1..10")
+    parser.add_argument("--out", default=None, help="the JSON to write (default benchmarks/results/bench_memory.json)")
     parser.add_argument("--case", nargs="+", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.case:
@@ -126,7 +128,7 @@ def main() -> None:
               f"{row.get('iterations', '-')!s:>3s} {row['estimated_bytes'] / MIB:14.1f} "
               f"{row['measured_bytes'] / MIB:13.1f} {ratio:9.2f}", flush=True)
     RESULTS.mkdir(exist_ok=True)
-    path = RESULTS / "bench_memory.json"
+    path = Path(args.out) if args.out else RESULTS / "bench_memory.json"
     path.write_text(json.dumps({"machine": machine(), "rows": rows,
                                 "note": "peak RSS increment over a warmed-up baseline, one subprocess per case"},
                                indent=1))
