@@ -81,7 +81,7 @@ class ParallelRRT(Planner):
                          executor=executor)
 
     def _round(self, state: RunState) -> None:
-        outcomes = map_tasks(self.executor, classical_extension, state.context, self._view(state),
+        outcomes = map_tasks(self.executor, classical_extension, state.worker_context, self._view(state),
                              range(self.workers))
         longest = 1
         for outcome in outcomes:

@@ -48,6 +48,13 @@ class WorkerContext:
     backend: QuantumSearchBackend | None = None
     annealing: AnnealingSchedule | None = None
     database_size: int = 1
+
+    @property
+    def search_backend(self) -> QuantumSearchBackend:
+        """The quantum planners' backend (classical planners' contexts have none)."""
+        if self.backend is None:
+            raise RuntimeError("this worker context has no search backend (a classical planner's)")
+        return self.backend
     token: str = field(default_factory=lambda: uuid.uuid4().hex, compare=False)
 
     def __reduce__(self):
@@ -84,6 +91,13 @@ class RoundView:
     round_index: int
     temperature_index: int = 0
     policy_state: PolicyState | None = None
+
+    @property
+    def search_policy_state(self) -> PolicyState:
+        """The quantum planners' policy state (classical planners' rounds have none)."""
+        if self.policy_state is None:
+            raise RuntimeError("this round has no search policy state (a classical planner's)")
+        return self.policy_state
 
     @property
     def tree_nodes(self) -> int:

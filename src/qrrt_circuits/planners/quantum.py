@@ -60,12 +60,12 @@ def search_databases_together(context: WorkerContext, view: RoundView,
     if not groups:
         return []
     built = [make_database(context, view, first) for first, _ in groups]
-    problems = [DatabaseSearch(marks, truth, context.backend, context.streams, view.round_index, first)
+    problems = [DatabaseSearch(marks, truth, context.search_backend, context.streams, view.round_index, first)
                 for (_, truth, marks), (first, _) in zip(built, groups, strict=True)]
     workers = groups[0][1]
     if any(count != workers for _, count in groups):
         raise ValueError("search_databases_together needs groups of one size")
-    outcomes = view.policy_state.run_many(problems, workers, view.tree_nodes)
+    outcomes = view.search_policy_state.run_many(problems, workers, view.tree_nodes)
     results = []
     for (db, truth, _), found_by in zip(built, outcomes, strict=True):
         found = tuple(None if outcome.index is None else (db.children[outcome.index], int(db.parents[outcome.index]))
@@ -174,13 +174,14 @@ class PQRRT(Planner):
     def _round(self, state: RunState) -> None:
         view = self._view(state, self._temperature_index(state))
         if self.executor is None:  # the round's searches go to the backend together (same outcomes)
-            results = search_databases_together(state.context, view, self._worker_groups())
+            results = search_databases_together(state.worker_context, view, self._worker_groups())
         else:
-            results = map_tasks(self.executor, search_database, state.context, view, self._worker_groups())
+            results = map_tasks(self.executor, search_database, state.worker_context, view,
+                                self._worker_groups())
         longest = 0
         for result in results:
             longest = max(longest, self._integrate(state, result))
-        state.policy_state.learn(outcome for result in results for outcome in result.outcomes)
+        state.search_policy_state.learn(outcome for result in results for outcome in result.outcomes)
         state.critical_path += longest
 
     @staticmethod
@@ -198,7 +199,7 @@ class PQRRT(Planner):
             state.verification_calls += outcome.verifications
             state.rejected += outcome.rejected
             longest = max(longest, outcome.oracle_calls)
-            if found is None:
+            if found is None or outcome.index is None:
                 continue
             if outcome.index in added:
                 state.duplicates += 1

@@ -2,10 +2,16 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..termination import Progress
 from ..tree import Tree
+
+if TYPE_CHECKING:  # annotations only (context imports the search modules)
+    from ..search.policies import PolicyState
+    from .context import WorkerContext
 
 HISTORY_KEYS = ("oracle_calls", "critical_path", "nodes", "entries", "reachable")
 
@@ -32,8 +38,22 @@ class RunState:
         self.round_entries = 0
         self.round_reachable = 0
         self._nodes_at_round_start = 0
-        self.policy_state = None
-        self.context = None  # the plan's WorkerContext, built once
+        self.policy_state: PolicyState | None = None  # quantum planners only
+        self.context: WorkerContext | None = None  # the plan's WorkerContext, built once
+
+    @property
+    def worker_context(self) -> WorkerContext:
+        """The plan's worker context (set when the plan starts)."""
+        if self.context is None:
+            raise RuntimeError("the plan has not started: no worker context yet")
+        return self.context
+
+    @property
+    def search_policy_state(self) -> PolicyState:
+        """The quantum planners' policy state (set when the plan starts)."""
+        if self.policy_state is None:
+            raise RuntimeError("this plan has no search policy state (a classical planner's)")
+        return self.policy_state
 
     @property
     def oracle_calls(self) -> int:

@@ -73,8 +73,8 @@ def search_database(context: WorkerContext, view: RoundView, group: tuple[int, i
     """Workers ``first, ..., first + count - 1`` search one database built by worker ``first``."""
     first, count = group
     db, truth, marks = make_database(context, view, first)
-    problem = DatabaseSearch(marks, truth, context.backend, context.streams, view.round_index, first)
-    outcomes = view.policy_state.run(problem, count, view.tree_nodes)
+    problem = DatabaseSearch(marks, truth, context.search_backend, context.streams, view.round_index, first)
+    outcomes = view.search_policy_state.run(problem, count, view.tree_nodes)
     found = tuple(None if outcome.index is None else (db.children[outcome.index], int(db.parents[outcome.index]))
                   for outcome in outcomes)
     return DatabaseOutcome(int(truth.shape[0]), int(np.count_nonzero(truth)), outcomes, found)
