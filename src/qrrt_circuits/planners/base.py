@@ -127,10 +127,43 @@ class Planner:
         termination: TerminationCondition | None = None,
     ) -> PlanResult:
         """Grow a tree from ``start`` until a node lands within ``goal_radius`` of ``goal`` or the
-        termination condition ends the plan. ``start``, ``goal`` and ``goal_radius`` default to the
-        environment's. The ``max_*`` and ``stall_rounds`` keywords are shorthands for the conditions
-        of ``qrrt_circuits.termination``; they combine (any of them ends the plan) with
-        ``termination``. A round limit (``DEFAULT_MAX_ROUNDS``) is added unless one is given."""
+        termination condition ends the plan (paper Alg. 1 for RRT, Alg. 2 for q-RRT, Alg. 3 for
+        Pq-RRT; Alg. 4 with an annealing schedule).
+
+        The ``max_*`` and ``stall_rounds`` keywords are shorthands for the conditions of
+        ``qrrt_circuits.termination``; they combine (any of them ends the plan) with
+        ``termination``. A round limit (``DEFAULT_MAX_ROUNDS``) and a stall limit
+        (``DEFAULT_STALL_ROUNDS``) are added unless the condition has its own, so every plan ends.
+        Conditions are checked before each round, so a round may overshoot an oracle-call budget
+        by less than one round's cost.
+
+        Args:
+            start: Root of the tree, shape (d,); default the environment's start. A start on the
+                workspace boundary, which the exact check can never leave, is refused.
+            goal: Goal point, shape (d,); default the environment's goal.
+            goal_radius: Radius of the goal ball (> 0); default the environment's. A start already
+                inside the ball is reached at once.
+            max_oracle_calls: End after this many oracle calls (DESIGN §2 counting).
+            max_nodes: End once the tree has this many nodes besides the root.
+            max_rounds: End after this many rounds.
+            max_time_s: End after this much wall time (seconds).
+            max_critical_path_calls: End after this many critical-path oracle calls (per round the
+                largest of any worker: the time of p parallel quantum devices).
+            stall_rounds: End after this many consecutive rounds without a new node.
+            termination: Any ``TerminationCondition`` (compose them with ``|``).
+
+        Returns:
+            A frozen ``PlanResult``: ``status`` (``PlanStatus``: ``"reached"`` or the condition that
+            ended the plan), the tree (``nodes``, ``parents``, ``tree``), ``path``, ``metrics``
+            (oracle calls as DESIGN §2 counts them), ``history``, ``settings`` and ``labels`` (every
+            simulation shortcut the numbers depend on).
+
+        Raises:
+            ValueError: A point outside the workspace or inside an obstacle, a boundary start, a
+                non-positive radius or budget, or a dimension mismatch, before any work.
+            TypeError: An argument of the wrong type (e.g. a ``termination`` that is not a
+                ``TerminationCondition``).
+        """
         start, goal, goal_radius = self._check_problem(start, goal, goal_radius)
         condition = from_budgets(max_oracle_calls, max_nodes, max_rounds, max_time_s,
                                  max_critical_path_calls, stall_rounds)

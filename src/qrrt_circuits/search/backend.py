@@ -105,8 +105,27 @@ class QuantumSearchBackend(abc.ABC):
     ) -> SearchResult:
         """Grover-search ``marks`` with ``iterations`` iterations; measure ``shots`` times.
 
-        ``seed`` seeds this call only (planners pass one per round and worker, so their results do
-        not depend on the order of calls); by default the backend's own stream is used.
+        Prepares W|0> = H^n|0>, applies Q^k with Q = ``grover_operator(phase_oracle(marks), W)``
+        (paper Alg. 2, lines 4-8; ``qrrt_circuits.search.circuits``) and measures; a marked index comes out with probability sin^2((2k+1) theta),
+        sin^2 theta = m / 2^n (paper Eq. 1, Lemma 1). Each shot is one worker's independent
+        preparation.
+
+        Args:
+            marks: Boolean array of length 2^n: the phase oracle's marked entries.
+            iterations: k, the Grover iterations (0 .. ``MAX_ITERATIONS``).
+            shots: Independent preparations and measurements (1 .. ``MAX_SHOTS``).
+            seed: Seeds this call only (planners pass one per round and worker, so their results
+                do not depend on the order of calls); by default the backend's own stream.
+
+        Returns:
+            ``SearchResult`` with ``indices`` (one measured index per shot), ``iterations``,
+            ``shots`` and ``oracle_calls = iterations * shots`` (DESIGN §2).
+
+        Raises:
+            ValueError: ``marks`` not of length 2^n (n >= 1), n above ``max_qubits``, an estimated
+                peak memory that does not fit (``qrrt_circuits.memory``), or ``iterations`` /
+                ``shots`` out of range, before any work.
+            TypeError: Arguments of the wrong type.
         """
         prepared = self._prepare(SearchRequest(marks, iterations, shots, seed))
         return self._finish(prepared, self._sample(*prepared))
