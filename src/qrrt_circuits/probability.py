@@ -43,13 +43,38 @@ def good_probability(num_items: int, num_marked: int, iterations: int) -> float:
 
 
 def success_probability(num_items: int, num_marked: int, iterations: int) -> float:
-    """P(G) = sin^2((2k+1) theta), sin^2 theta = m/N (Lemma 1; Boyer et al. 1998)."""
+    """P(G) = sin^2((2k+1) theta), sin^2 theta = m/N (Lemma 1; Boyer et al. 1998).
+
+    Args:
+        num_items: N, the database size (>= 1).
+        num_marked: m, the marked entries (0 .. N).
+        iterations: k, the Grover iterations (>= 0).
+
+    Returns:
+        The probability that one measurement after k iterations is a marked entry (0 if m = 0).
+
+    Raises:
+        ValueError: N < 1, m outside [0, N] or k < 0.
+        TypeError: A non-integer count.
+    """
     num_items, num_marked = _marked(num_items, num_marked)
     return good_probability(num_items, num_marked, _count(iterations, "iterations"))
 
 
 def optimal_iterations(num_items: int, num_marked: int) -> int:
-    """floor(pi / (4 theta)) with sin^2 theta = m/N, and 0 for m = 0 (Eq. 1, DESIGN §2)."""
+    """floor(pi / (4 theta)) with sin^2 theta = m/N, and 0 for m = 0 (Eq. 1, DESIGN §2).
+
+    Args:
+        num_items: N, the database size (>= 1).
+        num_marked: m, the marked entries (0 .. N).
+
+    Returns:
+        The iteration count that maximises P(G) up to the floor (the paper's optimal k).
+
+    Raises:
+        ValueError: N < 1 or m outside [0, N].
+        TypeError: A non-integer count.
+    """
     num_items, num_marked = _marked(num_items, num_marked)
     if num_marked == 0:
         return 0
@@ -58,7 +83,20 @@ def optimal_iterations(num_items: int, num_marked: int) -> int:
 
 
 def prob_all_same(workers: int, num_marked: int, p_good: float) -> float:
-    """Lemma 1: P(all p workers measure the same solution) = P(G)^p m^(1-p) (0 if m = 0)."""
+    """Lemma 1: P(all p workers measure the same solution) = P(G)^p m^(1-p) (0 if m = 0).
+
+    Args:
+        workers: p, independent preparations of one shared database (>= 1).
+        num_marked: m, the marked entries (>= 0).
+        p_good: P(G), one worker's probability of measuring a marked entry, in [0, 1].
+
+    Returns:
+        The probability that all p measurements are the same marked entry.
+
+    Raises:
+        ValueError: p < 1, m < 0 or P(G) outside [0, 1].
+        TypeError: A non-integer count or a non-numeric probability.
+    """
     workers = _count(workers, "workers", 1)
     num_marked = _count(num_marked, "num_marked")
     p_good = _probability(p_good, "p_good")
@@ -71,6 +109,18 @@ def prob_all_different(workers: int, num_marked: int, p_good: float) -> float:
     """Lemma 2: P(all p workers measure different solutions) = P(G)^p m! / (m^p (m-p)!).
 
     Stated for m >= p; for p > m it is 0 (pigeonhole), which the formula's (m-p)! cannot say.
+
+    Args:
+        workers: p (>= 1).
+        num_marked: m (>= 0).
+        p_good: P(G) in [0, 1].
+
+    Returns:
+        The probability that the p measurements are p distinct marked entries.
+
+    Raises:
+        ValueError: p < 1, m < 0 or P(G) outside [0, 1].
+        TypeError: A non-integer count or a non-numeric probability.
     """
     workers = _count(workers, "workers", 1)
     num_marked = _count(num_marked, "num_marked")
@@ -85,6 +135,17 @@ def expected_workers_all_found(num_marked: int, p_good: float) -> float:
     """Lemma 3: expected workers (draws) to find all m solutions, E(p) = m H_m / P(G).
 
     Coupon collection where each draw fails with probability 1 - P(G). Infinite if P(G) = 0 < m.
+
+    Args:
+        num_marked: m (>= 0).
+        p_good: P(G) in [0, 1].
+
+    Returns:
+        The expected number of workers until every marked entry has been measured.
+
+    Raises:
+        ValueError: m < 0 or P(G) outside [0, 1].
+        TypeError: A non-integer count or a non-numeric probability.
     """
     num_marked = _count(num_marked, "num_marked")
     p_good = _probability(p_good, "p_good")
@@ -111,7 +172,26 @@ def _error_counts(num_items, num_marked, true_marked, missed_good) -> tuple[int,
 
 def prob_true_solution(num_items: int, num_marked: int, true_marked: int, missed_good: int,
                        p_good: float) -> float:
-    """Lemma 4: P(G*) = (m1/m) P(G) + (m2/(N-m)) (1 - P(G)), a truly good entry is measured."""
+    """Lemma 4: P(G*) = (m1/m) P(G) + (m2/(N-m)) (1 - P(G)), a truly good entry is measured.
+
+    With oracle errors (DESIGN §2, ``OracleErrorModel``) the oracle marks m entries of which m1
+    are truly good, and misses m2 truly good entries among the N - m it leaves unmarked. (The
+    paper's q = (1 - m1)/m is a typo for (m - m1)/m.)
+
+    Args:
+        num_items: N (>= 1).
+        num_marked: m, entries the (erroneous) oracle marks (0 .. N).
+        true_marked: m1, the truly good entries among them (0 .. m).
+        missed_good: m2, truly good entries the oracle leaves unmarked (0 .. N - m).
+        p_good: P(G), the probability of measuring a marked entry, in [0, 1].
+
+    Returns:
+        P(G*), the probability that one measurement is a truly good entry.
+
+    Raises:
+        ValueError: A count outside its range or P(G) outside [0, 1].
+        TypeError: A non-integer count or a non-numeric probability.
+    """
     n_items, m, m1, m2 = _error_counts(num_items, num_marked, true_marked, missed_good)
     p_good = _probability(p_good, "p_good")
     marked_part = m1 / m * p_good if m else 0.0
@@ -122,7 +202,23 @@ def prob_true_solution(num_items: int, num_marked: int, true_marked: int, missed
 def prob_all_same_with_errors(workers: int, num_items: int, num_marked: int, true_marked: int,
                               missed_good: int, p_good: float) -> float:
     """Lemma 5: P(all p workers measure the same truly good entry)
-    = m1 (P(G)/m)^p + m2 ((1 - P(G))/(N - m))^p."""
+    = m1 (P(G)/m)^p + m2 ((1 - P(G))/(N - m))^p.
+
+    Args:
+        workers: p (>= 1).
+        num_items: N (>= 1).
+        num_marked: m (0 .. N).
+        true_marked: m1 (0 .. m).
+        missed_good: m2 (0 .. N - m).
+        p_good: P(G) in [0, 1].
+
+    Returns:
+        The probability that all p workers measure one and the same truly good entry.
+
+    Raises:
+        ValueError: A count outside its range or P(G) outside [0, 1].
+        TypeError: A non-integer count or a non-numeric probability.
+    """
     workers = _count(workers, "workers", 1)
     n_items, m, m1, m2 = _error_counts(num_items, num_marked, true_marked, missed_good)
     p_good = _probability(p_good, "p_good")
@@ -133,7 +229,21 @@ def prob_all_same_with_errors(workers: int, num_items: int, num_marked: int, tru
 
 def expected_workers_with_errors(num_marked: int, true_marked: int, p_good: float) -> float:
     """Lemma 6: expected workers to find all m1 truly good marked entries,
-    E(p*) = m1 H_{m1} / ((m1/m) P(G)) = m H_{m1} / P(G)."""
+    E(p*) = m1 H_{m1} / ((m1/m) P(G)) = m H_{m1} / P(G).
+
+    Args:
+        num_marked: m (>= 0).
+        true_marked: m1 (0 .. m).
+        p_good: P(G) in [0, 1].
+
+    Returns:
+        The expected number of workers until every truly good marked entry has been measured
+        (infinite if P(G) = 0 < m1).
+
+    Raises:
+        ValueError: A count outside its range or P(G) outside [0, 1].
+        TypeError: A non-integer count or a non-numeric probability.
+    """
     num_marked = _count(num_marked, "num_marked")
     true_marked = _count(true_marked, "true_marked")
     if true_marked > num_marked:
