@@ -491,9 +491,30 @@ def authors_check(parents, children, M, horizon, rtol, atol, refine, rast_num, t
 
 
 class AuthorsCheck:
-    """The authors' ``dynamicscheck.m`` as a batch reachability predicate (unsound; see the module
-    docstring). ``refine == 1`` reproduces Octave 7's ode45 (the reference verdicts), ``refine >=
-    2`` MATLAB's ode45 with that Refine (MATLAB's default is 4)."""
+    """The authors' ``dynamicscheck.m`` as a batch reachability predicate (unsound; DESIGN §2).
+
+    Integrates the tracking error with a port of ``ode45`` and tests the parent, the rasterized
+    segments between the first 25 outputs and the outputs 26 .. 50 against the closed boxes (the
+    workspace bounds are not tested); see the module docstring for the exact rules.
+
+    Args:
+        env: The ``Environment``.
+        dynamics: ``LinearTrackingDynamics`` of the same dimension (default: the paper's).
+        rast_num: Points tested per segment, 1 .. 1 000 000 (the authors' 37).
+        refine: 1 reproduces Octave 7's ode45 (the reference verdicts); 2 .. 10 000 MATLAB's
+            ode45 with that Refine (MATLAB's default, and ours, is 4). The class attributes
+            ``rel_tol`` (1e-3) and ``abs_tol`` (1e-6) are ode45's default tolerances.
+
+    Attributes:
+        name: ``"authors-octave"`` (refine 1) or ``"authors"``.
+        evaluations: Pairs evaluated so far.
+
+    Raises:
+        TypeError: ``env`` not an ``Environment``, ``dynamics`` not a ``LinearTrackingDynamics``,
+            or a non-integer ``rast_num`` / ``refine``.
+        ValueError: A dynamics dimension other than ``env.dim``, or ``rast_num`` / ``refine`` out
+            of range.
+    """
 
     rel_tol = REL_TOL
     abs_tol = ABS_TOL
@@ -528,12 +549,24 @@ class AuthorsCheck:
         return "octave" if self.refine == 1 else "matlab"
 
     def describe(self) -> dict:
+        """Name, rast_num, refine, tolerances, integrator, ``sound: False`` and the dynamics."""
         return {"name": self.name, "rast_num": self.rast_num, "refine": self.refine,
                 "rel_tol": self.rel_tol, "abs_tol": self.abs_tol, "integrator": self.integrator,
                 "sound": False, "dynamics": self.dynamics.describe()}
 
     def reachable(self, parents: np.ndarray, children: np.ndarray) -> np.ndarray:
-        """Bool (M,): does ``dynamicscheck`` accept each (parent, child) pair?"""
+        """Does ``dynamicscheck`` accept each (parent, child) pair?
+
+        Args:
+            parents: Float array (M, d), finite.
+            children: Float array of the same shape.
+
+        Returns:
+            Bool array (M,); adds M to ``evaluations``.
+
+        Raises:
+            ValueError: Shapes other than (M, d), different shapes, or non-finite coordinates.
+        """
         parents, children = as_pairs(parents, children, self.dim)
         out = np.zeros(parents.shape[0], dtype=np.int64)
         capacity = POINT_OUTPUTS + self.refine
@@ -542,8 +575,18 @@ class AuthorsCheck:
         return out.astype(np.bool_)
 
     def ode45_outputs(self, parent: np.ndarray, child: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``(times (n,), points (n, d))``: every output of the solver for one pair (all n, not
-        only the 50 the check uses); points are e + child, the first is the parent at t = 0."""
+        """Every output of the ported ode45 for one pair (all n, not only the 50 the check uses).
+
+        Args:
+            parent: One point (d,) (or (1, d)).
+            child: One point of the same shape.
+
+        Returns:
+            ``(times (n,), points (n, d))``; points are e + child, the first the parent at t = 0.
+
+        Raises:
+            ValueError: More than one pair, bad shapes or non-finite coordinates.
+        """
         parents, children = as_pairs(parent, child, self.dim)
         if parents.shape[0] != 1:
             raise ValueError(f"ode45_outputs takes one pair, got {parents.shape[0]}")

@@ -26,7 +26,22 @@ PAPER_K = ((1.9, -7.5), (1.0, 7.0))
 
 @dataclass(frozen=True, eq=False)
 class LinearTrackingDynamics:
-    """xdot = A x + B u, u = -K (x - c) + u_ff; closed loop M = A - B K must be Hurwitz."""
+    """Closed-loop linear tracking dynamics (paper §V, DESIGN §2).
+
+    xdot = A x + B u with u = -K (x - c) + u_ff, so the motion from a parent p towards a target c
+    is x(t) = c + expm(M t)(p - c), M = A - B K, t in [0, ``horizon``]. M must be Hurwitz.
+
+    Args:
+        A: Float (d, d), d >= 1, finite.
+        B: Float (d, m), finite.
+        K: Float (m, d), finite.
+        horizon: T, the motion's duration (> 0; the authors integrate over 5 s).
+
+    Raises:
+        TypeError: A, B or K not a real numeric matrix (bool included).
+        ValueError: Mismatched shapes, non-finite entries, ``horizon`` <= 0, or a closed loop
+            A - B K with an eigenvalue of non-negative real part.
+    """
 
     A: np.ndarray
     B: np.ndarray
@@ -66,7 +81,19 @@ class LinearTrackingDynamics:
 
     @classmethod
     def paper(cls, horizon: float = 5.0) -> LinearTrackingDynamics:
-        """The paper's A, B, K (§V); closed loop diag(-2.7, -4)."""
+        """The paper's dynamics (§V): A = [[-1.5, -2], [1, 3]], B = [[0.5, 0.25], [0, 1]],
+        K = [[1.9, -7.5], [1, 7]]; closed loop A - B K = diag(-2.7, -4).
+
+        Args:
+            horizon: T, > 0 (the authors' code integrates over 5 s).
+
+        Returns:
+            The ``LinearTrackingDynamics`` in d = 2.
+
+        Raises:
+            ValueError: ``horizon`` <= 0 or not finite.
+            TypeError: A non-numeric ``horizon``.
+        """
         return cls(np.array(PAPER_A), np.array(PAPER_B), np.array(PAPER_K), horizon=horizon)
 
     @property
@@ -102,10 +129,24 @@ class LinearTrackingDynamics:
     def trajectory(
         self, parent: np.ndarray, child: np.ndarray, num: int = 100, dense: int = 4000
     ) -> np.ndarray:
-        """``num`` points along x(t), t in [0, T], evenly spaced in arc length (ends included).
+        """``num`` points along x(t) = c + expm(M t)(p - c), t in [0, T], evenly spaced in arc length.
 
-        Arc length is integrated on ``dense`` time samples (geometric near t = 0, where the motion
-        is fastest) and inverted by linear interpolation.
+        Arc length is integrated on ``dense`` time samples (``dense_times``: geometric near t = 0,
+        where the motion is fastest) and inverted by linear interpolation. The ends (the parent at
+        t = 0 and x(T)) are included; a motion of zero length repeats the parent.
+
+        Args:
+            parent: p, (d,) (any shape with d elements).
+            child: c, the target, (d,).
+            num: Points returned, 2 .. 10 000 000.
+            dense: Time samples for the arc-length integration.
+
+        Returns:
+            Float array (num, d).
+
+        Raises:
+            ValueError: ``num`` out of range, or ``parent`` / ``child`` without d coordinates.
+            TypeError: A non-integer ``num``.
         """
         check_int(num, "num", 2, 10_000_000)
         times = self.dense_times(dense)
@@ -130,7 +171,7 @@ class LinearTrackingDynamics:
     def curvature_bound_times(
         self, max_error: float, resolution: float, max_step: float | None = None
     ) -> tuple[np.ndarray, np.ndarray]:
-        """A time grid and per-interval bounds a_i >= max ||M^2 expm(M t)||_2 on [t_i, t_{i+1}].
+        """A time grid and per-interval bounds ``a_i >= max ||M^2 expm(M t)||_2`` on ``[t_i, t_{i+1}]``.
 
         On an interval of length h the curve stays within ``h^2/8 * |e| * a_i`` of its chord
         (interpolation error bound with ``|x''(t)| = |M^2 expm(M t) e|``). The grid is fine enough

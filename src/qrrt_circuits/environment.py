@@ -54,10 +54,26 @@ def _metadata(value: Any) -> dict:
 
 @dataclass(frozen=True, eq=False)
 class Environment:
-    """Workspace ``bounds`` (d, 2) and box obstacles ``boxes`` (k, 2, d).
+    """The world (DESIGN §3, §4): workspace ``bounds`` (d, 2) and box obstacles ``boxes`` (k, 2, d).
 
-    ``boxes[i, 0]`` is the lower corner of box i and ``boxes[i, 1]`` its upper corner.
-    ``start``, ``goal`` and ``goal_radius`` are optional: scenarios fill them in.
+    ``boxes[i, 0]`` is the lower corner of box i and ``boxes[i, 1]`` its upper corner; boxes and
+    the workspace are closed. ``start``, ``goal`` and ``goal_radius`` are optional: scenarios fill
+    them in. Arrays are stored read-only; the object is frozen.
+
+    Args:
+        bounds: Float (d, 2), d >= 2: low < high per axis, within [-1e12, 1e12] (``MAX_EXTENT``).
+        boxes: Float (k, 2, d), k >= 0: lower corner <= upper corner on every axis.
+        name: The scenario's name (``"custom"`` by default).
+        start: Float (d,) or None.
+        goal: Float (d,) or None.
+        goal_radius: A float > 0 or None.
+        metadata: Free-form JSON-serialisable dict (scenario parameters).
+
+    Raises:
+        ValueError: Non-numeric or non-finite arrays, wrong shapes, low >= high on an axis, bounds
+            beyond ``MAX_EXTENT``, a box with lower > upper, a start / goal without d coordinates,
+            or a ``goal_radius`` that is not > 0.
+        TypeError: A non-numeric ``goal_radius``.
     """
 
     bounds: np.ndarray
@@ -125,12 +141,34 @@ class Environment:
         return float(np.prod(self.bounds[:, 1] - self.bounds[:, 0]))
 
     def in_bounds(self, points: np.ndarray) -> np.ndarray:
-        """True where ``points`` (..., d) lie in the closed workspace box."""
+        """True where ``points`` lie in the closed workspace box (obstacles ignored).
+
+        Args:
+            points: Float array (..., d); non-finite coordinates are allowed and never in bounds.
+
+        Returns:
+            Bool array of shape ``points.shape[:-1]``.
+
+        Raises:
+            ValueError: The last dimension is not d.
+        """
         points = self._check_points(points)
         return np.all((points >= self.bounds[:, 0]) & (points <= self.bounds[:, 1]), axis=-1)  # NaN: False
 
     def is_free(self, points: np.ndarray) -> np.ndarray:
-        """True where ``points`` (..., d) are inside the bounds and outside every (closed) box."""
+        """True where ``points`` are inside the bounds and outside every (closed) box.
+
+        Uses the grid index (``grid_index``); a point on a box's boundary is in collision.
+
+        Args:
+            points: Float array (..., d); non-finite coordinates are allowed and never free.
+
+        Returns:
+            Bool array of shape ``points.shape[:-1]``.
+
+        Raises:
+            ValueError: The last dimension is not d.
+        """
         from .collision import points_free
 
         points = self._check_points(points)
@@ -158,14 +196,39 @@ class Environment:
         return index
 
     def sample_uniform(self, count: int, rng: np.random.Generator) -> np.ndarray:
-        """``count`` points uniform in the workspace box (obstacles ignored)."""
+        """``count`` points uniform in the workspace box (obstacles ignored).
+
+        Args:
+            count: How many points (>= 0).
+            rng: The ``numpy.random.Generator`` to draw from.
+
+        Returns:
+            Float array (count, d).
+        """
         low, high = self.bounds[:, 0], self.bounds[:, 1]
         return low + (high - low) * rng.random((count, self.dim))
 
     def sample_free(
         self, count: int, rng: np.random.Generator, max_attempts: int = 1000
     ) -> np.ndarray:
-        """``count`` points uniform over free space, by rejection sampling."""
+        """``count`` points uniform over free space (``is_free``), by rejection sampling.
+
+        Draws batches of max(2 (count - found), 16) uniform points and keeps the free ones.
+
+        Args:
+            count: How many points (>= 0).
+            rng: The ``numpy.random.Generator`` to draw from.
+            max_attempts: How many batches to draw at most.
+
+        Returns:
+            Float array (count, d).
+
+        Raises:
+            TypeError: A non-integer ``count``.
+            ValueError: A negative ``count``, or ``rng`` not a ``numpy.random.Generator``.
+            RuntimeError: Fewer than ``count`` free points after ``max_attempts`` batches (the free
+                space is (nearly) empty).
+        """
         check_int(count, "count", 0)
         if not isinstance(rng, np.random.Generator):
             raise ValueError("rng must be a numpy.random.Generator (use np.random.default_rng)")
@@ -244,12 +307,37 @@ class Environment:
         )
 
     def save(self, path: str | Path) -> Path:
+        """Write the environment in the JSON format of the module docstring (``to_dict``).
+
+        Args:
+            path: The file to write (overwritten).
+
+        Returns:
+            The path written, as a ``Path``.
+
+        Raises:
+            OSError: The file cannot be written.
+        """
         path = Path(path)
         path.write_text(json.dumps(self.to_dict(), indent=1))
         return path
 
     @classmethod
     def load(cls, path: str | Path) -> Environment:
+        """Read an environment saved by ``save`` (the JSON format of the module docstring).
+
+        Args:
+            path: A UTF-8 JSON file with ``"format": "qrrt-environment"`` and ``"version": 1``.
+
+        Returns:
+            The ``Environment`` (validated as by the constructor).
+
+        Raises:
+            ValueError: Not UTF-8, not valid JSON, a wrong format or version, a missing
+                ``bounds`` / ``boxes``, or any value the constructor refuses; the message starts
+                with the path.
+            OSError: The file cannot be read.
+        """
         try:
             data = json.loads(Path(path).read_text(encoding="utf-8"))
         except UnicodeDecodeError as exc:

@@ -27,13 +27,37 @@ __all__ = ["OracleErrorModel", "ReachabilityOracle"]
 
 
 class ReachabilityOracle:
-    """Vectorized, sound batch reachability test with a spatial index and an evaluation counter.
+    """The sound reachability predicate (DESIGN §2): the truth the quantum oracle marks by.
+
+    A pair (p, c) is reachable iff x(t) = c + expm((A - BK) t)(p - c), t in [0, T], stays in the
+    workspace and outside every obstacle. The trajectory is cut into chords on a time grid fine
+    enough that the curve stays within ``resolution`` of each chord (``curvature_bound_times``),
+    and each chord is tested exactly against the boxes padded by its error bound, through the
+    environment's grid index (``collision.trajectories_free``). So every colliding trajectory is
+    rejected, and a free one is only rejected if it passes within ``false_rejection_bound``:
+    (1 + sqrt(d)) * ``resolution`` of an obstacle, or 2 * ``resolution`` of the boundary.
 
     ``evaluations`` counts predicate evaluations (pairs) made through this object. Planners do
     their own oracle-call accounting (DESIGN §2); this counter is the raw work done.
 
-    ``check="time_samples"`` (with ``time_samples=K``) is kept as an alias of
-    ``TimeSampledCheck(env, dynamics, time_samples=K)`` and returns that object.
+    Args:
+        env: The ``Environment``.
+        dynamics: ``LinearTrackingDynamics`` of the same dimension d (default: the paper's).
+        resolution: The collision resolution in length units, > 0 (default 0.01).
+        check: ``"exact"`` (this class) or ``"time_samples"``, kept as an alias that returns
+            ``TimeSampledCheck(env, dynamics, time_samples=time_samples)`` instead.
+        time_samples: K for ``check="time_samples"``; unused otherwise.
+
+    Attributes:
+        env: The environment.
+        dynamics: The dynamics.
+        resolution: The resolution.
+        evaluations: Pairs evaluated so far.
+
+    Raises:
+        ValueError: An unknown ``check``, a dynamics dimension other than ``env.dim``, or a
+            ``resolution`` that is not a finite number > 0.
+        TypeError: A non-numeric ``resolution``.
     """
 
     name = "exact"
@@ -84,11 +108,17 @@ class ReachabilityOracle:
 
     @property
     def false_rejection_bound(self) -> dict[str, float]:
-        """How close a free trajectory must pass to be rejected: (1 + sqrt(d)) * resolution to an
-        obstacle, 2 * resolution to the workspace boundary. Farther, a free trajectory is accepted."""
+        """How close a free trajectory must pass to be rejected (the check's only error).
+
+        Returns:
+            ``{"obstacle": (1 + sqrt(d)) * resolution, "boundary": 2 * resolution}``: a free
+            trajectory that stays farther than these from every obstacle and from the workspace
+            boundary is accepted (derivation in ``qrrt_circuits.collision``).
+        """
         return {"obstacle": (1.0 + float(np.sqrt(self.dim))) * self.resolution, "boundary": 2.0 * self.resolution}
 
     def describe(self) -> dict:
+        """Name, resolution, ``sound: True``, the false-rejection bound and the dynamics."""
         return {"name": self.name, "resolution": self.resolution, "sound": True,
                 "false_rejection_bound": self.false_rejection_bound,
                 "dynamics": self.dynamics.describe()}
@@ -105,7 +135,18 @@ class ReachabilityOracle:
         return not bool(np.any((point == self._bounds[:, 0]) | (point == self._bounds[:, 1])))
 
     def reachable(self, parents: np.ndarray, children: np.ndarray) -> np.ndarray:
-        """Bool (M,): may each child be reached from its parent without collision?"""
+        """May each child be reached from its parent without collision? (one evaluation per pair)
+
+        Args:
+            parents: Float array (M, d) (a single (d,) point is one pair), finite.
+            children: Float array of the same shape.
+
+        Returns:
+            Bool array (M,); adds M to ``evaluations``.
+
+        Raises:
+            ValueError: Shapes other than (M, d), different shapes, or non-finite coordinates.
+        """
         parents, children = as_pairs(parents, children, self.dim)
         out = np.zeros(parents.shape[0], dtype=np.bool_)
         index = self._index

@@ -60,9 +60,24 @@ def _world_rng(name: str, seed: int | None) -> np.random.Generator:
 
 def paper_clutter(seed: int | None = 0, num_boxes: int = CLUTTER_BOXES,
                   size: float = CLUTTER_SIZE) -> Environment:
-    """[0, 20]^2 with 525 boxes of sides U(0.25, 0.85) (the authors' comparison world).
+    """[0, 20]^2 with 525 boxes of sides U(0.25, 0.85): the authors' comparison world (DESIGN §4).
 
-    Start and goal are uniform free points at least half the side apart; goal radius 0.75.
+    Boxes lie fully inside the square and may overlap. Start and goal are uniform free points at
+    least half the side apart, with 0.75 / 4 axis clearance; goal radius 0.75. The heatmap and
+    wall-clock experiments use this world.
+
+    Args:
+        seed: Non-negative integer (same seed, same world) or None (fresh entropy).
+        num_boxes: Boxes, >= 0.
+        size: Side of the square, > 1.7 (twice the largest box side).
+
+    Returns:
+        The ``Environment`` with ``start``, ``goal``, ``goal_radius`` and metadata set.
+
+    Raises:
+        ValueError: A negative ``seed`` or ``num_boxes``, or ``size`` <= 1.7.
+        TypeError: A non-integer ``seed``.
+        RuntimeError: No start and goal could be placed (an overfull world).
     """
     _check_seed(seed)
     if num_boxes < 0:
@@ -81,10 +96,29 @@ def paper_clutter(seed: int | None = 0, num_boxes: int = CLUTTER_BOXES,
 
 def narrow_corridor(seed: int | None = 0, width: float = 0.4, length: float = 4.0,
                     clutter: int = 120, mouth_clearance: float = 1.5) -> Environment:
-    """[0, 20]^2 split by two large blocks leaving one horizontal channel ``width`` wide and
-    ``length`` long through the middle (paper §V.C); small random boxes on both sides, kept
-    ``mouth_clearance`` away from the channel's mouths (smaller: denser clutter beside the mouth).
-    Start in front of the left mouth (0.5 to 1.5 before it, on its axis), goal on the right."""
+    """[0, 20]^2 split by two blocks leaving one horizontal channel through the middle (paper §V.C).
+
+    The channel is ``width`` wide and ``length`` long; ``clutter`` small random boxes lie on both
+    sides, off the wall's columns and kept ``mouth_clearance`` away from the channel's mouths.
+    Start in front of the left mouth (0.5 to 1.5 before it, on its axis), goal on the right;
+    goal radius 0.75. The channel's corners are in ``metadata["channel"]``.
+
+    Args:
+        seed: Non-negative integer (same seed, same world) or None (fresh entropy).
+        width: Channel width, in (0, 10).
+        length: Channel length, in (0, 18).
+        clutter: Small boxes beside the wall.
+        mouth_clearance: Box-free margin around the mouths, in [0, 5] (smaller: denser clutter
+            beside the mouth).
+
+    Returns:
+        The ``Environment`` with ``start``, ``goal``, ``goal_radius`` and metadata set.
+
+    Raises:
+        ValueError: A negative ``seed``, or ``width``, ``length`` or ``mouth_clearance`` out of
+            range.
+        TypeError: A non-integer ``seed``.
+    """
     _check_seed(seed)
     if not (0 < width < 10):
         raise ValueError(f"width must be in (0, 10), got {width}")
@@ -125,8 +159,24 @@ def narrow_corridor(seed: int | None = 0, width: float = 0.4, length: float = 4.
 
 
 def annealing_field(seed: int | None = 0, num_boxes: int = 6025) -> Environment:
-    """6025 boxes with paper_clutter's sides on a square whose side keeps paper_clutter's box
-    density (20 * sqrt(6025 / 525) ~ 67.75), so the free fraction matches (paper §V.D)."""
+    """The Quantum Database Annealing world (paper §V.D, DESIGN §4).
+
+    ``num_boxes`` boxes with ``paper_clutter``'s sides U(0.25, 0.85) on a square whose side keeps
+    ``paper_clutter``'s box density (20 * sqrt(6025 / 525) ~ 67.75 by default), so the free
+    fraction matches. Start and goal as in ``paper_clutter``; goal radius 0.75.
+
+    Args:
+        seed: Non-negative integer (same seed, same world) or None (fresh entropy).
+        num_boxes: Boxes (the paper's 6025).
+
+    Returns:
+        The ``Environment`` with ``start``, ``goal``, ``goal_radius`` and metadata set.
+
+    Raises:
+        ValueError: A negative ``seed``.
+        TypeError: A non-integer ``seed``.
+        RuntimeError: No start and goal could be placed.
+    """
     _check_seed(seed)
     size = CLUTTER_SIZE * math.sqrt(num_boxes / CLUTTER_BOXES)
     rng = _world_rng("annealing_field", seed)
@@ -139,9 +189,26 @@ def annealing_field(seed: int | None = 0, num_boxes: int = 6025) -> Environment:
 
 
 def lattice(seed: int | None = 0, size: int = 72, blocked_fraction: float = 0.5) -> Environment:
-    """``size`` x ``size`` unit cells, a fraction ``blocked_fraction`` blocked at random (blocked
+    """A grid of unit cells, a fraction blocked at random (the predecessor paper's world, DESIGN §4).
+
+    round(``blocked_fraction`` * size^2) of the ``size`` x ``size`` cells are blocked (blocked
     cells along a row are merged into one box). Start and goal are centres of cells of the largest
-    4-connected free component, drawn far apart."""
+    4-connected free component, the goal among the farthest 10 % from the start; goal radius 0.45.
+
+    Args:
+        seed: Non-negative integer (same seed, same world) or None (fresh entropy).
+        size: L, cells per side, 2 .. 4096 (the authors' example: 72).
+        blocked_fraction: r, in [0, 1) (default 0.5).
+
+    Returns:
+        The ``Environment`` on [0, L]^2 with ``start``, ``goal``, ``goal_radius`` and metadata
+        (including the component's cell count).
+
+    Raises:
+        ValueError: A negative ``seed``, ``size`` out of range, ``blocked_fraction`` outside
+            [0, 1), or no free cell.
+        TypeError: A non-integer ``seed`` or ``size``.
+    """
     _check_seed(seed)
     check_int(size, "size", 2, 4096)
     if not (0.0 <= blocked_fraction < 1.0):

@@ -18,7 +18,25 @@ from .validation import check_int
 
 
 class TimeSampledCheck:
-    """Reachability predicate testing only ``time_samples`` evenly spaced samples of x(t)."""
+    """Reachability predicate testing only ``time_samples`` evenly spaced samples of x(t) (unsound).
+
+    A pair (p, c) is accepted iff x(t_j) = c + expm((A - BK) t_j)(p - c) is free at t_j =
+    j T / (K - 1), j = 0 .. K - 1, and c is free. DESIGN §2 explains why this is not enough: the
+    segments between samples are never tested, so corners and thin obstacles are stepped over.
+
+    Args:
+        env: The ``Environment``.
+        dynamics: ``LinearTrackingDynamics`` of the same dimension (default: the paper's).
+        time_samples: K, 2 .. 1 000 000 (keyword only).
+
+    Attributes:
+        time_samples: K.
+        evaluations: Pairs evaluated so far.
+
+    Raises:
+        ValueError: A dynamics dimension other than ``env.dim``, or K out of range.
+        TypeError: A non-integer K.
+    """
 
     name = "time-samples"
 
@@ -39,10 +57,23 @@ class TimeSampledCheck:
         return self.env.dim
 
     def describe(self) -> dict:
+        """Name, K, ``sound: False`` and the dynamics."""
         return {"name": self.name, "time_samples": self.time_samples, "sound": False,
                 "dynamics": self.dynamics.describe()}
 
     def reachable(self, parents: np.ndarray, children: np.ndarray) -> np.ndarray:
+        """Are all K samples of each pair's trajectory free?
+
+        Args:
+            parents: Float array (M, d), finite.
+            children: Float array of the same shape.
+
+        Returns:
+            Bool array (M,); adds M to ``evaluations``.
+
+        Raises:
+            ValueError: Shapes other than (M, d), different shapes, or non-finite coordinates.
+        """
         parents, children = as_pairs(parents, children, self.dim)
         points = children[:, None, :] + np.einsum("kij,mj->mki", self._phis, parents - children)
         free = self.env.is_free(points.reshape(-1, self.dim)).reshape(points.shape[:2])

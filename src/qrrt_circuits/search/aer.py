@@ -38,14 +38,42 @@ UNSUPPORTED_METHODS = {
 
 
 class AerBackend(QuantumSearchBackend):
-    """Grover search on ``AerSimulator(method=...)``; seeded through ``seed_simulator``.
+    """Gate-level Grover search (paper Alg. 2, lines 4-8) on ``AerSimulator(method=...)``.
 
-    ``noise_model`` (a ``qiskit_aer.noise.NoiseModel``) is passed to the simulator as is (and
-    selects the gate-by-gate circuit); ``device="GPU"`` needs Aer's GPU build.
-    ``max_parallel_threads`` = 0 lets Aer use all cores for circuits of ``SERIAL_BELOW_QUBITS`` or
-    more qubits; narrower ones run on one thread. ``synthesis``: the oracle's form, ``"auto"``
-    (``simulation_synthesis``, or with a noise model the CX-based ``choose_synthesis``),
-    ``"diagonal"`` or ``"mcz"``.
+    Each search builds the Grover circuit of the marks (``aer_grover_circuit``, or with a noise
+    model the gate-by-gate ``aer_literal_grover_circuit``) and runs it with ``shots`` shots; a
+    marked index is measured with probability sin^2((2k+1) theta), sin^2 theta = m / 2^n (paper
+    Eq. 1, Lemma 1). Every call draws a ``seed_simulator`` from its stream, so a plan depends on
+    the planner's seed only. Oracle calls: ``iterations * shots`` (DESIGN §2).
+
+    Args:
+        seed: The backend's own stream for ``search`` calls without a seed: a non-negative
+            integer, a ``numpy.random.Generator`` (used as is) or None (fresh entropy).
+        method: ``"statevector"`` (default) or ``"automatic"`` (``METHODS``). ``"density_matrix"``
+            and ``"matrix_product_state"`` are refused (``UNSUPPORTED_METHODS``: their
+            instruction sets lack the ``mcphase`` gate of the circuit).
+        synthesis: The oracle's form: ``"auto"`` (``simulation_synthesis``, or with a noise model
+            the CX-based ``choose_synthesis``), ``"diagonal"`` or ``"mcz"`` (``SYNTHESES``).
+        noise_model: A ``qiskit_aer.noise.NoiseModel`` passed to the simulator as is, or None.
+            With one, the gate-by-gate circuit runs, so per-gate noise acts on the paper's gates.
+        device: One of ``AerSimulator().available_devices()`` for this qiskit-aer build:
+            ``"CPU"`` (default) or ``"GPU"`` (needs qiskit-aer-gpu and an NVIDIA GPU).
+        max_parallel_threads: Aer's thread limit, 0 .. 4096; 0 lets Aer use all cores. Circuits
+            on fewer than ``SERIAL_BELOW_QUBITS`` (14) qubits always run on one thread.
+
+    Attributes:
+        method: The Aer simulation method.
+        synthesis: The oracle synthesis requested.
+        simulator: The ``AerSimulator`` the circuits run on.
+        device: ``"CPU"`` or ``"GPU"``.
+        max_parallel_threads: The thread limit for circuits of 14 or more qubits.
+
+    Raises:
+        TypeError: ``method``, ``synthesis`` or ``device`` is not a string, or
+            ``max_parallel_threads`` / ``seed`` is not an integer.
+        ValueError: An unsupported or unknown ``method``, a ``device`` this build does not offer,
+            an unknown ``synthesis``, ``max_parallel_threads`` outside [0, 4096] or a negative
+            ``seed``.
     """
 
     name = "aer"
@@ -88,6 +116,7 @@ class AerBackend(QuantumSearchBackend):
 
     @property
     def max_qubits(self) -> int:
+        """The largest n the simulator's configuration accepts (``n_qubits``, memory-limited)."""
         return int(self.simulator.configuration().n_qubits)
 
     #: calibrated on ``benchmarks/bench_memory.py`` (peak RSS of a round with many marked entries,
@@ -100,12 +129,29 @@ class AerBackend(QuantumSearchBackend):
     BYTES_PER_SHOT = 200
 
     def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1) -> int:
-        """Upper bound of one search with the diagonal oracle (the larger of the oracle forms)."""
+        """Upper bound of one search's peak memory, with the diagonal oracle (the larger form).
+
+        Args:
+            num_qubits: n, the index register's width.
+            shots: Measurements of the search.
+            iterations: k, the Grover iterations (Aer copies the oracle's phases once per iteration).
+
+        Returns:
+            ``(AER_BYTES_PER_ENTRY + AER_BYTES_PER_ENTRY_PER_ITERATION * k) * 2^n +
+            BYTES_PER_SHOT * shots`` bytes (used by the memory guard, ``qrrt_circuits.memory``).
+        """
         per_entry = self.AER_BYTES_PER_ENTRY + self.AER_BYTES_PER_ENTRY_PER_ITERATION * iterations
         return (per_entry << num_qubits) + self.BYTES_PER_SHOT * shots
 
     def threads_for(self, num_qubits: int) -> int:
-        """The ``max_parallel_threads`` a circuit on ``num_qubits`` qubits runs with."""
+        """The ``max_parallel_threads`` a circuit on ``num_qubits`` qubits runs with.
+
+        Args:
+            num_qubits: n, the circuit's width.
+
+        Returns:
+            1 below ``SERIAL_BELOW_QUBITS`` qubits, else the constructor's ``max_parallel_threads``.
+        """
         return 1 if num_qubits < SERIAL_BELOW_QUBITS else self.max_parallel_threads
 
     def _submit(self, marks, num_qubits, iterations, shots, rng):
@@ -127,14 +173,28 @@ class AerBackend(QuantumSearchBackend):
         return _measured_indices(job.result(), 0)
 
     def search_many(self, requests: Sequence[SearchRequest]) -> tuple[SearchResult, ...]:
-        """Submit every request's job before waiting for the first: Aer simulates job i on its
+        """Independent searches (the p databases of an unshared Pq-RRT round), pipelined.
+
+        Submits every request's job before waiting for the first: Aer simulates job i on its
         worker thread while this thread builds circuit i + 1. Results are identical to searching
         one by one (each circuit keeps its own ``seed_simulator``).
 
         Why not one job with all circuits: in a multi-circuit job Aer seeds circuit i with
         ``seed_simulator + 2113 i`` (qiskit-aer 0.18.2, checked by ``test_backends``), and
         ``seed_simulator`` takes one integer, so a single job cannot give each database the seed it
-        gets when searched alone: the planners' results would change."""
+        gets when searched alone: the planners' results would change.
+
+        Args:
+            requests: ``SearchRequest`` objects, each the arguments of one ``search`` call.
+
+        Returns:
+            One ``SearchResult`` per request, in order.
+
+        Raises:
+            TypeError: An item that is not a ``SearchRequest``.
+            ValueError: Any request that ``search`` would refuse; all are validated first.
+            RuntimeError: Aer reports a failed job.
+        """
         prepared = [self._prepare(request) for request in requests]
         jobs = [self._submit(*item) for item in prepared]
         return tuple(self._finish(item, _measured_indices(job.result(), 0))

@@ -50,11 +50,21 @@ BASIS_GATES = ("cx", "rz", "sx", "x")
 
 
 def phase_oracle(marks: np.ndarray, synthesis: str = "auto") -> QuantumCircuit:
-    """Circuit on n qubits equal to diag((-1)^marks).
+    """The phase oracle X of the paper (Alg. 2, line 7): a circuit on n qubits equal to diag((-1)^marks).
 
-    ``"diagonal"``: one ``DiagonalGate`` (about 2^n - 2 CX once synthesised);
-    ``"mcz"``: one multi-controlled Z per marked index, conjugated by X on its zero bits;
-    ``"auto"``: whichever has the smaller estimated CX count (``oracle_cx_estimate``).
+    Args:
+        marks: Boolean (or 0/1) array of length 2^n, n >= 1; entry i marks basis state i
+            (little-endian: qubit 0 is the least significant bit).
+        synthesis: ``"diagonal"``: one ``DiagonalGate`` (about 2^n - 2 CX once synthesised);
+            ``"mcz"``: one multi-controlled Z per marked index, conjugated by X on its zero bits;
+            ``"auto"``: whichever has the smaller estimated CX count (``choose_synthesis``).
+
+    Returns:
+        A ``QuantumCircuit`` named ``oracle`` on n qubits, without measurements.
+
+    Raises:
+        ValueError: ``marks`` not 1-D of length 2^n (n >= 1) or not boolean, or an unknown
+            ``synthesis``.
     """
     marks, n = validate_marks(marks)
     if synthesis not in SYNTHESES:
@@ -99,15 +109,36 @@ def _mcz_cx_count(n: int) -> int:
 
 
 def oracle_cx_estimate(num_qubits: int, num_marked: int) -> dict[str, int]:
-    """Estimated CX count of each synthesis: ``diagonal`` 2^n - 2 (uniformly controlled Rz
-    network), ``mcz`` = m x (CX of one transpiled n-qubit MCZ, counted once per n and cached)."""
+    """Estimated CX count of each oracle synthesis (the hardware cost ``choose_synthesis`` compares).
+
+    Args:
+        num_qubits: n, the index register's width (>= 1).
+        num_marked: m, the marked entries (>= 0).
+
+    Returns:
+        ``{"diagonal": 2^n - 2, "mcz": m * c_n}``: the uniformly controlled Rz network of a
+        diagonal, and m multi-controlled Z gates, c_n being the CX count of one n-qubit MCZ
+        transpiled to [cx, rz, sx, x] (counted once per n and cached).
+    """
     diagonal = max((1 << num_qubits) - 2, 0)
     return {"diagonal": diagonal, "mcz": num_marked * _mcz_cx_count(num_qubits)}
 
 
 def choose_synthesis(marks: np.ndarray) -> str:
-    """The synthesis with the fewer estimated CX gates (hardware cost; ``resource_estimate`` and
-    ``phase_oracle(synthesis="auto")`` use it). Aer's circuits use ``simulation_synthesis``."""
+    """The oracle synthesis with the fewer estimated CX gates (``oracle_cx_estimate``).
+
+    This is the hardware-cost choice that ``resource_estimate`` and
+    ``phase_oracle(synthesis="auto")`` use; Aer's circuits use ``simulation_synthesis`` instead.
+
+    Args:
+        marks: Boolean (or 0/1) array of length 2^n, n >= 1.
+
+    Returns:
+        ``"mcz"`` if m MCZ gates need fewer CX than the diagonal, else ``"diagonal"``.
+
+    Raises:
+        ValueError: ``marks`` not of length 2^n or not boolean.
+    """
     marks, n = validate_marks(marks)
     estimate = oracle_cx_estimate(n, int(np.count_nonzero(marks)))
     return "mcz" if estimate["mcz"] < estimate["diagonal"] else "diagonal"
@@ -123,8 +154,26 @@ def uniform_preparation(num_qubits: int) -> QuantumCircuit:
 def grover_circuit(
     marks: np.ndarray, iterations: int, measure: bool = True, synthesis: str = "auto"
 ) -> QuantumCircuit:
-    """W|0>, then ``iterations`` x Q with Q = grover_operator(phase_oracle(marks), W); measured
-    into a classical register named ``meas`` if ``measure``."""
+    """The Grover search circuit of one worker (paper Alg. 2, lines 4-8).
+
+    Prepares W applied to the all-zero state (W = H^n, line 6), applies ``iterations`` times
+    Q = grover_operator(phase_oracle(marks), W) (lines 7-8) and measures. A marked index is then
+    measured with probability sin^2((2k+1) theta), sin^2 theta = m / 2^n (paper Eq. 1, Lemma 1).
+
+    Args:
+        marks: Boolean (or 0/1) array of length 2^n, n >= 1.
+        iterations: k, 0 .. ``MAX_ITERATIONS``.
+        measure: Measure all qubits into a classical register named ``meas`` (``measure_all``).
+        synthesis: The oracle's form (``phase_oracle``): ``"auto"``, ``"diagonal"`` or ``"mcz"``.
+
+    Returns:
+        A ``QuantumCircuit`` named ``grover`` on n qubits.
+
+    Raises:
+        ValueError: ``marks`` not of length 2^n or not boolean, k out of range, or an unknown
+            ``synthesis``.
+        TypeError: A non-integer k.
+    """
     marks, n = validate_marks(marks)
     iterations = validate_iterations(iterations)
     preparation = uniform_preparation(n)
@@ -144,7 +193,7 @@ def aer_literal_grover_circuit(
 ) -> QuantumCircuit:
     """The Grover circuit gate by gate from Aer-native gates, for noisy simulation: H^n, then per
     iteration the oracle (``phase_oracle``: CX-based ``synthesis`` choice, as on hardware) followed
-    by the diffuser H^n X^n MCZ X^n H^n (= -(2|s><s| - I)); equal to ``grover_circuit`` up to a
+    by the diffuser H^n X^n MCZ X^n H^n (``= -(2|s><s| - I)``); equal to ``grover_circuit`` up to a
     global phase. A noise model attached to h, x or mcphase acts on every such gate of the paper's
     circuit (``aer_grover_circuit`` merges them into fewer instructions, which is faster but would
     change where such noise applies)."""
@@ -180,7 +229,16 @@ class ResourceCount:
 
 @dataclass(frozen=True)
 class ResourceEstimate:
-    """Cost of ``iterations`` Grover iterations after transpiling to [cx, rz, sx, x]."""
+    """Cost of ``iterations`` Grover iterations after transpiling to [cx, rz, sx, x].
+
+    Args:
+        num_qubits: n, the index register's width.
+        num_marked: m, the marked entries.
+        iterations: k.
+        synthesis: The oracle synthesis used (``"diagonal"`` or ``"mcz"``).
+        no_ancilla: Qubits, CX count, depth and size on n qubits.
+        one_ancilla: The same with one extra clean qubit the multi-controlled gates may use.
+    """
 
     num_qubits: int
     num_marked: int
@@ -193,8 +251,25 @@ class ResourceEstimate:
 def resource_estimate(
     marks: np.ndarray, iterations: int, synthesis: str = "auto", optimization_level: int = 1
 ) -> ResourceEstimate:
-    """Qubits, CX count and depth of the Grover circuit in the basis [cx, rz, sx, x], without and
-    with one extra (clean) ancilla qubit that the multi-controlled gates may use."""
+    """Qubits, CX count and depth of the Grover circuit in the basis [cx, rz, sx, x].
+
+    Transpiles ``grover_circuit(marks, iterations, measure=False)`` twice (``seed_transpiler=0``):
+    on its n qubits, and with one extra (clean) ancilla qubit the multi-controlled gates may use.
+
+    Args:
+        marks: Boolean (or 0/1) array of length 2^n, 1 <= n <= 14.
+        iterations: k, 0 .. ``MAX_ITERATIONS``.
+        synthesis: ``"auto"`` (``choose_synthesis``), ``"diagonal"`` or ``"mcz"``.
+        optimization_level: Qiskit's transpiler level, 0-3.
+
+    Returns:
+        A ``ResourceEstimate`` with the chosen synthesis and both counts.
+
+    Raises:
+        ValueError: ``marks`` not of length 2^n or not boolean, n > 14 (the full circuit is
+            transpiled), k out of range, or an unknown ``synthesis``.
+        TypeError: A non-integer k.
+    """
     marks, n = validate_marks(marks)
     iterations = validate_iterations(iterations)
     if n > 14:

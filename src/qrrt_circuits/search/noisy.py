@@ -27,7 +27,24 @@ METHODS = ("statevector", "density_matrix")
 
 
 class NoisySamplerBackend(SamplerBackend):
-    """A ``SamplerBackend`` whose sampler simulates device noise; ``noise`` describes it."""
+    """A ``SamplerBackend`` whose sampler simulates device noise (beyond the paper's ideal machine).
+
+    Build one with ``depolarizing_backend`` or ``fake_device_backend``. Seeding and caching are
+    the ``SamplerBackend``'s; every result additionally carries a ``noise: ...`` label.
+
+    Args:
+        sampler: A ``BaseSamplerV2`` with a noise model (qiskit-aer's ``SamplerV2``).
+        noise: Human-readable description of the noise, copied into the labels.
+        backend: A ``BackendV2`` to transpile to (a fake device), or None for [cx, rz, sx, x].
+        seed: The backend's own stream (see ``SamplerBackend``).
+        synthesis: The oracle's form: ``"auto"``, ``"diagonal"`` or ``"mcz"``.
+
+    Attributes:
+        noise: The noise description.
+
+    Raises:
+        ValueError: As ``SamplerBackend``.
+    """
 
     name = "noisy-sampler"
 
@@ -36,15 +53,36 @@ class NoisySamplerBackend(SamplerBackend):
         self.noise = noise
 
     def labels(self) -> tuple[str, ...]:
+        """The ``SamplerBackend`` labels plus ``"noise: <noise> (simulated device noise, ...)"``."""
         return (*super().labels(), f"noise: {self.noise} (simulated device noise, not the paper's perfect machine)")
 
     def describe(self) -> str:
+        """``"noisy-sampler (<noise>)"``."""
         return f"{self.name} ({self.noise})"
 
 
 def depolarizing_backend(p1: float, p2: float, method: str = "statevector", seed=None,
                          synthesis: str = "auto") -> NoisySamplerBackend:
-    """Aer's SamplerV2 with depolarizing errors p1 (sx, x) and p2 (cx) after transpiling to [cx, rz, sx, x]."""
+    """Aer's SamplerV2 with depolarizing errors p1 (sx, x) and p2 (cx) after transpiling to [cx, rz, sx, x].
+
+    The noise model is ``qrrt_circuits.noise.depolarizing_noise_model(p1, p2)`` on an all-to-all
+    device; Aer runs single-threaded.
+
+    Args:
+        p1: Depolarizing probability of each sx and x gate, in [0, 1].
+        p2: Depolarizing probability of each cx gate, in [0, 1].
+        method: ``"statevector"`` (one noise trajectory per shot) or ``"density_matrix"`` (shots
+            from the exact noisy distribution).
+        seed: The backend's own stream (see ``SamplerBackend``).
+        synthesis: The oracle's form: ``"auto"``, ``"diagonal"`` or ``"mcz"``.
+
+    Returns:
+        A ``NoisySamplerBackend`` labelled with p1 and p2.
+
+    Raises:
+        TypeError: A non-numeric probability.
+        ValueError: p1 or p2 outside [0, 1], or an unknown ``method``.
+    """
     from qiskit_aer.primitives import SamplerV2
 
     p1 = check_probability(p1, "p1")
@@ -67,8 +105,24 @@ def _device_sampler(name: str | None, method: str):
 
 
 def fake_device_backend(name: str | None = None, method: str = "statevector", seed=None) -> NoisySamplerBackend:
-    """The Grover circuit transpiled to a fake IBM device (its coupling map and basis) and run with
-    its calibrated noise model. Raises ``MissingExtraError`` if qiskit-ibm-runtime is missing."""
+    """The Grover circuit transpiled to a fake IBM device and run with its calibrated noise model.
+
+    The device's coupling map, basis, readout and relaxation errors come from the fake provider of
+    ``qiskit-ibm-runtime`` (optional extra ``noise``); the sampler is built once per (name,
+    method) and cached.
+
+    Args:
+        name: One of ``qrrt_circuits.noise.FAKE_DEVICES``, or None for the first installed.
+        method: ``"statevector"`` or ``"density_matrix"``.
+        seed: The backend's own stream (see ``SamplerBackend``).
+
+    Returns:
+        A ``NoisySamplerBackend`` that transpiles to the device, labelled with its name.
+
+    Raises:
+        ValueError: An unknown ``method`` or device name.
+        MissingExtraError: qiskit-ibm-runtime is not installed, or lacks the named device.
+    """
     method = check_choice(method, "method", METHODS)
     device, sampler = _device_sampler(name, method)
     return NoisySamplerBackend(sampler, f"{device.name} calibration snapshot (qiskit-ibm-runtime fake "
@@ -76,7 +130,15 @@ def fake_device_backend(name: str | None = None, method: str = "statevector", se
 
 
 def measured_indices_success(indices: np.ndarray, marks: np.ndarray) -> int:
-    """How many measured indices are marked."""
+    """How many measured indices are marked.
+
+    Args:
+        indices: Measured database indices (int array).
+        marks: Boolean (or 0/1) marks of the database.
+
+    Returns:
+        The count of ``indices`` whose entry is marked.
+    """
     return int(np.count_nonzero(np.asarray(marks, dtype=bool)[np.asarray(indices, dtype=np.int64)]))
 
 

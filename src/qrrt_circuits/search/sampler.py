@@ -24,9 +24,40 @@ from .fixed_point import generalized_grover_circuit
 
 
 class SamplerBackend(QuantumSearchBackend):
-    """Wraps a ``BaseSamplerV2``; ``backend`` (a ``BackendV2``) sets the transpile target.
+    """Grover search (paper Alg. 2, lines 4-8) through any Qiskit ``BaseSamplerV2``.
 
-    ``seed`` is the backend's own stream for direct ``search`` calls without a seed.
+    The logical circuit is ``grover_circuit(marks, k)``; it is transpiled once per shape (marks,
+    iterations) by one preset pass manager and cached (least recently used first out).
+
+    Seeding: for qiskit-aer's ``SamplerV2`` built without a seed, each search sets the sampler's
+    ``seed_simulator`` run option from the search's seed (or the backend's stream), so a plan
+    depends on the planner's seed only (``per_call_seed`` is True). Any other sampler (or an Aer
+    sampler with a fixed seed) seeds itself: then ``labels()`` returns a ``randomness: ...`` label,
+    which the planners copy into their results.
+
+    Args:
+        sampler: A ``BaseSamplerV2`` (any object with ``.run(pubs, shots=...)``).
+        backend: A ``BackendV2`` whose target (coupling map, basis) the circuits are transpiled
+            to, and whose ``num_qubits`` caps ``max_qubits``; None: the basis [cx, rz, sx, x],
+            all-to-all, at most 24 qubits.
+        optimization_level: The preset pass manager's level, 0, 1, 2 or 3.
+        synthesis: The oracle's form: ``"auto"``, ``"diagonal"`` or ``"mcz"`` (``phase_oracle``).
+        cache_size: How many transpiled circuits are kept.
+        max_qubits: A lower cap on n than the target's (None: the target's).
+        seed: The backend's own stream for ``search`` calls without a seed: a non-negative
+            integer, a ``numpy.random.Generator`` or None (fresh entropy).
+
+    Attributes:
+        sampler: The wrapped sampler.
+        synthesis: The oracle synthesis.
+        pass_manager: The preset pass manager (``seed_transpiler=0``).
+        transpile_count: How many circuits were transpiled (cache misses).
+        per_call_seed: Whether each search seeds the sampler (see Seeding).
+
+    Raises:
+        ValueError: ``sampler`` has no ``run``, an unknown ``synthesis``, an
+            ``optimization_level`` other than 0-3, or a negative ``seed``.
+        TypeError: A ``seed`` of the wrong type.
     """
 
     name = "sampler"
@@ -60,9 +91,19 @@ class SamplerBackend(QuantumSearchBackend):
 
     @property
     def max_qubits(self) -> int:
+        """The largest n: the target's qubits (24 without a backend), capped by ``max_qubits``."""
         return self._max_qubits
 
     def compiled(self, marks: np.ndarray, iterations: int):
+        """The transpiled ``grover_circuit(marks, iterations)``, from the cache when present.
+
+        Args:
+            marks: Validated boolean marks of length 2^n.
+            iterations: k, the Grover iterations.
+
+        Returns:
+            The transpiled, measured ``QuantumCircuit``.
+        """
         key = (marks.shape[0], np.packbits(marks).tobytes(), iterations)
         circuit = self._cache.get(key)
         if circuit is None:
@@ -90,6 +131,12 @@ class SamplerBackend(QuantumSearchBackend):
         return circuit
 
     def labels(self) -> tuple[str, ...]:
+        """Labels every result of this backend carries.
+
+        Returns:
+            Empty when each search seeds the sampler; else one ``"randomness: ..."`` label saying
+            that the sampler seeds itself, so results do not depend on the planner's seed only.
+        """
         if self.per_call_seed:
             return ()
         return (f"randomness: the sampler ({type(self.sampler).__name__}) seeds itself, so results "

@@ -30,7 +30,28 @@ def _memory_bytes() -> int:
 
 
 class StatevectorBackend(QuantumSearchBackend):
-    """Exact (noise-free) Grover search; ``closed_form=False`` samples from the iterated vector."""
+    """Exact (noise-free) Grover search: the ideal machine of the paper (Alg. 2, lines 4-8).
+
+    After k iterations every marked index has amplitude sin((2k+1) theta)/sqrt(m) and every
+    unmarked one cos((2k+1) theta)/sqrt(N - m), sin^2 theta = m/N (paper Eq. 1, Lemma 1). The
+    default samples from this closed form; ``closed_form=False`` iterates the full statevector
+    (O(N) per iteration) and samples from it. Oracle calls: ``iterations * shots`` (DESIGN §2).
+
+    Args:
+        seed: The backend's own stream for ``search`` calls without a seed: a non-negative
+            integer, a ``numpy.random.Generator`` (used as is) or None (fresh entropy).
+        closed_form: True (default) to sample from the two-level closed form, False to sample
+            from the iterated vector.
+        max_qubits: The largest n accepted, 1 .. the largest n whose state fits in half of this
+            machine's memory (the default).
+
+    Attributes:
+        closed_form: Whether the closed form is sampled.
+
+    Raises:
+        TypeError: ``closed_form`` is not a bool, or ``max_qubits`` / ``seed`` not an integer.
+        ValueError: ``max_qubits`` < 1 or above the memory limit, or a negative ``seed``.
+    """
 
     name = "statevector"
 
@@ -50,21 +71,48 @@ class StatevectorBackend(QuantumSearchBackend):
 
     @property
     def max_qubits(self) -> int:
+        """The largest n accepted (the constructor's ``max_qubits``, or the memory limit)."""
         return self._max_qubits
 
     #: per shot: the uniform draws, the good/unmarked split, the ranks and the measured indices
     BYTES_PER_SHOT = 64
 
     def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1) -> int:
-        """Closed form: the marked indices and their rank table (at most 8 + 16 bytes per entry
+        """Upper bound of one search's peak memory.
+
+        Closed form: the marked indices and their rank table (at most 8 + 16 bytes per entry
         when every entry is marked). ``closed_form=False``: the state, its update temporaries,
-        the probabilities and their cumulative sum (5 float64 arrays)."""
+        the probabilities and their cumulative sum (5 float64 arrays).
+
+        Args:
+            num_qubits: n, the index register's width.
+            shots: Measurements of the search.
+            iterations: k (unused: the footprint does not grow with k).
+
+        Returns:
+            ``(24 or 40) * 2^n + BYTES_PER_SHOT * shots`` bytes.
+        """
         per_entry = 24 if self.closed_form else 40
         return (per_entry << num_qubits) + self.BYTES_PER_SHOT * shots
 
     @staticmethod
     def amplitudes(marks: np.ndarray, iterations: int) -> np.ndarray:
-        """Real amplitudes after ``iterations`` x (oracle, then inversion about the mean)."""
+        """Real amplitudes after ``iterations`` x (oracle, then inversion about the mean).
+
+        Starts from the uniform state 1/sqrt(N) and applies k times the phase flip of the marked
+        entries followed by the diffusion a -> 2 mean(a) - a (the Grover iteration Q of Alg. 2).
+
+        Args:
+            marks: Boolean (or 0/1) array of length N = 2^n, n >= 1.
+            iterations: k, 0 .. ``MAX_ITERATIONS``.
+
+        Returns:
+            Float array (N,): the amplitudes; their squares are the measurement probabilities.
+
+        Raises:
+            ValueError: ``marks`` not of length 2^n or not boolean, or k out of range.
+            TypeError: A non-integer k.
+        """
         marks, _ = validate_marks(marks)
         iterations = validate_iterations(iterations)
         state = np.full(marks.shape[0], 1.0 / math.sqrt(marks.shape[0]))
