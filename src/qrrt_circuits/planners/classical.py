@@ -50,14 +50,68 @@ MAX_BATCH_ROUNDS = 256
 
 
 def batch_rounds(changed_rounds: int, recorded_rounds: int) -> int:
-    """Rounds to test ahead: ceil(1 / rate), rate = (changed + 1) / (recorded + 2), in
-    [1, MAX_BATCH_ROUNDS] (the expected number of rounds up to the next that adds a node)."""
+    """Rounds to test ahead in one batch: the expected number of rounds up to the next that adds a node.
+
+    Args:
+        changed_rounds: Rounds recorded so far that added a node (>= 0).
+        recorded_rounds: Rounds recorded so far (>= ``changed_rounds``).
+
+    Returns:
+        ceil(1 / rate) with rate = (changed + 1) / (recorded + 2) (a Laplace estimate of the rate at
+        which rounds add a node), clipped to [1, ``MAX_BATCH_ROUNDS``].
+    """
     rate = (changed_rounds + 1) / (recorded_rounds + 2)
     return max(1, min(MAX_BATCH_ROUNDS, math.ceil(1.0 / rate)))
 
 
 class ParallelRRT(Planner):
-    """Manager-worker parallel RRT with ``workers`` synchronous extensions per round."""
+    """Manager-worker parallel RRT (paper §V, Devaurs et al. 2013): the classical counterpart of Pq-RRT.
+
+    Each round, ``workers`` workers each sample a point, find its nearest tree node and run one
+    reachability test (the extension step of Alg. 1, RRT) against the same tree snapshot; the
+    manager adds every valid result, as the Pq-RRT manager does (Alg. 3). Each test is one oracle
+    call, counted as a ``verification_call`` (DESIGN §2); a round's critical path is 1 call (2 with
+    ``oracle_errors``). ``RRT`` is the case p = 1.
+
+    Args:
+        env: The ``Environment``: workspace bounds, obstacles and the default start, goal and goal
+            radius.
+        workers: Number p of workers, i.e. extensions per round, in [1, ``MAX_WORKERS``] (4096).
+            Default 8.
+        predicate: The ``ReachabilityPredicate`` that decides whether a child is reachable from its
+            parent (its ``dim`` must equal ``env.dim``). Default: the sound ``ReachabilityOracle``
+            of ``env`` built with ``dynamics`` and ``resolution``.
+        dynamics: A ``LinearTrackingDynamics`` (same ``dim`` as ``env``) for the default predicate;
+            give it only without ``predicate`` (a predicate carries its own motion model). Default:
+            ``LinearTrackingDynamics.paper()``.
+        oracle_errors: An ``OracleErrorModel`` that corrupts the reachability answers (false
+            positives and negatives), or None (default) for exact answers. A positive answer is
+            verified with the true predicate (one more verification call) before the node is added.
+        goal_bias: Probability in [0, 1) that a sample is drawn in the goal ball instead of
+            uniformly in the workspace. Default 0 (the paper's uniform sampling).
+        resolution: Clearance of the default ``ReachabilityOracle`` in length units (> 0, finite;
+            default 0.01): a free trajectory is accepted if it passes farther than (1 + sqrt(d)) *
+            resolution from every obstacle and 2 * resolution from the workspace boundary. Unused
+            when ``predicate`` is given.
+        executor: A ``concurrent.futures.Executor`` that runs the workers' extensions (one task per
+            worker per round), or None (default) to run them in-process in batches of rounds, with
+            the same results. Not pickled with the planner.
+        seed: Non-negative integer seed of the keyed random streams (one generator per (round,
+            worker, stream), so results do not depend on the executor or the order of the calls), or
+            None (default) for fresh entropy.
+        oracle: Alias of ``predicate`` kept from 0.1; giving both (as different objects) is an
+            error.
+
+    Raises:
+        TypeError: An argument of the wrong type: ``env`` not an ``Environment``, a non-integer
+            ``workers`` or ``seed``, a non-real ``goal_bias`` or ``resolution``, ``dynamics`` or
+            ``oracle_errors`` of the wrong class, or a ``predicate`` that lacks the members of the
+            ``ReachabilityPredicate`` protocol.
+        ValueError: ``workers`` outside [1, 4096], ``goal_bias`` outside [0, 1), a non-positive or
+            non-finite ``resolution``, a negative ``seed``, a dimension mismatch between ``env`` and
+            ``predicate`` or ``dynamics``, both ``predicate`` and ``oracle`` (or both ``predicate``
+            and ``dynamics``) given.
+    """
 
     name = "ParallelRRT"
 
@@ -177,7 +231,45 @@ class ParallelRRT(Planner):
 
 
 class RRT(ParallelRRT):
-    """Classical RRT: one sample, nearest node and reachability test per round."""
+    """Classical RRT (paper Alg. 1): one sample, nearest node and reachability test per round.
+
+    ``ParallelRRT`` with one worker and no executor. Each reachability test is one oracle call,
+    counted as a ``verification_call`` (DESIGN §2).
+
+    Args:
+        env: The ``Environment``: workspace bounds, obstacles and the default start, goal and goal
+            radius.
+        predicate: The ``ReachabilityPredicate`` that decides whether a child is reachable from its
+            parent (its ``dim`` must equal ``env.dim``). Default: the sound ``ReachabilityOracle``
+            of ``env`` built with ``dynamics`` and ``resolution``.
+        dynamics: A ``LinearTrackingDynamics`` (same ``dim`` as ``env``) for the default predicate;
+            give it only without ``predicate`` (a predicate carries its own motion model). Default:
+            ``LinearTrackingDynamics.paper()``.
+        oracle_errors: An ``OracleErrorModel`` that corrupts the reachability answers (false
+            positives and negatives), or None (default) for exact answers. A positive answer is
+            verified with the true predicate (one more verification call) before the node is added.
+        goal_bias: Probability in [0, 1) that a sample is drawn in the goal ball instead of
+            uniformly in the workspace. Default 0 (the paper's uniform sampling).
+        resolution: Clearance of the default ``ReachabilityOracle`` in length units (> 0, finite;
+            default 0.01): a free trajectory is accepted if it passes farther than (1 + sqrt(d)) *
+            resolution from every obstacle and 2 * resolution from the workspace boundary. Unused
+            when ``predicate`` is given.
+        seed: Non-negative integer seed of the keyed random streams (one generator per (round,
+            worker, stream), so results do not depend on the executor or the order of the calls), or
+            None (default) for fresh entropy.
+        oracle: Alias of ``predicate`` kept from 0.1; giving both (as different objects) is an
+            error.
+
+    Raises:
+        TypeError: An argument of the wrong type: ``env`` not an ``Environment``, a non-integer
+            ``seed``, a non-real ``goal_bias`` or ``resolution``, ``dynamics`` or ``oracle_errors``
+            of the wrong class, or a ``predicate`` that lacks the members of the
+            ``ReachabilityPredicate`` protocol.
+        ValueError: ``goal_bias`` outside [0, 1), a non-positive or non-finite ``resolution``, a
+            negative ``seed``, a dimension mismatch between ``env`` and ``predicate`` or
+            ``dynamics``, both ``predicate`` and ``oracle`` (or both ``predicate`` and ``dynamics``)
+            given.
+    """
 
     name = "RRT"
 

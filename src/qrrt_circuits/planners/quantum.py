@@ -1,4 +1,4 @@
-"""q-RRT and Pq-RRT (paper Alg. 1, 2 and 4).
+"""q-RRT and Pq-RRT (paper Alg. 2 and 3; Quantum Database Annealing, Alg. 4).
 
 One round of q-RRT: build a database of 2^n (sample, nearest parent) pairs, evaluate the predicate
 on all of them to build the phase oracle (``simulation_checks``; with an ``OracleErrorModel`` the
@@ -53,10 +53,25 @@ ORACLE_LOOKUP_LABEL = (
 
 def search_databases_together(context: WorkerContext, view: RoundView,
                               groups: list[tuple[int, int]]) -> list[DatabaseOutcome]:
-    """``search_database`` for every group of one round, with the databases' searches handed to
-    the search policy at once (``PolicyState.run_many``, hence ``backend.search_many``): the same
-    outcomes as searching them one by one, since every search draws its seed from the streams
-    keyed by (round, worker). Groups are (first worker, workers) with one worker count."""
+    """``search_database`` for every group of one round, with the searches handed over together.
+
+    The databases' searches go to the search policy at once (``PolicyState.run_many``, hence
+    ``backend.search_many``): the same outcomes as searching them one by one, since every search
+    draws its seed from the streams keyed by (round, worker).
+
+    Args:
+        context: The plan's ``WorkerContext`` (environment, predicate, streams, backend, sizes).
+        view: The round's ``RoundView`` (tree snapshot, goal, round and temperature index, policy
+            state).
+        groups: (first worker, workers) per database, all with the same worker count: one group of
+            p for a shared database, p groups of one for unshared ones.
+
+    Returns:
+        One ``DatabaseOutcome`` per group, in order (an empty list for no groups).
+
+    Raises:
+        ValueError: Groups with different worker counts.
+    """
     if not groups:
         return []
     built = [make_database(context, view, first) for first, _ in groups]
@@ -75,11 +90,78 @@ def search_databases_together(context: WorkerContext, view: RoundView,
 
 
 class PQRRT(Planner):
-    """Parallel q-RRT with ``workers`` quantum workers on a shared or unshared database.
+    """Parallel q-RRT (paper Alg. 3) with ``workers`` quantum workers on a shared or unshared database.
 
-    ``search_policy`` (alias ``iterations``, kept from 0.1) decides how each worker searches: a
-    ``PaperSchedule``, ``FixedIterations``, ``KnownOptimal``, ``BBHT`` or ``Adaptive`` (or any
-    ``IterationPolicy``)."""
+    Each round builds 2^n (sample, nearest parent) databases, marks their reachable entries in a
+    phase oracle, lets every worker run Grover search as ``search_policy`` decides, measure and
+    verify its measured entry classically (the finalizer), and adds every verified candidate. Oracle
+    calls follow DESIGN §2: per worker, 1 per Grover iteration plus 1 per verification; building the
+    phase oracle in simulation is reported as ``simulation_checks``. With ``annealing`` this is
+    Quantum Database Annealing (Alg. 4). ``QRRT`` is the case p = 1 (Alg. 2).
+
+    Args:
+        env: The ``Environment``: workspace bounds, obstacles and the default start, goal and goal
+            radius.
+        backend: The ``QuantumSearchBackend`` that simulates each Grover search (its ``max_qubits``
+            must allow ``num_qubits``). Default: a new ``AerBackend()`` (qiskit-aer statevector
+            sampling).
+        num_qubits: Qubits n per database, so each database holds N = 2^n (sample, nearest parent)
+            entries; an integer >= 1 and at most the backend's ``max_qubits``, and the estimated
+            peak memory of one round must fit in the available memory. Default 8.
+        workers: Number p of quantum workers per round, in [1, ``MAX_WORKERS``] (4096). Default 8.
+        shared_database: True (default): the manager builds one database per round and its p workers
+            all search it (Alg. 3 as printed; a solution measured by several workers is added once,
+            the extra copies counted as ``duplicates``). False: each worker builds and searches its
+            own database. Must be a ``bool``.
+        search_policy: The ``IterationPolicy`` that decides how each worker searches a database:
+            ``PaperSchedule()`` (the default: 5 Grover iterations, 3 once the tree has more than 10
+            nodes), ``FixedIterations(k)``, ``KnownOptimal()`` (Eq. 1 with the true m), ``BBHT()``,
+            ``Adaptive()``, ``FixedPointAmplification()``, ``EstimatedOptimal()`` or any other
+            ``IterationPolicy``.
+        annealing: An ``AnnealingSchedule`` for Quantum Database Annealing (Alg. 4: samples are
+            drawn in distance bands around the tree that shrink with the temperature index h), or
+            None (default) for uniform databases.
+        predicate: The ``ReachabilityPredicate`` that decides whether a child is reachable from its
+            parent (its ``dim`` must equal ``env.dim``). Default: the sound ``ReachabilityOracle``
+            of ``env`` built with ``dynamics`` and ``resolution``.
+        dynamics: A ``LinearTrackingDynamics`` (same ``dim`` as ``env``) for the default predicate;
+            give it only without ``predicate`` (a predicate carries its own motion model). Default:
+            ``LinearTrackingDynamics.paper()``.
+        oracle_errors: An ``OracleErrorModel`` that corrupts the marks of the phase oracle (false
+            positives and negatives), or None (default) for exact marks. The finalizer verifies
+            every measured entry with the true predicate, so a wrong mark costs oracle calls, never
+            a bad node.
+        goal_bias: Probability in [0, 1) that a sample is drawn in the goal ball instead of
+            uniformly in the workspace. Default 0 (the paper's uniform sampling).
+        resolution: Clearance of the default ``ReachabilityOracle`` in length units (> 0, finite;
+            default 0.01): a free trajectory is accepted if it passes farther than (1 + sqrt(d)) *
+            resolution from every obstacle and 2 * resolution from the workspace boundary. Unused
+            when ``predicate`` is given.
+        executor: A ``concurrent.futures.Executor`` that runs the workers' database searches (one
+            task per database), or None (default) to hand a round's searches to the backend
+            together, with the same results. Not pickled with the planner.
+        seed: Non-negative integer seed of the keyed random streams (one generator per (round,
+            worker, stream), so results do not depend on the executor or the order of the calls), or
+            None (default) for fresh entropy.
+        oracle: Alias of ``predicate`` kept from 0.1; giving both (as different objects) is an
+            error.
+        iterations: Alias of ``search_policy`` kept from 0.1; giving both (as different objects) is
+            an error.
+
+    Raises:
+        TypeError: An argument of the wrong type: ``env`` not an ``Environment``, a non-integer
+            ``num_qubits``, ``workers`` or ``seed``, a non-real ``goal_bias`` or ``resolution``,
+            ``dynamics`` or ``oracle_errors`` of the wrong class, a ``backend`` that is not a
+            ``QuantumSearchBackend``, a ``search_policy`` that is not an ``IterationPolicy``, an
+            ``annealing`` that is not an ``AnnealingSchedule``, a non-bool ``shared_database``, or a
+            ``predicate`` that lacks the members of the ``ReachabilityPredicate`` protocol.
+        ValueError: ``num_qubits`` < 1 or above the backend's ``max_qubits``, ``workers`` outside
+            [1, 4096], ``goal_bias`` outside [0, 1), a non-positive or non-finite ``resolution``, a
+            negative ``seed``, a dimension mismatch between ``env`` and ``predicate`` or
+            ``dynamics``, both ``predicate`` and ``oracle`` (or both ``predicate`` and ``dynamics``)
+            given, both ``search_policy`` and ``iterations`` given, or a plan whose estimated peak
+            memory (``memory_estimate``) exceeds the available memory.
+    """
 
     name = "PQRRT"
 
@@ -126,10 +208,19 @@ class PQRRT(Planner):
         check_fits(self.memory_estimate, self.num_qubits, "this plan")
 
     def memory_estimate(self, num_qubits: int | None = None) -> MemoryEstimate:
-        """Estimated peak memory of one round (``qrrt_circuits.memory``), for this planner's
-        settings at ``num_qubits`` (default its own): the databases alive at once (one, or one per
-        worker when unshared databases run on an executor), each with its backend search at the
-        policy's largest iteration count, plus the policy's state. Checked at construction."""
+        """Estimated peak memory of one round (``qrrt_circuits.memory``); checked at construction.
+
+        Counts the databases alive at once (one, or one per worker when unshared databases run on
+        an executor), each with its backend search at the policy's largest iteration count
+        (``IterationPolicy.iterations_bound``), plus the policy's state.
+
+        Args:
+            num_qubits: Qubits n to estimate for (databases of 2^n entries); default the planner's
+                own ``num_qubits``.
+
+        Returns:
+            A ``MemoryEstimate`` with the database, resident, search and policy bytes.
+        """
         n = self.num_qubits if num_qubits is None else num_qubits
         size = 1 << n
         concurrent = self.workers if (self.executor is not None and not self.shared_database) else 1
@@ -232,7 +323,68 @@ class PQRRT(Planner):
 
 
 class QRRT(PQRRT):
-    """q-RRT: one database, one search and one measurement per round (Pq-RRT with p = 1)."""
+    """q-RRT (paper Alg. 2): one database, one search and one measurement per round.
+
+    ``PQRRT`` with one worker on a shared database and no executor. Per round: build 2^n (sample,
+    nearest parent) pairs, mark the reachable ones in the phase oracle, run Grover search as
+    ``search_policy`` decides, measure, verify classically (1 oracle call) and add the entry if it
+    verifies. With ``annealing`` this is Quantum Database Annealing (Alg. 4).
+
+    Args:
+        env: The ``Environment``: workspace bounds, obstacles and the default start, goal and goal
+            radius.
+        backend: The ``QuantumSearchBackend`` that simulates each Grover search (its ``max_qubits``
+            must allow ``num_qubits``). Default: a new ``AerBackend()`` (qiskit-aer statevector
+            sampling).
+        num_qubits: Qubits n per database, so each database holds N = 2^n (sample, nearest parent)
+            entries; an integer >= 1 and at most the backend's ``max_qubits``, and the estimated
+            peak memory of one round must fit in the available memory. Default 8.
+        search_policy: The ``IterationPolicy`` that decides how each worker searches a database:
+            ``PaperSchedule()`` (the default: 5 Grover iterations, 3 once the tree has more than 10
+            nodes), ``FixedIterations(k)``, ``KnownOptimal()`` (Eq. 1 with the true m), ``BBHT()``,
+            ``Adaptive()``, ``FixedPointAmplification()``, ``EstimatedOptimal()`` or any other
+            ``IterationPolicy``.
+        annealing: An ``AnnealingSchedule`` for Quantum Database Annealing (Alg. 4: samples are
+            drawn in distance bands around the tree that shrink with the temperature index h), or
+            None (default) for uniform databases.
+        predicate: The ``ReachabilityPredicate`` that decides whether a child is reachable from its
+            parent (its ``dim`` must equal ``env.dim``). Default: the sound ``ReachabilityOracle``
+            of ``env`` built with ``dynamics`` and ``resolution``.
+        dynamics: A ``LinearTrackingDynamics`` (same ``dim`` as ``env``) for the default predicate;
+            give it only without ``predicate`` (a predicate carries its own motion model). Default:
+            ``LinearTrackingDynamics.paper()``.
+        oracle_errors: An ``OracleErrorModel`` that corrupts the marks of the phase oracle (false
+            positives and negatives), or None (default) for exact marks. The finalizer verifies
+            every measured entry with the true predicate, so a wrong mark costs oracle calls, never
+            a bad node.
+        goal_bias: Probability in [0, 1) that a sample is drawn in the goal ball instead of
+            uniformly in the workspace. Default 0 (the paper's uniform sampling).
+        resolution: Clearance of the default ``ReachabilityOracle`` in length units (> 0, finite;
+            default 0.01): a free trajectory is accepted if it passes farther than (1 + sqrt(d)) *
+            resolution from every obstacle and 2 * resolution from the workspace boundary. Unused
+            when ``predicate`` is given.
+        seed: Non-negative integer seed of the keyed random streams (one generator per (round,
+            worker, stream), so results do not depend on the executor or the order of the calls), or
+            None (default) for fresh entropy.
+        oracle: Alias of ``predicate`` kept from 0.1; giving both (as different objects) is an
+            error.
+        iterations: Alias of ``search_policy`` kept from 0.1; giving both (as different objects) is
+            an error.
+
+    Raises:
+        TypeError: An argument of the wrong type: ``env`` not an ``Environment``, a non-integer
+            ``num_qubits`` or ``seed``, a non-real ``goal_bias`` or ``resolution``, ``dynamics`` or
+            ``oracle_errors`` of the wrong class, a ``backend`` that is not a
+            ``QuantumSearchBackend``, a ``search_policy`` that is not an ``IterationPolicy``, an
+            ``annealing`` that is not an ``AnnealingSchedule``, or a ``predicate`` that lacks the
+            members of the ``ReachabilityPredicate`` protocol.
+        ValueError: ``num_qubits`` < 1 or above the backend's ``max_qubits``, ``goal_bias`` outside
+            [0, 1), a non-positive or non-finite ``resolution``, a negative ``seed``, a dimension
+            mismatch between ``env`` and ``predicate`` or ``dynamics``, both ``predicate`` and
+            ``oracle`` (or both ``predicate`` and ``dynamics``) given, both ``search_policy`` and
+            ``iterations`` given, or a plan whose estimated peak memory (``memory_estimate``)
+            exceeds the available memory.
+    """
 
     name = "QRRT"
 

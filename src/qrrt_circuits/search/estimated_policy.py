@@ -31,10 +31,27 @@ __all__ = ["EstimatedOptimal", "EstimatedOptimalState"]
 
 @dataclass(frozen=True)
 class EstimatedOptimal(IterationPolicy):
-    """One amplitude estimation per database (confidence 1 - ``alpha``, ``shots`` per estimation
-    circuit), then the optimal k for the estimate. ``method="mlae"``: the powers [0, 1, ...,
-    2^(schedule-1)] of the Grover operator, likelihood-ratio interval; ``method="iae"``: iterative,
-    to a half-width ``epsilon`` on m/N (see ``search/estimation.py`` for why MLAE is the default)."""
+    """One amplitude estimation per database, then the optimal k of Eq. 1 for the estimate.
+
+    Every worker of the database (Alg. 3; one for Alg. 2) runs k = floor(pi / (4 theta)),
+    sin^2 theta = m_hat / N with m_hat = max(1, round(a_hat N)), measures once and verifies. The
+    estimation's shots are counted as quantum oracle calls (k_i + 1 per shot) and shared by the
+    workers. Unlike ``KnownOptimal`` it never reads the true m.
+
+    Args:
+        method: ``"mlae"`` (default; maximum-likelihood amplitude estimation on the powers
+            [0, 1, ..., 2^(schedule-1)] of the Grover operator, likelihood-ratio interval) or
+            ``"iae"`` (iterative amplitude estimation to a half-width ``epsilon`` on m/N); see
+            ``search/estimation.py`` for why MLAE is the default.
+        schedule: Number of Grover powers of MLAE, in [0, 20] (default 3).
+        shots: Shots per estimation circuit, in [1, 1000000] (default 16).
+        alpha: The estimate's confidence is 1 - alpha, alpha in (0, 1) (default 0.05).
+        epsilon: Target half-width of IAE on m/N, in (0, 0.5] (default 0.05).
+
+    Raises:
+        TypeError: A non-integer ``schedule`` or ``shots``, or a non-real ``alpha`` or ``epsilon``.
+        ValueError: An unknown ``method`` or a field outside its range.
+    """
 
     method: str = "mlae"
     schedule: int = 3
@@ -56,8 +73,16 @@ class EstimatedOptimal(IterationPolicy):
         return EstimatedOptimalState(self, num_items)
 
     def estimate(self, problem: DatabaseSearch) -> AmplitudeEstimate:
-        """One amplitude estimation of ``problem``'s marked fraction, seeded from the policy
-        stream of its first worker."""
+        """One amplitude estimation of ``problem``'s marked fraction a = m/N.
+
+        Seeded from the policy stream of the database's first worker.
+
+        Args:
+            problem: The database search (its marks define the good states).
+
+        Returns:
+            The ``AmplitudeEstimate`` (estimate, interval and the quantum oracle calls it cost).
+        """
         return estimate_marked_fraction(problem.marks, alpha=self.alpha, shots=self.shots,
                                         rng=problem.worker_generator(0), method=self.method,
                                         schedule=self.schedule, epsilon=self.epsilon)
@@ -75,8 +100,15 @@ class EstimatedOptimal(IterationPolicy):
 
 
 class EstimatedOptimalState(PolicyState):
-    """Per database: one estimation, then every worker searches with the optimal k for it.
-    ``history`` keeps (estimate, k) per database, in the order they were run."""
+    """Per-plan state: per database one estimation, then every worker searches with its optimal k.
+
+    Args:
+        policy: The ``EstimatedOptimal`` policy.
+        num_items: N, the entries of each database.
+
+    Attributes:
+        history: (estimate, k) per database, in the order they were run.
+    """
 
     policy: EstimatedOptimal
 
@@ -90,6 +122,17 @@ class EstimatedOptimalState(PolicyState):
     iterations = choose_iterations
 
     def run(self, problem: DatabaseSearch, workers: int, tree_nodes: int) -> tuple[SearchOutcome, ...]:
+        """Estimate the database's m, then ``workers`` workers search it with the optimal k.
+
+        Args:
+            problem: The database search.
+            workers: Number p of workers (>= 1).
+            tree_nodes: Nodes in the tree so far (unused).
+
+        Returns:
+            One ``SearchOutcome`` per worker: the verified index or None, its share of the
+            estimation's calls plus k quantum calls, and 1 verification.
+        """
         estimate = self.policy.estimate(problem)
         k = optimal_iterations(problem.num_items, estimate.marked_count(problem.num_items))
         self.history.append((estimate, k))

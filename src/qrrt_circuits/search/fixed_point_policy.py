@@ -33,9 +33,26 @@ __all__ = ["FixedPointAmplification", "FixedPointState"]
 
 @dataclass(frozen=True)
 class FixedPointAmplification(IterationPolicy):
-    """Fixed-point amplitude amplification: P(marked) >= 1 - delta^2 for every marked fraction
-    >= ``min_fraction``. ``length_rule``: ``"paper"`` (L >= log(2/delta)/sqrt(w), Yoder et al.) or
-    ``"tight"`` (the smallest L with the same guarantee)."""
+    """Fixed-point amplitude amplification: P(marked) >= 1 - delta^2 for every marked fraction >= w.
+
+    Yoder, Low and Chuang, "Fixed-point quantum search with an optimal number of queries", PRL 113,
+    210501 (2014). Replaces the fixed Grover iteration count of the paper's Alg. 2 / 3 worker by
+    l generalized iterates that cannot overshoot: the success probability P_L(f) (L = 2l + 1) is at
+    least 1 - delta^2 for every marked fraction f >= w, where Eq. 1's k iterations need the true m.
+    Cost per worker and database (DESIGN §2): l quantum oracle calls + 1 verification.
+
+    Args:
+        delta: Target error, in (0, 1) (default 0.5: P >= 0.75).
+        min_fraction: w, the lower bound on the marked fraction m/N that the guarantee covers, in
+            (0, 1] (default 0.05).
+        length_rule: ``"paper"`` (the smallest L = 2l + 1 >= log(2/delta)/sqrt(w), Yoder et al.; the
+            default) or ``"tight"`` (the smallest L with the same guarantee).
+
+    Raises:
+        TypeError: A non-real ``delta`` or ``min_fraction``.
+        ValueError: ``delta`` outside (0, 1), ``min_fraction`` outside (0, 1], or an unknown
+            ``length_rule``.
+    """
 
     delta: float = 0.5
     min_fraction: float = 0.05
@@ -50,14 +67,23 @@ class FixedPointAmplification(IterationPolicy):
 
     @property
     def iterates(self) -> int:
-        """l, the generalized iterates (oracle calls) per worker."""
+        """l, the generalized iterates (quantum oracle calls) per worker and database."""
         return fixed_point_iterates(self.delta, self.min_fraction, self.length_rule)
 
     def sequence(self) -> IterateSequence:
+        """The phases of the l generalized iterates (Yoder et al.), as ``IterateSequence``."""
         return IterateSequence.fixed_point(self.delta, self.iterates)
 
     def success_probability(self, fraction: float) -> float:
-        """P_L(f) for this policy's sequence (Yoder et al.)."""
+        """Probability that one measurement is marked after this policy's sequence (Yoder et al.).
+
+        Args:
+            fraction: f = m/N, the database's marked fraction.
+
+        Returns:
+            P_L(f) = 1 - delta^2 T_L(T_(1/L)(1/delta) sqrt(1 - f))^2 (T: Chebyshev polynomials),
+            >= 1 - delta^2 for f >= ``min_fraction``.
+        """
         return fixed_point_success_probability(self.delta, self.iterates, fraction)
 
     def _iterations(self, num_items: int, tree_nodes: int, num_marked: int | None) -> int:
@@ -72,7 +98,12 @@ class FixedPointAmplification(IterationPolicy):
 
 
 class FixedPointState(PolicyState):
-    """Every worker: the fixed-point sequence, one measurement, one verification."""
+    """Per-plan state: every worker runs the fixed-point sequence, measures once and verifies.
+
+    Args:
+        policy: The ``FixedPointAmplification`` policy.
+        num_items: N, the entries of each database.
+    """
 
     policy: FixedPointAmplification
 
@@ -81,6 +112,20 @@ class FixedPointState(PolicyState):
         self.sequence = policy.sequence()
 
     def run(self, problem: DatabaseSearch, workers: int, tree_nodes: int) -> tuple[SearchOutcome, ...]:
+        """``workers`` workers search one database with the fixed-point sequence.
+
+        One backend call with ``shots = workers`` stands for the workers' independent preparations;
+        each worker verifies its own measurement.
+
+        Args:
+            problem: The database search.
+            workers: Number p of workers (>= 1).
+            tree_nodes: Nodes in the tree so far (unused).
+
+        Returns:
+            One ``SearchOutcome`` per worker: the verified index or None, l quantum calls and 1
+            verification.
+        """
         calls = self.sequence.oracle_calls
         outcomes = []
         for measured in problem.search_sequence(self.sequence, workers, problem.shared_seed()):

@@ -25,7 +25,8 @@ of a shared database, overrides ``run`` the same way.
 - ``FixedIterations(k)``: always k (Alg. 4 / QDA uses k = 2).
 - ``KnownOptimal()``: floor(pi / (4 theta)), sin^2 theta = m/N (Eq. 1), with the database's true
   marked count m. This is simulation knowledge a quantum device does not have: outputs say so.
-- ``BBHT()``: Boyer-Brassard-Hoyer-Tapp search for unknown m (BBHT 1998, Thm. 3). Per worker: draw
+- ``BBHT()``: Boyer-Brassard-Hoyer-Tapp search for unknown m (Boyer, Brassard, Hoyer and Tapp,
+  "Tight bounds on quantum searching", Fortschr. Phys. 46, 493 (1998), Thm. 3). Per worker: draw
   j uniformly in [0, M), run j iterations, measure, verify; on failure M <- min(lambda M, sqrt(N)).
   Stops at the first verified success or when the iterations spent reach ``cap_factor * sqrt(N)``
   (so m = 0 terminates). Expected cost O(sqrt(N/m)).
@@ -63,16 +64,30 @@ __all__ = [
 
 
 class IterationPolicy:
-    """Base class of the search policies (frozen configurations).
+    """Base class of the search policies: how a worker searches one database (frozen configurations).
 
-    ``uses_true_m``: the policy reads the database's true marked count (simulation knowledge,
-    labelled in every output that depends on it)."""
+    A policy picks the Grover iteration count k of the amplitude amplification loop of Alg. 2 / 3
+    (the paper fixes k by a schedule; Eq. 1 gives the optimal k for a known m). Subclasses implement
+    ``_iterations`` (policies that pick k before measuring) or return their own ``PolicyState``
+    from ``start`` with its own ``run``.
+
+    The class attribute ``uses_true_m`` is True if the policy reads the database's true marked
+    count m (simulation knowledge a quantum device does not have, labelled in every output that
+    depends on it); ``name`` is the policy's short name.
+    """
 
     uses_true_m: bool = False
     name: str = "policy"
 
     def start(self, num_items: int) -> PolicyState:
-        """The mutable state one plan uses with databases of ``num_items`` entries."""
+        """The mutable per-plan state of this policy.
+
+        Args:
+            num_items: N, the entries of each database the plan searches (2^n).
+
+        Returns:
+            A fresh ``PolicyState`` (or the subclass this policy needs).
+        """
         return PolicyState(self, num_items)
 
     def describe(self) -> str:
@@ -83,17 +98,39 @@ class IterationPolicy:
         return ()
 
     def iterations_for(self, problem: DatabaseSearch, tree_nodes: int) -> int:
-        """The k for one database (policies that pick k before measuring)."""
+        """The Grover iteration count k for one database (policies that pick k before measuring).
+
+        Args:
+            problem: The database search (its size N, and for ``KnownOptimal`` its marked count).
+            tree_nodes: Nodes in the tree so far.
+
+        Returns:
+            k >= 0.
+        """
         return self._iterations(problem.num_items, tree_nodes, None)
 
     def iterations_bound(self, num_items: int) -> int:
-        """The most Grover iterations one search (one circuit) of this policy can run on a
-        database of ``num_items`` entries (the memory guard sizes a search by it). By default the
-        optimal k for one marked entry, floor(pi / (4 asin(1/sqrt(N)))) (Eq. 1)."""
+        """The most Grover iterations one search (one circuit) of this policy can run.
+
+        The memory guard sizes a search by it.
+
+        Args:
+            num_items: N, the database size.
+
+        Returns:
+            By default the optimal k for one marked entry, floor(pi / (4 asin(1/sqrt(N)))) (Eq. 1).
+        """
         return optimal_iterations(num_items, 1)
 
     def state_bytes(self, num_items: int) -> int:
-        """Bytes the policy's per-plan state holds (the memory guard adds them)."""
+        """Bytes the policy's per-plan state holds (the memory guard adds them).
+
+        Args:
+            num_items: N, the database size.
+
+        Returns:
+            The bytes (0 by default).
+        """
         return 0
 
     def _iterations(self, num_items: int, tree_nodes: int, num_marked: int | None) -> int:
@@ -105,14 +142,35 @@ SearchPolicy = IterationPolicy
 
 
 class PolicyState:
-    """Per-plan state. The default runs one search with ``shots = workers`` at the policy's k."""
+    """Per-plan mutable state of a policy; the default runs one search with ``shots = workers``.
+
+    Args:
+        policy: The frozen ``IterationPolicy`` this state belongs to.
+        num_items: N, the entries of each database the plan searches.
+
+    Attributes:
+        policy: The policy.
+        num_items: N.
+    """
 
     def __init__(self, policy: IterationPolicy, num_items: int) -> None:
         self.policy = policy
         self.num_items = int(num_items)
 
     def choose_iterations(self, tree_nodes: int, num_marked: int | None = None) -> int:
-        """The Grover iterations for the next database (``num_marked`` only for KnownOptimal)."""
+        """The Grover iterations for the next database.
+
+        Args:
+            tree_nodes: Nodes in the tree so far.
+            num_marked: The database's true marked count m (only ``KnownOptimal`` reads it).
+
+        Returns:
+            k >= 0.
+
+        Raises:
+            ValueError: ``KnownOptimal`` without ``num_marked``.
+            TypeError: Policies that choose k inside their own loop (``BBHT``, ``EstimatedOptimal``).
+        """
         return self.policy._iterations(self.num_items, tree_nodes, num_marked)
 
     #: alias kept from 0.1 (``state.iterations(tree_nodes)``)
@@ -122,17 +180,41 @@ class PolicyState:
         return self.policy.iterations_for(problem, tree_nodes)
 
     def run(self, problem: DatabaseSearch, workers: int, tree_nodes: int) -> tuple[SearchOutcome, ...]:
-        """``workers`` workers search ``problem``: one backend search with ``shots = workers``,
-        then each worker verifies its own measurement (k quantum calls + 1 verification each)."""
+        """``workers`` workers search one database (Alg. 3 worker loop; Alg. 2 for one worker).
+
+        The default: one backend search at the policy's k with ``shots = workers`` (each shot
+        stands for one worker's independent preparation), then each worker verifies its own
+        measurement classically. Cost per worker (DESIGN §2): k quantum oracle calls + 1
+        verification.
+
+        Args:
+            problem: The database search (marks, classical verification, size N, seeded streams).
+            workers: Number p of workers searching this database (>= 1).
+            tree_nodes: Nodes in the tree so far (for schedules that depend on it).
+
+        Returns:
+            One ``SearchOutcome`` per worker, in worker order: the verified index or None, the
+            quantum calls and verifications spent, and the (k, success) observations.
+        """
         k = self.iterations_for(problem, tree_nodes)
         return _verified(problem, k, problem.search(k, workers, problem.shared_seed()))
 
     def run_many(self, problems: Sequence[DatabaseSearch], workers: int,
                  tree_nodes: int) -> tuple[tuple[SearchOutcome, ...], ...]:
-        """``run`` on each of several independent databases of one round (unshared Pq-RRT), with
-        all their searches handed to the backend at once (``QuantumSearchBackend.search_many``);
+        """``run`` on each of several independent databases of one round (unshared Pq-RRT).
+
+        All their searches are handed to the backend at once (``QuantumSearchBackend.search_many``);
         the outcomes are those of calling ``run`` on each database in turn. A state class that
-        overrides ``run`` but not ``run_many`` gets its own ``run`` on each database."""
+        overrides ``run`` but not ``run_many`` gets its own ``run`` on each database.
+
+        Args:
+            problems: The round's database searches.
+            workers: Workers per database (>= 1).
+            tree_nodes: Nodes in the tree so far.
+
+        Returns:
+            Per database, the outcomes ``run`` returns for it.
+        """
         if type(self).run is not PolicyState.run:
             return tuple(self.run(problem, workers, tree_nodes) for problem in problems)
         iterations = [self.iterations_for(problem, tree_nodes) for problem in problems]
@@ -167,7 +249,20 @@ def _check_iteration_count(value, name: str) -> int:
 
 @dataclass(frozen=True)
 class PaperSchedule(IterationPolicy):
-    """5 iterations, then ``late`` (3) once the tree has more than ``switch_nodes`` (10) nodes."""
+    """The authors' schedule: ``early`` iterations, then ``late`` once the tree is larger.
+
+    The paper's q-RRT / Pq-RRT experiments (Alg. 2 / 3) use k = 5, then k = 3 once the tree has more
+    than 10 nodes (the authors' code), not the optimal k of Eq. 1.
+
+    Args:
+        early: k while the tree has at most ``switch_nodes`` nodes (default 5).
+        late: k once the tree has more than ``switch_nodes`` nodes (default 3).
+        switch_nodes: The tree size at which the schedule switches (default 10).
+
+    Raises:
+        TypeError: A non-integer field.
+        ValueError: A field outside [0, 1000000].
+    """
 
     early: int = 5
     late: int = 3
@@ -190,7 +285,15 @@ class PaperSchedule(IterationPolicy):
 
 @dataclass(frozen=True)
 class FixedIterations(IterationPolicy):
-    """Always ``k`` iterations."""
+    """Always ``k`` Grover iterations (Alg. 4, QDA, uses k = 2).
+
+    Args:
+        k: The iteration count (default 2).
+
+    Raises:
+        TypeError: A non-integer ``k``.
+        ValueError: ``k`` outside [0, 1000000].
+    """
 
     k: int = 2
     name = "fixed"
@@ -210,7 +313,11 @@ class FixedIterations(IterationPolicy):
 
 @dataclass(frozen=True)
 class KnownOptimal(IterationPolicy):
-    """floor(pi/(4 theta)) for the database's true m (Eq. 1; simulation knowledge, labelled)."""
+    """The optimal k of Eq. 1 for each database's true marked count m.
+
+    k = floor(pi / (4 theta)) with sin^2 theta = m/N, and 0 for m = 0. Reading m is simulation
+    knowledge a quantum device does not have; every output planned with it is labelled so.
+    """
 
     name = "optimal"
     uses_true_m = True
@@ -243,7 +350,24 @@ class BBHTOutcome:
 
 @dataclass(frozen=True)
 class BBHT(IterationPolicy):
-    """Boyer-Brassard-Hoyer-Tapp search for unknown m, one loop per worker."""
+    """Boyer-Brassard-Hoyer-Tapp search for an unknown m, one loop per worker.
+
+    Boyer, Brassard, Hoyer and Tapp, "Tight bounds on quantum searching", Fortschr. Phys. 46, 493
+    (1998), Thm. 3. Per worker: draw j uniformly in [0, M), run j iterations, measure, verify; on
+    failure M <- min(lambda M, sqrt(N)), starting from M = 1. The loop stops at the first verified
+    success or once the iterations spent reach ``cap_factor * sqrt(N)`` (so m = 0 terminates).
+    Expected cost O(sqrt(N/m)) oracle calls. Each circuit costs j quantum calls + 1 verification.
+
+    Args:
+        growth: lambda, the growth factor of M, in (1, 4/3] (default 6/5; BBHT prove the bound for
+            1 < lambda < 4/3).
+        cap_factor: The iteration budget of one search as a multiple of sqrt(N), in (0, 1000]
+            (default 4.5).
+
+    Raises:
+        TypeError: A non-real field.
+        ValueError: A field outside its range.
+    """
 
     growth: float = 6 / 5
     cap_factor: float = 4.5
@@ -257,17 +381,42 @@ class BBHT(IterationPolicy):
         return BBHTState(self, num_items)
 
     def iterations_bound(self, num_items: int) -> int:
-        """One BBHT circuit runs j < M <= sqrt(N) iterations (the cap bounds their sum)."""
+        """The most iterations one BBHT circuit runs: j < M <= sqrt(N) (the cap bounds their sum).
+
+        Args:
+            num_items: N, the database size.
+
+        Returns:
+            min(isqrt(N), ``cap(N)``).
+        """
         return min(math.isqrt(num_items), self.cap(num_items))
 
     def cap(self, num_items: int) -> int:
-        """Iteration budget of one BBHT search: ``cap_factor * sqrt(N)``."""
+        """Iteration budget of one BBHT search.
+
+        Args:
+            num_items: N, the database size.
+
+        Returns:
+            ceil(``cap_factor`` * sqrt(N)), at least 1.
+        """
         return max(1, int(math.ceil(self.cap_factor * math.sqrt(num_items))))
 
     def run(self, search: Callable[[int], int], verify: Callable[[int], bool], num_items: int,
             rng: np.random.Generator) -> BBHTOutcome:
-        """One worker's BBHT search. ``search(j)`` measures an index after j iterations and
-        ``verify(index)`` is the classical check (1 oracle call each)."""
+        """One worker's BBHT search (BBHT 1998, Thm. 3, with an iteration cap).
+
+        Args:
+            search: ``search(j)`` prepares the database, runs j Grover iterations (j quantum oracle
+                calls) and returns the measured index.
+            verify: ``verify(index)`` is the classical check of a measured index (1 oracle call).
+            num_items: N, the database size.
+            rng: The generator that draws each j.
+
+        Returns:
+            A ``BBHTOutcome``: the verified index or None (cap reached), the iterations and
+            verifications spent, and the (j, success) attempts.
+        """
         bound = 1.0
         spent = 0
         attempts: list[tuple[int, bool]] = []
@@ -323,11 +472,25 @@ class BBHTState(PolicyState):
 class Adaptive(IterationPolicy):
     """Chooses k from a posterior over the marked fraction built from verified outcomes only.
 
-    ``prior``: ``"uniform"`` (flat in f on [1/N, 1], the default) or ``"log-uniform"`` (flat in
-    log f). ``forgetting``: each new observation multiplies the old log-likelihood by this factor
-    (an effective memory of about 1 / (1 - forgetting) measurements, as f drifts with the tree).
-    The defaults (uniform, 0.9) were chosen on 20 paper_clutter worlds plus sparse (100 boxes) and
-    dense (1000 boxes) ones, against log-uniform and 0.97.
+    Each measurement after k iterations succeeds with probability sin^2((2k+1) asin(sqrt f)) for
+    the marked fraction f = m/N (the success probability behind Eq. 1); a grid posterior over f
+    picks the k with the largest expected success per oracle call, P(k) / (k + 1). It never reads
+    the true m. The defaults (uniform, 0.9) were chosen on 20 paper_clutter worlds plus sparse (100
+    boxes) and dense (1000 boxes) ones, against log-uniform and 0.97.
+
+    Args:
+        grid_size: Points of the geometric grid over f in [1/N, 1], in [10, 100000] (default 200).
+        forgetting: Each new observation multiplies the old log-likelihood by this factor, in (0, 1]
+            (default 0.9): an effective memory of about 1 / (1 - forgetting) measurements, as f
+            drifts with the tree.
+        prior: ``"uniform"`` (flat in f on [1/N, 1], the default) or ``"log-uniform"`` (flat in
+            log f).
+        max_iterations: The largest k considered, in [0, 1000000], or None (default) for the optimal
+            k for one marked entry (Eq. 1).
+
+    Raises:
+        TypeError: A field of the wrong type.
+        ValueError: A field outside its range, or an unknown ``prior``.
     """
 
     grid_size: int = 200
