@@ -106,8 +106,9 @@ class QuantumSearchBackend(abc.ABC):
         """Grover-search ``marks`` with ``iterations`` iterations; measure ``shots`` times.
 
         Prepares W|0> = H^n|0>, applies Q^k with Q = ``grover_operator(phase_oracle(marks), W)``
-        (paper Alg. 2, lines 4-8; ``qrrt_circuits.search.circuits``) and measures; a marked index comes out with probability sin^2((2k+1) theta),
-        sin^2 theta = m / 2^n (paper Eq. 1, Lemma 1). Each shot is one worker's independent
+        (paper Alg. 2, lines 4-8; ``qrrt_circuits.search.circuits``) and measures; a marked index
+        comes out with probability sin^2((2k+1) theta), sin^2 theta = m / 2^n (paper Eq. 1,
+        Lemma 1). Each shot is one worker's independent
         preparation.
 
         Args:
