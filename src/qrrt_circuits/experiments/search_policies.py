@@ -29,7 +29,7 @@ from .figures import new_figure, save
 from .intervals import bootstrap_interval, rounded_interval
 from .measures import dumps, loads
 from .planners import planner_for
-from .tree_size import calls_at_sizes, reachable_fraction_by_window
+from .tree_size import calls_at_sizes, pooled_calls_per_node, reachable_fraction_by_window
 from .worlds import world
 
 SIZES = (30, 100, 300, 1000)
@@ -105,23 +105,14 @@ class SearchPolicies(Experiment):
         sizes = settings["sizes"]
         windows = [f"{a}-{b}" for a, b in zip(sizes[:-1], sizes[1:], strict=True)]
 
-        def pooled(rows, window, column=1):
-            low, high = (int(v) for v in window.split("-"))
-            calls = nodes = 0
-            for r in rows:
-                points = {p[0]: p for p in loads(r["points_json"])}
-                if low in points and high in points:
-                    calls += points[high][column] - points[low][column]
-                    nodes += high - low
-            return calls / nodes if nodes else float("nan")
-
         ours, interval, critical, whole = {}, {}, {}, {}
         for label in settings["configs"]:
             rows = [r for r in records if r["config"] == label]
-            ours[label] = {w: round(pooled(rows, w), 3) for w in windows}
-            interval[label] = {w: rounded_interval(bootstrap_interval(rows, lambda s, w=w: pooled(s, w),
+            ours[label] = {w: round(pooled_calls_per_node(rows, w), 3) for w in windows}
+            interval[label] = {w: rounded_interval(bootstrap_interval(rows,
+                                                                      lambda s, w=w: pooled_calls_per_node(s, w),
                                                                       settings["seed"]), 3) for w in windows}
-            critical[label] = {w: round(pooled(rows, w, 2), 3) for w in windows}
+            critical[label] = {w: round(pooled_calls_per_node(rows, w, 2), 3) for w in windows}
             nodes = sum(r["nodes"] for r in rows)
             whole[label] = {"calls_per_node": round(sum(r["oracle_calls"] for r in rows) / nodes, 3),
                             "critical_path_per_node": round(sum(r["critical_path_calls"] for r in rows) / nodes, 3)}

@@ -41,6 +41,19 @@ COLORS = {"RRT": "tab:gray", "ParallelRRT": "tab:brown", "QRRT paper": "tab:blue
           "QRRT bbht": "tab:green", "QRRT adaptive": "tab:orange", "PQRRT paper": "tab:red"}
 
 
+def pooled_calls_per_node(rows, window: str, column: int = 1) -> float:
+    """Calls added / nodes added in ``window`` ("low-high") over the rows (a pooled ratio);
+    ``column`` 1 counts oracle calls, 2 critical-path calls (the points of ``calls_at_sizes``)."""
+    low, high = (int(v) for v in window.split("-"))
+    calls = nodes = 0
+    for r in rows:
+        points = {p[0]: p for p in loads(r["points_json"])}
+        if low in points and high in points:
+            calls += points[high][column] - points[low][column]
+            nodes += high - low
+    return calls / nodes if nodes else float("nan")
+
+
 def calls_at_sizes(result, sizes) -> list[list[int]]:
     """[[size, oracle calls, critical-path calls], ...] at the first round the tree reaches each size."""
     nodes = result.history["nodes"]
@@ -105,24 +118,13 @@ class TreeSize(Experiment):
         sizes = settings["sizes"]
         windows = [f"{a}-{b}" for a, b in zip(sizes[:-1], sizes[1:], strict=True)]
 
-        def pooled(rows, window, column=1):
-            """Calls added / nodes added in ``window`` over the rows (pooled ratio)."""
-            low, high = (int(v) for v in window.split("-"))
-            calls = nodes = 0
-            for r in rows:
-                points = {p[0]: p for p in loads(r["points_json"])}
-                if low in points and high in points:
-                    calls += points[high][column] - points[low][column]
-                    nodes += high - low
-            return calls / nodes if nodes else float("nan")
-
         ours, interval, critical = {}, {}, {}
         for label in settings["configs"]:
             rows = [r for r in records if r["config"] == label]
-            ours[label] = {w: round(pooled(rows, w), 3) for w in windows}
-            interval[label] = {w: rounded_interval(bootstrap_interval(rows, lambda s, w=w: pooled(s, w),
+            ours[label] = {w: round(pooled_calls_per_node(rows, w), 3) for w in windows}
+            interval[label] = {w: rounded_interval(bootstrap_interval(rows, lambda s, w=w: pooled_calls_per_node(s, w),
                                                                       settings["seed"]), 3) for w in windows}
-            critical[label] = {w: round(pooled(rows, w, 2), 3) for w in windows}
+            critical[label] = {w: round(pooled_calls_per_node(rows, w, 2), 3) for w in windows}
         fractions = {label: {w: round(float(np.mean([loads(r["fractions_json"])[w] for r in records
                                                      if r["config"] == label and w in loads(r["fractions_json"])]
                                                     or [np.nan])), 4) for w in windows}

@@ -105,23 +105,19 @@ class SamplerBackend(QuantumSearchBackend):
             The transpiled, measured ``QuantumCircuit``.
         """
         key = (marks.shape[0], np.packbits(marks).tobytes(), iterations)
-        circuit = self._cache.get(key)
-        if circuit is None:
-            circuit = self.pass_manager.run(grover_circuit(marks, iterations, synthesis=self.synthesis))
-            self.transpile_count += 1
-            self._cache[key] = circuit
-            if len(self._cache) > self._cache_size:
-                self._cache.popitem(last=False)
-        else:
-            self._cache.move_to_end(key)
-        return circuit
+        return self._cached_transpile(key, lambda: grover_circuit(marks, iterations, synthesis=self.synthesis))
 
     def compiled_sequence(self, marks: np.ndarray, sequence):
         """The transpiled ``generalized_grover_circuit`` (cached by marks and phases)."""
         key = (marks.shape[0], np.packbits(marks).tobytes(), "sequence", sequence.key())
+        return self._cached_transpile(
+            key, lambda: generalized_grover_circuit(marks, sequence, synthesis=self.synthesis))
+
+    def _cached_transpile(self, key, build):
+        """The transpiled circuit for ``key`` from the LRU cache, built and transpiled once."""
         circuit = self._cache.get(key)
         if circuit is None:
-            circuit = self.pass_manager.run(generalized_grover_circuit(marks, sequence, synthesis=self.synthesis))
+            circuit = self.pass_manager.run(build())
             self.transpile_count += 1
             self._cache[key] = circuit
             if len(self._cache) > self._cache_size:
