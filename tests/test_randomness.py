@@ -48,3 +48,42 @@ def test_search_seeds_equal_numpy_integers(seed):
         key = (round_index, round_index % 5, int(Stream.SEARCH))
         expected = np.random.default_rng(np.random.SeedSequence(streams.entropy, spawn_key=key)).integers(0, 2**62)
         assert streams.seed(*key) == int(expected)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2**31 - 1, 2**32, 2**62 - 1, 2**100 + 17])
+def test_integer_seed_words_equal_default_rng(seed):
+    from qrrt_circuits.randomness import integer_seed_words
+
+    expected = np.random.SeedSequence(seed).generate_state(4, np.uint64)
+    assert np.array_equal(integer_seed_words(seed), expected)
+
+
+def test_first_integer_below_equals_default_rng_integers():
+    from qrrt_circuits.randomness import first_integer_below
+
+    rng = np.random.default_rng(5)
+    highs = [1, 2, 3, 5, 2**31 - 1, 2**32 - 1, 2**32, *rng.integers(1, 2**32, 40).tolist()]
+    for seed in rng.integers(0, 2**62, 60).tolist():
+        for high in highs:
+            assert first_integer_below(seed, high) == int(np.random.default_rng(seed).integers(0, high))
+    with pytest.raises(ValueError, match="high"):
+        first_integer_below(1, 2**32 + 1)
+
+
+def test_compiled_two_level_draws_equal_the_numpy_ones():
+    """The statevector backend's compiled sampler (integer seeds) draws what default_rng draws:
+    same doubles, then the buffered 32-bit Lemire draws of the marked picks and unmarked ranks."""
+    from qrrt_circuits.probability import good_probability
+    from qrrt_circuits.randomness import integer_seed_words
+    from qrrt_circuits.search.statevector import _draw_two_level, _draw_two_level_seeded
+
+    rng = np.random.default_rng(11)
+    for _ in range(400):
+        size = 1 << int(rng.integers(1, 12))
+        fraction = float(rng.choice([0.0, 1.0, rng.random(), 1.0 / size]))
+        marks = rng.random(size) < fraction
+        shots = int(rng.choice([1, 2, 3, 8, 33]))
+        seed = int(rng.integers(0, 2**62))
+        p_good = good_probability(size, int(marks.sum()), int(rng.integers(0, 6)))
+        expected = _draw_two_level(marks, p_good, shots, np.random.default_rng(seed))
+        assert np.array_equal(_draw_two_level_seeded(marks, p_good, shots, integer_seed_words(seed)), expected)

@@ -264,3 +264,94 @@ def uniform_draws(streams: RandomStreams, keys: np.ndarray, count: int) -> np.nd
     """(K, count): the first ``count`` doubles ``generator(*key).random()`` would return, for each
     key (round, worker, stream) of ``keys`` (K, 3), computed without building the generators."""
     return _uniform_draws(streams.seed_words(keys), int(count))
+
+
+# ``np.random.default_rng(seed)`` for one integer seed, compiled: the backends' per-search
+# generators. A search needs only a handful of draws, yet building the Generator costs about 30 us,
+# more than the draws; the functions below give the same numbers from the seed's words directly.
+# The state is a uint64 array [state_hi, state_lo, inc_hi, inc_lo, has_uint32, uinteger] that
+# mirrors numpy's pcg64_state (``pcg64.h``: the buffered upper half of a 64-bit output serves the
+# next 32-bit draw).
+_NO_KEYS = np.empty((1, 0), dtype=np.int64)
+
+
+def integer_seed_words(seed: int) -> np.ndarray:
+    """(4,) uint64: the words ``SeedSequence(seed).generate_state(4, np.uint64)`` returns, i.e.
+    the seed of ``np.random.default_rng(seed)``'s PCG64 (an entropy of at most four 32-bit words
+    is mixed exactly as when it is zero-padded to the pool size)."""
+    words = _uint32_words(int(seed))
+    if len(words) > _POOL_SIZE:
+        raise ValueError(f"seed must be below 2**128, got {seed}")
+    words += [0] * (_POOL_SIZE - len(words))
+    return _seed_words(np.asarray(words, dtype=np.uint64), _NO_KEYS)[0]
+
+
+@njit(cache=True, nogil=True)
+def _pcg_state(words):
+    """numpy's ``pcg64_set_seed`` from the four seed words: the generator state array."""
+    one = np.uint64(1)
+    state = np.zeros(6, dtype=np.uint64)
+    inc_hi = (words[2] << one) | (words[3] >> np.uint64(63))
+    inc_lo = (words[3] << one) | one
+    state_hi, state_lo = _pcg_step(np.uint64(0), np.uint64(0), inc_hi, inc_lo)
+    state_lo_sum = state_lo + words[1]
+    carry = one if state_lo_sum < state_lo else np.uint64(0)
+    state_hi, state_lo = _pcg_step(state_hi + words[0] + carry, state_lo_sum, inc_hi, inc_lo)
+    state[0], state[1], state[2], state[3] = state_hi, state_lo, inc_hi, inc_lo
+    return state
+
+
+@njit(cache=True, nogil=True)
+def _next64(state):
+    """``pcg64_next64``: advance, then the XSL-RR output of the new state."""
+    state_hi, state_lo = _pcg_step(state[0], state[1], state[2], state[3])
+    state[0], state[1] = state_hi, state_lo
+    rotation = state_hi >> np.uint64(58)
+    value = state_hi ^ state_lo
+    return (value >> rotation) | (value << ((np.uint64(64) - rotation) & np.uint64(63)))
+
+
+@njit(cache=True, nogil=True)
+def _next_double(state):
+    """``Generator.random()``: the top 53 bits of one 64-bit output."""
+    return np.float64(_next64(state) >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+
+
+@njit(cache=True, nogil=True)
+def _next32(state):
+    """``pcg64_next32``: the buffered upper half of the last output, else the lower half of a new one."""
+    if state[4]:
+        state[4] = np.uint64(0)
+        return state[5]
+    value = _next64(state)
+    state[4] = np.uint64(1)
+    state[5] = value >> np.uint64(32)
+    return value & np.uint64(0xFFFFFFFF)
+
+
+@njit(cache=True, nogil=True)
+def _bounded_below(state, high):
+    """One ``Generator.integers(0, high)`` draw for 1 <= high <= 2**32 (numpy's
+    ``random_bounded_uint64_fill``: nothing drawn for high = 1, Lemire's method on 32-bit draws)."""
+    span = np.uint64(high - 1)  # numpy's inclusive range ``rng``
+    if span == 0:
+        return 0
+    mask = np.uint64(0xFFFFFFFF)
+    if span == mask:
+        return np.int64(_next32(state))
+    span_excl = span + np.uint64(1)
+    product = _next32(state) * span_excl
+    leftover = product & mask
+    if leftover < span_excl:
+        threshold = (mask - span) % span_excl
+        while leftover < threshold:
+            product = _next32(state) * span_excl
+            leftover = product & mask
+    return np.int64(product >> np.uint64(32))
+
+
+def first_integer_below(seed: int, high: int) -> int:
+    """``int(np.random.default_rng(seed).integers(0, high))`` for 1 <= high <= 2**32, compiled."""
+    if not 1 <= high <= 1 << 32:
+        raise ValueError(f"high must be in [1, 2**32], got {high}")
+    return int(_bounded_below(_pcg_state(integer_seed_words(seed)), high))

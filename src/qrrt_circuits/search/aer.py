@@ -154,15 +154,18 @@ class AerBackend(QuantumSearchBackend):
         """
         return 1 if num_qubits < SERIAL_BELOW_QUBITS else self.max_parallel_threads
 
-    def _submit(self, marks, num_qubits, iterations, shots, rng):
-        """Build the circuit and start its Aer job (Aer runs jobs on its own worker thread)."""
+    def _submit(self, marks, num_qubits, iterations, shots, seed):
+        """Build the circuit and start its Aer job (Aer runs jobs on its own worker thread); the
+        simulator seed is the first ``integers(0, 2**31 - 1)`` of the search's generator."""
         circuit = self._build(marks, iterations, measure=True, synthesis=self.synthesis)
-        seed = int(rng.integers(0, 2**31 - 1))
-        return self.simulator.run(circuit, shots=shots, seed_simulator=seed, memory=True,
-                                  max_parallel_threads=self.threads_for(num_qubits))
+        return self.simulator.run(circuit, shots=shots, seed_simulator=self._first_integer(seed, 2**31 - 1),
+                                  memory=True, max_parallel_threads=self.threads_for(num_qubits))
+
+    def _sample_seeded(self, marks, num_qubits, iterations, shots, seed) -> np.ndarray:
+        return _measured_indices(self._submit(marks, num_qubits, iterations, shots, seed).result(), 0)
 
     def _sample(self, marks, num_qubits, iterations, shots, rng) -> np.ndarray:
-        return _measured_indices(self._submit(marks, num_qubits, iterations, shots, rng).result(), 0)
+        return self._sample_seeded(marks, num_qubits, iterations, shots, rng)
 
     def _sample_sequence(self, marks, num_qubits, sequence, shots, rng) -> np.ndarray:
         """Fixed-point amplification: the generalized iterates of ``sequence`` as one circuit."""

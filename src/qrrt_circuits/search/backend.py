@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..memory import MemoryEstimate, check_fits
+from ..randomness import first_integer_below
 from ..validation import check_int, check_seed
 
 
@@ -129,7 +130,7 @@ class QuantumSearchBackend(abc.ABC):
             TypeError: Arguments of the wrong type.
         """
         prepared = self._prepare(SearchRequest(marks, iterations, shots, seed))
-        return self._finish(prepared, self._sample(*prepared))
+        return self._finish(prepared, self._sample_seeded(*prepared))
 
     def search_many(self, requests: Sequence[SearchRequest]) -> tuple[SearchResult, ...]:
         """Independent searches (the p databases of one unshared Pq-RRT round): result i is exactly
@@ -137,10 +138,11 @@ class QuantumSearchBackend(abc.ABC):
         searched one after the other (same seeds, same measured indices). Every request is
         validated before any search runs. A backend may run them together (``AerBackend``)."""
         prepared = [self._prepare(request) for request in requests]
-        return tuple(self._finish(item, self._sample(*item)) for item in prepared)
+        return tuple(self._finish(item, self._sample_seeded(*item)) for item in prepared)
 
     def _prepare(self, request: SearchRequest):
-        """(marks, n, iterations, shots, rng) of one validated request."""
+        """(marks, n, iterations, shots, seed) of one validated request; the seed is None (the
+        backend's own stream), a non-negative int or a ``numpy.random.Generator``."""
         if not isinstance(request, SearchRequest):
             raise TypeError(f"requests must be SearchRequest objects, got {type(request).__name__}")
         marks, num_qubits = validate_marks(request.marks)
@@ -148,7 +150,27 @@ class QuantumSearchBackend(abc.ABC):
         shots = validate_shots(request.shots)
         self.check_qubits(num_qubits)
         self.check_memory(num_qubits, shots, iterations)
-        return marks, num_qubits, iterations, shots, self._rng if request.seed is None else seed_stream(request.seed)
+        seed = request.seed
+        if not isinstance(seed, np.random.Generator):
+            seed = check_seed(seed)
+        return marks, num_qubits, iterations, shots, seed
+
+    def _generator(self, seed: int | np.random.Generator | None) -> np.random.Generator:
+        """The generator of one search: the backend's own stream for None, else ``seed_stream``."""
+        return self._rng if seed is None else seed_stream(seed)
+
+    def _first_integer(self, seed: int | np.random.Generator | None, high: int) -> int:
+        """``int(self._generator(seed).integers(0, high))`` (a search's simulator seed), without
+        building a Generator for an integer seed (``randomness.first_integer_below``, compiled)."""
+        if seed is None or isinstance(seed, np.random.Generator):
+            return int(self._generator(seed).integers(0, high))
+        return first_integer_below(seed, high)
+
+    def _sample_seeded(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
+                       seed: int | np.random.Generator | None) -> np.ndarray:
+        """``_sample`` with the generator of ``seed``; a backend that can draw from an integer seed
+        without building a Generator overrides this (same indices)."""
+        return self._sample(marks, num_qubits, iterations, shots, self._generator(seed))
 
     @staticmethod
     def _finish(prepared, indices: np.ndarray) -> SearchResult:

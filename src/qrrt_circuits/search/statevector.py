@@ -13,8 +13,10 @@ import math
 import os
 
 import numpy as np
+from numba import njit
 
 from ..probability import good_probability
+from ..randomness import _bounded_below, _next_double, _pcg_state, integer_seed_words
 from ..validation import check_bool, check_int
 from .backend import QuantumSearchBackend, seed_stream, validate_iterations, validate_marks
 from .fixed_point import statevector_after
@@ -121,6 +123,14 @@ class StatevectorBackend(QuantumSearchBackend):
             state = 2.0 * state.mean() - state
         return state
 
+    def _sample_seeded(self, marks, num_qubits, iterations, shots, seed) -> np.ndarray:
+        """The closed form with an integer seed draws in one compiled call (``_draw_two_level_seeded``:
+        the same indices as ``_draw_two_level`` with ``np.random.default_rng(seed)``)."""
+        if not self.closed_form or seed is None or isinstance(seed, np.random.Generator) or num_qubits > 32:
+            return super()._sample_seeded(marks, num_qubits, iterations, shots, seed)
+        p_good = good_probability(marks.shape[0], int(np.count_nonzero(marks)), iterations)
+        return _draw_two_level_seeded(marks, p_good, shots, integer_seed_words(seed))
+
     def _sample(self, marks, num_qubits, iterations, shots, rng) -> np.ndarray:
         if not self.closed_form:
             return _draw(self.amplitudes(marks, iterations) ** 2, shots, rng)
@@ -161,6 +171,36 @@ def _draw_two_level(marks: np.ndarray, p_good: float, shots: int, rng: np.random
         # k-th unmarked index without listing them all: rank among the complement
         ranks = rng.integers(0, unmarked_count, shots - num_good)
         out[~good] = _kth_unmarked(marked, ranks)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _draw_two_level_seeded(marks, p_good, shots, words):
+    """``_draw_two_level(marks, p_good, shots, Generator(PCG64(words)))``, compiled: the same
+    draws in the same order (``shots`` doubles, then the marked picks, then the unmarked ranks, each
+    an ``integers(0, high)`` draw), so the same indices. Needs N <= 2^32 (32-bit bounded draws)."""
+    size = marks.shape[0]
+    marked = np.flatnonzero(marks)
+    num_marked = marked.shape[0]
+    if num_marked == 0 or num_marked == size:
+        p_good = 1.0 if num_marked == size else 0.0
+    state = _pcg_state(words)
+    good = np.empty(shots, dtype=np.bool_)
+    num_good = 0
+    for shot in range(shots):
+        good[shot] = _next_double(state) < p_good
+        num_good += good[shot]
+    out = np.empty(shots, dtype=np.int64)
+    if num_good:
+        for shot in range(shots):
+            if good[shot]:
+                out[shot] = marked[_bounded_below(state, num_marked)]
+    if num_good < shots:
+        shifted = marked - np.arange(num_marked)
+        for shot in range(shots):
+            if not good[shot]:
+                rank = _bounded_below(state, size - num_marked)
+                out[shot] = rank + np.searchsorted(shifted, rank, side="right")
     return out
 
 
