@@ -19,7 +19,7 @@ import numpy as np
 
 from .base import Experiment, Trial, TrialStream, replicate_seed
 from .figures import new_figure, node_heatmap, save
-from .intervals import bootstrap_interval, differs, rounded_interval
+from .intervals import bootstrap_ratio_interval, differs, rounded_interval
 from .measures import cut_at, dumps, loads, reachable_fraction, rounded
 from .planners import BACKEND_LABEL, planner_for
 from .worlds import world
@@ -82,15 +82,10 @@ class Heatmaps(Experiment):
             rows = [r for r in records if r["planner"] == kind]
             interval[kind], differs_from_paper[kind] = {}, {}
             for cut in settings["cuts"]:
-                def nodes(sample, cut=cut):
-                    return sum(r[f"nodes_at_{cut}"] for r in sample)
-
-                def efficiency(sample, cut=cut):
-                    calls = sum(r[f"calls_at_{cut}"] for r in sample)
-                    return sum(r[f"nodes_at_{cut}"] for r in sample) / calls if calls else float("nan")
-
-                span = {"nodes": rounded_interval(bootstrap_interval(rows, nodes, settings["seed"]), 1),
-                        "efficiency": rounded_interval(bootstrap_interval(rows, efficiency, settings["seed"]))}
+                nodes = [r[f"nodes_at_{cut}"] for r in rows]
+                calls = [r[f"calls_at_{cut}"] for r in rows]
+                span = {"nodes": rounded_interval(bootstrap_ratio_interval(nodes, None, settings["seed"]), 1),
+                        "efficiency": rounded_interval(bootstrap_ratio_interval(nodes, calls, settings["seed"]))}
                 interval[kind][str(cut)] = span
                 paper = self.paper.get(kind, {}).get(str(cut))
                 if paper:

@@ -35,6 +35,59 @@ def bootstrap_interval(trials: Sequence[Any], statistic: Callable[[list], float]
     return float(np.quantile(values, tail)), float(np.quantile(values, 1.0 - tail))
 
 
+def bootstrap_ratio_interval(numerators: Sequence[int], denominators: Sequence[int] | None, seed: int,
+                             resamples: int = RESAMPLES, level: float = LEVEL) -> tuple[float, float]:
+    """``bootstrap_interval`` of sum(numerators) / sum(denominators) (of sum(numerators) when
+    ``denominators`` is None) over resampled trials, on index arrays.
+
+    The same interval, bit for bit, as ``bootstrap_interval(trials, statistic, seed)`` with that
+    statistic, for integer counts: the same resamples (``Generator.integers`` draws the
+    (resamples, n) index matrix as ``resamples`` consecutive draws of n), exact integer sums, the
+    same float division, and resamples with a zero denominator left out as undefined.
+
+    Args:
+        numerators: One integer count per trial (nodes, say).
+        denominators: One integer count per trial (oracle calls, say), or None for a plain sum.
+        seed: Seed of the resampling generator.
+        resamples: Bootstrap resamples (default ``RESAMPLES``).
+        level: Confidence level of the percentile interval (default ``LEVEL``).
+
+    Returns:
+        (low, high); both the statistic itself for fewer than two trials, NaN for none.
+
+    Raises:
+        TypeError: Counts that are not integers.
+        ValueError: ``denominators`` of another length than ``numerators``.
+    """
+    top = np.asarray(numerators)
+    bottom = None if denominators is None else np.asarray(denominators)
+    for values, name in ((top, "numerators"), (bottom, "denominators")):
+        if values is not None and values.size and not np.issubdtype(values.dtype, np.integer):
+            raise TypeError(f"{name} must be integer counts, got dtype {values.dtype}")
+    if bottom is not None and bottom.shape != top.shape:
+        raise ValueError(f"denominators must have the length of numerators ({top.shape[0]}), got {bottom.shape[0]}")
+    count = top.shape[0]
+
+    def statistic(index: np.ndarray) -> np.ndarray:
+        total = top[index].sum(axis=-1)
+        if bottom is None:
+            return total.astype(float)
+        calls = bottom[index].sum(axis=-1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(calls != 0, total / np.where(calls != 0, calls, 1), np.nan)
+
+    if count < 2:
+        value = float(statistic(np.arange(count))) if count else float("nan")
+        return value, value
+    rng = np.random.default_rng(seed)
+    values = statistic(rng.integers(0, count, (resamples, count)))
+    values = values[np.isfinite(values)]
+    if values.size == 0:
+        return float("nan"), float("nan")
+    tail = (1.0 - level) / 2.0
+    return float(np.quantile(values, tail)), float(np.quantile(values, 1.0 - tail))
+
+
 def _defined(statistic: Callable[[list], float], sample: list) -> float:
     """The statistic of one resample, or NaN where it is undefined there (a line fit through one
     distinct x, say): such resamples are left out of the percentiles."""
