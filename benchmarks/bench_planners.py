@@ -78,6 +78,69 @@ class TimedPredicate:
         return out
 
 
+class PartTimer:
+    """Times the main parts of a quantum planner's round by wrapping, for the duration of a
+    ``with`` block, the class methods that do them: the nearest-node query of the candidates
+    (``Tree.nearest``), the compiled candidate draws (``database.uniform_draws``) and the backend's
+    searches (``QuantumSearchBackend.search_many``, also ``search``). The predicate is timed by
+    ``TimedPredicate``; the rest of the round (the policy, verification, bookkeeping, the planner's
+    loop) is the plan's wall time minus these."""
+
+    def __init__(self) -> None:
+        self.seconds = {"nearest": 0.0, "candidate_draws": 0.0, "search": 0.0}
+        self._patched: list[tuple[object, str, object]] = []
+
+    def _wrap(self, owner, attribute: str, part: str) -> None:
+        original = getattr(owner, attribute)
+        seconds = self.seconds
+
+        def timed(*args, **kwargs):
+            began = time.perf_counter()
+            try:
+                return original(*args, **kwargs)
+            finally:
+                seconds[part] += time.perf_counter() - began
+
+        self._patched.append((owner, attribute, original))
+        setattr(owner, attribute, timed)
+
+    def __enter__(self) -> PartTimer:
+        from qrrt_circuits import database
+        from qrrt_circuits.search.backend import QuantumSearchBackend
+        from qrrt_circuits.tree import Tree
+
+        self._wrap(Tree, "nearest", "nearest")
+        self._wrap(database, "uniform_draws", "candidate_draws")
+        self._wrap(QuantumSearchBackend, "search_many", "search")
+        return self
+
+    def __exit__(self, *exc_info) -> None:
+        for owner, attribute, original in reversed(self._patched):
+            setattr(owner, attribute, original)
+        self._patched.clear()
+
+
+def breakdown(make, env, seed: int, nodes: int, big: bool) -> dict:
+    """Microseconds per round in the predicate, the nearest-node queries, the candidate draws, the
+    backend search and the rest, for one plan (the wrappers add about a microsecond per call)."""
+    predicate = TimedPredicate(qc.ReachabilityOracle(env))
+    planner = make(env, seed, predicate)
+    with PartTimer() as parts:
+        result = planner.plan(max_nodes=nodes, goal_radius=1e-9) if big else planner.plan(max_nodes=nodes)
+    rounds = max(result.metrics.rounds, 1)
+    wall = result.metrics.wall_time_s
+    per_round = {"predicate": predicate.seconds, **parts.seconds}
+    per_round["rest"] = wall - sum(per_round.values())
+    return {"seed": seed, "nodes": result.metrics.nodes, "rounds": result.metrics.rounds,
+            "us_per_round": {k: v * 1e6 / rounds for k, v in per_round.items()},
+            "share": {k: v / wall for k, v in per_round.items()}}
+
+
+#: configurations whose round is broken down into parts (label, big)
+BREAKDOWN = (("QRRT statevector", False), ("QRRT statevector 3000 nodes", True),
+             ("PQRRT shared statevector", False))
+
+
 def configurations():
     """label -> planner factory (env, seed, predicate), every planner built through the registry."""
     from qrrt_circuits.experiments.planners import make_planner
@@ -170,15 +233,28 @@ def main() -> None:
                   f"{ompl_rows['ours_over_ompl']:.2f})")
     if not with_ompl:
         print("(ompl not importable: OMPL comparison skipped; pip install '.[ompl]')")
+    parts = {}
+    makers = configurations()
+    print(f"\n{'round breakdown, us per round':32s} " + " ".join(f"{k:>15s}" for k in
+          ("predicate", "nearest", "candidate_draws", "search", "rest")))
+    for name, big in BREAKDOWN:
+        runs = [breakdown(makers[name], env, seed, big_nodes if big else nodes, big)
+                for seed, env in enumerate(worlds[:big_seeds] if big else worlds)]
+        medians = {k: float(np.median([r["us_per_round"][k] for r in runs])) for k in runs[0]["us_per_round"]}
+        shares = {k: float(np.median([r["share"][k] for r in runs])) for k in runs[0]["share"]}
+        parts[name] = {"runs": runs, "us_per_round": medians, "share": shares}
+        print(f"{name:32s} " + " ".join(f"{medians[k]:8.1f} ({shares[k]:3.0%})" for k in medians))
     path = write_json("bench_planners" + ("_quick" if args.quick else ""),
                       {"machine": machine(), "seeds": seeds, "max_nodes": nodes, "big_nodes": big_nodes,
                        "big_seeds": big_seeds, "planners": rows, "ompl_rrt": ompl_rows,
+                       "round_breakdown": parts,
                        "note": "quantum planners: phase oracle built from a classical lookup of all "
                                "2^n entries (simulation_checks); shared Pq-RRT: one search with p "
                                "shots stands for p workers; 'known-optimal' uses the true m; "
                                "oracle_share: wall time inside predicate.reachable / plan wall time; "
                                "RRT and ParallelRRT test rounds in batches (wasted_checks: tests of "
-                               "rounds that never ran, not oracle calls)"},
+                               "rounds that never ran, not oracle calls); round_breakdown: medians "
+                               "over seeds of the time per round in each part (PartTimer)"},
                       args.out)
     print(f"wrote {path}")
 
