@@ -92,8 +92,12 @@ def test_killed_process_pool_worker_is_replaced(tmp_path):
                 killed.append(process.pid)
                 return
 
-    summary = run_experiment("oracle-efficiency", out=tmp_path, quick=True, trials=3, progress=False,
-                             executor="process", jobs=2, on_record=kill_one_worker, on_restart=restarts.append)
+    from qrrt_circuits.execution import WorkerPool
+
+    with WorkerPool("process", jobs=2) as pool:
+        assert pool.executor is not None  # started before the sweep: every trial goes to a worker
+        summary = run_experiment("oracle-efficiency", out=tmp_path, quick=True, trials=3, progress=False,
+                                 executor=pool, on_record=kill_one_worker, on_restart=restarts.append)
     assert killed and restarts == [1] and summary["complete"]
     rows = read_records(tmp_path / "oracle-efficiency" / "records.csv")
     assert len(rows) == len({r["trial_id"] for r in rows}) == 12
@@ -198,3 +202,36 @@ def test_process_pool_workers_exit_when_the_client_is_killed(tmp_path):
     client.wait()
     gone, alive = psutil.wait_procs(workers, timeout=10)
     assert not alive, f"workers still running 10 s after the client died: {[p.pid for p in alive]}"
+
+
+def test_client_runs_trials_while_a_new_pool_starts_and_each_trial_runs_once(tmp_path, monkeypatch):
+    """A fresh local pool: this process runs trials from the back of the list until the first
+    worker result arrives, a background thread starts the pool and submits from the front; every
+    trial is recorded exactly once, with the records serial execution gives."""
+    import functools
+
+    from qrrt_circuits.execution import WorkerPool
+    from qrrt_circuits.experiments import runner
+
+    ran_here = []
+    original = runner.execute_trial
+
+    @functools.wraps(original)
+    def counted(name, trial, settings):  # pickled by name: workers run the original
+        ran_here.append(trial.id)
+        return original(name, trial, settings)
+
+    monkeypatch.setattr(runner, "execute_trial", counted)
+    name, trials = "oracle-efficiency", 3
+    with WorkerPool("process", jobs=1) as pool:
+        assert pool.helps_while_starting and not pool.started
+        summary = run_experiment(name, out=tmp_path / "pool", quick=True, trials=trials, progress=False,
+                                 executor=pool)
+        assert pool.started
+    monkeypatch.setattr(runner, "execute_trial", original)
+    serial = run_experiment(name, out=tmp_path / "serial", quick=True, trials=trials, progress=False)
+    rows = read_records(tmp_path / "pool" / name / "records.csv")
+    assert len(rows) == len({r["trial_id"] for r in rows}) == 12
+    assert len(set(ran_here)) == len(ran_here) < len(rows)  # some ran here at most once, not all
+    assert summary["ours"] == serial["ours"]
+    assert _records(tmp_path / "pool", name) == _records(tmp_path / "serial", name)

@@ -26,6 +26,7 @@ when a local pool breaks. Install the Dask extra with ``pip install ".[dask]"``.
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import os
 from collections.abc import Iterator
 from concurrent.futures import Executor, ProcessPoolExecutor
@@ -138,9 +139,10 @@ def _warm_fork_server(extra_preload: tuple[str, ...] = ()) -> Iterator[str]:
             _stop_fork_server(server)
 
 
-def _stop_fork_server(server) -> None:
+def _stop_fork_server(server, wait_s: float = 5.0) -> None:
     """Close our end of the server's "alive" pipe (it exits when no worker holds one either) and
-    reap it; kill it if it has not gone after a few seconds."""
+    reap it; kill it if it has not gone after ``wait_s`` seconds (at once for 0: a server that
+    never forked a worker, perhaps still importing its preload, has nothing to finish)."""
     import signal
     import time
 
@@ -150,7 +152,7 @@ def _stop_fork_server(server) -> None:
     with server._lock:
         os.close(fd)
         server._forkserver_alive_fd = server._forkserver_address = server._forkserver_pid = None
-    deadline = time.monotonic() + 5.0
+    deadline = time.monotonic() + wait_s
     while True:
         done, _ = os.waitpid(pid, os.WNOHANG)
         if done:
@@ -256,6 +258,9 @@ class WorkerPool:
         self._open = False
         self._stack: contextlib.ExitStack | None = None
         self._executor: Executor | None = None
+        self._fork_server: tuple[contextlib.ExitStack, object] | None = None
+        self._forked = False
+        self._context = contextvars.copy_context()
 
     @property
     def executor(self) -> Executor | None:
@@ -266,19 +271,64 @@ class WorkerPool:
         return self._executor
 
     @property
+    def helps_while_starting(self) -> bool:
+        """Whether this process should run trials itself while the pool's workers start: local
+        pools only (``process``, or ``dask`` without a ``scheduler``), never a remote cluster."""
+        return self.kind == "process" or (self.kind == "dask" and self.scheduler is None)
+
+    @property
     def started(self) -> bool:
         """Whether workers (or a client) are running now."""
         return self._stack is not None
 
     def __enter__(self) -> WorkerPool:
         self._open = True
+        self._prestart_fork_server()
         return self
 
     def __exit__(self, *exc_info) -> None:
         self._shut_down()
         self._open = False
+        self._stop_prestarted_fork_server()
+
+    def _prestart_fork_server(self) -> None:
+        """Local workers are forked from the fork server, whose preload (every import a trial needs,
+        seconds of CPU) would otherwise begin only when the first trial is submitted. Starting it
+        here lets it import while this process prepares the sweep (its own imports, the records
+        already done), on another core. The pool's executors find it running and use it; it is
+        stopped when the pool closes."""
+        self._fork_server = None
+        self._forked = False
+        if self.kind == "serial" or (self.kind == "dask" and self.scheduler is not None):
+            return
+        if not _fork_server_available():
+            return
+        from multiprocessing import forkserver
+
+        server = forkserver._forkserver
+        if server._forkserver_pid is not None:  # type: ignore[attr-defined]  # one runs: not ours to stop
+            return
+        stack = contextlib.ExitStack()
+        stack.enter_context(_warm_fork_server(("distributed",) if self.kind == "dask" else ()))
+        self._fork_server = (stack, server)
+
+    def _stop_prestarted_fork_server(self) -> None:
+        if self._fork_server is None:
+            return
+        stack, server = self._fork_server
+        self._fork_server = None
+        if not self._forked:  # never used: kill it at once rather than wait for its preload
+            _stop_fork_server(server, wait_s=0.0)
+        stack.close()  # (stops it if it still runs)
 
     def _start(self) -> None:
+        """Start the executor, inside the pool's own ``contextvars.Context`` (as ``_shut_down``
+        stops it): the experiment runner may start a pool from a background thread while this
+        process runs trials, and a Dask ``Client`` must be closed in the context it was made in."""
+        self._forked = True
+        self._context.run(self._enter_executor)
+
+    def _enter_executor(self) -> None:
         stack = contextlib.ExitStack()
         with stack:
             self._executor = stack.enter_context(
@@ -292,4 +342,4 @@ class WorkerPool:
     def _shut_down(self) -> None:
         stack, self._stack, self._executor = self._stack, None, None
         if stack is not None:
-            stack.close()
+            self._context.run(stack.close)

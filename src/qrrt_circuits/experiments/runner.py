@@ -12,8 +12,11 @@ from __future__ import annotations
 
 import contextlib
 import json
+import threading
+from collections import deque
 from collections.abc import Callable
-from concurrent.futures import BrokenExecutor, Executor, as_completed
+from concurrent.futures import BrokenExecutor, Executor, Future, as_completed
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -45,14 +48,73 @@ def execute_trial(experiment_name: str, trial: Trial, settings: dict) -> dict:
     return record
 
 
-def _run_on(executor: Executor, name: str, trials: list[Trial], settings: dict, record_one) -> None:
-    futures = [executor.submit(execute_trial, name, trial, settings) for trial in trials]
+def _run_on(executor: Executor | Callable[[], Executor], name: str, trials: list[Trial], settings: dict,
+            record_one, client_helps: bool = False) -> None:
+    """Run ``trials`` on ``executor`` (or on the executor ``executor()`` returns), recording each
+    result as it arrives.
+
+    With ``client_helps`` (a local pool not started yet; ``executor`` is then the callable that
+    starts it), starting the workers takes seconds (the fork server's preload, a Dask cluster's
+    start) during which this process would sit idle. So a background thread starts the pool and
+    submits the trials from the front of the list, while this process runs trials itself from the
+    back until the first worker result arrives. A trial is taken from the list under a lock, either
+    submitted or run here, so each runs exactly once; its record does not depend on where it ran
+    (trials draw only from their own seeds)."""
+    if not client_helps:
+        pool = executor() if callable(executor) else executor
+        submitted = [pool.submit(execute_trial, name, trial, settings) for trial in trials]
+        try:
+            for future in as_completed(submitted):
+                record_one(future.result())
+        finally:
+            for future in submitted:
+                future.cancel()
+        return
+    queue = deque(trials)
+    lock = threading.Lock()
+    futures: list[Future] = []
+    failures: list[BaseException] = []
+
+    def submit_all() -> None:
+        try:
+            pool = executor() if callable(executor) else executor
+            while True:
+                with lock:
+                    if not queue:
+                        return
+                    trial = queue.popleft()
+                futures.append(pool.submit(execute_trial, name, trial, settings))
+        except BaseException as exc:  # re-raised in the calling thread
+            failures.append(exc)
+
+    submitter = threading.Thread(target=submit_all, name="qrrt-submit", daemon=True)
+    submitter.start()
     try:
+        while not failures and not any(future.done() for future in list(futures)):
+            with lock:
+                if not queue:
+                    break
+                trial = queue.pop()
+            record_one(execute_trial(name, trial, settings))
+        submitter.join()
+        if failures:
+            raise failures[0]
         for future in as_completed(futures):
             record_one(future.result())
     finally:
+        with lock:
+            queue.clear()  # a submitter still running stops at its next trial
+        submitter.join()  # (it may still be starting the pool: let it finish, so it can be shut down)
         for future in futures:
             future.cancel()
+
+
+def _started_executor(pool: WorkerPool) -> Executor:
+    """The executor of a (non-serial) ``WorkerPool``, started if it is not yet."""
+    executor = pool.executor
+    if executor is None:
+        raise RuntimeError("a serial WorkerPool has no executor")
+    return executor
 
 
 def _check_arguments(name: str, trials, seed, executor, jobs, scheduler, predicate: str) -> str | None:
@@ -129,9 +191,12 @@ def _execute(kind: str | None, executor, name: str, todo: list[Trial], settings:
     with opened as pool:
         for attempt in range(max_restarts + 1):
             try:
-                if pool.executor is None:  # a serial WorkerPool
+                if pool.kind == "serial":
                     for trial in remaining:
                         record_one(execute_trial(name, trial, settings))
+                elif pool.helps_while_starting and not pool.started:
+                    _run_on(partial(_started_executor, pool), name, remaining, settings, record_one,
+                            client_helps=True)
                 else:
                     _run_on(pool.executor, name, remaining, settings, record_one)
                 return
