@@ -286,7 +286,7 @@ def grid_minimizer(objective, bounds) -> float:
 def log_likelihood(theta: np.ndarray, powers, good_counts, shots: int) -> np.ndarray:
     """MLAE's log-likelihood: sum_k good_k log sin^2((2k+1) theta) + bad_k log cos^2((2k+1) theta).
 
-    Suzuki et al. 2020, Eq. 6: after k Grover iterates the good probability is sin^2((2k+1) theta)
+    Suzuki et al. 2020: after k Grover iterates the good probability is sin^2((2k+1) theta)
     with a = sin^2 theta (the paper's Eq. 1 with a = m/N).
 
     Args:
