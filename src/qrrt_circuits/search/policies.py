@@ -74,6 +74,18 @@ class IterationPolicy:
     The class attribute ``uses_true_m`` is True if the policy reads the database's true marked
     count m (simulation knowledge a quantum device does not have, labelled in every output that
     depends on it); ``name`` is the policy's short name.
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits import DatabaseSearch, KnownOptimal, PaperSchedule, StatevectorBackend
+        >>> from qrrt_circuits.randomness import RandomStreams
+        >>> marks = np.zeros(64, dtype=bool)
+        >>> marks[:2] = True
+        >>> problem = DatabaseSearch(marks, marks, StatevectorBackend(seed=0), RandomStreams(0), 0)
+        >>> PaperSchedule().iterations_for(problem, 0), PaperSchedule().iterations_for(problem, 11)
+        (5, 3)
+        >>> KnownOptimal().iterations_for(problem, 0)  # floor(pi / (4 asin(sqrt(2/64))))
+        4
     """
 
     uses_true_m: bool = False
@@ -91,6 +103,7 @@ class IterationPolicy:
         return PolicyState(self, num_items)
 
     def describe(self) -> str:
+        """The policy in words (recorded in ``PlanResult.settings``)."""
         return self.name
 
     def labels(self) -> tuple[str, ...]:
@@ -225,10 +238,21 @@ class PolicyState:
                      for problem, k, result in zip(problems, iterations, results, strict=True))
 
     def observe(self, iterations: int, success: bool) -> None:
-        """Record that a measurement after ``iterations`` iterations verified (or not)."""
+        """Record that a measurement after ``iterations`` iterations verified (or not).
+
+        Nothing by default; learning policies (``Adaptive``) update their posterior.
+
+        Args:
+            iterations: k of the measured preparation.
+            success: Whether the measured entry verified.
+        """
 
     def learn(self, outcomes: Iterable[SearchOutcome]) -> None:
-        """Feed a round's outcomes back, in worker order."""
+        """Feed a round's outcomes back, in worker order.
+
+        Args:
+            outcomes: The round's ``SearchOutcome`` objects; each observation goes to ``observe``.
+        """
         for outcome in outcomes:
             for iterations, success in outcome.observations:
                 self.observe(iterations, success)
@@ -317,6 +341,11 @@ class KnownOptimal(IterationPolicy):
 
     k = floor(pi / (4 theta)) with sin^2 theta = m/N, and 0 for m = 0. Reading m is simulation
     knowledge a quantum device does not have; every output planned with it is labelled so.
+
+    Example:
+        >>> from qrrt_circuits import KnownOptimal
+        >>> KnownOptimal.uses_true_m, KnownOptimal().describe()
+        (True, 'optimal (uses the true m of each database: simulation knowledge)')
     """
 
     name = "optimal"
@@ -566,7 +595,23 @@ class AdaptiveState(PolicyState):
 
 def parse_policy(text: str) -> IterationPolicy:
     """A policy from its registry name: ``paper``, ``optimal``, ``bbht``, ``adaptive`` or ``fixed:K``
-    (see ``qrrt_circuits.registry.POLICIES``)."""
+    (see ``qrrt_circuits.registry.POLICIES``).
+
+    Args:
+        text: A name of ``POLICIES`` (``"fixed:3"``, ``"fixed-point:0.3"``, ``"estimated"``, ...).
+
+    Returns:
+        The ``IterationPolicy``.
+
+    Raises:
+        TypeError: ``text`` is not a string.
+        ValueError: An unknown name or a malformed parameter.
+
+    Example:
+        >>> from qrrt_circuits.search.policies import parse_policy
+        >>> parse_policy("fixed:3")
+        FixedIterations(k=3)
+    """
     from ..registry import POLICIES
 
     return POLICIES.create(text)
