@@ -235,7 +235,7 @@ def check_fits(estimate_for: Callable[[int], MemoryEstimate], num_qubits: int, w
         >>> check_fits(estimate_for, 26, "this plan", available=2**30)  # doctest: +ELLIPSIS
         Traceback (most recent call last):
         ...
-        ValueError: num_qubits = 26: this plan needs about 3.7 GiB at its peak ...; the largest num_qubits that fits is 24
+        ValueError: num_qubits = 26: this plan needs about 3.7 GiB ...; the largest num_qubits that fits is 24
     """
     estimate = estimate_for(num_qubits)
     if estimate.total_bytes <= ALWAYS_FITS_BYTES:
