@@ -369,7 +369,14 @@ class KnownOptimal(IterationPolicy):
 
 @dataclass(frozen=True)
 class BBHTOutcome:
-    """One BBHT search: the verified index or None, iterations and verifications spent."""
+    """One BBHT search: the verified index or None, iterations and verifications spent.
+
+    Args:
+        index: The verified database entry, or None if the loop gave up.
+        iterations: Grover iterations spent over all attempts (quantum oracle calls).
+        verifications: Measured entries verified (one per attempt).
+        attempts: ``(iterations, verified)`` per attempt.
+    """
 
     index: int | None
     iterations: int
@@ -542,7 +549,14 @@ class Adaptive(IterationPolicy):
 
     def state_bytes(self, num_items: int) -> int:
         """The success table sin^2((2k+1) theta(f)), (k_max + 1) x grid_size float64, and the
-        temporaries that build it (3 tables)."""
+        temporaries that build it (3 tables).
+
+        Args:
+            num_items: N, the database size.
+
+        Returns:
+            3 x 8 x (k_max + 1) x ``grid_size`` bytes.
+        """
         return 3 * 8 * (self.iterations_bound(num_items) + 1) * int(self.grid_size)
 
     def describe(self) -> str:
@@ -550,6 +564,18 @@ class Adaptive(IterationPolicy):
 
 
 class AdaptiveState(PolicyState):
+    """Per-plan state of ``Adaptive``: a posterior over the marked fraction f on a geometric grid.
+
+    k is chosen to maximise E[sin^2((2k+1) theta(f))] / (k + 1), sin^2 theta = f (Eq. 1; the
+    expected successes per oracle call), the expectation under the posterior; each verified or
+    refuted measurement multiplies the likelihood by sin^2((2k+1) theta) or its complement (the old
+    log-likelihood discounted by ``forgetting``).
+
+    Args:
+        policy: The ``Adaptive`` policy.
+        num_items: N, the entries of each database.
+    """
+
     policy: Adaptive
 
     def __init__(self, policy: Adaptive, num_items: int) -> None:
@@ -566,6 +592,7 @@ class AdaptiveState(PolicyState):
 
     @property
     def log_posterior(self) -> np.ndarray:
+        """Log prior + log likelihood on the grid of fractions (unnormalised)."""
         return self.log_prior + self.log_likelihood
 
     def choose_iterations(self, tree_nodes: int, num_marked: int | None = None) -> int:
