@@ -198,7 +198,24 @@ def stream_database(
     """``build_database`` with the generator of (round, worker, ``Stream.CANDIDATES``), without
     building it unless needed: the uniform samples (``Environment.sample_uniform``: low + (high -
     low) * u) come from the compiled PCG64 draws; only goal bias or annealing build the generator,
-    advanced past those draws (each double is one 64-bit output). Same database, bit for bit."""
+    advanced past those draws (each double is one 64-bit output). Same database, bit for bit.
+
+    Args:
+        tree: The ``Tree`` whose nearest nodes become the parents.
+        size: Candidates N.
+        env: The ``Environment`` whose workspace is sampled.
+        streams: The plan's ``RandomStreams``.
+        round_index: The round (the generator's key).
+        worker: The worker (the generator's key).
+        goal: Goal point (d,) for goal-biased samples, or None.
+        goal_radius: Radius of the goal ball.
+        goal_bias: Fraction in [0, 1) of samples drawn in the goal ball.
+        annealing: An ``AnnealingSchedule`` (Alg. 4), or None.
+        temperature_index: Alg. 4's h.
+
+    Returns:
+        The ``Database``, identical to ``build_database`` with that generator.
+    """
     dim = tree.dim
     key = np.array([[round_index, worker, int(Stream.CANDIDATES)]], dtype=np.int64)
     low, high = env.bounds[:, 0], env.bounds[:, 1]

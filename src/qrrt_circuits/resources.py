@@ -362,11 +362,25 @@ class ProjectionAssumptions:
         check_positive_float(self.two_qubit_gate_s, "two_qubit_gate_s")
 
     def fault_tolerant_call_s(self, count: FaultTolerantCount) -> float:
-        """Seconds of one fault-tolerant oracle call: Toffoli equivalents x ``toffoli_s``."""
+        """Seconds of one fault-tolerant oracle call: Toffoli equivalents x ``toffoli_s``.
+
+        Args:
+            count: The ``FaultTolerantCount`` of one call.
+
+        Returns:
+            The seconds.
+        """
         return count.toffoli_equivalents * self.toffoli_s
 
     def near_term_call_s(self, count: NearTermCount) -> float:
-        """Seconds of one near-term iteration: two-qubit depth x ``two_qubit_gate_s``."""
+        """Seconds of one near-term iteration: two-qubit depth x ``two_qubit_gate_s``.
+
+        Args:
+            count: The ``NearTermCount`` of one iteration.
+
+        Returns:
+            The seconds (a lower bound, errors ignored).
+        """
         return count.two_qubit_depth * self.two_qubit_gate_s
 
 

@@ -247,6 +247,7 @@ class MaxRounds(_Limit):
 
     @property
     def limits_rounds(self) -> bool:
+        """True: a round limit."""
         return True
 
 
@@ -281,6 +282,7 @@ class Stall(_Limit):
 
     @property
     def detects_stall(self) -> bool:
+        """True: a stall limit."""
         return True
 
 
@@ -359,10 +361,12 @@ class AnyOf(TerminationCondition):
 
     @property
     def limits_rounds(self) -> bool:
+        """Whether any part limits rounds."""
         return any(condition.limits_rounds for condition in self.conditions)
 
     @property
     def detects_stall(self) -> bool:
+        """Whether any part detects a stall."""
         return any(condition.detects_stall for condition in self.conditions)
 
 

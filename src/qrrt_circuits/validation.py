@@ -61,6 +61,15 @@ def check_int(value: Any, name: str, minimum: int | None = 0, maximum: int | Non
 def check_optional_int(value: Any, name: str, minimum: int | None = 0, maximum: int | None = None) -> int | None:
     """None, or ``check_int(value, name, minimum, maximum)``.
 
+    Args:
+        value: The value to check.
+        name: The argument's name for the error message.
+        minimum: Smallest accepted value (default 0), or None.
+        maximum: Largest accepted value, or None (default).
+
+    Returns:
+        None, or ``value`` as a Python ``int``.
+
     Raises:
         TypeError: Neither None nor an integer.
         ValueError: Outside [minimum, maximum].
@@ -104,6 +113,13 @@ def check_float(value: Any, name: str, minimum: float | None = None, maximum: fl
 
 def check_positive_float(value: Any, name: str) -> float:
     """A finite real number > 0 (``check_float`` with an open minimum 0).
+
+    Args:
+        value: The value to check.
+        name: The argument's name for the error message.
+
+    Returns:
+        ``value`` as a Python ``float``.
 
     Raises:
         TypeError: Not a real number.
@@ -154,6 +170,13 @@ def check_seed(value: Any, name: str = "seed") -> int | None:
 def check_bool(value: Any, name: str) -> bool:
     """A ``bool`` (or ``numpy.bool_``), not a number standing for one.
 
+    Args:
+        value: The value to check.
+        name: The argument's name for the error message.
+
+    Returns:
+        ``value`` as a Python ``bool``.
+
     Raises:
         TypeError: Anything else.
     """
@@ -165,6 +188,14 @@ def check_bool(value: Any, name: str) -> bool:
 def check_choice(value: Any, name: str, choices: tuple[str, ...]) -> str:
     """One of ``choices``.
 
+    Args:
+        value: The value to check.
+        name: The argument's name for the error message.
+        choices: The accepted strings.
+
+    Returns:
+        ``value``.
+
     Raises:
         ValueError: Not one of them (the message lists them).
     """
@@ -175,6 +206,15 @@ def check_choice(value: Any, name: str, choices: tuple[str, ...]) -> str:
 
 def check_instance(value: Any, name: str, kind: type | tuple[type, ...], what: str) -> Any:
     """An instance of ``kind``; ``what`` describes it in the message ("an Environment").
+
+    Args:
+        value: The value to check.
+        name: The argument's name for the error message.
+        kind: The accepted type or types.
+        what: The accepted type in words.
+
+    Returns:
+        ``value``.
 
     Raises:
         TypeError: Not an instance of ``kind``.

@@ -101,6 +101,12 @@ MAX_SHOTS = 10_000_000
 def validate_iterations(iterations: int) -> int:
     """k as an int in [0, ``MAX_ITERATIONS``].
 
+    Args:
+        iterations: k.
+
+    Returns:
+        k as a Python ``int``.
+
     Raises:
         TypeError: A non-integer k.
         ValueError: k out of range.
@@ -110,6 +116,12 @@ def validate_iterations(iterations: int) -> int:
 
 def validate_shots(shots: int) -> int:
     """``shots`` as an int in [1, ``MAX_SHOTS``].
+
+    Args:
+        shots: The preparations.
+
+    Returns:
+        ``shots`` as a Python ``int``.
 
     Raises:
         TypeError: A non-integer ``shots``.

@@ -190,6 +190,15 @@ class PolicyState:
     iterations = choose_iterations
 
     def iterations_for(self, problem: DatabaseSearch, tree_nodes: int) -> int:
+        """The policy's k for ``problem`` (``IterationPolicy.iterations_for``).
+
+        Args:
+            problem: The database search.
+            tree_nodes: Nodes in the tree so far.
+
+        Returns:
+            k >= 0.
+        """
         return self.policy.iterations_for(problem, tree_nodes)
 
     def run(self, problem: DatabaseSearch, workers: int, tree_nodes: int) -> tuple[SearchOutcome, ...]:
@@ -605,6 +614,15 @@ class AdaptiveState(PolicyState):
     iterations = choose_iterations
 
     def iterations_for(self, problem: DatabaseSearch, tree_nodes: int) -> int:
+        """The posterior's k (``choose_iterations``); the problem's true m is never read.
+
+        Args:
+            problem: The database search (unused but for its type).
+            tree_nodes: Nodes in the tree so far.
+
+        Returns:
+            k >= 0.
+        """
         return self.choose_iterations(tree_nodes)
 
     def observe(self, iterations: int, success: bool) -> None:
