@@ -178,7 +178,7 @@ def trajectories_free(parents, children, times, phis, curvature, resolution, bou
                       upper, origin, cell_size, shape, cell_start, cell_items, out):
     """out[i] = trajectory parents[i] -> children[i] stays in bounds and misses every box.
 
-    Compiled (numba). Chords are merged greedily while their error bound h^2/8 |e| a stays below
+    Compiled (numba). Chords are merged greedily while their error bound ``h^2/8 |e| a`` stays below
     ``resolution``; each is tested against the boxes padded by that bound (module docstring),
     and the last chord to the child c itself unpadded.
 
@@ -187,7 +187,7 @@ def trajectories_free(parents, children, times, phis, curvature, resolution, bou
         children: Float (M, d), the targets c.
         times: Float (S + 1,), increasing times t_0 = 0 .. T.
         phis: Float (S + 1, d, d), expm(M t_j).
-        curvature: Float (S,), a bound on |M^2 Phi(t)| over each interval.
+        curvature: Float (S,), a bound on ``|M^2 Phi(t)|`` over each interval.
         resolution: The largest chord error bound (> 0).
         bounds: Float (d, 2), the workspace.
         lower: Float (k, d), the boxes' lower corners.

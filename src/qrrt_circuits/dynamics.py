@@ -230,7 +230,7 @@ class LinearTrackingDynamics:
         smaller ``|e|``. The bound uses ||expm(M s)|| <= exp(mu s), mu the logarithmic norm of M.
 
         Args:
-            max_error: The largest tracking error |e| = |p - c| to cover.
+            max_error: The largest tracking error ``|e| = |p - c|`` to cover.
             resolution: The chord error the grid must keep below.
             max_step: The longest interval (default T / 16).
 

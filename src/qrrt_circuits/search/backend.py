@@ -151,7 +151,7 @@ def seed_stream(seed: int | np.random.Generator | None) -> np.random.Generator:
 class QuantumSearchBackend(abc.ABC):
     """Runs Grover search on a marked database; subclasses differ in how (gates, exact, hardware).
 
-    The quantum part of the paper's Alg. 2 / 3 (lines 4-8 of the worker): prepare H^n|0>, apply k
+    The quantum part of the paper's Alg. 2 / 3 (lines 4-8 of the worker): prepare ``H^n|0>``, apply k
     Grover iterations and measure; a marked index comes out with probability sin^2((2k+1) theta),
     sin^2 theta = m / 2^n (Eq. 1, Lemma 1). Implementations: ``AerBackend`` (gate level on
     qiskit-aer), ``StatevectorBackend`` (exact), ``SamplerBackend`` (any ``SamplerV2``). A subclass
