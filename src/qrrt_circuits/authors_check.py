@@ -435,7 +435,32 @@ def authors_check(parents, children, M, horizon, rtol, atol, refine, rast_num, t
     the integration stops after the 50 outputs the test can use.
 
     ``test`` false: integrate each pair to the end, keeping its outputs (t, e + child) in ``times``
-    / ``ys`` (as many as fit; for one pair, the last pair's otherwise); out[i] = their number."""
+    / ``ys`` (as many as fit; for one pair, the last pair's otherwise); out[i] = their number.
+
+    Args:
+        parents: Float (M, d).
+        children: Float (M, d).
+        M: Float (d, d), the closed loop A - B K.
+        horizon: T, the integration's end time.
+        rtol: ode45's relative tolerance.
+        atol: ode45's absolute tolerance.
+        refine: 1 for Octave's output rule, else MATLAB's Refine.
+        rast_num: Points tested per segment.
+        test: Whether to test (True) or only integrate (False).
+        lower: Float (k, d), the boxes' lower corners.
+        upper: Float (k, d), the boxes' upper corners.
+        origin: ``GridIndex.origin``.
+        cell_size: ``GridIndex.cell_size``.
+        shape: ``GridIndex.shape``.
+        cell_start: ``GridIndex.cell_start``.
+        cell_items: ``GridIndex.cell_items``.
+        times: Float scratch / output of the output times.
+        ys: Float (len(times), d) scratch / output of the output points.
+        out: Int (M,), written in place.
+
+    Returns:
+        ``out``.
+    """
     d = parents.shape[1]
     e0 = np.empty(d)
     y = np.empty(d)
@@ -514,6 +539,15 @@ class AuthorsCheck:
             or a non-integer ``rast_num`` / ``refine``.
         ValueError: A dynamics dimension other than ``env.dim``, or ``rast_num`` / ``refine`` out
             of range.
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits import AuthorsCheck, Environment
+        >>> env = Environment([[0, 10], [0, 10]], [[[4, 0], [6, 6]]])  # one wall from below
+        >>> check = AuthorsCheck(env, refine=1)
+        >>> parents = np.array([[1.0, 8.0], [1.0, 1.0]])
+        >>> check.name, check.reachable(parents, np.array([[3.0, 8.0], [8.0, 1.0]])).tolist()
+        ('authors-octave', [True, False])
     """
 
     rel_tol = REL_TOL
@@ -541,6 +575,7 @@ class AuthorsCheck:
 
     @property
     def dim(self) -> int:
+        """d, the environment's dimension."""
         return self.env.dim
 
     @property

@@ -26,18 +26,47 @@ from numba import njit
 
 @dataclass(frozen=True, eq=False)
 class GridIndex:
-    """Uniform grid over the workspace; cell i lists the boxes overlapping it (CSR arrays)."""
+    """Uniform grid over the workspace; cell i lists the boxes overlapping it (CSR arrays).
 
-    origin: np.ndarray  # (d,)
-    cell_size: np.ndarray  # (d,)
-    shape: np.ndarray  # (d,) int64
-    cell_start: np.ndarray  # (num_cells + 1,) int64
-    cell_items: np.ndarray  # (total,) int64
+    Cells are numbered row-major over ``shape``; the boxes of cell i are
+    ``cell_items[cell_start[i]:cell_start[i + 1]]``, in index order.
+
+    Args:
+        origin: Float (d,), the workspace's lower corner.
+        cell_size: Float (d,), a cell's side on each axis.
+        shape: Int64 (d,), cells per axis.
+        cell_start: Int64 (num_cells + 1,), CSR offsets.
+        cell_items: Int64 (total,), box indices per cell.
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits.collision import GridIndex
+        >>> boxes = np.array([[[0.5, 0.5], [1.5, 1.5]], [[2.5, 2.5], [3.5, 3.5]]])
+        >>> grid = GridIndex.build(np.array([[0.0, 4.0], [0.0, 4.0]]), boxes)
+        >>> grid.shape.tolist(), grid.cell_start.tolist(), grid.cell_items.tolist()
+        ([2, 2], [0, 1, 1, 1, 2], [0, 1])
+    """
+
+    origin: np.ndarray
+    cell_size: np.ndarray
+    shape: np.ndarray
+    cell_start: np.ndarray
+    cell_items: np.ndarray
 
     @classmethod
     def build(
         cls, bounds: np.ndarray, boxes: np.ndarray, max_cells: int = 1 << 20
     ) -> GridIndex:
+        """Index ``boxes`` on a grid of about one box per cell, cells no smaller than a typical box.
+
+        Args:
+            bounds: Float (d, 2), the workspace.
+            boxes: Float (k, 2, d), lower and upper corners.
+            max_cells: The most cells (default 2^20); cells are enlarged until they fit.
+
+        Returns:
+            The ``GridIndex``.
+        """
         d = bounds.shape[0]
         extent = bounds[:, 1] - bounds[:, 0]
         count = max(len(boxes), 1)
@@ -147,7 +176,32 @@ def _segment_free(p, q, pad, bounds, lower, upper, origin, cell_size, shape, cel
 @njit(cache=True, nogil=True)
 def trajectories_free(parents, children, times, phis, curvature, resolution, bounds, lower,
                       upper, origin, cell_size, shape, cell_start, cell_items, out):
-    """out[i] = trajectory parents[i] -> children[i] stays in bounds and misses every box."""
+    """out[i] = trajectory parents[i] -> children[i] stays in bounds and misses every box.
+
+    Compiled (numba). Chords are merged greedily while their error bound ``h^2/8 |e| a`` stays below
+    ``resolution``; each is tested against the boxes padded by that bound (module docstring),
+    and the last chord to the child c itself unpadded.
+
+    Args:
+        parents: Float (M, d), the start points p.
+        children: Float (M, d), the targets c.
+        times: Float (S + 1,), increasing times t_0 = 0 .. T.
+        phis: Float (S + 1, d, d), expm(M t_j).
+        curvature: Float (S,), a bound on ``|M^2 Phi(t)|`` over each interval.
+        resolution: The largest chord error bound (> 0).
+        bounds: Float (d, 2), the workspace.
+        lower: Float (k, d), the boxes' lower corners.
+        upper: Float (k, d), the boxes' upper corners.
+        origin: ``GridIndex.origin``.
+        cell_size: ``GridIndex.cell_size``.
+        shape: ``GridIndex.shape``.
+        cell_start: ``GridIndex.cell_start``.
+        cell_items: ``GridIndex.cell_items``.
+        out: Bool (M,), written in place.
+
+    Returns:
+        ``out``.
+    """
     d = parents.shape[1]
     num_intervals = times.shape[0] - 1
     stamp = np.full(lower.shape[0], -1, dtype=np.int64)
@@ -209,7 +263,25 @@ def trajectories_free(parents, children, times, phis, curvature, resolution, bou
 @njit(cache=True, nogil=True)
 def points_free(points, bounds, lower, upper, origin, cell_size, shape, cell_start, cell_items,
                 out):
-    """out[i] = points[i] lies in the closed bounds and outside every closed box."""
+    """out[i] = points[i] lies in the closed bounds and outside every closed box.
+
+    Compiled (numba); only the boxes listed in the point's grid cell are tested.
+
+    Args:
+        points: Float (M, d).
+        bounds: Float (d, 2), the workspace.
+        lower: Float (k, d), the boxes' lower corners.
+        upper: Float (k, d), the boxes' upper corners.
+        origin: ``GridIndex.origin``.
+        cell_size: ``GridIndex.cell_size``.
+        shape: ``GridIndex.shape``.
+        cell_start: ``GridIndex.cell_start``.
+        cell_items: ``GridIndex.cell_items``.
+        out: Bool (M,), written in place.
+
+    Returns:
+        ``out``.
+    """
     d = points.shape[1]
     for i in range(points.shape[0]):
         free = True

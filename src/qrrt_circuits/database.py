@@ -41,6 +41,26 @@ class AnnealingSchedule:
     (``counter="databases"``, Alg. 4's h++ per loop) or nodes in the tree (``counter="nodes"``).
     In Alg. 4 every database adds a node, so the two coincide; with the classical verification a
     database can add none, and counting nodes keeps the hot phase for the tree's first ``switch_at[0]`` nodes.
+
+    Args:
+        bands: Non-empty sequence of (r_min, r_max) distance bands, finite, 0 <= r_min <= r_max and
+            r_max > 0; band i is the distance range of Alg. 4's temperature H[i].
+        switch_at: ``len(bands) - 1`` strictly increasing integers >= 1: the temperature indices at
+            which the next band takes over (default ``()`` for one band).
+        counter: What h counts: ``"databases"`` (default, Alg. 4) or ``"nodes"``.
+
+    Raises:
+        TypeError: ``bands`` not a sequence of pairs, a non-real distance, ``switch_at`` not a
+            tuple or list, or a non-integer entry of it.
+        ValueError: An empty ``bands``, a negative or non-finite distance, r_min > r_max, r_max = 0,
+            ``switch_at`` of the wrong length or not strictly increasing and >= 1, or an unknown
+            ``counter``.
+
+    Example:
+        >>> from qrrt_circuits import AnnealingSchedule
+        >>> schedule = AnnealingSchedule(bands=((2.7, 4.2), (0.8, 2.0)), switch_at=(8,))
+        >>> schedule.band(0), schedule.band(7), schedule.band(8)
+        ((2.7, 4.2), (2.7, 4.2), (0.8, 2.0))
     """
 
     bands: tuple[tuple[float, float], ...]
@@ -70,26 +90,60 @@ class AnnealingSchedule:
 
     @classmethod
     def paper(cls, switch_at: int = 8) -> AnnealingSchedule:
-        """The paper's §V.D bands: [2.7, 4.2], then [0.8, 2.0] (the switch point is ours)."""
+        """The paper's §V.D bands: [2.7, 4.2], then [0.8, 2.0] (the switch point is ours).
+
+        Args:
+            switch_at: The temperature index (databases built) at which the second band takes over,
+                an integer >= 1 (default 8).
+
+        Returns:
+            ``AnnealingSchedule(bands=((2.7, 4.2), (0.8, 2.0)), switch_at=(switch_at,))``.
+
+        Raises:
+            TypeError: A non-integer ``switch_at``.
+            ValueError: ``switch_at`` < 1.
+        """
         return cls(bands=((2.7, 4.2), (0.8, 2.0)), switch_at=(switch_at,))
 
     def temperature_index(self, databases: int, nodes: int) -> int:
-        """Alg. 4's h: databases built so far or nodes in the tree, per ``counter``."""
+        """Alg. 4's h: databases built so far or nodes in the tree, per ``counter``.
+
+        Args:
+            databases: Databases built so far.
+            nodes: Nodes in the tree so far.
+
+        Returns:
+            ``nodes`` if ``counter == "nodes"``, else ``databases``.
+        """
         return nodes if self.counter == "nodes" else databases
 
     def describe(self) -> dict:
+        """The schedule as JSON-able settings: ``bands``, ``switch_at`` and ``counter``."""
         return {"bands": [list(band) for band in self.bands], "switch_at": list(self.switch_at),
                 "counter": self.counter}
 
     def band(self, temperature_index: int) -> tuple[float, float]:
-        """The band in force at temperature index h (h = 0, 1, ...)."""
+        """The band in force at temperature index h (h = 0, 1, ...).
+
+        Args:
+            temperature_index: h, an integer >= 0.
+
+        Returns:
+            (r_min, r_max) of band i, where i is the number of ``switch_at`` entries <= h.
+        """
         index = int(np.searchsorted(np.asarray(self.switch_at), temperature_index, side="right"))
         return self.bands[index]
 
 
 @dataclass(frozen=True)
 class Database:
-    """2^n candidates: ``children`` (N, d) and their ``parents`` (N,) as tree indices."""
+    """2^n candidates: ``children`` (N, d) and their ``parents`` (N,) as tree indices.
+
+    Args:
+        children: Float (N, d), the candidate points (Alg. 1's x_new, one per database entry).
+        parents: Int (N,), the tree row of each candidate's nearest node.
+        band: The annealing band (r_min, r_max) the candidates were moved into, or None.
+    """
 
     children: np.ndarray
     parents: np.ndarray
@@ -107,7 +161,22 @@ def build_database(
     annealing: AnnealingSchedule | None = None,
     temperature_index: int = 0,
 ) -> Database:
-    """Alg. 1 lines 4-8 (and Alg. 4 line 7 with ``annealing``)."""
+    """Alg. 1 lines 4-8 (and Alg. 4 line 7 with ``annealing``).
+
+    Args:
+        tree: The ``Tree`` whose nearest nodes become the parents.
+        size: Candidates N (2^n for a quantum database).
+        env: The ``Environment`` whose workspace is sampled.
+        rng: The generator of the samples.
+        goal: Goal point (d,) for goal-biased samples, or None.
+        goal_radius: Radius of the goal ball the biased samples are drawn in.
+        goal_bias: Fraction in [0, 1) of samples drawn uniformly in the goal ball.
+        annealing: An ``AnnealingSchedule`` (Alg. 4), or None.
+        temperature_index: Alg. 4's h, which picks the annealing band.
+
+    Returns:
+        The ``Database`` of candidates and their nearest parents.
+    """
     samples = env.sample_uniform(size, rng)
     return _finish_database(samples, tree, size, lambda: rng, goal, goal_radius, goal_bias, annealing,
                             temperature_index)
@@ -129,7 +198,24 @@ def stream_database(
     """``build_database`` with the generator of (round, worker, ``Stream.CANDIDATES``), without
     building it unless needed: the uniform samples (``Environment.sample_uniform``: low + (high -
     low) * u) come from the compiled PCG64 draws; only goal bias or annealing build the generator,
-    advanced past those draws (each double is one 64-bit output). Same database, bit for bit."""
+    advanced past those draws (each double is one 64-bit output). Same database, bit for bit.
+
+    Args:
+        tree: The ``Tree`` whose nearest nodes become the parents.
+        size: Candidates N.
+        env: The ``Environment`` whose workspace is sampled.
+        streams: The plan's ``RandomStreams``.
+        round_index: The round (the generator's key).
+        worker: The worker (the generator's key).
+        goal: Goal point (d,) for goal-biased samples, or None.
+        goal_radius: Radius of the goal ball.
+        goal_bias: Fraction in [0, 1) of samples drawn in the goal ball.
+        annealing: An ``AnnealingSchedule`` (Alg. 4), or None.
+        temperature_index: Alg. 4's h.
+
+    Returns:
+        The ``Database``, identical to ``build_database`` with that generator.
+    """
     dim = tree.dim
     key = np.array([[round_index, worker, int(Stream.CANDIDATES)]], dtype=np.int64)
     low, high = env.bounds[:, 0], env.bounds[:, 1]
@@ -173,7 +259,19 @@ def _finish_database(samples, tree, size, generator, goal, goal_radius, goal_bia
 
 
 def sample_ball(centre: np.ndarray, radius: float, count: int, rng: np.random.Generator) -> np.ndarray:
-    """``count`` points uniform in the d-ball of ``radius`` around ``centre``."""
+    """``count`` points uniform in the d-ball of ``radius`` around ``centre``.
+
+    A Gaussian direction, normalised, scaled by ``radius * u^(1/d)`` with u uniform in [0, 1).
+
+    Args:
+        centre: Float (d,), the ball's centre.
+        radius: The ball's radius.
+        count: Number of points.
+        rng: The generator of the draws.
+
+    Returns:
+        Float array (count, d).
+    """
     d = centre.shape[0]
     direction = rng.normal(size=(count, d))
     direction /= np.linalg.norm(direction, axis=1, keepdims=True)

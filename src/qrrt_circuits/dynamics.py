@@ -98,6 +98,7 @@ class LinearTrackingDynamics:
 
     @property
     def dim(self) -> int:
+        """d, the state dimension."""
         return int(self.A.shape[0])
 
     def describe(self) -> dict:
@@ -106,7 +107,24 @@ class LinearTrackingDynamics:
 
     @classmethod
     def from_description(cls, description: dict) -> LinearTrackingDynamics:
-        """The inverse of ``describe``."""
+        """The inverse of ``describe``.
+
+        Args:
+            description: A dict with ``"A"``, ``"B"``, ``"K"`` (nested lists) and ``"horizon"``.
+
+        Returns:
+            The dynamics.
+
+        Raises:
+            KeyError: A missing key.
+            ValueError: As the constructor (shapes, finiteness, a closed loop that is not Hurwitz).
+
+        Example:
+            >>> from qrrt_circuits import LinearTrackingDynamics
+            >>> paper = LinearTrackingDynamics.paper()
+            >>> LinearTrackingDynamics.from_description(paper.describe()).closed_loop.tolist()
+            [[-2.7, 0.0], [0.0, -4.0]]
+        """
         return cls(np.array(description["A"]), np.array(description["B"]), np.array(description["K"]),
                    horizon=description["horizon"])
 
@@ -116,12 +134,38 @@ class LinearTrackingDynamics:
         return self.A - self.B @ self.K
 
     def propagators(self, times: np.ndarray) -> np.ndarray:
-        """expm(M t) for each t: shape (len(times), d, d)."""
+        """expm(M t) for each t: shape (len(times), d, d).
+
+        Args:
+            times: Float array of times (any shape; flattened).
+
+        Returns:
+            Float array (len(times), d, d).
+        """
         times = np.asarray(times, dtype=float).reshape(-1)
         return expm(times[:, None, None] * self.closed_loop[None])
 
     def positions(self, parent: np.ndarray, child: np.ndarray, times: np.ndarray) -> np.ndarray:
-        """x(t) = c + expm(M t)(p - c) at the given times: shape (len(times), d)."""
+        """x(t) = c + expm(M t)(p - c) at the given times: shape (len(times), d).
+
+        Args:
+            parent: p, (d,).
+            child: c, the target, (d,).
+            times: Float array of times.
+
+        Returns:
+            Float array (len(times), d).
+
+        Raises:
+            ValueError: ``parent`` or ``child`` without d coordinates.
+
+        Example:
+            >>> import numpy as np
+            >>> from qrrt_circuits import LinearTrackingDynamics
+            >>> x = LinearTrackingDynamics.paper().positions([1.0, 1.0], [3.0, 2.0], [0.0, 5.0])
+            >>> np.round(x, 4).tolist()  # starts at p, ends (numerically) at c
+            [[1.0, 1.0], [3.0, 2.0]]
+        """
         parent, child = self._pair(parent, child)
         phis = self.propagators(times)
         return child + phis @ (parent - child)
@@ -160,7 +204,14 @@ class LinearTrackingDynamics:
         return self.positions(parent, child, sample_times)
 
     def dense_times(self, count: int = 4000) -> np.ndarray:
-        """Times in [0, T] that are dense where the motion is fast (a mix of linear and geometric)."""
+        """Times in [0, T] that are dense where the motion is fast (a mix of linear and geometric).
+
+        Args:
+            count: About how many times (half geometric from a small first time, half linear).
+
+        Returns:
+            Sorted unique float array, starting at 0 and ending at T.
+        """
         slowest = float(np.min(-np.linalg.eigvals(self.closed_loop).real))
         fastest = float(np.max(np.abs(np.linalg.eigvals(self.closed_loop))))
         first = min(self.horizon, 1e-3 / max(fastest, 1e-9))
@@ -177,6 +228,14 @@ class LinearTrackingDynamics:
         (interpolation error bound with ``|x''(t)| = |M^2 expm(M t) e|``). The grid is fine enough
         that this is <= ``resolution`` for every ``|e| <= max_error``; callers merge intervals for
         smaller ``|e|``. The bound uses ||expm(M s)|| <= exp(mu s), mu the logarithmic norm of M.
+
+        Args:
+            max_error: The largest tracking error ``|e| = |p - c|`` to cover.
+            resolution: The chord error the grid must keep below.
+            max_step: The longest interval (default T / 16).
+
+        Returns:
+            (times, bounds): the grid t_0 = 0 .. T and one bound a_i per interval.
         """
         closed = self.closed_loop
         mu = max(float(np.max(np.linalg.eigvalsh((closed + closed.T) / 2))), 0.0)

@@ -134,10 +134,12 @@ class Environment:
 
     @property
     def num_boxes(self) -> int:
+        """k, the number of boxes."""
         return int(self.boxes.shape[0])
 
     @property
     def volume(self) -> float:
+        """The workspace's volume, the product of its side lengths (obstacles not subtracted)."""
         return float(np.prod(self.bounds[:, 1] - self.bounds[:, 0]))
 
     def in_bounds(self, points: np.ndarray) -> np.ndarray:
@@ -250,7 +252,21 @@ class Environment:
         return np.concatenate(found)[:count] if found else np.zeros((0, self.dim))
 
     def free_fraction(self, samples: int = 20000, seed: int = 0) -> float:
-        """Monte-Carlo estimate of the free fraction of the workspace."""
+        """Monte-Carlo estimate of the free fraction of the workspace.
+
+        Args:
+            samples: Uniform samples (default 20 000).
+            seed: Seed of the samples' own generator (default 0).
+
+        Returns:
+            The fraction of samples outside every box.
+
+        Example:
+            >>> from qrrt_circuits import Environment
+            >>> env = Environment([[0, 10], [0, 10]], [[[4, 0], [6, 6]]])  # 12 % blocked
+            >>> env.free_fraction()
+            0.8815
+        """
         rng = np.random.default_rng([0xF4EE, seed])
         return float(np.mean(self.is_free(self.sample_uniform(samples, rng))))
 
@@ -267,6 +283,12 @@ class Environment:
 
     # ------------------------------------------------------------------ JSON
     def to_dict(self) -> dict:
+        """The environment as JSON-able data in the format of the module docstring.
+
+        Returns:
+            A dict with ``format``, ``version``, ``name``, ``bounds``, ``boxes``, ``start``,
+            ``goal``, ``goal_radius`` and ``metadata``.
+        """
         return {
             "format": FORMAT_NAME,
             "version": FORMAT_VERSION,
@@ -281,6 +303,26 @@ class Environment:
 
     @classmethod
     def from_dict(cls, data: dict) -> Environment:
+        """The inverse of ``to_dict`` (what ``load`` reads).
+
+        Args:
+            data: A dict with ``"format": "qrrt-environment"``, ``"version": 1``, ``bounds`` and
+                ``boxes`` (the other keys optional).
+
+        Returns:
+            The ``Environment``.
+
+        Raises:
+            ValueError: Not a dict, a wrong format or version, a missing ``bounds`` / ``boxes``,
+                ``boxes`` not a list, bad metadata, or any value the constructor refuses.
+            TypeError: A value of the wrong type the constructor refuses.
+
+        Example:
+            >>> from qrrt_circuits import Environment
+            >>> env = Environment([[0, 10], [0, 10]], [[[4, 0], [6, 6]]])
+            >>> Environment.from_dict(env.to_dict()).boxes.tolist()
+            [[[4.0, 0.0], [6.0, 6.0]]]
+        """
         if not isinstance(data, dict):
             raise ValueError("environment JSON must be an object")
         if data.get("format") != FORMAT_NAME:

@@ -165,6 +165,30 @@ def _stop_fork_server(server, wait_s: float = 5.0) -> None:
 
 
 def check_executor_args(kind: str, jobs: int | None, scheduler: str | None) -> int:
+    """Validate the executor arguments of ``get_executor`` and ``WorkerPool`` before any work.
+
+    Args:
+        kind: One of ``EXECUTORS``: ``"serial"``, ``"process"`` or ``"dask"``.
+        jobs: Worker processes (an integer >= 1), or None for ``os.cpu_count()``.
+        scheduler: A Dask scheduler address (only with ``kind="dask"``), or None.
+
+    Returns:
+        The number of jobs: ``jobs``, or the machine's CPU count for None.
+
+    Raises:
+        ValueError: An unknown ``kind``, ``jobs`` < 1, a ``scheduler`` without ``kind="dask"``, or
+            ``kind="dask"`` without the ``dask`` extra installed.
+        TypeError: A non-integer ``jobs``.
+
+    Example:
+        >>> from qrrt_circuits.execution import check_executor_args
+        >>> check_executor_args("process", 2, None)
+        2
+        >>> check_executor_args("mpi", None, None)
+        Traceback (most recent call last):
+        ...
+        ValueError: executor must be one of ('serial', 'process', 'dask'), got 'mpi'
+    """
     if kind not in EXECUTORS:
         raise ValueError(f"executor must be one of {EXECUTORS}, got {kind!r}")
     check_optional_int(jobs, "jobs", 1)
@@ -233,7 +257,36 @@ def _open(kind: str, jobs: int, scheduler: str | None, retries: int,
 def get_executor(kind: str = "serial", jobs: int | None = None, scheduler: str | None = None,
                  retries: int = 2, local_directory: str | None = None) -> Iterator[Executor | None]:
     """Context manager yielding an executor (``None`` for serial); everything it started is shut
-    down on exit."""
+    down on exit.
+
+    ``"process"``: a ``ProcessPoolExecutor`` of ``jobs`` single-threaded workers forked from a warm
+    fork server. ``"dask"``: ``Client.get_executor(retries=retries)`` of a ``LocalCluster`` of
+    ``jobs`` single-threaded workers, or of the cluster at ``scheduler``.
+
+    Args:
+        kind: One of ``EXECUTORS``: ``"serial"`` (default), ``"process"`` or ``"dask"``.
+        jobs: Worker processes (an integer >= 1); None means ``os.cpu_count()``. Unused by an
+            existing Dask cluster.
+        scheduler: Address of a running Dask scheduler (``kind="dask"`` only), or None for a local
+            cluster.
+        retries: Dask retries of a task whose worker failed (default 2).
+        local_directory: Scratch directory of a local Dask cluster; None (default) for a temporary
+            one removed on exit.
+
+    Returns:
+        A context manager that yields a ``concurrent.futures.Executor``, or None for ``"serial"``.
+
+    Raises:
+        ValueError: An unknown ``kind``, ``jobs`` < 1, a ``scheduler`` without ``kind="dask"``, or
+            ``kind="dask"`` without the ``dask`` extra.
+        TypeError: A non-integer ``jobs``.
+
+    Example:
+        >>> from qrrt_circuits.execution import get_executor
+        >>> with get_executor("serial") as executor:
+        ...     print(executor)
+        None
+    """
     jobs = check_executor_args(kind, jobs, scheduler)
     with _open(kind, jobs, scheduler, retries, local_directory) as executor:
         yield executor
@@ -246,6 +299,24 @@ class WorkerPool:
     whose sweeps are all finished already starts no workers; ``renew()`` shuts it down and starts
     a new one (after a local pool broke because a worker died). ``run_experiment(executor=pool)``
     uses it and renews it when it breaks, so ``qrrt reproduce all`` pays the start of workers once.
+
+    Args:
+        kind: One of ``EXECUTORS``: ``"serial"`` (default), ``"process"`` or ``"dask"``.
+        jobs: Worker processes (an integer >= 1); None means ``os.cpu_count()``.
+        scheduler: Address of a running Dask scheduler (``kind="dask"`` only), or None.
+        retries: Dask retries of a task whose worker failed (default 2).
+        local_directory: Scratch directory of a local Dask cluster, or None for a temporary one.
+
+    Raises:
+        ValueError: An unknown ``kind``, ``jobs`` < 1, a ``scheduler`` without ``kind="dask"``, or
+            ``kind="dask"`` without the ``dask`` extra.
+        TypeError: A non-integer ``jobs``.
+
+    Example:
+        >>> from qrrt_circuits.execution import WorkerPool
+        >>> with WorkerPool("serial", jobs=2) as pool:
+        ...     print(pool.executor, pool.jobs)
+        None 2
     """
 
     def __init__(self, kind: str = "serial", jobs: int | None = None, scheduler: str | None = None,
@@ -264,6 +335,11 @@ class WorkerPool:
 
     @property
     def executor(self) -> Executor | None:
+        """The live executor (None for ``"serial"``), started on first access.
+
+        Raises:
+            RuntimeError: The pool is not open (used outside its ``with`` block).
+        """
         if not self._open:
             raise RuntimeError("WorkerPool is not open: use it as a context manager")
         if self._stack is None:

@@ -42,7 +42,12 @@ SCRATCH_BYTES = 64 * MIB
 
 
 def available_memory_bytes() -> int | None:
-    """Memory that can still be allocated without swapping, in bytes (None if unknown)."""
+    """Memory that can still be allocated without swapping, in bytes (None if unknown).
+
+    Returns:
+        ``MemAvailable`` of ``/proc/meminfo`` (Linux), else free pages times the page size, else
+        None.
+    """
     try:
         with open("/proc/meminfo", encoding="ascii") as meminfo:
             for line in meminfo:
@@ -58,7 +63,26 @@ def available_memory_bytes() -> int | None:
 
 def database_bytes(num_qubits: int, dim: int, annealing: bool = False) -> int:
     """Peak bytes of building one database of 2^n candidates in d dimensions and evaluating the
-    predicate on it (Alg. 1 lines 4-8; Alg. 4 line 7 with ``annealing``)."""
+    predicate on it (Alg. 1 lines 4-8; Alg. 4 line 7 with ``annealing``).
+
+    (26 + 16 d) 2^n bytes, or (46 + 38 d) 2^n with annealing: per-entry constants calibrated by
+    ``benchmarks/bench_memory.py`` (see the module docstring).
+
+    Args:
+        num_qubits: n (the database holds 2^n candidates).
+        dim: d, the dimension of the states.
+        annealing: Whether Quantum Database Annealing moves the candidates (default False).
+
+    Returns:
+        The estimated peak bytes.
+
+    Example:
+        >>> from qrrt_circuits.memory import database_bytes
+        >>> database_bytes(20, 2) == (26 + 16 * 2) * 2**20
+        True
+        >>> database_bytes(20, 2, annealing=True) == (46 + 38 * 2) * 2**20
+        True
+    """
     if annealing:
         per_entry = ANNEALING_BYTES_PER_ENTRY + ANNEALING_BYTES_PER_COORDINATE * dim
     else:
@@ -68,7 +92,20 @@ def database_bytes(num_qubits: int, dim: int, annealing: bool = False) -> int:
 
 def database_resident_bytes(num_qubits: int, dim: int) -> int:
     """Bytes one built database keeps while it is searched: candidates (8 d), parent indices (8),
-    the predicate's answers and the marks (1 + 1)."""
+    the predicate's answers and the marks (1 + 1).
+
+    Args:
+        num_qubits: n.
+        dim: d.
+
+    Returns:
+        (10 + 8 d) 2^n bytes.
+
+    Example:
+        >>> from qrrt_circuits.memory import database_resident_bytes
+        >>> database_resident_bytes(20, 2) // 2**20  # MiB: 26 bytes per entry
+        26
+    """
     return (10 + 8 * dim) << num_qubits
 
 
@@ -78,7 +115,26 @@ class MemoryEstimate:
 
     The database's build scratch is freed before the search starts, so the peak is the larger of
     building the databases and searching them while they are kept:
-    ``max(database_bytes, resident_bytes + search_bytes) + policy_bytes + scratch_bytes``."""
+    ``max(database_bytes, resident_bytes + search_bytes) + policy_bytes + scratch_bytes``.
+
+    Args:
+        num_qubits: n, the database's qubits.
+        database_bytes: Peak of building one round's databases (``database_bytes``).
+        resident_bytes: The databases kept while they are searched (``database_resident_bytes``).
+        search_bytes: The backend's search (``QuantumSearchBackend.peak_bytes``).
+        policy_bytes: The search policy's state (``IterationPolicy.state_bytes``).
+        scratch_bytes: Fixed allowance (default ``SCRATCH_BYTES``, 64 MiB).
+
+    Example:
+        >>> from qrrt_circuits.memory import MemoryEstimate, database_bytes, database_resident_bytes
+        >>> estimate = MemoryEstimate(20, database_bytes=database_bytes(20, 2),
+        ...                           resident_bytes=database_resident_bytes(20, 2),
+        ...                           search_bytes=16 * 2**20)
+        >>> estimate.total_bytes // 2**20  # max(58, 26 + 16) + 64 MiB
+        122
+        >>> estimate.breakdown()
+        'database build 58 MiB, database kept 26 MiB, search 16 MiB, scratch 64 MiB'
+    """
 
     num_qubits: int
     database_bytes: int = 0
@@ -89,16 +145,19 @@ class MemoryEstimate:
 
     @property
     def total_bytes(self) -> int:
+        """The estimated peak: ``max(database, resident + search) + policy + scratch`` bytes."""
         return (max(self.database_bytes, self.resident_bytes + self.search_bytes) + self.policy_bytes
                 + self.scratch_bytes)
 
     def describe(self) -> dict:
+        """The parts and ``total_bytes`` as a JSON-able dict."""
         return {"num_qubits": self.num_qubits, "database_bytes": self.database_bytes,
                 "resident_bytes": self.resident_bytes, "search_bytes": self.search_bytes,
                 "policy_bytes": self.policy_bytes, "scratch_bytes": self.scratch_bytes,
                 "total_bytes": self.total_bytes}
 
     def breakdown(self) -> str:
+        """The non-zero parts in words (MiB or GiB), for error messages."""
         parts = [("database build", self.database_bytes), ("database kept", self.resident_bytes),
                  ("search", self.search_bytes), ("search policy", self.policy_bytes),
                  ("scratch", self.scratch_bytes)]
@@ -120,7 +179,23 @@ _LARGEST_TRIED = 64
 
 
 def largest_fitting(estimate_for: Callable[[int], MemoryEstimate], available: int, below: int) -> int:
-    """The largest n < ``below`` whose estimate fits in ``available`` bytes (0 if none does)."""
+    """The largest n < ``below`` whose estimate fits in ``available`` bytes (0 if none does).
+
+    Args:
+        estimate_for: The run's ``MemoryEstimate`` as a function of n.
+        available: The available bytes.
+        below: Exclusive upper bound on n (n is never tried beyond 63).
+
+    Returns:
+        The largest fitting n, trying n = 1, 2, ... until one does not fit; 0 if n = 1 does not.
+
+    Example:
+        >>> from qrrt_circuits.memory import MemoryEstimate, database_bytes, largest_fitting
+        >>> def estimate_for(n):
+        ...     return MemoryEstimate(n, database_bytes=database_bytes(n, 2))
+        >>> largest_fitting(estimate_for, available=2**30, below=30)
+        24
+    """
     best = 0
     for n in range(1, min(below, _LARGEST_TRIED)):
         if estimate_for(n).total_bytes > available:
@@ -133,7 +208,35 @@ def check_fits(estimate_for: Callable[[int], MemoryEstimate], num_qubits: int, w
                available: int | None = None) -> MemoryEstimate:
     """Refuse (``ValueError``) a run whose estimated peak exceeds the available memory, naming
     ``num_qubits``, the estimate, the available memory and the largest n that fits. ``what`` names
-    the run ("this plan", "this search"). Returns the estimate when it fits."""
+    the run ("this plan", "this search"). Returns the estimate when it fits.
+
+    Estimates up to ``ALWAYS_FITS_BYTES`` (256 MiB) are accepted without reading the available
+    memory; so is any estimate when the available memory is unknown.
+
+    Args:
+        estimate_for: The run's ``MemoryEstimate`` as a function of n.
+        num_qubits: The n asked for.
+        what: The run's name for the message.
+        available: The available bytes; None (default) for ``available_memory_bytes()``.
+
+    Returns:
+        ``estimate_for(num_qubits)``.
+
+    Raises:
+        ValueError: The estimate exceeds the available memory (the message names the largest n
+            that fits).
+
+    Example:
+        >>> from qrrt_circuits.memory import MemoryEstimate, check_fits, database_bytes
+        >>> def estimate_for(n):
+        ...     return MemoryEstimate(n, database_bytes=database_bytes(n, 2))
+        >>> check_fits(estimate_for, 10, "this plan", available=2**30).num_qubits
+        10
+        >>> check_fits(estimate_for, 26, "this plan", available=2**30)  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        ValueError: num_qubits = 26: this plan needs about 3.7 GiB ...; the largest num_qubits that fits is 24
+    """
     estimate = estimate_for(num_qubits)
     if estimate.total_bytes <= ALWAYS_FITS_BYTES:
         return estimate

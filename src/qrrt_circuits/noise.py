@@ -50,7 +50,24 @@ class MissingExtraError(ImportError):
 
 
 def depolarizing_noise_model(p1: float, p2: float):
-    """A ``NoiseModel`` with depolarizing errors p1 on sx/x and p2 on cx (see the module text)."""
+    """A ``NoiseModel`` with depolarizing errors p1 on sx/x and p2 on cx (see the module text).
+
+    Args:
+        p1: One-qubit depolarizing parameter, in [0, 1].
+        p2: Two-qubit depolarizing parameter, in [0, 1].
+
+    Returns:
+        A qiskit-aer ``NoiseModel`` on the basis ``DEVICE_BASIS`` (no error added for a zero p).
+
+    Raises:
+        TypeError: A non-real probability.
+        ValueError: A probability outside [0, 1].
+
+    Example:
+        >>> from qrrt_circuits.noise import depolarizing_noise_model
+        >>> sorted(depolarizing_noise_model(0.001, 0.01).noise_instructions)
+        ['cx', 'sx', 'x']
+    """
     from qiskit_aer.noise import NoiseModel, depolarizing_error
 
     p1 = check_probability(p1, "p1")
@@ -65,7 +82,14 @@ def depolarizing_noise_model(p1: float, p2: float):
 
 @functools.lru_cache(maxsize=4)
 def device_pass_manager(optimization_level: int = 1):
-    """The one pass manager of the depolarizing sweep: basis [cx, rz, sx, x], all-to-all."""
+    """The one pass manager of the depolarizing sweep: basis [cx, rz, sx, x], all-to-all.
+
+    Args:
+        optimization_level: Qiskit's preset level, 0-3 (default 1); ``seed_transpiler=0``.
+
+    Returns:
+        A cached ``PassManager``.
+    """
     from qiskit.transpiler import generate_preset_pass_manager
 
     return generate_preset_pass_manager(optimization_level=optimization_level, basis_gates=list(DEVICE_BASIS),
@@ -73,7 +97,14 @@ def device_pass_manager(optimization_level: int = 1):
 
 
 def available_fake_device() -> str:
-    """The name of the first of ``FAKE_DEVICES`` the installed qiskit-ibm-runtime has."""
+    """The name of the first of ``FAKE_DEVICES`` the installed qiskit-ibm-runtime has.
+
+    Returns:
+        A name of ``FAKE_DEVICES``.
+
+    Raises:
+        MissingExtraError: qiskit-ibm-runtime is not installed or has none of them.
+    """
     provider = _fake_provider()
     for name in FAKE_DEVICES:
         if hasattr(provider, name):
@@ -85,7 +116,18 @@ def available_fake_device() -> str:
 @functools.lru_cache(maxsize=4)
 def fake_device(name: str | None = None):
     """A fake IBM device (``BackendV2`` with the calibration snapshot's coupling map, gates and
-    errors); ``name`` one of ``FAKE_DEVICES`` (default: the first installed)."""
+    errors); ``name`` one of ``FAKE_DEVICES`` (default: the first installed).
+
+    Args:
+        name: One of ``FAKE_DEVICES``, or None for ``available_fake_device()``.
+
+    Returns:
+        The fake backend (cached per name).
+
+    Raises:
+        ValueError: A name not in ``FAKE_DEVICES``.
+        MissingExtraError: qiskit-ibm-runtime is not installed or lacks that device.
+    """
     provider = _fake_provider()
     name = available_fake_device() if name is None else check_choice(name, "device", FAKE_DEVICES)
     if not hasattr(provider, name):
@@ -104,6 +146,7 @@ def _fake_provider():
 
 
 def has_fake_devices() -> bool:
+    """Whether a fake IBM device is available (the ``noise`` extra is installed)."""
     try:
         available_fake_device()
     except MissingExtraError:
@@ -113,7 +156,14 @@ def has_fake_devices() -> bool:
 
 def noisy_gate_counts(circuit) -> tuple[int, int]:
     """(one-qubit, two-qubit) gates of a transpiled circuit that carry an error in the depolarizing
-    model (rz, barriers and measurements carry none)."""
+    model (rz, barriers and measurements carry none).
+
+    Args:
+        circuit: A circuit transpiled to ``DEVICE_BASIS``.
+
+    Returns:
+        (n1, n2): the ``sx``/``x`` and the ``cx`` gate counts.
+    """
     ops = circuit.count_ops()
     return (int(sum(ops.get(g, 0) for g in NOISY_ONE_QUBIT_GATES)),
             int(sum(ops.get(g, 0) for g in NOISY_TWO_QUBIT_GATES)))
@@ -121,18 +171,64 @@ def noisy_gate_counts(circuit) -> tuple[int, int]:
 
 def white_noise_fidelity(one_qubit_gates: int, two_qubit_gates: int, p1: float, p2: float) -> float:
     """F = (1 - p1)^{n1} (1 - p2)^{n2}: the weight left on the ideal state if every error
-    depolarized the whole register."""
+    depolarized the whole register.
+
+    Args:
+        one_qubit_gates: n1, the noisy one-qubit gates.
+        two_qubit_gates: n2, the noisy two-qubit gates.
+        p1: One-qubit depolarizing parameter.
+        p2: Two-qubit depolarizing parameter.
+
+    Returns:
+        F in [0, 1] (unvalidated inputs).
+
+    Example:
+        >>> from qrrt_circuits.noise import white_noise_fidelity
+        >>> round(white_noise_fidelity(10, 5, p1=0.001, p2=0.01), 6)  # 0.999^10 0.99^5
+        0.941523
+    """
     return float((1.0 - p1) ** one_qubit_gates * (1.0 - p2) ** two_qubit_gates)
 
 
 def white_noise_success(num_items: int, num_marked: int, iterations: int, fidelity: float) -> float:
-    """P_noisy = F P_ideal + (1 - F) m / N (the white-noise approximation)."""
+    """P_noisy = F P_ideal + (1 - F) m / N (the white-noise approximation).
+
+    P_ideal = sin^2((2k+1) theta), sin^2 theta = m/N (the paper's Lemma 1, Eq. 1).
+
+    Args:
+        num_items: N.
+        num_marked: m.
+        iterations: k.
+        fidelity: F, the weight on the ideal state (``white_noise_fidelity``).
+
+    Returns:
+        The approximate probability of measuring a marked entry (unvalidated inputs).
+
+    Example:
+        >>> from qrrt_circuits.noise import white_noise_success
+        >>> round(white_noise_success(8, 1, 2, fidelity=1.0), 6), round(white_noise_success(8, 1, 2, 0.9), 6)
+        (0.945312, 0.863281)
+    """
     ideal = good_probability(num_items, num_marked, iterations)
     return float(fidelity * ideal + (1.0 - fidelity) * num_marked / num_items)
 
 
 def transpiled_grover(marks: np.ndarray, iterations: int, measure: bool = False, pass_manager=None):
-    """``grover_circuit(marks, iterations)`` through ``pass_manager`` (default ``device_pass_manager()``)."""
+    """``grover_circuit(marks, iterations)`` through ``pass_manager`` (default ``device_pass_manager()``).
+
+    Args:
+        marks: Boolean (or 0/1) array of length 2^n.
+        iterations: k, 0 .. ``MAX_ITERATIONS``.
+        measure: Whether to measure all qubits (default False).
+        pass_manager: A Qiskit ``PassManager``, or None for ``device_pass_manager()``.
+
+    Returns:
+        The transpiled circuit.
+
+    Raises:
+        ValueError: ``marks`` not of length 2^n or not boolean, or k out of range.
+        TypeError: A non-integer k.
+    """
     from .search.circuits import grover_circuit
 
     marks, _ = validate_marks(marks)
@@ -144,7 +240,30 @@ def transpiled_grover(marks: np.ndarray, iterations: int, measure: bool = False,
 def noisy_index_distribution(compiled, noise_model, num_qubits: int) -> np.ndarray:
     """Exact probabilities of the n index qubits (virtual order) after the transpiled, unmeasured
     circuit ``compiled`` under ``noise_model``: AerSimulator(method="density_matrix") with
-    ``save_probabilities`` on the physical qubits the final layout assigns to the index."""
+    ``save_probabilities`` on the physical qubits the final layout assigns to the index.
+
+    Args:
+        compiled: The transpiled circuit without measurements (``transpiled_grover``).
+        noise_model: A qiskit-aer ``NoiseModel`` (or None for the ideal distribution).
+        num_qubits: n, the index register's width.
+
+    Returns:
+        Float array of 2^n probabilities, index i in Qiskit's little-endian order.
+
+    Raises:
+        RuntimeError: The simulation failed.
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits.noise import (depolarizing_noise_model, noisy_index_distribution,
+        ...                                  transpiled_grover)
+        >>> marks = np.array([0, 0, 0, 0, 0, 1, 0, 0], dtype=bool)
+        >>> compiled = transpiled_grover(marks, 2)
+        >>> ideal = noisy_index_distribution(compiled, None, 3)
+        >>> noisy = noisy_index_distribution(compiled, depolarizing_noise_model(0.001, 0.01), 3)
+        >>> round(float(ideal[5]), 4), bool(noisy[5] < ideal[5])  # sin^2(5 theta), theta = asin(8^-1/2)
+        (0.9453, True)
+    """
     from qiskit_aer import AerSimulator
 
     circuit = compiled.copy()
@@ -161,7 +280,25 @@ def noisy_index_distribution(compiled, noise_model, num_qubits: int) -> np.ndarr
 def wrong_answer_collision(distribution: np.ndarray, marks: np.ndarray) -> float:
     """The probability that two independent wrong (unmarked) answers are the same entry:
     sum_i p_i^2 / (sum_i p_i)^2 over unmarked i. 1 / (N - m) if wrong answers are uniform; 1 / f if
-    they are the f false-positive marks of Lemma 4's erroneous oracle."""
+    they are the f false-positive marks of Lemma 4's erroneous oracle.
+
+    Args:
+        distribution: Probabilities of the N indices (``noisy_index_distribution``).
+        marks: Boolean (or 0/1) array of length N = 2^n.
+
+    Returns:
+        The collision probability, or NaN if the unmarked entries have probability 0.
+
+    Raises:
+        ValueError: ``marks`` not of length 2^n or not boolean.
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits.noise import wrong_answer_collision
+        >>> marks = np.array([1, 0, 0, 0, 0, 0, 0, 0], dtype=bool)
+        >>> round(wrong_answer_collision(np.full(8, 1 / 8), marks), 6)  # uniform: 1 / 7
+        0.142857
+    """
     marks, _ = validate_marks(marks)
     wrong = np.asarray(distribution, dtype=float)[~marks]
     total = wrong.sum()
@@ -174,7 +311,29 @@ def effective_false_positive_rate(num_items: int, num_marked: int, iterations: i
     marks, m of them good) whose truly-good probability (m / m') P(G; N, m', k) equals
     ``success_probability`` with the same k; m' is treated as continuous. NaN if no q in [0, 1]
     matches (the ideal probability is already below the target, or noise pushes it below every
-    false-positive oracle's)."""
+    false-positive oracle's).
+
+    Solved by locating the first sign change of the gap on a grid of 4001 values of q in [0, 1],
+    refined by linear interpolation.
+
+    Args:
+        num_items: N.
+        num_marked: m.
+        iterations: k.
+        success_probability: The measured (noisy) probability of a marked entry, in [0, 1].
+
+    Returns:
+        The smallest matching q, or NaN (also for m = 0 or m >= N).
+
+    Raises:
+        TypeError: A non-real ``success_probability``.
+        ValueError: ``success_probability`` outside [0, 1].
+
+    Example:
+        >>> from qrrt_circuits.noise import effective_false_positive_rate
+        >>> round(effective_false_positive_rate(64, 2, 4, success_probability=0.8), 4)
+        0.0067
+    """
     success_probability = check_probability(success_probability, "success_probability")
     if num_marked <= 0 or num_marked >= num_items:
         return math.nan

@@ -58,6 +58,16 @@ class ReachabilityOracle:
         ValueError: An unknown ``check``, a dynamics dimension other than ``env.dim``, or a
             ``resolution`` that is not a finite number > 0.
         TypeError: A non-numeric ``resolution``.
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits import Environment, ReachabilityOracle
+        >>> env = Environment([[0, 10], [0, 10]], [[[4, 0], [6, 6]]])  # one wall from below
+        >>> oracle = ReachabilityOracle(env)
+        >>> parents = np.array([[1.0, 8.0], [1.0, 1.0]])
+        >>> children = np.array([[3.0, 8.0], [8.0, 1.0]])  # the second crosses the wall
+        >>> oracle.reachable(parents, children).tolist(), oracle.evaluations
+        ([True, False], 2)
     """
 
     name = "exact"
@@ -104,6 +114,7 @@ class ReachabilityOracle:
 
     @property
     def dim(self) -> int:
+        """d, the environment's dimension."""
         return self.env.dim
 
     @property
@@ -130,7 +141,14 @@ class ReachabilityOracle:
         bounds test is strict (x - delta < low rejects), so the first chord from a point with
         x_i = low_i or x_i = high_i is always rejected. (Inside the margin but off the boundary,
         a child close enough has a smaller delta and may pass: not decidable here; the planners'
-        stall limit ends such plans.)"""
+        stall limit ends such plans.)
+
+        Args:
+            point: Float (d,), a candidate start.
+
+        Returns:
+            False for a point on the workspace boundary, else True.
+        """
         point = np.asarray(point, dtype=float).reshape(-1)
         return not bool(np.any((point == self._bounds[:, 0]) | (point == self._bounds[:, 1])))
 

@@ -15,7 +15,29 @@ class OracleErrorModel:
 
     Each truly unreachable entry is marked good with probability ``false_positive`` and each
     reachable one is marked bad with probability ``false_negative``. (The paper's q = (1 - m1)/m is
-    a typo for q = (m - m1)/m.)
+    a typo for q = (m - m1)/m.) Of the m marked entries m1 are then truly good, and m2 truly good
+    entries are marked bad: the setting of the paper's Lemmas 4-6
+    (``probability.prob_true_solution``, ``prob_all_same_with_errors``,
+    ``expected_workers_with_errors``).
+
+    Args:
+        false_positive: Probability in [0, 1] that an unreachable entry is marked good (default 0).
+        false_negative: Probability in [0, 1] that a reachable entry is marked bad (default 0).
+        seed: Seed (integer >= 0) of the model's own generator, used when ``apply`` gets none; None
+            (default) for fresh entropy.
+
+    Raises:
+        TypeError: A non-real probability or a non-integer ``seed``.
+        ValueError: A probability outside [0, 1] or a negative ``seed``.
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits import OracleErrorModel
+        >>> always_wrong = OracleErrorModel(false_positive=1.0, false_negative=1.0)
+        >>> always_wrong.apply(np.array([True, False, False]), np.random.default_rng(0))
+        array([False,  True,  True])
+        >>> OracleErrorModel().is_exact
+        True
     """
 
     false_positive: float = 0.0
@@ -31,13 +53,25 @@ class OracleErrorModel:
 
     @property
     def is_exact(self) -> bool:
+        """Whether both error probabilities are 0 (``apply`` returns the truth unchanged)."""
         return self.false_positive == 0.0 and self.false_negative == 0.0
 
     def describe(self) -> dict:
+        """The model as JSON-able settings: ``false_positive`` and ``false_negative``."""
         return {"false_positive": self.false_positive, "false_negative": self.false_negative}
 
     def apply(self, truth: np.ndarray, rng: np.random.Generator | None = None) -> np.ndarray:
-        """Noisy marks for the true reachability ``truth`` (bool array)."""
+        """Noisy marks for the true reachability ``truth`` (bool array).
+
+        Args:
+            truth: Boolean array of the true reachability of each entry.
+            rng: The generator of the flips; None (default) for the model's own (seeded by
+                ``seed``).
+
+        Returns:
+            A new boolean array of the same shape: each true entry kept with probability
+            1 - ``false_negative``, each false entry set with probability ``false_positive``.
+        """
         truth = np.asarray(truth, dtype=bool)
         if self.is_exact:
             return truth.copy()

@@ -28,7 +28,16 @@ def _axes(ax: Axes | None) -> Axes:
 
 
 def plot_environment(env: Environment, ax: Axes | None = None, color: str = "0.15") -> Axes:
-    """Obstacles as filled rectangles inside the workspace outline."""
+    """Obstacles as filled rectangles inside the workspace outline (first two axes).
+
+    Args:
+        env: The ``Environment`` to draw.
+        ax: Matplotlib axes to draw on; None (default) for a new 6 x 6 inch figure.
+        color: Fill colour of the obstacles (default dark grey ``"0.15"``).
+
+    Returns:
+        The axes, with limits set to the workspace and an equal aspect ratio.
+    """
     from matplotlib.collections import PatchCollection
     from matplotlib.patches import Rectangle
 
@@ -48,7 +57,29 @@ def edge_curves(nodes: np.ndarray, parents: np.ndarray, dynamics: LinearTracking
                 samples: int = 24) -> np.ndarray:
     """(E, samples, d) points along each edge: the closed-loop trajectory
     x(t) = c + expm(Mt)(p - c) of ``dynamics``, or the straight segment when ``dynamics`` is None
-    (a predicate without closed-loop dynamics)."""
+    (a predicate without closed-loop dynamics).
+
+    Each curve starts at the parent p (t = 0) and runs towards the child c, the tracking target;
+    with dynamics the times are 0 and ``samples - 1`` geometrically spaced
+    times from 1e-3 to the horizon T (DESIGN §2, the paper's §V motion model).
+
+    Args:
+        nodes: Float (N+1, d), the tree's nodes (root in row 0).
+        parents: Int (N+1,), each node's parent row, -1 for the root.
+        dynamics: The ``LinearTrackingDynamics`` the edges follow, or None for straight segments.
+        samples: Points per edge (default 24).
+
+    Returns:
+        Float array (E, samples, d), one curve per node with a parent (E = number of edges).
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits.plotting import edge_curves
+        >>> nodes = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 2.0]])
+        >>> curves = edge_curves(nodes, np.array([-1, 0, 1]), None, samples=3)
+        >>> curves.shape, curves[1].tolist()
+        ((2, 3, 2), [[1.0, 0.0], [1.0, 1.0], [1.0, 2.0]])
+    """
     children = np.flatnonzero(parents >= 0)
     if children.size == 0:
         return np.zeros((0, samples, nodes.shape[1]))
@@ -63,7 +94,14 @@ def edge_curves(nodes: np.ndarray, parents: np.ndarray, dynamics: LinearTracking
 
 def plan_dynamics(result: PlanResult) -> LinearTrackingDynamics | None:
     """The dynamics a plan's predicate followed, from ``result.settings["dynamics"]`` (None: the
-    predicate describes none, and edges are drawn straight)."""
+    predicate describes none, and edges are drawn straight).
+
+    Args:
+        result: A ``PlanResult``.
+
+    Returns:
+        The ``LinearTrackingDynamics`` rebuilt from its recorded description, or None.
+    """
     description = result.settings.get("dynamics")
     return None if description is None else LinearTrackingDynamics.from_description(description)
 
@@ -71,7 +109,19 @@ def plan_dynamics(result: PlanResult) -> LinearTrackingDynamics | None:
 def plot_edges(env: Environment, nodes: np.ndarray, parents: np.ndarray,
                dynamics: LinearTrackingDynamics | None, ax: Axes | None = None,
                edge_color: str = "tab:blue") -> Axes:
-    """Obstacles, the tree's edges along their motion (see ``edge_curves``), nodes and the root."""
+    """Obstacles, the tree's edges along their motion (see ``edge_curves``), nodes and the root.
+
+    Args:
+        env: The ``Environment`` (obstacles and workspace).
+        nodes: Float (N+1, d), the tree's nodes (root in row 0).
+        parents: Int (N+1,), each node's parent row, -1 for the root.
+        dynamics: The ``LinearTrackingDynamics`` the edges follow, or None for straight segments.
+        ax: Matplotlib axes to draw on; None (default) for a new figure.
+        edge_color: Colour of the edges and nodes (default ``"tab:blue"``).
+
+    Returns:
+        The axes.
+    """
     from matplotlib.collections import LineCollection
 
     ax = plot_environment(env, ax)
@@ -86,7 +136,21 @@ def plot_tree(env: Environment, result: PlanResult, ax: Axes | None = None,
               dynamics: LinearTrackingDynamics | None = None, edge_color: str = "tab:blue",
               path_color: str = "tab:red", title: str | None = None) -> Axes:
     """Obstacles, tree edges along the motion the plan's predicate used (``dynamics`` overrides
-    what ``result.settings`` records), the path, the start and the goal ball."""
+    what ``result.settings`` records), the path, the start and the goal ball.
+
+    Args:
+        env: The ``Environment`` the plan ran in.
+        result: The ``PlanResult`` to draw.
+        ax: Matplotlib axes to draw on; None (default) for a new figure.
+        dynamics: The motion to draw the edges along; None (default) for the one recorded in
+            ``result.settings`` (``plan_dynamics``).
+        edge_color: Colour of the tree (default ``"tab:blue"``).
+        path_color: Colour of the path and the goal ball (default ``"tab:red"``).
+        title: The axes' title; None (default) for the planner, nodes, oracle calls and status.
+
+    Returns:
+        The axes.
+    """
     from matplotlib.collections import LineCollection
     from matplotlib.patches import Circle
 

@@ -32,22 +32,73 @@ REQUIRED_MEMBERS = ("reachable", "dim", "name", "describe")
 
 @runtime_checkable
 class ReachabilityPredicate(Protocol):
-    """Batch motion validator (see the module docstring)."""
+    """Batch motion validator (see the module docstring).
+
+    The question the paper's oracle answers for every database entry (Alg. 2 / 3: the phase oracle
+    marks the entries whose child is reachable from its parent; the finalizer asks it once more).
+    Any object with ``dim``, ``name``, ``reachable`` and ``describe`` is one (a structural
+    ``typing.Protocol``, checkable with ``isinstance``); planners pass it around without asking
+    its class.
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits import ReachabilityPredicate
+        >>> class ShortHops:
+        ...     dim = 2
+        ...     name = "short-hops"
+        ...     def reachable(self, parents, children):
+        ...         return np.linalg.norm(children - parents, axis=1) <= 1.0
+        ...     def describe(self):
+        ...         return {"max_hop": 1.0}
+        >>> isinstance(ShortHops(), ReachabilityPredicate)
+        True
+        >>> ShortHops().reachable(np.zeros((2, 2)), np.array([[0.5, 0.5], [2.0, 0.0]])).tolist()
+        [True, False]
+    """
 
     @property
-    def dim(self) -> int: ...
+    def dim(self) -> int:
+        """d, the dimension of the states."""
+        ...
 
     @property
-    def name(self) -> str: ...
+    def name(self) -> str:
+        """A short name recorded in every result."""
+        ...
 
-    def reachable(self, parents: np.ndarray, children: np.ndarray) -> np.ndarray: ...
+    def reachable(self, parents: np.ndarray, children: np.ndarray) -> np.ndarray:
+        """Whether the robot can move from each parent to its child without collision.
 
-    def describe(self) -> dict: ...
+        Args:
+            parents: Float (M, d) start points.
+            children: Float (M, d) targets.
+
+        Returns:
+            Bool array (M,).
+        """
+        ...
+
+    def describe(self) -> dict:
+        """The settings that fix the answers, JSON-able (``"dynamics"`` for closed-loop motion)."""
+        ...
 
 
 def check_predicate(predicate: Any, dim: int, name: str = "predicate") -> ReachabilityPredicate:
     """Return ``predicate`` if it implements the protocol in dimension ``dim``; else raise a
-    ``TypeError`` naming the missing members or a ``ValueError`` naming the dimension mismatch."""
+    ``TypeError`` naming the missing members or a ``ValueError`` naming the dimension mismatch.
+
+    Args:
+        predicate: The object to check.
+        dim: The environment's dimension d.
+        name: The argument's name for the error messages (default ``"predicate"``).
+
+    Returns:
+        ``predicate`` itself.
+
+    Raises:
+        TypeError: A member of ``REQUIRED_MEMBERS`` is missing.
+        ValueError: ``predicate.dim != dim``.
+    """
     missing = [member for member in REQUIRED_MEMBERS if not hasattr(predicate, member)]
     if missing:
         raise TypeError(
@@ -63,7 +114,20 @@ def as_pairs(parents: np.ndarray, children: np.ndarray, dim: int) -> tuple[np.nd
     """Validate and broadcast a batch of pairs to two C-contiguous float arrays of shape (M, d).
 
     A single parent (shape (d,) or (1, d)) is broadcast against M children. Non-finite
-    coordinates are refused."""
+    coordinates are refused.
+
+    Args:
+        parents: Float (M, d), (1, d) or (d,).
+        children: Float (M, d) or (d,).
+        dim: d.
+
+    Returns:
+        (parents, children), both C-contiguous float (M, d).
+
+    Raises:
+        ValueError: A last axis other than d, more than 2 axes, different M (other than a single
+            parent), or a non-finite coordinate.
+    """
     parents = np.ascontiguousarray(parents, dtype=float)
     children = np.ascontiguousarray(children, dtype=float)
     if parents.ndim == 1:
@@ -84,6 +148,14 @@ def as_pairs(parents: np.ndarray, children: np.ndarray, dim: int) -> tuple[np.nd
 
 
 def can_leave(predicate: ReachabilityPredicate, point: np.ndarray) -> bool:
-    """The predicate's own ``can_leave(point)`` if it has one, else True (not decidable)."""
+    """The predicate's own ``can_leave(point)`` if it has one, else True (not decidable).
+
+    Args:
+        predicate: Any ``ReachabilityPredicate``.
+        point: Float (d,), a candidate start.
+
+    Returns:
+        False only where the predicate is certain to reject every motion from ``point``.
+    """
     method = getattr(predicate, "can_leave", None)
     return True if method is None else bool(method(point))

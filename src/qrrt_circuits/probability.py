@@ -29,7 +29,23 @@ def _marked(num_items, num_marked) -> tuple[int, int]:
 
 
 def harmonic(k: int) -> float:
-    """H_k = 1 + 1/2 + ... + 1/k (H_0 = 0)."""
+    """H_k = 1 + 1/2 + ... + 1/k (H_0 = 0): the harmonic number of Lemmas 3 and 6.
+
+    Args:
+        k: An integer >= 0.
+
+    Returns:
+        H_k, summed with ``math.fsum``.
+
+    Raises:
+        TypeError: A non-integer k.
+        ValueError: k < 0.
+
+    Example:
+        >>> from qrrt_circuits.probability import harmonic
+        >>> harmonic(3)  # 1 + 1/2 + 1/3
+        1.8333333333333333
+    """
     return math.fsum(1.0 / i for i in range(1, _count(k, "k") + 1))
 
 

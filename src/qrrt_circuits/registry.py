@@ -21,7 +21,25 @@ from typing import Any
 @dataclass(frozen=True)
 class Entry:
     """One named choice: ``factory(**options)`` builds it (``factory(value, **options)`` for a
-    parametric entry written ``name:VALUE``)."""
+    parametric entry written ``name:VALUE``).
+
+    Args:
+        name: The canonical name (``"qrrt"``, ``"fixed"``, ...).
+        factory: The callable that builds the object.
+        help: One line for the CLI's help.
+        aliases: Other names that resolve to this entry (0.1's class names, ...).
+        parameter: The parameter's placeholder for a parametric entry (``"K"`` for ``fixed:K``), or
+            None.
+        tags: Free labels (``"classical"``, ``"quantum"``, ``"parallel"``).
+        parameter_optional: Whether the parameter may be left out (``fixed-point`` or
+            ``fixed-point:0.3``); the factory then gets None.
+
+    Example:
+        >>> from qrrt_circuits.registry import POLICIES
+        >>> entry = POLICIES.resolve("fixed-point:0.3")
+        >>> entry.name, entry.label, entry.accepts(None)
+        ('fixed-point', 'fixed-point[:DELTA]', True)
+    """
 
     name: str
     factory: Callable[..., Any]
@@ -29,23 +47,39 @@ class Entry:
     aliases: tuple[str, ...] = ()
     parameter: str | None = None  # e.g. "K" for "fixed:K"
     tags: frozenset[str] = field(default_factory=frozenset)
-    #: the parameter may be left out (``fixed-point`` or ``fixed-point:0.3``); the factory gets None
     parameter_optional: bool = False
 
     @property
     def label(self) -> str:
+        """The name as a user types it: ``name``, ``name:PARAM`` or ``name[:PARAM]`` (optional)."""
         if self.parameter is None:
             return self.name
         return f"{self.name}[:{self.parameter}]" if self.parameter_optional else f"{self.name}:{self.parameter}"
 
     def accepts(self, value: str | None) -> bool:
-        """Whether ``name:VALUE`` (or the bare name, for value None) is this entry's form."""
+        """Whether ``name:VALUE`` (or the bare name, for value None) is this entry's form.
+
+        Args:
+            value: The text after the colon, or None for the bare name.
+
+        Returns:
+            True for a bare name of a plain entry, a value for a parametric one, or a bare name of
+            an entry whose parameter is optional.
+        """
         if self.parameter is None:
             return value is None
         return value is not None or self.parameter_optional
 
     def options(self) -> frozenset[str]:
-        """The keyword options the factory accepts."""
+        """The keyword options the factory accepts.
+
+        Returns:
+            The names of the factory's keyword (or positional-or-keyword) parameters, looking
+            through ``functools.partial``.
+
+        Raises:
+            ValueError: A factory without an inspectable signature (a builtin type).
+        """
         target = self.factory
         while isinstance(target, functools.partial):
             target = target.func
@@ -54,7 +88,31 @@ class Entry:
 
 
 class Registry:
-    """Named factories of one kind (``kind`` is used in error messages: "planner", ...)."""
+    """Named factories of one kind (``kind`` is used in error messages: "planner", ...).
+
+    The module's registries are ``PLANNERS``, ``BACKENDS``, ``POLICIES``, ``SCENARIOS`` and
+    ``PREDICATES``; the CLI, the experiments, the benchmarks and the tests build objects through
+    them, so a name means the same thing everywhere. An unknown name is refused with the list of
+    choices.
+
+    Args:
+        kind: What the entries are, for error messages (``"planner"``, ``"search policy"``, ...).
+
+    Example:
+        >>> from qrrt_circuits.registry import PLANNERS, POLICIES
+        >>> PLANNERS.names()
+        ('rrt', 'prrt', 'qrrt', 'pqrrt', 'pqrrt-unshared')
+        >>> PLANNERS.canonical("PQRRT"), "qrrt" in PLANNERS, "astar" in PLANNERS
+        ('pqrrt', True, False)
+        >>> POLICIES.labels()
+        ('paper', 'optimal', 'bbht', 'adaptive', 'fixed:K', 'fixed-point[:DELTA]', 'estimated')
+        >>> POLICIES.create("fixed:2")
+        FixedIterations(k=2)
+        >>> PLANNERS.resolve("astar")
+        Traceback (most recent call last):
+        ...
+        ValueError: unknown planner 'astar'; choose one of rrt, prrt, qrrt, pqrrt, pqrrt-unshared
+    """
 
     def __init__(self, kind: str) -> None:
         self.kind = kind
@@ -64,6 +122,24 @@ class Registry:
     def register(self, name: str, factory: Callable[..., Any], help: str, *, aliases: tuple[str, ...] = (),
                  parameter: str | None = None, tags: tuple[str, ...] = (),
                  parameter_optional: bool = False) -> Entry:
+        """Add a named factory.
+
+        Args:
+            name: The canonical name.
+            factory: Builds the object: ``factory(**options)``, or ``factory(value, **options)``
+                for a parametric entry.
+            help: One line for the CLI's help.
+            aliases: Other names for the same entry.
+            parameter: The parameter's placeholder (``"K"``) for an entry written ``name:VALUE``.
+            tags: Free labels.
+            parameter_optional: Whether the bare name is accepted too (the factory gets None).
+
+        Returns:
+            The new ``Entry``.
+
+        Raises:
+            ValueError: ``name`` or an alias already registered.
+        """
         entry = Entry(name, factory, help, tuple(aliases), parameter, frozenset(tags), parameter_optional)
         for key in (name, *aliases):
             if key in self._lookup:
@@ -100,8 +176,18 @@ class Registry:
         return base, (value if _ else None)
 
     def resolve(self, name: str) -> Entry:
-        """The entry for ``name`` (canonical, alias, or ``name:VALUE``); ValueError listing the
-        choices if there is none."""
+        """The entry for ``name`` (canonical, alias, or ``name:VALUE``).
+
+        Args:
+            name: A canonical name, an alias, or ``name:VALUE`` for a parametric entry.
+
+        Returns:
+            The ``Entry``.
+
+        Raises:
+            TypeError: ``name`` is not a string.
+            ValueError: No entry has that name or form (the message lists the choices).
+        """
         base, value = self._split(name)
         key = self._lookup.get(base)
         entry = None if key is None else self._entries[key]
@@ -110,14 +196,39 @@ class Registry:
         return entry
 
     def canonical(self, name: str) -> str:
-        """The canonical spelling of ``name`` (aliases resolved, a parameter kept)."""
+        """The canonical spelling of ``name`` (aliases resolved, a parameter kept).
+
+        Args:
+            name: A canonical name, an alias, or ``name:VALUE``.
+
+        Returns:
+            ``entry.name``, or ``entry.name:VALUE`` for a parametric entry.
+
+        Raises:
+            TypeError: ``name`` is not a string.
+            ValueError: An unknown name.
+        """
         entry = self.resolve(name)
         _, value = self._split(name)
         return entry.name if value is None else f"{entry.name}:{value}"
 
     def create(self, name: str, /, **options: Any) -> Any:
         """Build the object ``name`` stands for, with ``options``; an option the entry does not
-        take is refused (use ``applicable`` to keep only the ones that apply)."""
+        take is refused (use ``applicable`` to keep only the ones that apply).
+
+        Args:
+            name: A canonical name, an alias, or ``name:VALUE`` (the value is passed to the factory
+                as text).
+            **options: Keyword arguments for the factory.
+
+        Returns:
+            What the factory returns (a planner, backend, policy, ``Environment`` or predicate).
+
+        Raises:
+            TypeError: ``name`` is not a string.
+            ValueError: An unknown name, an option the entry does not take, or a parameter that is
+                not a number; the factory's own ``ValueError`` / ``TypeError`` for a bad option.
+        """
         entry = self.resolve(name)
         unknown = set(options) - entry.options()
         if unknown:
@@ -129,12 +240,33 @@ class Registry:
         return entry.factory(**options)
 
     def applicable(self, name: str, options: dict[str, Any]) -> dict[str, Any]:
-        """The subset of ``options`` that ``name`` takes."""
+        """The subset of ``options`` that ``name`` takes.
+
+        Args:
+            name: A canonical name, an alias, or ``name:VALUE``.
+            options: Candidate keyword options.
+
+        Returns:
+            A new dict with only the options the entry's factory accepts.
+
+        Raises:
+            TypeError: ``name`` is not a string.
+            ValueError: An unknown name.
+
+        Example:
+            >>> from qrrt_circuits.registry import BACKENDS
+            >>> BACKENDS.applicable("statevector", {"seed": 1, "method": "statevector"})
+            {'seed': 1}
+        """
         accepted = self.resolve(name).options()
         return {key: value for key, value in options.items() if key in accepted}
 
     def help_text(self) -> str:
-        """``name: help`` for every entry (CLI help)."""
+        """``label: help`` for every entry, joined by ``"; "`` (CLI help).
+
+        Returns:
+            One line of text.
+        """
         return "; ".join(f"{entry.label}: {entry.help}" for entry in self._entries.values())
 
 

@@ -258,7 +258,26 @@ SCENARIOS: dict[str, Callable[..., Environment]] = {
 
 
 def by_name(name: str, seed: int | None = 0) -> Environment:
-    """Build a scenario from its name (one of ``SCENARIOS``)."""
+    """Build a scenario from its name (one of ``SCENARIOS``).
+
+    Args:
+        name: ``"paper_clutter"``, ``"narrow_corridor"``, ``"annealing_field"`` or ``"lattice"``.
+        seed: Non-negative integer (same seed, same world; default 0) or None (fresh entropy).
+
+    Returns:
+        The ``Environment``.
+
+    Raises:
+        ValueError: An unknown ``name`` or a negative ``seed``.
+        TypeError: A non-integer ``seed``.
+        RuntimeError: The scenario could not place its start and goal (see each scenario).
+
+    Example:
+        >>> from qrrt_circuits import scenarios
+        >>> env = scenarios.by_name("narrow_corridor")
+        >>> env.name, env.dim, env.goal_radius
+        ('narrow_corridor', 2, 0.75)
+    """
     if name not in SCENARIOS:
         raise ValueError(f"unknown scenario {name!r}; choose one of {sorted(SCENARIOS)}")
     return SCENARIOS[name](seed=seed)

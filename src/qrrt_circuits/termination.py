@@ -34,7 +34,16 @@ class PlanStatus(StrEnum):
     """Why a plan ended: the goal was reached, or the name of the condition that ended it.
 
     A ``StrEnum``: ``result.status == "reached"`` works, and it is written to JSON and CSV as its
-    value.
+    value. ``REACHED`` is the goal; each other member is the status of one condition
+    (``MaxOracleCalls``, ``MaxCriticalPathCalls``, ``MaxNodes``, ``MaxRounds``, ``MaxWallTime``,
+    ``Stall``).
+
+    Example:
+        >>> from qrrt_circuits.termination import PlanStatus
+        >>> PlanStatus.MAX_NODES == "max_nodes", str(PlanStatus.STALLED)
+        (True, 'stalled')
+        >>> PlanStatus("reached").reached
+        True
     """
 
     REACHED = "reached"
@@ -47,12 +56,23 @@ class PlanStatus(StrEnum):
 
     @property
     def reached(self) -> bool:
+        """Whether this is ``REACHED`` (the goal was reached)."""
         return self is PlanStatus.REACHED
 
 
 @dataclass(frozen=True)
 class Progress:
-    """What the conditions may look at: the plan's counters before the next round."""
+    """What the conditions may look at: the plan's counters before the next round.
+
+    Args:
+        oracle_calls: Oracle calls so far (quantum + verification, DESIGN §2).
+        critical_path_oracle_calls: Critical-path oracle calls so far (per round the largest count
+            of one worker).
+        nodes: Nodes in the tree, root excluded.
+        rounds: Rounds run so far.
+        rounds_without_new_node: Consecutive rounds, up to now, that added no node.
+        elapsed_s: Wall-clock seconds since the plan started.
+    """
 
     oracle_calls: int
     critical_path_oracle_calls: int
@@ -63,15 +83,44 @@ class Progress:
 
 
 class TerminationCondition(abc.ABC):
-    """Decides, before each round, whether the plan ends; ``a | b`` combines two."""
+    """Decides, before each round, whether the plan ends; ``a | b`` combines two.
+
+    Modelled on OMPL's ``PlannerTerminationCondition``. A subclass implements ``ended_by`` (the
+    ``PlanStatus`` it ends the plan with, or None) and ``describe`` (its JSON-able settings).
+    ``a | b`` is ``AnyOf((a, b))``: the plan ends as soon as either ends it, and the first one in
+    order that does names the status.
+
+    Example:
+        >>> from qrrt_circuits.termination import MaxNodes, MaxOracleCalls, Progress
+        >>> condition = MaxOracleCalls(1000) | MaxNodes(50)
+        >>> condition
+        AnyOf(conditions=(MaxOracleCalls(limit=1000), MaxNodes(limit=50)))
+        >>> condition.describe()
+        {'max_oracle_calls': 1000, 'max_nodes': 50}
+        >>> progress = Progress(oracle_calls=1200, critical_path_oracle_calls=300, nodes=10,
+        ...                     rounds=40, rounds_without_new_node=0, elapsed_s=1.0)
+        >>> condition.ended_by(progress)
+        <PlanStatus.MAX_ORACLE_CALLS: 'max_oracle_calls'>
+    """
 
     @abc.abstractmethod
     def ended_by(self, progress: Progress) -> PlanStatus | None:
-        """The status if this condition ends the plan now, else None."""
+        """The status if this condition ends the plan now, else None.
+
+        Args:
+            progress: The plan's counters before the next round.
+
+        Returns:
+            The ``PlanStatus`` naming this condition if it ends the plan, else None.
+        """
 
     @abc.abstractmethod
     def describe(self) -> dict:
-        """The condition as JSON-able settings (recorded in ``PlanResult.settings``)."""
+        """The condition as JSON-able settings (recorded in ``PlanResult.settings``).
+
+        Returns:
+            A dict from the condition's name (``"max_nodes"``, ``"stall_rounds"``, ...) to its limit.
+        """
 
     @property
     def limits_rounds(self) -> bool:
@@ -84,6 +133,7 @@ class TerminationCondition(abc.ABC):
         return False
 
     def __or__(self, other: TerminationCondition) -> AnyOf:
+        """``AnyOf((self, other))``: ends the plan when either does (nested ``AnyOf`` flattened)."""
         if not isinstance(other, TerminationCondition):
             return NotImplemented
         return AnyOf((self, other))
@@ -109,7 +159,23 @@ class _Limit(TerminationCondition):
 
 @dataclass(frozen=True)
 class MaxOracleCalls(_Limit):
-    """Ends the plan once ``oracle_calls`` (quantum + verification) reach ``limit``."""
+    """Ends the plan once ``oracle_calls`` (quantum + verification) reach ``limit``.
+
+    Status ``PlanStatus.MAX_ORACLE_CALLS``. Checked before each round, so the last round may
+    overshoot ``limit`` by less than one round's cost.
+
+    Args:
+        limit: The oracle-call budget (DESIGN §2 counting), an integer >= 1.
+
+    Raises:
+        TypeError: A non-integer ``limit``.
+        ValueError: ``limit`` < 1.
+
+    Example:
+        >>> from qrrt_circuits.termination import MaxOracleCalls
+        >>> MaxOracleCalls(500).describe()
+        {'max_oracle_calls': 500}
+    """
 
     status = PlanStatus.MAX_ORACLE_CALLS
 
@@ -120,7 +186,17 @@ class MaxOracleCalls(_Limit):
 @dataclass(frozen=True)
 class MaxCriticalPathCalls(_Limit):
     """Ends the plan once the critical-path oracle calls (per round the largest count of one
-    worker: the time of p parallel quantum devices) reach ``limit``."""
+    worker: the time of p parallel quantum devices) reach ``limit``.
+
+    Status ``PlanStatus.MAX_CRITICAL_PATH_CALLS``.
+
+    Args:
+        limit: The critical-path oracle-call budget, an integer >= 1.
+
+    Raises:
+        TypeError: A non-integer ``limit``.
+        ValueError: ``limit`` < 1.
+    """
 
     status = PlanStatus.MAX_CRITICAL_PATH_CALLS
 
@@ -130,7 +206,18 @@ class MaxCriticalPathCalls(_Limit):
 
 @dataclass(frozen=True)
 class MaxNodes(_Limit):
-    """Ends the plan once the tree holds ``limit`` nodes (root excluded)."""
+    """Ends the plan once the tree holds ``limit`` nodes (root excluded).
+
+    Status ``PlanStatus.MAX_NODES``. A round of p workers may add up to p nodes, so the tree may end
+    with up to p - 1 nodes more than ``limit``.
+
+    Args:
+        limit: The node budget, an integer >= 1.
+
+    Raises:
+        TypeError: A non-integer ``limit``.
+        ValueError: ``limit`` < 1.
+    """
 
     status = PlanStatus.MAX_NODES
 
@@ -140,7 +227,18 @@ class MaxNodes(_Limit):
 
 @dataclass(frozen=True)
 class MaxRounds(_Limit):
-    """Ends the plan after ``limit`` rounds."""
+    """Ends the plan after ``limit`` rounds.
+
+    Status ``PlanStatus.MAX_ROUNDS``; it bounds the number of rounds (``limits_rounds`` is True), so
+    ``with_defaults`` adds no other round limit.
+
+    Args:
+        limit: The round budget, an integer >= 1.
+
+    Raises:
+        TypeError: A non-integer ``limit``.
+        ValueError: ``limit`` < 1.
+    """
 
     status = PlanStatus.MAX_ROUNDS
 
@@ -149,12 +247,30 @@ class MaxRounds(_Limit):
 
     @property
     def limits_rounds(self) -> bool:
+        """True: a round limit."""
         return True
 
 
 @dataclass(frozen=True)
 class Stall(_Limit):
-    """Ends the plan when ``limit`` consecutive rounds added no node."""
+    """Ends the plan when ``limit`` consecutive rounds added no node.
+
+    Status ``PlanStatus.STALLED``; described as ``{"stall_rounds": limit}``.
+
+    Args:
+        limit: Consecutive rounds without a new node that end the plan, an integer >= 1.
+
+    Raises:
+        TypeError: A non-integer ``limit``.
+        ValueError: ``limit`` < 1.
+
+    Example:
+        >>> from qrrt_circuits.termination import Progress, Stall
+        >>> stuck = Progress(oracle_calls=0, critical_path_oracle_calls=0, nodes=0, rounds=5,
+        ...                  rounds_without_new_node=3, elapsed_s=0.0)
+        >>> Stall(3).ended_by(stuck)
+        <PlanStatus.STALLED: 'stalled'>
+    """
 
     status = PlanStatus.STALLED
 
@@ -166,13 +282,24 @@ class Stall(_Limit):
 
     @property
     def detects_stall(self) -> bool:
+        """True: a stall limit."""
         return True
 
 
 @dataclass(frozen=True)
 class MaxWallTime(TerminationCondition):
     """Ends the plan once ``seconds`` of wall-clock time have passed (not reproducible: prefer
-    the other conditions in experiments and tests)."""
+    the other conditions in experiments and tests).
+
+    Status ``PlanStatus.MAX_TIME``; described as ``{"max_time_s": seconds}``.
+
+    Args:
+        seconds: The wall-clock budget in seconds, a finite real number > 0.
+
+    Raises:
+        TypeError: A non-real ``seconds``.
+        ValueError: ``seconds`` not finite or not > 0.
+    """
 
     seconds: float
 
@@ -188,7 +315,24 @@ class MaxWallTime(TerminationCondition):
 
 @dataclass(frozen=True)
 class AnyOf(TerminationCondition):
-    """Ends the plan when any of ``conditions`` does; the first one (in order) names the status."""
+    """Ends the plan when any of ``conditions`` does; the first one (in order) names the status.
+
+    What ``a | b`` builds (OMPL's ``plannerOrTerminationCondition``). Nested ``AnyOf`` are
+    flattened; ``describe`` merges the parts' settings; ``limits_rounds`` and ``detects_stall`` hold
+    if they hold for any part.
+
+    Args:
+        conditions: The ``TerminationCondition`` objects, at least one.
+
+    Raises:
+        TypeError: An element that is not a ``TerminationCondition``.
+        ValueError: No condition.
+
+    Example:
+        >>> from qrrt_circuits.termination import AnyOf, MaxNodes, MaxRounds, Stall
+        >>> AnyOf((MaxNodes(50) | MaxRounds(100), Stall(10))).conditions
+        (MaxNodes(limit=50), MaxRounds(limit=100), Stall(limit=10))
+    """
 
     conditions: tuple[TerminationCondition, ...]
 
@@ -217,10 +361,12 @@ class AnyOf(TerminationCondition):
 
     @property
     def limits_rounds(self) -> bool:
+        """Whether any part limits rounds."""
         return any(condition.limits_rounds for condition in self.conditions)
 
     @property
     def detects_stall(self) -> bool:
+        """Whether any part detects a stall."""
         return any(condition.detects_stall for condition in self.conditions)
 
 
@@ -228,7 +374,31 @@ def from_budgets(max_oracle_calls: int | None = None, max_nodes: int | None = No
                  max_rounds: int | None = None, max_time_s: float | None = None,
                  max_critical_path_calls: int | None = None,
                  stall_rounds: int | None = None) -> TerminationCondition | None:
-    """The condition the ``plan()`` keyword shorthands stand for (None if none is given)."""
+    """The condition the ``plan()`` keyword shorthands stand for (None if none is given).
+
+    Args:
+        max_oracle_calls: ``MaxOracleCalls`` limit (integer >= 1) or None.
+        max_nodes: ``MaxNodes`` limit (integer >= 1) or None.
+        max_rounds: ``MaxRounds`` limit (integer >= 1) or None.
+        max_time_s: ``MaxWallTime`` seconds (finite, > 0) or None.
+        max_critical_path_calls: ``MaxCriticalPathCalls`` limit (integer >= 1) or None.
+        stall_rounds: ``Stall`` limit (integer >= 1) or None.
+
+    Returns:
+        None if every argument is None, the one condition if one is given, else their ``AnyOf``
+        (in the order oracle calls, critical path, nodes, rounds, stall, time).
+
+    Raises:
+        TypeError: A non-integer count or a non-real ``max_time_s``.
+        ValueError: A count < 1, or a ``max_time_s`` that is not finite and > 0.
+
+    Example:
+        >>> from qrrt_circuits.termination import from_budgets
+        >>> from_budgets(max_nodes=50, max_rounds=100)
+        AnyOf(conditions=(MaxNodes(limit=50), MaxRounds(limit=100)))
+        >>> from_budgets() is None
+        True
+    """
     parts: list[TerminationCondition] = []
     if max_oracle_calls is not None:
         parts.append(MaxOracleCalls(check_int(max_oracle_calls, "max_oracle_calls", 1)))
@@ -251,7 +421,26 @@ def with_defaults(condition: TerminationCondition | None, default_max_rounds: in
                   default_stall_rounds: int | None = None) -> TerminationCondition:
     """``condition`` with ``MaxRounds(DEFAULT_MAX_ROUNDS)`` added unless it already limits rounds,
     and ``Stall(DEFAULT_STALL_ROUNDS)`` unless it already has a stall condition: the guarantee
-    that every plan ends, and soon when it cannot grow."""
+    that every plan ends, and soon when it cannot grow.
+
+    Args:
+        condition: The caller's condition, or None.
+        default_max_rounds: The round limit to add; None means ``DEFAULT_MAX_ROUNDS``.
+        default_stall_rounds: The stall limit to add; None means ``DEFAULT_STALL_ROUNDS``.
+
+    Returns:
+        ``condition`` itself if it already limits rounds and detects a stall, else an ``AnyOf`` with
+        the missing defaults appended.
+
+    Raises:
+        TypeError: A non-integer default that has to be added.
+        ValueError: A default < 1 that has to be added.
+
+    Example:
+        >>> from qrrt_circuits.termination import MaxNodes, with_defaults
+        >>> with_defaults(MaxNodes(50))
+        AnyOf(conditions=(MaxNodes(limit=50), MaxRounds(limit=20000), Stall(limit=5000)))
+    """
     rounds = DEFAULT_MAX_ROUNDS if default_max_rounds is None else default_max_rounds
     stall = DEFAULT_STALL_ROUNDS if default_stall_rounds is None else default_stall_rounds
     parts = [] if condition is None else [condition]
@@ -264,7 +453,25 @@ def with_defaults(condition: TerminationCondition | None, default_max_rounds: in
 
 def with_round_limit(condition: TerminationCondition | None,
                      default_max_rounds: int = DEFAULT_MAX_ROUNDS) -> TerminationCondition:
-    """``condition`` with ``MaxRounds(default_max_rounds)`` added unless it already limits rounds."""
+    """``condition`` with ``MaxRounds(default_max_rounds)`` added unless it already limits rounds.
+
+    Args:
+        condition: The caller's condition, or None.
+        default_max_rounds: The round limit to add (default ``DEFAULT_MAX_ROUNDS``).
+
+    Returns:
+        ``MaxRounds(default_max_rounds)`` for None, ``condition`` if it limits rounds, else
+        ``condition | MaxRounds(default_max_rounds)``.
+
+    Raises:
+        TypeError: A non-integer ``default_max_rounds`` that has to be added.
+        ValueError: A ``default_max_rounds`` < 1 that has to be added.
+
+    Example:
+        >>> from qrrt_circuits.termination import MaxNodes, with_round_limit
+        >>> with_round_limit(MaxNodes(50), 100)
+        AnyOf(conditions=(MaxNodes(limit=50), MaxRounds(limit=100)))
+    """
     if condition is None:
         return MaxRounds(default_max_rounds)
     if condition.limits_rounds:

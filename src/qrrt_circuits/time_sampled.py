@@ -36,6 +36,16 @@ class TimeSampledCheck:
     Raises:
         ValueError: A dynamics dimension other than ``env.dim``, or K out of range.
         TypeError: A non-integer K.
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits import Environment, ReachabilityOracle, TimeSampledCheck
+        >>> env = Environment([[0, 10], [0, 10]], [[[5, 0], [5.01, 10]]])  # a thin wall
+        >>> parent, child = np.array([[2.0, 5.0]]), np.array([[8.0, 5.0]])
+        >>> TimeSampledCheck(env, time_samples=50).reachable(parent, child).tolist()  # stepped over
+        [True]
+        >>> ReachabilityOracle(env).reachable(parent, child).tolist()
+        [False]
     """
 
     name = "time-samples"
@@ -54,6 +64,7 @@ class TimeSampledCheck:
 
     @property
     def dim(self) -> int:
+        """d, the environment's dimension."""
         return self.env.dim
 
     def describe(self) -> dict:

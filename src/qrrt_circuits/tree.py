@@ -23,7 +23,24 @@ _MAX_CELLS = 1 << 22
 
 
 class Tree:
-    """Growable arrays of node positions and parent indices; node 0 is the root."""
+    """Growable arrays of node positions and parent indices; node 0 is the root.
+
+    The tree T of the paper's Alg. 1-4, with the exact nearest-node query of Alg. 1 line 6 (see the
+    module docstring for the grid).
+
+    Args:
+        root: Float (d,), the root's position.
+        capacity: Initial room for nodes (grown by doubling; default 256).
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits.tree import Tree
+        >>> tree = Tree(np.array([0.0, 0.0]))
+        >>> tree.add(np.array([2.0, 0.0]), parent=0), tree.add(np.array([2.0, 2.0]), parent=1)
+        (1, 2)
+        >>> tree.nearest(np.array([[1.9, 1.5], [0.2, -0.1]])).tolist(), tree.parents.tolist()
+        ([2, 0], [-1, 0, 1])
+    """
 
     def __init__(self, root: np.ndarray, capacity: int = 256) -> None:
         root = np.asarray(root, dtype=float)
@@ -38,13 +55,24 @@ class Tree:
 
     @property
     def nodes(self) -> np.ndarray:
+        """Float (size, d) view of the node positions, root in row 0."""
         return self._nodes[: self.size]
 
     @property
     def parents(self) -> np.ndarray:
+        """Int (size,) view of the parent indices, -1 for the root."""
         return self._parents[: self.size]
 
     def add(self, position: np.ndarray, parent: int) -> int:
+        """Append a node (amortized O(1); the grid is rebuilt when the tree doubles).
+
+        Args:
+            position: Float (d,), the new node.
+            parent: Index of its parent node (unvalidated).
+
+        Returns:
+            The new node's index.
+        """
         if self.size == self._nodes.shape[0]:
             self._nodes = np.concatenate([self._nodes, np.empty_like(self._nodes)])
             self._parents = np.concatenate([self._parents, np.empty_like(self._parents)])
@@ -61,7 +89,16 @@ class Tree:
         return index
 
     def nearest(self, points: np.ndarray) -> np.ndarray:
-        """Index of the nearest node (Euclidean) to each of ``points`` (M, d)."""
+        """Index of the nearest node (Euclidean) to each of ``points`` (M, d).
+
+        Exact; among equally near nodes the lowest index.
+
+        Args:
+            points: Float (M, d) or (d,).
+
+        Returns:
+            Int array (M,) of node indices.
+        """
         points = np.ascontiguousarray(np.atleast_2d(points), dtype=float)
         out = np.empty(points.shape[0], dtype=np.int64)
         _grid_nearest(points, self._nodes, self._next, self._head, self._origin, self._cell, self._shape,

@@ -26,7 +26,30 @@ def _range_text(minimum: float | None, maximum: float | None) -> str:
 
 
 def check_int(value: Any, name: str, minimum: int | None = 0, maximum: int | None = None) -> int:
-    """An integer (Python or numpy, not ``bool``, not a float) within [minimum, maximum]."""
+    """An integer (Python or numpy, not ``bool``, not a float) within [minimum, maximum].
+
+    Args:
+        value: The value to check.
+        name: The argument's name for the error message.
+        minimum: Smallest accepted value (default 0), or None for no bound.
+        maximum: Largest accepted value (default None: no bound).
+
+    Returns:
+        ``value`` as a Python ``int``.
+
+    Raises:
+        TypeError: Not an integer (a ``bool`` or a float included).
+        ValueError: Outside [minimum, maximum].
+
+    Example:
+        >>> from qrrt_circuits.validation import check_int
+        >>> check_int(3, "workers", 1)
+        3
+        >>> check_int(0, "workers", 1)
+        Traceback (most recent call last):
+        ...
+        ValueError: workers must be an integer >= 1, got 0
+    """
     if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Integral):
         raise TypeError(f"{name} must be an integer {_range_text(minimum, maximum)}, got {value!r}")
     value = int(value)
@@ -36,13 +59,43 @@ def check_int(value: Any, name: str, minimum: int | None = 0, maximum: int | Non
 
 
 def check_optional_int(value: Any, name: str, minimum: int | None = 0, maximum: int | None = None) -> int | None:
+    """None, or ``check_int(value, name, minimum, maximum)``.
+
+    Args:
+        value: The value to check.
+        name: The argument's name for the error message.
+        minimum: Smallest accepted value (default 0), or None.
+        maximum: Largest accepted value, or None (default).
+
+    Returns:
+        None, or ``value`` as a Python ``int``.
+
+    Raises:
+        TypeError: Neither None nor an integer.
+        ValueError: Outside [minimum, maximum].
+    """
     return None if value is None else check_int(value, name, minimum, maximum)
 
 
 def check_float(value: Any, name: str, minimum: float | None = None, maximum: float | None = None,
                 open_minimum: bool = False) -> float:
     """A finite real number (not ``bool``, not complex) within the range; ``open_minimum`` excludes
-    the minimum itself."""
+    the minimum itself.
+
+    Args:
+        value: The value to check.
+        name: The argument's name for the error message.
+        minimum: Lower bound, or None (default).
+        maximum: Upper bound, or None (default).
+        open_minimum: Whether the minimum itself is refused (default False).
+
+    Returns:
+        ``value`` as a Python ``float``.
+
+    Raises:
+        TypeError: Not a real number (a ``bool`` or a complex included).
+        ValueError: Not finite, or outside the range.
+    """
     if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
         raise TypeError(f"{name} must be a real number, got {value!r}")
     value = float(value)
@@ -59,11 +112,36 @@ def check_float(value: Any, name: str, minimum: float | None = None, maximum: fl
 
 
 def check_positive_float(value: Any, name: str) -> float:
+    """A finite real number > 0 (``check_float`` with an open minimum 0).
+
+    Args:
+        value: The value to check.
+        name: The argument's name for the error message.
+
+    Returns:
+        ``value`` as a Python ``float``.
+
+    Raises:
+        TypeError: Not a real number.
+        ValueError: Not finite, or <= 0.
+    """
     return check_float(value, name, 0.0, open_minimum=True)
 
 
 def check_probability(value: Any, name: str) -> float:
-    """A probability: a finite real number in [0, 1]."""
+    """A probability: a finite real number in [0, 1].
+
+    Args:
+        value: The value to check.
+        name: The argument's name for the error message.
+
+    Returns:
+        ``value`` as a Python ``float``.
+
+    Raises:
+        TypeError: Not a real number (a ``bool`` included).
+        ValueError: Outside [0, 1] (NaN included).
+    """
     if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
         raise TypeError(f"{name} must be a probability in [0, 1], got {value!r}")
     value = float(value)
@@ -73,23 +151,74 @@ def check_probability(value: Any, name: str) -> float:
 
 
 def check_seed(value: Any, name: str = "seed") -> int | None:
-    """A non-negative integer or None (fresh entropy)."""
+    """A non-negative integer or None (fresh entropy).
+
+    Args:
+        value: The seed.
+        name: The argument's name for the error message (default ``"seed"``).
+
+    Returns:
+        The seed as an ``int``, or None.
+
+    Raises:
+        TypeError: Neither None nor an integer.
+        ValueError: A negative integer.
+    """
     return None if value is None else check_int(value, name, 0)
 
 
 def check_bool(value: Any, name: str) -> bool:
+    """A ``bool`` (or ``numpy.bool_``), not a number standing for one.
+
+    Args:
+        value: The value to check.
+        name: The argument's name for the error message.
+
+    Returns:
+        ``value`` as a Python ``bool``.
+
+    Raises:
+        TypeError: Anything else.
+    """
     if not isinstance(value, bool | np.bool_):
         raise TypeError(f"{name} must be True or False, got {value!r}")
     return bool(value)
 
 
 def check_choice(value: Any, name: str, choices: tuple[str, ...]) -> str:
+    """One of ``choices``.
+
+    Args:
+        value: The value to check.
+        name: The argument's name for the error message.
+        choices: The accepted strings.
+
+    Returns:
+        ``value``.
+
+    Raises:
+        ValueError: Not one of them (the message lists them).
+    """
     if value not in choices:
         raise ValueError(f"{name} must be one of {', '.join(map(repr, choices))}, got {value!r}")
     return value
 
 
 def check_instance(value: Any, name: str, kind: type | tuple[type, ...], what: str) -> Any:
+    """An instance of ``kind``; ``what`` describes it in the message ("an Environment").
+
+    Args:
+        value: The value to check.
+        name: The argument's name for the error message.
+        kind: The accepted type or types.
+        what: The accepted type in words.
+
+    Returns:
+        ``value``.
+
+    Raises:
+        TypeError: Not an instance of ``kind``.
+    """
     if not isinstance(value, kind):
         raise TypeError(f"{name} must be {what}, got {type(value).__name__}")
     return value

@@ -59,6 +59,16 @@ class OMPLMotionPredicate:
     ``ompl.base.RealVectorStateSpace`` (its dimension is ``dim``). It is set up here if it is not
     yet (``si.setup()``, as OMPL's planners do); its validity checker and motion validator are used
     as they are. ``evaluations`` counts the pairs checked through this object.
+
+    Args:
+        space_information: An ``ompl.base.SpaceInformation`` on a ``RealVectorStateSpace``.
+        name: A non-empty short name recorded in every result (default ``"ompl"``).
+
+    Raises:
+        TypeError: ``space_information`` not a ``SpaceInformation``, or an empty or non-string
+            ``name``.
+        ValueError: A state space that is not a ``RealVectorStateSpace``, or one OMPL cannot set up
+            (its bounds unset).
     """
 
     def __init__(self, space_information, name: str = "ompl") -> None:
@@ -88,6 +98,7 @@ class OMPLMotionPredicate:
 
     @property
     def dim(self) -> int:
+        """d, the state space's dimension."""
         return self._dim
 
     def bounds(self) -> np.ndarray:
@@ -125,7 +136,18 @@ class OMPLMotionPredicate:
 
     def reachable(self, parents: np.ndarray, children: np.ndarray) -> np.ndarray:
         """Bool (M,): ``si.checkMotion(parent, child)`` for each pair (a Python loop; see the
-        module docstring). A single parent is broadcast against M children."""
+        module docstring). A single parent is broadcast against M children.
+
+        Args:
+            parents: Float (M, d), (1, d) or (d,).
+            children: Float (M, d) or (d,).
+
+        Returns:
+            Bool array (M,); adds M to ``evaluations``.
+
+        Raises:
+            ValueError: Shapes other than (M, d), different M, or non-finite coordinates.
+        """
         parents, children = as_pairs(parents, children, self._dim)
         si, axes = self.si, range(self._dim)
         parent_state, child_state = si.allocState(), si.allocState()  # owned by Python: no freeState
@@ -146,7 +168,14 @@ class OMPLMotionPredicate:
 def environment_space_information(env: Environment) -> ob.SpaceInformation:
     """An OMPL ``SpaceInformation`` for ``env``: a ``RealVectorStateSpace`` with its bounds and a
     state validity checker that is ``env.is_free`` on one state (motion validation left to OMPL's
-    default, or to whatever the caller installs)."""
+    default, or to whatever the caller installs).
+
+    Args:
+        env: The ``Environment``.
+
+    Returns:
+        The ``SpaceInformation`` (not yet set up).
+    """
     d = env.dim
     space = ob.RealVectorStateSpace(d)
     bounds = ob.RealVectorBounds(d)
@@ -172,6 +201,18 @@ def from_environment(env: Environment, resolution: float = 0.01, name: str = "om
     OMPL 2.0 does not bind the class itself), with ``resolution`` as the longest valid segment
     fraction (``si.setStateValidityCheckingResolution``): states along a segment are tested at most
     ``resolution * space.getMaximumExtent()`` apart (the workspace diagonal times ``resolution``).
+
+    Args:
+        env: The ``Environment``.
+        resolution: The longest valid segment fraction, in (0, 1] (default 0.01).
+        name: The predicate's name (default ``"ompl"``).
+
+    Returns:
+        The ``OMPLMotionPredicate``, its ``environment`` set to ``env``.
+
+    Raises:
+        TypeError: ``env`` not an ``Environment``, or a non-real ``resolution``.
+        ValueError: ``resolution`` outside (0, 1].
     """
     check_instance(env, "env", Environment, "an Environment")
     resolution = check_float(resolution, "resolution", 0.0, 1.0, open_minimum=True)

@@ -102,7 +102,19 @@ class Planner:
         return self.predicate
 
     def rng(self, round_index: int, worker: int = 0, stream: int = Stream.CANDIDATES) -> np.random.Generator:
-        """The generator of one (round, worker, stream): independent of call order and executor."""
+        """The generator of one (round, worker, stream): independent of call order and executor.
+
+        Args:
+            round_index: The round (>= 0).
+            worker: The worker (>= 0, default 0).
+            stream: A ``Stream`` number (default ``Stream.CANDIDATES``).
+
+        Returns:
+            The ``numpy.random.Generator`` of that key (``RandomStreams.generator``).
+
+        Raises:
+            ValueError: A negative key or an unknown stream number.
+        """
         return self.streams.generator(round_index, worker, Stream(stream))
 
     def __getstate__(self) -> dict:
@@ -252,6 +264,11 @@ class Planner:
                 "oracle_errors": None if self.oracle_errors is None else self.oracle_errors.describe()}
 
     def labels(self) -> tuple[str, ...]:
+        """Every simulation shortcut this planner's numbers depend on (copied into each result).
+
+        Returns:
+            Label sentences (none for the base class).
+        """
         return ()
 
     def _result(self, state: RunState, status: PlanStatus, elapsed: float, start, goal, goal_radius,

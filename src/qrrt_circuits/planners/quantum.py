@@ -241,6 +241,7 @@ class PQRRT(Planner):
 
     @property
     def database_size(self) -> int:
+        """N = 2^n, the entries of each database."""
         return 1 << self.num_qubits
 
     def _start_policy(self):
@@ -311,6 +312,13 @@ class PQRRT(Planner):
         }
 
     def labels(self) -> tuple[str, ...]:
+        """The simulation shortcuts of this planner: the classical lookup behind the phase oracle,
+        the one search standing for p workers of a shared database (p > 1), and the search
+        policy's and the backend's own labels.
+
+        Returns:
+            Label sentences, copied into every result.
+        """
         labels = [ORACLE_LOOKUP_LABEL]
         if self.shared_database and self.workers > 1:
             labels.append(

@@ -19,7 +19,39 @@ class Metrics:
     ``critical_path_oracle_calls`` sums, over rounds, the largest count of one worker (the time of
     p parallel quantum devices); ``simulation_checks`` are the 2^n predicate evaluations per
     database the simulated phase oracle needs (not oracle calls); ``wasted_checks`` the predicate
-    evaluations the batched classical planners made for rounds that never ran (not oracle calls)."""
+    evaluations the batched classical planners made for rounds that never ran (not oracle calls).
+
+    Args:
+        oracle_calls: All oracle calls: ``quantum_oracle_calls + verification_calls``.
+        quantum_oracle_calls: Phase-oracle queries: k per worker per Grover search of k iterations,
+            plus k_i + 1 per amplitude-estimation shot of ``EstimatedOptimal``.
+        verification_calls: Classical reachability tests: every RRT test, and every measured
+            q-RRT / Pq-RRT candidate verified by the finalizer.
+        critical_path_oracle_calls: Sum over rounds of the largest oracle-call count of one worker.
+        simulation_checks: Predicate evaluations that build the simulated phase oracle (2^n per
+            database); a simulation cost, not oracle calls.
+        nodes: Nodes added to the tree (root excluded).
+        rounds: Rounds run.
+        databases: Databases built (0 for the classical planners).
+        duplicates: Verified candidates measured by more than one worker of a shared database and
+            added once.
+        rejected: Candidates the verification refused (a measured entry that is not reachable, or
+            an answer corrupted by the ``OracleErrorModel``).
+        wall_time_s: Wall-clock time of the plan in seconds (not reproducible).
+        wasted_checks: Predicate evaluations done ahead of time and thrown away (batched RRT:
+            candidates of rounds after the round that changed the tree); raw work, never oracle
+            calls.
+
+    Example:
+        >>> from qrrt_circuits import QRRT, Environment, StatevectorBackend
+        >>> env = Environment([[0, 10], [0, 10]], [], start=[1, 1], goal=[9, 9], goal_radius=1.0)
+        >>> planner = QRRT(env, backend=StatevectorBackend(seed=0), num_qubits=3, seed=0)
+        >>> metrics = planner.plan(max_rounds=5).metrics
+        >>> metrics.oracle_calls, metrics.quantum_oracle_calls, metrics.verification_calls
+        (6, 5, 1)
+        >>> metrics["simulation_checks"]  # 2^3 predicate evaluations built the phase oracle
+        8
+    """
 
     oracle_calls: int
     quantum_oracle_calls: int
@@ -32,29 +64,61 @@ class Metrics:
     duplicates: int
     rejected: int
     wall_time_s: float
-    #: predicate evaluations done ahead of time and thrown away (batched RRT: candidates of rounds
-    #: after the round that changed the tree); raw work, never oracle calls
     wasted_checks: int = 0
 
     def as_dict(self) -> dict[str, Any]:
+        """The counters as a plain dict (field name to value), in field order.
+
+        Returns:
+            A new ``dict`` (JSON-serialisable: ints and one float).
+        """
         return asdict(self)
 
     def __getitem__(self, key: str) -> Any:
         return getattr(self, key)
 
     def keys(self):
+        """The counter names, in field order (with ``__getitem__``, ``dict(metrics)`` works).
+
+        Returns:
+            The keys view of ``as_dict()``.
+        """
         return self.as_dict().keys()
 
 
 @dataclass(frozen=True, eq=False)
 class PlanResult:
-    """A finished plan.
+    """A finished plan: the tree, the path, the counters, why it ended and how it was run.
 
-    ``status`` is a ``PlanStatus``: ``"reached"`` or the name of the termination condition that
-    ended the plan. ``nodes`` (N+1, d) with the root in row 0, ``parents`` (N+1,) with
-    ``parents[0] == -1``; ``path`` root .. goal node or None. ``settings`` records the planner, the
-    predicate (and the dynamics it follows), the problem and the termination condition;
-    ``labels`` every simulation shortcut the numbers depend on; ``history`` per-round arrays."""
+    What ``Planner.plan`` returns (paper Alg. 1-4). ``settings`` records the planner, the predicate
+    (and the dynamics it follows), the problem and the termination condition; ``labels`` every
+    simulation shortcut the numbers depend on.
+
+    Args:
+        status: A ``PlanStatus``: ``"reached"`` or the name of the termination condition that ended
+            the plan.
+        nodes: Float (N+1, d), the tree's nodes with the root in row 0.
+        parents: Int (N+1,), the parent row of each node; ``parents[0] == -1``.
+        path: Float (L, d), the nodes from the root to the goal node, or None if not reached.
+        metrics: The ``Metrics`` (oracle calls counted as in DESIGN §2).
+        planner: The planner's name (``"RRT"``, ``"ParallelRRT"``, ``"QRRT"``, ``"PQRRT"``, ...).
+        settings: JSON-able dict of the planner's settings, the problem and the termination.
+        labels: Every simulation shortcut the numbers depend on, as sentences.
+        history: Per-round arrays (name to array of one value per round).
+        goal_node: The row of the node inside the goal ball, or None if not reached.
+
+    Example:
+        >>> from qrrt_circuits import QRRT, Environment, StatevectorBackend
+        >>> env = Environment([[0, 10], [0, 10]], [], start=[1, 1], goal=[9, 9], goal_radius=1.0)
+        >>> planner = QRRT(env, backend=StatevectorBackend(seed=0), num_qubits=3, seed=0)
+        >>> result = planner.plan(max_rounds=5)
+        >>> result.status, result.reached
+        (<PlanStatus.REACHED: 'reached'>, True)
+        >>> result.nodes.shape, result.parents.tolist(), result.goal_node
+        ((2, 2), [-1, 0], 1)
+        >>> len(result.path), result.tree.number_of_edges()
+        (2, 1)
+    """
 
     status: PlanStatus
     nodes: np.ndarray
@@ -69,6 +133,7 @@ class PlanResult:
 
     @property
     def reached(self) -> bool:
+        """Whether the goal was reached (``status is PlanStatus.REACHED``)."""
         return self.status is PlanStatus.REACHED
 
     @property
@@ -88,6 +153,12 @@ class PlanResult:
         return graph
 
     def to_dict(self) -> dict:
+        """The result as JSON-serialisable data (arrays as nested lists, status as its string).
+
+        Returns:
+            A dict with keys ``status``, ``planner``, ``settings``, ``labels``, ``metrics``,
+            ``nodes``, ``parents``, ``path``, ``goal_node`` and ``history``.
+        """
         return {
             "status": str(self.status),
             "planner": self.planner,

@@ -69,7 +69,19 @@ def _diagonal_gate(phases: np.ndarray) -> DiagonalGate:
 
 
 def parity_signs(num_qubits: int) -> np.ndarray:
-    """(-1)^popcount(i) for i = 0 .. 2^n - 1: the diagonal of Z^n."""
+    """(-1)^popcount(i) for i = 0 .. 2^n - 1: the diagonal of Z^n.
+
+    Args:
+        num_qubits: n.
+
+    Returns:
+        Float array of 2^n entries +-1.
+
+    Example:
+        >>> from qrrt_circuits.search.aer_circuits import parity_signs
+        >>> parity_signs(2).tolist()
+        [1.0, -1.0, -1.0, 1.0]
+    """
     index = np.arange(1 << num_qubits, dtype=np.int64)
     parity = np.zeros_like(index)
     for bit in range(num_qubits):
@@ -114,7 +126,17 @@ def _parts(num_qubits: int, block: int) -> _Parts:
 
 def simulation_synthesis(marks: np.ndarray) -> str:
     """The oracle form Aer runs fastest (``"diagonal"`` or ``"mcz"``): a ``diagonal`` costs its
-    2^n entries, the ``mcz`` form two instructions per flipped entry (min(m, N - m) of them)."""
+    2^n entries, the ``mcz`` form two instructions per flipped entry (min(m, N - m) of them).
+
+    Args:
+        marks: Boolean (or 0/1) array of length 2^n.
+
+    Returns:
+        ``"diagonal"`` if N <= ``ENTRIES_PER_INSTRUCTION`` (2 min(m, N - m) + 1), else ``"mcz"``.
+
+    Raises:
+        ValueError: ``marks`` not of length 2^n or not boolean.
+    """
     marks, n = validate_marks(marks)
     marked = int(np.count_nonzero(marks))
     flipped = min(marked, marks.shape[0] - marked)
@@ -168,7 +190,33 @@ def aer_grover_circuit(
 
     ``synthesis``: the oracle's form, ``"diagonal"``, ``"mcz"`` or ``"auto"``
     (``simulation_synthesis``); ``block``: the widest Walsh-Hadamard block (1 gives single-qubit
-    ones)."""
+    ones).
+
+    Args:
+        marks: Boolean (or 0/1) array of length 2^n, n >= 1.
+        iterations: k, 0 .. ``MAX_ITERATIONS`` (paper Alg. 2, lines 7-8).
+        measure: Measure into the register ``c`` (default True).
+        synthesis: ``"auto"`` (default), ``"diagonal"`` or ``"mcz"``.
+        block: The widest Walsh-Hadamard block, 1 .. 10 qubits.
+
+    Returns:
+        An n-qubit ``QuantumCircuit`` named ``grover_aer``.
+
+    Raises:
+        ValueError: ``marks`` not of length 2^n or not boolean, k out of range, an unknown
+            ``synthesis`` or ``block`` out of range.
+        TypeError: A non-integer k or ``block``.
+
+    Example:
+        >>> import numpy as np
+        >>> from qiskit.quantum_info import Operator
+        >>> from qrrt_circuits.search.aer_circuits import aer_grover_circuit
+        >>> from qrrt_circuits.search.circuits import grover_circuit
+        >>> marks = np.array([0, 0, 0, 0, 0, 1, 0, 0], dtype=bool)
+        >>> fast = aer_grover_circuit(marks, 2, measure=False)
+        >>> Operator(fast).equiv(Operator(grover_circuit(marks, 2, measure=False)))
+        True
+    """
     marks, n = validate_marks(marks)
     iterations = validate_iterations(iterations)
     if synthesis not in AER_SYNTHESES:

@@ -29,7 +29,14 @@ from ..validation import check_int, check_seed
 
 @dataclass(frozen=True)
 class SearchResult:
-    """Measured database indices (one per shot) and the oracle calls they cost."""
+    """Measured database indices (one per shot) and the oracle calls they cost.
+
+    Args:
+        indices: The measured indices, one per shot (stored as a read-only int64 array).
+        iterations: k, the Grover iterations (or generalized iterates) of each preparation.
+        shots: The preparations measured.
+        oracle_calls: ``iterations * shots`` (DESIGN §2: one call per iteration per preparation).
+    """
 
     indices: np.ndarray
     iterations: int
@@ -44,7 +51,14 @@ class SearchResult:
 
 @dataclass(frozen=True, eq=False)
 class SearchRequest:
-    """One search of ``QuantumSearchBackend.search_many``: the arguments of one ``search`` call."""
+    """One search of ``QuantumSearchBackend.search_many``: the arguments of one ``search`` call.
+
+    Args:
+        marks: Boolean array of length 2^n, the phase oracle's marks.
+        iterations: k, 0 .. ``MAX_ITERATIONS``.
+        shots: Preparations, 1 .. ``MAX_SHOTS`` (default 1).
+        seed: This search's seed, or None (default) for the backend's own stream.
+    """
 
     marks: np.ndarray
     iterations: int
@@ -53,7 +67,17 @@ class SearchRequest:
 
 
 def validate_marks(marks: np.ndarray) -> tuple[np.ndarray, int]:
-    """Return (marks as bool array, n) or raise a ValueError naming the problem."""
+    """Return (marks as bool array, n) or raise a ValueError naming the problem.
+
+    Args:
+        marks: A 1-D array of length 2^n (n >= 1) of booleans or 0/1 values.
+
+    Returns:
+        (the marks as a bool array, n).
+
+    Raises:
+        ValueError: Not 1-D, a length that is not a power of two >= 2, or values other than 0/1.
+    """
     array = np.asarray(marks)
     if array.ndim != 1:
         raise ValueError(f"marks must be a 1-D array of length 2**n, got shape {array.shape}")
@@ -76,22 +100,77 @@ MAX_SHOTS = 10_000_000
 
 
 def validate_iterations(iterations: int) -> int:
+    """k as an int in [0, ``MAX_ITERATIONS``].
+
+    Args:
+        iterations: k.
+
+    Returns:
+        k as a Python ``int``.
+
+    Raises:
+        TypeError: A non-integer k.
+        ValueError: k out of range.
+    """
     return check_int(iterations, "iterations", 0, MAX_ITERATIONS)
 
 
 def validate_shots(shots: int) -> int:
+    """``shots`` as an int in [1, ``MAX_SHOTS``].
+
+    Args:
+        shots: The preparations.
+
+    Returns:
+        ``shots`` as a Python ``int``.
+
+    Raises:
+        TypeError: A non-integer ``shots``.
+        ValueError: ``shots`` out of range.
+    """
     return check_int(shots, "shots", 1, MAX_SHOTS)
 
 
 def seed_stream(seed: int | np.random.Generator | None) -> np.random.Generator:
-    """A numpy Generator from a seed, a Generator (used as is) or None (fresh entropy)."""
+    """A numpy Generator from a seed, a Generator (used as is) or None (fresh entropy).
+
+    Args:
+        seed: A non-negative integer, a ``numpy.random.Generator`` or None.
+
+    Returns:
+        The generator.
+
+    Raises:
+        TypeError: A seed that is neither an integer, a Generator nor None.
+        ValueError: A negative seed.
+    """
     if isinstance(seed, np.random.Generator):
         return seed
     return np.random.default_rng(check_seed(seed))
 
 
 class QuantumSearchBackend(abc.ABC):
-    """Runs Grover search on a marked database; subclasses differ in how (gates, exact, hardware)."""
+    """Runs Grover search on a marked database; subclasses differ in how (gates, exact, hardware).
+
+    The quantum part of the paper's Alg. 2 / 3 (lines 4-8 of the worker): prepare ``H^n|0>``, apply k
+    Grover iterations and measure; a marked index comes out with probability sin^2((2k+1) theta),
+    sin^2 theta = m / 2^n (Eq. 1, Lemma 1). Implementations: ``AerBackend`` (gate level on
+    qiskit-aer), ``StatevectorBackend`` (exact), ``SamplerBackend`` (any ``SamplerV2``). A subclass
+    implements ``max_qubits`` and ``_sample``.
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits import SearchRequest, StatevectorBackend
+        >>> backend = StatevectorBackend(seed=0)
+        >>> marks = np.zeros(8, dtype=bool)
+        >>> marks[5] = True
+        >>> result = backend.search(marks, iterations=2, shots=4, seed=1)
+        >>> result.shots, result.oracle_calls  # 2 iterations x 4 preparations
+        (4, 8)
+        >>> again, = backend.search_many([SearchRequest(marks, 2, 4, seed=1)])
+        >>> bool(np.array_equal(again.indices, result.indices))
+        True
+    """
 
     #: short name used in outputs and the CLI
     name: str = "backend"
@@ -136,7 +215,18 @@ class QuantumSearchBackend(abc.ABC):
         """Independent searches (the p databases of one unshared Pq-RRT round): result i is exactly
         what ``search(marks, iterations, shots, seed)`` of request i returns when the requests are
         searched one after the other (same seeds, same measured indices). Every request is
-        validated before any search runs. A backend may run them together (``AerBackend``)."""
+        validated before any work. A backend may run them together (``AerBackend``).
+
+        Args:
+            requests: The ``SearchRequest`` objects.
+
+        Returns:
+            One ``SearchResult`` per request, in order.
+
+        Raises:
+            TypeError: An element that is not a ``SearchRequest``, or arguments of the wrong type.
+            ValueError: Any request that ``search`` would refuse (checked for all before any runs).
+        """
         prepared = [self._prepare(request) for request in requests]
         return tuple(self._finish(item, self._sample_seeded(*item)) for item in prepared)
 
@@ -184,23 +274,69 @@ class QuantumSearchBackend(abc.ABC):
 
     def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1) -> int:
         """Peak bytes one ``search`` of a 2^n-entry database adds to the process, beyond the marks
-        the caller holds (used by the memory guard, ``qrrt_circuits.memory``)."""
+        the caller holds (used by the memory guard, ``qrrt_circuits.memory``).
+
+        Args:
+            num_qubits: n.
+            shots: Preparations (default 1).
+            iterations: k (default 1; the generic estimate ignores it).
+
+        Returns:
+            ``BYTES_PER_ENTRY * 2^n + BYTES_PER_SHOT * shots`` here; subclasses report their own.
+        """
         return (self.BYTES_PER_ENTRY << num_qubits) + self.BYTES_PER_SHOT * shots
 
     def memory_estimate(self, num_qubits: int, shots: int = 1, iterations: int = 1) -> MemoryEstimate:
-        """This backend's search alone, as a ``MemoryEstimate``."""
+        """This backend's search alone, as a ``MemoryEstimate``.
+
+        Args:
+            num_qubits: n.
+            shots: Preparations (default 1).
+            iterations: k (default 1).
+
+        Returns:
+            A ``MemoryEstimate`` with ``search_bytes = peak_bytes(n, shots, iterations)``.
+        """
         return MemoryEstimate(num_qubits, search_bytes=self.peak_bytes(num_qubits, shots, iterations),
                               scratch_bytes=0)
 
     def check_memory(self, num_qubits: int, shots: int = 1, iterations: int = 1) -> None:
-        """Refuse a search whose estimated peak exceeds the available memory (before allocating)."""
+        """Refuse a search whose estimated peak exceeds the available memory (before allocating).
+
+        Args:
+            num_qubits: n.
+            shots: Preparations (default 1).
+            iterations: k (default 1).
+
+        Raises:
+            ValueError: The estimate does not fit in the available memory.
+        """
         check_fits(lambda n: self.memory_estimate(n, shots, iterations), num_qubits,
                    f"this {self.name} search ({shots} shots, {iterations} iterations)")
 
     def search_sequence(self, marks: np.ndarray, sequence, shots: int = 1,
                         seed: int | None = None) -> SearchResult:
         """Apply the generalized Grover iterates of ``sequence`` (an ``IterateSequence``) to the
-        uniform state and measure ``shots`` times; ``iterations`` of the result = len(sequence)."""
+        uniform state and measure ``shots`` times; ``iterations`` of the result = len(sequence).
+
+        Fixed-point amplitude amplification (Yoder, Low and Chuang 2014): each generalized iterate
+        queries the oracle once, so ``oracle_calls = len(sequence) * shots``.
+
+        Args:
+            marks: Boolean array of length 2^n.
+            sequence: The ``IterateSequence``.
+            shots: Preparations, 1 .. ``MAX_SHOTS`` (default 1).
+            seed: This call's seed, or None (default) for the backend's own stream.
+
+        Returns:
+            The ``SearchResult``.
+
+        Raises:
+            ValueError: ``marks`` not of length 2^n, n above ``max_qubits``, ``shots`` out of
+                range, or an estimated peak memory that does not fit.
+            TypeError: ``sequence`` not an ``IterateSequence``, or a non-integer ``shots``.
+            NotImplementedError: A backend that does not run generalized iterates.
+        """
         from .fixed_point import IterateSequence
 
         marks, num_qubits = validate_marks(marks)
@@ -225,9 +361,18 @@ class QuantumSearchBackend(abc.ABC):
         return ()
 
     def describe(self) -> str:
+        """The backend's settings in words (recorded in ``PlanResult.settings``)."""
         return self.name
 
     def check_qubits(self, num_qubits: int) -> None:
+        """Refuse an n this backend does not support.
+
+        Args:
+            num_qubits: n.
+
+        Raises:
+            ValueError: n < 1 or n > ``max_qubits``.
+        """
         if num_qubits < 1 or num_qubits > self.max_qubits:
             raise ValueError(
                 f"num_qubits = {num_qubits} is outside the range this backend supports "

@@ -145,7 +145,19 @@ def choose_synthesis(marks: np.ndarray) -> str:
 
 
 def uniform_preparation(num_qubits: int) -> QuantumCircuit:
-    """W = H^n, the paper's Walsh-Hadamard state preparation."""
+    """W = H^n, the paper's Walsh-Hadamard state preparation (Alg. 2 / 3, worker line 6).
+
+    Args:
+        num_qubits: n, the index register's width.
+
+    Returns:
+        An n-qubit ``QuantumCircuit`` named ``W`` of n Hadamard gates.
+
+    Example:
+        >>> from qrrt_circuits.search.circuits import uniform_preparation
+        >>> dict(uniform_preparation(3).count_ops())
+        {'h': 3}
+    """
     circuit = QuantumCircuit(num_qubits, name="W")
     circuit.h(range(num_qubits))
     return circuit
@@ -196,7 +208,31 @@ def aer_literal_grover_circuit(
     by the diffuser H^n X^n MCZ X^n H^n (``= -(2|s><s| - I)``); equal to ``grover_circuit`` up to a
     global phase. A noise model attached to h, x or mcphase acts on every such gate of the paper's
     circuit (``aer_grover_circuit`` merges them into fewer instructions, which is faster but would
-    change where such noise applies)."""
+    change where such noise applies).
+
+    Args:
+        marks: Boolean (or 0/1) array of length 2^n, n >= 1.
+        iterations: k, 0 .. ``MAX_ITERATIONS``.
+        measure: Measure all qubits into ``meas`` (default True).
+        synthesis: The oracle's form (``phase_oracle``): ``"auto"``, ``"diagonal"`` or ``"mcz"``.
+
+    Returns:
+        An n-qubit ``QuantumCircuit`` named ``grover_aer``.
+
+    Raises:
+        ValueError: ``marks`` not of length 2^n or not boolean, k out of range, or an unknown
+            ``synthesis``.
+        TypeError: A non-integer k.
+
+    Example:
+        >>> import numpy as np
+        >>> from qiskit.quantum_info import Operator
+        >>> from qrrt_circuits.search.circuits import aer_literal_grover_circuit, grover_circuit
+        >>> marks = np.array([0, 0, 0, 0, 0, 1, 0, 0], dtype=bool)
+        >>> literal = aer_literal_grover_circuit(marks, 2, measure=False)
+        >>> Operator(literal).equiv(Operator(grover_circuit(marks, 2, measure=False)))
+        True
+    """
     marks, n = validate_marks(marks)
     iterations = validate_iterations(iterations)
     oracle = phase_oracle(marks, synthesis)
@@ -221,6 +257,15 @@ def aer_literal_grover_circuit(
 
 @dataclass(frozen=True)
 class ResourceCount:
+    """One transpiled circuit's cost in the basis [cx, rz, sx, x].
+
+    Args:
+        qubits: Width of the transpiled circuit.
+        cx: CX gates.
+        depth: Circuit depth.
+        size: Total gates.
+    """
+
     qubits: int
     cx: int
     depth: int
@@ -269,6 +314,16 @@ def resource_estimate(
         ValueError: ``marks`` not of length 2^n or not boolean, n > 14 (the full circuit is
             transpiled), k out of range, or an unknown ``synthesis``.
         TypeError: A non-integer k.
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits.search.circuits import resource_estimate
+        >>> marks = np.array([0, 0, 0, 0, 0, 1, 0, 0], dtype=bool)
+        >>> estimate = resource_estimate(marks, iterations=2)
+        >>> estimate.num_qubits, estimate.num_marked, estimate.synthesis
+        (3, 1, 'diagonal')
+        >>> estimate.no_ancilla.qubits, estimate.one_ancilla.qubits, estimate.no_ancilla.cx > 0
+        (3, 4, True)
     """
     marks, n = validate_marks(marks)
     iterations = validate_iterations(iterations)

@@ -51,6 +51,19 @@ class EstimatedOptimal(IterationPolicy):
     Raises:
         TypeError: A non-integer ``schedule`` or ``shots``, or a non-real ``alpha`` or ``epsilon``.
         ValueError: An unknown ``method`` or a field outside its range.
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits import DatabaseSearch, EstimatedOptimal, StatevectorBackend
+        >>> from qrrt_circuits.randomness import RandomStreams
+        >>> marks = np.zeros(16, dtype=bool)
+        >>> marks[[1, 5, 9, 13]] = True
+        >>> problem = DatabaseSearch(marks, marks, StatevectorBackend(seed=0), RandomStreams(0), 0)
+        >>> estimate = EstimatedOptimal(shots=64).estimate(problem)
+        >>> estimate.powers, estimate.oracle_calls  # 64 shots x (1 + 2 + 3 + 5) calls
+        ((0, 1, 2, 4), 704)
+        >>> estimate.marked_count(16)
+        4
     """
 
     method: str = "mlae"
@@ -82,6 +95,10 @@ class EstimatedOptimal(IterationPolicy):
 
         Returns:
             The ``AmplitudeEstimate`` (estimate, interval and the quantum oracle calls it cost).
+
+        Raises:
+            RuntimeError: IAE running more than ``MAX_IAE_ROUNDS`` circuits, or an oracle-query
+                count that disagrees with qiskit-algorithms' (``estimate_marked_fraction``).
         """
         return estimate_marked_fraction(problem.marks, alpha=self.alpha, shots=self.shots,
                                         rng=problem.worker_generator(0), method=self.method,

@@ -48,7 +48,20 @@ AER_NATIVE = frozenset({"h", "x", "p", "diagonal", "mcphase", "measure", "barrie
 
 
 def grover_iterate(marks: np.ndarray, synthesis: str = "auto") -> QuantumCircuit:
-    """Q = -S_s(pi) S_t(pi): the phase oracle, then the inversion about the mean (Aer-native)."""
+    """Q = -S_s(pi) S_t(pi): the phase oracle, then the inversion about the mean (Aer-native).
+
+    One standard Grover iterate (the paper's Alg. 2 / 3 loop body; Yoder et al.'s G(pi, pi)).
+
+    Args:
+        marks: Boolean (or 0/1) array of length 2^n.
+        synthesis: The oracle's synthesis: ``"auto"`` (default), ``"diagonal"`` or ``"mcz"``.
+
+    Returns:
+        An n-qubit ``QuantumCircuit`` named ``"Q"``.
+
+    Raises:
+        ValueError: ``marks`` not of length 2^n or not boolean, or an unknown ``synthesis``.
+    """
     marks, n = validate_marks(marks)
     circuit = QuantumCircuit(n, name="Q")
     circuit.compose(phase_oracle(marks, synthesis), inplace=True)
@@ -58,7 +71,21 @@ def grover_iterate(marks: np.ndarray, synthesis: str = "auto") -> QuantumCircuit
 
 
 def estimation_problem(marks: np.ndarray, synthesis: str = "auto"):
-    """qiskit-algorithms' ``EstimationProblem`` for the marked fraction a = m / N of ``marks``."""
+    """qiskit-algorithms' ``EstimationProblem`` for the marked fraction a = m / N of ``marks``.
+
+    State preparation A = H^n (the paper's W), Grover operator ``grover_iterate(marks)``, all n
+    qubits objective qubits, and a bitstring b good when ``marks[int(b, 2)]``.
+
+    Args:
+        marks: Boolean (or 0/1) array of length 2^n.
+        synthesis: The oracle's synthesis: ``"auto"`` (default), ``"diagonal"`` or ``"mcz"``.
+
+    Returns:
+        A ``qiskit_algorithms.EstimationProblem``.
+
+    Raises:
+        ValueError: ``marks`` not of length 2^n or not boolean, or an unknown ``synthesis``.
+    """
     from qiskit_algorithms import EstimationProblem
 
     marks, n = validate_marks(marks)
@@ -72,7 +99,14 @@ def estimation_problem(marks: np.ndarray, synthesis: str = "auto"):
 
 def flatten(circuit: QuantumCircuit) -> QuantumCircuit:
     """``circuit`` with every composite instruction replaced by its definition, recursively, down
-    to ``AER_NATIVE`` operations (global phases of the definitions are kept)."""
+    to ``AER_NATIVE`` operations (global phases of the definitions are kept).
+
+    Args:
+        circuit: Any ``QuantumCircuit``.
+
+    Returns:
+        A new circuit on the same qubits and clbits with the same operator.
+    """
     out = circuit.copy_empty_like()
 
     def add(source: QuantumCircuit, qubits: list, clbits: list) -> None:
@@ -100,7 +134,13 @@ METHODS = ("mlae", "iae")
 class SeededAerSampler(BaseSamplerV2):
     """qiskit-aer's ``SamplerV2`` with ``shots`` per circuit, a fresh ``seed_simulator`` from
     ``rng`` for every call, and composite gates flattened to Aer-native ones. More than
-    ``max_calls`` calls raise a RuntimeError (see the module docstring)."""
+    ``max_calls`` calls raise a RuntimeError (see the module docstring).
+
+    Args:
+        shots: Shots per circuit (default of every call).
+        rng: The generator that draws each call's ``seed_simulator``.
+        max_calls: The most ``run`` calls allowed, or None for no limit.
+    """
 
     def __init__(self, shots: int, rng: np.random.Generator, max_calls: int | None = None) -> None:
         from qiskit_aer.primitives import SamplerV2
@@ -112,6 +152,18 @@ class SeededAerSampler(BaseSamplerV2):
         self.calls = 0
 
     def run(self, pubs, *, shots: int | None = None):
+        """Run the pubs on Aer's ``SamplerV2``, flattened, with a fresh ``seed_simulator``.
+
+        Args:
+            pubs: Sampler pubs (circuits, or (circuit, parameter values, shots) tuples).
+            shots: Shots per pub; None for ``default_shots``.
+
+        Returns:
+            Aer's ``PrimitiveJob``.
+
+        Raises:
+            RuntimeError: More than ``max_calls`` calls.
+        """
         if self.max_calls is not None and self.calls >= self.max_calls:
             raise RuntimeError(f"amplitude estimation made more than {self.max_calls} sampler calls "
                                "(qiskit-algorithms' IterativeAmplitudeEstimation loops forever when a "
@@ -130,7 +182,27 @@ class AmplitudeEstimate:
 
     ``powers``: the k of each sampler round (Q^k A|0>, ``shots`` shots each);
     ``oracle_calls`` = sum shots (k + 1) (see the module docstring);
-    ``library_oracle_queries``: qiskit-algorithms' ``num_oracle_queries`` (= sum shots k)."""
+    ``library_oracle_queries``: qiskit-algorithms' ``num_oracle_queries`` (= sum shots k).
+
+    Args:
+        estimate: The estimate of a = m / N.
+        interval: The confidence interval (low, high) on a, at confidence 1 - alpha.
+        alpha: The interval's error level.
+        powers: k of each sampler round.
+        shots: Shots per round.
+        oracle_calls: sum over rounds of shots (k + 1), DESIGN §2.
+        library_oracle_queries: qiskit-algorithms' count, sum over rounds of shots k.
+
+    Example:
+        >>> from qrrt_circuits.search.estimation import AmplitudeEstimate
+        >>> estimate = AmplitudeEstimate(estimate=0.25, interval=(0.2, 0.3), alpha=0.05,
+        ...                              powers=(0, 1, 2), shots=10, oracle_calls=60,
+        ...                              library_oracle_queries=30)
+        >>> estimate.marked_count(16), estimate.count_interval(16)
+        (4, (3.2, 4.8))
+        >>> estimate.calls_per_worker(4)  # 10 shots a round: 3, 3, 2, 2 shots of k + 1 calls
+        (18, 18, 12, 12)
+    """
 
     estimate: float
     interval: tuple[float, float]
@@ -141,18 +213,39 @@ class AmplitudeEstimate:
     library_oracle_queries: int
 
     def marked_count(self, num_items: int) -> int:
-        """The estimate of m: round(a N), at least 1 (a search for none would be pointless)."""
+        """The estimate of m: round(a N), at least 1 (a search for none would be pointless).
+
+        Args:
+            num_items: N, the database size.
+
+        Returns:
+            max(1, round(a N)).
+        """
         return max(1, int(round(self.estimate * num_items)))
 
     def count_interval(self, num_items: int) -> tuple[float, float]:
-        """The confidence interval on m = a N."""
+        """The confidence interval on m = a N.
+
+        Args:
+            num_items: N, the database size.
+
+        Returns:
+            (low N, high N).
+        """
         return (self.interval[0] * num_items, self.interval[1] * num_items)
 
     def calls_per_worker(self, workers: int) -> tuple[int, ...]:
         """The estimation's oracle calls when its shots are shared by ``workers`` devices: in each
         sampler round worker w runs shots // p shots (one more for w < shots % p), each costing
         k + 1 calls. Worker 0 carries the largest share, which is the estimation's critical path
-        (the rounds are sequential; the shots within one are independent)."""
+        (the rounds are sequential; the shots within one are independent).
+
+        Args:
+            workers: p, the devices sharing the shots (>= 1).
+
+        Returns:
+            p oracle-call counts, worker 0 first (they sum to ``oracle_calls``).
+        """
         calls = [0] * workers
         for k in self.powers:
             base, extra = divmod(self.shots, workers)
@@ -170,7 +263,15 @@ def _theta_grid(max_power: int = 0) -> np.ndarray:
 def grid_minimizer(objective, bounds) -> float:
     """MLAE's minimizer hook: the library's own grid search (``brute`` over 10 000 points, then a
     local polish) evaluated on the whole grid at once (its log-likelihood accepts an array of
-    theta), then polished by a bounded scalar minimization between the neighbouring grid points."""
+    theta), then polished by a bounded scalar minimization between the neighbouring grid points.
+
+    Args:
+        objective: The negative log-likelihood of theta, accepting an array of thetas.
+        bounds: ((theta_low, theta_high),), the search interval.
+
+    Returns:
+        The minimizing theta.
+    """
     from scipy.optimize import minimize_scalar
 
     grid = np.linspace(bounds[0][0], bounds[0][1], 10_000)
@@ -183,7 +284,20 @@ def grid_minimizer(objective, bounds) -> float:
 
 
 def log_likelihood(theta: np.ndarray, powers, good_counts, shots: int) -> np.ndarray:
-    """MLAE's log-likelihood: sum_k good_k log sin^2((2k+1) theta) + bad_k log cos^2((2k+1) theta)."""
+    """MLAE's log-likelihood: sum_k good_k log sin^2((2k+1) theta) + bad_k log cos^2((2k+1) theta).
+
+    Suzuki et al. 2020: after k Grover iterates the good probability is sin^2((2k+1) theta)
+    with a = sin^2 theta (the paper's Eq. 1 with a = m/N).
+
+    Args:
+        theta: Array of angles in (0, pi/2).
+        powers: k of each round.
+        good_counts: Good outcomes of each round.
+        shots: Shots per round.
+
+    Returns:
+        The log-likelihood at each theta (-inf where a term's probability is 0).
+    """
     total = np.zeros_like(np.asarray(theta, dtype=float))
     with np.errstate(divide="ignore"):
         for k, good in zip(powers, good_counts, strict=True):
@@ -197,7 +311,18 @@ def likelihood_ratio_interval(theta_mle: float, powers, good_counts, shots: int,
     """The likelihood-ratio interval of qiskit-algorithms' MLAE (``kind="likelihood_ratio"``: the
     thetas whose log-likelihood is within chi2_{1-alpha, 1} / 2 of the maximum, outermost ones,
     mapped to a = sin^2 theta), computed on the same grid but vectorized (the library loops over
-    10 000 points in Python; tests check the two agree)."""
+    10 000 points in Python; tests check the two agree).
+
+    Args:
+        theta_mle: The maximum-likelihood theta.
+        powers: k of each round.
+        good_counts: Good outcomes of each round.
+        shots: Shots per round.
+        alpha: The error level (confidence 1 - alpha).
+
+    Returns:
+        (a_low, a_high).
+    """
     from scipy.stats import chi2
 
     grid = _theta_grid(max(powers))
@@ -216,7 +341,40 @@ def estimate_marked_fraction(marks: np.ndarray, *, alpha: float, shots: int, rng
 
     ``"mlae"``: ``MaximumLikelihoodAmplitudeEstimation`` with the powers [0, 1, 2, ..., 2^(schedule-1)]
     and its likelihood-ratio confidence interval. ``"iae"``: ``IterativeAmplitudeEstimation`` with
-    target half-width ``epsilon`` on a and Clopper-Pearson intervals."""
+    target half-width ``epsilon`` on a and Clopper-Pearson intervals.
+
+    Args:
+        marks: Boolean (or 0/1) array of length 2^n.
+        alpha: The confidence interval's error level, in (0, 1).
+        shots: Shots per sampler round.
+        rng: The generator that seeds every sampler call.
+        method: ``"mlae"`` (default) or ``"iae"``.
+        schedule: MLAE's evaluation schedule: k = 0 and 2^0 .. 2^(schedule-1) (default 3: k = 0, 1, 2,
+            4).
+        epsilon: IAE's target half-width on a (default 0.05).
+        synthesis: The oracle's synthesis: ``"auto"`` (default), ``"diagonal"`` or ``"mcz"``.
+
+    Returns:
+        The ``AmplitudeEstimate``, its oracle calls counted as sum shots (k + 1).
+
+    Raises:
+        ValueError: An unknown ``method``, ``marks`` not of length 2^n or not boolean, an unknown
+            ``synthesis``, or qiskit-algorithms' own refusal of an argument.
+        RuntimeError: IAE running more than ``MAX_IAE_ROUNDS`` circuits (its endless loop), or an
+            oracle-query count that disagrees with qiskit-algorithms'.
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits.search.estimation import estimate_marked_fraction
+        >>> marks = np.zeros(16, dtype=bool)
+        >>> marks[[1, 5, 9, 13]] = True
+        >>> estimate = estimate_marked_fraction(marks, alpha=0.05, shots=64,
+        ...                                     rng=np.random.default_rng(0))
+        >>> estimate.powers, estimate.oracle_calls, estimate.library_oracle_queries
+        ((0, 1, 2, 4), 704, 448)
+        >>> estimate.marked_count(16)
+        4
+    """
     from qiskit_algorithms import IterativeAmplitudeEstimation, MaximumLikelihoodAmplitudeEstimation
 
     if method not in METHODS:

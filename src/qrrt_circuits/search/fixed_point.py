@@ -46,7 +46,25 @@ LENGTH_RULES = ("paper", "tight")
 
 
 def chebyshev(order: float, x: float) -> float:
-    """T_order(x) = cos(order acos x) on [-1, 1] and cosh(order acosh x) for x > 1 (real order)."""
+    """T_order(x) = cos(order acos x) on [-1, 1] and cosh(order acosh x) for x > 1 (real order).
+
+    The Chebyshev polynomial of Yoder et al.'s closed form (its order 1/L is not an integer).
+
+    Args:
+        order: The order (any real number).
+        x: The argument, >= -1.
+
+    Returns:
+        T_order(x).
+
+    Raises:
+        ValueError: x < -1.
+
+    Example:
+        >>> from qrrt_circuits.search.fixed_point import chebyshev
+        >>> round(chebyshev(2, 0.5), 6)  # T_2(x) = 2 x^2 - 1
+        -0.5
+    """
     if abs(x) <= 1.0:
         return math.cos(order * math.acos(x))
     if x > 1.0:
@@ -55,12 +73,31 @@ def chebyshev(order: float, x: float) -> float:
 
 
 def gamma(delta: float, length: int) -> float:
-    """gamma with 1 / gamma = T_{1/L}(1 / delta) (Yoder et al.)."""
+    """gamma with 1 / gamma = T_{1/L}(1 / delta) (Yoder et al.).
+
+    Args:
+        delta: The target error, in (0, 1) (unvalidated).
+        length: L = 2l + 1, the sequence's length.
+
+    Returns:
+        gamma in (0, 1].
+    """
     return 1.0 / chebyshev(1.0 / length, 1.0 / delta)
 
 
 def check_delta(delta) -> float:
-    """The target error delta in (0, 1) (delta = 1 would promise nothing)."""
+    """The target error delta in (0, 1) (delta = 1 would promise nothing).
+
+    Args:
+        delta: The value to check.
+
+    Returns:
+        ``delta`` as a float.
+
+    Raises:
+        TypeError: A non-real ``delta``.
+        ValueError: ``delta`` not in (0, 1).
+    """
     value = check_float(delta, "delta", 0.0, 1.0, open_minimum=True)
     if value == 1.0:
         raise ValueError("delta must be in (0, 1) (the guarantee is P >= 1 - delta^2), got 1.0")
@@ -68,13 +105,45 @@ def check_delta(delta) -> float:
 
 
 def check_fraction(fraction, name: str = "min_fraction") -> float:
+    """A marked fraction w in (0, 1].
+
+    Args:
+        fraction: The value to check.
+        name: The argument's name for the error message.
+
+    Returns:
+        ``fraction`` as a float.
+
+    Raises:
+        TypeError: A non-real ``fraction``.
+        ValueError: ``fraction`` not in (0, 1].
+    """
     return check_float(fraction, name, 0.0, 1.0, open_minimum=True)
 
 
 def fixed_point_iterates(delta: float, min_fraction: float, length_rule: str = "paper") -> int:
     """The number l of generalized iterates (oracle calls) for error ``delta`` and marked fraction
     >= ``min_fraction``: the smallest l with L = 2l + 1 >= log(2/delta)/sqrt(w) (``"paper"``), or the
-    smallest with 1 - gamma(L)^2 <= w (``"tight"``; never larger than the paper's)."""
+    smallest with 1 - gamma(L)^2 <= w (``"tight"``; never larger than the paper's).
+
+    Args:
+        delta: The target error delta in (0, 1): P >= 1 - delta^2 for every fraction >= w.
+        min_fraction: w, the smallest marked fraction m/N the guarantee must cover, in (0, 1].
+        length_rule: ``"paper"`` (default) or ``"tight"``.
+
+    Returns:
+        l >= 0.
+
+    Raises:
+        TypeError: A non-real ``delta`` or ``min_fraction``.
+        ValueError: ``delta`` not in (0, 1), ``min_fraction`` not in (0, 1], or an unknown
+            ``length_rule``.
+
+    Example:
+        >>> from qrrt_circuits.search.fixed_point import fixed_point_iterates
+        >>> fixed_point_iterates(0.5, 0.05)
+        3
+    """
     delta = check_delta(delta)
     w = check_fraction(min_fraction)
     if length_rule not in LENGTH_RULES:
@@ -90,7 +159,21 @@ def fixed_point_iterates(delta: float, min_fraction: float, length_rule: str = "
 
 
 def fixed_point_phases(delta: float, iterates: int) -> tuple[np.ndarray, np.ndarray]:
-    """(alphas, betas) of length l for error ``delta`` (Yoder et al.'s closed form)."""
+    """(alphas, betas) of length l for error ``delta`` (Yoder et al.'s closed form).
+
+    alpha_j = -beta_{l-j+1} = 2 cot^{-1}(tan(2 pi j / L) sqrt(1 - gamma^2)), L = 2l + 1.
+
+    Args:
+        delta: The target error, in (0, 1).
+        iterates: l, 0 .. ``MAX_ITERATIONS``.
+
+    Returns:
+        Two float arrays of length l: the alphas and the betas.
+
+    Raises:
+        TypeError: A non-real ``delta`` or a non-integer ``iterates``.
+        ValueError: ``delta`` not in (0, 1) or ``iterates`` out of range.
+    """
     delta = check_delta(delta)
     iterates = check_int(iterates, "iterates", 0, MAX_ITERATIONS)
     length = 2 * iterates + 1
@@ -103,7 +186,26 @@ def fixed_point_phases(delta: float, iterates: int) -> tuple[np.ndarray, np.ndar
 
 
 def fixed_point_success_probability(delta: float, iterates: int, fraction: float) -> float:
-    """P_L(f) = 1 - delta^2 T_L(T_{1/L}(1/delta) sqrt(1 - f))^2, L = 2l + 1 (Yoder et al.)."""
+    """P_L(f) = 1 - delta^2 T_L(T_{1/L}(1/delta) sqrt(1 - f))^2, L = 2l + 1 (Yoder et al.).
+
+    Args:
+        delta: The target error, in (0, 1).
+        iterates: l, 0 .. ``MAX_ITERATIONS``.
+        fraction: f = m/N, the marked fraction, in [0, 1].
+
+    Returns:
+        The probability of measuring a marked index after the l iterates.
+
+    Raises:
+        TypeError: A non-real ``delta`` or ``fraction``, or a non-integer ``iterates``.
+        ValueError: ``delta`` not in (0, 1), ``fraction`` not in [0, 1] or ``iterates`` out of
+            range.
+
+    Example:
+        >>> from qrrt_circuits.search.fixed_point import fixed_point_success_probability
+        >>> round(fixed_point_success_probability(0.5, 3, 0.05), 4)  # >= 1 - 0.5^2
+        0.9003
+    """
     delta = check_delta(delta)
     fraction = check_float(fraction, "fraction", 0.0, 1.0)
     length = 2 * check_int(iterates, "iterates", 0, MAX_ITERATIONS) + 1
@@ -115,7 +217,27 @@ def fixed_point_success_probability(delta: float, iterates: int, fraction: float
 class IterateSequence:
     """Generalized Grover iterates G(alpha_j, beta_j), applied to ``|s>`` in order j = 1, 2, ...
 
-    ``oracle_calls`` = l per preparation (one phase oracle per iterate)."""
+    G(alpha, beta) = -S_s(alpha) S_t(beta) (Yoder, Low and Chuang 2014, Eq. 1); alpha = beta = pi
+    is the standard Grover iterate of the paper's Alg. 2 / 3. ``oracle_calls`` = l per preparation
+    (one phase oracle per iterate, DESIGN §2).
+
+    Args:
+        alphas: The l state-reflection phases (finite; stored as a read-only float array).
+        betas: The l oracle phases, the same length (finite).
+
+    Raises:
+        ValueError: ``alphas`` and ``betas`` of different lengths, more than ``MAX_ITERATIONS``
+            iterates, or a non-finite phase.
+
+    Example:
+        >>> from qrrt_circuits import IterateSequence
+        >>> grover = IterateSequence.grover(1)
+        >>> grover.oracle_calls, round(grover.good_probability(0.25), 6)  # sin^2(3 theta) = 1
+        (1, 1.0)
+        >>> fixed = IterateSequence.fixed_point(delta=0.5, iterates=3)
+        >>> all(fixed.good_probability(f) >= 0.75 for f in (0.05, 0.3, 0.9))
+        True
+    """
 
     alphas: np.ndarray
     betas: np.ndarray
@@ -136,16 +258,41 @@ class IterateSequence:
 
     @classmethod
     def grover(cls, iterations: int) -> IterateSequence:
-        """k standard Grover iterations: alpha = beta = pi."""
+        """k standard Grover iterations: alpha = beta = pi.
+
+        Args:
+            iterations: k, 0 .. ``MAX_ITERATIONS``.
+
+        Returns:
+            The sequence of k standard iterates.
+
+        Raises:
+            TypeError: A non-integer k.
+            ValueError: k out of range.
+        """
         k = check_int(iterations, "iterations", 0, MAX_ITERATIONS)
         return cls(np.full(k, math.pi), np.full(k, math.pi))
 
     @classmethod
     def fixed_point(cls, delta: float, iterates: int) -> IterateSequence:
+        """Yoder et al.'s fixed-point sequence of l iterates for error delta (``fixed_point_phases``).
+
+        Args:
+            delta: The target error, in (0, 1).
+            iterates: l, 0 .. ``MAX_ITERATIONS``.
+
+        Returns:
+            The sequence; P >= 1 - delta^2 for every marked fraction >= 1 - gamma^2.
+
+        Raises:
+            TypeError: A non-real ``delta`` or a non-integer ``iterates``.
+            ValueError: ``delta`` not in (0, 1) or ``iterates`` out of range.
+        """
         return cls(*fixed_point_phases(delta, iterates))
 
     @property
     def oracle_calls(self) -> int:
+        """l: oracle calls of one preparation (one per iterate)."""
         return int(self.alphas.size)
 
     def __len__(self) -> int:
@@ -158,7 +305,18 @@ class IterateSequence:
     def marked_amplitude(self, fraction: float) -> tuple[complex, complex]:
         """(amplitude on the normalized marked state, on the unmarked one) after the sequence, for
         marked fraction ``fraction``: the exact 2-dimensional evolution (every operator keeps the
-        span of ``|T>`` and ``|s>``)."""
+        span of ``|T>`` and ``|s>``).
+
+        Args:
+            fraction: f = m/N, in [0, 1].
+
+        Returns:
+            (a_T, a_U): the amplitudes on the normalized marked and unmarked states.
+
+        Raises:
+            TypeError: A non-real ``fraction``.
+            ValueError: ``fraction`` not in [0, 1].
+        """
         f = check_float(fraction, "fraction", 0.0, 1.0)
         s = np.array([math.sqrt(f), math.sqrt(1.0 - f)], dtype=complex)
         psi = s.copy()
@@ -168,14 +326,36 @@ class IterateSequence:
         return complex(psi[0]), complex(psi[1])
 
     def good_probability(self, fraction: float) -> float:
-        """Probability of measuring a marked index after the sequence (exact)."""
+        """Probability of measuring a marked index after the sequence (exact): ``|a_T|^2``.
+
+        Args:
+            fraction: f = m/N, in [0, 1].
+
+        Returns:
+            The probability, in [0, 1].
+
+        Raises:
+            TypeError: A non-real ``fraction``.
+            ValueError: ``fraction`` not in [0, 1].
+        """
         return float(abs(self.marked_amplitude(fraction)[0]) ** 2)
 
 
 def statevector_after(marks: np.ndarray, sequence: IterateSequence) -> np.ndarray:
     """The full 2^n-dimensional statevector after ``sequence``, iterated operator by operator
     (O(N) per iterate): S_t(beta) multiplies marked amplitudes by e^{i beta}, S_s(alpha) subtracts
-    (1 - e^{-i alpha}) <s|psi> |s>, then the sign of G."""
+    (1 - e^{-i alpha}) <s|psi> |s>, then the sign of G.
+
+    Args:
+        marks: Boolean (or 0/1) array of length 2^n.
+        sequence: The ``IterateSequence``.
+
+    Returns:
+        Complex array of length 2^n.
+
+    Raises:
+        ValueError: ``marks`` not of length 2^n or not boolean.
+    """
     marks, _ = validate_marks(marks)
     size = marks.shape[0]
     state = np.full(size, 1.0 / math.sqrt(size), dtype=complex)
@@ -190,7 +370,19 @@ def statevector_after(marks: np.ndarray, sequence: IterateSequence) -> np.ndarra
 def phase_oracle_beta(marks: np.ndarray, beta: float, synthesis: str = "diagonal") -> QuantumCircuit:
     """S_t(beta) = diag(e^{i beta marks}) on n qubits. ``"diagonal"``: one ``DiagonalGate``;
     ``"mcz"``: one multi-controlled phase(beta) per marked index, conjugated by X on its zero bits
-    (``"auto"`` picks the cheaper as ``circuits.choose_synthesis`` does)."""
+    (``"auto"`` picks the cheaper as ``circuits.choose_synthesis`` does).
+
+    Args:
+        marks: Boolean (or 0/1) array of length 2^n.
+        beta: The phase beta.
+        synthesis: ``"diagonal"`` (default), ``"mcz"`` or ``"auto"``.
+
+    Returns:
+        An n-qubit ``QuantumCircuit``.
+
+    Raises:
+        ValueError: ``marks`` not of length 2^n or not boolean, or an unknown ``synthesis``.
+    """
     from .circuits import SYNTHESES, _flip, choose_synthesis
 
     marks, n = validate_marks(marks)
@@ -223,7 +415,12 @@ def _mcphase(circuit: QuantumCircuit, angle: float, n: int) -> None:
 
 def append_state_reflection(circuit: QuantumCircuit, alpha: float) -> None:
     """S_s(alpha) = I - (1 - e^{-i alpha}) |s><s| = H^n X^n MCPhase(-alpha) X^n H^n: the phase
-    e^{-i alpha} on |1...1> is the phase on |s> once conjugated by X^n H^n."""
+    e^{-i alpha} on |1...1> is the phase on |s> once conjugated by X^n H^n.
+
+    Args:
+        circuit: The circuit to append to, on all its qubits (modified in place).
+        alpha: The phase alpha.
+    """
     qubits = list(range(circuit.num_qubits))
     circuit.h(qubits)
     circuit.x(qubits)
@@ -236,7 +433,21 @@ def generalized_grover_circuit(marks: np.ndarray, sequence: IterateSequence, mea
                                synthesis: str = "auto") -> QuantumCircuit:
     """H^n |0>, then G(alpha_j, beta_j) = -S_s(alpha_j) S_t(beta_j) for j = 1..l, from gates Aer runs
     natively (h, x, diagonal, mcphase); the sign of each G is the circuit's global phase, so the
-    circuit's operator equals the product of the G's times H^n exactly. Measured into ``meas``."""
+    circuit's operator equals the product of the G's times H^n exactly. Measured into ``meas``.
+
+    Args:
+        marks: Boolean (or 0/1) array of length 2^n.
+        sequence: The ``IterateSequence`` to apply.
+        measure: Whether to measure all qubits (default True).
+        synthesis: The oracles' synthesis: ``"auto"`` (default), ``"diagonal"`` or ``"mcz"``.
+
+    Returns:
+        An n-qubit ``QuantumCircuit``.
+
+    Raises:
+        ValueError: ``marks`` not of length 2^n or not boolean, or an unknown ``synthesis``.
+        TypeError: ``sequence`` not an ``IterateSequence``.
+    """
     marks, n = validate_marks(marks)
     if not isinstance(sequence, IterateSequence):
         raise TypeError(f"sequence must be an IterateSequence, got {type(sequence).__name__}")

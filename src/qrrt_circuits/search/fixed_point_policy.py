@@ -52,6 +52,14 @@ class FixedPointAmplification(IterationPolicy):
         TypeError: A non-real ``delta`` or ``min_fraction``.
         ValueError: ``delta`` outside (0, 1), ``min_fraction`` outside (0, 1], or an unknown
             ``length_rule``.
+
+    Example:
+        >>> from qrrt_circuits import FixedPointAmplification
+        >>> policy = FixedPointAmplification(delta=0.5, min_fraction=0.05)
+        >>> policy.iterates  # the smallest l with 2l + 1 >= log(2/0.5) / sqrt(0.05)
+        3
+        >>> round(policy.success_probability(0.05), 4), round(policy.success_probability(0.5), 4)
+        (0.9003, 0.906)
     """
 
     delta: float = 0.5
@@ -67,11 +75,16 @@ class FixedPointAmplification(IterationPolicy):
 
     @property
     def iterates(self) -> int:
-        """l, the generalized iterates (quantum oracle calls) per worker and database."""
+        """l, the generalized iterates (quantum oracle calls) per worker and database
+        (``fixed_point_iterates(delta, min_fraction, length_rule)``)."""
         return fixed_point_iterates(self.delta, self.min_fraction, self.length_rule)
 
     def sequence(self) -> IterateSequence:
-        """The phases of the l generalized iterates (Yoder et al.), as ``IterateSequence``."""
+        """The phases of the l generalized iterates (Yoder et al.), as ``IterateSequence``.
+
+        Returns:
+            ``IterateSequence.fixed_point(delta, iterates)``.
+        """
         return IterateSequence.fixed_point(self.delta, self.iterates)
 
     def success_probability(self, fraction: float) -> float:

@@ -82,6 +82,12 @@ def depolarizing_backend(p1: float, p2: float, method: str = "statevector", seed
     Raises:
         TypeError: A non-numeric probability.
         ValueError: p1 or p2 outside [0, 1], or an unknown ``method``.
+
+    Example:
+        >>> from qrrt_circuits.search.noisy import depolarizing_backend
+        >>> backend = depolarizing_backend(0.001, 0.01, seed=0)
+        >>> backend.describe()
+        'noisy-sampler (depolarizing p1=0.001 (sx, x), p2=0.01 (cx))'
     """
     from qiskit_aer.primitives import SamplerV2
 

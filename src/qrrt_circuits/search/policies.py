@@ -74,6 +74,18 @@ class IterationPolicy:
     The class attribute ``uses_true_m`` is True if the policy reads the database's true marked
     count m (simulation knowledge a quantum device does not have, labelled in every output that
     depends on it); ``name`` is the policy's short name.
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits import DatabaseSearch, KnownOptimal, PaperSchedule, StatevectorBackend
+        >>> from qrrt_circuits.randomness import RandomStreams
+        >>> marks = np.zeros(64, dtype=bool)
+        >>> marks[:2] = True
+        >>> problem = DatabaseSearch(marks, marks, StatevectorBackend(seed=0), RandomStreams(0), 0)
+        >>> PaperSchedule().iterations_for(problem, 0), PaperSchedule().iterations_for(problem, 11)
+        (5, 3)
+        >>> KnownOptimal().iterations_for(problem, 0)  # floor(pi / (4 asin(sqrt(2/64))))
+        4
     """
 
     uses_true_m: bool = False
@@ -91,6 +103,7 @@ class IterationPolicy:
         return PolicyState(self, num_items)
 
     def describe(self) -> str:
+        """The policy in words (recorded in ``PlanResult.settings``)."""
         return self.name
 
     def labels(self) -> tuple[str, ...]:
@@ -177,6 +190,15 @@ class PolicyState:
     iterations = choose_iterations
 
     def iterations_for(self, problem: DatabaseSearch, tree_nodes: int) -> int:
+        """The policy's k for ``problem`` (``IterationPolicy.iterations_for``).
+
+        Args:
+            problem: The database search.
+            tree_nodes: Nodes in the tree so far.
+
+        Returns:
+            k >= 0.
+        """
         return self.policy.iterations_for(problem, tree_nodes)
 
     def run(self, problem: DatabaseSearch, workers: int, tree_nodes: int) -> tuple[SearchOutcome, ...]:
@@ -225,10 +247,21 @@ class PolicyState:
                      for problem, k, result in zip(problems, iterations, results, strict=True))
 
     def observe(self, iterations: int, success: bool) -> None:
-        """Record that a measurement after ``iterations`` iterations verified (or not)."""
+        """Record that a measurement after ``iterations`` iterations verified (or not).
+
+        Nothing by default; learning policies (``Adaptive``) update their posterior.
+
+        Args:
+            iterations: k of the measured preparation.
+            success: Whether the measured entry verified.
+        """
 
     def learn(self, outcomes: Iterable[SearchOutcome]) -> None:
-        """Feed a round's outcomes back, in worker order."""
+        """Feed a round's outcomes back, in worker order.
+
+        Args:
+            outcomes: The round's ``SearchOutcome`` objects; each observation goes to ``observe``.
+        """
         for outcome in outcomes:
             for iterations, success in outcome.observations:
                 self.observe(iterations, success)
@@ -317,6 +350,11 @@ class KnownOptimal(IterationPolicy):
 
     k = floor(pi / (4 theta)) with sin^2 theta = m/N, and 0 for m = 0. Reading m is simulation
     knowledge a quantum device does not have; every output planned with it is labelled so.
+
+    Example:
+        >>> from qrrt_circuits import KnownOptimal
+        >>> KnownOptimal.uses_true_m, KnownOptimal().describe()
+        (True, 'optimal (uses the true m of each database: simulation knowledge)')
     """
 
     name = "optimal"
@@ -340,7 +378,14 @@ class KnownOptimal(IterationPolicy):
 
 @dataclass(frozen=True)
 class BBHTOutcome:
-    """One BBHT search: the verified index or None, iterations and verifications spent."""
+    """One BBHT search: the verified index or None, iterations and verifications spent.
+
+    Args:
+        index: The verified database entry, or None if the loop gave up.
+        iterations: Grover iterations spent over all attempts (quantum oracle calls).
+        verifications: Measured entries verified (one per attempt).
+        attempts: ``(iterations, verified)`` per attempt.
+    """
 
     index: int | None
     iterations: int
@@ -513,7 +558,14 @@ class Adaptive(IterationPolicy):
 
     def state_bytes(self, num_items: int) -> int:
         """The success table sin^2((2k+1) theta(f)), (k_max + 1) x grid_size float64, and the
-        temporaries that build it (3 tables)."""
+        temporaries that build it (3 tables).
+
+        Args:
+            num_items: N, the database size.
+
+        Returns:
+            3 x 8 x (k_max + 1) x ``grid_size`` bytes.
+        """
         return 3 * 8 * (self.iterations_bound(num_items) + 1) * int(self.grid_size)
 
     def describe(self) -> str:
@@ -521,6 +573,18 @@ class Adaptive(IterationPolicy):
 
 
 class AdaptiveState(PolicyState):
+    """Per-plan state of ``Adaptive``: a posterior over the marked fraction f on a geometric grid.
+
+    k is chosen to maximise E[sin^2((2k+1) theta(f))] / (k + 1), sin^2 theta = f (Eq. 1; the
+    expected successes per oracle call), the expectation under the posterior; each verified or
+    refuted measurement multiplies the likelihood by sin^2((2k+1) theta) or its complement (the old
+    log-likelihood discounted by ``forgetting``).
+
+    Args:
+        policy: The ``Adaptive`` policy.
+        num_items: N, the entries of each database.
+    """
+
     policy: Adaptive
 
     def __init__(self, policy: Adaptive, num_items: int) -> None:
@@ -537,6 +601,7 @@ class AdaptiveState(PolicyState):
 
     @property
     def log_posterior(self) -> np.ndarray:
+        """Log prior + log likelihood on the grid of fractions (unnormalised)."""
         return self.log_prior + self.log_likelihood
 
     def choose_iterations(self, tree_nodes: int, num_marked: int | None = None) -> int:
@@ -549,6 +614,15 @@ class AdaptiveState(PolicyState):
     iterations = choose_iterations
 
     def iterations_for(self, problem: DatabaseSearch, tree_nodes: int) -> int:
+        """The posterior's k (``choose_iterations``); the problem's true m is never read.
+
+        Args:
+            problem: The database search (unused but for its type).
+            tree_nodes: Nodes in the tree so far.
+
+        Returns:
+            k >= 0.
+        """
         return self.choose_iterations(tree_nodes)
 
     def observe(self, iterations: int, success: bool) -> None:
@@ -566,7 +640,23 @@ class AdaptiveState(PolicyState):
 
 def parse_policy(text: str) -> IterationPolicy:
     """A policy from its registry name: ``paper``, ``optimal``, ``bbht``, ``adaptive`` or ``fixed:K``
-    (see ``qrrt_circuits.registry.POLICIES``)."""
+    (see ``qrrt_circuits.registry.POLICIES``).
+
+    Args:
+        text: A name of ``POLICIES`` (``"fixed:3"``, ``"fixed-point:0.3"``, ``"estimated"``, ...).
+
+    Returns:
+        The ``IterationPolicy``.
+
+    Raises:
+        TypeError: ``text`` is not a string.
+        ValueError: An unknown name or a malformed parameter.
+
+    Example:
+        >>> from qrrt_circuits.search.policies import parse_policy
+        >>> parse_policy("fixed:3")
+        FixedIterations(k=3)
+    """
     from ..registry import POLICIES
 
     return POLICIES.create(text)

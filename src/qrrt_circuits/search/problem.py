@@ -27,7 +27,25 @@ from .backend import QuantumSearchBackend, SearchRequest, SearchResult
 
 @dataclass(frozen=True)
 class SearchOutcome:
-    """One worker's search: ``index`` is the measured entry that verified, or None."""
+    """One worker's search: ``index`` is the measured entry that verified, or None.
+
+    Oracle calls as DESIGN §2 counts them: ``quantum_calls`` (one per Grover iteration, or per
+    generalized iterate, of every preparation this worker ran) plus ``verifications`` (the
+    classical finalizer of Alg. 2 / 3, one per measured entry checked).
+
+    Args:
+        index: The measured database entry that verified, or None if none did.
+        quantum_calls: Quantum oracle calls this worker spent.
+        verifications: Verification calls this worker spent.
+        observations: ``(iterations, verified)`` per measurement, for learning policies.
+
+    Example:
+        >>> from qrrt_circuits import SearchOutcome
+        >>> outcome = SearchOutcome(index=5, quantum_calls=6, verifications=2,
+        ...                         observations=((3, False), (3, True)))
+        >>> outcome.verified, outcome.oracle_calls, outcome.rejected
+        (True, 8, 1)
+    """
 
     index: int | None
     quantum_calls: int
@@ -36,6 +54,7 @@ class SearchOutcome:
 
     @property
     def verified(self) -> bool:
+        """Whether a measured entry verified (``index is not None``)."""
         return self.index is not None
 
     @property
@@ -53,7 +72,31 @@ class SearchOutcome:
 class DatabaseSearch:
     """A database of ``len(marks)`` entries searched by workers ``first_worker, first_worker + 1, ...``
     in round ``round_index``. ``marks`` are the phase oracle's (possibly erroneous) marks;
-    ``truth`` the true predicate used by ``verify``."""
+    ``truth`` the true predicate used by ``verify``.
+
+    What a search policy sees of one database of Alg. 2 / 3: Grover search (``search``),
+    generalized iterates (``search_sequence``), the classical finalizer (``verify``, 1 oracle call)
+    and the size N. ``marked_count`` is simulation knowledge (``KnownOptimal`` only, labelled).
+
+    Args:
+        marks: Boolean array of length N = 2^n, the phase oracle's marks.
+        truth: Boolean array of length N, the true reachability used by ``verify``.
+        backend: The ``QuantumSearchBackend`` that runs the searches.
+        streams: The plan's ``RandomStreams`` (seeds keyed by round and worker).
+        round_index: The planner's round.
+        first_worker: The first worker searching this database (default 0).
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits import DatabaseSearch, StatevectorBackend
+        >>> from qrrt_circuits.randomness import RandomStreams
+        >>> marks = np.zeros(8, dtype=bool)
+        >>> marks[5] = True
+        >>> problem = DatabaseSearch(marks, marks, StatevectorBackend(seed=0), RandomStreams(0),
+        ...                          round_index=0)
+        >>> problem.num_items, problem.marked_count(), problem.verify(5), problem.verify(0)
+        (8, 1, True, False)
+    """
 
     marks: np.ndarray
     truth: np.ndarray
@@ -64,23 +107,62 @@ class DatabaseSearch:
 
     @property
     def num_items(self) -> int:
+        """N, the database's entries."""
         return int(self.marks.shape[0])
 
     def search(self, iterations: int, shots: int, seed: int) -> np.ndarray:
-        """Measured indices (one per shot) after ``iterations`` Grover iterations."""
+        """Measured indices (one per shot) after ``iterations`` Grover iterations.
+
+        Args:
+            iterations: k, the Grover iterations of each preparation (k quantum oracle calls).
+            shots: Independent preparations and measurements (one per worker).
+            seed: The backend's sampling seed.
+
+        Returns:
+            Int array of ``shots`` measured indices.
+
+        Raises:
+            ValueError: k or ``shots`` out of the backend's range.
+            TypeError: A non-integer k or ``shots``.
+        """
         return self.backend.search(self.marks, iterations, shots, seed=seed).indices
 
     def search_sequence(self, sequence, shots: int, seed: int) -> np.ndarray:
         """Measured indices (one per shot) after the generalized iterates of ``sequence`` (an
-        ``IterateSequence``: fixed-point amplification), len(sequence) oracle calls per shot."""
+        ``IterateSequence``: fixed-point amplification), len(sequence) oracle calls per shot.
+
+        Args:
+            sequence: The ``IterateSequence``.
+            shots: Independent preparations and measurements.
+            seed: The backend's sampling seed.
+
+        Returns:
+            Int array of ``shots`` measured indices.
+        """
         return self.backend.search_sequence(self.marks, sequence, shots, seed=seed).indices
 
     def request(self, iterations: int, shots: int, seed: int) -> SearchRequest:
-        """``search``'s arguments as a request for ``search_together``."""
+        """``search``'s arguments as a request for ``search_together``.
+
+        Args:
+            iterations: k.
+            shots: Preparations.
+            seed: The sampling seed.
+
+        Returns:
+            A ``SearchRequest`` for this database's marks.
+        """
         return SearchRequest(self.marks, iterations, shots, seed)
 
     def verify(self, index: int) -> bool:
-        """The classical finalizer: is entry ``index`` truly reachable? (1 oracle call.)"""
+        """The classical finalizer: is entry ``index`` truly reachable? (1 oracle call.)
+
+        Args:
+            index: A database entry, 0 .. N - 1.
+
+        Returns:
+            ``truth[index]``.
+        """
         return bool(self.truth[index])
 
     def marked_count(self) -> int:
@@ -88,16 +170,38 @@ class DatabaseSearch:
         return int(np.count_nonzero(self.marks))
 
     def shared_seed(self) -> int:
-        """The seed of one search serving all the workers of this database."""
+        """The seed of one search serving all the workers of this database.
+
+        Returns:
+            The seed of stream (``round_index``, ``first_worker``, ``Stream.SEARCH``).
+        """
         return self.streams.seed(self.round_index, self.first_worker, Stream.SEARCH)
 
     def worker_generator(self, offset: int) -> np.random.Generator:
-        """The policy's own generator for worker ``first_worker + offset``."""
+        """The policy's own generator for worker ``first_worker + offset``.
+
+        Args:
+            offset: The worker's offset from ``first_worker`` (>= 0).
+
+        Returns:
+            The generator of stream (``round_index``, worker, ``Stream.POLICY``).
+        """
         return self.streams.generator(self.round_index, self.first_worker + offset, Stream.POLICY)
 
 
 def search_together(problems: Sequence[DatabaseSearch], requests: Sequence[SearchRequest]) -> tuple[SearchResult, ...]:
-    """One request per database, all handed to their (common) backend's ``search_many``."""
+    """One request per database, all handed to their (common) backend's ``search_many``.
+
+    Args:
+        problems: The databases, all searched by one backend.
+        requests: One ``SearchRequest`` per database, in order.
+
+    Returns:
+        One ``SearchResult`` per request, in order (empty for no problems).
+
+    Raises:
+        ValueError: Databases with different backends.
+    """
     if not problems:
         return ()
     backend = problems[0].backend

@@ -58,6 +58,17 @@ class SamplerBackend(QuantumSearchBackend):
         ValueError: ``sampler`` has no ``run``, an unknown ``synthesis``, an
             ``optimization_level`` other than 0-3, or a negative ``seed``.
         TypeError: A ``seed`` of the wrong type.
+
+    Example:
+        >>> import numpy as np
+        >>> from qiskit_aer.primitives import SamplerV2
+        >>> from qrrt_circuits import SamplerBackend
+        >>> backend = SamplerBackend(SamplerV2(), seed=0)
+        >>> marks = np.zeros(8, dtype=bool)
+        >>> marks[5] = True
+        >>> result = backend.search(marks, iterations=2, shots=100, seed=1)
+        >>> result.oracle_calls, backend.transpile_count, backend.labels()
+        (200, 1, ())
     """
 
     name = "sampler"
@@ -108,7 +119,15 @@ class SamplerBackend(QuantumSearchBackend):
         return self._cached_transpile(key, lambda: grover_circuit(marks, iterations, synthesis=self.synthesis))
 
     def compiled_sequence(self, marks: np.ndarray, sequence):
-        """The transpiled ``generalized_grover_circuit`` (cached by marks and phases)."""
+        """The transpiled ``generalized_grover_circuit`` (cached by marks and phases).
+
+        Args:
+            marks: Validated boolean marks of length 2^n.
+            sequence: The ``IterateSequence``.
+
+        Returns:
+            The transpiled, measured ``QuantumCircuit``.
+        """
         key = (marks.shape[0], np.packbits(marks).tobytes(), "sequence", sequence.key())
         return self._cached_transpile(
             key, lambda: generalized_grover_circuit(marks, sequence, synthesis=self.synthesis))
