@@ -16,7 +16,7 @@ from ..database import AnnealingSchedule
 from ..dynamics import LinearTrackingDynamics
 from ..plotting import plot_edges
 from ..search.policies import FixedIterations
-from .base import Experiment, TrialStream, paired_trials
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, paired_trials
 from .figures import new_figure, save
 from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import dumps, loads, rounded
@@ -32,16 +32,16 @@ class Annealing(Experiment):
     title = "Quantum Database Annealing vs uniform databases (paper Figs. 15-17)"
     paper = {"QDA": 3.68, "QRRT": 1.70}
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         return {"trials": trials or (3 if quick else 20), "num_qubits": 9, "iterations": 2,
                 "bands": [[2.7, 4.2], [0.8, 2.0]], "switch_at": 16, "sizes": list(SIZES),
                 "backend": "aer", "scenario": "annealing_field", "seed": seed, "quick": quick}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         return paired_trials(settings, [(method, {"method": method}) for method in METHODS],
                              TrialStream.ANNEALING_WORLDS, TrialStream.ANNEALING_PLANNERS)
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         env = world(settings["scenario"], trial.params["world_seed"])
         annealing = None
         if trial.params["method"] == "QDA":
@@ -61,7 +61,7 @@ class Annealing(Experiment):
         record["parents_json"] = dumps(result.parents.tolist())
         return record
 
-    def summarize(self, records, settings):
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
         ours = {}
         for method in METHODS:
             rows = [r for r in records if r["method"] == method]
@@ -84,7 +84,7 @@ class Annealing(Experiment):
                 "target_2x_reached": bool(ratio[str(min(settings["sizes"]))] >= 2.0),
                 "note": "mean distance from node to parent over the first 16 and all 48 nodes"}
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         first = {r["method"]: r for r in records if r["replicate"] == 0}
         env = world(settings["scenario"], first["QDA"]["world_seed"])
         sizes = settings["sizes"]

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .base import Experiment, Trial, TrialStream, replicate_seed
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, node_heatmap, save
 from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import cut_at, dumps, loads, reachable_fraction, rounded
@@ -28,17 +28,17 @@ class Corridor(Experiment):
     title = "Narrow corridor at 25 oracle calls (paper Figs. 13-14)"
     paper = {"QRRT": 47, "RRT": 14}
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         return {"trials": trials or (10 if quick else 50), "budget": 25, "num_qubits": 8,
                 "backend": "aer", "schedule": "paper", "scenario": "narrow_corridor", "world_seed": 0,
                 "seed": seed, "quick": quick}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         return [Trial(f"{kind}-{i}", {"planner": kind, "replicate": i},
                       replicate_seed(settings["seed"], i, TrialStream.CORRIDOR))
                 for kind in PLANNERS for i in range(settings["trials"])]
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         env = world(settings["scenario"], settings["world_seed"])
         planner = planner_for(settings, trial.params["planner"], env, trial.seed, settings["backend"],
                                num_qubits=settings["num_qubits"])
@@ -52,7 +52,7 @@ class Corridor(Experiment):
                 "through_channel": int((positions[:, 0] > channel[1][0]).sum()),
                 "positions_json": dumps(rounded(positions))}
 
-    def summarize(self, records, settings):
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
         ours = {kind: sum(r["in_channel"] for r in records if r["planner"] == kind) for kind in PLANNERS}
         interval = {kind: rounded_interval(bootstrap_interval(
             [r for r in records if r["planner"] == kind], lambda rows: sum(r["in_channel"] for r in rows),
@@ -68,7 +68,7 @@ class Corridor(Experiment):
                 "note": "nodes inside the channel rectangle, summed over the trials; reachable_fraction is "
                         "the share of candidates (RRT tests, q-RRT database entries) that were reachable"}
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         env = world(settings["scenario"], settings["world_seed"])
         fig, axes = new_figure(1, len(PLANNERS), (5.2 * len(PLANNERS), 4.6))
         for col, kind in enumerate(PLANNERS):

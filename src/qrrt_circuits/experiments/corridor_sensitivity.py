@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .base import Experiment, Trial, TrialStream, replicate_seed
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .corridor import in_channel
 from .figures import new_figure, save
 from .intervals import bootstrap_interval, rounded_interval
@@ -64,19 +64,19 @@ class CorridorSensitivity(Experiment):
     title = "Narrow corridor: channel nodes against start, clutter, iterations and database size"
     paper = PAPER
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         factors = {key: values[::2] if quick else values for key, values in FACTORS.items()}
         if quick:
             factors = {key: sorted(set(values) | {BASE[key]}, key=str) for key, values in factors.items()}
         return {"trials": trials or (10 if quick else 50), "budget": 25, "backend": "statevector",
                 "scenario": "narrow_corridor", "world_seed": 0, "factors": factors, "seed": seed, "quick": quick}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         return [Trial(f"{kind}-{cell_id(cell)}-{i}", {"planner": kind, **cell, "replicate": i},
                       replicate_seed(settings["seed"], i, TrialStream.CORRIDOR_SENSITIVITY))
                 for cell in cells(settings["factors"]) for kind in PLANNERS for i in range(settings["trials"])]
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         params = trial.params
         env = world(settings["scenario"], settings["world_seed"], mouth_clearance=params["mouth_clearance"])
         start, distance = start_before_mouth(env, params["distance"])
@@ -88,7 +88,7 @@ class CorridorSensitivity(Experiment):
         return {"nodes": nodes, "oracle_calls": calls, "start_distance": round(distance, 3),
                 "in_channel": int(in_channel(positions, env.metadata["channel"]).sum())}
 
-    def summarize(self, records, settings):
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
         ours, interval = {}, {}
         for cell in cells(settings["factors"]):
             key = cell_id(cell)
@@ -112,7 +112,7 @@ class CorridorSensitivity(Experiment):
                 "labels": ["phase oracle from a classical lookup of all 2^n entries",
                            "backend: exact statevector (ideal; same statistics as Aer)"]}
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         factors = settings["factors"]
         fig, axes = new_figure(1, len(factors), (4.4 * len(factors), 4.2))
         colors = {"RRT": "tab:gray", "QRRT": "tab:blue"}

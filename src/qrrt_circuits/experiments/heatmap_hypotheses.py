@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from ..search.policies import FixedIterations, PaperSchedule
-from .base import Experiment, Trial, TrialStream, replicate_seed
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import cut_at
@@ -70,20 +70,20 @@ class HeatmapHypotheses(Experiment):
     title = "Which setup gives the paper's heatmap numbers? (Figs. 10-12 hypotheses)"
     paper = PAPER
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         return {"trials": trials or (20 if quick else 100), "worlds": 2 if quick else 10, "cuts": list(CUTS),
                 "box_counts": list(BOX_COUNTS[::2] + (525,) if quick else BOX_COUNTS), "num_qubits": 8,
                 "backend": "statevector", "scenario": "paper_clutter",
                 "variants": list(VARIANTS), "seed": seed, "quick": quick}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         return [Trial(f"{variant}-{boxes}-{i}", {"variant": variant, "boxes": boxes, "replicate": i,
                                                  "world_seed": i % settings["worlds"]},
                       replicate_seed(settings["seed"], i, TrialStream.HEATMAP_HYPOTHESES))
                 for boxes in settings["box_counts"] for variant in settings["variants"]
                 for i in range(settings["trials"])]
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         env = world(settings["scenario"], trial.params["world_seed"], num_boxes=trial.params["boxes"])
         planner_name, policy = VARIANTS[trial.params["variant"]]
         planner = planner_for(settings, planner_name, env, trial.seed, settings["backend"],
@@ -94,7 +94,7 @@ class HeatmapHypotheses(Experiment):
             record[f"nodes_at_{cut}"], record[f"calls_at_{cut}"] = cut_at(result, cut)
         return record
 
-    def summarize(self, records, settings):
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
         counts, cuts = settings["box_counts"], [str(c) for c in settings["cuts"]]
         table, spans = {}, {}
         for variant in settings["variants"]:
@@ -148,7 +148,7 @@ class HeatmapHypotheses(Experiment):
                 "labels": ["phase oracle from a classical lookup of all 2^8 entries",
                            "backend: exact statevector (ideal; same statistics as Aer)"]}
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         fig, axes = new_figure(1, 2, (12, 4.6))
         counts = settings["box_counts"]
         colors = {"RRT": "tab:gray", "QRRT paper": "tab:blue", "QRRT k=2": "tab:orange"}

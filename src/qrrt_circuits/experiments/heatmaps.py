@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .base import Experiment, Trial, TrialStream, replicate_seed
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, node_heatmap, save
 from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import cut_at, dumps, loads, reachable_fraction, rounded
@@ -36,17 +36,17 @@ class Heatmaps(Experiment):
              "RRT": {"10": {"nodes": 125, "efficiency": 0.125}, "20": {"nodes": 231, "efficiency": 0.116},
                      "40": {"nodes": 526, "efficiency": 0.132}}}
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         return {"trials": trials or (50 if quick else 100), "cuts": list(CUTS), "workers": 8,
                 "num_qubits": 8, "backend": "aer", "schedule": "paper", "scenario": "paper_clutter",
                 "world_seed": 0, "seed": seed, "quick": quick}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         return [Trial(f"{kind}-{i}", {"planner": kind, "replicate": i},
                       replicate_seed(settings["seed"], i, TrialStream.HEATMAPS))
                 for kind in PLANNERS for i in range(settings["trials"])]
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         env = world(settings["scenario"], settings["world_seed"])
         planner = planner_for(settings, trial.params["planner"], env, trial.seed, settings["backend"],
                                settings["workers"], settings["num_qubits"])
@@ -65,7 +65,7 @@ class Heatmaps(Experiment):
         record["positions_json"] = dumps(rounded(result.nodes[1:]))
         return record
 
-    def summarize(self, records, settings):
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
         ours = {}
         for kind in PLANNERS:
             rows = [r for r in records if r["planner"] == kind]
@@ -102,7 +102,7 @@ class Heatmaps(Experiment):
                 "labels": ["phase oracle from a classical lookup of all 2^8 entries",
                            f"backend: {BACKEND_LABEL[settings['backend']]}"]}
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         env = world(settings["scenario"], settings["world_seed"])
         cuts = settings["cuts"]
         fig, axes = new_figure(len(PLANNERS), len(cuts), (4.6 * len(cuts), 4.2 * len(PLANNERS)))

@@ -19,7 +19,7 @@ import numpy as np
 
 from .. import probability as pr
 from ..oracle import OracleErrorModel
-from .base import Experiment, Trial, TrialStream, replicate_seed
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import binomial_interval, rounded_interval
 from .planners import make_backend
@@ -54,7 +54,7 @@ class Lemmas(Experiment):
              "lemma3": "m H_m / P(G)", "lemma4": "(m1/m) P(G) + (m2/(N-m)) (1-P(G))",
              "lemma5": "m1 (P(G)/m)^p + m2 ((1-P(G))/(N-m))^p", "lemma6": "m1 H_m1 / ((m1/m) P(G))"}
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         grid = [[n, m, p, fp, fn] for n in GRID_QUBITS for m in GRID_MARKED for p in GRID_WORKERS
                 for fp, fn in ERRORS if m <= 2**n]
         if quick:
@@ -62,13 +62,13 @@ class Lemmas(Experiment):
         return {"repeats": trials or (400 if quick else 3000), "grid": grid, "backend": "aer",
                 "seed": seed, "quick": quick}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         return [Trial(f"n{n}-m{m}-p{p}-fp{fp}-fn{fn}", {"qubits": n, "marked": m, "workers": p,
                                                          "false_positive": fp, "false_negative": fn},
                       replicate_seed(settings["seed"], i, TrialStream.LEMMAS))
                 for i, (n, m, p, fp, fn) in enumerate(settings["grid"])]
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         n, m, p = trial.params["qubits"], trial.params["marked"], trial.params["workers"]
         size = 2**n
         rng = np.random.default_rng(trial.seed)
@@ -121,7 +121,7 @@ class Lemmas(Experiment):
                 put(name, float("nan"), theory, float("nan"))
         return record
 
-    def summarize(self, records, settings):
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
         ours = {}
         for lemma in ("lemma1", "lemma2", "lemma3", "lemma4", "lemma5", "lemma6"):
             z = []
@@ -139,7 +139,7 @@ class Lemmas(Experiment):
                 "note": "z = (observed - lemma) / standard error; the lemmas are exact for these "
                         "events, so about 99.7% of points should lie within 3 sigma"}
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         lemmas = ("lemma1", "lemma2", "lemma3", "lemma4", "lemma5", "lemma6")
         fig, axes = new_figure(2, 3, (14, 8.5))
         for ax, lemma in zip(axes.ravel(), lemmas, strict=True):

@@ -29,7 +29,7 @@ from ..probability import good_probability
 from ..registry import PLANNERS, PREDICATES
 from ..search.noisy import depolarizing_backend, fake_device_backend
 from ..search.policies import Adaptive, KnownOptimal
-from .base import Experiment, Trial, TrialStream, replicate_seed
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import binomial_interval, bootstrap_interval, rounded_interval
 from .worlds import world
@@ -64,7 +64,7 @@ class Noise(Experiment):
     uses_predicate = True
     paper = {"noise": "none: the paper assumes a perfect quantum computer"}
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         device = noise.available_fake_device() if noise.has_fake_devices() else None
         if quick:
             return {"trials": trials or 1, "seed": seed, "quick": True,
@@ -81,7 +81,7 @@ class Noise(Experiment):
                 "planning_p2": [0.0, 1e-3, 3e-3, 1e-2], "planning_qubits": 6, "nodes": 15,
                 "planning_configs": list(QRRT_CONFIGS)}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         out = []
         root = settings["seed"]
         # sweep: every (n, k, p2) on the first database; n <= exact_max_qubits on `trials` databases
@@ -109,7 +109,7 @@ class Noise(Experiment):
                                      {**common, "config": config, "p2": p2}, seed))
         return out
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         record = getattr(self, f"_run_{trial.params['part']}")(trial, settings)
         return {key: value for key, value in COLUMNS.items() if key not in trial.params} | record
 
@@ -177,7 +177,7 @@ class Noise(Experiment):
                 "rejected": m.rejected, "rounds": m.rounds, "calls_per_node": m.oracle_calls / max(m.nodes, 1)}
 
     # ------------------------------------------------------------------ summary
-    def summarize(self, records, settings):
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
         sweep = [r for r in records if r["part"] == "sweep"]
         k_top = max(settings["sweep_iterations"])
         success = {}
@@ -242,7 +242,7 @@ class Noise(Experiment):
                                    for c, v in calls.items()},
                 "intervals": calls, "break_even_p2": break_even}
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         fig, axes = new_figure(2, 2, (11, 8.5))
         self._plot_sweep(axes[0, 0], records, settings)
         self._plot_device(axes[0, 1], records, settings)

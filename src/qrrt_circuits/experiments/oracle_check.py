@@ -16,7 +16,7 @@ import numpy as np
 
 from ..oracle import ReachabilityOracle
 from ..registry import PREDICATES
-from .base import Experiment, Trial, TrialStream, replicate_seed
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import bootstrap_interval, rounded_interval
 from .measures import cut_at, reachable_fraction
@@ -44,17 +44,17 @@ class OracleCheck(Experiment):
     title = "Exact collision check vs time-sampled checks (beyond the paper)"
     paper = {"RRT": 0.132, "QRRT": 0.260}
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         return {"trials": trials or (4 if quick else 30), "budget": 40, "num_qubits": 8, "backend": "statevector",
                 "scenario": "paper_clutter", "world_seed": 0, "checks": list(CHECKS), "seed": seed,
                 "quick": quick}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         return [Trial(f"{check}-{kind}-{i}", {"check": check, "planner": kind, "replicate": i},
                       replicate_seed(settings["seed"], i, TrialStream.ORACLE_CHECK))
                 for check in settings["checks"] for kind in PLANNERS for i in range(settings["trials"])]
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         env = world(settings["scenario"], settings["world_seed"])
         predicate = make_predicate(env, trial.params["check"])
         planner = make_planner(trial.params["planner"], env, trial.seed, settings["backend"],
@@ -67,7 +67,7 @@ class OracleCheck(Experiment):
         return {"nodes": nodes, "oracle_calls": calls, "invalid_edges": int(nodes - np.sum(valid)),
                 "reachable_fraction": reachable_fraction(result)}
 
-    def summarize(self, records, settings):
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
         ours, invalid, fraction, interval = {}, {}, {}, {}
         for check in settings["checks"]:
             ours[check], invalid[check], fraction[check], interval[check] = {}, {}, {}, {}
@@ -83,7 +83,7 @@ class OracleCheck(Experiment):
                 "note": "efficiency = nodes / oracle calls at the 40-call cut; invalid edges are tree edges the "
                         "exact check rejects (they pass through an obstacle)"}
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         fig, axes = new_figure(1, 2, (11, 4.2))
         checks = settings["checks"]
         x = np.arange(len(checks))

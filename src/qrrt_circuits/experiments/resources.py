@@ -24,7 +24,7 @@ import numpy as np
 from .. import resources as res
 from ..registry import PLANNERS, PREDICATES
 from ..search.policies import PaperSchedule
-from .base import Experiment, Trial, TrialStream, replicate_seed
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import bootstrap_interval, rounded_interval
 from .worlds import world
@@ -50,7 +50,7 @@ class Resources(Experiment):
     title = "Gates and time per oracle call and per plan, near term and fault tolerant (beyond the paper)"
     paper = {"cost_model": "oracle calls only; the paper gives no gate counts or times"}
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         lookups = ["qrom", "select-swap"] if res.has_qualtran() else ["qrom"]
         return {"trials": trials or (1 if quick else 10), "seed": seed, "quick": quick,
                 "qubits": [3, 4] if quick else list(range(4, 13)), "syntheses": ["diagonal", "mcz"],
@@ -59,7 +59,7 @@ class Resources(Experiment):
                 "plan_qubits": 4 if quick else 8, "nodes": 3 if quick else 30,
                 "toffoli_s": ASSUMPTIONS.toffoli_s, "two_qubit_gate_s": ASSUMPTIONS.two_qubit_gate_s}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         out = []
         root = settings["seed"]
         for n in settings["qubits"]:
@@ -81,7 +81,7 @@ class Resources(Experiment):
                                  seed))
         return out
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         part = trial.params["part"].replace("-", "_")
         record = getattr(self, f"_run_{part}")(trial, settings)
         return {key: value for key, value in COLUMNS.items() if key not in trial.params} | record
@@ -117,7 +117,7 @@ class Resources(Experiment):
                 "simulation_checks": m.simulation_checks, "rounds": m.rounds, "wall_time_s": m.wall_time_s}
 
     # ------------------------------------------------------------------ summary
-    def summarize(self, records, settings):
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
         near = {}
         for r in (r for r in records if r["part"] == "near-term"):
             near.setdefault(str(r["n"]), {})[f"{r['synthesis']}/{r['connectivity']}"] = {
@@ -185,7 +185,7 @@ class Resources(Experiment):
                                                      if table["break_even_call_s"] > 0 else math.inf))
         return {"table": table, "interval_95": intervals}
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         fig, axes = new_figure(1, 3, (16, 4.8))
         ax = axes[0, 0]
         for synthesis, marker in zip(settings["syntheses"], "os", strict=False):

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ..search.policies import BBHT, Adaptive, KnownOptimal
-from .base import Experiment, Trial, TrialStream, replicate_seed
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .fitting import power_law_exponent
 from .intervals import bootstrap_interval, rounded_interval
@@ -31,12 +31,12 @@ class Scaling(Experiment):
     title = "Oracle calls per node against the reachable fraction (beyond the paper)"
     paper = {"RRT": -1.0, "QRRT optimal": -0.5, "QRRT bbht": -0.5, "QRRT adaptive": -0.5}
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         return {"trials": trials or (2 if quick else 6),
                 "densities": list(DENSITIES[::2] if quick else DENSITIES), "nodes": 30,
                 "num_qubits": 8, "backend": "statevector", "seed": seed, "quick": quick}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         out = []
         for density in settings["densities"]:
             for replicate in range(settings["trials"]):
@@ -49,7 +49,7 @@ class Scaling(Experiment):
                                                     TrialStream.SCALING_PLANNERS)))
         return out
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         env = world("paper_clutter", trial.params["world_seed"], num_boxes=trial.params["boxes"])
         name = trial.params["config"]
         if name == "RRT":
@@ -63,7 +63,7 @@ class Scaling(Experiment):
                 "calls_per_node": m.oracle_calls / max(m.nodes, 1),
                 "reachable_fraction": reachable_fraction(result)}
 
-    def summarize(self, records, settings):
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
         ours, fits = {}, {}
         for name in CONFIGS:
             rows = [r for r in records if r["config"] == name and r["nodes"] > 0]
@@ -80,7 +80,7 @@ class Scaling(Experiment):
                 "labels": ["QRRT optimal uses the true m of each database (simulation knowledge)",
                            f"backend: {BACKEND_LABEL[settings['backend']]}"]}
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         fig, axes = new_figure(1, 1, (6.5, 5))
         ax = axes[0, 0]
         colors = dict(zip(CONFIGS, ["tab:gray", "tab:blue", "tab:green", "tab:orange"], strict=True))

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..registry import POLICIES
 from ..search.estimated_policy import EstimatedOptimal
-from .base import Experiment, TrialStream, paired_trials
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, paired_trials
 from .figures import new_figure, save
 from .intervals import bootstrap_interval, rounded_interval
 from .measures import dumps, loads
@@ -68,19 +68,19 @@ class SearchPolicies(Experiment):
     title = "Search that cannot overshoot: fixed-point amplification and estimated m (beyond the paper)"
     paper = {"note": "the paper uses a fixed schedule (5 then 3 iterations) and reports 30-node trees only"}
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         return {"trials": trials or (2 if quick else 3), "sizes": list(SIZES[:2] if quick else SIZES),
                 "workers": 8, "num_qubits": 8, "backend": "statevector", "scenario": "paper_clutter",
                 "configs": list(CONFIGS), "policies": {name: POLICIES.create(name).describe()
                                                        for name in POLICY_NAMES},
                 "seed": seed, "quick": quick}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         variants = [(label, {"config": label}) for label in settings["configs"]]
         return paired_trials(settings, variants, TrialStream.SEARCH_POLICIES_WORLDS,
                              TrialStream.SEARCH_POLICIES_PLANNERS)
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         env = world(settings["scenario"], trial.params["world_seed"])
         planner_name, policy_name = CONFIGS[trial.params["config"]]
         policy = _policy(policy_name)
@@ -101,7 +101,7 @@ class SearchPolicies(Experiment):
                 "points_json": dumps(calls_at_sizes(result, settings["sizes"])),
                 "fractions_json": dumps(reachable_fraction_by_window(result, settings["sizes"]))}
 
-    def summarize(self, records, settings):
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
         sizes = settings["sizes"]
         windows = [f"{a}-{b}" for a, b in zip(sizes[:-1], sizes[1:], strict=True)]
 
@@ -168,7 +168,7 @@ class SearchPolicies(Experiment):
                                       "no number of workers pays")
         return out
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         fig, axes = new_figure(1, 2, (12, 5))
         sizes = settings["sizes"]
         windows = list(summary["ours"]["RRT"])

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .base import Experiment, TrialStream, paired_trials
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, paired_trials
 from .figures import new_figure, save
 from .fitting import slope_through_origin
 from .intervals import bootstrap_interval, rounded_interval
@@ -34,15 +34,15 @@ class Wallclock(Experiment):
     paper = {"seconds_per_oracle_call": {"QRRT": 3.52, "PQRRT": 0.20},
              "seconds_per_node": {"RRT": 1.23, "ParallelRRT": 0.58, "QRRT": 25.3, "PQRRT": 3.17}}
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         return {"trials": trials or (3 if quick else 20), "nodes": 30, "workers": 8, "num_qubits": 8,
                 "scenario": "paper_clutter", "seed": seed, "quick": quick}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         variants = [(label(planner, backend), {"planner": planner, "backend": backend}) for planner, backend in CONFIGS]
         return paired_trials(settings, variants, TrialStream.PAPER_WORLDS, TrialStream.PAPER_PLANNERS)
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         env = world(settings["scenario"], trial.params["world_seed"])
         backend = trial.params["backend"]
         planner = planner_for(settings, trial.params["planner"], env, trial.seed,
@@ -55,7 +55,7 @@ class Wallclock(Experiment):
                 "critical_path_oracle_calls": m.critical_path_oracle_calls,
                 "wall_time_s": m.wall_time_s}
 
-    def summarize(self, records, settings):
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
         per_call, per_node, ms_node, ms_interval = {}, {}, {}, {}
         for planner, backend in CONFIGS:
             rows = [r for r in records if r["planner"] == planner and r["backend"] == backend]
@@ -83,7 +83,7 @@ class Wallclock(Experiment):
         low, high = summary["ms_per_node_interval_95"][name]
         return f" [{low:.3g}, {high:.3g}]"
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         fig, axes = new_figure(1, 2, (11, 4.4))
         colors = dict(zip([label(*c) for c in CONFIGS],
                           ["tab:gray", "tab:brown", "tab:blue", "tab:cyan", "tab:orange", "gold"], strict=True))
