@@ -8,6 +8,8 @@ of 16 and 48 nodes; the mean distance from a node to its parent, and tree figure
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +27,20 @@ from .worlds import world
 
 METHODS = ("QDA", "QRRT")
 SIZES = (16, 48)
+
+
+def mean_parent_distance(rows: Sequence[Record], size: int) -> float:
+    """The mean over ``rows`` of their mean node-to-parent distance in the first ``size`` nodes.
+
+    Args:
+        rows: Annealing records (column ``mean_parent_distance_{size}``; empty cells skipped).
+        size: A tree size of the settings.
+
+    Returns:
+        The mean (NaN, with a RuntimeWarning, if no row has a value).
+    """
+    return float(np.mean([r[f"mean_parent_distance_{size}"] for r in rows
+                          if r[f"mean_parent_distance_{size}"] is not None]))
 
 
 class Annealing(Experiment):
@@ -45,14 +61,14 @@ class Annealing(Experiment):
         env = world(settings["scenario"], trial.params["world_seed"])
         annealing = None
         if trial.params["method"] == "QDA":
-            annealing = AnnealingSchedule(bands=[tuple(b) for b in settings["bands"]],
+            annealing = AnnealingSchedule(bands=tuple((low, high) for low, high in settings["bands"]),
                                           switch_at=(settings["switch_at"],), counter="nodes")
         planner = planner_for(settings, "QRRT", env, trial.seed, settings["backend"],
                                num_qubits=settings["num_qubits"],
                                search_policy=FixedIterations(settings["iterations"]), annealing=annealing)
         result = planner.plan(max_nodes=max(settings["sizes"]))
         distances = np.linalg.norm(result.nodes[1:] - result.nodes[result.parents[1:]], axis=1)
-        record = {"nodes": result.metrics.nodes, "oracle_calls": result.metrics.oracle_calls,
+        record: Record = {"nodes": result.metrics.nodes, "oracle_calls": result.metrics.oracle_calls,
                   "rounds": result.metrics.rounds}
         for size in settings["sizes"]:
             part = distances[:size]
@@ -62,20 +78,19 @@ class Annealing(Experiment):
         return record
 
     def summarize(self, records: list[Record], settings: Settings) -> Summary:
-        ours = {}
+        ours: dict[str, dict[str, float]] = {}
         for method in METHODS:
             rows = [r for r in records if r["method"] == method]
             ours[method] = {str(size): round(float(np.mean([r[f"mean_parent_distance_{size}"] for r in rows
                                                             if r[f"mean_parent_distance_{size}"] is not None])), 3)
                             for size in settings["sizes"]}
         ratio = {str(s): round(ours["QDA"][str(s)] / ours["QRRT"][str(s)], 2) for s in settings["sizes"]}
-        interval = {}
+        interval: dict[str, dict[str, list[float]]] = {}
         for method in METHODS:
             rows = [r for r in records if r["method"] == method]
             interval[method] = {
-                str(size): rounded_interval(bootstrap_interval(rows, lambda sample, size=size: float(np.mean(
-                    [r[f"mean_parent_distance_{size}"] for r in sample
-                     if r[f"mean_parent_distance_{size}"] is not None])), settings["seed"]), 3)
+                str(size): rounded_interval(bootstrap_interval(
+                    rows, functools.partial(mean_parent_distance, size=size), settings["seed"]), 3)
                 for size in settings["sizes"]}
         smallest = str(min(settings["sizes"]))
         return {"ours": ours, "paper": self.paper, "ratio_qda_over_uniform": ratio,

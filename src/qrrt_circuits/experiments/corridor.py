@@ -18,7 +18,16 @@ from .worlds import world
 PLANNERS = ("RRT", "QRRT")
 
 
-def in_channel(points: np.ndarray, channel) -> np.ndarray:
+def in_channel(points: np.ndarray, channel: tuple[tuple[float, float], tuple[float, float]]) -> np.ndarray:
+    """Which points lie in the closed channel rectangle.
+
+    Args:
+        points: (N, >=2) positions.
+        channel: ``((x0, y0), (x1, y1))``, the rectangle's lower-left and upper-right corners.
+
+    Returns:
+        (N,) booleans.
+    """
     (x0, y0), (x1, y1) = channel
     return (points[:, 0] >= x0) & (points[:, 0] <= x1) & (points[:, 1] >= y0) & (points[:, 1] <= y1)
 
@@ -72,11 +81,12 @@ class Corridor(Experiment):
         env = world(settings["scenario"], settings["world_seed"])
         fig, axes = new_figure(1, len(PLANNERS), (5.2 * len(PLANNERS), 4.6))
         for col, kind in enumerate(PLANNERS):
-            points = [np.array(loads(r["positions_json"])).reshape(-1, 2) for r in records if r["planner"] == kind]
-            points = np.concatenate(points) if points else np.zeros((0, 2))
+            clouds = [np.array(loads(r["positions_json"])).reshape(-1, 2) for r in records if r["planner"] == kind]
+            points = np.concatenate(clouds) if clouds else np.zeros((0, 2))
             node_heatmap(axes[0, col], env, points,
                          f"{kind}: {summary['ours'][kind]} nodes in the channel "
                          f"{summary['interval_95'][kind]} (paper {self.paper[kind]})",
                          goal=env.goal, radius=env.goal_radius)
-            axes[0, col].plot(*env.start, "o", color="tab:green")
+            if env.start is not None:  # narrow_corridor always has a start
+                axes[0, col].plot(*env.start, "o", color="tab:green")
         return [save(fig, out_dir / "corridor.png")]

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -37,10 +38,12 @@ BOX_COUNTS = (50, 100, 150, 200, 250, 300, 400, 525)
 CUTS = (10, 20, 40)
 #: label -> (registry planner, search policy)
 VARIANTS = {"RRT": ("rrt", None), "QRRT paper": ("qrrt", PaperSchedule()), "QRRT k=2": ("qrrt", FixedIterations(2))}
-PAPER = {"RRT": {"10": {"nodes": 125, "efficiency": 0.125}, "20": {"nodes": 231, "efficiency": 0.116},
-                 "40": {"nodes": 526, "efficiency": 0.132}},
-         "QRRT": {"10": {"nodes": 372, "efficiency": 0.312}, "20": {"nodes": 650, "efficiency": 0.310},
-                  "40": {"nodes": 1091, "efficiency": 0.260}}}
+#: planner -> cut -> {"nodes", "efficiency"}
+PAPER: dict[str, dict[str, dict[str, float]]] = {
+    "RRT": {"10": {"nodes": 125, "efficiency": 0.125}, "20": {"nodes": 231, "efficiency": 0.116},
+            "40": {"nodes": 526, "efficiency": 0.132}},
+    "QRRT": {"10": {"nodes": 372, "efficiency": 0.312}, "20": {"nodes": 650, "efficiency": 0.310},
+             "40": {"nodes": 1091, "efficiency": 0.260}}}
 TARGET_RRT_EFFICIENCY = PAPER["RRT"]["10"]["efficiency"]
 
 
@@ -89,24 +92,26 @@ class HeatmapHypotheses(Experiment):
         planner = planner_for(settings, planner_name, env, trial.seed, settings["backend"],
                               num_qubits=settings["num_qubits"], search_policy=policy)
         result = planner.plan(max_oracle_calls=max(settings["cuts"]))
-        record = {"status": str(result.status)}
+        record: Record = {"status": str(result.status)}
         for cut in settings["cuts"]:
             record[f"nodes_at_{cut}"], record[f"calls_at_{cut}"] = cut_at(result, cut)
         return record
 
     def summarize(self, records: list[Record], settings: Settings) -> Summary:
         counts, cuts = settings["box_counts"], [str(c) for c in settings["cuts"]]
-        table, spans = {}, {}
+        # variant -> boxes -> cut -> {"nodes", "efficiency"}: the value, and its 95 % interval
+        table: dict[str, dict[str, dict[str, dict[str, float]]]] = {}
+        spans: dict[str, dict[str, dict[str, dict[str, list[float]]]]] = {}
         for variant in settings["variants"]:
             table[variant], spans[variant] = {}, {}
             for boxes in counts:
                 rows = [r for r in records if r["variant"] == variant and r["boxes"] == boxes]
                 table[variant][str(boxes)], spans[variant][str(boxes)] = {}, {}
                 for cut in cuts:
-                    def nodes(sample, cut=cut):  # per 100 trials, as the paper counts them
+                    def nodes(sample: list[Record], cut: str = cut) -> float:  # per 100 trials, as the paper counts
                         return 100.0 * sum(r[f"nodes_at_{cut}"] for r in sample) / len(sample)
 
-                    def efficiency(sample, cut=cut):
+                    def efficiency(sample: list[Record], cut: str = cut) -> float:
                         calls = sum(r[f"calls_at_{cut}"] for r in sample)
                         return sum(r[f"nodes_at_{cut}"] for r in sample) / calls if calls else float("nan")
 
@@ -117,13 +122,14 @@ class HeatmapHypotheses(Experiment):
                         "efficiency": rounded_interval(bootstrap_interval(rows, efficiency, settings["seed"]))}
         rrt_efficiency = [table["RRT"][str(b)]["10"]["efficiency"] for b in counts]
         calibrated = calibrate(counts, rrt_efficiency, TARGET_RRT_EFFICIENCY)
-        predictions, verdicts = {}, {}
+        predictions: dict[str, dict[str, dict[str, dict[str, Any]]]] = {}
+        verdicts: dict[str, dict[str, dict[str, bool]]] = {}
         for variant in ("QRRT paper", "QRRT k=2"):
             if calibrated is None:
                 break
             predictions[variant], verdicts[variant] = {}, {}
             for cut in cuts:
-                prediction = {}
+                prediction: dict[str, dict[str, Any]] = {}
                 for key in ("nodes", "efficiency"):
                     value = interpolate(counts, [table[variant][str(b)][cut][key] for b in counts], calibrated)
                     low = interpolate(counts, [spans[variant][str(b)][cut][key][0] for b in counts], calibrated)

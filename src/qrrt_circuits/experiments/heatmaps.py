@@ -14,6 +14,7 @@ same run that ends after the first round reaching 10 calls.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -55,7 +56,7 @@ class Heatmaps(Experiment):
             result = planner.plan(max_critical_path_calls=max(settings["cuts"]))
         else:
             result = planner.plan(max_oracle_calls=max(settings["cuts"]))
-        record = {"cut_on": "critical_path" if critical else "oracle_calls"}
+        record: Record = {"cut_on": "critical_path" if critical else "oracle_calls"}
         for cut in settings["cuts"]:
             nodes, calls = cut_at(result, cut, "critical_path" if critical else "oracle_calls")
             record[f"nodes_at_{cut}"] = nodes
@@ -66,7 +67,7 @@ class Heatmaps(Experiment):
         return record
 
     def summarize(self, records: list[Record], settings: Settings) -> Summary:
-        ours = {}
+        ours: dict[str, dict[str, dict[str, Any]]] = {}
         for kind in PLANNERS:
             rows = [r for r in records if r["planner"] == kind]
             ours[kind] = {}
@@ -77,15 +78,16 @@ class Heatmaps(Experiment):
                                         "efficiency": round(nodes / calls, 4) if calls else None}
         fractions = {k: round(float(np.mean([r["reachable_fraction"] for r in records if r["planner"] == k])), 4)
                      for k in PLANNERS}
-        interval, differs_from_paper = {}, {}
+        interval: dict[str, dict[str, dict[str, list[float]]]] = {}
+        differs_from_paper: dict[str, dict[str, dict[str, bool | None]]] = {}
         for kind in PLANNERS:
             rows = [r for r in records if r["planner"] == kind]
             interval[kind], differs_from_paper[kind] = {}, {}
             for cut in settings["cuts"]:
-                def nodes(sample, cut=cut):
+                def nodes(sample: list[Record], cut: int = cut) -> float:
                     return sum(r[f"nodes_at_{cut}"] for r in sample)
 
-                def efficiency(sample, cut=cut):
+                def efficiency(sample: list[Record], cut: int = cut) -> float:
                     calls = sum(r[f"calls_at_{cut}"] for r in sample)
                     return sum(r[f"nodes_at_{cut}"] for r in sample) / calls if calls else float("nan")
 
@@ -109,8 +111,8 @@ class Heatmaps(Experiment):
         for row, kind in enumerate(PLANNERS):
             rows = [r for r in records if r["planner"] == kind]
             for col, cut in enumerate(cuts):
-                points = [np.array(loads(r["positions_json"]))[: r[f"nodes_at_{cut}"]] for r in rows]
-                points = np.concatenate([p.reshape(-1, 2) for p in points]) if points else np.zeros((0, 2))
+                clouds = [np.array(loads(r["positions_json"]))[: r[f"nodes_at_{cut}"]] for r in rows]
+                points = np.concatenate([p.reshape(-1, 2) for p in clouds]) if clouds else np.zeros((0, 2))
                 stats = summary["ours"][kind][str(cut)]
                 paper = self.paper.get(kind, {}).get(str(cut))
                 unit = "critical-path calls" if kind == "PQRRT" else "calls"

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import SupportsFloat
 
 import numpy as np
 
@@ -90,15 +91,15 @@ class Lemmas(Experiment):
         different = good & np.array([len(set(row)) == p for row in groups])
         true_hit = truth[groups[:, 0]]
         same_true = truth[groups].all(axis=1) & (groups == groups[:, :1]).all(axis=1)
-        record = {"iterations": k, "oracle_marked": m_oracle, "true_marked": m1, "missed_good": m2,
+        record: Record = {"iterations": k, "oracle_marked": m_oracle, "true_marked": m1, "missed_good": m2,
                   "p_good": p_good, "repeats": repeats}
 
-        def put(name, observed, theory, stderr):
+        def put(name: str, observed: SupportsFloat, theory: SupportsFloat, stderr: SupportsFloat) -> None:
             record[f"{name}_observed"] = float(observed)
             record[f"{name}_theory"] = float(theory)
             record[f"{name}_stderr"] = float(stderr)
 
-        def binomial(observed, theory):
+        def binomial(observed: float, theory: float) -> float:
             return math.sqrt(max(theory * (1 - theory), 1.0 / repeats) / repeats)
 
         lemma1 = pr.prob_all_same(p, m_oracle, p_good) if m_oracle else 0.0

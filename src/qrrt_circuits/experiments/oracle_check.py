@@ -10,7 +10,9 @@ candidates, and the fraction of tree edges the exact check says go through an ob
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -23,18 +25,41 @@ from .measures import cut_at, reachable_fraction
 from .planners import make_planner
 from .worlds import world
 
+if TYPE_CHECKING:
+    from ..environment import Environment
+    from ..predicate import ReachabilityPredicate
+
 PLANNERS = ("RRT", "QRRT")
 CHECKS = ("exact", "authors", "authors-octave", "samples-200", "samples-50", "samples-20")
 
 
-def make_predicate(env, check: str):
-    """A registry predicate name, or ``samples-K`` (the registry's ``time-samples:K``)."""
+def make_predicate(env: Environment, check: str) -> ReachabilityPredicate:
+    """A registry predicate name, or ``samples-K`` (the registry's ``time-samples:K``).
+
+    Args:
+        env: The world the predicate checks motions in.
+        check: A ``PREDICATES`` name or ``samples-K``.
+
+    Returns:
+        The predicate, built on ``env``.
+
+    Raises:
+        ValueError: If ``check`` names no predicate.
+    """
     name = f"time-samples:{check.split('-')[1]}" if check.startswith("samples-") else check
-    return PREDICATES.create(name, env=env)
+    predicate: ReachabilityPredicate = PREDICATES.create(name, env=env)
+    return predicate
 
 
-def efficiency(rows) -> float:
-    """Nodes per oracle call over ``rows`` (the paper's oracle efficiency)."""
+def efficiency(rows: Sequence[Record]) -> float:
+    """Nodes per oracle call over ``rows`` (the paper's oracle efficiency).
+
+    Args:
+        rows: Records with ``nodes`` and ``oracle_calls``.
+
+    Returns:
+        Summed nodes / summed oracle calls (0.0 without calls).
+    """
     return sum(r["nodes"] for r in rows) / max(sum(r["oracle_calls"] for r in rows), 1)
 
 
@@ -63,12 +88,16 @@ class OracleCheck(Experiment):
         nodes, calls = cut_at(result, settings["budget"])
         exact = ReachabilityOracle(env)
         children = np.arange(1, nodes + 1)
-        valid = exact.reachable(result.nodes[result.parents[children]], result.nodes[children]) if nodes else []
+        valid: np.ndarray | list[bool] = (
+            exact.reachable(result.nodes[result.parents[children]], result.nodes[children]) if nodes else [])
         return {"nodes": nodes, "oracle_calls": calls, "invalid_edges": int(nodes - np.sum(valid)),
                 "reachable_fraction": reachable_fraction(result)}
 
     def summarize(self, records: list[Record], settings: Settings) -> Summary:
-        ours, invalid, fraction, interval = {}, {}, {}, {}
+        ours: dict[str, dict[str, float]] = {}
+        invalid: dict[str, dict[str, float]] = {}
+        fraction: dict[str, dict[str, float]] = {}
+        interval: dict[str, dict[str, list[float]]] = {}
         for check in settings["checks"]:
             ours[check], invalid[check], fraction[check], interval[check] = {}, {}, {}, {}
             for kind in PLANNERS:

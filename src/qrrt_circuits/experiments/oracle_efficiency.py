@@ -63,7 +63,7 @@ class OracleEfficiency(Experiment):
             per_node[kind] = round(sum(r["oracle_calls"] for r in rows) / max(sum(r["nodes"] for r in rows), 1), 3)
         quantum_first = max(slopes["QRRT"], slopes["PQRRT"]) < min(slopes["RRT"], slopes["ParallelRRT"])
 
-        def slope(rows, column=1):
+        def slope(rows: list[Record], column: int = 1) -> float:
             points = np.array([p for r in rows for p in loads(r["curve_json"])])
             return linear_fit(points[:, 0], points[:, column]).slope if len(points) > 1 else float("nan")
 

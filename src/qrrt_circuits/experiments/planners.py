@@ -72,7 +72,8 @@ def make_planner(kind: str, env: Environment, seed: int, backend: str = "aer", w
         predicate = PREDICATES.create(predicate, env=env)
     if predicate is not None:
         options["predicate"] = predicate
-    defaults: dict[str, Any] = {"workers": workers, "num_qubits": num_qubits, "search_policy": search_policy, "seed": seed}
+    defaults: dict[str, Any] = {"workers": workers, "num_qubits": num_qubits, "search_policy": search_policy,
+                                "seed": seed}
     if "quantum" in PLANNERS.resolve(kind).tags:
         defaults["backend"] = make_backend(backend)
     planner: Planner = PLANNERS.create(kind, env=env, **PLANNERS.applicable(kind, defaults), **options)

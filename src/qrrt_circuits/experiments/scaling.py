@@ -9,11 +9,12 @@ Grover search, whose cost is O(sqrt(N/m)).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
-from ..search.policies import BBHT, Adaptive, KnownOptimal
+from ..search.policies import BBHT, Adaptive, IterationPolicy, KnownOptimal
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .fitting import power_law_exponent
@@ -22,7 +23,9 @@ from .measures import reachable_fraction
 from .planners import BACKEND_LABEL, planner_for
 from .worlds import world
 
-CONFIGS = {"RRT": None, "QRRT optimal": KnownOptimal, "QRRT bbht": BBHT, "QRRT adaptive": Adaptive}
+#: label -> q-RRT's search policy (its class), or None for RRT
+CONFIGS: dict[str, Callable[[], IterationPolicy] | None] = {
+    "RRT": None, "QRRT optimal": KnownOptimal, "QRRT bbht": BBHT, "QRRT adaptive": Adaptive}
 DENSITIES = (100, 250, 400, 550, 700, 850, 1000)
 
 
@@ -37,7 +40,7 @@ class Scaling(Experiment):
                 "num_qubits": 8, "backend": "statevector", "seed": seed, "quick": quick}
 
     def trials(self, settings: Settings) -> list[Trial]:
-        out = []
+        out: list[Trial] = []
         for density in settings["densities"]:
             for replicate in range(settings["trials"]):
                 world_seed = replicate_seed(settings["seed"], replicate * 1000 + density, TrialStream.SCALING_WORLDS)
@@ -51,12 +54,12 @@ class Scaling(Experiment):
 
     def run_trial(self, trial: Trial, settings: Settings) -> Record:
         env = world("paper_clutter", trial.params["world_seed"], num_boxes=trial.params["boxes"])
-        name = trial.params["config"]
-        if name == "RRT":
+        make_policy = CONFIGS[trial.params["config"]]
+        if make_policy is None:  # RRT
             planner = planner_for(settings, "RRT", env, trial.seed)
         else:
             planner = planner_for(settings, "QRRT", env, trial.seed, settings["backend"],
-                                   num_qubits=settings["num_qubits"], search_policy=CONFIGS[name]())
+                                   num_qubits=settings["num_qubits"], search_policy=make_policy())
         result = planner.plan(max_nodes=settings["nodes"])
         m = result.metrics
         return {"nodes": m.nodes, "oracle_calls": m.oracle_calls,

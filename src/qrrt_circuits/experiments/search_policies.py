@@ -18,12 +18,16 @@ shared database are ignored in that formula (they only make sharing worse), so p
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from ..registry import POLICIES
-from ..search.estimated_policy import EstimatedOptimal
+from ..search.estimated_policy import EstimatedOptimal, EstimatedOptimalState
+from ..search.policies import IterationPolicy
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, paired_trials
 from .figures import new_figure, save
 from .intervals import bootstrap_interval, rounded_interval
@@ -45,22 +49,25 @@ COLORS = {"paper": "tab:blue", "bbht": "tab:green", "adaptive": "tab:orange", "f
 class _LoggedEstimatedOptimal(EstimatedOptimal):
     """EstimatedOptimal whose plan state is kept, to read its per-database (estimate, k) history."""
 
-    states: list  # not a dataclass field: set in __post_init__
+    states: list[EstimatedOptimalState]  # not a dataclass field: set in __post_init__
 
     def __post_init__(self) -> None:
         super().__post_init__()
         object.__setattr__(self, "states", [])  # a frozen dataclass; the list is this trial's log
 
-    def start(self, num_items):
+    def start(self, num_items: int) -> EstimatedOptimalState:
         state = super().start(num_items)
         self.states.append(state)
         return state
 
 
-def _policy(name: str | None):
+def _policy(name: str | None) -> IterationPolicy | None:
     if name == "estimated":
         return _LoggedEstimatedOptimal()
-    return None if name is None else POLICIES.create(name)
+    if name is None:
+        return None
+    policy: IterationPolicy = POLICIES.create(name)
+    return policy
 
 
 class SearchPolicies(Experiment):
@@ -105,13 +112,15 @@ class SearchPolicies(Experiment):
         sizes = settings["sizes"]
         windows = [f"{a}-{b}" for a, b in zip(sizes[:-1], sizes[1:], strict=True)]
 
-        ours, interval, critical, whole = {}, {}, {}, {}
+        ours: dict[str, dict[str, float]] = {}
+        interval: dict[str, dict[str, list[float]]] = {}
+        critical: dict[str, dict[str, float]] = {}
+        whole: dict[str, dict[str, float]] = {}
         for label in settings["configs"]:
             rows = [r for r in records if r["config"] == label]
             ours[label] = {w: round(pooled_calls_per_node(rows, w), 3) for w in windows}
-            interval[label] = {w: rounded_interval(bootstrap_interval(rows,
-                                                                      lambda s, w=w: pooled_calls_per_node(s, w),
-                                                                      settings["seed"]), 3) for w in windows}
+            interval[label] = {w: rounded_interval(bootstrap_interval(
+                rows, functools.partial(pooled_calls_per_node, window=w), settings["seed"]), 3) for w in windows}
             critical[label] = {w: round(pooled_calls_per_node(rows, w, 2), 3) for w in windows}
             nodes = sum(r["nodes"] for r in rows)
             whole[label] = {"calls_per_node": round(sum(r["oracle_calls"] for r in rows) / nodes, 3),
@@ -132,10 +141,10 @@ class SearchPolicies(Experiment):
                            "backend: exact statevector (ideal; same statistics as Aer)"]}
 
     @staticmethod
-    def _estimation_summary(records) -> dict:
+    def _estimation_summary(records: Sequence[Record]) -> dict[str, Any]:
         """Estimation vs search calls of EstimatedOptimal, and the workers p* at which one estimation
         per database would match Adaptive's calls per node (from the q-RRT runs)."""
-        out = {}
+        out: dict[str, Any] = {}
         for prefix in ("QRRT", "PQRRT"):
             rows = [r for r in records if r["config"] == f"{prefix} estimated"]
             databases = sum(r["databases"] for r in rows)

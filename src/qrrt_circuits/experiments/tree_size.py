@@ -162,8 +162,8 @@ class TreeSize(Experiment):
         for label in settings["configs"]:
             rows = [r for r in records if r["config"] == label]
             ours[label] = {w: round(pooled_calls_per_node(rows, w), 3) for w in windows}
-            interval[label] = {w: rounded_interval(bootstrap_interval(rows, functools.partial(pooled_calls_per_node, window=w),
-                                                                      settings["seed"]), 3) for w in windows}
+            interval[label] = {w: rounded_interval(bootstrap_interval(
+                rows, functools.partial(pooled_calls_per_node, window=w), settings["seed"]), 3) for w in windows}
             critical[label] = {w: round(pooled_calls_per_node(rows, w, 2), 3) for w in windows}
         fractions = {label: {w: round(float(np.mean([loads(r["fractions_json"])[w] for r in records
                                                      if r["config"] == label and w in loads(r["fractions_json"])]

@@ -77,7 +77,7 @@ class Wallclock(Experiment):
                 "note": "the paper's times are MATLAB on an 8-core M2; ours one process on this machine"}
 
     @staticmethod
-    def _interval(summary, key: str, name: str) -> str:
+    def _interval(summary: Summary, key: str, name: str) -> str:
         if key != "seconds_per_node":
             return ""
         low, high = summary["ms_per_node_interval_95"][name]

@@ -4,7 +4,6 @@ immutable, and building ``annealing_field`` or a predicate's index is not free).
 from __future__ import annotations
 
 import functools
-
 from typing import Any
 
 from ..environment import Environment
