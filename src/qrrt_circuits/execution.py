@@ -29,6 +29,7 @@ import contextlib
 import os
 from collections.abc import Iterator
 from concurrent.futures import Executor, ProcessPoolExecutor
+from typing import Any
 
 from .validation import check_optional_int
 
@@ -138,7 +139,7 @@ def _warm_fork_server(extra_preload: tuple[str, ...] = ()) -> Iterator[str]:
             _stop_fork_server(server)
 
 
-def _stop_fork_server(server) -> None:
+def _stop_fork_server(server: Any) -> None:  # a multiprocessing.forkserver.ForkServer
     """Close our end of the server's "alive" pipe (it exits when no worker holds one either) and
     reap it; kill it if it has not gone after a few seconds."""
     import signal
@@ -274,7 +275,7 @@ class WorkerPool:
         self._open = True
         return self
 
-    def __exit__(self, *exc_info) -> None:
+    def __exit__(self, *exc_info: object) -> None:
         self._shut_down()
         self._open = False
 

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from qiskit import QuantumCircuit
@@ -59,7 +60,7 @@ def gamma(delta: float, length: int) -> float:
     return 1.0 / chebyshev(1.0 / length, 1.0 / delta)
 
 
-def check_delta(delta) -> float:
+def check_delta(delta: Any) -> float:
     """The target error delta in (0, 1) (delta = 1 would promise nothing)."""
     value = check_float(delta, "delta", 0.0, 1.0, open_minimum=True)
     if value == 1.0:
@@ -67,7 +68,7 @@ def check_delta(delta) -> float:
     return value
 
 
-def check_fraction(fraction, name: str = "min_fraction") -> float:
+def check_fraction(fraction: Any, name: str = "min_fraction") -> float:
     return check_float(fraction, name, 0.0, 1.0, open_minimum=True)
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import os
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -18,6 +19,9 @@ from ..probability import good_probability
 from ..validation import check_bool, check_int
 from .backend import QuantumSearchBackend, seed_stream, validate_iterations, validate_marks
 from .fixed_point import statevector_after
+
+if TYPE_CHECKING:
+    from .fixed_point import IterateSequence
 
 BYTES_PER_ENTRY = 32  # amplitudes (8) + probabilities (8) + index lists (8) + marks, with slack
 
@@ -121,13 +125,15 @@ class StatevectorBackend(QuantumSearchBackend):
             state = 2.0 * state.mean() - state
         return state
 
-    def _sample(self, marks, num_qubits, iterations, shots, rng) -> np.ndarray:
+    def _sample(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
+                rng: np.random.Generator) -> np.ndarray:
         if not self.closed_form:
             return _draw(self.amplitudes(marks, iterations) ** 2, shots, rng)
         p_good = good_probability(marks.shape[0], int(np.count_nonzero(marks)), iterations)
         return _draw_two_level(marks, p_good, shots, rng)
 
-    def _sample_sequence(self, marks, num_qubits, sequence, shots, rng) -> np.ndarray:
+    def _sample_sequence(self, marks: np.ndarray, num_qubits: int, sequence: IterateSequence, shots: int,
+                         rng: np.random.Generator) -> np.ndarray:
         """Generalized iterates: the exact 2-dimensional evolution (closed form; every marked index
         keeps the same amplitude) or, with ``closed_form=False``, the full iterated vector."""
         if not self.closed_form:
