@@ -49,14 +49,32 @@ TARGET_RRT_EFFICIENCY = PAPER["RRT"]["10"]["efficiency"]
 
 def max_nodes_within(budget: int, round_cost: int, trials: int) -> int:
     """The most nodes ``trials`` runs can add when each round costs ``round_cost`` calls and a run
-    stops after the first round that reaches ``budget`` (1 node per round at best)."""
+    stops after the first round that reaches ``budget`` (1 node per round at best).
+
+    Args:
+        budget: The oracle-call cut.
+        round_cost: Oracle calls of one round.
+        trials: How many runs.
+
+    Returns:
+        ``trials * ceil(budget / round_cost)``.
+    """
     return trials * math.ceil(budget / round_cost)
 
 
 def calibrate(counts: list[int], efficiency: list[float], target: float) -> float | None:
     """The obstacle count at which RRT's efficiency equals ``target``: linear interpolation between
     the two grid counts that bracket it (efficiency falls as obstacles are added); None if the
-    grid does not bracket the target."""
+    grid does not bracket the target.
+
+    Args:
+        counts: Increasing obstacle counts of the grid.
+        efficiency: RRT's efficiency at each count.
+        target: The efficiency to reach (the paper's 12.5 %).
+
+    Returns:
+        The interpolated count, or None.
+    """
     for (c0, e0), (c1, e1) in zip(zip(counts, efficiency, strict=True), zip(counts[1:], efficiency[1:], strict=True),
                                   strict=False):
         if (e0 - target) * (e1 - target) <= 0 and e0 != e1:
@@ -65,10 +83,28 @@ def calibrate(counts: list[int], efficiency: list[float], target: float) -> floa
 
 
 def interpolate(counts: list[int], values: list[float], at: float) -> float:
+    """A value of the grid at a calibrated count (linear interpolation, ``numpy.interp``).
+
+    Args:
+        counts: Increasing obstacle counts of the grid.
+        values: The value at each count.
+        at: The count to read the value at.
+
+    Returns:
+        The interpolated value.
+    """
     return float(np.interp(at, counts, values))
 
 
 class HeatmapHypotheses(Experiment):
+    """Tests two hypotheses for the paper's heatmap numbers (Figs. 10-12; see the module docstring).
+
+    A trial runs RRT, q-RRT with the paper's schedule or q-RRT with 2 iterations in a
+    ``paper_clutter``-style world with a given obstacle count, cut at 10, 20 and 40 oracle calls.
+    The summary calibrates the obstacle count on RRT's efficiency (``calibrate``) and predicts
+    q-RRT's nodes and efficiency there, each with its 95 % interval, against the paper's.
+    """
+
     name = "heatmap-hypotheses"
     title = "Which setup gives the paper's heatmap numbers? (Figs. 10-12 hypotheses)"
     paper = PAPER

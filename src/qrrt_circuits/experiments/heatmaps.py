@@ -30,6 +30,14 @@ CUTS = (10, 20, 40)
 
 
 class Heatmaps(Experiment):
+    """Exploration speed (paper Figs. 10-12): nodes and oracle efficiency at 10, 20 and 40 calls.
+
+    A trial grows RRT, q-RRT or Pq-RRT (cut on critical-path calls) in one ``paper_clutter`` world
+    to 40 calls and reads the 10- and 20-call cuts from its history (``cut_at``). The summary gives
+    the total nodes and the efficiency (nodes / calls) at each cut with 95 % bootstrap intervals,
+    against the paper's; the figure shows node heatmaps.
+    """
+
     name = "heatmaps"
     title = "Exploration heatmaps at 10, 20 and 40 oracle calls (paper Figs. 10-12)"
     paper = {"QRRT": {"10": {"nodes": 372, "efficiency": 0.312}, "20": {"nodes": 650, "efficiency": 0.310},

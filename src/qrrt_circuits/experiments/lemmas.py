@@ -48,6 +48,15 @@ def _collection_times(indices: np.ndarray, targets: np.ndarray) -> list[int]:
 
 
 class Lemmas(Experiment):
+    """Lemmas 1-6 of the paper against Aer shot frequencies (see the module docstring).
+
+    A trial is one point (n, m, p, false-positive and false-negative rates) of the grid: one Aer
+    search with p x R shots, read as R groups of p workers. Its record holds, for each lemma, the
+    observed frequency, the ``qrrt_circuits.probability`` value and the standard error; the summary
+    gives, per lemma, the largest |z| = |observed - theory| / stderr over the grid and the share of
+    points within 3 standard errors (with its 95 % interval).
+    """
+
     name = "lemmas"
     uses_predicate = False  # no planner: random marked databases
     title = "Lemmas 1-6 against Aer shot frequencies"

@@ -77,6 +77,14 @@ def _compiled(num_qubits: int, seed: int, iterations: int) -> QuantumCircuit:
 
 
 class Noise(Experiment):
+    """Device noise (beyond the paper, which assumes a perfect quantum computer).
+
+    Three parts (see the module docstring): ``sweep`` (one search under depolarizing noise against
+    the white-noise model), ``device`` (a fake IBM device, when the ``noise`` extra is installed)
+    and ``planning`` (q-RRT's oracle calls per node as the two-qubit error grows, against RRT's,
+    and the break-even error rate with its 95 % interval).
+    """
+
     name = "noise"
     title = "Device noise: one search, the fake IBM device, and q-RRT's calls per node (beyond the paper)"
     uses_predicate = True

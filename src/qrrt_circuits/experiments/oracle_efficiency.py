@@ -26,6 +26,14 @@ COLORS = {"RRT": "tab:gray", "ParallelRRT": "tab:brown", "QRRT": "tab:blue", "PQ
 
 
 class OracleEfficiency(Experiment):
+    """Oracle calls per node (paper Fig. 9) for RRT, parallel RRT, q-RRT and Pq-RRT.
+
+    A trial grows one 30-node tree and records its growth curve (``growth_curve``); the summary fits
+    a least-squares line through all (nodes, calls) points of a planner (the slope is calls per
+    node, paper: 21.5, 19.4, 7.6, 10.7), with 95 % bootstrap intervals, the critical-path slope and
+    whether the paper's ordering is reproduced.
+    """
+
     name = "oracle-efficiency"
     title = "Oracle calls per node (paper Fig. 9)"
     paper = {"RRT": 21.5, "ParallelRRT": 19.4, "QRRT": 7.6, "PQRRT": 10.7}

@@ -61,6 +61,14 @@ def database_marks(num_qubits: int, seed: int) -> np.ndarray:
 
 
 class Resources(Experiment):
+    """Gates and time per oracle call and per plan, near term and fault tolerant (beyond the paper).
+
+    Three parts (see the module docstring): ``near-term`` (two-qubit gates and depth of one Grover
+    iteration after routing), ``fault-tolerant`` (Toffoli and T counts of one call with a lookup
+    oracle) and ``plan`` (RRT's measured time against q-RRT's projected time, and the break-even
+    time per call), each summarized with its assumptions.
+    """
+
     name = "resources"
     title = "Gates and time per oracle call and per plan, near term and fault tolerant (beyond the paper)"
     paper = {"cost_model": "oracle calls only; the paper gives no gate counts or times"}

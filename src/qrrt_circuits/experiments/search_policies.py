@@ -71,6 +71,14 @@ def _policy(name: str | None) -> IterationPolicy | None:
 
 
 class SearchPolicies(Experiment):
+    """Search policies that cannot overshoot or that estimate m, as the tree grows (beyond the paper).
+
+    A trial grows one tree with RRT or q-RRT / Pq-RRT under one policy of ``POLICY_NAMES`` and
+    records the calls at sizes 30, 100, 300 and 1000 (``calls_at_sizes``). The summary gives the
+    marginal calls per node in each window with 95 % intervals, and for ``EstimatedOptimal`` the
+    estimation's share of the calls and the break-even number of workers (module docstring).
+    """
+
     name = "search-policies"
     title = "Search that cannot overshoot: fixed-point amplification and estimated m (beyond the paper)"
     paper = {"note": "the paper uses a fixed schedule (5 then 3 iterations) and reports 30-node trees only"}

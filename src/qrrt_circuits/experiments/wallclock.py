@@ -25,10 +25,28 @@ CONFIGS = (("RRT", "none"), ("ParallelRRT", "none"), ("QRRT", "aer"), ("QRRT", "
 
 
 def label(planner: str, backend: str) -> str:
+    """A configuration's label in records and summaries.
+
+    Args:
+        planner: A planner of ``CONFIGS``.
+        backend: Its backend, ``"none"`` for the classical planners.
+
+    Returns:
+        ``planner`` alone, or ``"planner (backend)"``.
+    """
     return planner if backend == "none" else f"{planner} ({backend})"
 
 
 class Wallclock(Experiment):
+    """Wall-clock seconds per oracle call and per node (paper Figs. 6-8).
+
+    A trial times one 30-node tree of a configuration of ``CONFIGS`` (the worlds and seeds of
+    oracle-efficiency). The summary fits seconds against oracle calls and against nodes through
+    the origin (``slope_through_origin``), a 95 % interval on the per-node slope, next to the
+    paper's MATLAB times;
+    the timings are of this machine and are labelled so.
+    """
+
     name = "wallclock"
     title = "Wall-clock seconds per oracle call and per node (paper Figs. 6-8)"
     paper = {"seconds_per_oracle_call": {"QRRT": 3.52, "PQRRT": 0.20},
