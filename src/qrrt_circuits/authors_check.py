@@ -113,7 +113,7 @@ _SCALARS = 5
 
 
 @njit(cache=True, nogil=True)
-def _matvec(M, x, out):
+def _matvec(M: np.ndarray, x: np.ndarray, out: np.ndarray) -> None:
     d = x.shape[0]
     for row in range(d):
         acc = 0.0
@@ -123,7 +123,7 @@ def _matvec(M, x, out):
 
 
 @njit(cache=True, nogil=True)
-def _store(count, t, e, offset, times, states):
+def _store(count: int, t: float, e: np.ndarray, offset: np.ndarray, times: np.ndarray, states: np.ndarray) -> None:
     """Output number ``count`` (0-based) is (t, e + offset), if the arrays have room for it."""
     if count < times.shape[0]:
         times[count] = t
@@ -132,7 +132,8 @@ def _store(count, t, e, offset, times, states):
 
 
 @njit(cache=True, nogil=True)
-def _octave_start(e0, M, horizon, rtol, atol, x, k, tmp, scalars):
+def _octave_start(e0: np.ndarray, M: np.ndarray, horizon: float, rtol: float, atol: float, x: np.ndarray, k: np.ndarray,
+                  tmp: np.ndarray, scalars: np.ndarray) -> None:
     """Octave: x = e0, k[0] = f(x) and the first step from starting_stepsize (Hairer, Norsett &
     Wanner, order 5), capped at MaxStep = 0.1 |tspan|."""
     d = e0.shape[0]
@@ -165,8 +166,9 @@ def _octave_start(e0, M, horizon, rtol, atol, x, k, tmp, scalars):
 
 
 @njit(cache=True, nogil=True)
-def _octave_advance(M, horizon, rtol, atol, x, k, x_new, x_est, tmp, scalars, offset, times, states,
-                    count):
+def _octave_advance(M: np.ndarray, horizon: float, rtol: float, atol: float, x: np.ndarray, k: np.ndarray,
+                    x_new: np.ndarray, x_est: np.ndarray, tmp: np.ndarray, scalars: np.ndarray, offset: np.ndarray,
+                    times: np.ndarray, states: np.ndarray, count: int) -> int:
     """Octave's integrate_adaptive with runge_kutta_45_dorpri: attempt steps until one is accepted
     (its end becomes output ``count``) or the integration ends. Returns the new output count."""
     d = x.shape[0]
@@ -236,7 +238,8 @@ def _octave_advance(M, horizon, rtol, atol, x, k, x_new, x_est, tmp, scalars, of
 
 
 @njit(cache=True, nogil=True)
-def _matlab_start(e0, M, horizon, rtol, atol, y, f, scalars):
+def _matlab_start(e0: np.ndarray, M: np.ndarray, horizon: float, rtol: float, atol: float, y: np.ndarray, f: np.ndarray,
+                  scalars: np.ndarray) -> None:
     """MATLAB: y = e0, f[0] = f(y) and ode45's initial step (absh = min(hmax, |tspan|), then 1/rh
     if smaller, at least hmin)."""
     d = e0.shape[0]
@@ -257,8 +260,9 @@ def _matlab_start(e0, M, horizon, rtol, atol, y, f, scalars):
 
 
 @njit(cache=True, nogil=True)
-def _matlab_advance(M, horizon, rtol, atol, refine, y, f, y_new, tmp, scalars, offset, times, states,
-                    count):
+def _matlab_advance(M: np.ndarray, horizon: float, rtol: float, atol: float, refine: int, y: np.ndarray,
+                    f: np.ndarray, y_new: np.ndarray, tmp: np.ndarray, scalars: np.ndarray, offset: np.ndarray,
+                    times: np.ndarray, states: np.ndarray, count: int) -> int:
     """One pass of ode45.m's main loop: attempt the step until accepted, then output ``refine``
     points (ntrp45 at fractions 1/refine .. (refine-1)/refine, then the step end) from output
     ``count`` on. Returns the new output count."""
@@ -352,7 +356,8 @@ def _matlab_advance(M, horizon, rtol, atol, refine, y, f, y_new, tmp, scalars, o
 
 
 @njit(cache=True, nogil=True)
-def _in_a_box(point, lower, upper, origin, cell_size, shape, cell_start, cell_items):
+def _in_a_box(point: np.ndarray, lower: np.ndarray, upper: np.ndarray, origin: np.ndarray, cell_size: np.ndarray,
+              shape: np.ndarray, cell_start: np.ndarray, cell_items: np.ndarray) -> bool:
     """pointobscheck: does ``point`` lie in a closed box? (Workspace bounds are not tested.)"""
     d = point.shape[0]
     cell = 0
@@ -373,8 +378,10 @@ def _in_a_box(point, lower, upper, origin, cell_size, shape, cell_start, cell_it
 
 
 @njit(cache=True, nogil=True)
-def _segment_collides(a, b, rast_num, lower, upper, origin, cell_size, shape, cell_start, cell_items,
-                      stamp, stamp_id, lo_cell, hi_cell, cursor):
+def _segment_collides(a: np.ndarray, b: np.ndarray, rast_num: int, lower: np.ndarray, upper: np.ndarray,
+                      origin: np.ndarray, cell_size: np.ndarray, shape: np.ndarray, cell_start: np.ndarray,
+                      cell_items: np.ndarray, stamp: np.ndarray, stamp_id: int, lo_cell: np.ndarray,
+                      hi_cell: np.ndarray, cursor: np.ndarray) -> bool:
     """Is one of the points b + (j / rast_num)(a - b), j = 1 .. rast_num, in a closed box?
 
     Exactly that test, done fast: the points lie on the segment [b, a] up to a few ulps, so only a
@@ -425,8 +432,10 @@ def _segment_collides(a, b, rast_num, lower, upper, origin, cell_size, shape, ce
 
 
 @njit(cache=True, nogil=True)
-def authors_check(parents, children, M, horizon, rtol, atol, refine, rast_num, test, lower, upper,
-                  origin, cell_size, shape, cell_start, cell_items, times, ys, out):
+def authors_check(parents: np.ndarray, children: np.ndarray, M: np.ndarray, horizon: float, rtol: float, atol: float,
+                  refine: int, rast_num: int, test: bool, lower: np.ndarray, upper: np.ndarray, origin: np.ndarray,
+                  cell_size: np.ndarray, shape: np.ndarray, cell_start: np.ndarray, cell_items: np.ndarray,
+                  times: np.ndarray, ys: np.ndarray, out: np.ndarray) -> np.ndarray:
     """The one compiled kernel (one compile, not one per use).
 
     ``test`` true: out[i] = 1 if dynamicscheck accepts (parents[i], children[i]), else 0 (see the
@@ -636,7 +645,8 @@ class AuthorsCheck:
                 return times[:n], states[:n]
             capacity = n
 
-    def _run(self, parents, children, test, times, states, out) -> None:
+    def _run(self, parents: np.ndarray, children: np.ndarray, test: bool, times: np.ndarray, states: np.ndarray,
+             out: np.ndarray) -> None:
         index = self._index
         authors_check(parents, children, self._closed_loop, self.dynamics.horizon, self.rel_tol, self.abs_tol,
                       self.refine, self.rast_num, test, self._lower, self._upper, index.origin, index.cell_size,

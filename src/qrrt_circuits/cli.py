@@ -10,12 +10,22 @@ import argparse
 import json
 import math
 import sys
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
 
 from . import __version__, probability
 from .registry import BACKENDS, PLANNERS, POLICIES, PREDICATES, SCENARIOS
+
+if TYPE_CHECKING:
+    from .environment import Environment
+    from .memory import MemoryEstimate
+    from .planners.base import Planner
+    from .planners.result import PlanResult
+    from .registry import Registry
+    from .search.backend import QuantumSearchBackend, SearchResult
 
 
 def _positive_int(text: str) -> int:
@@ -32,7 +42,7 @@ def _nonnegative_int(text: str) -> int:
     return value
 
 
-def _registered(registry):
+def _registered(registry: Registry) -> Callable[[str], str]:
     """argparse type: a name the registry knows, canonicalised (aliases accepted)."""
     def parse(text: str) -> str:
         try:
@@ -67,20 +77,20 @@ def cmd_search(args: argparse.Namespace) -> int:
 SEARCH_MARKS_BYTES_PER_ENTRY = 9
 
 
-def _check_search_memory(backend, num_qubits: int, shots: int, iterations: int) -> None:
+def _check_search_memory(backend: QuantumSearchBackend, num_qubits: int, shots: int, iterations: int) -> None:
     """Refuse before allocating the marks when the marks and the search would not fit."""
     from dataclasses import replace
 
     from .memory import check_fits
 
-    def estimate(n: int):
+    def estimate(n: int) -> MemoryEstimate:
         search = backend.memory_estimate(n, shots, iterations)
         return replace(search, resident_bytes=SEARCH_MARKS_BYTES_PER_ENTRY << n)
 
     check_fits(estimate, num_qubits, f"this {backend.name} search ({shots} shots, {iterations} iterations)")
 
 
-def _print_search(args: argparse.Namespace, marks: np.ndarray, iterations: int, result) -> None:
+def _print_search(args: argparse.Namespace, marks: np.ndarray, iterations: int, result: SearchResult) -> None:
     num_items = marks.shape[0]
     rate = float(marks[result.indices].mean())
     theory = probability.success_probability(num_items, args.marked, iterations)
@@ -132,7 +142,7 @@ def _check_output_file(path: str | None, option: str, suffixes: tuple[str, ...] 
         raise ValueError(f"{option}: {path!r} must end in one of {', '.join(suffixes)}")
 
 
-def _load_environment(args: argparse.Namespace):
+def _load_environment(args: argparse.Namespace) -> Environment:
     if args.scenario_file:
         from .environment import Environment
 
@@ -142,17 +152,18 @@ def _load_environment(args: argparse.Namespace):
     return SCENARIOS.create(args.scenario, seed=args.scenario_seed)
 
 
-def build_planner(args: argparse.Namespace, env):
+def build_planner(args: argparse.Namespace, env: Environment) -> Planner:
     """The planner the arguments name, with only the options that apply to it."""
-    options = {"goal_bias": args.goal_bias, "seed": args.seed, "workers": args.workers,
+    options: dict[str, Any] = {"goal_bias": args.goal_bias, "seed": args.seed, "workers": args.workers,
                "num_qubits": args.qubits, "predicate": PREDICATES.create(args.predicate, env=env)}
     if "quantum" in PLANNERS.resolve(args.planner).tags:
         options["backend"] = BACKENDS.create(args.backend, seed=args.seed)
         options["search_policy"] = POLICIES.create(args.policy)
-    return PLANNERS.create(args.planner, env=env, **PLANNERS.applicable(args.planner, options))
+    planner: Planner = PLANNERS.create(args.planner, env=env, **PLANNERS.applicable(args.planner, options))
+    return planner
 
 
-def _print_plan(result, env, seed: int) -> None:
+def _print_plan(result: PlanResult, env: Environment, seed: int) -> None:
     metrics = result.metrics
     print(f"{result.planner} on {env.name} (seed {seed}): {result.status}")
     for key, value in result.settings.items():
@@ -174,7 +185,7 @@ def _print_plan(result, env, seed: int) -> None:
         print(f"note: {label}")
 
 
-def _write_plan_outputs(args: argparse.Namespace, result, env) -> None:
+def _write_plan_outputs(args: argparse.Namespace, result: PlanResult, env: Environment) -> None:
     if args.json:
         Path(args.json).write_text(json.dumps(result.to_dict(), indent=1))
         print(f"wrote {args.json}")
@@ -245,7 +256,11 @@ def _print_summary(name: str, summary: dict, out: str) -> None:
 
 
 # ----------------------------------------------------------------------------------------- parser
-def _add_search_parser(sub, formatter) -> None:
+_Subparsers: TypeAlias = "argparse._SubParsersAction[argparse.ArgumentParser]"
+_Formatter: TypeAlias = "type[argparse.HelpFormatter]"
+
+
+def _add_search_parser(sub: _Subparsers, formatter: _Formatter) -> None:
     search = sub.add_parser("search", help="Grover-search a random marked database", formatter_class=formatter)
     search.add_argument("--qubits", type=_positive_int, default=8)
     search.add_argument("--marked", type=_nonnegative_int, default=12)
@@ -259,7 +274,7 @@ def _add_search_parser(sub, formatter) -> None:
     search.set_defaults(func=cmd_search)
 
 
-def _add_plan_parser(sub, formatter) -> None:
+def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
     plan = sub.add_parser("plan", help="plan a path with one planner and print its metrics",
                           formatter_class=formatter)
     plan.add_argument("--scenario", type=_registered(SCENARIOS), choices=SCENARIOS.names(),
@@ -292,7 +307,7 @@ def _add_plan_parser(sub, formatter) -> None:
     plan.set_defaults(func=cmd_plan)
 
 
-def _add_reproduce_parser(sub, formatter) -> None:
+def _add_reproduce_parser(sub: _Subparsers, formatter: _Formatter) -> None:
     reproduce = sub.add_parser("reproduce", help="reproduce the paper's figures and tables",
                                formatter_class=formatter)
     reproduce.add_argument("experiment", help="an experiment name or 'all'")

@@ -114,7 +114,7 @@ def _box_cells(bounds: np.ndarray, boxes: np.ndarray, cell_size: np.ndarray, sha
 
 
 @njit(cache=True, nogil=True)
-def _segment_hits_box(p, q, lo, hi, pad):
+def _segment_hits_box(p: np.ndarray, q: np.ndarray, lo: np.ndarray, hi: np.ndarray, pad: float) -> bool:
     """Closed slab test: does segment p->q meet the box [lo - pad, hi + pad]?"""
     t0 = 0.0
     t1 = 1.0
@@ -140,8 +140,10 @@ def _segment_hits_box(p, q, lo, hi, pad):
 
 
 @njit(cache=True, nogil=True)
-def _segment_free(p, q, pad, bounds, lower, upper, origin, cell_size, shape, cell_start,
-                  cell_items, stamp, stamp_id, lo_cell, hi_cell, cursor):
+def _segment_free(p: np.ndarray, q: np.ndarray, pad: float, bounds: np.ndarray, lower: np.ndarray,
+                  upper: np.ndarray, origin: np.ndarray, cell_size: np.ndarray, shape: np.ndarray,
+                  cell_start: np.ndarray, cell_items: np.ndarray, stamp: np.ndarray, stamp_id: int,
+                  lo_cell: np.ndarray, hi_cell: np.ndarray, cursor: np.ndarray) -> bool:
     d = p.shape[0]
     for axis in range(d):
         if min(p[axis], q[axis]) - pad < bounds[axis, 0] or max(p[axis], q[axis]) + pad > bounds[axis, 1]:
@@ -174,8 +176,10 @@ def _segment_free(p, q, pad, bounds, lower, upper, origin, cell_size, shape, cel
 
 
 @njit(cache=True, nogil=True)
-def trajectories_free(parents, children, times, phis, curvature, resolution, bounds, lower,
-                      upper, origin, cell_size, shape, cell_start, cell_items, out):
+def trajectories_free(parents: np.ndarray, children: np.ndarray, times: np.ndarray, phis: np.ndarray,
+                      curvature: np.ndarray, resolution: float, bounds: np.ndarray, lower: np.ndarray,
+                      upper: np.ndarray, origin: np.ndarray, cell_size: np.ndarray, shape: np.ndarray,
+                      cell_start: np.ndarray, cell_items: np.ndarray, out: np.ndarray) -> np.ndarray:
     """out[i] = trajectory parents[i] -> children[i] stays in bounds and misses every box.
 
     Compiled (numba). Chords are merged greedily while their error bound ``h^2/8 |e| a`` stays below
@@ -261,8 +265,9 @@ def trajectories_free(parents, children, times, phis, curvature, resolution, bou
 
 
 @njit(cache=True, nogil=True)
-def points_free(points, bounds, lower, upper, origin, cell_size, shape, cell_start, cell_items,
-                out):
+def points_free(points: np.ndarray, bounds: np.ndarray, lower: np.ndarray, upper: np.ndarray, origin: np.ndarray,
+                cell_size: np.ndarray, shape: np.ndarray, cell_start: np.ndarray, cell_items: np.ndarray,
+                out: np.ndarray) -> np.ndarray:
     """out[i] = points[i] lies in the closed bounds and outside every closed box.
 
     Compiled (numba); only the boxes listed in the point's grid cell are tested.

@@ -10,7 +10,9 @@ from its parent to the sample but is moved to a distance drawn uniformly in the 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -20,7 +22,7 @@ from .tree import Tree
 from .validation import check_choice, check_float, check_int
 
 
-def _check_bands(bands) -> tuple[tuple[float, float], ...]:
+def _check_bands(bands: Any) -> tuple[tuple[float, float], ...]:
     """(r_min, r_max) pairs of finite distances >= 0, as floats (strings are not coerced)."""
     if not isinstance(bands, tuple | list) or not bands:
         raise TypeError(f"bands must be a non-empty sequence of (r_min, r_max) pairs, got {bands!r}")
@@ -230,11 +232,12 @@ def stream_database(
                             temperature_index)
 
 
-def _finish_database(samples, tree, size, generator, goal, goal_radius, goal_bias, annealing,
-                     temperature_index) -> Database:
+def _finish_database(samples: np.ndarray, tree: Tree, size: int, generator: Callable[[], np.random.Generator],
+                     goal: np.ndarray | None, goal_radius: float, goal_bias: float,
+                     annealing: AnnealingSchedule | None, temperature_index: int) -> Database:
     """The rest of Alg. 1 lines 4-8 / Alg. 4 line 7 after the uniform samples; ``generator()``
     gives the candidates' generator positioned after them (called only if more draws are needed)."""
-    rng = None
+    rng: np.random.Generator | None = None
     if goal_bias > 0 and goal is not None:
         rng = generator()
         biased = rng.random(size) < goal_bias

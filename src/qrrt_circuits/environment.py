@@ -17,11 +17,14 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .validation import check_float, check_int
+
+if TYPE_CHECKING:
+    from .collision import GridIndex
 
 FORMAT_NAME = "qrrt-environment"
 FORMAT_VERSION = 1
@@ -185,7 +188,7 @@ class Environment:
         return out.reshape(shape)
 
     @property
-    def grid_index(self):
+    def grid_index(self) -> GridIndex:
         """Uniform-grid spatial index of the boxes (built once, on first use)."""
         from .collision import GridIndex
 

@@ -30,6 +30,7 @@ import contextvars
 import os
 from collections.abc import Iterator
 from concurrent.futures import Executor, ProcessPoolExecutor
+from typing import Any
 
 from .validation import check_optional_int
 
@@ -139,7 +140,7 @@ def _warm_fork_server(extra_preload: tuple[str, ...] = ()) -> Iterator[str]:
             _stop_fork_server(server)
 
 
-def _stop_fork_server(server, wait_s: float = 5.0) -> None:
+def _stop_fork_server(server: Any, wait_s: float = 5.0) -> None:  # a multiprocessing.forkserver.ForkServer
     """Close our end of the server's "alive" pipe (it exits when no worker holds one either) and
     reap it; kill it if it has not gone after ``wait_s`` seconds (at once for 0: a server that
     never forked a worker, perhaps still importing its preload, has nothing to finish)."""
@@ -362,7 +363,7 @@ class WorkerPool:
         self._prestart_fork_server()
         return self
 
-    def __exit__(self, *exc_info) -> None:
+    def __exit__(self, *exc_info: object) -> None:
         self._shut_down()
         self._open = False
         self._stop_prestarted_fork_server()

@@ -28,12 +28,21 @@ from __future__ import annotations
 
 import functools
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .probability import good_probability
 from .search.backend import validate_iterations, validate_marks
 from .validation import check_choice, check_probability
+
+if TYPE_CHECKING:
+    from types import ModuleType
+
+    from qiskit import QuantumCircuit
+    from qiskit.providers import BackendV2
+    from qiskit.transpiler import PassManager
+    from qiskit_aer.noise import NoiseModel
 
 #: the device basis of the depolarizing sweep (IBM's pre-Heron basis; rz is virtual and error-free)
 DEVICE_BASIS = ("cx", "rz", "sx", "x")
@@ -49,7 +58,7 @@ class MissingExtraError(ImportError):
     """An optional dependency is not installed; the message says which and how to install it."""
 
 
-def depolarizing_noise_model(p1: float, p2: float):
+def depolarizing_noise_model(p1: float, p2: float) -> NoiseModel:
     """A ``NoiseModel`` with depolarizing errors p1 on sx/x and p2 on cx (see the module text).
 
     Args:
@@ -81,7 +90,7 @@ def depolarizing_noise_model(p1: float, p2: float):
 
 
 @functools.lru_cache(maxsize=4)
-def device_pass_manager(optimization_level: int = 1):
+def device_pass_manager(optimization_level: int = 1) -> PassManager:
     """The one pass manager of the depolarizing sweep: basis [cx, rz, sx, x], all-to-all.
 
     Args:
@@ -114,7 +123,7 @@ def available_fake_device() -> str:
 
 
 @functools.lru_cache(maxsize=4)
-def fake_device(name: str | None = None):
+def fake_device(name: str | None = None) -> BackendV2:
     """A fake IBM device (``BackendV2`` with the calibration snapshot's coupling map, gates and
     errors); ``name`` one of ``FAKE_DEVICES`` (default: the first installed).
 
@@ -136,7 +145,7 @@ def fake_device(name: str | None = None):
     return getattr(provider, name)()
 
 
-def _fake_provider():
+def _fake_provider() -> ModuleType:
     try:
         from qiskit_ibm_runtime import fake_provider
     except ImportError as exc:
@@ -154,7 +163,7 @@ def has_fake_devices() -> bool:
     return True
 
 
-def noisy_gate_counts(circuit) -> tuple[int, int]:
+def noisy_gate_counts(circuit: QuantumCircuit) -> tuple[int, int]:
     """(one-qubit, two-qubit) gates of a transpiled circuit that carry an error in the depolarizing
     model (rz, barriers and measurements carry none).
 
@@ -213,7 +222,8 @@ def white_noise_success(num_items: int, num_marked: int, iterations: int, fideli
     return float(fidelity * ideal + (1.0 - fidelity) * num_marked / num_items)
 
 
-def transpiled_grover(marks: np.ndarray, iterations: int, measure: bool = False, pass_manager=None):
+def transpiled_grover(marks: np.ndarray, iterations: int, measure: bool = False,
+                      pass_manager: PassManager | None = None) -> QuantumCircuit:
     """``grover_circuit(marks, iterations)`` through ``pass_manager`` (default ``device_pass_manager()``).
 
     Args:
@@ -237,7 +247,7 @@ def transpiled_grover(marks: np.ndarray, iterations: int, measure: bool = False,
     return manager.run(grover_circuit(marks, iterations, measure=measure))
 
 
-def noisy_index_distribution(compiled, noise_model, num_qubits: int) -> np.ndarray:
+def noisy_index_distribution(compiled: QuantumCircuit, noise_model: NoiseModel, num_qubits: int) -> np.ndarray:
     """Exact probabilities of the n index qubits (virtual order) after the transpiled, unmeasured
     circuit ``compiled`` under ``noise_model``: AerSimulator(method="density_matrix") with
     ``save_probabilities`` on the physical qubits the final layout assigns to the index.

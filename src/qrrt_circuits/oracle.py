@@ -14,6 +14,8 @@ re-exported here.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from .collision import trajectories_free
@@ -74,7 +76,8 @@ class ReachabilityOracle:
     check = "exact"
 
     def __new__(cls, env: Environment, dynamics: LinearTrackingDynamics | None = None,
-                resolution: float = 0.01, check: str = "exact", time_samples: int = 50):
+                resolution: float = 0.01, check: str = "exact", time_samples: int = 50) -> Any:
+        # Any: a ReachabilityOracle, or for check="time_samples" a TimeSampledCheck (0.1's alias)
         if check == "time_samples":
             from .time_sampled import TimeSampledCheck
 
@@ -109,7 +112,7 @@ class ReachabilityOracle:
         self._upper = np.ascontiguousarray(env.boxes[:, 1])
         self._bounds = np.ascontiguousarray(env.bounds)
 
-    def __getnewargs__(self):  # pickling goes through __new__ with the env (check stays exact)
+    def __getnewargs__(self) -> tuple[Environment]:  # pickling goes through __new__ with the env (check stays exact)
         return (self.env,)
 
     @property

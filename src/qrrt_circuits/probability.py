@@ -8,19 +8,20 @@ entries are truly good and m2 truly good entries were marked bad.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from .validation import check_int, check_probability
 
 
-def _count(value, name: str, minimum: int = 0) -> int:
+def _count(value: Any, name: str, minimum: int = 0) -> int:
     return check_int(value, name, minimum)
 
 
-def _probability(value, name: str) -> float:
+def _probability(value: Any, name: str) -> float:
     return check_probability(value, name)
 
 
-def _marked(num_items, num_marked) -> tuple[int, int]:
+def _marked(num_items: Any, num_marked: Any) -> tuple[int, int]:
     num_items = _count(num_items, "num_items", 1)
     num_marked = _count(num_marked, "num_marked", 0)
     if num_marked > num_items:
@@ -172,7 +173,7 @@ def expected_workers_all_found(num_marked: int, p_good: float) -> float:
     return num_marked * harmonic(num_marked) / p_good
 
 
-def _error_counts(num_items, num_marked, true_marked, missed_good) -> tuple[int, int, int, int]:
+def _error_counts(num_items: Any, num_marked: Any, true_marked: Any, missed_good: Any) -> tuple[int, int, int, int]:
     num_items, num_marked = _marked(num_items, num_marked)
     true_marked = _count(true_marked, "true_marked")
     missed_good = _count(missed_good, "missed_good")

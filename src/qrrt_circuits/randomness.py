@@ -20,11 +20,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import IntEnum
 from functools import cached_property
-from typing import cast
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 from numba import njit
 from numpy.random.bit_generator import ISeedSequence
+
+if TYPE_CHECKING:
+    from numpy.typing import DTypeLike
 
 
 class Stream(IntEnum):
@@ -64,7 +67,7 @@ def _uint32_words(value: int) -> list[int]:
 
 
 @njit(cache=True, nogil=True)
-def _hashmix(value, hash_const):
+def _hashmix(value: np.uint64, hash_const: np.ndarray) -> np.uint64:
     """numpy's ``hashmix``; ``hash_const`` is a 1-element uint64 array (its state)."""
     mask = np.uint64(_MASK)
     value = value ^ hash_const[0]
@@ -74,14 +77,14 @@ def _hashmix(value, hash_const):
 
 
 @njit(cache=True, nogil=True)
-def _mix(x, y):
+def _mix(x: np.uint64, y: np.uint64) -> np.uint64:
     mask = np.uint64(_MASK)
     result = (np.uint64(_MIX_MULT_L) * x - np.uint64(_MIX_MULT_R) * y) & mask
     return result ^ (result >> np.uint64(16))
 
 
 @njit(cache=True, nogil=True)
-def _seed_words(run_entropy, keys):
+def _seed_words(run_entropy: np.ndarray, keys: np.ndarray) -> np.ndarray:
     """For each row of ``keys`` (K, c) non-negative int64: the 4 uint64 words that
     ``SeedSequence(entropy, spawn_key=tuple(row)).generate_state(4, np.uint64)`` returns, where
     ``run_entropy`` (uint64 holding 32-bit words) is the entropy's words padded to the pool size."""
@@ -135,7 +138,7 @@ class _SeedWords(ISeedSequence):
     def __init__(self, words: np.ndarray) -> None:
         self.words = words
 
-    def generate_state(self, n_words: int, dtype=np.uint32) -> np.ndarray:
+    def generate_state(self, n_words: int, dtype: DTypeLike = np.uint32) -> np.ndarray:
         if n_words != 4 or np.dtype(dtype) != np.uint64:
             raise ValueError("_SeedWords only seeds PCG64 (4 uint64 words)")
         return self.words
@@ -273,7 +276,7 @@ _PCG_MULT_LOW = 0x4385DF649FCCF645
 
 
 @njit(cache=True, nogil=True)
-def _mul64(a, b):
+def _mul64(a: np.uint64, b: np.uint64) -> tuple[np.uint64, np.uint64]:
     """The 128-bit product of two uint64 as (high, low)."""
     mask = np.uint64(0xFFFFFFFF)
     shift = np.uint64(32)
@@ -288,7 +291,8 @@ def _mul64(a, b):
 
 
 @njit(cache=True, nogil=True)
-def _pcg_step(state_hi, state_lo, inc_hi, inc_lo):
+def _pcg_step(state_hi: np.uint64, state_lo: np.uint64, inc_hi: np.uint64,
+              inc_lo: np.uint64) -> tuple[np.uint64, np.uint64]:
     """state * MULT + inc (mod 2^128)."""
     mult_hi, mult_lo = np.uint64(_PCG_MULT_HIGH), np.uint64(_PCG_MULT_LOW)
     high, low = _mul64(state_lo, mult_lo)
@@ -299,7 +303,7 @@ def _pcg_step(state_hi, state_lo, inc_hi, inc_lo):
 
 
 @njit(cache=True, nogil=True)
-def _raw_outputs(words, count):
+def _raw_outputs(words: np.ndarray, count: int) -> np.ndarray:
     """(K, count) uint64: the first ``count`` outputs of ``PCG64(seed words)`` (``random_raw``)."""
     out = np.empty((words.shape[0], count), dtype=np.uint64)
     one = np.uint64(1)
@@ -321,7 +325,7 @@ def _raw_outputs(words, count):
 
 
 @njit(cache=True, nogil=True)
-def _uniform_draws(words, count):
+def _uniform_draws(words: np.ndarray, count: int) -> np.ndarray:
     """(K, count): the first ``count`` values of ``Generator(PCG64(seed words)).random()``
     (numpy's next_double: the top 53 bits of one output)."""
     raw = _raw_outputs(words, count)
@@ -371,7 +375,7 @@ def integer_seed_words(seed: int) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True)
-def _pcg_state(words):
+def _pcg_state(words: np.ndarray) -> np.ndarray:
     """numpy's ``pcg64_set_seed`` from the four seed words: the generator state array."""
     one = np.uint64(1)
     state = np.zeros(6, dtype=np.uint64)
@@ -386,7 +390,7 @@ def _pcg_state(words):
 
 
 @njit(cache=True, nogil=True)
-def _next64(state):
+def _next64(state: np.ndarray) -> np.uint64:
     """``pcg64_next64``: advance, then the XSL-RR output of the new state."""
     state_hi, state_lo = _pcg_step(state[0], state[1], state[2], state[3])
     state[0], state[1] = state_hi, state_lo
@@ -396,13 +400,13 @@ def _next64(state):
 
 
 @njit(cache=True, nogil=True)
-def _next_double(state):
+def _next_double(state: np.ndarray) -> float:
     """``Generator.random()``: the top 53 bits of one 64-bit output."""
     return np.float64(_next64(state) >> np.uint64(11)) * (1.0 / 9007199254740992.0)
 
 
 @njit(cache=True, nogil=True)
-def _next32(state):
+def _next32(state: np.ndarray) -> np.uint64:
     """``pcg64_next32``: the buffered upper half of the last output, else the lower half of a new one."""
     if state[4]:
         state[4] = np.uint64(0)
@@ -414,12 +418,12 @@ def _next32(state):
 
 
 @njit(cache=True, nogil=True)
-def _bounded_below(state, high):
+def _bounded_below(state: np.ndarray, high: int) -> np.int64:
     """One ``Generator.integers(0, high)`` draw for 1 <= high <= 2**32 (numpy's
     ``random_bounded_uint64_fill``: nothing drawn for high = 1, Lemire's method on 32-bit draws)."""
     span = np.uint64(high - 1)  # numpy's inclusive range ``rng``
     if span == 0:
-        return 0
+        return np.int64(0)
     mask = np.uint64(0xFFFFFFFF)
     if span == mask:
         return np.int64(_next32(state))

@@ -15,7 +15,21 @@ import functools
 import inspect
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import numpy as np
+    from qiskit_aer.noise import NoiseModel
+
+    from .authors_check import AuthorsCheck
+    from .dynamics import LinearTrackingDynamics
+    from .environment import Environment
+    from .oracle import ReachabilityOracle
+    from .search import AerBackend, SamplerBackend, StatevectorBackend
+    from .search.estimated_policy import EstimatedOptimal
+    from .search.fixed_point_policy import FixedPointAmplification
+    from .search.policies import FixedIterations
+    from .time_sampled import TimeSampledCheck
 
 
 @dataclass(frozen=True)
@@ -291,21 +305,21 @@ def _planners() -> Registry:
 
 
 # ----------------------------------------------------------------------------------------- backends
-def _aer(seed=None, max_parallel_threads: int = 0, method: str = "statevector", noise_model=None,
-         device: str = "CPU"):
+def _aer(seed: int | np.random.Generator | None = None, max_parallel_threads: int = 0, method: str = "statevector",
+         noise_model: NoiseModel | None = None, device: str = "CPU") -> AerBackend:
     from .search import AerBackend
 
     return AerBackend(seed=seed, method=method, noise_model=noise_model, device=device,
                       max_parallel_threads=max_parallel_threads)
 
 
-def _statevector(seed=None, closed_form: bool = True):
+def _statevector(seed: int | np.random.Generator | None = None, closed_form: bool = True) -> StatevectorBackend:
     from .search import StatevectorBackend
 
     return StatevectorBackend(seed=seed, closed_form=closed_form)
 
 
-def _aer_sampler(seed=None):
+def _aer_sampler(seed: int | np.random.Generator | None = None) -> SamplerBackend:
     from qiskit_aer.primitives import SamplerV2
 
     from .search import SamplerBackend
@@ -322,7 +336,7 @@ def _backends() -> Registry:
 
 
 # ----------------------------------------------------------------------------------------- policies
-def _fixed(value: str):
+def _fixed(value: str) -> FixedIterations:
     from .search.policies import FixedIterations
 
     try:
@@ -332,7 +346,7 @@ def _fixed(value: str):
     return FixedIterations(k)
 
 
-def _fixed_point(value: str | None):
+def _fixed_point(value: str | None) -> FixedPointAmplification:
     from .search.fixed_point_policy import FixedPointAmplification
 
     if value is None:
@@ -345,7 +359,7 @@ def _fixed_point(value: str | None):
     return FixedPointAmplification(delta=delta)
 
 
-def _estimated():
+def _estimated() -> EstimatedOptimal:
     from .search.estimated_policy import EstimatedOptimal
 
     return EstimatedOptimal()
@@ -382,13 +396,14 @@ def _scenarios() -> Registry:
 
 
 # ----------------------------------------------------------------------------------------- predicates
-def _exact(env, dynamics=None, resolution: float = 0.01):
+def _exact(env: Environment, dynamics: LinearTrackingDynamics | None = None,
+           resolution: float = 0.01) -> ReachabilityOracle:
     from .oracle import ReachabilityOracle
 
     return ReachabilityOracle(env, dynamics, resolution=resolution)
 
 
-def _time_samples(value: str, env, dynamics=None):
+def _time_samples(value: str, env: Environment, dynamics: LinearTrackingDynamics | None = None) -> TimeSampledCheck:
     from .time_sampled import TimeSampledCheck
 
     try:
@@ -398,13 +413,13 @@ def _time_samples(value: str, env, dynamics=None):
     return TimeSampledCheck(env, dynamics, time_samples=count)
 
 
-def _authors(env, dynamics=None):
+def _authors(env: Environment, dynamics: LinearTrackingDynamics | None = None) -> AuthorsCheck:
     from .authors_check import AuthorsCheck
 
     return AuthorsCheck(env, dynamics, refine=4)
 
 
-def _authors_octave(env, dynamics=None):
+def _authors_octave(env: Environment, dynamics: LinearTrackingDynamics | None = None) -> AuthorsCheck:
     from .authors_check import AuthorsCheck
 
     return AuthorsCheck(env, dynamics, refine=1)

@@ -37,11 +37,17 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .search.backend import validate_marks
 from .validation import check_choice, check_int, check_positive_float
+
+if TYPE_CHECKING:
+    from qiskit import QuantumCircuit
+    from qiskit.transpiler import CouplingMap
+    from qualtran.resource_counting import GateCounts
 
 CONNECTIVITIES = ("all-to-all", "line", "heavy-hex")
 #: the heavy-hex lattice used (57 qubits, distance 5): enough room for n <= 12 plus routing
@@ -76,7 +82,7 @@ class NearTermCount:
 
 
 @functools.lru_cache(maxsize=8)
-def coupling_map(connectivity: str, num_qubits: int):
+def coupling_map(connectivity: str, num_qubits: int) -> CouplingMap | None:
     """None (all-to-all), a line of n qubits, or the distance-5 heavy-hex lattice.
 
     Args:
@@ -99,7 +105,7 @@ def coupling_map(connectivity: str, num_qubits: int):
     return CouplingMap.from_heavy_hex(HEAVY_HEX_DISTANCE)
 
 
-def iteration_circuit(marks: np.ndarray, synthesis: str = "diagonal"):
+def iteration_circuit(marks: np.ndarray, synthesis: str = "diagonal") -> QuantumCircuit:
     """One Grover iteration Q = grover_operator(phase_oracle(marks, synthesis), H^n): one oracle call.
 
     Args:
@@ -152,7 +158,8 @@ def near_term_counts(marks: np.ndarray, synthesis: str = "diagonal", connectivit
                          int(compiled.depth()), len(used))
 
 
-def transpile_to(circuit, connectivity: str = "all-to-all", optimization_level: int = 1):
+def transpile_to(circuit: QuantumCircuit, connectivity: str = "all-to-all",
+                 optimization_level: int = 1) -> QuantumCircuit:
     """``circuit`` transpiled (fixed seed) to [cx, rz, sx, x] on ``connectivity``.
 
     Args:
@@ -321,11 +328,11 @@ def _qualtran_counts(n: int, lookup: str) -> FaultTolerantCount:
                               _ands(diffuser) + _ts(diffuser) // 4, "qualtran " + _version("qualtran"))
 
 
-def _ands(cost) -> int:
+def _ands(cost: GateCounts) -> int:
     return int(cost.and_bloq) + int(cost.toffoli) + int(cost.cswap)
 
 
-def _ts(cost) -> int:
+def _ts(cost: GateCounts) -> int:
     if int(cost.rotation):
         raise RuntimeError(f"unexpected arbitrary rotations in a lookup's cost: {cost}")
     return int(cost.t)

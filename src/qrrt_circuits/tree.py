@@ -128,7 +128,7 @@ class Tree:
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _cell_of(point, origin, cell, shape, out):
+def _cell_of(point: np.ndarray, origin: np.ndarray, cell: float, shape: np.ndarray, out: np.ndarray) -> int:
     """The (clamped) integer cell coordinates of ``point`` into ``out``; returns the flat index."""
     flat = 0
     for axis in range(point.shape[0]):
@@ -145,7 +145,8 @@ def _cell_of(point, origin, cell, shape, out):
 
 
 @njit(cache=True, nogil=True)
-def _grid_insert(nodes, next_node, head, origin, cell, shape, index, low, high):
+def _grid_insert(nodes: np.ndarray, next_node: np.ndarray, head: np.ndarray, origin: np.ndarray, cell: float,
+                 shape: np.ndarray, index: int, low: np.ndarray, high: np.ndarray) -> None:
     for axis in range(low.shape[0]):
         low[axis] = min(low[axis], nodes[index, axis])
         high[axis] = max(high[axis], nodes[index, axis])
@@ -156,7 +157,8 @@ def _grid_insert(nodes, next_node, head, origin, cell, shape, index, low, high):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _visit_cell(point, nodes, next_node, head, flat, size, best, best_index):
+def _visit_cell(point: np.ndarray, nodes: np.ndarray, next_node: np.ndarray, head: np.ndarray, flat: int, size: int,
+                best: float, best_index: int) -> tuple[float, int]:
     node = head[flat]
     while node >= 0:
         if node < size:
@@ -172,7 +174,9 @@ def _visit_cell(point, nodes, next_node, head, flat, size, best, best_index):
 
 
 @njit(cache=True, nogil=True)
-def _grid_nearest(points, nodes, next_node, head, origin, cell, shape, size, low, high, out):
+def _grid_nearest(points: np.ndarray, nodes: np.ndarray, next_node: np.ndarray, head: np.ndarray, origin: np.ndarray,
+                  cell: float, shape: np.ndarray, size: int, low: np.ndarray, high: np.ndarray,
+                  out: np.ndarray) -> None:
     """Ring search: for each point, the node with the smallest (squared distance, index)."""
     dim = points.shape[1]
     last = dim - 1

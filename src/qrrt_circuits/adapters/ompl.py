@@ -71,7 +71,7 @@ class OMPLMotionPredicate:
             (its bounds unset).
     """
 
-    def __init__(self, space_information, name: str = "ompl") -> None:
+    def __init__(self, space_information: ob.SpaceInformation, name: str = "ompl") -> None:
         if not isinstance(space_information, ob.SpaceInformation):
             raise TypeError("space_information must be an ompl.base.SpaceInformation, got "
                             f"{type(space_information).__name__}")
@@ -185,7 +185,7 @@ def environment_space_information(env: Environment) -> ob.SpaceInformation:
     space.setBounds(bounds)
     si = ob.SpaceInformation(space)
 
-    def is_valid(state) -> bool:
+    def is_valid(state: ob.State) -> bool:
         return bool(env.is_free(np.array(state[0:d])))
 
     si.setStateValidityChecker(is_valid)

@@ -12,11 +12,21 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from enum import IntEnum
 from pathlib import Path
+from typing import Any, TypeAlias
 
 import numpy as np
 
 #: record columns that measure time: excluded when records are compared across executors
 TIMING_SUFFIX = "_s"
+
+#: an experiment's settings: JSON scalars and lists, stored in ``settings.json``
+Settings: TypeAlias = dict[str, Any]
+#: one trial's record: a flat mapping of column name to JSON scalar (one ``records.csv`` row);
+#: its columns differ per experiment, so it stays a plain dict
+Record: TypeAlias = dict[str, Any]
+#: an experiment's summary (``summary.json``): ``{"ours": ..., "paper": ...}`` plus what each
+#: experiment keeps (nested JSON whose shape differs per experiment)
+Summary: TypeAlias = dict[str, Any]
 
 
 class TrialStream(IntEnum):
@@ -50,24 +60,49 @@ class TrialStream(IntEnum):
 
 @dataclass(frozen=True)
 class Trial:
-    """One unit of work: a unique id, its parameters (JSON-able scalars) and its seed."""
+    """One unit of work: a unique id, its parameters (JSON-able scalars) and its seed.
+
+    Attributes:
+        id: Unique within the experiment (``records.csv`` is keyed by it).
+        params: The trial's parameters, copied into its record.
+        seed: The trial's seed (from ``replicate_seed``).
+    """
 
     id: str
-    params: dict = field(default_factory=dict)
+    params: dict[str, Any] = field(default_factory=dict)
     seed: int = 0
 
 
 def replicate_seed(root_seed: int, replicate: int, stream: int = 0) -> int:
-    """The seed of replicate ``replicate``: SeedSequence(root_seed) spawned at (stream, replicate)."""
+    """The seed of replicate ``replicate``: SeedSequence(root_seed) spawned at (stream, replicate).
+
+    Args:
+        root_seed: The experiment's ``--seed``.
+        replicate: The replicate index (0-based).
+        stream: The ``TrialStream`` the seed is drawn from.
+
+    Returns:
+        The first 32-bit word of ``SeedSequence(root_seed, spawn_key=(stream, replicate))``.
+    """
     sequence = np.random.SeedSequence(int(root_seed), spawn_key=(int(stream), int(replicate)))
     return int(sequence.generate_state(1, dtype=np.uint32)[0])
 
 
-def paired_trials(settings: dict, variants: list[tuple[str, dict]], world_stream: int,
+def paired_trials(settings: Settings, variants: list[tuple[str, dict[str, Any]]], world_stream: int,
                   seed_stream: int) -> list[Trial]:
     """One world per replicate, shared by every variant (so variants are compared on the same
     worlds): trial ``f"{label}-{replicate}"`` with ``params`` plus ``replicate`` and ``world_seed``;
-    all variants of a replicate share its seed too."""
+    all variants of a replicate share its seed too.
+
+    Args:
+        settings: The experiment's settings (``trials`` replicates, root ``seed``).
+        variants: ``(label, params)`` for each variant run on every replicate.
+        world_stream: The ``TrialStream`` of the world seeds.
+        seed_stream: The ``TrialStream`` of the planner seeds.
+
+    Returns:
+        ``settings["trials"] * len(variants)`` trials, replicate by replicate.
+    """
     trials = []
     for replicate in range(settings["trials"]):
         world_seed = replicate_seed(settings["seed"], replicate, world_stream)
@@ -79,27 +114,80 @@ def paired_trials(settings: dict, variants: list[tuple[str, dict]], world_stream
 
 
 class Experiment:
-    """Base class; subclasses define the five methods below (and ``name``, ``title``)."""
+    """Base class; subclasses define the five methods below (and ``name``, ``title``).
+
+    Attributes:
+        name: The experiment's name (``qrrt reproduce NAME``, its folder under ``--out``).
+        title: A one-line title naming the paper's figure or table it reproduces.
+        uses_predicate: Whether its planners take the predicate chosen by ``--predicate``.
+        paper: What the paper reports (filled by subclasses).
+    """
 
     name = "experiment"
     title = ""
     #: whether the experiment's planners take the reachability predicate chosen by ``--predicate``
     uses_predicate = True
     #: what the paper reports (filled by subclasses)
-    paper: dict = {}
+    paper: dict[str, Any] = {}
 
-    def settings(self, quick: bool, trials: int | None, seed: int) -> dict:
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
+        """The settings of a run (stored in ``settings.json``; a resumed run must match them).
+
+        Args:
+            quick: Small settings (each experiment then takes under two minutes).
+            trials: Trials per variant, or None for the experiment's default.
+            seed: The root seed of every trial's seed.
+
+        Returns:
+            JSON-able settings.
+        """
         raise NotImplementedError
 
-    def trials(self, settings: dict) -> list[Trial]:
+    def trials(self, settings: Settings) -> list[Trial]:
+        """The independent units of work, with unique ids and their seeds.
+
+        Args:
+            settings: As returned by ``settings``.
+
+        Returns:
+            The trials, in a fixed order (summaries follow it).
+        """
         raise NotImplementedError
 
-    def run_trial(self, trial: Trial, settings: dict) -> dict:
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
+        """Run one trial.
+
+        Args:
+            trial: One of ``trials(settings)``.
+            settings: As returned by ``settings``.
+
+        Returns:
+            The trial's measurements (flat JSON scalars; the runner adds the id, seed and params).
+        """
         raise NotImplementedError
 
-    def summarize(self, records: list[dict], settings: dict) -> dict:
-        """Return at least {"ours": ..., "paper": ...} (plus anything else worth keeping)."""
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
+        """Summarize all records against the paper's numbers.
+
+        Args:
+            records: One record per trial, in ``trials`` order.
+            settings: As returned by ``settings``.
+
+        Returns:
+            At least ``{"ours": ..., "paper": ...}`` (plus anything else worth keeping).
+        """
         raise NotImplementedError
 
-    def plot(self, records: list[dict], settings: dict, summary: dict, out_dir: Path) -> list[Path]:
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
+        """Draw the experiment's figures.
+
+        Args:
+            records: One record per trial, in ``trials`` order.
+            settings: As returned by ``settings``.
+            summary: As returned by ``summarize`` (with the runner's keys added).
+            out_dir: The folder the figures are written to.
+
+        Returns:
+            The paths of the figures written.
+        """
         raise NotImplementedError

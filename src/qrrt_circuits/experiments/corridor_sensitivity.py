@@ -12,10 +12,11 @@ over the trials, with a 95 % bootstrap interval).
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .base import Experiment, Trial, TrialStream, replicate_seed
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .corridor import in_channel
 from .figures import new_figure, save
 from .intervals import bootstrap_interval, rounded_interval
@@ -23,16 +24,29 @@ from .measures import cut_at
 from .planners import planner_for
 from .worlds import world
 
-BASE = {"distance": 1.0, "mouth_clearance": 1.5, "policy": "paper", "num_qubits": 8}
-FACTORS = {"distance": [0.25, 0.5, 1.0, 2.0, 4.0], "mouth_clearance": [0.3, 0.75, 1.5, 3.0],
+if TYPE_CHECKING:
+    from ..environment import Environment
+
+#: factor -> value of the base cell (numbers and a policy name)
+BASE: dict[str, Any] = {"distance": 1.0, "mouth_clearance": 1.5, "policy": "paper", "num_qubits": 8}
+#: factor -> the values it takes, one at a time
+FACTORS: dict[str, list[Any]] = {"distance": [0.25, 0.5, 1.0, 2.0, 4.0], "mouth_clearance": [0.3, 0.75, 1.5, 3.0],
            "policy": ["fixed:1", "fixed:2", "paper"], "num_qubits": [4, 6, 8, 10]}
 PAPER = {"QRRT": 47, "RRT": 14}
 PLANNERS = ("RRT", "QRRT")
 
 
-def cells(factors: dict) -> list[dict]:
-    """The base cell and every one-factor change of it (each distinct cell once)."""
-    out, seen = [], set()
+def cells(factors: dict[str, list[Any]]) -> list[dict[str, Any]]:
+    """The base cell and every one-factor change of it (each distinct cell once).
+
+    Args:
+        factors: Factor -> the values it takes (a subset of ``FACTORS``).
+
+    Returns:
+        Cells (``BASE`` with one factor changed), in the order of ``factors``, without repeats.
+    """
+    out: list[dict[str, Any]] = []
+    seen: set[tuple[tuple[str, Any], ...]] = set()
     for factor, values in factors.items():
         for value in values:
             cell = {**BASE, factor: value}
@@ -43,13 +57,32 @@ def cells(factors: dict) -> list[dict]:
     return out
 
 
-def cell_id(cell: dict) -> str:
+def cell_id(cell: dict[str, Any]) -> str:
+    """A cell's id, e.g. ``d1.0-c1.5-paper-n8``.
+
+    Args:
+        cell: A cell (or a record holding its factors).
+
+    Returns:
+        The id naming its distance, mouth clearance, policy and qubits.
+    """
     return f"d{cell['distance']}-c{cell['mouth_clearance']}-{cell['policy']}-n{cell['num_qubits']}"
 
 
-def start_before_mouth(env, distance: float) -> tuple[np.ndarray, float]:
+def start_before_mouth(env: Environment, distance: float) -> tuple[np.ndarray, float]:
     """A free start on the channel's axis at least ``distance`` before its left mouth (stepping
-    back 0.05 at a time past any clutter box); returns it and its actual distance."""
+    back 0.05 at a time past any clutter box); returns it and its actual distance.
+
+    Args:
+        env: A ``narrow_corridor`` world (its ``metadata["channel"]``).
+        distance: The least distance before the mouth.
+
+    Returns:
+        ``(start, actual_distance)``.
+
+    Raises:
+        ValueError: If no free start is found within 400 steps (20 units) or inside the bounds.
+    """
     (x0, y0), (_, y1) = env.metadata["channel"]
     for step in range(400):
         actual = distance + 0.05 * step
@@ -60,23 +93,31 @@ def start_before_mouth(env, distance: float) -> tuple[np.ndarray, float]:
 
 
 class CorridorSensitivity(Experiment):
+    """The narrow corridor as a sensitivity study (beyond paper Figs. 13-14).
+
+    Each cell of ``cells(FACTORS)`` changes one factor of ``BASE`` (start distance, mouth
+    clearance, iteration schedule, database size); a trial runs RRT or q-RRT there, cut at 25
+    oracle calls, and counts nodes in the channel. The summary lists, per cell, the sums with 95 %
+    intervals, the cells where q-RRT is ahead of RRT and those where the paper's 47 vs 14 is reached.
+    """
+
     name = "corridor-sensitivity"
     title = "Narrow corridor: channel nodes against start, clutter, iterations and database size"
     paper = PAPER
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         factors = {key: values[::2] if quick else values for key, values in FACTORS.items()}
         if quick:
             factors = {key: sorted(set(values) | {BASE[key]}, key=str) for key, values in factors.items()}
         return {"trials": trials or (10 if quick else 50), "budget": 25, "backend": "statevector",
                 "scenario": "narrow_corridor", "world_seed": 0, "factors": factors, "seed": seed, "quick": quick}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         return [Trial(f"{kind}-{cell_id(cell)}-{i}", {"planner": kind, **cell, "replicate": i},
                       replicate_seed(settings["seed"], i, TrialStream.CORRIDOR_SENSITIVITY))
                 for cell in cells(settings["factors"]) for kind in PLANNERS for i in range(settings["trials"])]
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         params = trial.params
         env = world(settings["scenario"], settings["world_seed"], mouth_clearance=params["mouth_clearance"])
         start, distance = start_before_mouth(env, params["distance"])
@@ -88,8 +129,9 @@ class CorridorSensitivity(Experiment):
         return {"nodes": nodes, "oracle_calls": calls, "start_distance": round(distance, 3),
                 "in_channel": int(in_channel(positions, env.metadata["channel"]).sum())}
 
-    def summarize(self, records, settings):
-        ours, interval = {}, {}
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
+        ours: dict[str, dict[str, int]] = {}
+        interval: dict[str, dict[str, list[float]]] = {}
         for cell in cells(settings["factors"]):
             key = cell_id(cell)
             ours[key], interval[key] = {}, {}
@@ -112,7 +154,7 @@ class CorridorSensitivity(Experiment):
                 "labels": ["phase oracle from a classical lookup of all 2^n entries",
                            "backend: exact statevector (ideal; same statistics as Aer)"]}
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         factors = settings["factors"]
         fig, axes = new_figure(1, len(factors), (4.4 * len(factors), 4.2))
         colors = {"RRT": "tab:gray", "QRRT": "tab:blue"}

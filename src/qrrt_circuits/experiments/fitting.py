@@ -5,18 +5,41 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 
 @dataclass(frozen=True)
 class LineFit:
+    """A least-squares line ``y = slope x + intercept``.
+
+    Attributes:
+        slope: The fitted slope.
+        intercept: The fitted intercept.
+        slope_stderr: The standard error of the slope.
+        points: How many points were fitted.
+    """
+
     slope: float
     intercept: float
     slope_stderr: float
     points: int
 
 
-def linear_fit(x, y) -> LineFit:
-    """Ordinary least squares y = a x + b, with the standard error of a."""
+def linear_fit(x: ArrayLike, y: ArrayLike) -> LineFit:
+    """Ordinary least squares y = a x + b, with the standard error of a.
+
+    Args:
+        x: 1-D abscissae (at least two distinct values).
+        y: 1-D ordinates, as many as ``x``.
+
+    Returns:
+        The fit; ``slope_stderr`` = sqrt(s^2 / sum (x - mean x)^2) with s^2 the residual variance
+        on max(n - 2, 1) degrees of freedom.
+
+    Raises:
+        ValueError: If ``x`` and ``y`` are not 1-D of equal length, or ``x`` has fewer than two
+            distinct values.
+    """
     x = np.asarray(x, dtype=float)
     y = np.asarray(y, dtype=float)
     if x.shape != y.shape or x.ndim != 1:
@@ -32,8 +55,19 @@ def linear_fit(x, y) -> LineFit:
     return LineFit(float(coef[0]), float(coef[1]), stderr, int(x.size))
 
 
-def slope_through_origin(x, y) -> float:
-    """Least squares y = a x: a = sum(x y) / sum(x^2)."""
+def slope_through_origin(x: ArrayLike, y: ArrayLike) -> float:
+    """Least squares y = a x: a = sum(x y) / sum(x^2).
+
+    Args:
+        x: Abscissae.
+        y: Ordinates, as many as ``x``.
+
+    Returns:
+        The slope a.
+
+    Raises:
+        ValueError: If every x is 0.
+    """
     x = np.asarray(x, dtype=float)
     y = np.asarray(y, dtype=float)
     denominator = float(np.sum(x * x))
@@ -42,8 +76,19 @@ def slope_through_origin(x, y) -> float:
     return float(np.sum(x * y) / denominator)
 
 
-def power_law_exponent(x, y) -> LineFit:
-    """Fit y = C x^alpha by least squares on log y = alpha log x + log C (x, y > 0)."""
+def power_law_exponent(x: ArrayLike, y: ArrayLike) -> LineFit:
+    """Fit y = C x^alpha by least squares on log y = alpha log x + log C (x, y > 0).
+
+    Args:
+        x: Abscissae; points with x <= 0 or y <= 0 are left out.
+        y: Ordinates, as many as ``x``.
+
+    Returns:
+        The line fit in log-log space: ``slope`` is alpha, ``intercept`` is log C.
+
+    Raises:
+        ValueError: If fewer than two distinct positive x (with positive y) remain.
+    """
     x = np.asarray(x, dtype=float)
     y = np.asarray(y, dtype=float)
     keep = (x > 0) & (y > 0)

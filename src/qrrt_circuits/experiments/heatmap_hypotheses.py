@@ -22,11 +22,12 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from ..search.policies import FixedIterations, PaperSchedule
-from .base import Experiment, Trial, TrialStream, replicate_seed
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import cut_at
@@ -37,23 +38,43 @@ BOX_COUNTS = (50, 100, 150, 200, 250, 300, 400, 525)
 CUTS = (10, 20, 40)
 #: label -> (registry planner, search policy)
 VARIANTS = {"RRT": ("rrt", None), "QRRT paper": ("qrrt", PaperSchedule()), "QRRT k=2": ("qrrt", FixedIterations(2))}
-PAPER = {"RRT": {"10": {"nodes": 125, "efficiency": 0.125}, "20": {"nodes": 231, "efficiency": 0.116},
-                 "40": {"nodes": 526, "efficiency": 0.132}},
-         "QRRT": {"10": {"nodes": 372, "efficiency": 0.312}, "20": {"nodes": 650, "efficiency": 0.310},
-                  "40": {"nodes": 1091, "efficiency": 0.260}}}
+#: planner -> cut -> {"nodes", "efficiency"}
+PAPER: dict[str, dict[str, dict[str, float]]] = {
+    "RRT": {"10": {"nodes": 125, "efficiency": 0.125}, "20": {"nodes": 231, "efficiency": 0.116},
+            "40": {"nodes": 526, "efficiency": 0.132}},
+    "QRRT": {"10": {"nodes": 372, "efficiency": 0.312}, "20": {"nodes": 650, "efficiency": 0.310},
+             "40": {"nodes": 1091, "efficiency": 0.260}}}
 TARGET_RRT_EFFICIENCY = PAPER["RRT"]["10"]["efficiency"]
 
 
 def max_nodes_within(budget: int, round_cost: int, trials: int) -> int:
     """The most nodes ``trials`` runs can add when each round costs ``round_cost`` calls and a run
-    stops after the first round that reaches ``budget`` (1 node per round at best)."""
+    stops after the first round that reaches ``budget`` (1 node per round at best).
+
+    Args:
+        budget: The oracle-call cut.
+        round_cost: Oracle calls of one round.
+        trials: How many runs.
+
+    Returns:
+        ``trials * ceil(budget / round_cost)``.
+    """
     return trials * math.ceil(budget / round_cost)
 
 
 def calibrate(counts: list[int], efficiency: list[float], target: float) -> float | None:
     """The obstacle count at which RRT's efficiency equals ``target``: linear interpolation between
     the two grid counts that bracket it (efficiency falls as obstacles are added); None if the
-    grid does not bracket the target."""
+    grid does not bracket the target.
+
+    Args:
+        counts: Increasing obstacle counts of the grid.
+        efficiency: RRT's efficiency at each count.
+        target: The efficiency to reach (the paper's 12.5 %).
+
+    Returns:
+        The interpolated count, or None.
+    """
     for (c0, e0), (c1, e1) in zip(zip(counts, efficiency, strict=True), zip(counts[1:], efficiency[1:], strict=True),
                                   strict=False):
         if (e0 - target) * (e1 - target) <= 0 and e0 != e1:
@@ -62,51 +83,71 @@ def calibrate(counts: list[int], efficiency: list[float], target: float) -> floa
 
 
 def interpolate(counts: list[int], values: list[float], at: float) -> float:
+    """A value of the grid at a calibrated count (linear interpolation, ``numpy.interp``).
+
+    Args:
+        counts: Increasing obstacle counts of the grid.
+        values: The value at each count.
+        at: The count to read the value at.
+
+    Returns:
+        The interpolated value.
+    """
     return float(np.interp(at, counts, values))
 
 
 class HeatmapHypotheses(Experiment):
+    """Tests two hypotheses for the paper's heatmap numbers (Figs. 10-12; see the module docstring).
+
+    A trial runs RRT, q-RRT with the paper's schedule or q-RRT with 2 iterations in a
+    ``paper_clutter``-style world with a given obstacle count, cut at 10, 20 and 40 oracle calls.
+    The summary calibrates the obstacle count on RRT's efficiency (``calibrate``) and predicts
+    q-RRT's nodes and efficiency there, each with its 95 % interval, against the paper's.
+    """
+
     name = "heatmap-hypotheses"
     title = "Which setup gives the paper's heatmap numbers? (Figs. 10-12 hypotheses)"
     paper = PAPER
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         return {"trials": trials or (20 if quick else 100), "worlds": 2 if quick else 10, "cuts": list(CUTS),
                 "box_counts": list(BOX_COUNTS[::2] + (525,) if quick else BOX_COUNTS), "num_qubits": 8,
                 "backend": "statevector", "scenario": "paper_clutter",
                 "variants": list(VARIANTS), "seed": seed, "quick": quick}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         return [Trial(f"{variant}-{boxes}-{i}", {"variant": variant, "boxes": boxes, "replicate": i,
                                                  "world_seed": i % settings["worlds"]},
                       replicate_seed(settings["seed"], i, TrialStream.HEATMAP_HYPOTHESES))
                 for boxes in settings["box_counts"] for variant in settings["variants"]
                 for i in range(settings["trials"])]
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         env = world(settings["scenario"], trial.params["world_seed"], num_boxes=trial.params["boxes"])
         planner_name, policy = VARIANTS[trial.params["variant"]]
         planner = planner_for(settings, planner_name, env, trial.seed, settings["backend"],
                               num_qubits=settings["num_qubits"], search_policy=policy)
         result = planner.plan(max_oracle_calls=max(settings["cuts"]))
-        record = {"status": str(result.status)}
+        record: Record = {"status": str(result.status)}
         for cut in settings["cuts"]:
             record[f"nodes_at_{cut}"], record[f"calls_at_{cut}"] = cut_at(result, cut)
         return record
 
-    def summarize(self, records, settings):
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
         counts, cuts = settings["box_counts"], [str(c) for c in settings["cuts"]]
-        table, spans = {}, {}
+        # variant -> boxes -> cut -> {"nodes", "efficiency"}: the value, and its 95 % interval
+        table: dict[str, dict[str, dict[str, dict[str, float]]]] = {}
+        spans: dict[str, dict[str, dict[str, dict[str, list[float]]]]] = {}
         for variant in settings["variants"]:
             table[variant], spans[variant] = {}, {}
             for boxes in counts:
                 rows = [r for r in records if r["variant"] == variant and r["boxes"] == boxes]
                 table[variant][str(boxes)], spans[variant][str(boxes)] = {}, {}
                 for cut in cuts:
-                    def nodes(sample, cut=cut):  # per 100 trials, as the paper counts them
+                    def nodes(sample: list[Record], cut: str = cut) -> float:  # per 100 trials, as the paper counts
                         return 100.0 * sum(r[f"nodes_at_{cut}"] for r in sample) / len(sample)
 
-                    def efficiency(sample, cut=cut):
+                    def efficiency(sample: list[Record], cut: str = cut) -> float:
                         calls = sum(r[f"calls_at_{cut}"] for r in sample)
                         return sum(r[f"nodes_at_{cut}"] for r in sample) / calls if calls else float("nan")
 
@@ -117,13 +158,14 @@ class HeatmapHypotheses(Experiment):
                         "efficiency": rounded_interval(bootstrap_interval(rows, efficiency, settings["seed"]))}
         rrt_efficiency = [table["RRT"][str(b)]["10"]["efficiency"] for b in counts]
         calibrated = calibrate(counts, rrt_efficiency, TARGET_RRT_EFFICIENCY)
-        predictions, verdicts = {}, {}
+        predictions: dict[str, dict[str, dict[str, dict[str, Any]]]] = {}
+        verdicts: dict[str, dict[str, dict[str, bool]]] = {}
         for variant in ("QRRT paper", "QRRT k=2"):
             if calibrated is None:
                 break
             predictions[variant], verdicts[variant] = {}, {}
             for cut in cuts:
-                prediction = {}
+                prediction: dict[str, dict[str, Any]] = {}
                 for key in ("nodes", "efficiency"):
                     value = interpolate(counts, [table[variant][str(b)][cut][key] for b in counts], calibrated)
                     low = interpolate(counts, [spans[variant][str(b)][cut][key][0] for b in counts], calibrated)
@@ -148,7 +190,7 @@ class HeatmapHypotheses(Experiment):
                 "labels": ["phase oracle from a classical lookup of all 2^8 entries",
                            "backend: exact statevector (ideal; same statistics as Aer)"]}
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         fig, axes = new_figure(1, 2, (12, 4.6))
         counts = settings["box_counts"]
         colors = {"RRT": "tab:gray", "QRRT paper": "tab:blue", "QRRT k=2": "tab:orange"}

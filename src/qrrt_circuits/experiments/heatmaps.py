@@ -14,10 +14,11 @@ same run that ends after the first round reaching 10 calls.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from .base import Experiment, Trial, TrialStream, replicate_seed
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, node_heatmap, save
 from .intervals import bootstrap_ratio_interval, differs, rounded_interval
 from .measures import cut_at, dumps, loads, reachable_fraction, rounded
@@ -29,6 +30,14 @@ CUTS = (10, 20, 40)
 
 
 class Heatmaps(Experiment):
+    """Exploration speed (paper Figs. 10-12): nodes and oracle efficiency at 10, 20 and 40 calls.
+
+    A trial grows RRT, q-RRT or Pq-RRT (cut on critical-path calls) in one ``paper_clutter`` world
+    to 40 calls and reads the 10- and 20-call cuts from its history (``cut_at``). The summary gives
+    the total nodes and the efficiency (nodes / calls) at each cut with 95 % bootstrap intervals,
+    against the paper's; the figure shows node heatmaps.
+    """
+
     name = "heatmaps"
     title = "Exploration heatmaps at 10, 20 and 40 oracle calls (paper Figs. 10-12)"
     paper = {"QRRT": {"10": {"nodes": 372, "efficiency": 0.312}, "20": {"nodes": 650, "efficiency": 0.310},
@@ -36,17 +45,17 @@ class Heatmaps(Experiment):
              "RRT": {"10": {"nodes": 125, "efficiency": 0.125}, "20": {"nodes": 231, "efficiency": 0.116},
                      "40": {"nodes": 526, "efficiency": 0.132}}}
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         return {"trials": trials or (50 if quick else 100), "cuts": list(CUTS), "workers": 8,
                 "num_qubits": 8, "backend": "aer", "schedule": "paper", "scenario": "paper_clutter",
                 "world_seed": 0, "seed": seed, "quick": quick}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         return [Trial(f"{kind}-{i}", {"planner": kind, "replicate": i},
                       replicate_seed(settings["seed"], i, TrialStream.HEATMAPS))
                 for kind in PLANNERS for i in range(settings["trials"])]
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         env = world(settings["scenario"], settings["world_seed"])
         planner = planner_for(settings, trial.params["planner"], env, trial.seed, settings["backend"],
                                settings["workers"], settings["num_qubits"])
@@ -55,7 +64,7 @@ class Heatmaps(Experiment):
             result = planner.plan(max_critical_path_calls=max(settings["cuts"]))
         else:
             result = planner.plan(max_oracle_calls=max(settings["cuts"]))
-        record = {"cut_on": "critical_path" if critical else "oracle_calls"}
+        record: Record = {"cut_on": "critical_path" if critical else "oracle_calls"}
         for cut in settings["cuts"]:
             nodes, calls = cut_at(result, cut, "critical_path" if critical else "oracle_calls")
             record[f"nodes_at_{cut}"] = nodes
@@ -65,8 +74,8 @@ class Heatmaps(Experiment):
         record["positions_json"] = dumps(rounded(result.nodes[1:]))
         return record
 
-    def summarize(self, records, settings):
-        ours = {}
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
+        ours: dict[str, dict[str, dict[str, Any]]] = {}
         for kind in PLANNERS:
             rows = [r for r in records if r["planner"] == kind]
             ours[kind] = {}
@@ -77,7 +86,8 @@ class Heatmaps(Experiment):
                                         "efficiency": round(nodes / calls, 4) if calls else None}
         fractions = {k: round(float(np.mean([r["reachable_fraction"] for r in records if r["planner"] == k])), 4)
                      for k in PLANNERS}
-        interval, differs_from_paper = {}, {}
+        interval: dict[str, dict[str, dict[str, list[float]]]] = {}
+        differs_from_paper: dict[str, dict[str, dict[str, bool | None]]] = {}
         for kind in PLANNERS:
             rows = [r for r in records if r["planner"] == kind]
             interval[kind], differs_from_paper[kind] = {}, {}
@@ -97,15 +107,15 @@ class Heatmaps(Experiment):
                 "labels": ["phase oracle from a classical lookup of all 2^8 entries",
                            f"backend: {BACKEND_LABEL[settings['backend']]}"]}
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         env = world(settings["scenario"], settings["world_seed"])
         cuts = settings["cuts"]
         fig, axes = new_figure(len(PLANNERS), len(cuts), (4.6 * len(cuts), 4.2 * len(PLANNERS)))
         for row, kind in enumerate(PLANNERS):
             rows = [r for r in records if r["planner"] == kind]
             for col, cut in enumerate(cuts):
-                points = [np.array(loads(r["positions_json"]))[: r[f"nodes_at_{cut}"]] for r in rows]
-                points = np.concatenate([p.reshape(-1, 2) for p in points]) if points else np.zeros((0, 2))
+                clouds = [np.array(loads(r["positions_json"]))[: r[f"nodes_at_{cut}"]] for r in rows]
+                points = np.concatenate([p.reshape(-1, 2) for p in clouds]) if clouds else np.zeros((0, 2))
                 stats = summary["ours"][kind][str(cut)]
                 paper = self.paper.get(kind, {}).get(str(cut))
                 unit = "critical-path calls" if kind == "PQRRT" else "calls"

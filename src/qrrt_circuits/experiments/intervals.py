@@ -20,7 +20,20 @@ RESAMPLES = 2000
 
 def bootstrap_interval(trials: Sequence[Any], statistic: Callable[[list], float], seed: int,
                        resamples: int = RESAMPLES, level: float = LEVEL) -> tuple[float, float]:
-    """Percentile bootstrap interval of ``statistic(trials)``, resampling whole trials."""
+    """Percentile bootstrap interval of ``statistic(trials)``, resampling whole trials.
+
+    Args:
+        trials: The independent units (records, or world indices).
+        statistic: The number computed from a list of trials; resamples where it raises
+            ``ValueError`` or ``ZeroDivisionError`` or gives a non-finite value are left out.
+        seed: Seed of the resampling generator (a summary is reproducible).
+        resamples: Bootstrap resamples.
+        level: Coverage of the interval.
+
+    Returns:
+        ``(low, high)``: the (1 - level) / 2 and (1 + level) / 2 quantiles of the resampled
+        statistic; ``(s, s)`` for fewer than two trials, NaNs if no resample is defined.
+    """
     trials = list(trials)
     if len(trials) < 2:
         value = float(statistic(trials)) if trials else float("nan")
@@ -98,7 +111,16 @@ def _defined(statistic: Callable[[list], float], sample: list) -> float:
 
 
 def binomial_interval(successes: int, trials: int, level: float = LEVEL) -> tuple[float, float]:
-    """Exact (Clopper-Pearson) interval of a success rate."""
+    """Exact (Clopper-Pearson) interval of a success rate.
+
+    Args:
+        successes: Observed successes.
+        trials: Bernoulli trials.
+        level: Coverage of the interval.
+
+    Returns:
+        ``(low, high)``; NaNs when ``trials`` is 0.
+    """
     if trials <= 0:
         return float("nan"), float("nan")
     interval = binomtest(int(successes), int(trials)).proportion_ci(confidence_level=level, method="exact")
@@ -106,11 +128,29 @@ def binomial_interval(successes: int, trials: int, level: float = LEVEL) -> tupl
 
 
 def rounded_interval(interval: tuple[float, float], digits: int = 4) -> list[float]:
+    """An interval as a JSON list, rounded.
+
+    Args:
+        interval: ``(low, high)``.
+        digits: Decimal digits kept.
+
+    Returns:
+        ``[low, high]`` rounded to ``digits``.
+    """
     return [round(interval[0], digits), round(interval[1], digits)]
 
 
 def differs(paper: float | None, interval: Sequence[float]) -> bool | None:
-    """True if the paper's value lies outside our interval (None if there is nothing to compare)."""
+    """True if the paper's value lies outside our interval (None if there is nothing to compare).
+
+    Args:
+        paper: The paper's value, or None.
+        interval: Our ``[low, high]``.
+
+    Returns:
+        Whether ``paper`` is outside the closed interval; None if ``paper`` is None or the
+        interval is not finite.
+    """
     if paper is None or not np.all(np.isfinite(interval)):
         return None
     return bool(paper < interval[0] or paper > interval[1])

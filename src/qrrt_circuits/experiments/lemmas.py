@@ -14,12 +14,13 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import SupportsFloat
 
 import numpy as np
 
 from .. import probability as pr
 from ..oracle import OracleErrorModel
-from .base import Experiment, Trial, TrialStream, replicate_seed
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import binomial_interval, rounded_interval
 from .planners import make_backend
@@ -47,6 +48,15 @@ def _collection_times(indices: np.ndarray, targets: np.ndarray) -> list[int]:
 
 
 class Lemmas(Experiment):
+    """Lemmas 1-6 of the paper against Aer shot frequencies (see the module docstring).
+
+    A trial is one point (n, m, p, false-positive and false-negative rates) of the grid: one Aer
+    search with p x R shots, read as R groups of p workers. Its record holds, for each lemma, the
+    observed frequency, the ``qrrt_circuits.probability`` value and the standard error; the summary
+    gives, per lemma, the largest |z| = |observed - theory| / stderr over the grid and the share of
+    points within 3 standard errors (with its 95 % interval).
+    """
+
     name = "lemmas"
     uses_predicate = False  # no planner: random marked databases
     title = "Lemmas 1-6 against Aer shot frequencies"
@@ -54,7 +64,7 @@ class Lemmas(Experiment):
              "lemma3": "m H_m / P(G)", "lemma4": "(m1/m) P(G) + (m2/(N-m)) (1-P(G))",
              "lemma5": "m1 (P(G)/m)^p + m2 ((1-P(G))/(N-m))^p", "lemma6": "m1 H_m1 / ((m1/m) P(G))"}
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         grid = [[n, m, p, fp, fn] for n in GRID_QUBITS for m in GRID_MARKED for p in GRID_WORKERS
                 for fp, fn in ERRORS if m <= 2**n]
         if quick:
@@ -62,13 +72,13 @@ class Lemmas(Experiment):
         return {"repeats": trials or (400 if quick else 3000), "grid": grid, "backend": "aer",
                 "seed": seed, "quick": quick}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         return [Trial(f"n{n}-m{m}-p{p}-fp{fp}-fn{fn}", {"qubits": n, "marked": m, "workers": p,
                                                          "false_positive": fp, "false_negative": fn},
                       replicate_seed(settings["seed"], i, TrialStream.LEMMAS))
                 for i, (n, m, p, fp, fn) in enumerate(settings["grid"])]
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         n, m, p = trial.params["qubits"], trial.params["marked"], trial.params["workers"]
         size = 2**n
         rng = np.random.default_rng(trial.seed)
@@ -90,15 +100,15 @@ class Lemmas(Experiment):
         different = good & np.array([len(set(row)) == p for row in groups])
         true_hit = truth[groups[:, 0]]
         same_true = truth[groups].all(axis=1) & (groups == groups[:, :1]).all(axis=1)
-        record = {"iterations": k, "oracle_marked": m_oracle, "true_marked": m1, "missed_good": m2,
+        record: Record = {"iterations": k, "oracle_marked": m_oracle, "true_marked": m1, "missed_good": m2,
                   "p_good": p_good, "repeats": repeats}
 
-        def put(name, observed, theory, stderr):
+        def put(name: str, observed: SupportsFloat, theory: SupportsFloat, stderr: SupportsFloat) -> None:
             record[f"{name}_observed"] = float(observed)
             record[f"{name}_theory"] = float(theory)
             record[f"{name}_stderr"] = float(stderr)
 
-        def binomial(observed, theory):
+        def binomial(observed: float, theory: float) -> float:
             return math.sqrt(max(theory * (1 - theory), 1.0 / repeats) / repeats)
 
         lemma1 = pr.prob_all_same(p, m_oracle, p_good) if m_oracle else 0.0
@@ -121,7 +131,7 @@ class Lemmas(Experiment):
                 put(name, float("nan"), theory, float("nan"))
         return record
 
-    def summarize(self, records, settings):
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
         ours = {}
         for lemma in ("lemma1", "lemma2", "lemma3", "lemma4", "lemma5", "lemma6"):
             z = []
@@ -139,7 +149,7 @@ class Lemmas(Experiment):
                 "note": "z = (observed - lemma) / standard error; the lemmas are exact for these "
                         "events, so about 99.7% of points should lie within 3 sigma"}
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         lemmas = ("lemma1", "lemma2", "lemma3", "lemma4", "lemma5", "lemma6")
         fig, axes = new_figure(2, 3, (14, 8.5))
         for ax, lemma in zip(axes.ravel(), lemmas, strict=True):

@@ -20,7 +20,9 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -29,12 +31,20 @@ from ..probability import good_probability
 from ..registry import PLANNERS, PREDICATES
 from ..search.noisy import depolarizing_backend, fake_device_backend
 from ..search.policies import Adaptive, KnownOptimal
-from .base import Experiment, Trial, TrialStream, replicate_seed
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import binomial_interval, bootstrap_interval, rounded_interval
 from .worlds import world
 
-QRRT_CONFIGS = {"QRRT adaptive": Adaptive, "QRRT optimal": KnownOptimal}
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from numpy.typing import ArrayLike
+    from qiskit import QuantumCircuit
+
+    from ..search.policies import IterationPolicy
+
+#: label -> q-RRT's search policy (its class)
+QRRT_CONFIGS: dict[str, Callable[[], IterationPolicy]] = {"QRRT adaptive": Adaptive, "QRRT optimal": KnownOptimal}
 FRACTION_LOG2 = 4  # m = N / 16: k_opt = 3 for every n
 #: every record has every column (records.csv has one header): what a part does not measure is NaN
 _NUMBERS = ("n", "k", "m", "p1", "p2", "one_qubit_gates", "two_qubit_gates", "ideal", "fidelity", "white_noise",
@@ -42,11 +52,19 @@ _NUMBERS = ("n", "k", "m", "p1", "p2", "one_qubit_gates", "two_qubit_gates", "id
             "effective_false_positive", "collision_uniform", "collision_false_positive_model",
             "nodes", "oracle_calls", "quantum_oracle_calls", "verification_calls", "rejected", "rounds",
             "calls_per_node", "world_seed")
-COLUMNS = {**dict.fromkeys(_NUMBERS, math.nan), "method": "", "config": "", "status": ""}
+COLUMNS: dict[str, Any] = {**dict.fromkeys(_NUMBERS, math.nan), "method": "", "config": "", "status": ""}
 
 
 def sweep_marks(num_qubits: int, seed: int) -> np.ndarray:
-    """A database of N = 2^n entries with m = N / 16 marks at random positions."""
+    """A database of N = 2^n entries with m = N / 16 marks at random positions.
+
+    Args:
+        num_qubits: Index qubits n.
+        seed: Seed of the marks' positions.
+
+    Returns:
+        (2^n,) booleans with max(1, N / 16) marked.
+    """
     size = 1 << num_qubits
     marks = np.zeros(size, dtype=bool)
     marks[np.random.default_rng(seed).choice(size, max(1, size >> FRACTION_LOG2), replace=False)] = True
@@ -54,17 +72,25 @@ def sweep_marks(num_qubits: int, seed: int) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=64)
-def _compiled(num_qubits: int, seed: int, iterations: int):
+def _compiled(num_qubits: int, seed: int, iterations: int) -> QuantumCircuit:
     return noise.transpiled_grover(sweep_marks(num_qubits, seed), iterations)
 
 
 class Noise(Experiment):
+    """Device noise (beyond the paper, which assumes a perfect quantum computer).
+
+    Three parts (see the module docstring): ``sweep`` (one search under depolarizing noise against
+    the white-noise model), ``device`` (a fake IBM device, when the ``noise`` extra is installed)
+    and ``planning`` (q-RRT's oracle calls per node as the two-qubit error grows, against RRT's,
+    and the break-even error rate with its 95 % interval).
+    """
+
     name = "noise"
     title = "Device noise: one search, the fake IBM device, and q-RRT's calls per node (beyond the paper)"
     uses_predicate = True
     paper = {"noise": "none: the paper assumes a perfect quantum computer"}
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         device = noise.available_fake_device() if noise.has_fake_devices() else None
         if quick:
             return {"trials": trials or 1, "seed": seed, "quick": True,
@@ -81,8 +107,8 @@ class Noise(Experiment):
                 "planning_p2": [0.0, 1e-3, 3e-3, 1e-2], "planning_qubits": 6, "nodes": 15,
                 "planning_configs": list(QRRT_CONFIGS)}
 
-    def trials(self, settings):
-        out = []
+    def trials(self, settings: Settings) -> list[Trial]:
+        out: list[Trial] = []
         root = settings["seed"]
         # sweep: every (n, k, p2) on the first database; n <= exact_max_qubits on `trials` databases
         for n in settings["sweep_qubits"]:
@@ -109,11 +135,11 @@ class Noise(Experiment):
                                      {**common, "config": config, "p2": p2}, seed))
         return out
 
-    def run_trial(self, trial, settings):
-        record = getattr(self, f"_run_{trial.params['part']}")(trial, settings)
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
+        record: Record = getattr(self, f"_run_{trial.params['part']}")(trial, settings)
         return {key: value for key, value in COLUMNS.items() if key not in trial.params} | record
 
-    def _run_sweep(self, trial, settings):
+    def _run_sweep(self, trial: Trial, settings: Settings) -> Record:
         n, k, p2 = trial.params["n"], trial.params["k"], trial.params["p2"]
         p1 = settings["p1_ratio"] * p2
         size = 1 << n
@@ -123,7 +149,7 @@ class Noise(Experiment):
         one, two = noise.noisy_gate_counts(compiled)
         model = noise.depolarizing_noise_model(p1, p2)
         fidelity = noise.white_noise_fidelity(one, two, p1, p2)
-        record = {"m": m, "p1": p1, "one_qubit_gates": one, "two_qubit_gates": two,
+        record: Record = {"m": m, "p1": p1, "one_qubit_gates": one, "two_qubit_gates": two,
                   "ideal": good_probability(size, m, k), "fidelity": fidelity,
                   "white_noise": noise.white_noise_success(size, m, k, fidelity)}
         if n <= settings["exact_max_qubits"]:
@@ -146,7 +172,7 @@ class Noise(Experiment):
                       collision_false_positive_model=1.0 / (q * (size - m)) if q and q > 0 else math.nan)
         return record
 
-    def _run_device(self, trial, settings):
+    def _run_device(self, trial: Trial, settings: Settings) -> Record:
         n, k = trial.params["n"], trial.params["k"]
         marks = sweep_marks(n, trial.seed)
         backend = fake_device_backend(settings["device"])
@@ -160,10 +186,11 @@ class Noise(Experiment):
                 "success_low": low, "success_high": high, "two_qubit_gates": int(two),
                 "method": f"{settings['device']} noise model (statevector trajectories)"}
 
-    def _run_planning(self, trial, settings):
+    def _run_planning(self, trial: Trial, settings: Settings) -> Record:
         env = world("paper_clutter", trial.params["world_seed"])
         config, p2 = trial.params["config"], trial.params["p2"]
-        options = {"env": env, "seed": trial.seed, "predicate": PREDICATES.create(settings["predicate"], env=env)}
+        options: dict[str, Any] = {"env": env, "seed": trial.seed,
+                                   "predicate": PREDICATES.create(settings["predicate"], env=env)}
         if config == "RRT":
             planner = PLANNERS.create("RRT", **options)
         else:
@@ -177,10 +204,10 @@ class Noise(Experiment):
                 "rejected": m.rejected, "rounds": m.rounds, "calls_per_node": m.oracle_calls / max(m.nodes, 1)}
 
     # ------------------------------------------------------------------ summary
-    def summarize(self, records, settings):
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
         sweep = [r for r in records if r["part"] == "sweep"]
         k_top = max(settings["sweep_iterations"])
-        success = {}
+        success: dict[str, dict[str, float]] = {}
         for n in settings["sweep_qubits"]:
             success[str(n)] = {f"{p2:g}": _mean([r["success"] for r in sweep if r["n"] == n and r["k"] == k_top
                                                  and r["p2"] == p2]) for p2 in settings["p2"]}
@@ -209,40 +236,51 @@ class Noise(Experiment):
                            "QRRT optimal uses the true m of each database (simulation knowledge)",
                            f"p1 = {settings['p1_ratio']:g} x p2; rz is virtual and error-free"]}
 
-    def _planning_summary(self, rows, settings):
-        by_world = {}
+    def _planning_summary(self, rows: list[Record], settings: Settings) -> dict[str, Any]:
+        by_world: dict[int, list[Record]] = {}
         for r in rows:
             by_world.setdefault(r["replicate"], []).append(r)
         worlds = sorted(by_world)
         levels = settings["planning_p2"]
 
-        def stats(sample_worlds, config):
+        def stats(sample_worlds: Sequence[int], config: str) -> tuple[Any, list[Any]]:
             rrt = np.mean([_calls(by_world[w], "RRT", 0.0) for w in sample_worlds])
             quantum = [np.mean([_calls(by_world[w], config, p2) for w in sample_worlds]) for p2 in levels]
             return rrt, quantum
 
-        calls, break_even = {}, {}
+        def rrt_calls(sample_worlds: Sequence[int], config: str) -> Any:
+            return stats(sample_worlds, config)[0]
+
+        def quantum_calls(sample_worlds: Sequence[int], config: str, level: int) -> Any:
+            return stats(sample_worlds, config)[1][level]
+
+        def capped_crossing(sample_worlds: Sequence[int], config: str, cap: float) -> float:
+            rrt, quantum = stats(sample_worlds, config)
+            return min(crossing(levels, quantum, rrt), cap)
+
+        calls: dict[str, dict[str, Any]] = {}
+        break_even: dict[str, dict[str, Any]] = {}
         beyond = 1e6 * max(levels)
         rrt_all, _ = stats(worlds, settings["planning_configs"][0])
         calls["RRT"] = {"mean": rrt_all, "interval_95": rounded_interval(bootstrap_interval(
-            worlds, lambda s: stats(s, settings["planning_configs"][0])[0], settings["seed"]), 3)}
+            worlds, functools.partial(rrt_calls, config=settings["planning_configs"][0]), settings["seed"]), 3)}
         for config in settings["planning_configs"]:
             _, quantum = stats(worlds, config)
             calls[config] = {f"{p2:g}": {"mean": q, "interval_95": rounded_interval(bootstrap_interval(
-                worlds, lambda s, i=i, c=config: stats(s, c)[1][i], settings["seed"]), 3)}
+                worlds, functools.partial(quantum_calls, config=config, level=i), settings["seed"]), 3)}
                 for i, (p2, q) in enumerate(zip(levels, quantum, strict=True))}
             value = crossing(levels, quantum, rrt_all)
             # a resample that never crosses counts as "beyond the largest level" (a finite stand-in, so
             # that the bootstrap keeps it), and is reported as inf
             interval = bootstrap_interval(
-                worlds, lambda s, c=config, b=beyond: min(crossing(levels, *stats(s, c)[::-1]), b), settings["seed"])
+                worlds, functools.partial(capped_crossing, config=config, cap=beyond), settings["seed"])
             break_even[config] = {"p2": value, "interval_95": [_beyond(x, beyond) for x in interval],
                                   "meaning": _crossing_meaning(value, levels)}
         return {"calls_per_node": {c: (v["mean"] if c == "RRT" else {p: x["mean"] for p, x in v.items()})
                                    for c, v in calls.items()},
                 "intervals": calls, "break_even_p2": break_even}
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         fig, axes = new_figure(2, 2, (11, 8.5))
         self._plot_sweep(axes[0, 0], records, settings)
         self._plot_device(axes[0, 1], records, settings)
@@ -250,7 +288,7 @@ class Noise(Experiment):
         self._plot_collision(axes[1, 1], records, settings)
         return [save(fig, out_dir / "noise.png")]
 
-    def _plot_sweep(self, ax, records, settings):
+    def _plot_sweep(self, ax: Axes, records: list[Record], settings: Settings) -> None:
         k = max(settings["sweep_iterations"])
         levels = [p for p in settings["p2"] if p > 0]
         for n in settings["sweep_qubits"]:
@@ -267,7 +305,7 @@ class Noise(Experiment):
         ax.legend(fontsize=7, ncol=2)
         ax.grid(alpha=0.3)
 
-    def _plot_device(self, ax, records, settings):
+    def _plot_device(self, ax: Axes, records: list[Record], settings: Settings) -> None:
         rows = [r for r in records if r["part"] == "device"]
         if not rows:
             ax.text(0.5, 0.5, "fake device part skipped:\n" + _missing_message(), ha="center", va="center",
@@ -288,7 +326,7 @@ class Noise(Experiment):
         ax.legend(fontsize=7)
         ax.grid(alpha=0.3)
 
-    def _plot_planning(self, ax, summary, settings):
+    def _plot_planning(self, ax: Axes, summary: Summary, settings: Settings) -> None:
         planning = summary["planning"]
         levels = settings["planning_p2"]
         x = [p if p > 0 else levels[1] / 3 for p in levels]  # p2 = 0 drawn at the left edge
@@ -310,7 +348,7 @@ class Noise(Experiment):
         ax.legend(fontsize=7)
         ax.grid(alpha=0.3, which="both")
 
-    def _plot_collision(self, ax, records, settings):
+    def _plot_collision(self, ax: Axes, records: list[Record], settings: Settings) -> None:
         rows = [r for r in records if r["part"] == "sweep" and r["shots"] == 0 and r["p2"] > 0
                 and np.isfinite(r["collision_false_positive_model"])]
         ax.scatter([r["p2"] for r in rows], [r["collision"] / r["collision_uniform"] for r in rows], s=12,
@@ -328,10 +366,19 @@ class Noise(Experiment):
         ax.grid(alpha=0.3, which="both")
 
 
-def crossing(levels, values, target) -> float:
+def crossing(levels: Sequence[float], values: ArrayLike, target: float) -> float:
     """The smallest level where ``values`` reaches ``target`` (log-linear interpolation between
     levels; the first level is read as a lower edge when it is 0). 0.0 if the first value is
-    already at or above the target; inf if no value reaches it."""
+    already at or above the target; inf if no value reaches it.
+
+    Args:
+        levels: Increasing levels (noise rates p2), the first possibly 0.
+        values: The value at each level.
+        target: The value to reach.
+
+    Returns:
+        The interpolated level, 0.0 or inf as above.
+    """
     values = np.asarray(values, dtype=float)
     if values[0] >= target:
         return 0.0
@@ -346,7 +393,7 @@ def crossing(levels, values, target) -> float:
     return float(math.exp(math.log(low) + fraction * (math.log(high) - math.log(low))))
 
 
-def _crossing_meaning(value: float, levels) -> str:
+def _crossing_meaning(value: float, levels: Sequence[float]) -> str:
     if value == 0.0:
         return "q-RRT needs at least RRT's calls per node even without noise"
     if math.isinf(value):
@@ -354,7 +401,7 @@ def _crossing_meaning(value: float, levels) -> str:
     return "q-RRT needs more calls per node than RRT above this p2"
 
 
-def _calls(rows, config, p2) -> float:
+def _calls(rows: Sequence[Record], config: str, p2: float) -> float:
     return next(r["calls_per_node"] for r in rows if r["config"] == config and r["p2"] == p2)
 
 
@@ -362,11 +409,11 @@ def _beyond(value: float, beyond: float) -> float:
     return math.inf if value >= beyond else float(value)
 
 
-def _mean(values) -> float:
+def _mean(values: Sequence[float]) -> float:
     return float(np.mean(values)) if len(values) else math.nan
 
 
-def _range(values) -> list[float]:
+def _range(values: Sequence[float]) -> list[float]:
     return [float(min(values)), float(max(values))] if values else [math.nan, math.nan]
 
 

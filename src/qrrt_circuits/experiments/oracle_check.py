@@ -10,51 +10,84 @@ candidates, and the fraction of tree edges the exact check says go through an ob
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..oracle import ReachabilityOracle
 from ..registry import PREDICATES
-from .base import Experiment, Trial, TrialStream, replicate_seed
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import bootstrap_interval, rounded_interval
 from .measures import cut_at, reachable_fraction
 from .planners import make_planner
 from .worlds import world
 
+if TYPE_CHECKING:
+    from ..environment import Environment
+    from ..predicate import ReachabilityPredicate
+
 PLANNERS = ("RRT", "QRRT")
 CHECKS = ("exact", "authors", "authors-octave", "samples-200", "samples-50", "samples-20")
 
 
-def make_predicate(env, check: str):
-    """A registry predicate name, or ``samples-K`` (the registry's ``time-samples:K``)."""
+def make_predicate(env: Environment, check: str) -> ReachabilityPredicate:
+    """A registry predicate name, or ``samples-K`` (the registry's ``time-samples:K``).
+
+    Args:
+        env: The world the predicate checks motions in.
+        check: A ``PREDICATES`` name or ``samples-K``.
+
+    Returns:
+        The predicate, built on ``env``.
+
+    Raises:
+        ValueError: If ``check`` names no predicate.
+    """
     name = f"time-samples:{check.split('-')[1]}" if check.startswith("samples-") else check
-    return PREDICATES.create(name, env=env)
+    predicate: ReachabilityPredicate = PREDICATES.create(name, env=env)
+    return predicate
 
 
-def efficiency(rows) -> float:
-    """Nodes per oracle call over ``rows`` (the paper's oracle efficiency)."""
+def efficiency(rows: Sequence[Record]) -> float:
+    """Nodes per oracle call over ``rows`` (the paper's oracle efficiency).
+
+    Args:
+        rows: Records with ``nodes`` and ``oracle_calls``.
+
+    Returns:
+        Summed nodes / summed oracle calls (0.0 without calls).
+    """
     return sum(r["nodes"] for r in rows) / max(sum(r["oracle_calls"] for r in rows), 1)
 
 
 class OracleCheck(Experiment):
+    """The exact reachability check against the authors' and time-sampled checks (beyond the paper).
+
+    A trial runs RRT or q-RRT with one check of ``CHECKS`` in ``paper_clutter``, cut at 40 oracle
+    calls, and counts the tree edges the exact check rejects. The summary gives the oracle
+    efficiency (``efficiency``) with 95 % intervals and the fraction of invalid edges per check,
+    against the paper's efficiency at 40 calls (Figs. 10-12).
+    """
+
     name = "oracle-check"
     uses_predicate = False  # it sweeps its own list of checks
     title = "Exact collision check vs time-sampled checks (beyond the paper)"
     paper = {"RRT": 0.132, "QRRT": 0.260}
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         return {"trials": trials or (4 if quick else 30), "budget": 40, "num_qubits": 8, "backend": "statevector",
                 "scenario": "paper_clutter", "world_seed": 0, "checks": list(CHECKS), "seed": seed,
                 "quick": quick}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         return [Trial(f"{check}-{kind}-{i}", {"check": check, "planner": kind, "replicate": i},
                       replicate_seed(settings["seed"], i, TrialStream.ORACLE_CHECK))
                 for check in settings["checks"] for kind in PLANNERS for i in range(settings["trials"])]
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         env = world(settings["scenario"], settings["world_seed"])
         predicate = make_predicate(env, trial.params["check"])
         planner = make_planner(trial.params["planner"], env, trial.seed, settings["backend"],
@@ -63,12 +96,16 @@ class OracleCheck(Experiment):
         nodes, calls = cut_at(result, settings["budget"])
         exact = ReachabilityOracle(env)
         children = np.arange(1, nodes + 1)
-        valid = exact.reachable(result.nodes[result.parents[children]], result.nodes[children]) if nodes else []
+        valid: np.ndarray | list[bool] = (
+            exact.reachable(result.nodes[result.parents[children]], result.nodes[children]) if nodes else [])
         return {"nodes": nodes, "oracle_calls": calls, "invalid_edges": int(nodes - np.sum(valid)),
                 "reachable_fraction": reachable_fraction(result)}
 
-    def summarize(self, records, settings):
-        ours, invalid, fraction, interval = {}, {}, {}, {}
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
+        ours: dict[str, dict[str, float]] = {}
+        invalid: dict[str, dict[str, float]] = {}
+        fraction: dict[str, dict[str, float]] = {}
+        interval: dict[str, dict[str, list[float]]] = {}
         for check in settings["checks"]:
             ours[check], invalid[check], fraction[check], interval[check] = {}, {}, {}, {}
             for kind in PLANNERS:
@@ -83,7 +120,7 @@ class OracleCheck(Experiment):
                 "note": "efficiency = nodes / oracle calls at the 40-call cut; invalid edges are tree edges the "
                         "exact check rejects (they pass through an obstacle)"}
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         fig, axes = new_figure(1, 2, (11, 4.2))
         checks = settings["checks"]
         x = np.arange(len(checks))

@@ -3,8 +3,16 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
 from ..registry import BACKENDS, PLANNERS, POLICIES, PREDICATES
 from ..search.policies import IterationPolicy
+
+if TYPE_CHECKING:
+    from ..environment import Environment
+    from ..planners.base import Planner
+    from ..predicate import ReachabilityPredicate
+    from ..search.backend import QuantumSearchBackend
 
 #: how each backend is described in summaries
 BACKEND_LABEL = {
@@ -17,29 +25,81 @@ BACKEND_LABEL = {
 BACKEND_OPTIONS = {"aer": {"max_parallel_threads": 1}}
 
 
-def make_backend(name: str):
-    return BACKENDS.create(name, **BACKEND_OPTIONS.get(BACKENDS.canonical(name), {}))
+def make_backend(name: str) -> QuantumSearchBackend:
+    """The ``BACKENDS`` backend ``name`` with the experiments' options (one Aer thread).
+
+    Args:
+        name: A ``qrrt_circuits.registry.BACKENDS`` name.
+
+    Returns:
+        A new backend.
+
+    Raises:
+        ValueError: If ``name`` is not a backend.
+    """
+    backend: QuantumSearchBackend = BACKENDS.create( name, **BACKEND_OPTIONS.get(BACKENDS.canonical(name), {}))
+    return backend
 
 
-def make_planner(kind: str, env, seed: int, backend: str = "aer", workers: int = 8, num_qubits: int = 8,
-                 search_policy: IterationPolicy | str | None = None, predicate=None, **options):
+def make_planner(kind: str, env: Environment, seed: int, backend: str = "aer", workers: int = 8,
+                 num_qubits: int = 8, search_policy: IterationPolicy | str | None = None,
+                 predicate: ReachabilityPredicate | str | None = None, **options: Any) -> Planner:
     """The registry planner ``kind`` (``RRT``, ``ParallelRRT``, ``QRRT``, ``PQRRT``, ``PQRRT-unshared``
     or their lower-case names). Options a planner does not take (a backend for RRT, workers for
     q-RRT) are left out; ``options`` are passed as given. ``predicate`` is a predicate object, a
-    ``PREDICATES`` name (built on ``env``) or None (the planner's default, the exact check)."""
+    ``PREDICATES`` name (built on ``env``) or None (the planner's default, the exact check).
+
+    Args:
+        kind: A ``PLANNERS`` name.
+        env: The world to plan in.
+        seed: The planner's seed.
+        backend: A ``BACKENDS`` name (quantum planners only).
+        workers: Parallel workers (planners that take them).
+        num_qubits: Qubits per database, 2^n entries (quantum planners only).
+        search_policy: An iteration policy, a ``POLICIES`` name or None (the planner's default).
+        predicate: A predicate, a ``PREDICATES`` name or None (the exact check).
+        **options: Further planner options, passed as given.
+
+    Returns:
+        The planner.
+
+    Raises:
+        ValueError: If a name is unknown or an option does not apply to ``kind``.
+    """
     if isinstance(search_policy, str):
         search_policy = POLICIES.create(search_policy)
     if isinstance(predicate, str):
         predicate = PREDICATES.create(predicate, env=env)
     if predicate is not None:
         options["predicate"] = predicate
-    defaults = {"workers": workers, "num_qubits": num_qubits, "search_policy": search_policy, "seed": seed}
+    defaults: dict[str, Any] = {"workers": workers, "num_qubits": num_qubits, "search_policy": search_policy,
+                                "seed": seed}
     if "quantum" in PLANNERS.resolve(kind).tags:
         defaults["backend"] = make_backend(backend)
-    return PLANNERS.create(kind, env=env, **PLANNERS.applicable(kind, defaults), **options)
+    planner: Planner = PLANNERS.create(kind, env=env, **PLANNERS.applicable(kind, defaults), **options)
+    return planner
 
 
-def planner_for(settings: dict, kind: str, env, seed: int, *args, **options):
+def planner_for(settings: dict[str, Any], kind: str, env: Environment, seed: int, backend: str = "aer",
+                workers: int = 8, num_qubits: int = 8, **options: Any) -> Planner:
     """``make_planner`` with the experiment's predicate (``settings["predicate"]``; the exact check
-    when the settings name none, as 0.1's did)."""
-    return make_planner(kind, env, seed, *args, predicate=settings.get("predicate"), **options)
+    when the settings name none, as 0.1's did).
+
+    Args:
+        settings: The experiment's settings (its ``predicate``, if any).
+        kind: A ``PLANNERS`` name.
+        env: The world to plan in.
+        seed: The planner's seed.
+        backend: A ``BACKENDS`` name (quantum planners only).
+        workers: Parallel workers (planners that take them).
+        num_qubits: Qubits per database (quantum planners only).
+        **options: Further ``make_planner`` options.
+
+    Returns:
+        The planner.
+
+    Raises:
+        ValueError: If a name is unknown or an option does not apply to ``kind``.
+    """
+    return make_planner(kind, env, seed, backend, workers, num_qubits, predicate=settings.get("predicate"),
+                        **options)

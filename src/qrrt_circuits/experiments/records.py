@@ -12,9 +12,10 @@ import csv
 import os
 import warnings
 from pathlib import Path
+from typing import Any
 
 
-def _convert(value: str):
+def _convert(value: str) -> int | float | bool | str | None:
     if value == "":
         return None
     for kind in (int, float):
@@ -27,9 +28,20 @@ def _convert(value: str):
     return value
 
 
-def read_records(path: Path) -> list[dict]:
+def read_records(path: Path) -> list[dict[str, Any]]:
     """Rows of a records.csv (numbers converted). A torn last line (no newline: the writer was
-    killed mid-write) or a row of the wrong width is dropped and the file rewritten without it."""
+    killed mid-write) or a row of the wrong width is dropped and the file rewritten without it.
+
+    Args:
+        path: The ``records.csv`` file (need not exist).
+
+    Returns:
+        One dict per kept row, column name to value (ints, floats and booleans converted back,
+        empty cells as None); ``[]`` for a missing or empty file.
+
+    Warns:
+        UserWarning: For each dropped second row of a ``trial_id``.
+    """
     if not path.exists():
         return []
     text = path.read_text()
@@ -66,7 +78,11 @@ def _rewrite(path: Path, header: list[str], rows: list[list[str]]) -> None:
 
 
 class RecordWriter:
-    """Appends records to records.csv, one flushed line per trial."""
+    """Appends records to records.csv, one flushed line per trial.
+
+    Args:
+        path: The ``records.csv`` file; an existing file's header fixes the columns.
+    """
 
     def __init__(self, path: Path) -> None:
         self.path = path
@@ -75,7 +91,15 @@ class RecordWriter:
             with path.open(newline="") as handle:
                 self.header = next(csv.reader(handle), None)
 
-    def write(self, record: dict) -> None:
+    def write(self, record: dict[str, Any]) -> None:
+        """Append ``record`` as one row and flush it to disk (fsync).
+
+        Args:
+            record: Column name to value; the first record written fixes the columns.
+
+        Raises:
+            ValueError: If its columns differ from the file's header.
+        """
         if self.header is None:
             self.header = list(record)
             with self.path.open("w", newline="") as handle:

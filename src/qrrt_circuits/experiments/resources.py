@@ -16,29 +16,44 @@ Three parts, one trial list (``qrrt_circuits.resources`` holds the counting and 
 
 from __future__ import annotations
 
+import functools
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .. import resources as res
 from ..registry import PLANNERS, PREDICATES
 from ..search.policies import PaperSchedule
-from .base import Experiment, Trial, TrialStream, replicate_seed
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import bootstrap_interval, rounded_interval
 from .worlds import world
+
+if TYPE_CHECKING:
+    from ..search.statevector import StatevectorBackend
 
 _NUMBERS = ("n", "m", "two_qubit_gates", "two_qubit_depth", "depth", "physical_qubits", "oracle_ands",
             "oracle_t", "diffuser_ands", "t_count", "toffoli_equivalents", "nodes", "oracle_calls",
             "quantum_oracle_calls", "verification_calls", "simulation_checks", "rounds", "wall_time_s",
             "world_seed", "replicate")
-COLUMNS = {**dict.fromkeys(_NUMBERS, math.nan), "synthesis": "", "connectivity": "", "lookup": "", "source": "",
-           "planner": "", "status": ""}
+#: every column of a record, with its value where a part leaves it out
+COLUMNS: dict[str, Any] = {**dict.fromkeys(_NUMBERS, math.nan), "synthesis": "", "connectivity": "", "lookup": "",
+                           "source": "", "planner": "", "status": ""}
 ASSUMPTIONS = res.ProjectionAssumptions()
 
 
 def database_marks(num_qubits: int, seed: int) -> np.ndarray:
+    """A database's marks for the gate counts: max(1, N / 16) random entries of N = 2^n.
+
+    Args:
+        num_qubits: Index qubits n.
+        seed: Seed of the marks' positions.
+
+    Returns:
+        (2^n,) booleans.
+    """
     size = 1 << num_qubits
     marks = np.zeros(size, dtype=bool)
     marks[np.random.default_rng(seed).choice(size, max(1, size >> 4), replace=False)] = True
@@ -46,11 +61,19 @@ def database_marks(num_qubits: int, seed: int) -> np.ndarray:
 
 
 class Resources(Experiment):
+    """Gates and time per oracle call and per plan, near term and fault tolerant (beyond the paper).
+
+    Three parts (see the module docstring): ``near-term`` (two-qubit gates and depth of one Grover
+    iteration after routing), ``fault-tolerant`` (Toffoli and T counts of one call with a lookup
+    oracle) and ``plan`` (RRT's measured time against q-RRT's projected time, and the break-even
+    time per call), each summarized with its assumptions.
+    """
+
     name = "resources"
     title = "Gates and time per oracle call and per plan, near term and fault tolerant (beyond the paper)"
     paper = {"cost_model": "oracle calls only; the paper gives no gate counts or times"}
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         lookups = ["qrom", "select-swap"] if res.has_qualtran() else ["qrom"]
         return {"trials": trials or (1 if quick else 10), "seed": seed, "quick": quick,
                 "qubits": [3, 4] if quick else list(range(4, 13)), "syntheses": ["diagonal", "mcz"],
@@ -59,8 +82,8 @@ class Resources(Experiment):
                 "plan_qubits": 4 if quick else 8, "nodes": 3 if quick else 30,
                 "toffoli_s": ASSUMPTIONS.toffoli_s, "two_qubit_gate_s": ASSUMPTIONS.two_qubit_gate_s}
 
-    def trials(self, settings):
-        out = []
+    def trials(self, settings: Settings) -> list[Trial]:
+        out: list[Trial] = []
         root = settings["seed"]
         for n in settings["qubits"]:
             seed = replicate_seed(root, n, TrialStream.RESOURCES_WORLDS)
@@ -81,12 +104,12 @@ class Resources(Experiment):
                                  seed))
         return out
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         part = trial.params["part"].replace("-", "_")
-        record = getattr(self, f"_run_{part}")(trial, settings)
+        record: Record = getattr(self, f"_run_{part}")(trial, settings)
         return {key: value for key, value in COLUMNS.items() if key not in trial.params} | record
 
-    def _run_near_term(self, trial, settings):
+    def _run_near_term(self, trial: Trial, settings: Settings) -> Record:
         p = trial.params
         marks = database_marks(p["n"], trial.seed)
         count = res.near_term_counts(marks, p["synthesis"], p["connectivity"])
@@ -94,15 +117,18 @@ class Resources(Experiment):
                 "two_qubit_depth": count.two_qubit_depth, "depth": count.depth,
                 "physical_qubits": count.physical_qubits}
 
-    def _run_fault_tolerant(self, trial, settings):
+    def _run_fault_tolerant(self, trial: Trial, settings: Settings) -> Record:
         count = res.fault_tolerant_counts(trial.params["n"], trial.params["lookup"],
                                           use_qualtran=settings["ft_source"] == "qualtran")
         return {"oracle_ands": count.oracle_ands, "oracle_t": count.oracle_t, "diffuser_ands": count.diffuser_ands,
                 "t_count": count.t_count, "toffoli_equivalents": count.toffoli_equivalents, "source": count.source}
 
-    def _run_plan(self, trial, settings):
+    def _run_plan(self, trial: Trial, settings: Settings) -> Record:
         env = world("paper_clutter", trial.params["world_seed"])
-        options = {"env": env, "seed": trial.seed, "predicate": PREDICATES.create(settings["predicate"], env=env)}
+        if env.start is None:
+            raise ValueError("paper_clutter must have a start")
+        options: dict[str, Any] = {"env": env, "seed": trial.seed,
+                                   "predicate": PREDICATES.create(settings["predicate"], env=env)}
         # compile the predicate's kernels before the timed plan (a first call in a process JIT-compiles)
         options["predicate"].reachable(env.start[None, :], env.start[None, :])
         if trial.params["planner"] == "RRT":
@@ -117,12 +143,12 @@ class Resources(Experiment):
                 "simulation_checks": m.simulation_checks, "rounds": m.rounds, "wall_time_s": m.wall_time_s}
 
     # ------------------------------------------------------------------ summary
-    def summarize(self, records, settings):
-        near = {}
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
+        near: dict[str, dict[str, dict[str, Any]]] = {}
         for r in (r for r in records if r["part"] == "near-term"):
             near.setdefault(str(r["n"]), {})[f"{r['synthesis']}/{r['connectivity']}"] = {
                 "two_qubit_gates": r["two_qubit_gates"], "two_qubit_depth": r["two_qubit_depth"]}
-        fault = {}
+        fault: dict[str, dict[str, dict[str, Any]]] = {}
         for r in (r for r in records if r["part"] == "fault-tolerant"):
             fault.setdefault(str(r["n"]), {})[r["lookup"]] = {
                 "ands": r["oracle_ands"] + r["diffuser_ands"], "t_count": r["t_count"],
@@ -138,9 +164,10 @@ class Resources(Experiment):
                            "q-RRT plans on the exact statevector backend (same statistics as Aer)",
                            f"fault-tolerant counts from {settings['ft_source']}"]}
 
-    def _plan_summary(self, records, settings, near, fault):
+    def _plan_summary(self, records: list[Record], settings: Settings, near: dict[str, dict[str, dict[str, Any]]],
+                      fault: dict[str, dict[str, dict[str, Any]]]) -> dict[str, Any]:
         rows = [r for r in records if r["part"] == "plan"]
-        by_world = {}
+        by_world: dict[int, dict[str, Record]] = {}
         for r in rows:
             by_world.setdefault(r["replicate"], {})[r["planner"]] = r
         worlds = sorted(by_world)
@@ -151,7 +178,7 @@ class Resources(Experiment):
         call_nt = (near[str(n)][near_key]["two_qubit_depth"] * settings["two_qubit_gate_s"]
                    if str(n) in near else math.nan)
 
-        def means(sample):
+        def means(sample: list[int]) -> dict[str, Any]:
             rrt = [by_world[w]["RRT"] for w in sample]
             q = [by_world[w]["QRRT"] for w in sample]
             test_s = sum(r["wall_time_s"] for r in rrt) / sum(r["oracle_calls"] for r in rrt)
@@ -162,7 +189,7 @@ class Resources(Experiment):
                     "verifications": np.mean([r["verification_calls"] for r in q]),
                     "table_checks": np.mean([r["simulation_checks"] for r in q])}
 
-        def derived(sample):
+        def derived(sample: list[int]) -> dict[str, Any]:
             v = means(sample)
             v["qrrt_fault_tolerant_s"] = res.plan_time_s(v["quantum_calls"], v["verifications"], call_ft, v["test_s"])
             v["qrrt_fault_tolerant_with_table_s"] = v["qrrt_fault_tolerant_s"] + v["table_checks"] * v["test_s"]
@@ -177,15 +204,18 @@ class Resources(Experiment):
             v["break_even_two_qubit_layers"] = v["break_even_call_s"] / settings["two_qubit_gate_s"]
             return v
 
-        table = {key: float(value) for key, value in derived(worlds).items()}
-        intervals = {key: rounded_interval(bootstrap_interval(worlds, lambda s, k=key: derived(s)[k],
+        table: dict[str, Any] = {key: float(value) for key, value in derived(worlds).items()}
+        def statistic(sample: list[int], key: str) -> Any:
+            return derived(sample)[key]
+
+        intervals = {key: rounded_interval(bootstrap_interval(worlds, functools.partial(statistic, key=key),
                                                               settings["seed"]), 9) for key in table}
         table.update(num_qubits=n, lookup=lookup, fault_tolerant_call_s=call_ft, near_term_call_s=call_nt,
                      fault_tolerant_over_break_even=(call_ft / table["break_even_call_s"]
                                                      if table["break_even_call_s"] > 0 else math.inf))
         return {"table": table, "interval_95": intervals}
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         fig, axes = new_figure(1, 3, (16, 4.8))
         ax = axes[0, 0]
         for synthesis, marker in zip(settings["syntheses"], "os", strict=False):
@@ -235,8 +265,12 @@ class Resources(Experiment):
         return [save(fig, out_dir / "resources.png")]
 
 
-def plan_backend():
-    """The ideal backend of the plan part (only oracle calls are taken from q-RRT's plans)."""
+def plan_backend() -> StatevectorBackend:
+    """The ideal backend of the plan part (only oracle calls are taken from q-RRT's plans).
+
+    Returns:
+        A new exact statevector backend.
+    """
     from ..search.statevector import StatevectorBackend
 
     return StatevectorBackend()

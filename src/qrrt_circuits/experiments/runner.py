@@ -18,12 +18,12 @@ from collections.abc import Callable
 from concurrent.futures import BrokenExecutor, Executor, Future, as_completed
 from functools import partial
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 from tqdm.auto import tqdm
 
 from ..validation import check_int, check_optional_int
-from .base import Trial
+from .base import Experiment, Record, Settings, Summary, Trial
 from .records import RecordWriter, read_records
 
 if TYPE_CHECKING:
@@ -38,8 +38,20 @@ SUMMARY = "summary.json"
 SETTINGS = "settings.json"
 
 
-def execute_trial(experiment_name: str, trial: Trial, settings: dict) -> dict:
-    """Module-level task (picklable) run by any executor: one trial -> one record."""
+def execute_trial(experiment_name: str, trial: Trial, settings: Settings) -> Record:
+    """Module-level task (picklable) run by any executor: one trial -> one record.
+
+    Args:
+        experiment_name: An ``EXPERIMENTS`` name.
+        trial: One of the experiment's trials.
+        settings: The run's settings.
+
+    Returns:
+        ``{"trial_id", "seed", **trial.params}`` followed by the experiment's measurements.
+
+    Raises:
+        KeyError: If ``experiment_name`` is not an experiment.
+    """
     from . import EXPERIMENTS
 
     experiment = EXPERIMENTS[experiment_name]
@@ -48,8 +60,8 @@ def execute_trial(experiment_name: str, trial: Trial, settings: dict) -> dict:
     return record
 
 
-def _run_on(executor: Executor | Callable[[], Executor], name: str, trials: list[Trial], settings: dict,
-            record_one, client_helps: bool = False) -> None:
+def _run_on(executor: Executor | Callable[[], Executor], name: str, trials: list[Trial], settings: Settings,
+            record_one: Callable[[Record], None], client_helps: bool = False) -> None:
     """Run ``trials`` on ``executor`` (or on the executor ``executor()`` returns), recording each
     result as it arrives.
 
@@ -117,7 +129,8 @@ def _started_executor(pool: WorkerPool) -> Executor:
     return executor
 
 
-def _check_arguments(name: str, trials, seed, executor, jobs, scheduler, predicate: str) -> str | None:
+def _check_arguments(name: str, trials: int | None, seed: int, executor: str | Executor | WorkerPool | None,
+                     jobs: int | None, scheduler: str | None, predicate: str) -> str | None:
     """Refuse bad arguments before any work; returns the executor kind (None for an object)."""
     from ..execution import check_executor_args
     from ..registry import PREDICATES
@@ -142,11 +155,25 @@ def check_experiment_arguments(name: str, trials: int | None = None, seed: int =
                                executor: str | Executor | WorkerPool | None = None, jobs: int | None = None,
                                scheduler: str | None = None, predicate: str = "exact") -> None:
     """Refuse the arguments ``run_experiment`` would refuse, without doing anything (so a caller
-    running several experiments can check them all before starting workers)."""
+    running several experiments can check them all before starting workers).
+
+    Args:
+        name: An ``EXPERIMENTS`` name.
+        trials: Trials per variant (1 to ``MAX_TRIALS``) or None.
+        seed: The root seed (>= 0).
+        executor: ``"serial"``, ``"process"``, ``"dask"``, an executor, a ``WorkerPool`` or None.
+        jobs: Worker processes for a pool built by the runner.
+        scheduler: A Dask scheduler's address (``executor="dask"`` only).
+        predicate: A ``PREDICATES`` name (only ``"exact"`` for experiments that take none).
+
+    Raises:
+        ValueError: If an argument is out of range or names nothing known.
+        TypeError: If an argument has the wrong type.
+    """
     _check_arguments(name, trials, seed, executor, jobs, scheduler, predicate)
 
 
-def _claim_directory(directory: Path, settings: dict) -> None:
+def _claim_directory(directory: Path, settings: Settings) -> None:
     """Create ``directory`` for ``settings``, or accept it if it holds results for the same settings."""
     directory.mkdir(parents=True, exist_ok=True)
     settings_path = directory / SETTINGS
@@ -171,8 +198,9 @@ def _claim_directory(directory: Path, settings: dict) -> None:
         settings_path.write_text(json.dumps(settings, indent=1))
 
 
-def _execute(kind: str | None, executor, name: str, todo: list[Trial], settings: dict, record_one,
-             records_path: Path, jobs, scheduler, max_restarts: int, on_restart) -> None:
+def _execute(kind: str | None, executor: str | Executor | WorkerPool | None, name: str, todo: list[Trial],
+             settings: Settings, record_one: Callable[[Record], None], records_path: Path, jobs: int | None,
+             scheduler: str | None, max_restarts: int, on_restart: Callable[[int], None] | None) -> None:
     """Run ``todo`` serially, on a given executor or ``WorkerPool``, or on a pool built here; a
     pool whose executor breaks is renewed and the unfinished trials resubmitted."""
     from ..execution import WorkerPool
@@ -183,10 +211,12 @@ def _execute(kind: str | None, executor, name: str, todo: list[Trial], settings:
         for trial in todo:
             record_one(execute_trial(name, trial, settings))
         return
+    # kind is None exactly when ``executor`` is an object: an Executor or a WorkerPool
     if kind is None and not isinstance(executor, WorkerPool):
-        _run_on(executor, name, todo, settings, record_one)
+        _run_on(cast(Executor, executor), name, todo, settings, record_one)
         return
-    opened = contextlib.nullcontext(executor) if kind is None else WorkerPool(kind, jobs, scheduler)
+    opened: contextlib.AbstractContextManager[WorkerPool] = (
+        contextlib.nullcontext(cast(WorkerPool, executor)) if kind is None else WorkerPool(kind, jobs, scheduler))
     remaining = list(todo)
     with opened as pool:
         for attempt in range(max_restarts + 1):
@@ -198,7 +228,7 @@ def _execute(kind: str | None, executor, name: str, todo: list[Trial], settings:
                     _run_on(partial(_started_executor, pool), name, remaining, settings, record_one,
                             client_helps=True)
                 else:
-                    _run_on(pool.executor, name, remaining, settings, record_one)
+                    _run_on(_started_executor(pool), name, remaining, settings, record_one)
                 return
             except BrokenExecutor:
                 if attempt == max_restarts:
@@ -210,7 +240,8 @@ def _execute(kind: str | None, executor, name: str, todo: list[Trial], settings:
             pool.renew()
 
 
-def _summarize(experiment, name: str, directory: Path, settings: dict, all_trials: list[Trial]) -> dict:
+def _summarize(experiment: Experiment, name: str, directory: Path, settings: Settings,
+               all_trials: list[Trial]) -> Summary:
     """summary.json and the figures from all records (or a partial summary if trials are missing)."""
     ids = [trial.id for trial in all_trials]
     order = {trial_id: index for index, trial_id in enumerate(ids)}
@@ -241,11 +272,11 @@ def run_experiment(
     scheduler: str | None = None,
     progress: bool = True,
     stop_after: int | None = None,
-    on_record: Callable[[dict], None] | None = None,
+    on_record: Callable[[Record], None] | None = None,
     max_restarts: int = 3,
     on_restart: Callable[[int], None] | None = None,
     predicate: str = "exact",
-) -> dict:
+) -> Summary:
     """Run (or resume) experiment ``name`` into ``out/name``; returns the summary.
 
     ``executor``: ``"serial"`` (default), ``"process"``, ``"dask"`` (built here with ``jobs`` and
@@ -256,6 +287,30 @@ def run_experiment(
     ``max_restarts`` times; Dask reschedules a dead worker's tasks itself. ``stop_after`` stops
     after that many new trials (for tests of resuming). ``predicate`` (a ``PREDICATES`` name) is
     the reachability check the experiment's planners use, recorded in the settings.
+
+    Args:
+        name: An ``EXPERIMENTS`` name.
+        out: The results folder; the run writes ``out/name``.
+        quick: Small settings (each experiment under two minutes).
+        trials: Trials per variant (default: the experiment's).
+        seed: The root seed (>= 0).
+        executor: Where trials run (see above).
+        jobs: Worker processes for a pool built here (default: cores).
+        scheduler: A Dask scheduler's address (``executor="dask"``).
+        progress: Show a progress bar.
+        stop_after: Stop after this many new trials (a partial summary is returned).
+        on_record: Called with each record as it is written.
+        max_restarts: How many times a broken pool is renewed.
+        on_restart: Called with the restart's number before each renewal.
+        predicate: The planners' reachability check (a ``PREDICATES`` name).
+
+    Returns:
+        The summary written to ``summary.json`` (``"complete": False`` with the counts of
+        finished and total trials when some are missing).
+
+    Raises:
+        ValueError: If an argument is refused, or ``out/name`` holds results for other settings.
+        RuntimeError: If the experiment produced duplicate trial ids.
     """
     from ..registry import PREDICATES
     from . import EXPERIMENTS
@@ -279,7 +334,7 @@ def run_experiment(
     writer = RecordWriter(records_path)
     bar = tqdm(total=len(all_trials), initial=len(done), desc=name, disable=not progress, unit="trial")
 
-    def record_one(record: dict) -> None:
+    def record_one(record: Record) -> None:
         writer.write(record)
         if on_record:
             on_record(record)

@@ -9,12 +9,13 @@ Grover search, whose cost is O(sqrt(N/m)).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
-from ..search.policies import BBHT, Adaptive, KnownOptimal
-from .base import Experiment, Trial, TrialStream, replicate_seed
+from ..search.policies import BBHT, Adaptive, IterationPolicy, KnownOptimal
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .fitting import power_law_exponent
 from .intervals import bootstrap_interval, rounded_interval
@@ -22,22 +23,32 @@ from .measures import reachable_fraction
 from .planners import BACKEND_LABEL, planner_for
 from .worlds import world
 
-CONFIGS = {"RRT": None, "QRRT optimal": KnownOptimal, "QRRT bbht": BBHT, "QRRT adaptive": Adaptive}
+#: label -> q-RRT's search policy (its class), or None for RRT
+CONFIGS: dict[str, Callable[[], IterationPolicy] | None] = {
+    "RRT": None, "QRRT optimal": KnownOptimal, "QRRT bbht": BBHT, "QRRT adaptive": Adaptive}
 DENSITIES = (100, 250, 400, 550, 700, 850, 1000)
 
 
 class Scaling(Experiment):
+    """Oracle calls per node against the reachable fraction f (beyond the paper).
+
+    A trial grows a 30-node tree with RRT or q-RRT (KnownOptimal, BBHT, Adaptive) in a
+    ``paper_clutter`` world of a given obstacle density and records calls per node and f
+    (``reachable_fraction``). The summary fits calls/node = C f^alpha (``power_law_exponent``):
+    alpha near -1 for RRT and near -1/2 for Grover search, with 95 % bootstrap intervals.
+    """
+
     name = "scaling"
     title = "Oracle calls per node against the reachable fraction (beyond the paper)"
     paper = {"RRT": -1.0, "QRRT optimal": -0.5, "QRRT bbht": -0.5, "QRRT adaptive": -0.5}
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         return {"trials": trials or (2 if quick else 6),
                 "densities": list(DENSITIES[::2] if quick else DENSITIES), "nodes": 30,
                 "num_qubits": 8, "backend": "statevector", "seed": seed, "quick": quick}
 
-    def trials(self, settings):
-        out = []
+    def trials(self, settings: Settings) -> list[Trial]:
+        out: list[Trial] = []
         for density in settings["densities"]:
             for replicate in range(settings["trials"]):
                 world_seed = replicate_seed(settings["seed"], replicate * 1000 + density, TrialStream.SCALING_WORLDS)
@@ -49,21 +60,21 @@ class Scaling(Experiment):
                                                     TrialStream.SCALING_PLANNERS)))
         return out
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         env = world("paper_clutter", trial.params["world_seed"], num_boxes=trial.params["boxes"])
-        name = trial.params["config"]
-        if name == "RRT":
+        make_policy = CONFIGS[trial.params["config"]]
+        if make_policy is None:  # RRT
             planner = planner_for(settings, "RRT", env, trial.seed)
         else:
             planner = planner_for(settings, "QRRT", env, trial.seed, settings["backend"],
-                                   num_qubits=settings["num_qubits"], search_policy=CONFIGS[name]())
+                                   num_qubits=settings["num_qubits"], search_policy=make_policy())
         result = planner.plan(max_nodes=settings["nodes"])
         m = result.metrics
         return {"nodes": m.nodes, "oracle_calls": m.oracle_calls,
                 "calls_per_node": m.oracle_calls / max(m.nodes, 1),
                 "reachable_fraction": reachable_fraction(result)}
 
-    def summarize(self, records, settings):
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
         ours, fits = {}, {}
         for name in CONFIGS:
             rows = [r for r in records if r["config"] == name and r["nodes"] > 0]
@@ -80,7 +91,7 @@ class Scaling(Experiment):
                 "labels": ["QRRT optimal uses the true m of each database (simulation knowledge)",
                            f"backend: {BACKEND_LABEL[settings['backend']]}"]}
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         fig, axes = new_figure(1, 1, (6.5, 5))
         ax = axes[0, 0]
         colors = dict(zip(CONFIGS, ["tab:gray", "tab:blue", "tab:green", "tab:orange"], strict=True))

@@ -18,13 +18,17 @@ shared database are ignored in that formula (they only make sharing worse), so p
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from ..registry import POLICIES
-from ..search.estimated_policy import EstimatedOptimal
-from .base import Experiment, TrialStream, paired_trials
+from ..search.estimated_policy import EstimatedOptimal, EstimatedOptimalState
+from ..search.policies import IterationPolicy
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, paired_trials
 from .figures import new_figure, save
 from .intervals import bootstrap_interval, rounded_interval
 from .measures import dumps, loads
@@ -45,42 +49,53 @@ COLORS = {"paper": "tab:blue", "bbht": "tab:green", "adaptive": "tab:orange", "f
 class _LoggedEstimatedOptimal(EstimatedOptimal):
     """EstimatedOptimal whose plan state is kept, to read its per-database (estimate, k) history."""
 
-    states: list  # not a dataclass field: set in __post_init__
+    states: list[EstimatedOptimalState]  # not a dataclass field: set in __post_init__
 
     def __post_init__(self) -> None:
         super().__post_init__()
         object.__setattr__(self, "states", [])  # a frozen dataclass; the list is this trial's log
 
-    def start(self, num_items):
+    def start(self, num_items: int) -> EstimatedOptimalState:
         state = super().start(num_items)
         self.states.append(state)
         return state
 
 
-def _policy(name: str | None):
+def _policy(name: str | None) -> IterationPolicy | None:
     if name == "estimated":
         return _LoggedEstimatedOptimal()
-    return None if name is None else POLICIES.create(name)
+    if name is None:
+        return None
+    policy: IterationPolicy = POLICIES.create(name)
+    return policy
 
 
 class SearchPolicies(Experiment):
+    """Search policies that cannot overshoot or that estimate m, as the tree grows (beyond the paper).
+
+    A trial grows one tree with RRT or q-RRT / Pq-RRT under one policy of ``POLICY_NAMES`` and
+    records the calls at sizes 30, 100, 300 and 1000 (``calls_at_sizes``). The summary gives the
+    marginal calls per node in each window with 95 % intervals, and for ``EstimatedOptimal`` the
+    estimation's share of the calls and the break-even number of workers (module docstring).
+    """
+
     name = "search-policies"
     title = "Search that cannot overshoot: fixed-point amplification and estimated m (beyond the paper)"
     paper = {"note": "the paper uses a fixed schedule (5 then 3 iterations) and reports 30-node trees only"}
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         return {"trials": trials or (2 if quick else 3), "sizes": list(SIZES[:2] if quick else SIZES),
                 "workers": 8, "num_qubits": 8, "backend": "statevector", "scenario": "paper_clutter",
                 "configs": list(CONFIGS), "policies": {name: POLICIES.create(name).describe()
                                                        for name in POLICY_NAMES},
                 "seed": seed, "quick": quick}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         variants = [(label, {"config": label}) for label in settings["configs"]]
         return paired_trials(settings, variants, TrialStream.SEARCH_POLICIES_WORLDS,
                              TrialStream.SEARCH_POLICIES_PLANNERS)
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         env = world(settings["scenario"], trial.params["world_seed"])
         planner_name, policy_name = CONFIGS[trial.params["config"]]
         policy = _policy(policy_name)
@@ -101,17 +116,19 @@ class SearchPolicies(Experiment):
                 "points_json": dumps(calls_at_sizes(result, settings["sizes"])),
                 "fractions_json": dumps(reachable_fraction_by_window(result, settings["sizes"]))}
 
-    def summarize(self, records, settings):
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
         sizes = settings["sizes"]
         windows = [f"{a}-{b}" for a, b in zip(sizes[:-1], sizes[1:], strict=True)]
 
-        ours, interval, critical, whole = {}, {}, {}, {}
+        ours: dict[str, dict[str, float]] = {}
+        interval: dict[str, dict[str, list[float]]] = {}
+        critical: dict[str, dict[str, float]] = {}
+        whole: dict[str, dict[str, float]] = {}
         for label in settings["configs"]:
             rows = [r for r in records if r["config"] == label]
             ours[label] = {w: round(pooled_calls_per_node(rows, w), 3) for w in windows}
-            interval[label] = {w: rounded_interval(bootstrap_interval(rows,
-                                                                      lambda s, w=w: pooled_calls_per_node(s, w),
-                                                                      settings["seed"]), 3) for w in windows}
+            interval[label] = {w: rounded_interval(bootstrap_interval(
+                rows, functools.partial(pooled_calls_per_node, window=w), settings["seed"]), 3) for w in windows}
             critical[label] = {w: round(pooled_calls_per_node(rows, w, 2), 3) for w in windows}
             nodes = sum(r["nodes"] for r in rows)
             whole[label] = {"calls_per_node": round(sum(r["oracle_calls"] for r in rows) / nodes, 3),
@@ -132,10 +149,10 @@ class SearchPolicies(Experiment):
                            "backend: exact statevector (ideal; same statistics as Aer)"]}
 
     @staticmethod
-    def _estimation_summary(records) -> dict:
+    def _estimation_summary(records: Sequence[Record]) -> dict[str, Any]:
         """Estimation vs search calls of EstimatedOptimal, and the workers p* at which one estimation
         per database would match Adaptive's calls per node (from the q-RRT runs)."""
-        out = {}
+        out: dict[str, Any] = {}
         for prefix in ("QRRT", "PQRRT"):
             rows = [r for r in records if r["config"] == f"{prefix} estimated"]
             databases = sum(r["databases"] for r in rows)
@@ -168,7 +185,7 @@ class SearchPolicies(Experiment):
                                       "no number of workers pays")
         return out
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         fig, axes = new_figure(1, 2, (12, 5))
         sizes = settings["sizes"]
         windows = list(summary["ours"]["RRT"])

@@ -15,16 +15,22 @@ Pq-RRT is reported on its critical path (the time of 8 parallel devices) and in 
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .base import Experiment, TrialStream, paired_trials
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, paired_trials
 from .figures import new_figure, save
 from .intervals import bootstrap_interval, rounded_interval
 from .measures import dumps, loads
 from .planners import planner_for
 from .worlds import world
+
+if TYPE_CHECKING:
+    from ..planners.result import PlanResult
 
 SIZES = (30, 100, 300, 1000, 3000)
 #: label -> (registry planner, search policy)
@@ -41,9 +47,19 @@ COLORS = {"RRT": "tab:gray", "ParallelRRT": "tab:brown", "QRRT paper": "tab:blue
           "QRRT bbht": "tab:green", "QRRT adaptive": "tab:orange", "PQRRT paper": "tab:red"}
 
 
-def pooled_calls_per_node(rows, window: str, column: int = 1) -> float:
+def pooled_calls_per_node(rows: Sequence[Record], window: str, column: int = 1) -> float:
     """Calls added / nodes added in ``window`` ("low-high") over the rows (a pooled ratio);
-    ``column`` 1 counts oracle calls, 2 critical-path calls (the points of ``calls_at_sizes``)."""
+    ``column`` 1 counts oracle calls, 2 critical-path calls (the points of ``calls_at_sizes``).
+
+    Args:
+        rows: Records with a ``points_json`` column (``calls_at_sizes`` points).
+        window: ``"low-high"``, two tree sizes.
+        column: 1 for oracle calls, 2 for critical-path calls.
+
+    Returns:
+        Summed calls added / summed nodes added over the rows whose trees reached both sizes;
+        NaN if none did.
+    """
     low, high = (int(v) for v in window.split("-"))
     calls = nodes = 0
     for r in rows:
@@ -54,10 +70,18 @@ def pooled_calls_per_node(rows, window: str, column: int = 1) -> float:
     return calls / nodes if nodes else float("nan")
 
 
-def calls_at_sizes(result, sizes) -> list[list[int]]:
-    """[[size, oracle calls, critical-path calls], ...] at the first round the tree reaches each size."""
+def calls_at_sizes(result: PlanResult, sizes: Sequence[int]) -> list[list[int]]:
+    """[[size, oracle calls, critical-path calls], ...] at the first round the tree reaches each size.
+
+    Args:
+        result: A finished plan (its per-round ``history``).
+        sizes: Tree sizes (nodes).
+
+    Returns:
+        One ``[size, oracle_calls, critical_path_calls]`` triple per size the tree reached.
+    """
     nodes = result.history["nodes"]
-    out = []
+    out: list[list[int]] = []
     for size in sizes:
         reached = np.flatnonzero(nodes >= size)
         if reached.size:
@@ -67,12 +91,20 @@ def calls_at_sizes(result, sizes) -> list[list[int]]:
     return out
 
 
-def reachable_fraction_by_window(result, sizes) -> dict[str, float]:
+def reachable_fraction_by_window(result: PlanResult, sizes: Sequence[int]) -> dict[str, float]:
     """The truly reachable share of the candidates evaluated while the tree grew through each window
     of sizes (RRT: its tests; q-RRT: its database entries): what sets Grover's success
-    probability sin^2((2k+1) theta), sin^2 theta = f."""
+    probability sin^2((2k+1) theta), sin^2 theta = f.
+
+    Args:
+        result: A finished plan (its per-round ``history``).
+        sizes: Increasing tree sizes; consecutive pairs are the windows.
+
+    Returns:
+        ``{"low-high": f}`` for each window the tree grew through and evaluated candidates in.
+    """
     nodes = result.history["nodes"]
-    out = {}
+    out: dict[str, float] = {}
     for low, high in zip(sizes[:-1], sizes[1:], strict=True):
         rounds = (nodes >= low) & (np.concatenate([[0], nodes[:-1]]) < high)
         entries = int(result.history["entries"][rounds].sum())
@@ -82,28 +114,44 @@ def reachable_fraction_by_window(result, sizes) -> dict[str, float]:
 
 
 def marginal(points: list[list[int]], column: int = 1) -> dict[str, float]:
-    """Calls added per node added between consecutive sizes: {"30-100": ..., ...}."""
-    out = {}
+    """Calls added per node added between consecutive sizes: {"30-100": ..., ...}.
+
+    Args:
+        points: ``calls_at_sizes`` points, by increasing size.
+        column: 1 for oracle calls, 2 for critical-path calls.
+
+    Returns:
+        ``{"n0-n1": (calls at n1 - calls at n0) / (n1 - n0)}`` for consecutive points.
+    """
+    out: dict[str, float] = {}
     for (n0, *c0), (n1, *c1) in zip(points[:-1], points[1:], strict=False):
         out[f"{n0}-{n1}"] = (c1[column - 1] - c0[column - 1]) / (n1 - n0)
     return out
 
 
 class TreeSize(Experiment):
+    """Oracle calls per node against tree size (beyond the paper's 30-node trees of Fig. 9).
+
+    A trial grows one tree with a configuration of ``CONFIGS`` toward an unreachable goal and
+    records the calls at each tree size (``calls_at_sizes``). The summary gives the marginal calls
+    per node in each window of sizes (``pooled_calls_per_node``) with 95 % intervals, the critical
+    path's, and the first window where a quantum planner stops being cheaper than RRT.
+    """
+
     name = "tree-size"
     title = "Oracle calls per node against tree size (beyond the paper)"
     paper = {"note": "the paper reports 30-node trees only (Fig. 9)"}
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         return {"trials": trials or (2 if quick else 5), "sizes": list(SIZES[:2] if quick else SIZES),
                 "workers": 8, "num_qubits": 8, "backend": "statevector", "scenario": "paper_clutter",
                 "configs": list(CONFIGS), "seed": seed, "quick": quick}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         variants = [(label, {"config": label}) for label in settings["configs"]]
         return paired_trials(settings, variants, TrialStream.TREE_SIZE_WORLDS, TrialStream.TREE_SIZE_PLANNERS)
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         env = world(settings["scenario"], trial.params["world_seed"])
         planner_name, policy = CONFIGS[trial.params["config"]]
         planner = planner_for(settings, planner_name, env, trial.seed, settings["backend"], settings["workers"],
@@ -114,7 +162,7 @@ class TreeSize(Experiment):
                 "points_json": dumps(calls_at_sizes(result, settings["sizes"])),
                 "fractions_json": dumps(reachable_fraction_by_window(result, settings["sizes"]))}
 
-    def summarize(self, records, settings):
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
         sizes = settings["sizes"]
         windows = [f"{a}-{b}" for a, b in zip(sizes[:-1], sizes[1:], strict=True)]
 
@@ -122,8 +170,8 @@ class TreeSize(Experiment):
         for label in settings["configs"]:
             rows = [r for r in records if r["config"] == label]
             ours[label] = {w: round(pooled_calls_per_node(rows, w), 3) for w in windows}
-            interval[label] = {w: rounded_interval(bootstrap_interval(rows, lambda s, w=w: pooled_calls_per_node(s, w),
-                                                                      settings["seed"]), 3) for w in windows}
+            interval[label] = {w: rounded_interval(bootstrap_interval(
+                rows, functools.partial(pooled_calls_per_node, window=w), settings["seed"]), 3) for w in windows}
             critical[label] = {w: round(pooled_calls_per_node(rows, w, 2), 3) for w in windows}
         fractions = {label: {w: round(float(np.mean([loads(r["fractions_json"])[w] for r in records
                                                      if r["config"] == label and w in loads(r["fractions_json"])]
@@ -146,7 +194,7 @@ class TreeSize(Experiment):
                            "phase oracle from a classical lookup of all 2^8 entries",
                            "backend: exact statevector (ideal; same statistics as Aer)"]}
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         fig, axes = new_figure(1, 1, (7.5, 5))
         ax = axes[0, 0]
         sizes = settings["sizes"]

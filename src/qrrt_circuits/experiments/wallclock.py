@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .base import Experiment, TrialStream, paired_trials
+from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, paired_trials
 from .figures import new_figure, save
 from .fitting import slope_through_origin
 from .intervals import bootstrap_interval, rounded_interval
@@ -25,24 +25,42 @@ CONFIGS = (("RRT", "none"), ("ParallelRRT", "none"), ("QRRT", "aer"), ("QRRT", "
 
 
 def label(planner: str, backend: str) -> str:
+    """A configuration's label in records and summaries.
+
+    Args:
+        planner: A planner of ``CONFIGS``.
+        backend: Its backend, ``"none"`` for the classical planners.
+
+    Returns:
+        ``planner`` alone, or ``"planner (backend)"``.
+    """
     return planner if backend == "none" else f"{planner} ({backend})"
 
 
 class Wallclock(Experiment):
+    """Wall-clock seconds per oracle call and per node (paper Figs. 6-8).
+
+    A trial times one 30-node tree of a configuration of ``CONFIGS`` (the worlds and seeds of
+    oracle-efficiency). The summary fits seconds against oracle calls and against nodes through
+    the origin (``slope_through_origin``), a 95 % interval on the per-node slope, next to the
+    paper's MATLAB times;
+    the timings are of this machine and are labelled so.
+    """
+
     name = "wallclock"
     title = "Wall-clock seconds per oracle call and per node (paper Figs. 6-8)"
     paper = {"seconds_per_oracle_call": {"QRRT": 3.52, "PQRRT": 0.20},
              "seconds_per_node": {"RRT": 1.23, "ParallelRRT": 0.58, "QRRT": 25.3, "PQRRT": 3.17}}
 
-    def settings(self, quick, trials, seed):
+    def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         return {"trials": trials or (3 if quick else 20), "nodes": 30, "workers": 8, "num_qubits": 8,
                 "scenario": "paper_clutter", "seed": seed, "quick": quick}
 
-    def trials(self, settings):
+    def trials(self, settings: Settings) -> list[Trial]:
         variants = [(label(planner, backend), {"planner": planner, "backend": backend}) for planner, backend in CONFIGS]
         return paired_trials(settings, variants, TrialStream.PAPER_WORLDS, TrialStream.PAPER_PLANNERS)
 
-    def run_trial(self, trial, settings):
+    def run_trial(self, trial: Trial, settings: Settings) -> Record:
         env = world(settings["scenario"], trial.params["world_seed"])
         backend = trial.params["backend"]
         planner = planner_for(settings, trial.params["planner"], env, trial.seed,
@@ -55,7 +73,7 @@ class Wallclock(Experiment):
                 "critical_path_oracle_calls": m.critical_path_oracle_calls,
                 "wall_time_s": m.wall_time_s}
 
-    def summarize(self, records, settings):
+    def summarize(self, records: list[Record], settings: Settings) -> Summary:
         per_call, per_node, ms_node, ms_interval = {}, {}, {}, {}
         for planner, backend in CONFIGS:
             rows = [r for r in records if r["planner"] == planner and r["backend"] == backend]
@@ -77,13 +95,13 @@ class Wallclock(Experiment):
                 "note": "the paper's times are MATLAB on an 8-core M2; ours one process on this machine"}
 
     @staticmethod
-    def _interval(summary, key: str, name: str) -> str:
+    def _interval(summary: Summary, key: str, name: str) -> str:
         if key != "seconds_per_node":
             return ""
         low, high = summary["ms_per_node_interval_95"][name]
         return f" [{low:.3g}, {high:.3g}]"
 
-    def plot(self, records, settings, summary, out_dir: Path):
+    def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         fig, axes = new_figure(1, 2, (11, 4.4))
         colors = dict(zip([label(*c) for c in CONFIGS],
                           ["tab:gray", "tab:brown", "tab:blue", "tab:cyan", "tab:orange", "gold"], strict=True))

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import time
 from concurrent.futures import Executor
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -34,18 +35,23 @@ from .context import RoundView, WorkerContext
 from .result import Metrics, PlanResult
 from .run_state import RunState
 
+if TYPE_CHECKING:
+    from ..search.policies import PolicyState
+
 #: kept for 0.1 code that imports it from here; the value lives in ``qrrt_circuits.termination``
 DEFAULT_MAX_ROUNDS = _termination.DEFAULT_MAX_ROUNDS
 
 __all__ = ["DEFAULT_MAX_ROUNDS", "Metrics", "PlanResult", "Planner", "RunState"]
 
 
-def _check_count(value, name: str, minimum: int = 1) -> int:
+def _check_count(value: Any, name: str, minimum: int = 1) -> int:
     """0.1's integer check, kept for callers outside the package."""
     return check_int(value, name, minimum)
 
 
-def resolve_predicate(env: Environment, predicate, oracle, dynamics, resolution) -> ReachabilityPredicate:
+def resolve_predicate(env: Environment, predicate: ReachabilityPredicate | None,
+                      oracle: ReachabilityPredicate | None, dynamics: LinearTrackingDynamics | None,
+                      resolution: float) -> ReachabilityPredicate:
     """The planner's predicate: ``predicate=`` (or its alias ``oracle=``), else the sound
     ``ReachabilityOracle`` built with ``dynamics`` and ``resolution``."""
     if predicate is not None and oracle is not None and predicate is not oracle:
@@ -204,7 +210,8 @@ class Planner:
             state.end_round()
         return PlanStatus.REACHED
 
-    def _check_problem(self, start, goal, goal_radius):
+    def _check_problem(self, start: np.ndarray | None, goal: np.ndarray | None,
+                       goal_radius: float | None) -> tuple[np.ndarray, np.ndarray, float]:
         env = self.env
         start = env.start if start is None else start
         goal = env.goal if goal is None else goal
@@ -241,7 +248,7 @@ class Planner:
     def _check_ready(self) -> None:
         """Subclasses validate their own settings before any work."""
 
-    def _start_policy(self):
+    def _start_policy(self) -> PolicyState | None:
         return None
 
     def _round(self, state: RunState) -> None:
@@ -271,8 +278,8 @@ class Planner:
         """
         return ()
 
-    def _result(self, state: RunState, status: PlanStatus, elapsed: float, start, goal, goal_radius,
-                condition: TerminationCondition) -> PlanResult:
+    def _result(self, state: RunState, status: PlanStatus, elapsed: float, start: np.ndarray, goal: np.ndarray,
+                goal_radius: float, condition: TerminationCondition) -> PlanResult:
         tree = state.tree
         path = None
         if state.goal_node is not None:

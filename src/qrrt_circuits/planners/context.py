@@ -57,7 +57,7 @@ class WorkerContext:
         return self.backend
     token: str = field(default_factory=lambda: uuid.uuid4().hex, compare=False)
 
-    def __reduce__(self):
+    def __reduce__(self) -> tuple[Callable[[str, bytes], WorkerContext], tuple[str, bytes]]:
         payload = self.__dict__.get("_payload")
         if payload is None:
             state = {key: value for key, value in self.__dict__.items() if key != "_payload"}

@@ -36,7 +36,7 @@ from ..oracle_errors import OracleErrorModel
 from ..predicate import ReachabilityPredicate
 from ..search.aer import AerBackend
 from ..search.backend import QuantumSearchBackend
-from ..search.policies import IterationPolicy, PaperSchedule
+from ..search.policies import IterationPolicy, PaperSchedule, PolicyState
 from ..search.problem import DatabaseSearch
 from ..validation import check_bool, check_instance, check_int
 from .base import Planner
@@ -244,7 +244,7 @@ class PQRRT(Planner):
         """N = 2^n, the entries of each database."""
         return 1 << self.num_qubits
 
-    def _start_policy(self):
+    def _start_policy(self) -> PolicyState:
         return self.search_policy.start(self.database_size)
 
     def _context(self) -> WorkerContext:

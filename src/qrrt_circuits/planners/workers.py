@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..database import stream_database
+from ..database import Database, stream_database
 from ..randomness import Stream
 from ..search.problem import DatabaseSearch, SearchOutcome
 from .context import RoundView, WorkerContext
@@ -56,7 +56,7 @@ class DatabaseOutcome:
     found: tuple[tuple[np.ndarray, int] | None, ...]
 
 
-def make_database(context: WorkerContext, view: RoundView, worker: int):
+def make_database(context: WorkerContext, view: RoundView, worker: int) -> tuple[Database, np.ndarray, np.ndarray]:
     """Alg. 1 lines 4-8: the database, the true predicate on it, and the oracle's marks."""
     db = stream_database(view.tree, context.database_size, context.env, context.streams, view.round_index,
                          worker, view.goal, view.goal_radius, context.goal_bias, context.annealing,

@@ -17,6 +17,7 @@ on; below it, extra OpenMP threads only cost their start-up and synchronisation 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 from qiskit_aer import AerSimulator
@@ -25,6 +26,13 @@ from ..validation import check_int
 from .backend import QuantumSearchBackend, SearchRequest, SearchResult, seed_stream
 from .circuits import SYNTHESES, aer_grover_circuit, aer_literal_grover_circuit
 from .fixed_point import generalized_grover_circuit
+
+if TYPE_CHECKING:
+    from qiskit.result import Result
+    from qiskit_aer.jobs import AerJob
+    from qiskit_aer.noise import NoiseModel
+
+    from .fixed_point import IterateSequence
 
 METHODS = ("statevector", "automatic")
 #: circuits on fewer qubits run single-threaded (Aer's default statevector_parallel_threshold)
@@ -83,7 +91,7 @@ class AerBackend(QuantumSearchBackend):
         seed: int | np.random.Generator | None = None,
         method: str = "statevector",
         synthesis: str = "auto",
-        noise_model=None,
+        noise_model: NoiseModel | None = None,
         device: str = "CPU",
         max_parallel_threads: int = 0,
     ) -> None:
@@ -154,20 +162,24 @@ class AerBackend(QuantumSearchBackend):
         """
         return 1 if num_qubits < SERIAL_BELOW_QUBITS else self.max_parallel_threads
 
-    def _submit(self, marks, num_qubits, iterations, shots, seed):
+    def _submit(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
+                seed: int | np.random.Generator | None) -> AerJob:
         """Build the circuit and start its Aer job (Aer runs jobs on its own worker thread); the
         simulator seed is the first ``integers(0, 2**31 - 1)`` of the search's generator."""
         circuit = self._build(marks, iterations, measure=True, synthesis=self.synthesis)
         return self.simulator.run(circuit, shots=shots, seed_simulator=self._first_integer(seed, 2**31 - 1),
                                   memory=True, max_parallel_threads=self.threads_for(num_qubits))
 
-    def _sample_seeded(self, marks, num_qubits, iterations, shots, seed) -> np.ndarray:
+    def _sample_seeded(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
+                       seed: int | np.random.Generator | None) -> np.ndarray:
         return _measured_indices(self._submit(marks, num_qubits, iterations, shots, seed).result(), 0)
 
-    def _sample(self, marks, num_qubits, iterations, shots, rng) -> np.ndarray:
+    def _sample(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
+                rng: np.random.Generator) -> np.ndarray:
         return self._sample_seeded(marks, num_qubits, iterations, shots, rng)
 
-    def _sample_sequence(self, marks, num_qubits, sequence, shots, rng) -> np.ndarray:
+    def _sample_sequence(self, marks: np.ndarray, num_qubits: int, sequence: IterateSequence, shots: int,
+                         rng: np.random.Generator) -> np.ndarray:
         """Fixed-point amplification: the generalized iterates of ``sequence`` as one circuit."""
         circuit = generalized_grover_circuit(marks, sequence, measure=True, synthesis=self.synthesis)
         seed = int(rng.integers(0, 2**31 - 1))
@@ -204,7 +216,7 @@ class AerBackend(QuantumSearchBackend):
                      for item, job in zip(prepared, jobs, strict=True))
 
 
-def _measured_indices(result, experiment: int) -> np.ndarray:
+def _measured_indices(result: Result, experiment: int) -> np.ndarray:
     """The measured indices of one experiment, from Aer's per-shot memory (hexadecimal strings
     of the classical register, so no bitstring formatting per shot)."""
     if not result.success:

@@ -19,12 +19,19 @@ from __future__ import annotations
 import abc
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, TypeAlias
 
 import numpy as np
 
 from ..memory import MemoryEstimate, check_fits
 from ..randomness import first_integer_below
 from ..validation import check_int, check_seed
+
+if TYPE_CHECKING:
+    from .fixed_point import IterateSequence
+
+#: a validated request: (marks, num_qubits, iterations, shots, rng)
+_Prepared: TypeAlias = tuple[np.ndarray, int, int, int, "int | np.random.Generator | None"]
 
 
 @dataclass(frozen=True)
@@ -230,7 +237,7 @@ class QuantumSearchBackend(abc.ABC):
         prepared = [self._prepare(request) for request in requests]
         return tuple(self._finish(item, self._sample_seeded(*item)) for item in prepared)
 
-    def _prepare(self, request: SearchRequest):
+    def _prepare(self, request: SearchRequest) -> _Prepared:
         """(marks, n, iterations, shots, seed) of one validated request; the seed is None (the
         backend's own stream), a non-negative int or a ``numpy.random.Generator``."""
         if not isinstance(request, SearchRequest):
@@ -263,7 +270,7 @@ class QuantumSearchBackend(abc.ABC):
         return self._sample(marks, num_qubits, iterations, shots, self._generator(seed))
 
     @staticmethod
-    def _finish(prepared, indices: np.ndarray) -> SearchResult:
+    def _finish(prepared: _Prepared, indices: np.ndarray) -> SearchResult:
         _, _, iterations, shots, _ = prepared
         return SearchResult(indices, iterations, shots, iterations * shots)
 
@@ -314,7 +321,7 @@ class QuantumSearchBackend(abc.ABC):
         check_fits(lambda n: self.memory_estimate(n, shots, iterations), num_qubits,
                    f"this {self.name} search ({shots} shots, {iterations} iterations)")
 
-    def search_sequence(self, marks: np.ndarray, sequence, shots: int = 1,
+    def search_sequence(self, marks: np.ndarray, sequence: IterateSequence, shots: int = 1,
                         seed: int | None = None) -> SearchResult:
         """Apply the generalized Grover iterates of ``sequence`` (an ``IterateSequence``) to the
         uniform state and measure ``shots`` times; ``iterations`` of the result = len(sequence).
@@ -349,7 +356,7 @@ class QuantumSearchBackend(abc.ABC):
         indices = self._sample_sequence(marks, num_qubits, sequence, shots, rng)
         return SearchResult(indices, len(sequence), shots, sequence.oracle_calls * shots)
 
-    def _sample_sequence(self, marks: np.ndarray, num_qubits: int, sequence, shots: int,
+    def _sample_sequence(self, marks: np.ndarray, num_qubits: int, sequence: IterateSequence, shots: int,
                          rng: np.random.Generator) -> np.ndarray:
         """``shots`` measured indices after ``sequence`` (validated inputs); backends that can run
         generalized iterates override this."""

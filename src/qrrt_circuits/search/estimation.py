@@ -32,7 +32,9 @@ sampler here therefore refuses to run more than ``MAX_IAE_ROUNDS`` circuits for 
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from qiskit import QuantumCircuit
@@ -42,6 +44,10 @@ from qiskit.primitives.containers.sampler_pub import SamplerPub
 from .backend import validate_marks
 from .circuits import phase_oracle
 from .fixed_point import append_state_reflection
+
+if TYPE_CHECKING:
+    from qiskit.primitives import PrimitiveJob
+    from qiskit_algorithms import EstimationProblem
 
 #: operations Aer's SamplerV2 executes without a transpile (our circuits use only these)
 AER_NATIVE = frozenset({"h", "x", "p", "diagonal", "mcphase", "measure", "barrier", "unitary"})
@@ -70,7 +76,7 @@ def grover_iterate(marks: np.ndarray, synthesis: str = "auto") -> QuantumCircuit
     return circuit
 
 
-def estimation_problem(marks: np.ndarray, synthesis: str = "auto"):
+def estimation_problem(marks: np.ndarray, synthesis: str = "auto") -> EstimationProblem:
     """qiskit-algorithms' ``EstimationProblem`` for the marked fraction a = m / N of ``marks``.
 
     State preparation A = H^n (the paper's W), Grover operator ``grover_iterate(marks)``, all n
@@ -151,7 +157,7 @@ class SeededAerSampler(BaseSamplerV2):
         self.max_calls = max_calls
         self.calls = 0
 
-    def run(self, pubs, *, shots: int | None = None):
+    def run(self, pubs: Iterable[Any], *, shots: int | None = None) -> PrimitiveJob:
         """Run the pubs on Aer's ``SamplerV2``, flattened, with a fresh ``seed_simulator``.
 
         Args:
@@ -260,7 +266,7 @@ def _theta_grid(max_power: int = 0) -> np.ndarray:
     return np.linspace(eps, np.pi / 2 - eps, max(10_000, int(np.pi / 2 * 1000 * 2 * max_power)))
 
 
-def grid_minimizer(objective, bounds) -> float:
+def grid_minimizer(objective: Callable[[Any], Any], bounds: Sequence[tuple[float, float]]) -> float:
     """MLAE's minimizer hook: the library's own grid search (``brute`` over 10 000 points, then a
     local polish) evaluated on the whole grid at once (its log-likelihood accepts an array of
     theta), then polished by a bounded scalar minimization between the neighbouring grid points.
@@ -283,7 +289,7 @@ def grid_minimizer(objective, bounds) -> float:
     return float(polished.x) if polished.fun <= values[best] else float(grid[best])
 
 
-def log_likelihood(theta: np.ndarray, powers, good_counts, shots: int) -> np.ndarray:
+def log_likelihood(theta: np.ndarray, powers: Sequence[int], good_counts: Sequence[int], shots: int) -> np.ndarray:
     """MLAE's log-likelihood: sum_k good_k log sin^2((2k+1) theta) + bad_k log cos^2((2k+1) theta).
 
     Suzuki et al. 2020: after k Grover iterates the good probability is sin^2((2k+1) theta)
@@ -306,7 +312,7 @@ def log_likelihood(theta: np.ndarray, powers, good_counts, shots: int) -> np.nda
     return total
 
 
-def likelihood_ratio_interval(theta_mle: float, powers, good_counts, shots: int,
+def likelihood_ratio_interval(theta_mle: float, powers: Sequence[int], good_counts: Sequence[int], shots: int,
                               alpha: float) -> tuple[float, float]:
     """The likelihood-ratio interval of qiskit-algorithms' MLAE (``kind="likelihood_ratio"``: the
     thetas whose log-likelihood is within chi2_{1-alpha, 1} / 2 of the maximum, outermost ones,

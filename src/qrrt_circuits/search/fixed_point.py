@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from qiskit import QuantumCircuit
@@ -85,7 +86,7 @@ def gamma(delta: float, length: int) -> float:
     return 1.0 / chebyshev(1.0 / length, 1.0 / delta)
 
 
-def check_delta(delta) -> float:
+def check_delta(delta: Any) -> float:
     """The target error delta in (0, 1) (delta = 1 would promise nothing).
 
     Args:
@@ -104,7 +105,7 @@ def check_delta(delta) -> float:
     return value
 
 
-def check_fraction(fraction, name: str = "min_fraction") -> float:
+def check_fraction(fraction: Any, name: str = "min_fraction") -> float:
     """A marked fraction w in (0, 1].
 
     Args:

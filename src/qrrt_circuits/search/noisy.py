@@ -16,12 +16,17 @@ naming the noise.
 from __future__ import annotations
 
 import functools
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..noise import depolarizing_noise_model, fake_device
 from ..validation import check_choice, check_probability
 from .sampler import SamplerBackend
+
+if TYPE_CHECKING:
+    from qiskit.primitives import BaseSamplerV2
+    from qiskit.providers import BackendV2
 
 METHODS = ("statevector", "density_matrix")
 
@@ -48,7 +53,8 @@ class NoisySamplerBackend(SamplerBackend):
 
     name = "noisy-sampler"
 
-    def __init__(self, sampler, noise: str, backend=None, seed=None, synthesis: str = "auto"):
+    def __init__(self, sampler: BaseSamplerV2, noise: str, backend: BackendV2 | None = None,
+                 seed: int | np.random.Generator | None = None, synthesis: str = "auto") -> None:
         super().__init__(sampler, backend=backend, seed=seed, synthesis=synthesis)
         self.noise = noise
 
@@ -61,8 +67,8 @@ class NoisySamplerBackend(SamplerBackend):
         return f"{self.name} ({self.noise})"
 
 
-def depolarizing_backend(p1: float, p2: float, method: str = "statevector", seed=None,
-                         synthesis: str = "auto") -> NoisySamplerBackend:
+def depolarizing_backend(p1: float, p2: float, method: str = "statevector",
+                         seed: int | np.random.Generator | None = None, synthesis: str = "auto") -> NoisySamplerBackend:
     """Aer's SamplerV2 with depolarizing errors p1 (sx, x) and p2 (cx) after transpiling to [cx, rz, sx, x].
 
     The noise model is ``qrrt_circuits.noise.depolarizing_noise_model(p1, p2)`` on an all-to-all
@@ -101,7 +107,7 @@ def depolarizing_backend(p1: float, p2: float, method: str = "statevector", seed
 
 
 @functools.lru_cache(maxsize=2)
-def _device_sampler(name: str | None, method: str):
+def _device_sampler(name: str | None, method: str) -> tuple[BackendV2, BaseSamplerV2]:
     """Aer's SamplerV2 with a fake device's noise model (building it takes seconds: cached)."""
     from qiskit_aer.primitives import SamplerV2
 
@@ -110,7 +116,8 @@ def _device_sampler(name: str | None, method: str):
                                                                                "max_parallel_threads": 1}})
 
 
-def fake_device_backend(name: str | None = None, method: str = "statevector", seed=None) -> NoisySamplerBackend:
+def fake_device_backend(name: str | None = None, method: str = "statevector",
+                        seed: int | np.random.Generator | None = None) -> NoisySamplerBackend:
     """The Grover circuit transpiled to a fake IBM device and run with its calibrated noise model.
 
     The device's coupling map, basis, readout and relaxation errors come from the fake provider of

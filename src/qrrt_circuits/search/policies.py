@@ -41,6 +41,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -276,7 +277,7 @@ def _verified(problem: DatabaseSearch, k: int, measured: np.ndarray) -> tuple[Se
     return tuple(outcomes)
 
 
-def _check_iteration_count(value, name: str) -> int:
+def _check_iteration_count(value: Any, name: str) -> int:
     return check_int(value, name, 0, 1_000_000)
 
 

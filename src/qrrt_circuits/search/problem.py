@@ -18,11 +18,15 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..randomness import RandomStreams, Stream
 from .backend import QuantumSearchBackend, SearchRequest, SearchResult
+
+if TYPE_CHECKING:
+    from .fixed_point import IterateSequence
 
 
 @dataclass(frozen=True)
@@ -127,7 +131,7 @@ class DatabaseSearch:
         """
         return self.backend.search(self.marks, iterations, shots, seed=seed).indices
 
-    def search_sequence(self, sequence, shots: int, seed: int) -> np.ndarray:
+    def search_sequence(self, sequence: IterateSequence, shots: int, seed: int) -> np.ndarray:
         """Measured indices (one per shot) after the generalized iterates of ``sequence`` (an
         ``IterateSequence``: fixed-point amplification), len(sequence) oracle calls per shot.
 

@@ -14,6 +14,8 @@ circuit is cached by its shape (marks, iterations), so a repeated search transpi
 from __future__ import annotations
 
 from collections import OrderedDict
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from qiskit.transpiler import generate_preset_pass_manager
@@ -21,6 +23,13 @@ from qiskit.transpiler import generate_preset_pass_manager
 from .backend import QuantumSearchBackend, seed_stream
 from .circuits import BASIS_GATES, SYNTHESES, grover_circuit
 from .fixed_point import generalized_grover_circuit
+
+if TYPE_CHECKING:
+    from qiskit import QuantumCircuit
+    from qiskit.primitives import BaseSamplerV2
+    from qiskit.providers import BackendV2
+
+    from .fixed_point import IterateSequence
 
 
 class SamplerBackend(QuantumSearchBackend):
@@ -73,9 +82,9 @@ class SamplerBackend(QuantumSearchBackend):
 
     name = "sampler"
 
-    def __init__(self, sampler, backend=None, optimization_level: int = 1,
+    def __init__(self, sampler: BaseSamplerV2, backend: BackendV2 | None = None, optimization_level: int = 1,
                  synthesis: str = "auto", cache_size: int = 128, max_qubits: int | None = None,
-                 seed: int | np.random.Generator | None = None):
+                 seed: int | np.random.Generator | None = None) -> None:
         if not hasattr(sampler, "run"):
             raise ValueError("sampler must be a qiskit BaseSamplerV2 (an object with .run(pubs, shots=...))")
         if synthesis not in SYNTHESES:
@@ -94,7 +103,7 @@ class SamplerBackend(QuantumSearchBackend):
                 seed_transpiler=0)
             limit = 24
         self._max_qubits = limit if max_qubits is None else min(int(max_qubits), limit)
-        self._cache: OrderedDict[tuple, object] = OrderedDict()
+        self._cache: OrderedDict[tuple[Any, ...], QuantumCircuit] = OrderedDict()
         self._cache_size = int(cache_size)
         self.transpile_count = 0
         self._rng = seed_stream(seed)
@@ -105,7 +114,7 @@ class SamplerBackend(QuantumSearchBackend):
         """The largest n: the target's qubits (24 without a backend), capped by ``max_qubits``."""
         return self._max_qubits
 
-    def compiled(self, marks: np.ndarray, iterations: int):
+    def compiled(self, marks: np.ndarray, iterations: int) -> QuantumCircuit:
         """The transpiled ``grover_circuit(marks, iterations)``, from the cache when present.
 
         Args:
@@ -118,7 +127,7 @@ class SamplerBackend(QuantumSearchBackend):
         key = (marks.shape[0], np.packbits(marks).tobytes(), iterations)
         return self._cached_transpile(key, lambda: grover_circuit(marks, iterations, synthesis=self.synthesis))
 
-    def compiled_sequence(self, marks: np.ndarray, sequence):
+    def compiled_sequence(self, marks: np.ndarray, sequence: IterateSequence) -> QuantumCircuit:
         """The transpiled ``generalized_grover_circuit`` (cached by marks and phases).
 
         Args:
@@ -132,7 +141,7 @@ class SamplerBackend(QuantumSearchBackend):
         return self._cached_transpile(
             key, lambda: generalized_grover_circuit(marks, sequence, synthesis=self.synthesis))
 
-    def _cached_transpile(self, key, build):
+    def _cached_transpile(self, key: tuple[Any, ...], build: Callable[[], QuantumCircuit]) -> QuantumCircuit:
         """The transpiled circuit for ``key`` from the LRU cache, built and transpiled once."""
         circuit = self._cache.get(key)
         if circuit is None:
@@ -157,13 +166,15 @@ class SamplerBackend(QuantumSearchBackend):
         return (f"randomness: the sampler ({type(self.sampler).__name__}) seeds itself, so results "
                 "depend on it and not only on the planner's seed",)
 
-    def _sample(self, marks, num_qubits, iterations, shots, rng) -> np.ndarray:
+    def _sample(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
+                rng: np.random.Generator) -> np.ndarray:
         return self._execute(self.compiled(marks, iterations), shots, rng)
 
-    def _sample_sequence(self, marks, num_qubits, sequence, shots, rng) -> np.ndarray:
+    def _sample_sequence(self, marks: np.ndarray, num_qubits: int, sequence: IterateSequence, shots: int,
+                         rng: np.random.Generator) -> np.ndarray:
         return self._execute(self.compiled_sequence(marks, sequence), shots, rng)
 
-    def _execute(self, circuit, shots, rng) -> np.ndarray:
+    def _execute(self, circuit: QuantumCircuit, shots: int, rng: np.random.Generator) -> np.ndarray:
         if self.per_call_seed:
             self.sampler.options.run_options["seed_simulator"] = int(rng.integers(0, 2**31 - 1))
         result = self.sampler.run([circuit], shots=shots).result()[0]
@@ -172,7 +183,7 @@ class SamplerBackend(QuantumSearchBackend):
                            count=len(bitstrings))
 
 
-def _accepts_run_seed(sampler) -> bool:
+def _accepts_run_seed(sampler: BaseSamplerV2) -> bool:
     """True for qiskit-aer's SamplerV2 without a fixed seed: its ``seed_simulator`` run option
     then seeds each run."""
     try:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import os
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
@@ -20,6 +21,9 @@ from ..randomness import _bounded_below, _next_double, _pcg_state, integer_seed_
 from ..validation import check_bool, check_int
 from .backend import QuantumSearchBackend, seed_stream, validate_iterations, validate_marks
 from .fixed_point import statevector_after
+
+if TYPE_CHECKING:
+    from .fixed_point import IterateSequence
 
 BYTES_PER_ENTRY = 32  # amplitudes (8) + probabilities (8) + index lists (8) + marks, with slack
 
@@ -123,7 +127,8 @@ class StatevectorBackend(QuantumSearchBackend):
             state = 2.0 * state.mean() - state
         return state
 
-    def _sample_seeded(self, marks, num_qubits, iterations, shots, seed) -> np.ndarray:
+    def _sample_seeded(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
+                       seed: int | np.random.Generator | None) -> np.ndarray:
         """The closed form with an integer seed draws in one compiled call (``_draw_two_level_seeded``:
         the same indices as ``_draw_two_level`` with ``np.random.default_rng(seed)``)."""
         if not self.closed_form or seed is None or isinstance(seed, np.random.Generator) or num_qubits > 32:
@@ -131,13 +136,15 @@ class StatevectorBackend(QuantumSearchBackend):
         p_good = good_probability(marks.shape[0], int(np.count_nonzero(marks)), iterations)
         return _draw_two_level_seeded(marks, p_good, shots, integer_seed_words(seed))
 
-    def _sample(self, marks, num_qubits, iterations, shots, rng) -> np.ndarray:
+    def _sample(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
+                rng: np.random.Generator) -> np.ndarray:
         if not self.closed_form:
             return _draw(self.amplitudes(marks, iterations) ** 2, shots, rng)
         p_good = good_probability(marks.shape[0], int(np.count_nonzero(marks)), iterations)
         return _draw_two_level(marks, p_good, shots, rng)
 
-    def _sample_sequence(self, marks, num_qubits, sequence, shots, rng) -> np.ndarray:
+    def _sample_sequence(self, marks: np.ndarray, num_qubits: int, sequence: IterateSequence, shots: int,
+                         rng: np.random.Generator) -> np.ndarray:
         """Generalized iterates: the exact 2-dimensional evolution (closed form; every marked index
         keeps the same amplitude) or, with ``closed_form=False``, the full iterated vector."""
         if not self.closed_form:
@@ -175,7 +182,7 @@ def _draw_two_level(marks: np.ndarray, p_good: float, shots: int, rng: np.random
 
 
 @njit(cache=True, nogil=True)
-def _draw_two_level_seeded(marks, p_good, shots, words):
+def _draw_two_level_seeded(marks: np.ndarray, p_good: float, shots: int, words: np.ndarray) -> np.ndarray:
     """``_draw_two_level(marks, p_good, shots, Generator(PCG64(words)))``, compiled: the same
     draws in the same order (``shots`` doubles, then the marked picks, then the unmarked ranks, each
     an ``integers(0, high)`` draw), so the same indices. Needs N <= 2^32 (32-bit bounded draws)."""
