@@ -12,7 +12,6 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
-from scipy.stats import binomtest
 
 LEVEL = 0.95
 RESAMPLES = 2000
@@ -123,6 +122,8 @@ def binomial_interval(successes: int, trials: int, level: float = LEVEL) -> tupl
     """
     if trials <= 0:
         return float("nan"), float("nan")
+    from scipy.stats import binomtest  # about 1 s to import: only the summaries that need it pay
+
     interval = binomtest(int(successes), int(trials)).proportion_ci(confidence_level=level, method="exact")
     return float(interval.low), float(interval.high)
 
