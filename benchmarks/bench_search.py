@@ -148,16 +148,20 @@ def bench_floor(quick: bool) -> list[dict]:
 def bench_search(quick: bool) -> list[dict]:
     rows = []
     rng = np.random.default_rng(0)
+    # "statevector-seeded": a seed per call, as the planners search (the compiled default_rng draws)
     for name, registered, options, top in (("aer", "aer", {"max_parallel_threads": 1}, 16),
                                            ("statevector", "statevector", {}, 20),
+                                           ("statevector-seeded", "statevector", {}, 20),
                                            ("statevector-iterated", "statevector", {"closed_form": False}, 20)):
         backend = BACKENDS.create(registered, seed=1, **options)
+        seed = 12345 if name.endswith("-seeded") else None
         for n in range(4, (12 if quick else top) + 1, 2 if quick else 1):
             m = min(12, 2 ** n // 4)
             marks = np.zeros(2**n, dtype=bool)
             marks[rng.choice(2**n, m, replace=False)] = True
             repeats = 5 if quick else (10 if n >= 15 else 30)
-            med, lo, hi = median_time(lambda b=backend, mk=marks: b.search(mk, 12, shots=8), repeats)
+            med, lo, hi = median_time(lambda b=backend, mk=marks, sd=seed: b.search(mk, 12, shots=8, seed=sd),
+                                      repeats)
             rows.append({"backend": name, "qubits": n, "marked": m, "iterations": 12, "shots": 8,
                          "median_s": med, "min_s": lo, "max_s": hi, "repeats": repeats})
             print(f"  {name:20s} n={n:2d}  {med * 1e3:9.3f} ms  (min {lo * 1e3:.3f}, max {hi * 1e3:.3f})")
@@ -205,6 +209,10 @@ def main() -> None:
     sv12 = next((r["median_s"] for r in search if r["backend"] == "statevector" and r["qubits"] == 12), None)
     summary = {"aer_n12_ms": aer12 and aer12 * 1e3, "statevector_n12_ms": sv12 and sv12 * 1e3,
                "statevector_speedup_n12": aer12 / sv12 if aer12 and sv12 else None}
+    for n in (8, 12):
+        for name in ("statevector", "statevector-seeded"):
+            time_s = next((r["median_s"] for r in search if r["backend"] == name and r["qubits"] == n), None)
+            summary[f"{name.replace('-', '_')}_n{n}_us"] = time_s and time_s * 1e6
     sv20 = next((r["median_s"] for r in search if r["backend"] == "statevector" and r["qubits"] == 20), None)
     summary["statevector_n20_ms"] = sv20 and sv20 * 1e3
     for row in floor:

@@ -300,6 +300,10 @@ class WorkerPool:
     whose sweeps are all finished already starts no workers; ``renew()`` shuts it down and starts
     a new one (after a local pool broke because a worker died). ``run_experiment(executor=pool)``
     uses it and renews it when it breaks, so ``qrrt reproduce all`` pays the start of workers once.
+    Opening a local pool (``process``, or ``dask`` without a ``scheduler``) starts the fork server at
+    once, so its preload overlaps the caller's preparation; it is killed unused if no worker was
+    ever needed. While a new local pool starts, ``run_experiment`` runs trials in this process
+    (``helps_while_starting``).
 
     Args:
         kind: One of ``EXECUTORS``: ``"serial"`` (default), ``"process"`` or ``"dask"``.
