@@ -131,7 +131,10 @@ def breakdown(make, env, seed: int, nodes: int, big: bool) -> dict:
     wall = result.metrics.wall_time_s
     per_round = {"predicate": predicate.seconds, **parts.seconds}
     per_round["rest"] = wall - sum(per_round.values())
+    entries = float(np.sum(result.history["entries"]))
     return {"seed": seed, "nodes": result.metrics.nodes, "rounds": result.metrics.rounds,
+            "reachable_fraction": float(np.sum(result.history["reachable"])) / entries if entries else float("nan"),
+            "predicate_us_per_pair": predicate.seconds * 1e6 / max(predicate.pairs, 1),
             "us_per_round": {k: v * 1e6 / rounds for k, v in per_round.items()},
             "share": {k: v / wall for k, v in per_round.items()}}
 
@@ -242,8 +245,12 @@ def main() -> None:
                 for seed, env in enumerate(worlds[:big_seeds] if big else worlds)]
         medians = {k: float(np.median([r["us_per_round"][k] for r in runs])) for k in runs[0]["us_per_round"]}
         shares = {k: float(np.median([r["share"][k] for r in runs])) for k in runs[0]["share"]}
-        parts[name] = {"runs": runs, "us_per_round": medians, "share": shares}
-        print(f"{name:32s} " + " ".join(f"{medians[k]:8.1f} ({shares[k]:3.0%})" for k in medians))
+        parts[name] = {"runs": runs, "us_per_round": medians, "share": shares,
+                       "reachable_fraction": float(np.median([r["reachable_fraction"] for r in runs])),
+                       "predicate_us_per_pair": float(np.median([r["predicate_us_per_pair"] for r in runs]))}
+        print(f"{name:32s} " + " ".join(f"{medians[k]:8.1f} ({shares[k]:3.0%})" for k in medians)
+              + f"   reachable {parts[name]['reachable_fraction']:.2f}, "
+              f"predicate {parts[name]['predicate_us_per_pair']:.2f} us/pair")
     path = write_json("bench_planners" + ("_quick" if args.quick else ""),
                       {"machine": machine(), "seeds": seeds, "max_nodes": nodes, "big_nodes": big_nodes,
                        "big_seeds": big_seeds, "planners": rows, "ompl_rrt": ompl_rows,
