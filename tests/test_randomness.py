@@ -50,7 +50,7 @@ def test_search_seeds_equal_numpy_integers(seed):
         assert streams.seed(*key) == int(expected)
 
 
-@pytest.mark.parametrize("seed", [0, 1, 2**31 - 1, 2**32, 2**62 - 1, 2**100 + 17])
+@pytest.mark.parametrize("seed", [0, 1, 2**31 - 1, 2**32, 2**62 - 1, 2**100 + 17, 2**128, 2**300 - 1])
 def test_integer_seed_words_equal_default_rng(seed):
     from qrrt_circuits.randomness import integer_seed_words
 
@@ -66,6 +66,7 @@ def test_first_integer_below_equals_default_rng_integers():
     for seed in rng.integers(0, 2**62, 60).tolist():
         for high in highs:
             assert first_integer_below(seed, high) == int(np.random.default_rng(seed).integers(0, high))
+    assert first_integer_below(2**130 + 7, 1000) == int(np.random.default_rng(2**130 + 7).integers(0, 1000))
     with pytest.raises(ValueError, match="high"):
         first_integer_below(1, 2**32 + 1)
 

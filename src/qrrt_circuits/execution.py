@@ -28,6 +28,7 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import os
+import threading
 from collections.abc import Iterator
 from concurrent.futures import Executor, ProcessPoolExecutor
 from typing import Any
@@ -224,9 +225,12 @@ def _local_dask(jobs: int, retries: int, local_directory: str | None) -> Iterato
     scratch = None if local_directory is not None else tempfile.TemporaryDirectory(prefix="qrrt-dask-")
     local_directory = local_directory if scratch is None else scratch.name
     try:
+        # workers forked from the fork server inherit its single-thread environment (set when it
+        # started); only spawned ones need it in ours (a change of os.environ while another thread
+        # runs trials would race with C code reading the environment)
         with _warm_fork_server(("distributed",)) as method, \
                 dask.config.set({**LOCAL_DASK_CONFIG, "distributed.worker.multiprocessing-method": method}), \
-                _single_thread_environment(), \
+                (_single_thread_environment() if method == "spawn" else contextlib.nullcontext()), \
                 LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, host="127.0.0.1",
                              dashboard_address=NO_DASHBOARD, local_directory=local_directory) as cluster, \
                 Client(cluster) as client:
@@ -337,6 +341,7 @@ class WorkerPool:
         self._fork_server: tuple[contextlib.ExitStack, object] | None = None
         self._forked = False
         self._context = contextvars.copy_context()
+        self._lock = threading.RLock()
 
     @property
     def executor(self) -> Executor | None:
@@ -347,15 +352,19 @@ class WorkerPool:
         """
         if not self._open:
             raise RuntimeError("WorkerPool is not open: use it as a context manager")
-        if self._stack is None:
-            self._start()
-        return self._executor
+        with self._lock:  # a start and a shut-down never overlap (the runner starts from a thread)
+            if self._stack is None:
+                self._start()
+            return self._executor
 
     @property
     def helps_while_starting(self) -> bool:
         """Whether this process should run trials itself while the pool's workers start: local
-        pools only (``process``, or ``dask`` without a ``scheduler``), never a remote cluster."""
-        return self.kind == "process" or (self.kind == "dask" and self.scheduler is None)
+        pools only (``process``, or ``dask`` without a ``scheduler``), never a remote cluster, and
+        only where workers are forked from the fork server (so starting them changes nothing in
+        this process's environment while it runs trials)."""
+        local = self.kind == "process" or (self.kind == "dask" and self.scheduler is None)
+        return local and _fork_server_available()
 
     @property
     def started(self) -> bool:
@@ -368,9 +377,11 @@ class WorkerPool:
         return self
 
     def __exit__(self, *exc_info: object) -> None:
-        self._shut_down()
-        self._open = False
-        self._stop_prestarted_fork_server()
+        try:
+            self._shut_down()
+        finally:
+            self._open = False
+            self._stop_prestarted_fork_server()
 
     def _prestart_fork_server(self) -> None:
         """Local workers are forked from the fork server, whose preload (every import a trial needs,
@@ -421,6 +432,7 @@ class WorkerPool:
         self._shut_down()
 
     def _shut_down(self) -> None:
-        stack, self._stack, self._executor = self._stack, None, None
-        if stack is not None:
-            self._context.run(stack.close)
+        with self._lock:
+            stack, self._stack, self._executor = self._stack, None, None
+            if stack is not None:
+                self._context.run(stack.close)

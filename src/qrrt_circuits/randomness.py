@@ -365,12 +365,10 @@ _NO_KEYS = np.empty((1, 0), dtype=np.int64)
 
 def integer_seed_words(seed: int) -> np.ndarray:
     """(4,) uint64: the words ``SeedSequence(seed).generate_state(4, np.uint64)`` returns, i.e.
-    the seed of ``np.random.default_rng(seed)``'s PCG64 (an entropy of at most four 32-bit words
-    is mixed exactly as when it is zero-padded to the pool size)."""
+    the seed of ``np.random.default_rng(seed)``'s PCG64, for any non-negative int (an entropy of at
+    most four 32-bit words is mixed exactly as when it is zero-padded to the pool size)."""
     words = _uint32_words(int(seed))
-    if len(words) > _POOL_SIZE:
-        raise ValueError(f"seed must be below 2**128, got {seed}")
-    words += [0] * (_POOL_SIZE - len(words))
+    words += [0] * max(0, _POOL_SIZE - len(words))  # longer entropy is mixed in after the pool
     return _seed_words(np.asarray(words, dtype=np.uint64), _NO_KEYS)[0]
 
 

@@ -89,6 +89,9 @@ def _run_on(executor: Executor | Callable[[], Executor], name: str, trials: list
 
     def submit_all() -> None:
         try:
+            with lock:
+                if not queue:  # this process already ran them all: no pool to start
+                    return
             pool = executor() if callable(executor) else executor
             while True:
                 with lock:
