@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -66,8 +67,10 @@ class RunState:
 
     def add_node(self, position: np.ndarray, parent: int) -> int:
         index = self.tree.add(position, parent)
-        if self.goal_node is None and np.linalg.norm(position - self.goal) <= self.goal_radius:
-            self.goal_node = index
+        if self.goal_node is None:
+            offset = position - self.goal  # math.sqrt(offset @ offset) is np.linalg.norm's own formula
+            if math.sqrt(float(offset.dot(offset))) <= self.goal_radius:
+                self.goal_node = index
         return index
 
     def progress(self, elapsed_s: float) -> Progress:
