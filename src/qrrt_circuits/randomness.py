@@ -302,76 +302,9 @@ def _pcg_step(state_hi: np.uint64, state_lo: np.uint64, inc_hi: np.uint64,
     return high + inc_hi + carry, new_lo
 
 
-@njit(cache=True, nogil=True)
-def _raw_outputs(words: np.ndarray, count: int) -> np.ndarray:
-    """(K, count) uint64: the first ``count`` outputs of ``PCG64(seed words)`` (``random_raw``)."""
-    out = np.empty((words.shape[0], count), dtype=np.uint64)
-    one = np.uint64(1)
-    for row in range(words.shape[0]):
-        # pcg64_set_seed: state seed = words[0]:words[1], increment (words[2]:words[3]) << 1 | 1
-        inc_hi = (words[row, 2] << one) | (words[row, 3] >> np.uint64(63))
-        inc_lo = (words[row, 3] << one) | one
-        state_hi, state_lo = _pcg_step(np.uint64(0), np.uint64(0), inc_hi, inc_lo)
-        state_lo_sum = state_lo + words[row, 1]
-        carry = one if state_lo_sum < state_lo else np.uint64(0)
-        state_hi, state_lo = state_hi + words[row, 0] + carry, state_lo_sum
-        state_hi, state_lo = _pcg_step(state_hi, state_lo, inc_hi, inc_lo)
-        for column in range(count):
-            state_hi, state_lo = _pcg_step(state_hi, state_lo, inc_hi, inc_lo)
-            rotation = state_hi >> np.uint64(58)
-            value = state_hi ^ state_lo
-            out[row, column] = (value >> rotation) | (value << ((np.uint64(64) - rotation) & np.uint64(63)))
-    return out
-
-
-@njit(cache=True, nogil=True)
-def _uniform_draws(words: np.ndarray, count: int) -> np.ndarray:
-    """(K, count): the first ``count`` values of ``Generator(PCG64(seed words)).random()``
-    (numpy's next_double: the top 53 bits of one output)."""
-    raw = _raw_outputs(words, count)
-    out = np.empty(raw.shape)
-    for row in range(raw.shape[0]):
-        for column in range(count):
-            out[row, column] = np.float64(raw[row, column] >> np.uint64(11)) * (1.0 / 9007199254740992.0)
-    return out
-
-
-def uniform_draws(streams: RandomStreams, keys: np.ndarray, count: int) -> np.ndarray:
-    """(K, count): the first ``count`` doubles ``generator(*key).random()`` would return, for each
-    key (round, worker, stream) of ``keys`` (K, 3), computed without building the generators.
-
-    Args:
-        streams: The plan's ``RandomStreams``.
-        keys: Non-negative int array (K, 3).
-        count: Doubles per key.
-
-    Returns:
-        Float array (K, count) in [0, 1).
-
-    Raises:
-        ValueError: A negative key.
-    """
-    return _uniform_draws(streams.seed_words(keys), int(count))
-
-
-# ``np.random.default_rng(seed)`` for one integer seed, compiled: the backends' per-search
-# generators. A search needs only a handful of draws, yet building the Generator costs about 30 us,
-# more than the draws; the functions below give the same numbers from the seed's words directly.
-# The state is a uint64 array [state_hi, state_lo, inc_hi, inc_lo, has_uint32, uinteger] that
-# mirrors numpy's pcg64_state (``pcg64.h``: the buffered upper half of a 64-bit output serves the
-# next 32-bit draw).
-_NO_KEYS = np.empty((1, 0), dtype=np.int64)
-
-
-def integer_seed_words(seed: int) -> np.ndarray:
-    """(4,) uint64: the words ``SeedSequence(seed).generate_state(4, np.uint64)`` returns, i.e.
-    the seed of ``np.random.default_rng(seed)``'s PCG64, for any non-negative int (an entropy of at
-    most four 32-bit words is mixed exactly as when it is zero-padded to the pool size)."""
-    words = _uint32_words(int(seed))
-    words += [0] * max(0, _POOL_SIZE - len(words))  # longer entropy is mixed in after the pool
-    return _seed_words(np.asarray(words, dtype=np.uint64), _NO_KEYS)[0]
-
-
+# The state of one generator is a uint64 array [state_hi, state_lo, inc_hi, inc_lo, has_uint32,
+# uinteger] that mirrors numpy's pcg64_state (``pcg64.h``: the buffered upper half of a 64-bit
+# output serves the next 32-bit draw).
 @njit(cache=True, nogil=True)
 def _pcg_state(words: np.ndarray) -> np.ndarray:
     """numpy's ``pcg64_set_seed`` from the four seed words: the generator state array."""
@@ -401,6 +334,62 @@ def _next64(state: np.ndarray) -> np.uint64:
 def _next_double(state: np.ndarray) -> float:
     """``Generator.random()``: the top 53 bits of one 64-bit output."""
     return np.float64(_next64(state) >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+
+
+@njit(cache=True, nogil=True)
+def _raw_outputs(words: np.ndarray, count: int) -> np.ndarray:
+    """(K, count) uint64: the first ``count`` outputs of ``PCG64(seed words)`` (``random_raw``)."""
+    out = np.empty((words.shape[0], count), dtype=np.uint64)
+    for row in range(words.shape[0]):
+        state = _pcg_state(words[row])
+        for column in range(count):
+            out[row, column] = _next64(state)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _uniform_draws(words: np.ndarray, count: int) -> np.ndarray:
+    """(K, count): the first ``count`` values of ``Generator(PCG64(seed words)).random()``."""
+    out = np.empty((words.shape[0], count))
+    for row in range(words.shape[0]):
+        state = _pcg_state(words[row])
+        for column in range(count):
+            out[row, column] = _next_double(state)
+    return out
+
+
+def uniform_draws(streams: RandomStreams, keys: np.ndarray, count: int) -> np.ndarray:
+    """(K, count): the first ``count`` doubles ``generator(*key).random()`` would return, for each
+    key (round, worker, stream) of ``keys`` (K, 3), computed without building the generators.
+
+    Args:
+        streams: The plan's ``RandomStreams``.
+        keys: Non-negative int array (K, 3).
+        count: Doubles per key.
+
+    Returns:
+        Float array (K, count) in [0, 1).
+
+    Raises:
+        ValueError: A negative key.
+    """
+    return _uniform_draws(streams.seed_words(keys), int(count))
+
+
+# ``np.random.default_rng(seed)`` for one integer seed, compiled: the backends' per-search
+# generators. A search needs only a handful of draws, yet building the Generator costs more than
+# the draws (``bench_search.py``: "statevector-seeded" against "statevector"); the functions below
+# give the same numbers from the seed's words directly.
+_NO_KEYS = np.empty((1, 0), dtype=np.int64)
+
+
+def integer_seed_words(seed: int) -> np.ndarray:
+    """(4,) uint64: the words ``SeedSequence(seed).generate_state(4, np.uint64)`` returns, i.e.
+    the seed of ``np.random.default_rng(seed)``'s PCG64, for any non-negative int (an entropy of at
+    most four 32-bit words is mixed exactly as when it is zero-padded to the pool size)."""
+    words = _uint32_words(int(seed))
+    words += [0] * max(0, _POOL_SIZE - len(words))  # longer entropy is mixed in after the pool
+    return _seed_words(np.asarray(words, dtype=np.uint64), _NO_KEYS)[0]
 
 
 @njit(cache=True, nogil=True)
