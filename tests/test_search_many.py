@@ -52,8 +52,9 @@ def test_search_many_checks_every_request_before_searching():
 
 
 def test_one_aer_job_cannot_carry_independent_seeds():
-    """Why ``AerBackend.search_many`` submits one job per request: in a multi-circuit job Aer seeds
-    circuit i with seed_simulator + 2113 i, so one job cannot give each circuit its own seed."""
+    """Why ``AerBackend.search_many`` runs one simulation per request: in a multi-circuit run Aer
+    seeds circuit i with seed_simulator + 2113 i (also on its controller, ``aer_direct``), so one
+    run cannot give each circuit its own seed."""
     from qiskit import QuantumCircuit
     from qiskit_aer import AerSimulator
 

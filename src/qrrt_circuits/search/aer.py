@@ -7,6 +7,13 @@ circuit (``aer_literal_grover_circuit``: h, x, mcphase) is run instead, so per-g
 the paper's gates. Each shot is an independent preparation, k Grover iterations and a measurement
 (``memory=True`` keeps them per shot).
 
+Without a noise model the circuit's instructions (``aer_grover_program``) go to the simulator's
+C++ controller directly (``aer_direct``): the same simulation, the same configuration and the same
+measured words as ``AerSimulator.run`` (tested seed by seed), without the job thread, Aer's generic
+assembler and the ``Result`` conversion, which cost more than simulating these small circuits.
+Independent searches (``search_many``) run one after the other: in a multi-circuit run Aer seeds
+circuit i with ``seed_simulator + 2113 i``, so one run cannot give each database its own seed.
+
 Threads: Aer parallelises a state update only from ``statevector_parallel_threshold`` (14) qubits
 on; below it, extra OpenMP threads only cost their start-up and synchronisation (on a loaded
 2-core machine a 1-qubit circuit took many times longer with all cores than with one:
@@ -16,20 +23,20 @@ on; below it, extra OpenMP threads only cost their start-up and synchronisation 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
 from qiskit_aer import AerSimulator
 
 from ..validation import check_int
-from .backend import QuantumSearchBackend, SearchRequest, SearchResult, seed_stream
+from . import aer_direct
+from .aer_circuits import GroverProgram, aer_grover_program
+from .backend import QuantumSearchBackend, seed_stream
 from .circuits import SYNTHESES, aer_grover_circuit, aer_literal_grover_circuit
 from .fixed_point import generalized_grover_circuit
 
 if TYPE_CHECKING:
-    from qiskit.result import Result
-    from qiskit_aer.jobs import AerJob
+    from qiskit import QuantumCircuit
     from qiskit_aer.noise import NoiseModel
 
     from .fixed_point import IterateSequence
@@ -48,8 +55,9 @@ UNSUPPORTED_METHODS = {
 class AerBackend(QuantumSearchBackend):
     """Gate-level Grover search (paper Alg. 2, lines 4-8) on ``AerSimulator(method=...)``.
 
-    Each search builds the Grover circuit of the marks (``aer_grover_circuit``, or with a noise
-    model the gate-by-gate ``aer_literal_grover_circuit``) and runs it with ``shots`` shots; a
+    Each search runs the Grover circuit of the marks (``aer_grover_circuit``, handed to Aer's
+    controller as its instructions, ``aer_direct``; with a noise model the gate-by-gate
+    ``aer_literal_grover_circuit`` through ``AerSimulator.run``) with ``shots`` shots; a
     marked index is measured with probability sin^2((2k+1) theta), sin^2 theta = m / 2^n (paper
     Eq. 1, Lemma 1). Every call draws a ``seed_simulator`` from its stream, so a plan depends on
     the planner's seed only. Oracle calls: ``iterations * shots`` (DESIGN §2).
@@ -121,6 +129,8 @@ class AerBackend(QuantumSearchBackend):
         self.device = device
         self.max_parallel_threads = int(max_parallel_threads)
         self._build = aer_grover_circuit if noise_model is None else aer_literal_grover_circuit
+        #: run on the controller directly (no noise model, and this qiskit-aer has the internals)
+        self._direct = noise_model is None and aer_direct.DIRECT_AVAILABLE
 
     @property
     def max_qubits(self) -> int:
@@ -162,17 +172,34 @@ class AerBackend(QuantumSearchBackend):
         """
         return 1 if num_qubits < SERIAL_BELOW_QUBITS else self.max_parallel_threads
 
-    def _submit(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
-                seed: int | np.random.Generator | None) -> AerJob:
-        """Build the circuit and start its Aer job (Aer runs jobs on its own worker thread); the
-        simulator seed is the first ``integers(0, 2**31 - 1)`` of the search's generator."""
-        circuit = self._build(marks, iterations, measure=True, synthesis=self.synthesis)
-        return self.simulator.run(circuit, shots=shots, seed_simulator=self._first_integer(seed, 2**31 - 1),
-                                  memory=True, max_parallel_threads=self.threads_for(num_qubits))
+    def _run(self, circuit: QuantumCircuit | GroverProgram, num_qubits: int, shots: int, seed: int) -> np.ndarray:
+        """The measured index of every shot of ``circuit`` with ``seed_simulator = seed``.
+
+        Without a noise model the circuit goes to the simulator's controller directly
+        (``aer_direct.execute``: the same simulation and the same measured words as
+        ``AerSimulator.run``, without its job and generic-assembler overhead); with one, through
+        ``AerSimulator.run``, whose compile step prepares the noise model."""
+        threads = self.threads_for(num_qubits)
+        if self._direct:
+            words = aer_direct.execute(self.simulator, circuit, shots, seed, threads)
+        else:
+            result = self.simulator.run(circuit, shots=shots, seed_simulator=seed, memory=True,
+                                        max_parallel_threads=threads).result()
+            if not result.success:
+                raise RuntimeError(f"AerSimulator failed: {result.status}")
+            words = result.results[0].data.memory
+        return np.fromiter((int(word, 16) for word in words), dtype=np.int64, count=len(words))
 
     def _sample_seeded(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
                        seed: int | np.random.Generator | None) -> np.ndarray:
-        return _measured_indices(self._submit(marks, num_qubits, iterations, shots, seed).result(), 0)
+        """Build the Grover circuit and run it; the simulator seed is the first
+        ``integers(0, 2**31 - 1)`` of the search's generator."""
+        seed_simulator = self._first_integer(seed, 2**31 - 1)
+        if self._direct:  # the circuit's instructions straight to the controller
+            return self._run(aer_grover_program(marks, iterations, self.synthesis), num_qubits, shots,
+                             seed_simulator)
+        circuit = self._build(marks, iterations, measure=True, synthesis=self.synthesis)
+        return self._run(circuit, num_qubits, shots, seed_simulator)
 
     def _sample(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
                 rng: np.random.Generator) -> np.ndarray:
@@ -182,44 +209,4 @@ class AerBackend(QuantumSearchBackend):
                          rng: np.random.Generator) -> np.ndarray:
         """Fixed-point amplification: the generalized iterates of ``sequence`` as one circuit."""
         circuit = generalized_grover_circuit(marks, sequence, measure=True, synthesis=self.synthesis)
-        seed = int(rng.integers(0, 2**31 - 1))
-        job = self.simulator.run(circuit, shots=shots, seed_simulator=seed, memory=True,
-                                 max_parallel_threads=self.threads_for(num_qubits))
-        return _measured_indices(job.result(), 0)
-
-    def search_many(self, requests: Sequence[SearchRequest]) -> tuple[SearchResult, ...]:
-        """Independent searches (the p databases of an unshared Pq-RRT round), pipelined.
-
-        Submits every request's job before waiting for the first: Aer simulates job i on its
-        worker thread while this thread builds circuit i + 1. Results are identical to searching
-        one by one (each circuit keeps its own ``seed_simulator``).
-
-        Why not one job with all circuits: in a multi-circuit job Aer seeds circuit i with
-        ``seed_simulator + 2113 i`` (qiskit-aer 0.18.2, checked by ``test_backends``), and
-        ``seed_simulator`` takes one integer, so a single job cannot give each database the seed it
-        gets when searched alone: the planners' results would change.
-
-        Args:
-            requests: ``SearchRequest`` objects, each the arguments of one ``search`` call.
-
-        Returns:
-            One ``SearchResult`` per request, in order.
-
-        Raises:
-            TypeError: An item that is not a ``SearchRequest``.
-            ValueError: Any request that ``search`` would refuse; all are validated first.
-            RuntimeError: Aer reports a failed job.
-        """
-        prepared = [self._prepare(request) for request in requests]
-        jobs = [self._submit(*item) for item in prepared]
-        return tuple(self._finish(item, _measured_indices(job.result(), 0))
-                     for item, job in zip(prepared, jobs, strict=True))
-
-
-def _measured_indices(result: Result, experiment: int) -> np.ndarray:
-    """The measured indices of one experiment, from Aer's per-shot memory (hexadecimal strings
-    of the classical register, so no bitstring formatting per shot)."""
-    if not result.success:
-        raise RuntimeError(f"AerSimulator failed: {result.status}")
-    memory = result.results[experiment].data.memory
-    return np.fromiter((int(word, 16) for word in memory), dtype=np.int64, count=len(memory))
+        return self._run(circuit, num_qubits, shots, int(rng.integers(0, 2**31 - 1)))

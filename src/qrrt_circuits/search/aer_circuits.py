@@ -27,18 +27,21 @@ from ``circuits.choose_synthesis``, which counts CX gates for hardware and is wh
 ``resource_estimate`` uses.
 
 The parts that depend only on n (the W blocks, the ``mcphase``, the ``pauli`` Z^n,
-the measurements, as ``CircuitInstruction`` objects) are built once per n and reused; per search
-only the oracle's instructions are new, built from numpy arrays without per-entry Python work.
+the measurements) are built once per n and reused; per search only the oracle's instructions are
+new, built from numpy arrays without per-entry Python work. ``aer_grover_program`` gives the
+instructions as a ``GroverProgram`` of (operation, qubits) steps, which ``AerBackend`` hands to
+Aer's controller without building a ``QuantumCircuit`` (``aer_direct``).
 """
 
 from __future__ import annotations
 
 import functools
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from qiskit import QuantumCircuit
-from qiskit.circuit import CircuitInstruction, Gate, Measure
+from qiskit.circuit import CircuitInstruction, Gate, Measure, Operation, Qubit
 from qiskit.circuit.library import DiagonalGate, MCPhaseGate, PauliGate, PhaseGate, UnitaryGate
 
 from ..validation import check_int
@@ -55,6 +58,11 @@ WALSH_HADAMARD_BLOCK = 3
 #: 2-core machine for n = 6..12, m = 1..16: the forms crossed over at 2^n / (2m + 1) between about
 #: 100 and 200; ``benchmarks/bench_search.py`` times both forms at n = 8 and 12 with m = 12)
 ENTRIES_PER_INSTRUCTION = 128
+
+#: one instruction of a Grover program: an operation and the qubits it acts on (a
+#: ``CircuitInstruction`` is made of it only when a ``QuantumCircuit`` is built: making one copies
+#: a ``diagonal``'s 2^n phases into qiskit's own representation, ~1 us per phase)
+Step = tuple[Operation, tuple[Qubit, ...]]
 
 
 def _diagonal_gate(phases: np.ndarray) -> DiagonalGate:
@@ -103,20 +111,30 @@ class _Parts:
     def __init__(self, num_qubits: int, block: int) -> None:
         self.num_qubits = n = num_qubits
         template = QuantumCircuit(n, n, name="grover_aer")
-        self.qubits = qubits = template.qubits
+        self.qubits = qubits = tuple(template.qubits)
         self.clbits = template.clbits
         self.qregs, self.cregs = template.qregs, template.cregs
         walsh = []
         for start in range(0, n, block):
             group = qubits[start:start + block]
-            walsh.append(CircuitInstruction(_walsh_hadamard(len(group)), group))
+            walsh.append((_walsh_hadamard(len(group)), group))
         self.walsh = tuple(walsh)
         reflection = PhaseGate(math.pi) if n == 1 else MCPhaseGate(math.pi, n - 1)
-        self.reflection = CircuitInstruction(reflection, qubits)
-        self.parity = CircuitInstruction(PauliGate("Z" * n), qubits)
+        self.reflection: Step = (reflection, qubits)
+        self.parity: Step = (PauliGate("Z" * n), qubits)
         self.measures = tuple(CircuitInstruction(Measure(), (qubit,), (clbit,))
                               for qubit, clbit in zip(qubits, self.clbits, strict=True))
         self.signs = parity_signs(n)
+        #: qubit tuple -> its indices, filled as instructions are assembled for Aer (aer_direct)
+        self.qubit_indices: dict[tuple, list[int]] = {}
+
+    def indices_of(self, qubits: tuple) -> list[int]:
+        """The indices of ``qubits`` in this register (cached per tuple)."""
+        indices = self.qubit_indices.get(qubits)
+        if indices is None:
+            position = {qubit: index for index, qubit in enumerate(self.qubits)}
+            indices = self.qubit_indices[qubits] = [position[qubit] for qubit in qubits]
+        return indices
 
 
 @functools.lru_cache(maxsize=32)
@@ -143,7 +161,7 @@ def simulation_synthesis(marks: np.ndarray) -> str:
     return "diagonal" if marks.shape[0] <= ENTRIES_PER_INSTRUCTION * (2 * flipped + 1) else "mcz"
 
 
-def _sparse_oracles(parts: _Parts, marks: np.ndarray, iterations: int) -> tuple[list[list], float]:
+def _sparse_oracles(parts: _Parts, marks: np.ndarray, iterations: int) -> tuple[list[list[Step]], float]:
     """The ``mcz`` form of the k oracles: per oracle call one ``mcphase`` per flipped index i,
     conjugated by X on the zero bits of i (which maps |i> to |1...1>); returns the instructions
     to put before each iteration's diffuser, and the global phase of one oracle call.
@@ -171,13 +189,13 @@ def _sparse_oracles(parts: _Parts, marks: np.ndarray, iterations: int) -> tuple[
     return calls, phase
 
 
-def _x_string(parts: _Parts, mask: int) -> list[CircuitInstruction]:
+def _x_string(parts: _Parts, mask: int) -> list[Step]:
     """X on the qubits whose bit is set in ``mask`` (one ``PauliGate``, whose label is big-endian;
     none for mask 0)."""
     if not mask:
         return []
     label = "".join("X" if mask >> qubit & 1 else "I" for qubit in reversed(range(parts.num_qubits)))
-    return [CircuitInstruction(PauliGate(label), parts.qubits)]
+    return [(PauliGate(label), parts.qubits)]
 
 
 def aer_grover_circuit(
@@ -217,6 +235,67 @@ def aer_grover_circuit(
         >>> Operator(fast).equiv(Operator(grover_circuit(marks, 2, measure=False)))
         True
     """
+    return aer_grover_program(marks, iterations, synthesis, block).circuit(measure)
+
+
+@dataclass(frozen=True, eq=False)
+class GroverProgram:
+    """The instruction sequence of ``aer_grover_circuit`` before it becomes a ``QuantumCircuit``:
+    the Walsh-Hadamard blocks, then per Grover iteration the oracle's instructions, W, one
+    ``mcphase`` and W, and the final Z^n, with the circuit's global phase.
+
+    ``circuit()`` makes the ``QuantumCircuit``; ``aer_direct.assemble_program`` hands the same
+    instructions, in the same order, to Aer's controller without building one (``AerBackend``'s
+    path; the measured words are the same, tested).
+
+    Attributes:
+        num_qubits: n.
+        steps: The (operation, qubits) pairs, in order (without measurements).
+        global_phase: The circuit's global phase.
+    """
+
+    parts: _Parts
+    steps: tuple[Step, ...]
+    global_phase: float
+
+    @property
+    def num_qubits(self) -> int:
+        return self.parts.num_qubits
+
+    def circuit(self, measure: bool = True) -> QuantumCircuit:
+        """The n-qubit ``QuantumCircuit`` named ``grover_aer`` (with ``measure``, measured into
+        the classical register ``c``, qubit i into bit i)."""
+        parts = self.parts
+        circuit = QuantumCircuit(*parts.qregs, *(parts.cregs if measure else ()), name="grover_aer")
+        append = circuit._append
+        for operation, qubits in self.steps:
+            append(CircuitInstruction(operation, qubits))
+        circuit.global_phase = self.global_phase
+        if measure:
+            for instruction in parts.measures:
+                append(instruction)
+        return circuit
+
+
+def aer_grover_program(marks: np.ndarray, iterations: int, synthesis: str = "auto",
+                       block: int = WALSH_HADAMARD_BLOCK) -> GroverProgram:
+    """The instructions of ``aer_grover_circuit(marks, iterations, synthesis=synthesis,
+    block=block)`` as a ``GroverProgram`` (same arguments, same checks).
+
+    Args:
+        marks: Boolean (or 0/1) array of length 2^n, n >= 1.
+        iterations: k, 0 .. ``MAX_ITERATIONS``.
+        synthesis: ``"auto"`` (default), ``"diagonal"`` or ``"mcz"``.
+        block: The widest Walsh-Hadamard block, 1 .. 10 qubits.
+
+    Returns:
+        The ``GroverProgram``.
+
+    Raises:
+        ValueError: ``marks`` not of length 2^n or not boolean, k out of range, an unknown
+            ``synthesis`` or ``block`` out of range.
+        TypeError: A non-integer k or ``block``.
+    """
     marks, n = validate_marks(marks)
     iterations = validate_iterations(iterations)
     if synthesis not in AER_SYNTHESES:
@@ -225,30 +304,21 @@ def aer_grover_circuit(
     if synthesis == "auto":
         synthesis = simulation_synthesis(marks)
     parts = _parts(n, block)
-    circuit = QuantumCircuit(*parts.qregs, *(parts.cregs if measure else ()), name="grover_aer")
-    append = circuit._append
-    for instruction in parts.walsh:
-        append(instruction)
+    steps: list[Step] = list(parts.walsh)
+    phase = 0.0
     if iterations:
         if synthesis == "diagonal":
             signs = np.where(marks, -1.0, 1.0)
-            first = CircuitInstruction(_diagonal_gate(signs * parts.signs), parts.qubits)
-            rest = CircuitInstruction(_diagonal_gate(signs), parts.qubits) if iterations > 1 else None
-            calls, phase = [[first]] + [[rest]] * (iterations - 1), 0.0
+            first: Step = (_diagonal_gate(signs * parts.signs), parts.qubits)
+            rest: Step = (_diagonal_gate(signs), parts.qubits) if iterations > 1 else first
+            calls: list[list[Step]] = [[first]] + [[rest]] * (iterations - 1)
         else:
             calls, phase = _sparse_oracles(parts, marks, iterations)
             calls[0].insert(0, parts.parity)
         for oracle in calls:
-            for instruction in oracle:
-                append(instruction)
-            for instruction in parts.walsh:
-                append(instruction)
-            append(parts.reflection)
-            for instruction in parts.walsh:
-                append(instruction)
-        append(parts.parity)
-        circuit.global_phase = phase * iterations
-    if measure:
-        for instruction in parts.measures:
-            append(instruction)
-    return circuit
+            steps += oracle
+            steps += parts.walsh
+            steps.append(parts.reflection)
+            steps += parts.walsh
+        steps.append(parts.parity)
+    return GroverProgram(parts, tuple(steps), phase * iterations)

@@ -1,0 +1,219 @@
+"""Running a circuit on ``AerSimulator``'s C++ controller directly: the simulation that
+``AerSimulator.run`` performs, without its job machinery and its generic assembler.
+
+``AerSimulator.run(circuit).result()`` does three things around the simulation itself (profiled
+with cProfile, qiskit-aer 0.18.2, an 8-qubit Grover circuit of 36 instructions): it starts an
+``AerJob`` on a thread pool and waits on it, it converts the circuit with
+``aer_compiler.assemble_circuits`` (a generic converter that inspects every parameter of every
+instruction: the 256 phases of each ``diagonal`` one by one, ~0.6 ms of ~1.8 ms), and it turns the
+controller's output into a ``qiskit.result.Result``. The controller call itself is the same
+whoever makes it.
+
+``assemble`` converts the few instruction kinds the Grover circuits of this package use
+(``unitary``, ``diagonal``, ``mcphase``, ``p``, ``h``, ``x``, ``pauli``, ``measure``) with the same
+controller-wrapper calls and arguments as Aer's assembler (one call per instruction, the phases
+of a ``diagonal`` handed over as the list they already are), and falls back to Aer's own
+assembler for anything else (parameters, control flow, other instructions). ``execute`` builds
+the run configuration with Aer's ``generate_aer_config`` from the simulator's options and the
+run options, calls the simulator's controller and returns the per-shot memory. The measured
+words are identical to ``AerSimulator.run``'s for every seed (``tests/test_aer_direct.py``),
+so the planners' results do not change.
+
+These are qiskit-aer internals (``AerCircuit``, ``CircuitHeader``, ``generate_aer_config``,
+``AerSimulator._execute_circuits``); if an installed qiskit-aer lacks them, ``DIRECT_AVAILABLE``
+is False and ``AerBackend`` runs its circuits through ``AerSimulator.run``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from qiskit import QuantumCircuit
+
+from .aer_circuits import GroverProgram
+
+try:  # qiskit-aer internals (present in 0.15 - 0.18); without them AerBackend uses AerSimulator.run
+    from qiskit_aer.backends.aer_compiler import assemble_circuits, generate_aer_config
+    from qiskit_aer.backends.backend_utils import CircuitHeader
+    from qiskit_aer.backends.controller_wrappers import AerCircuit
+    DIRECT_AVAILABLE = True
+except ImportError:  # pragma: no cover - depends on the installed qiskit-aer
+    DIRECT_AVAILABLE = False
+
+#: the register of no condition, as Aer's assembler passes it
+_UNCONDITIONAL = -1
+
+
+def _unitary(aer: Any, qubits: list[int], operation: Any) -> None:
+    aer.unitary(qubits, operation.params[0], _UNCONDITIONAL, None, operation.label or "unitary")
+
+
+def _diagonal(aer: Any, qubits: list[int], operation: Any) -> None:
+    aer.diagonal(qubits, operation.params, _UNCONDITIONAL, operation.label or "diagonal")
+
+
+def _pauli(aer: Any, qubits: list[int], operation: Any) -> None:
+    aer.gate("pauli", qubits, [], operation.params, _UNCONDITIONAL, None, operation.label or "pauli")
+
+
+def _gate(aer: Any, qubits: list[int], operation: Any) -> None:
+    name = operation.name
+    aer.gate(name, qubits, [float(p) for p in operation.params], [], _UNCONDITIONAL, None,
+             operation.label or name)
+
+
+#: instruction name -> the controller-wrapper call Aer's assembler makes for it (measure apart)
+_CONVERTERS: dict[str, Callable[[Any, list[int], Any], None]] = {
+    "unitary": _unitary, "diagonal": _diagonal, "pauli": _pauli,
+    "mcphase": _gate, "p": _gate, "h": _gate, "x": _gate, "z": _gate,
+}
+
+
+class _Unconvertible(Exception):
+    """An instruction this module does not convert (the circuit goes to Aer's assembler)."""
+
+
+def _header(aer: Any, circuit_name: str, num_qubits: int, num_memory: int, qregs: Any, cregs: Any,
+            global_phase: float) -> None:
+    header = CircuitHeader(
+        n_qubits=num_qubits,
+        qreg_sizes=[[register.name, register.size] for register in qregs],
+        memory_slots=num_memory,
+        creg_sizes=[[register.name, register.size] for register in cregs],
+        name=circuit_name,
+        global_phase=global_phase,
+    )
+    aer.set_header(header)
+    aer.num_qubits = num_qubits
+    aer.num_memory = num_memory
+    aer.global_phase_angle = global_phase
+
+
+def _convert(aer: Any, operation: Any, qubits: list[int], clbits: list[int]) -> None:
+    if operation.name == "measure":
+        aer.measure(qubits, clbits, [])
+        return
+    converter = _CONVERTERS.get(operation.name)
+    if converter is None:
+        raise _Unconvertible(operation.name)
+    converter(aer, qubits, operation)
+
+
+def _convertible(circuit: QuantumCircuit) -> bool:
+    """True when every instruction has a converter here and nothing is parameterized."""
+    if circuit.num_parameters:
+        return False
+    return all(instruction.operation.name in _CONVERTERS or instruction.operation.name == "measure"
+               for instruction in circuit.data)
+
+
+def assemble(circuit: QuantumCircuit) -> Any:
+    """The ``AerCircuit`` Aer's ``assemble_circuits`` makes of ``circuit`` (experiment id 0).
+
+    The instructions of this package's Grover circuits are converted here, one controller-wrapper
+    call each with Aer's own arguments; any other circuit (parameters, other instructions) goes
+    through Aer's assembler.
+
+    Args:
+        circuit: A ``QuantumCircuit`` without classical conditions.
+
+    Returns:
+        A ``qiskit_aer.backends.controller_wrappers.AerCircuit``.
+    """
+    if not circuit.num_parameters:
+        aer = AerCircuit()
+        _header(aer, circuit.name, circuit.num_qubits, circuit.num_clbits, circuit.qregs, circuit.cregs,
+                float(circuit.global_phase))
+        qubit_index = {qubit: index for index, qubit in enumerate(circuit.qubits)}
+        clbit_index = {clbit: index for index, clbit in enumerate(circuit.clbits)}
+        try:
+            for instruction in circuit.data:
+                _convert(aer, instruction.operation, [qubit_index[qubit] for qubit in instruction.qubits],
+                         [clbit_index[clbit] for clbit in instruction.clbits])
+        except _Unconvertible:
+            pass
+        else:
+            aer.circ_id = 0
+            return aer
+    aer_circuits, _ = assemble_circuits([circuit])
+    aer = aer_circuits[0]
+    aer.circ_id = 0
+    return aer
+
+
+def assemble_program(program: GroverProgram) -> Any:
+    """The ``AerCircuit`` of ``program.circuit(measure=True)``, made from the program's
+    instructions without building the ``QuantumCircuit`` (the same calls, in the same order, as
+    ``assemble(program.circuit())``).
+
+    Args:
+        program: An ``aer_circuits.GroverProgram``.
+
+    Returns:
+        A ``qiskit_aer.backends.controller_wrappers.AerCircuit`` with experiment id 0.
+    """
+    parts = program.parts
+    n = parts.num_qubits
+    aer = AerCircuit()
+    _header(aer, "grover_aer", n, n, parts.qregs, parts.cregs, float(program.global_phase))
+    indices_of = parts.indices_of
+    for operation, qubits in program.steps:
+        _convert(aer, operation, indices_of(qubits), [])
+    for qubit in range(n):
+        aer.measure([qubit], [qubit], [])
+    aer.circ_id = 0
+    return aer
+
+
+@dataclass(frozen=True)
+class _Width:
+    """What ``generate_aer_config`` reads of its circuits: their qubits and classical bits."""
+
+    num_qubits: int
+    num_clbits: int
+
+
+def execute(simulator: Any, circuit: QuantumCircuit | GroverProgram, shots: int, seed: int,
+            threads: int) -> list[str]:
+    """Simulate ``circuit`` on ``simulator``'s controller with ``shots`` shots and
+    ``seed_simulator = seed``; the per-shot measured words (hexadecimal strings, as
+    ``Result.get_memory`` gives them before formatting).
+
+    The configuration is Aer's ``generate_aer_config`` of the simulator's options and the run
+    options ``shots``, ``seed_simulator``, ``memory=True`` and ``max_parallel_threads = threads``,
+    exactly what ``simulator.run(circuit, shots=..., seed_simulator=..., memory=True,
+    max_parallel_threads=...)`` passes to the controller. Only for a simulator without a noise
+    model (``AerSimulator.run``'s own compile step prepares a noise model).
+
+    Args:
+        simulator: A ``qiskit_aer.AerSimulator`` without a noise model.
+        circuit: The circuit, with measurements into its classical register, or a
+            ``GroverProgram`` (run as ``program.circuit(measure=True)``, without building it).
+        shots: Shots (>= 1).
+        seed: The simulator seed.
+        threads: Aer's ``max_parallel_threads`` for this run (0 = all cores).
+
+    Returns:
+        One hexadecimal word per shot.
+
+    Raises:
+        RuntimeError: The controller reports a failure.
+    """
+    if isinstance(circuit, GroverProgram):
+        aer = assemble_program(circuit)
+        width = _Width(circuit.num_qubits, circuit.num_qubits)
+    else:
+        aer = assemble(circuit)
+        width = _Width(circuit.num_qubits, circuit.num_clbits)
+    config = generate_aer_config([width], simulator.options, shots=shots, seed_simulator=seed,
+                                 memory=True, max_parallel_threads=threads)
+    output = simulator._execute_circuits([aer], None, config)
+    if not isinstance(output, dict) or not output.get("success", False):
+        status = output.get("status") if isinstance(output, dict) else output
+        raise RuntimeError(f"AerSimulator failed: {status}")
+    result = output["results"][0]
+    if not result.get("success", False):
+        raise RuntimeError(f"AerSimulator failed: {result.get('status')}")
+    return list(result["data"]["memory"])

@@ -1,0 +1,130 @@
+"""``aer_direct``: running circuits on AerSimulator's controller directly measures exactly what
+``AerSimulator.run`` measures (same words for the same seed), for every circuit form the package
+runs, and falls back to Aer's own assembler for anything else."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from qiskit import QuantumCircuit
+from qiskit.circuit import Parameter
+from qiskit_aer import AerSimulator
+
+import qrrt_circuits as qc
+from qrrt_circuits.search import aer_direct
+from qrrt_circuits.search.aer_circuits import aer_grover_program
+from qrrt_circuits.search.circuits import aer_grover_circuit, aer_literal_grover_circuit
+from qrrt_circuits.search.fixed_point import IterateSequence, generalized_grover_circuit
+
+pytestmark = pytest.mark.skipif(not aer_direct.DIRECT_AVAILABLE, reason="this qiskit-aer lacks the internals")
+
+SIMULATOR = AerSimulator(method="statevector")
+
+
+def job_memory(circuit: QuantumCircuit, shots: int, seed: int, threads: int = 1) -> list[str]:
+    result = SIMULATOR.run(circuit, shots=shots, seed_simulator=seed, memory=True,
+                           max_parallel_threads=threads).result()
+    return list(result.results[0].data.memory)
+
+
+def signature(circuit: QuantumCircuit) -> list:
+    """Each instruction's name, qubit and clbit indices and parameters (as numbers), in order."""
+    def value(param):
+        return param if isinstance(param, str) else np.asarray(param, dtype=complex).round(12).tolist()
+    return [(i.operation.name, [circuit.find_bit(q).index for q in i.qubits],
+             [circuit.find_bit(c).index for c in i.clbits], [value(p) for p in i.operation.params])
+            for i in circuit.data] + [circuit.global_phase]
+
+
+def random_marks(num_qubits: int, seed: int) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    marks = rng.random(1 << num_qubits) < 0.2
+    marks[rng.integers(1 << num_qubits)] = True
+    return marks
+
+
+@pytest.mark.parametrize("num_qubits", [1, 2, 3, 5, 7])
+@pytest.mark.parametrize("synthesis", ["diagonal", "mcz"])
+@pytest.mark.parametrize("iterations", [0, 1, 3])
+def test_grover_circuits_measure_the_same_words(num_qubits, synthesis, iterations):
+    for seed in range(3):
+        circuit = aer_grover_circuit(random_marks(num_qubits, seed), iterations, synthesis=synthesis)
+        assert aer_direct.execute(SIMULATOR, circuit, 32, 1000 + seed, 1) == job_memory(circuit, 32, 1000 + seed)
+
+
+@pytest.mark.parametrize("num_qubits", [1, 3, 5])
+def test_literal_and_generalized_circuits_measure_the_same_words(num_qubits):
+    marks = random_marks(num_qubits, 7)
+    circuits = [aer_literal_grover_circuit(marks, 2),
+                generalized_grover_circuit(marks, IterateSequence.fixed_point(delta=0.5, iterates=2)),
+                generalized_grover_circuit(marks, IterateSequence.grover(2), synthesis="mcz")]
+    for circuit in circuits:
+        for seed in (3, 99):
+            assert aer_direct.execute(SIMULATOR, circuit, 24, seed, 1) == job_memory(circuit, 24, seed)
+
+
+def test_the_fast_assembler_covers_the_grover_circuits():
+    """The circuits the planners run are converted here, not by Aer's generic assembler."""
+    for synthesis in ("diagonal", "mcz"):
+        assert aer_direct._convertible(aer_grover_circuit(random_marks(6, 1), 3, synthesis=synthesis))
+
+
+def test_other_circuits_fall_back_to_aers_assembler():
+    theta = Parameter("theta")
+    parameterized = QuantumCircuit(2, 2)
+    parameterized.rx(theta, 0)
+    assert not aer_direct._convertible(parameterized)
+    other = QuantumCircuit(3, 3)
+    other.ry(0.7, 0)
+    other.cx(0, 1)
+    other.ccx(0, 1, 2)
+    other.measure(range(3), range(3))
+    assert not aer_direct._convertible(other)
+    assert aer_direct.execute(SIMULATOR, other, 40, 5, 1) == job_memory(other, 40, 5)
+
+
+def test_aer_backend_results_equal_the_job_path():
+    """``AerBackend.search`` through the controller equals the same backend through
+    ``AerSimulator.run`` (the path it takes with a noise model), seed for seed."""
+    direct = qc.AerBackend(seed=3)
+    through_jobs = qc.AerBackend(seed=3)
+    through_jobs._direct = False
+    assert direct._direct
+    for seed in range(6):
+        marks = random_marks(6, seed)
+        a = direct.search(marks, 2, shots=16, seed=seed)
+        b = through_jobs.search(marks, 2, shots=16, seed=seed)
+        np.testing.assert_array_equal(a.indices, b.indices)
+
+
+def test_a_noise_model_runs_through_aersimulator_run():
+    from qiskit_aer.noise import NoiseModel
+
+    assert not qc.AerBackend(noise_model=NoiseModel())._direct
+
+
+def test_a_failed_simulation_raises():
+    wide = QuantumCircuit(1, 1)
+    wide.h(0)
+    wide.measure(0, 0)
+    simulator = AerSimulator(method="statevector", max_memory_mb=1)
+    big = QuantumCircuit(26, 26)
+    big.h(range(26))
+    big.measure(range(26), range(26))
+    with pytest.raises(RuntimeError, match="AerSimulator failed"):
+        aer_direct.execute(simulator, big, 1, 1, 1)
+    assert len(aer_direct.execute(simulator, wide, 3, 1, 1)) == 3
+
+
+@pytest.mark.parametrize("num_qubits", [1, 2, 4, 6])
+@pytest.mark.parametrize("synthesis", ["diagonal", "mcz"])
+def test_a_grover_program_runs_as_its_circuit(num_qubits, synthesis):
+    """``execute(program)`` (no QuantumCircuit built) measures what ``AerSimulator.run`` measures
+    on ``aer_grover_circuit`` of the same marks, and ``program.circuit()`` is that circuit."""
+    for iterations in (0, 1, 4):
+        marks = random_marks(num_qubits, iterations)
+        program = aer_grover_program(marks, iterations, synthesis)
+        circuit = aer_grover_circuit(marks, iterations, synthesis=synthesis)
+        assert signature(program.circuit()) == signature(circuit)
+        for seed in (0, 17):
+            assert aer_direct.execute(SIMULATOR, program, 32, seed, 1) == job_memory(circuit, 32, seed)
