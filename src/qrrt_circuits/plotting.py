@@ -38,13 +38,15 @@ def plot_environment(env: Environment, ax: Axes | None = None, color: str = "0.1
     Returns:
         The axes, with limits set to the workspace and an equal aspect ratio.
     """
-    from matplotlib.collections import PatchCollection
-    from matplotlib.patches import Rectangle
+    from matplotlib.collections import PolyCollection
 
     ax = _axes(ax)
-    boxes = env.boxes[:, :, :2]
-    patches = [Rectangle(lo, *(hi - lo)) for lo, hi in boxes]
-    ax.add_collection(PatchCollection(patches, facecolor=color, edgecolor="none"))
+    lo, hi = env.boxes[:, 0, :2], env.boxes[:, 1, :2]
+    # each box's four corners, counter-clockwise, as one polygon of one collection (no Python
+    # object per box: worlds have hundreds of boxes)
+    corners = np.stack([lo, np.stack([hi[:, 0], lo[:, 1]], axis=1), hi,
+                        np.stack([lo[:, 0], hi[:, 1]], axis=1)], axis=1)
+    ax.add_collection(PolyCollection(corners, facecolors=color, edgecolors="none"))
     (x0, x1), (y0, y1) = env.bounds[0], env.bounds[1]
     ax.plot([x0, x1, x1, x0, x0], [y0, y0, y1, y1, y0], color="0.3", lw=0.8)
     ax.set_xlim(x0, x1)
