@@ -6,8 +6,14 @@ Against Aer's floor (n = 4, 8, 12, 16; ``--quick``: 4, 8, 12), m = 12 marked ent
 k = 12 iterations, 8 shots, Aer on one thread; in each repeat, one after the other:
 - ``floor``: Aer's own floor, a 1-qubit circuit (h, measure) run with 8 shots (and
   ``floor_all_threads``: the same with Aer's default thread count, all cores);
-- ``ours``: ``AerBackend.search`` (the compact circuit of ``aer_grover_circuit``), and
-  ``build`` its circuit construction alone (its share of the search);
+- ``floor_controller``: that 1-qubit circuit on Aer's controller directly (``aer_direct``), the
+  floor of the path ``AerBackend`` takes;
+- ``ours``: ``AerBackend.search`` (the compact circuit of ``aer_grover_circuit``, its instructions
+  handed to Aer's controller), ``build`` its construction per search (the ``GroverProgram``: its
+  share of the search), ``assemble`` the program's conversion into Aer's circuit object (which
+  Aer's own assembler did inside ``AerSimulator.run`` before), ``build_circuit`` the same circuit as
+  a ``QuantumCircuit``, and ``ours_via_run`` the same searches through ``AerSimulator.run`` (the
+  path before ``aer_direct``);
 - ``gate_by_gate``: the previous implementation (``aer_literal_grover_circuit`` with the CX-based
   synthesis choice, bitstring memory parsing), for before/after figures from one run;
 - ``qiskit_algorithms``: qiskit-algorithms' ``Grover`` (12 iterations) with qiskit-aer's
@@ -37,7 +43,8 @@ from _common import machine, median_time, write_json
 
 import qrrt_circuits as qc
 from qrrt_circuits.registry import BACKENDS
-from qrrt_circuits.search import circuits
+from qrrt_circuits.search import aer_direct, circuits
+from qrrt_circuits.search.aer_circuits import aer_grover_program
 
 FLOOR_QUBITS = (4, 8, 12, 16)
 
@@ -58,6 +65,9 @@ def _contenders(n: int, marks: np.ndarray) -> dict:
     floor.h(0)
     floor.measure(0, 0)
     ours = qc.AerBackend(seed=1, max_parallel_threads=1)
+    via_run = qc.AerBackend(seed=1, max_parallel_threads=1)
+    via_run._direct = False  # the same circuits through AerSimulator.run (the path before aer_direct)
+    program = aer_grover_program(marks, 12)
     seeds = np.random.default_rng(2)
 
     def gate_by_gate():  # the implementation before this benchmark's figures (same seeds per call)
@@ -72,8 +82,16 @@ def _contenders(n: int, marks: np.ndarray) -> dict:
         # the same 1-qubit circuit with Aer's default thread count (all cores), as AerBackend ran
         # every circuit before it kept circuits under 14 qubits on one thread
         "floor_all_threads": lambda: all_threads.run(floor, shots=8, seed_simulator=1, memory=True).result(),
+        # the same 1-qubit circuit on Aer's controller directly (aer_direct): the floor of the
+        # path AerBackend takes without a noise model
+        "floor_controller": lambda: aer_direct.execute(simulator, floor, 8, 1, 1),
         "ours": lambda: ours.search(marks, 12, shots=8),
-        "build": lambda: circuits.aer_grover_circuit(marks, 12),
+        # the circuit's construction (its GroverProgram: what AerBackend builds per search), and
+        # its conversion into Aer's circuit object (what Aer's own assembler did inside run)
+        "build": lambda: aer_grover_program(marks, 12),
+        "assemble": lambda: aer_direct.assemble_program(program),
+        "build_circuit": lambda: circuits.aer_grover_circuit(marks, 12),
+        "ours_via_run": lambda: via_run.search(marks, 12, shots=8),
         "gate_by_gate": gate_by_gate,
     }
     if n in (8, 12):
@@ -136,10 +154,12 @@ def bench_floor(quick: bool) -> list[dict]:
                # the fastest repeat of each: less sensitive to other processes on a busy machine
                "min_ms": {name: value * 1e3 for name, value in minimums.items()},
                "ratio_of_minimums_to_floor": {name: value / minimums["floor"] for name, value in minimums.items()},
-               "build_share": medians["build"] / medians["ours"]}
+               "build_share": medians["build"] / medians["ours"],
+               "assemble_share": medians["assemble"] / medians["ours"]}
         rows.append(row)
         text = "  ".join(f"{name} {value * 1e3:8.3f} ms ({value / floor:6.1f}x)" for name, value in medians.items())
-        print(f"  n={n:2d} m={row['marked']:2d}  {text}  build share {row['build_share']:.1%}")
+        print(f"  n={n:2d} m={row['marked']:2d}  {text}  build share {row['build_share']:.1%}, "
+              f"assembly share {row['assemble_share']:.1%}")
         text = "  ".join(f"{name} {value:6.1f}x" for name, value in row["ratio_of_minimums_to_floor"].items())
         print(f"        fastest repeats over the fastest floor: {text}")
     return rows
@@ -224,6 +244,7 @@ def main() -> None:
                 summary[f"{name}_min_over_floor_min_n{n}"] = row["ratio_of_minimums_to_floor"][name]
         summary[f"ours_ms_n{n}"] = row["median_ms"]["ours"]
         summary[f"build_share_n{n}"] = row["build_share"]
+        summary[f"assemble_share_n{n}"] = row["assemble_share"]
     print("summary:", {k: (round(v, 3) if isinstance(v, float) else v) for k, v in summary.items()})
     path = write_json("bench_search" + ("_quick" if args.quick else ""),
                       {"machine": machine(), "quick": args.quick, "against_floor": floor, "search": search,
