@@ -46,7 +46,7 @@ def plot_environment(env: Environment, ax: Axes | None = None, color: str = "0.1
     # object per box: worlds have hundreds of boxes)
     corners = np.stack([lo, np.stack([hi[:, 0], lo[:, 1]], axis=1), hi,
                         np.stack([lo[:, 0], hi[:, 1]], axis=1)], axis=1)
-    ax.add_collection(PolyCollection(corners, facecolors=color, edgecolors="none"))
+    ax.add_collection(PolyCollection(list(corners), facecolors=color, edgecolors="none"))
     (x0, x1), (y0, y1) = env.bounds[0], env.bounds[1]
     ax.plot([x0, x1, x1, x0, x0], [y0, y0, y1, y1, y0], color="0.3", lw=0.8)
     ax.set_xlim(x0, x1)
