@@ -1,0 +1,98 @@
+"""Nearest-node queries: ``Tree.nearest`` (a compiled grid) against a compiled brute force.
+
+    python benchmarks/bench_nearest.py [--quick] [--out FILE]
+
+One quantum round of the planners pairs 2^n = 256 candidates with their nearest tree nodes. This
+times ``Tree.nearest`` and a compiled 2-D brute force (every query against every node, a reference
+for what another structure could save) for 256 uniform queries on trees of 100 to 3 000 nodes
+(``--quick``: up to 300): uniform in the 20 x 20 workspace, and the tree q-RRT grows on paper_clutter (which
+clusters around the start, so many queries lie far from every node). Medians of repeated calls;
+one thread. Prints a table and writes JSON.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+
+os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+
+import numpy as np
+from _common import machine, median_time, write_json
+from numba import njit
+
+import qrrt_circuits as qc
+from qrrt_circuits.tree import Tree
+
+QUERIES = 256
+SIZES = (100, 150, 200, 300, 1000, 3000)
+
+
+@njit(cache=True)
+def brute_force(points: np.ndarray, nodes: np.ndarray, size: int, out: np.ndarray) -> None:
+    """out[i] = the lowest index among the nodes nearest to points[i] (2-D, every pair)."""
+    for i in range(points.shape[0]):
+        best = np.inf
+        best_index = 0
+        px, py = points[i, 0], points[i, 1]
+        for j in range(size):
+            dx, dy = px - nodes[j, 0], py - nodes[j, 1]
+            squared = dx * dx + dy * dy
+            if squared < best:
+                best = squared
+                best_index = j
+        out[i] = best_index
+
+
+def uniform_tree(size: int, rng: np.random.Generator) -> Tree:
+    """A tree of ``size`` nodes uniform in the 20 x 20 workspace."""
+    tree = Tree(rng.random(2) * 20.0)
+    while tree.size < size:
+        tree.add(rng.random(2) * 20.0, 0)
+    return tree
+
+
+def planner_tree(size: int) -> Tree:
+    """The tree q-RRT (statevector, n = 8) grows on paper_clutter world 0 toward an unreachable
+    goal, to ``size`` nodes: the trees the planners query (clustered around the start)."""
+    env = qc.scenarios.paper_clutter(seed=0)
+    result = qc.QRRT(env, backend=qc.StatevectorBackend(), seed=0).plan(max_nodes=size - 1, goal_radius=1e-9)
+    tree = Tree(result.nodes[0])
+    for node, parent in zip(result.nodes[1:], result.parents[1:], strict=True):
+        tree.add(node, int(parent))
+    return tree
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--out", default=None)
+    args = parser.parse_args()
+    repeats = 50 if args.quick else 300
+    rng = np.random.default_rng(0)
+    rows = []
+    for layout in ("uniform", "planner"):
+        for size in (SIZES[:4] if args.quick else SIZES):
+            tree = uniform_tree(size, rng) if layout == "uniform" else planner_tree(size)
+            queries = rng.random((QUERIES, 2)) * 20.0
+            out = np.empty(QUERIES, dtype=np.int64)
+
+            def brute(t=tree, q=queries, o=out):
+                brute_force(q, t.nodes, t.size, o)
+
+            times = {"nearest_us": median_time(lambda t=tree, q=queries: t.nearest(q), repeats)[0] * 1e6,
+                     "brute_force_us": median_time(brute, repeats)[0] * 1e6}
+            brute()
+            assert np.array_equal(out, tree.nearest(queries)), "the kernels disagree"
+            rows.append({"layout": layout, "nodes": size, "queries": QUERIES, **times})
+            print(f"  {layout:8s} {size:5d} nodes: Tree.nearest {times['nearest_us']:7.1f} us, brute force "
+                  f"{times['brute_force_us']:8.1f} us ({QUERIES} queries)")
+    summary = {f"{row['layout']}_n{row['nodes']}_{key}": row[key]
+               for row in rows for key in ("nearest_us", "brute_force_us")}
+    path = write_json("bench_nearest_quick" if args.quick else "bench_nearest",
+                      {"machine": machine(), "quick": args.quick, "rows": rows, "summary": summary}, args.out)
+    print(f"wrote {path}")
+
+
+if __name__ == "__main__":
+    main()
