@@ -20,6 +20,9 @@ k = 12 iterations, 8 shots, Aer on one thread; in each repeat, one after the oth
   ``SamplerV2`` (8 shots, one thread) and a preset pass manager for AerSimulator (n <= 12);
 - ``ours_diagonal`` / ``ours_mcz``: both oracle forms at n = 8 and 12, to check
   ``simulation_synthesis``'s choice.
+Oracle forms (``synthesis``): both forms over n = 8..14 and m = 1..64 (``--quick``: n = 8, 10), the
+choice of ``simulation_synthesis`` and its time over the faster form's (the data its cost model's
+constants were fitted on).
 Medians over the repeats (and the fastest repeat of each); every figure is also given as a ratio
 to the floor of the same run.
 
@@ -188,6 +191,45 @@ def bench_search(quick: bool) -> list[dict]:
     return rows
 
 
+def bench_synthesis(quick: bool) -> dict:
+    """Both oracle forms of ``AerBackend`` (k = 12, 8 shots, one thread) over n and m, interleaved,
+    and what ``simulation_synthesis`` picks: per (n, m) the median time of each form, the ratio
+    2^n / (2m + 1) the cost model weighs, and the choice's time over the faster form's."""
+    from qrrt_circuits.search.aer_circuits import simulation_synthesis
+
+    forms = {form: qc.AerBackend(seed=1, max_parallel_threads=1, synthesis=form) for form in ("diagonal", "mcz")}
+    rng = np.random.default_rng(3)
+    repeats = 3 if quick else 7
+    rows = []
+    for n in ((8, 10) if quick else (8, 10, 12, 14)):
+        for m in (1, 2, 4, 8, 16, 32, 64):
+            if m > 2**n // 4:
+                continue
+            marks = np.zeros(2**n, dtype=bool)
+            marks[rng.choice(2**n, m, replace=False)] = True
+            times: dict[str, list[float]] = {form: [] for form in forms}
+            for backend in forms.values():
+                backend.search(marks, 12, shots=8, seed=0)
+            for repeat in range(repeats):
+                for form, backend in forms.items():
+                    start = time.perf_counter()
+                    backend.search(marks, 12, shots=8, seed=repeat)
+                    times[form].append(time.perf_counter() - start)
+            medians = {form: float(np.median(values)) for form, values in times.items()}
+            choice = simulation_synthesis(marks)
+            rows.append({"qubits": n, "marked": m, "entries_per_instruction": 2**n / (2 * m + 1),
+                         "diagonal_ms": medians["diagonal"] * 1e3, "mcz_ms": medians["mcz"] * 1e3,
+                         "faster": min(medians, key=medians.__getitem__), "choice": choice,
+                         "choice_over_faster": medians[choice] / min(medians.values())})
+            row = rows[-1]
+            print(f"  n={n:2d} m={m:2d}  2^n/(2m+1) {row['entries_per_instruction']:7.1f}  diagonal "
+                  f"{row['diagonal_ms']:8.2f} ms  mcz {row['mcz_ms']:8.2f} ms  chosen {choice:8s} "
+                  f"({row['choice_over_faster']:.2f}x the faster)")
+    regrets = [row["choice_over_faster"] for row in rows]
+    return {"rows": rows, "worst_choice_over_faster": max(regrets),
+            "mean_choice_over_faster": float(np.mean(regrets))}
+
+
 def bench_reachability(quick: bool) -> list[dict]:
     rows = []
     count = 20000 if quick else 200000
@@ -223,6 +265,8 @@ def main() -> None:
     floor = bench_floor(args.quick)
     print("Grover search, time per search (k = 12, 8 shots):")
     search = bench_search(args.quick)
+    print("Oracle forms for Aer (k = 12, 8 shots) and simulation_synthesis's choice:")
+    synthesis = bench_synthesis(args.quick)
     print("Reachability (one core):")
     reach = bench_reachability(args.quick)
     aer12 = next((r["median_s"] for r in search if r["backend"] == "aer" and r["qubits"] == 12), None)
@@ -245,10 +289,12 @@ def main() -> None:
         summary[f"ours_ms_n{n}"] = row["median_ms"]["ours"]
         summary[f"build_share_n{n}"] = row["build_share"]
         summary[f"assemble_share_n{n}"] = row["assemble_share"]
+    summary["synthesis_worst_choice_over_faster"] = synthesis["worst_choice_over_faster"]
+    summary["synthesis_mean_choice_over_faster"] = synthesis["mean_choice_over_faster"]
     print("summary:", {k: (round(v, 3) if isinstance(v, float) else v) for k, v in summary.items()})
     path = write_json("bench_search" + ("_quick" if args.quick else ""),
                       {"machine": machine(), "quick": args.quick, "against_floor": floor, "search": search,
-                       "reachability": reach, "summary": summary,
+                       "synthesis": synthesis, "reachability": reach, "summary": summary,
                        "note": "phase oracle built from a classical lookup of all 2^n marks; "
                                "one circuit with 8 shots stands for 8 workers"}, args.out)
     print(f"wrote {path}")

@@ -21,7 +21,8 @@ Why these forms (profiled with cProfile on qiskit 2.6 / qiskit-aer 0.18; the res
 measured by ``benchmarks/bench_search.py``): for small n, Aer's Python assembler and its
 per-instruction binding cost far more than the arithmetic on the state vector, so the circuit has
 as few instructions as possible; a ``diagonal`` instruction is cheap to call but costs per entry
-(qiskit's circuit and Aer's assembler handle each of its 2^n phases as a parameter), so
+(its 2^n phases are converted into Aer's own form; through ``AerSimulator.run`` qiskit's circuit
+and Aer's assembler also handle each phase as a parameter), so
 ``simulation_synthesis`` weighs 2^n entries against 2m + 1 instructions. That choice is separate
 from ``circuits.choose_synthesis``, which counts CX gates for hardware and is what
 ``resource_estimate`` uses.
@@ -54,10 +55,13 @@ AER_SYNTHESES = ("auto", "diagonal", "mcz")
 WALSH_HADAMARD_BLOCK = 3
 
 #: cost model of ``simulation_synthesis``: one phase of a ``diagonal`` instruction costs about
-#: 1/ENTRIES_PER_INSTRUCTION of one extra instruction (qiskit 2.6 / Aer 0.18, timed on a busy
-#: 2-core machine for n = 6..12, m = 1..16: the forms crossed over at 2^n / (2m + 1) between about
-#: 100 and 200; ``benchmarks/bench_search.py`` times both forms at n = 8 and 12 with m = 12)
-ENTRIES_PER_INSTRUCTION = 128
+#: 1/ENTRIES_PER_INSTRUCTION of one extra instruction. Fitted on ``AerBackend``'s controller path
+#: (``aer_direct``; qiskit 2.6 / Aer 0.18, 2-core machine, ``benchmarks/bench_search.py``'s
+#: ``synthesis`` sweep: both forms for n = 8..14, m = 1..64, k = 12, 8 shots): the diagonal form
+#: won up to 2^n / (2m + 1) = 252 and the mcz form from 341 on (equal at 496 for n = 14); 300 lies
+#: between (through ``AerSimulator.run``, whose assembler handles each phase in Python, the
+#: crossover was 100-200 and this constant 128)
+ENTRIES_PER_INSTRUCTION = 300
 
 #: one instruction of a Grover program: an operation and the qubits it acts on (a
 #: ``CircuitInstruction`` is made of it only when a ``QuantumCircuit`` is built: making one copies
