@@ -128,3 +128,29 @@ def test_a_grover_program_runs_as_its_circuit(num_qubits, synthesis):
         assert signature(program.circuit()) == signature(circuit)
         for seed in (0, 17):
             assert aer_direct.execute(SIMULATOR, program, 32, seed, 1) == job_memory(circuit, 32, seed)
+
+
+def test_the_run_configuration_follows_the_simulators_options():
+    """The configuration is made once and reused with a new seed, but made again when the
+    simulator's options change (so a changed option is never ignored)."""
+    simulator = AerSimulator(method="statevector")
+    width = aer_direct._Width(3, 3)
+    first = aer_direct._configuration(simulator, width, 4, 11, 1)
+    assert first.seed_simulator == 11 and first.precision == "double"
+    again = aer_direct._configuration(simulator, width, 4, 12, 1)
+    assert again is first and again.seed_simulator == 12
+    simulator.set_options(precision="single")
+    changed = aer_direct._configuration(simulator, width, 4, 13, 1)
+    assert changed is not first and changed.precision == "single" and changed.seed_simulator == 13
+    assert aer_direct._configuration(simulator, width, 8, 13, 1) is not changed  # other shots
+
+
+def test_threads_searching_at_once_measure_what_one_thread_does():
+    from concurrent.futures import ThreadPoolExecutor
+
+    circuits = [aer_grover_circuit(random_marks(5, seed), 2) for seed in range(12)]
+    alone = [aer_direct.execute(SIMULATOR, circuit, 16, seed, 1) for seed, circuit in enumerate(circuits)]
+    with ThreadPoolExecutor(max_workers=4) as pool:
+        together = list(pool.map(lambda item: aer_direct.execute(SIMULATOR, item[1], 16, item[0], 1),
+                                 enumerate(circuits)))
+    assert together == alone

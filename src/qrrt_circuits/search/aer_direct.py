@@ -15,7 +15,9 @@ controller-wrapper calls and arguments as Aer's assembler (one call per instruct
 of a ``diagonal`` handed over as the list they already are), and falls back to Aer's own
 assembler for anything else (parameters, control flow, other instructions). ``execute`` builds
 the run configuration with Aer's ``generate_aer_config`` from the simulator's options and the
-run options, calls the simulator's controller and returns the per-shot memory. The measured
+run options (once per thread, circuit width, shots and thread count, and again whenever the
+simulator's options change; only the seed changes between searches), calls the simulator's
+controller and returns the per-shot memory. The measured
 words are identical to ``AerSimulator.run``'s for every seed (``tests/test_aer_direct.py``),
 so the planners' results do not change.
 
@@ -26,6 +28,7 @@ is False and ``AerBackend`` runs its circuits through ``AerSimulator.run``.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -161,8 +164,7 @@ def assemble_program(program: GroverProgram) -> Any:
     indices_of = parts.indices_of
     for operation, qubits in program.steps:
         _convert(aer, operation, indices_of(qubits), [])
-    for qubit in range(n):
-        aer.measure([qubit], [qubit], [])
+    aer.measure(list(range(n)), list(range(n)), [])  # qubit i into bit i, as n one-qubit measurements
     aer.circ_id = 0
     return aer
 
@@ -173,6 +175,36 @@ class _Width:
 
     num_qubits: int
     num_clbits: int
+
+
+#: per thread: (simulator, width, shots, threads) -> (the simulator's options when the configuration
+#: was made, the configuration); the controller reads a configuration, it does not keep it
+_CONFIGURATIONS = threading.local()
+
+
+def _configuration(simulator: Any, width: _Width, shots: int, seed: int, threads: int) -> Any:
+    """``generate_aer_config([width], simulator.options, shots=..., seed_simulator=seed,
+    memory=True, max_parallel_threads=threads)``, made once per thread and reused (with the new
+    seed) while the simulator's options stay the same."""
+    cache = getattr(_CONFIGURATIONS, "cache", None)
+    if cache is None:
+        cache = _CONFIGURATIONS.cache = {}
+    key = (id(simulator), width, shots, threads)
+    options = dict(simulator.options.__dict__)
+    cached = cache.get(key)
+    if cached is None or cached[0] != options or cached[2] is not simulator:
+        if len(cache) >= _CONFIGURATIONS_KEPT:
+            cache.clear()
+        config = generate_aer_config([width], simulator.options, shots=shots, seed_simulator=seed, memory=True,
+                                     max_parallel_threads=threads)
+        cache[key] = (options, config, simulator)
+        return config
+    config = cached[1]
+    config.seed_simulator = seed
+    return config
+
+
+_CONFIGURATIONS_KEPT = 64
 
 
 def execute(simulator: Any, circuit: QuantumCircuit | GroverProgram, shots: int, seed: int,
@@ -207,9 +239,7 @@ def execute(simulator: Any, circuit: QuantumCircuit | GroverProgram, shots: int,
     else:
         aer = assemble(circuit)
         width = _Width(circuit.num_qubits, circuit.num_clbits)
-    config = generate_aer_config([width], simulator.options, shots=shots, seed_simulator=seed,
-                                 memory=True, max_parallel_threads=threads)
-    output = simulator._execute_circuits([aer], None, config)
+    output = simulator._execute_circuits([aer], None, _configuration(simulator, width, shots, seed, threads))
     if not isinstance(output, dict) or not output.get("success", False):
         status = output.get("status") if isinstance(output, dict) else output
         raise RuntimeError(f"AerSimulator failed: {status}")
