@@ -148,8 +148,9 @@ def assemble(circuit: QuantumCircuit) -> Any:
 
 def assemble_program(program: GroverProgram) -> Any:
     """The ``AerCircuit`` of ``program.circuit(measure=True)``, made from the program's
-    instructions without building the ``QuantumCircuit`` (the same calls, in the same order, as
-    ``assemble(program.circuit())``).
+    instructions without building the ``QuantumCircuit``: the same calls, in the same order, as
+    ``assemble(program.circuit())``, except that the n one-qubit measurements are one n-qubit
+    measurement (qubit i into bit i; the same measured words, tested).
 
     Args:
         program: An ``aer_circuits.GroverProgram``.
