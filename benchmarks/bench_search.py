@@ -138,12 +138,16 @@ def bench_floor(quick: bool) -> list[dict]:
         runs = _contenders(n, marks)
         for run in runs.values():  # warm-up (imports, caches, the pass manager)
             run()
-        repeats = (5 if quick else 30) if n <= 8 else (3 if quick else (12 if n == 12 else 5))
-        times = {name: [] for name in runs}
-        for _ in range(repeats):
-            for name, run in runs.items():
+        repeats = (5 if quick else 30) if n <= 8 else (3 if quick else (12 if n == 12 else 8))
+        times: dict[str, list[float]] = {name: [] for name in runs}
+        names = list(runs)
+        for repeat in range(repeats):
+            # a different order in each repeat, so no contender always follows the same one (the
+            # all-threads floor leaves OpenMP threads that can slow whatever runs right after it)
+            shift = repeat % len(names)
+            for name in names[shift:] + names[:shift]:
                 start = time.perf_counter()
-                run()
+                runs[name]()
                 times[name].append(time.perf_counter() - start)
         medians = {name: float(np.median(values)) for name, values in times.items()}
         minimums = {name: float(np.min(values)) for name, values in times.items()}

@@ -272,8 +272,12 @@ class GroverProgram:
         parts = self.parts
         circuit = QuantumCircuit(*parts.qregs, *(parts.cregs if measure else ()), name="grover_aer")
         append = circuit._append
-        for operation, qubits in self.steps:
-            append(CircuitInstruction(operation, qubits))
+        made: dict[int, CircuitInstruction] = {}  # one instruction per operation object (the k - 1
+        for operation, qubits in self.steps:      # later oracle calls share one diagonal)
+            instruction = made.get(id(operation))
+            if instruction is None or instruction.qubits != qubits:
+                instruction = made[id(operation)] = CircuitInstruction(operation, qubits)
+            append(instruction)
         circuit.global_phase = self.global_phase
         if measure:
             for instruction in parts.measures:
