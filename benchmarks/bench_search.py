@@ -69,7 +69,7 @@ def _contenders(n: int, marks: np.ndarray) -> dict:
     floor.measure(0, 0)
     ours = qc.AerBackend(seed=1, max_parallel_threads=1)
     via_run = qc.AerBackend(seed=1, max_parallel_threads=1)
-    via_run._direct = False  # the same circuits through AerSimulator.run (the path before aer_direct)
+    via_run._use_controller = False  # the same circuits through AerSimulator.run (the path before aer_direct)
     program = aer_grover_program(marks, 12)
     seeds = np.random.default_rng(2)
 

@@ -63,24 +63,57 @@ def test_literal_and_generalized_circuits_measure_the_same_words(num_qubits):
             assert aer_direct.execute(SIMULATOR, circuit, 24, seed, 1) == job_memory(circuit, 24, seed)
 
 
-def test_the_fast_assembler_covers_the_grover_circuits():
-    """The circuits the planners run are converted here, not by Aer's generic assembler."""
-    for synthesis in ("diagonal", "mcz"):
-        assert aer_direct._convertible(aer_grover_circuit(random_marks(6, 1), 3, synthesis=synthesis))
+def test_the_package_circuits_need_no_aer_assembler(monkeypatch):
+    """Every circuit form the backends run is converted here (Aer's generic assembler is never
+    called), barriers of the gate-by-gate and fixed-point circuits included."""
+    def refuse(*args, **kwargs):
+        raise AssertionError("Aer's assembler was called")
+
+    monkeypatch.setattr(aer_direct, "assemble_circuits", refuse)
+    marks = random_marks(5, 2)
+    for circuit in (aer_grover_circuit(marks, 3, synthesis="diagonal"), aer_grover_circuit(marks, 3, synthesis="mcz"),
+                    aer_literal_grover_circuit(marks, 2),
+                    generalized_grover_circuit(marks, IterateSequence.fixed_point(delta=0.5, iterates=2))):
+        aer_direct.assemble(circuit)
+    aer_direct.assemble_program(aer_grover_program(marks, 3))
 
 
-def test_other_circuits_fall_back_to_aers_assembler():
+def test_other_circuits_fall_back_to_aers_assembler(monkeypatch):
+    calls = []
+    original = aer_direct.assemble_circuits
+
+    def counted(circuits, *args, **kwargs):
+        calls.append(len(circuits))
+        return original(circuits, *args, **kwargs)
+
+    monkeypatch.setattr(aer_direct, "assemble_circuits", counted)
     theta = Parameter("theta")
-    parameterized = QuantumCircuit(2, 2)
-    parameterized.rx(theta, 0)
-    assert not aer_direct._convertible(parameterized)
+    parameterized = QuantumCircuit(1, 1)
+    parameterized.h(0)
+    parameterized.p(theta, 0)
+    parameterized.h(0)
+    parameterized.measure(0, 0)
+    bound = parameterized.assign_parameters({theta: 0.3})
+    assert aer_direct.execute(SIMULATOR, bound, 64, 3, 1) == job_memory(bound, 64, 3)  # converted here
+    assert calls == []
     other = QuantumCircuit(3, 3)
+    other.h(0)  # converted, then a gate that is not: the whole circuit goes to Aer's assembler
     other.ry(0.7, 0)
     other.cx(0, 1)
     other.ccx(0, 1, 2)
     other.measure(range(3), range(3))
-    assert not aer_direct._convertible(other)
     assert aer_direct.execute(SIMULATOR, other, 40, 5, 1) == job_memory(other, 40, 5)
+    assert calls == [1]
+
+
+def test_a_noisy_simulator_is_refused():
+    from qiskit_aer.noise import NoiseModel, depolarizing_error
+
+    noise = NoiseModel()
+    noise.add_all_qubit_quantum_error(depolarizing_error(0.1, 1), ["h"])
+    circuit = aer_grover_circuit(random_marks(3, 0), 1)
+    with pytest.raises(ValueError, match="noise_model"):
+        aer_direct.execute(AerSimulator(noise_model=noise), circuit, 4, 1, 1)
 
 
 def test_aer_backend_results_equal_the_job_path():
@@ -88,7 +121,7 @@ def test_aer_backend_results_equal_the_job_path():
     ``AerSimulator.run`` (the path it takes with a noise model), seed for seed."""
     direct = qc.AerBackend(seed=3)
     through_jobs = qc.AerBackend(seed=3)
-    through_jobs._direct = False
+    through_jobs._use_controller = False
     assert direct._direct
     for seed in range(6):
         marks = random_marks(6, seed)
@@ -98,9 +131,24 @@ def test_aer_backend_results_equal_the_job_path():
 
 
 def test_a_noise_model_runs_through_aersimulator_run():
-    from qiskit_aer.noise import NoiseModel
+    """With a noise model, given to the constructor or set on the simulator later, circuits go
+    through ``AerSimulator.run`` (which prepares the model), so the noise acts."""
+    from qiskit_aer.noise import NoiseModel, depolarizing_error
 
-    assert not qc.AerBackend(noise_model=NoiseModel())._direct
+    noise = NoiseModel()
+    noise.add_all_qubit_quantum_error(depolarizing_error(0.9, 4), ["mcphase"])
+    assert not qc.AerBackend(noise_model=noise)._direct
+    later = qc.AerBackend(seed=2, synthesis="mcz")
+    assert later._direct
+    later.simulator.set_options(noise_model=noise)
+    assert not later._direct
+    marks = np.zeros(16, dtype=bool)
+    marks[3] = True
+    measured = later.search(marks, 3, shots=64, seed=1).indices
+    seed = later._first_integer(1, 2**31 - 1)
+    expected = later.simulator.run(aer_grover_circuit(marks, 3, synthesis="mcz"), shots=64, seed_simulator=seed,
+                                   memory=True, max_parallel_threads=1).result().get_memory(0)
+    np.testing.assert_array_equal(measured, [int(word, 2) for word in expected])
 
 
 def test_a_failed_simulation_raises():

@@ -129,8 +129,8 @@ class AerBackend(QuantumSearchBackend):
         self.device = device
         self.max_parallel_threads = int(max_parallel_threads)
         self._build = aer_grover_circuit if noise_model is None else aer_literal_grover_circuit
-        #: run on the controller directly (no noise model, and this qiskit-aer has the internals)
-        self._direct = noise_model is None and aer_direct.DIRECT_AVAILABLE
+        #: False sends every circuit through AerSimulator.run (the benchmarks' before/after figures)
+        self._use_controller = True
 
     @property
     def max_qubits(self) -> int:
@@ -171,6 +171,14 @@ class AerBackend(QuantumSearchBackend):
             1 below ``SERIAL_BELOW_QUBITS`` qubits, else the constructor's ``max_parallel_threads``.
         """
         return 1 if num_qubits < SERIAL_BELOW_QUBITS else self.max_parallel_threads
+
+    @property
+    def _direct(self) -> bool:
+        """Whether circuits go to the controller directly: no noise model on the simulator (also one
+        set after construction) and a qiskit-aer with the internals (checked where the backend
+        runs, e.g. after unpickling on another machine)."""
+        return (self._use_controller and aer_direct.DIRECT_AVAILABLE
+                and getattr(self.simulator.options, "noise_model", None) is None)
 
     def _run(self, circuit: QuantumCircuit | GroverProgram, num_qubits: int, shots: int, seed: int) -> np.ndarray:
         """The measured index of every shot of ``circuit`` with ``seed_simulator = seed``.

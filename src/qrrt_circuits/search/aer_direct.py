@@ -22,13 +22,16 @@ words are identical to ``AerSimulator.run``'s for every seed (``tests/test_aer_d
 so the planners' results do not change.
 
 These are qiskit-aer internals (``AerCircuit``, ``CircuitHeader``, ``generate_aer_config``,
-``AerSimulator._execute_circuits``); if an installed qiskit-aer lacks them, ``DIRECT_AVAILABLE``
-is False and ``AerBackend`` runs its circuits through ``AerSimulator.run``.
+``AerSimulator._execute_circuits``; checked with qiskit-aer 0.18.2, and ``tests/test_aer_direct.py``
+compares every circuit form against ``AerSimulator.run``, so a change in them fails the suite); if
+an installed qiskit-aer lacks them, ``DIRECT_AVAILABLE`` is False and ``AerBackend`` runs its
+circuits through ``AerSimulator.run``.
 """
 
 from __future__ import annotations
 
 import threading
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -37,11 +40,12 @@ from qiskit import QuantumCircuit
 
 from .aer_circuits import GroverProgram
 
-try:  # qiskit-aer internals (present in 0.15 - 0.18); without them AerBackend uses AerSimulator.run
+try:  # qiskit-aer internals (checked with 0.18.2); without them AerBackend uses AerSimulator.run
+    from qiskit_aer import AerSimulator
     from qiskit_aer.backends.aer_compiler import assemble_circuits, generate_aer_config
     from qiskit_aer.backends.backend_utils import CircuitHeader
     from qiskit_aer.backends.controller_wrappers import AerCircuit
-    DIRECT_AVAILABLE = True
+    DIRECT_AVAILABLE = hasattr(AerSimulator, "_execute_circuits")
 except ImportError:  # pragma: no cover - depends on the installed qiskit-aer
     DIRECT_AVAILABLE = False
 
@@ -67,10 +71,14 @@ def _gate(aer: Any, qubits: list[int], operation: Any) -> None:
              operation.label or name)
 
 
+def _barrier(aer: Any, qubits: list[int], operation: Any) -> None:
+    """Aer's assembler makes no operation of a barrier."""
+
+
 #: instruction name -> the controller-wrapper call Aer's assembler makes for it (measure apart)
 _CONVERTERS: dict[str, Callable[[Any, list[int], Any], None]] = {
     "unitary": _unitary, "diagonal": _diagonal, "pauli": _pauli,
-    "mcphase": _gate, "p": _gate, "h": _gate, "x": _gate, "z": _gate,
+    "mcphase": _gate, "p": _gate, "h": _gate, "x": _gate, "z": _gate, "barrier": _barrier,
 }
 
 
@@ -102,14 +110,6 @@ def _convert(aer: Any, operation: Any, qubits: list[int], clbits: list[int]) -> 
     if converter is None:
         raise _Unconvertible(operation.name)
     converter(aer, qubits, operation)
-
-
-def _convertible(circuit: QuantumCircuit) -> bool:
-    """True when every instruction has a converter here and nothing is parameterized."""
-    if circuit.num_parameters:
-        return False
-    return all(instruction.operation.name in _CONVERTERS or instruction.operation.name == "measure"
-               for instruction in circuit.data)
 
 
 def assemble(circuit: QuantumCircuit) -> Any:
@@ -163,8 +163,11 @@ def assemble_program(program: GroverProgram) -> Any:
     aer = AerCircuit()
     _header(aer, "grover_aer", n, n, parts.qregs, parts.cregs, float(program.global_phase))
     indices_of = parts.indices_of
-    for operation, qubits in program.steps:
-        _convert(aer, operation, indices_of(qubits), [])
+    try:
+        for operation, qubits in program.steps:
+            _convert(aer, operation, indices_of(qubits), [])
+    except _Unconvertible:  # a step of a kind not converted here: the whole circuit through Aer's assembler
+        return assemble(program.circuit())
     aer.measure(list(range(n)), list(range(n)), [])  # qubit i into bit i, as n one-qubit measurements
     aer.circ_id = 0
     return aer
@@ -193,12 +196,12 @@ def _configuration(simulator: Any, width: _Width, shots: int, seed: int, threads
     key = (id(simulator), width, shots, threads)
     options = dict(simulator.options.__dict__)
     cached = cache.get(key)
-    if cached is None or cached[0] != options or cached[2] is not simulator:
+    if cached is None or cached[0] != options or cached[2]() is not simulator:
         if len(cache) >= _CONFIGURATIONS_KEPT:
             cache.clear()
         config = generate_aer_config([width], simulator.options, shots=shots, seed_simulator=seed, memory=True,
                                      max_parallel_threads=threads)
-        cache[key] = (options, config, simulator)
+        cache[key] = (options, config, weakref.ref(simulator))  # the cache keeps no simulator alive
         return config
     config = cached[1]
     config.seed_simulator = seed
@@ -232,8 +235,12 @@ def execute(simulator: Any, circuit: QuantumCircuit | GroverProgram, shots: int,
         One hexadecimal word per shot.
 
     Raises:
+        ValueError: The simulator has a noise model.
         RuntimeError: The controller reports a failure.
     """
+    if getattr(simulator.options, "noise_model", None) is not None:
+        raise ValueError("aer_direct.execute runs noiseless simulators only; a simulator with a noise_model "
+                         "goes through AerSimulator.run, whose compile step prepares the model")
     if isinstance(circuit, GroverProgram):
         aer = assemble_program(circuit)
         width = _Width(circuit.num_qubits, circuit.num_qubits)

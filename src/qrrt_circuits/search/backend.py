@@ -222,7 +222,7 @@ class QuantumSearchBackend(abc.ABC):
         """Independent searches (the p databases of one unshared Pq-RRT round): result i is exactly
         what ``search(marks, iterations, shots, seed)`` of request i returns when the requests are
         searched one after the other (same seeds, same measured indices). Every request is
-        validated before any work. A backend may run them together (``AerBackend``).
+        validated before any work. A backend may override this to run them together.
 
         Args:
             requests: The ``SearchRequest`` objects.
