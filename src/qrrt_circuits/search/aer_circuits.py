@@ -58,7 +58,8 @@ WALSH_HADAMARD_BLOCK = 3
 #: 1/ENTRIES_PER_INSTRUCTION of one extra instruction. Fitted on ``AerBackend``'s controller path
 #: (``aer_direct``; qiskit 2.6 / Aer 0.18, 2-core machine, ``benchmarks/bench_search.py``'s
 #: ``synthesis`` sweep: both forms for n = 8..14, m = 1..64, k = 12, 8 shots): the diagonal form
-#: won up to 2^n / (2m + 1) = 252 and the mcz form from 341 on (equal at 496 for n = 14); 300 lies
+#: was faster up to 2^n / (2m + 1) = 252 at every n, the mcz form from 341 on for n = 10-12, while
+#: at n = 14 the two crossed near 500 (the arithmetic of the X strings grows with 2^n); 300 lies
 #: between (through ``AerSimulator.run``, whose assembler handles each phase in Python, the
 #: crossover was 100-200 and this constant 128)
 ENTRIES_PER_INSTRUCTION = 300
