@@ -10,9 +10,10 @@ controller's output into a ``qiskit.result.Result``. The controller call itself 
 whoever makes it.
 
 ``assemble`` converts the few instruction kinds the Grover circuits of this package use
-(``unitary``, ``diagonal``, ``mcphase``, ``p``, ``h``, ``x``, ``pauli``, ``measure``) with the same
-controller-wrapper calls and arguments as Aer's assembler (one call per instruction, the phases
-of a ``diagonal`` handed over as the list they already are), and falls back to Aer's own
+(``unitary``, ``diagonal``, ``mcphase``, ``p``, ``h``, ``x``, ``z``, ``pauli``, ``measure``, and
+``barrier``, which becomes nothing) with the same controller-wrapper calls and arguments as Aer's
+assembler (one call per instruction, the phases of a ``diagonal`` handed over as the list they
+already are), and falls back to Aer's own
 assembler for anything else (parameters, control flow, other instructions). ``execute`` builds
 the run configuration with Aer's ``generate_aer_config`` from the simulator's options and the
 run options (once per thread, circuit width, shots and thread count, and again whenever the
