@@ -26,6 +26,12 @@ constants were fitted on).
 Medians over the repeats (and the fastest repeat of each); every figure is also given as a ratio
 to the floor of the same run.
 
+One job for a round's databases (``one_job``): the p = 8 databases of an unshared Pq-RRT round
+(n = 8, k = 3, one shot each, random marks) searched one after the other by
+``AerBackend.search_many`` against one controller call with the 8 circuits (what "one Aer job"
+would be), interleaved; and whether such a call can give each database its own seed (Aer sets
+circuit i's seed to seed_simulator + 2113 i, whatever the circuit carries).
+
 Search table: Aer for n = 4..16, the exact statevector for n = 4..20. Reachability: one core,
 batches of pairs on paper_clutter and annealing_field, for two pair distributions (``uniform``: a
 free parent and a uniform child anywhere; ``local``: child = parent + N(0, 1.5^2) per axis, like a
@@ -172,6 +178,76 @@ def bench_floor(quick: bool) -> list[dict]:
     return rows
 
 
+def bench_one_job(quick: bool) -> dict:
+    """The p databases of one unshared Pq-RRT round in one Aer controller call against
+    ``AerBackend.search_many`` (one call each), and the seeds Aer gives the circuits of one call."""
+    workers, n, k = 8, 8, 3
+    rng = np.random.default_rng(3)
+    marks = [rng.random(2**n) < 0.1 for _ in range(workers)]
+    seeds = [int(s) for s in rng.integers(0, 2**31 - 1, workers)]
+    backend = qc.AerBackend(seed=0, max_parallel_threads=1)
+    simulator = backend.simulator
+    synthesis = backend.synthesis
+
+    def one_by_one() -> None:  # the simulator seeds as AerBackend draws them, one call per database
+        for mk, seed in zip(marks, seeds, strict=True):
+            aer_direct.execute(simulator, aer_grover_program(mk, k, synthesis), 1, seed, 1)
+
+    requests = [qc.SearchRequest(mk, k, 1, seed) for mk, seed in zip(marks, seeds, strict=True)]
+    runs = {"search_many": lambda: backend.search_many(requests), "one_by_one_controller": one_by_one,
+            "one_controller_call": lambda: _one_call_words(simulator, marks, k, synthesis, seeds[0], 1)}
+    for run in runs.values():
+        run()
+    repeats = 10 if quick else 60
+    times: dict[str, list[float]] = {name: [] for name in runs}
+    names = list(runs)
+    for repeat in range(repeats):
+        shift = repeat % len(names)
+        for name in names[shift:] + names[:shift]:
+            start = time.perf_counter()
+            runs[name]()
+            times[name].append(time.perf_counter() - start)
+    medians = {name: float(np.median(values)) * 1e3 for name, values in times.items()}
+    # the seeds of one call: circuit i ran with seeds[0] + 2113 i, not with its own seeds[i]
+    own = [aer_direct.execute(simulator, aer_grover_program(mk, k, synthesis), 64, seed, 1)
+           for mk, seed in zip(marks, seeds, strict=True)]
+    together64 = _one_call_words(simulator, marks, k, synthesis, seeds[0], 64, circuit_seeds=seeds)
+    shifted = [aer_direct.execute(simulator, aer_grover_program(mk, k, synthesis), 64,
+                                  seeds[0] + 2113 * index, 1) for index, mk in enumerate(marks)]
+    row = {"workers": workers, "qubits": n, "iterations": k, "shots_per_database": 1, "repeats": repeats,
+           "median_ms": medians,
+           "one_call_over_search_many": medians["one_controller_call"] / medians["search_many"],
+           "circuit_seeds_are_first_plus_2113_i": together64 == shifted,
+           "circuit_seeds_are_their_own": together64 == own}
+    print(f"  {workers} databases (n={n}, k={k}, 1 shot): "
+          + "  ".join(f"{name} {value:.3f} ms" for name, value in medians.items())
+          + f"  one call / search_many = {row['one_call_over_search_many']:.2f}; circuit i seeded "
+          f"first + 2113 i: {row['circuit_seeds_are_first_plus_2113_i']}, its own seed: "
+          f"{row['circuit_seeds_are_their_own']}")
+    return row
+
+
+def _one_call_words(simulator, marks, k: int, synthesis: str, seed: int, shots: int,
+                    circuit_seeds: list[int] | None = None) -> list[list[str]]:
+    """The measured words of one controller call with one Grover circuit per marks array, with
+    ``seed_simulator = seed`` and, if given, circuit i's own ``seed`` attribute set to
+    ``circuit_seeds[i]`` (to show that Aer replaces it by seed + 2113 i)."""
+    from qiskit_aer.backends.aer_compiler import generate_aer_config
+
+    circuits_ = []
+    for index, mk in enumerate(marks):
+        aer = aer_direct.assemble_program(aer_grover_program(mk, k, synthesis))
+        aer.circ_id = index
+        if circuit_seeds is not None:
+            aer.seed = circuit_seeds[index]
+        circuits_.append(aer)
+    n = int(marks[0].shape[0]).bit_length() - 1
+    config = generate_aer_config([aer_direct._Width(n, n)] * len(marks), simulator.options, shots=shots,
+                                 seed_simulator=seed, memory=True, max_parallel_threads=1)
+    output = simulator._execute_circuits(circuits_, None, config)
+    return [list(result["data"]["memory"]) for result in output["results"]]
+
+
 def bench_search(quick: bool) -> list[dict]:
     rows = []
     rng = np.random.default_rng(0)
@@ -267,6 +343,8 @@ def main() -> None:
     args = parser.parse_args()
     print("Grover search against Aer's floor (k = 12, 8 shots, medians, ratio to the floor):")
     floor = bench_floor(args.quick)
+    print("A round's databases in one Aer job:")
+    one_job = bench_one_job(args.quick)
     print("Grover search, time per search (k = 12, 8 shots):")
     search = bench_search(args.quick)
     print("Oracle forms for Aer (k = 12, 8 shots) and simulation_synthesis's choice:")
@@ -293,11 +371,14 @@ def main() -> None:
         summary[f"ours_ms_n{n}"] = row["median_ms"]["ours"]
         summary[f"build_share_n{n}"] = row["build_share"]
         summary[f"assemble_share_n{n}"] = row["assemble_share"]
+    summary["one_job_over_search_many"] = one_job["one_call_over_search_many"]
+    summary["one_job_circuit_seeds_own"] = one_job["circuit_seeds_are_their_own"]
     summary["synthesis_worst_choice_over_faster"] = synthesis["worst_choice_over_faster"]
     summary["synthesis_mean_choice_over_faster"] = synthesis["mean_choice_over_faster"]
     print("summary:", {k: (round(v, 3) if isinstance(v, float) else v) for k, v in summary.items()})
     path = write_json("bench_search" + ("_quick" if args.quick else ""),
-                      {"machine": machine(), "quick": args.quick, "against_floor": floor, "search": search,
+                      {"machine": machine(), "quick": args.quick, "against_floor": floor, "one_job": one_job,
+                       "search": search,
                        "synthesis": synthesis, "reachability": reach, "summary": summary,
                        "note": "phase oracle built from a classical lookup of all 2^n marks; "
                                "one circuit with 8 shots stands for 8 workers"}, args.out)

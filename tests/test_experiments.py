@@ -314,3 +314,34 @@ def test_trial_count_has_a_documented_limit(tmp_path):
     with pytest.raises(ValueError, match=r"trials must be an integer in \[1, 100000\]"):
         run_experiment("heatmaps", out=tmp_path, trials=10**9)
     assert not (tmp_path / "heatmaps").exists()  # refused before any file is written
+
+
+def test_heatmaps_share_one_colour_scale(tmp_path, monkeypatch):
+    """The heatmaps figure puts every panel on one logarithmic scale whose top is the largest cell
+    count of any panel, with one colour bar for the figure (not one per panel)."""
+    import matplotlib.pyplot as plt
+
+    from qrrt_circuits.experiments import figures
+    from qrrt_circuits.experiments.heatmaps import Heatmaps
+    from qrrt_circuits.experiments.worlds import world
+
+    run_experiment("heatmaps", quick=True, trials=2, out=tmp_path, seed=3, progress=False)
+    out = tmp_path / "heatmaps"
+    settings = json.loads((out / "settings.json").read_text())
+    summary = json.loads((out / "summary.json").read_text())
+    records = read_records(out / "records.csv")
+    kept = []
+    monkeypatch.setattr(plt, "close", kept.append)  # keep the figure open to inspect it
+    (tmp_path / "again").mkdir()
+    Heatmaps().plot(records, settings, summary, tmp_path / "again")
+    fig, = kept
+    images = [image for ax in fig.axes for image in ax.images]
+    assert 1 <= len(images) <= 9  # a panel without nodes has no image
+    assert len({id(image.norm) for image in images}) == 1
+    env = world(settings["scenario"], settings["world_seed"])
+    largest = max(float(image.get_array().max()) for image in images)
+    assert images[0].norm.vmax == max(largest, 2.0)
+    assert images[0].norm.vmin == 1
+    assert len(fig.axes) == 10  # nine panels and one colour bar
+    assert figures.heatmap_counts(env, np.zeros((0, 2))).shape == (50, 50)
+    plt.close(fig)

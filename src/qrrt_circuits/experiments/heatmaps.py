@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
-from .figures import new_figure, node_heatmap, save
+from .figures import heatmap_counts, new_figure, node_heatmap, save
 from .intervals import bootstrap_ratio_interval, differs, rounded_interval
 from .measures import cut_at, dumps, loads, reachable_fraction, rounded
 from .planners import BACKEND_LABEL, planner_for
@@ -108,21 +108,39 @@ class Heatmaps(Experiment):
                            f"backend: {BACKEND_LABEL[settings['backend']]}"]}
 
     def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
+        """One panel per planner (rows) and cut (columns), all on one logarithmic colour scale (the
+        largest count of any cell), so the panels can be compared; the axes are placed by hand
+        (``tight_layout`` on this grid cost more than the rest of the figure)."""
+        from matplotlib.colors import LogNorm
+
         env = world(settings["scenario"], settings["world_seed"])
         cuts = settings["cuts"]
-        fig, axes = new_figure(len(PLANNERS), len(cuts), (4.6 * len(cuts), 4.2 * len(PLANNERS)))
-        for row, kind in enumerate(PLANNERS):
-            rows = [r for r in records if r["planner"] == kind]
-            for col, cut in enumerate(cuts):
-                clouds = [np.array(loads(r["positions_json"]))[: r[f"nodes_at_{cut}"]] for r in rows]
-                points = np.concatenate([p.reshape(-1, 2) for p in clouds]) if clouds else np.zeros((0, 2))
-                stats = summary["ours"][kind][str(cut)]
-                paper = self.paper.get(kind, {}).get(str(cut))
-                unit = "critical-path calls" if kind == "PQRRT" else "calls"
-                low, high = summary["interval_95"][kind][str(cut)]["efficiency"]
-                text = (f"{kind}, {cut} {unit}: {stats['nodes']} nodes, eff. {stats['efficiency']:.1%} "
-                        f"[{low:.1%}, {high:.1%}]")
-                if paper:
-                    text += f"\npaper: {paper['nodes']} nodes, {paper['efficiency']:.1%}"
-                node_heatmap(axes[row, col], env, points, text, goal=env.goal, radius=env.goal_radius)
-        return [save(fig, out_dir / "heatmaps.png")]
+        rows, cols = len(PLANNERS), len(cuts)
+        fig, axes = new_figure(rows, cols, (4.4 * cols + 1.0, 4.3 * rows))
+        fig.subplots_adjust(left=0.04, right=0.9, bottom=0.03, top=0.94, wspace=0.18, hspace=0.38)
+        panels = []
+        for kind in PLANNERS:
+            kept = [r for r in records if r["planner"] == kind]
+            for cut in cuts:
+                clouds = [np.array(loads(r["positions_json"]))[: r[f"nodes_at_{cut}"]] for r in kept]
+                panels.append(np.concatenate([p.reshape(-1, 2) for p in clouds]) if clouds else np.zeros((0, 2)))
+        largest = max((float(heatmap_counts(env, points).max()) for points in panels), default=0.0)
+        norm = LogNorm(vmin=1, vmax=max(largest, 2.0))
+        image = None
+        for index, points in enumerate(panels):
+            kind, cut = PLANNERS[index // cols], cuts[index % cols]
+            stats = summary["ours"][kind][str(cut)]
+            paper = self.paper.get(kind, {}).get(str(cut))
+            unit = "critical-path calls" if kind == "PQRRT" else "calls"
+            low, high = summary["interval_95"][kind][str(cut)]["efficiency"]
+            text = (f"{kind}, {cut} {unit}\n{stats['nodes']} nodes, eff. {stats['efficiency']:.1%} "
+                    f"[{low:.1%}, {high:.1%}]")
+            if paper:
+                text += f"\npaper: {paper['nodes']} nodes, {paper['efficiency']:.1%}"
+            drawn = node_heatmap(axes[index // cols, index % cols], env, points, text, goal=env.goal,
+                                 radius=env.goal_radius, norm=norm)
+            image = drawn or image
+        if image is not None:
+            fig.colorbar(image, cax=fig.add_axes((0.92, 0.2, 0.015, 0.6)),
+                         label=f"nodes per cell, summed over {settings['trials']} trials")
+        return [save(fig, out_dir / "heatmaps.png", tight=False)]
