@@ -1,6 +1,6 @@
 """Speed-up of ``qrrt reproduce EXPERIMENT --quick`` on 2 jobs over serial.
 
-    python benchmarks/bench_scaleout.py [--experiment heatmaps] [--repeats 3] [--jobs 2] [--full] [--quick]
+    python benchmarks/bench_scaleout.py [--experiment heatmaps|all|NAME] [--repeats 3] [--jobs 2] [--full] [--quick]
                                         [--baseline-src OTHER_CHECKOUT/src]
 
 Runs the real command line (a fresh ``--out`` each time, so nothing is resumed), end to end
@@ -50,17 +50,22 @@ start = clock()
 from qrrt_circuits.experiments import EXPERIMENTS
 from qrrt_circuits.experiments.runner import execute_trial
 imported = clock()
-name = sys.argv[1]
-experiment = EXPERIMENTS[name]
-settings = json.loads(json.dumps({**experiment.settings(sys.argv[2] == "quick", None, 0), "predicate": "exact"}))
-records = [execute_trial(name, trial, settings) for trial in experiment.trials(settings)]
-ran = clock()
-result = experiment.summarize(records, settings)
-summarized = clock()
-experiment.plot(records, settings, {**result, "ours": result["ours"]}, pathlib.Path(tempfile.mkdtemp()))
-plotted = clock()
-print(json.dumps({"import_s": imported - start, "trials_s": ran - imported, "summarize_s": summarized - ran,
-                  "plot_s": plotted - summarized}))
+names = sorted(EXPERIMENTS) if sys.argv[1] == "all" else [sys.argv[1]]
+phases = {"import_s": imported - start, "trials_s": 0.0, "summarize_s": 0.0, "plot_s": 0.0}
+for name in names:
+    experiment = EXPERIMENTS[name]
+    settings = json.loads(json.dumps({**experiment.settings(sys.argv[2] == "quick", None, 0), "predicate": "exact"}))
+    began = clock()
+    records = [execute_trial(name, trial, settings) for trial in experiment.trials(settings)]
+    ran = clock()
+    result = experiment.summarize(records, settings)
+    summarized = clock()
+    experiment.plot(records, settings, result, pathlib.Path(tempfile.mkdtemp()))
+    plotted = clock()
+    phases["trials_s"] += ran - began
+    phases["summarize_s"] += summarized - ran
+    phases["plot_s"] += plotted - summarized
+print(json.dumps(phases))
 """
 
 

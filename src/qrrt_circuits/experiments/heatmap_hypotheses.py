@@ -29,7 +29,7 @@ import numpy as np
 from ..search.policies import FixedIterations, PaperSchedule
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
-from .intervals import bootstrap_interval, differs, rounded_interval
+from .intervals import bootstrap_ratio_interval, differs, rounded_interval
 from .measures import cut_at
 from .planners import planner_for
 from .worlds import world
@@ -153,9 +153,13 @@ class HeatmapHypotheses(Experiment):
 
                     table[variant][str(boxes)][cut] = {"nodes": round(nodes(rows), 1),
                                                        "efficiency": round(efficiency(rows), 4)}
+                    # the same intervals as bootstrap_interval(rows, nodes / efficiency, seed), on index arrays
+                    placed = [r[f"nodes_at_{cut}"] for r in rows]
+                    calls = [r[f"calls_at_{cut}"] for r in rows]
                     spans[variant][str(boxes)][cut] = {
-                        "nodes": rounded_interval(bootstrap_interval(rows, nodes, settings["seed"]), 1),
-                        "efficiency": rounded_interval(bootstrap_interval(rows, efficiency, settings["seed"]))}
+                        "nodes": rounded_interval(bootstrap_ratio_interval(placed, None, settings["seed"],
+                                                                           per_trials=100.0), 1),
+                        "efficiency": rounded_interval(bootstrap_ratio_interval(placed, calls, settings["seed"]))}
         rrt_efficiency = [table["RRT"][str(b)]["10"]["efficiency"] for b in counts]
         calibrated = calibrate(counts, rrt_efficiency, TARGET_RRT_EFFICIENCY)
         predictions: dict[str, dict[str, dict[str, dict[str, Any]]]] = {}

@@ -48,14 +48,17 @@ def bootstrap_interval(trials: Sequence[Any], statistic: Callable[[list], float]
 
 
 def bootstrap_ratio_interval(numerators: Sequence[int], denominators: Sequence[int] | None, seed: int,
-                             resamples: int = RESAMPLES, level: float = LEVEL) -> tuple[float, float]:
+                             resamples: int = RESAMPLES, level: float = LEVEL,
+                             per_trials: float | None = None) -> tuple[float, float]:
     """``bootstrap_interval`` of sum(numerators) / sum(denominators) (of sum(numerators) when
-    ``denominators`` is None) over resampled trials, on index arrays.
+    ``denominators`` is None, or of ``per_trials * sum(numerators) / len(numerators)`` with
+    ``per_trials``) over resampled trials, on index arrays.
 
     The same interval, bit for bit, as ``bootstrap_interval(trials, statistic, seed)`` with that
     statistic, for integer counts: the same resamples (``Generator.integers`` draws the
     (resamples, n) index matrix as ``resamples`` consecutive draws of n), exact integer sums, the
-    same float division, and resamples with a zero denominator left out as undefined.
+    same float operations in the same order, and resamples with a zero denominator left out as
+    undefined.
 
     Args:
         numerators: One integer count per trial (nodes, say).
@@ -63,13 +66,16 @@ def bootstrap_ratio_interval(numerators: Sequence[int], denominators: Sequence[i
         seed: Seed of the resampling generator.
         resamples: Bootstrap resamples (default ``RESAMPLES``).
         level: Confidence level of the percentile interval (default ``LEVEL``).
+        per_trials: Without ``denominators``: the total per this many trials (``per_trials *
+            sum / n``, e.g. 100.0 for nodes per 100 trials), or None (default) for the sum.
 
     Returns:
         (low, high); both the statistic itself for fewer than two trials, NaN for none.
 
     Raises:
         TypeError: Counts that are not integers.
-        ValueError: ``denominators`` of another length than ``numerators``.
+        ValueError: ``denominators`` of another length than ``numerators``, or ``per_trials``
+            given with ``denominators``.
     """
     top = np.asarray(numerators)
     bottom = None if denominators is None else np.asarray(denominators)
@@ -78,11 +84,15 @@ def bootstrap_ratio_interval(numerators: Sequence[int], denominators: Sequence[i
             raise TypeError(f"{name} must be integer counts, got dtype {values.dtype}")
     if bottom is not None and bottom.shape != top.shape:
         raise ValueError(f"denominators must have the length of numerators ({top.shape[0]}), got {bottom.shape[0]}")
+    if per_trials is not None and bottom is not None:
+        raise ValueError("per_trials scales a plain sum; give it without denominators")
     count = top.shape[0]
 
     def statistic(index: np.ndarray) -> np.ndarray:
         total = top[index].sum(axis=-1)
         if bottom is None:
+            if per_trials is not None:
+                return float(per_trials) * total / count
             return total.astype(float)
         calls = bottom[index].sum(axis=-1)
         with np.errstate(divide="ignore", invalid="ignore"):

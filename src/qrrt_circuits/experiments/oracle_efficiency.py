@@ -71,12 +71,16 @@ class OracleEfficiency(Experiment):
             per_node[kind] = round(sum(r["oracle_calls"] for r in rows) / max(sum(r["nodes"] for r in rows), 1), 3)
         quantum_first = max(slopes["QRRT"], slopes["PQRRT"]) < min(slopes["RRT"], slopes["ParallelRRT"])
 
-        def slope(rows: list[Record], column: int = 1) -> float:
-            points = np.array([p for r in rows for p in loads(r["curve_json"])])
-            return linear_fit(points[:, 0], points[:, column]).slope if len(points) > 1 else float("nan")
+        def slope(curves: list[np.ndarray]) -> float:  # the fit over the resampled trials' points
+            points = np.concatenate(curves) if curves else np.zeros((0, 3))
+            return linear_fit(points[:, 0], points[:, 1]).slope if len(points) > 1 else float("nan")
 
-        interval = {kind: rounded_interval(bootstrap_interval([r for r in records if r["planner"] == kind], slope,
-                                                              settings["seed"]), 3) for kind in PLANNERS}
+        # each trial's growth curve parsed once, not once per resample (the same points, so the
+        # same fits and intervals as resampling the records)
+        curves = {kind: [np.array(loads(r["curve_json"]), dtype=float).reshape(-1, 3)
+                         for r in records if r["planner"] == kind] for kind in PLANNERS}
+        interval = {kind: rounded_interval(bootstrap_interval(curves[kind], slope, settings["seed"]), 3)
+                    for kind in PLANNERS}
         return {"ours": slopes, "paper": dict(self.paper),
                 "interval_95": interval,
                 "differs_from_paper": {kind: differs(self.paper[kind], interval[kind]) for kind in PLANNERS},

@@ -18,7 +18,6 @@ shared database are ignored in that formula (they only make sharing worse), so p
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -30,10 +29,10 @@ from ..search.estimated_policy import EstimatedOptimal, EstimatedOptimalState
 from ..search.policies import IterationPolicy
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, paired_trials
 from .figures import new_figure, save
-from .intervals import bootstrap_interval, rounded_interval
+from .intervals import rounded_interval
 from .measures import dumps, loads
 from .planners import planner_for
-from .tree_size import calls_at_sizes, pooled_calls_per_node, reachable_fraction_by_window
+from .tree_size import calls_at_sizes, pooled_calls_per_node, pooled_interval, reachable_fraction_by_window
 from .worlds import world
 
 SIZES = (30, 100, 300, 1000)
@@ -127,8 +126,7 @@ class SearchPolicies(Experiment):
         for label in settings["configs"]:
             rows = [r for r in records if r["config"] == label]
             ours[label] = {w: round(pooled_calls_per_node(rows, w), 3) for w in windows}
-            interval[label] = {w: rounded_interval(bootstrap_interval(
-                rows, functools.partial(pooled_calls_per_node, window=w), settings["seed"]), 3) for w in windows}
+            interval[label] = {w: rounded_interval(pooled_interval(rows, w, settings["seed"]), 3) for w in windows}
             critical[label] = {w: round(pooled_calls_per_node(rows, w, 2), 3) for w in windows}
             nodes = sum(r["nodes"] for r in rows)
             whole[label] = {"calls_per_node": round(sum(r["oracle_calls"] for r in rows) / nodes, 3),

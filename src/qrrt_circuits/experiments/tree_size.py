@@ -15,7 +15,6 @@ Pq-RRT is reported on its critical path (the time of 8 parallel devices) and in 
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -24,7 +23,7 @@ import numpy as np
 
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, paired_trials
 from .figures import new_figure, save
-from .intervals import bootstrap_interval, rounded_interval
+from .intervals import bootstrap_ratio_interval, rounded_interval
 from .measures import dumps, loads
 from .planners import planner_for
 from .worlds import world
@@ -47,6 +46,28 @@ COLORS = {"RRT": "tab:gray", "ParallelRRT": "tab:brown", "QRRT paper": "tab:blue
           "QRRT bbht": "tab:green", "QRRT adaptive": "tab:orange", "PQRRT paper": "tab:red"}
 
 
+def window_counts(rows: Sequence[Record], window: str, column: int = 1) -> tuple[list[int], list[int]]:
+    """Per row, the calls and the nodes added in ``window`` ("low-high"); (0, 0) for a row whose
+    tree did not reach both sizes.
+
+    Args:
+        rows: Records with a ``points_json`` column (``calls_at_sizes`` points).
+        window: ``"low-high"``, two tree sizes.
+        column: 1 for oracle calls, 2 for critical-path calls.
+
+    Returns:
+        (calls added per row, nodes added per row), integers.
+    """
+    low, high = (int(v) for v in window.split("-"))
+    calls, nodes = [], []
+    for r in rows:
+        points = {p[0]: p for p in loads(r["points_json"])}
+        reached = low in points and high in points
+        calls.append(int(points[high][column] - points[low][column]) if reached else 0)
+        nodes.append(high - low if reached else 0)
+    return calls, nodes
+
+
 def pooled_calls_per_node(rows: Sequence[Record], window: str, column: int = 1) -> float:
     """Calls added / nodes added in ``window`` ("low-high") over the rows (a pooled ratio);
     ``column`` 1 counts oracle calls, 2 critical-path calls (the points of ``calls_at_sizes``).
@@ -60,14 +81,25 @@ def pooled_calls_per_node(rows: Sequence[Record], window: str, column: int = 1) 
         Summed calls added / summed nodes added over the rows whose trees reached both sizes;
         NaN if none did.
     """
-    low, high = (int(v) for v in window.split("-"))
-    calls = nodes = 0
-    for r in rows:
-        points = {p[0]: p for p in loads(r["points_json"])}
-        if low in points and high in points:
-            calls += points[high][column] - points[low][column]
-            nodes += high - low
-    return calls / nodes if nodes else float("nan")
+    calls, nodes = window_counts(rows, window, column)
+    return sum(calls) / sum(nodes) if sum(nodes) else float("nan")
+
+
+def pooled_interval(rows: Sequence[Record], window: str, seed: int) -> tuple[float, float]:
+    """The 95 % bootstrap interval of ``pooled_calls_per_node(rows, window)`` over the rows
+    (``bootstrap_ratio_interval`` on the per-row counts: the interval ``bootstrap_interval`` gives
+    with that statistic, bit for bit, without re-reading every record in every resample).
+
+    Args:
+        rows: Records with a ``points_json`` column.
+        window: ``"low-high"``.
+        seed: Seed of the resampling generator.
+
+    Returns:
+        (low, high).
+    """
+    calls, nodes = window_counts(rows, window)
+    return bootstrap_ratio_interval(calls, nodes, seed)
 
 
 def calls_at_sizes(result: PlanResult, sizes: Sequence[int]) -> list[list[int]]:
@@ -170,8 +202,7 @@ class TreeSize(Experiment):
         for label in settings["configs"]:
             rows = [r for r in records if r["config"] == label]
             ours[label] = {w: round(pooled_calls_per_node(rows, w), 3) for w in windows}
-            interval[label] = {w: rounded_interval(bootstrap_interval(
-                rows, functools.partial(pooled_calls_per_node, window=w), settings["seed"]), 3) for w in windows}
+            interval[label] = {w: rounded_interval(pooled_interval(rows, w, settings["seed"]), 3) for w in windows}
             critical[label] = {w: round(pooled_calls_per_node(rows, w, 2), 3) for w in windows}
         fractions = {label: {w: round(float(np.mean([loads(r["fractions_json"])[w] for r in records
                                                      if r["config"] == label and w in loads(r["fractions_json"])]
