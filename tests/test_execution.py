@@ -234,3 +234,44 @@ def test_client_runs_trials_while_a_new_pool_starts_and_each_trial_runs_once(tmp
     assert len(set(ran_here)) == len(ran_here) <= len(rows)  # each that ran here ran once
     assert summary["ours"] == serial["ours"]
     assert _records(tmp_path / "pool", name) == _records(tmp_path / "serial", name)
+
+
+def test_reproducing_several_experiments_makes_each_summary_while_the_next_trials_run(tmp_path, monkeypatch):
+    """run_experiments (``qrrt reproduce all``) on a process pool: every summary.json and figure is
+    the serial run's, the summaries are reported in order, and an experiment's summary is made in
+    the background thread, not by the thread that runs the next experiment's trials."""
+    import threading
+
+    from qrrt_circuits.execution import WorkerPool
+    from qrrt_circuits.experiments import EXPERIMENTS
+    from qrrt_circuits.experiments.runner import run_experiments
+
+    names = ["corridor", "heatmaps", "oracle-efficiency"]
+    options = {"quick": True, "trials": 2, "progress": False}
+    made_by: dict[str, str] = {}
+    for name in names:  # record which thread makes each summary
+        original = type(EXPERIMENTS[name]).summarize
+
+        def summarize(self, records, settings, original=original, name=name):
+            made_by[name] = threading.current_thread().name
+            return original(self, records, settings)
+
+        monkeypatch.setattr(type(EXPERIMENTS[name]), "summarize", summarize)
+    serial, pooled = [], []
+    with WorkerPool("serial") as pool:
+        run_experiments(names, pool, lambda name, summary: serial.append((name, summary)),
+                        out=tmp_path / "serial", **options)
+    assert set(made_by.values()) == {threading.current_thread().name}
+    made_by.clear()
+    with WorkerPool("process", jobs=2) as pool:
+        run_experiments(names, pool, lambda name, summary: pooled.append((name, summary)),
+                        out=tmp_path / "pool", **options)
+    assert all(thread.startswith("qrrt-summary") for thread in made_by.values()), made_by
+    assert [name for name, _ in pooled] == names == [name for name, _ in serial]
+    for (name, ours), (_, reference) in zip(pooled, serial, strict=True):
+        assert ours["complete"] and ours["ours"] == reference["ours"], name
+        assert _records(tmp_path / "pool", name) == _records(tmp_path / "serial", name), name
+        written = (tmp_path / "pool" / name / "summary.json").read_text()
+        assert written == (tmp_path / "serial" / name / "summary.json").read_text(), name
+        assert ours["figures"] and all((tmp_path / "pool" / name / figure).stat().st_size
+                                       for figure in ours["figures"])

@@ -220,8 +220,8 @@ def cmd_plan(args: argparse.Namespace) -> int:
 # ----------------------------------------------------------------------------------------- reproduce
 def cmd_reproduce(args: argparse.Namespace) -> int:
     from .execution import WorkerPool
-    from .experiments import EXPERIMENTS, run_experiment
-    from .experiments.runner import check_experiment_arguments
+    from .experiments import EXPERIMENTS
+    from .experiments.runner import check_experiment_arguments, run_experiments
 
     if str(args.out).strip() == "":
         raise ValueError("--out must name a folder, got ''")
@@ -235,12 +235,12 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     for name in names:  # bad arguments are refused before any worker starts
         check_experiment_arguments(name, trials=args.trials, seed=args.seed, executor=args.executor,
                                    jobs=args.jobs, scheduler=args.scheduler, predicate=args.predicate)
-    # one pool or Dask cluster for every experiment, started when the first trial needs it
+    # one pool or Dask cluster for every experiment, started when the first trial needs it; with
+    # workers, an experiment's summary and figures are made while the next one's trials run
     with WorkerPool(args.executor, args.jobs, args.scheduler) as pool:
-        for name in names:
-            summary = run_experiment(name, out=args.out, quick=args.quick, trials=args.trials, seed=args.seed,
-                                     progress=not args.no_progress, executor=pool, predicate=args.predicate)
-            _print_summary(name, summary, args.out)
+        run_experiments(names, pool, lambda name, summary: _print_summary(name, summary, args.out),
+                        out=args.out, quick=args.quick, trials=args.trials, seed=args.seed,
+                        progress=not args.no_progress, predicate=args.predicate)
     return 0
 
 

@@ -18,7 +18,7 @@ from collections.abc import Callable
 from concurrent.futures import BrokenExecutor, Executor, Future, as_completed
 from functools import partial
 from pathlib import Path
-from typing import TYPE_CHECKING, cast
+from typing import TYPE_CHECKING, Any, cast
 
 from tqdm.auto import tqdm
 
@@ -29,7 +29,7 @@ from .records import RecordWriter, read_records
 if TYPE_CHECKING:
     from ..execution import WorkerPool
 
-__all__ = ["check_experiment_arguments", "execute_trial", "read_records", "run_experiment"]
+__all__ = ["check_experiment_arguments", "execute_trial", "read_records", "run_experiment", "run_experiments"]
 
 RECORDS = "records.csv"
 #: the most trials per variant ``--trials`` accepts (a trial list is built in memory)
@@ -279,6 +279,7 @@ def run_experiment(
     max_restarts: int = 3,
     on_restart: Callable[[int], None] | None = None,
     predicate: str = "exact",
+    defer_summary: Callable[[Callable[[], Summary]], None] | None = None,
 ) -> Summary:
     """Run (or resume) experiment ``name`` into ``out/name``; returns the summary.
 
@@ -306,10 +307,14 @@ def run_experiment(
         max_restarts: How many times a broken pool is renewed.
         on_restart: Called with the restart's number before each renewal.
         predicate: The planners' reachability check (a ``PREDICATES`` name).
+        defer_summary: Called, after the trials, with a function that makes and returns the
+            summary (and writes ``summary.json`` and the figures), instead of calling it here
+            (``run_experiments`` hands it to a background thread); None (default) makes it here.
 
     Returns:
         The summary written to ``summary.json`` (``"complete": False`` with the counts of
-        finished and total trials when some are missing).
+        finished and total trials when some are missing); with ``defer_summary``, only
+        ``{"experiment": name, "deferred": True}``.
 
     Raises:
         ValueError: If an argument is refused, or ``out/name`` holds results for other settings.
@@ -348,4 +353,50 @@ def run_experiment(
                  max_restarts, on_restart)
     finally:
         bar.close()
+    if defer_summary is not None:
+        defer_summary(partial(_summarize, experiment, name, directory, settings, all_trials))
+        return {"experiment": name, "deferred": True}
     return _summarize(experiment, name, directory, settings, all_trials)
+
+
+def run_experiments(names: list[str], pool: WorkerPool, on_summary: Callable[[str, Summary], None],
+                    **options: Any) -> None:
+    """``run_experiment`` for each of ``names`` on one ``WorkerPool`` (``qrrt reproduce all``),
+    calling ``on_summary(name, summary)`` in order.
+
+    With workers (a process pool or Dask), experiment i's summary and figures are made in one
+    background thread of this process while experiment i + 1's trials run on the workers, which
+    would otherwise wait for them; the summaries are made one at a time, in order, from the same
+    records, so ``summary.json`` and the figures are those of running the experiments one after the
+    other (tested). Serially, everything runs in this thread, one experiment after the other.
+
+    Args:
+        names: ``EXPERIMENTS`` names, run in this order.
+        pool: The open ``WorkerPool`` every experiment's trials run on.
+        on_summary: Called with each experiment's name and summary, in the order of ``names``.
+        **options: ``run_experiment``'s other keywords (``out``, ``quick``, ``trials``, ``seed``,
+            ``progress``, ``predicate``, ...).
+
+    Raises:
+        Whatever ``run_experiment`` or a summary raises (a failed summary after the trials of the
+        experiments after it have run).
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
+    if pool.kind == "serial":
+        for name in names:
+            on_summary(name, run_experiment(name, executor=pool, **options))
+        return
+    pending: deque[tuple[str, Future[Summary]]] = deque()
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="qrrt-summary") as finisher:
+        for name in names:
+            def defer(make: Callable[[], Summary], name: str = name) -> None:
+                pending.append((name, finisher.submit(make)))
+
+            run_experiment(name, executor=pool, defer_summary=defer, **options)
+            while pending and pending[0][1].done():  # report finished summaries, in order
+                done_name, future = pending.popleft()
+                on_summary(done_name, future.result())
+        while pending:
+            done_name, future = pending.popleft()
+            on_summary(done_name, future.result())
