@@ -36,7 +36,8 @@ sys.path.insert(0, str(HERE))
 from _figures import flatten  # noqa: E402
 
 #: packages whose versions describe the run
-PACKAGES = ("qrrt-circuits", "qiskit", "qiskit-aer", "numpy", "numba", "scipy", "dask", "distributed")
+PACKAGES = ("qrrt-circuits", "qiskit", "qiskit-aer", "qiskit-algorithms", "numpy", "numba", "scipy", "matplotlib",
+            "dask", "distributed", "ompl")
 
 
 def discover(directory: Path = HERE) -> dict[str, Path]:

@@ -116,3 +116,26 @@ def test_oracle_agrees_with_exact_diagonal_check(clutter):
             inner = clutter.bounds + np.array([0.0101, -0.0101])
             assert diagonal_edge_hits(p, c, rates, dyn.horizon, inner, grown, shrink=0.0)
     assert 0.1 < verdict.mean() < 0.9
+
+
+def test_chord_grid_is_computed_once_per_dynamics_and_equals_the_direct_computation(clutter):
+    from qrrt_circuits import oracle as oracle_module
+
+    oracle_module._CHORD_GRIDS.clear()
+    dyn = qc.LinearTrackingDynamics.paper()
+    max_error = float(np.linalg.norm(clutter.bounds[:, 1] - clutter.bounds[:, 0])) * 1.0001
+    times, bounds = dyn.curvature_bound_times(max_error, 0.01)
+    phis = dyn.propagators(times)
+    first = qc.ReachabilityOracle(clutter, dyn, resolution=0.01)
+    assert len(oracle_module._CHORD_GRIDS) == 1
+    first._times[0] = 99.0  # each predicate owns its copy: corrupting it reaches no other
+    # another dynamics object with the same closed loop and horizon reuses the grid...
+    second = qc.ReachabilityOracle(clutter, qc.LinearTrackingDynamics.paper(), resolution=0.01)
+    assert len(oracle_module._CHORD_GRIDS) == 1
+    for got, want in ((second._times, times), (second._curvature, bounds), (second._phis, phis)):
+        np.testing.assert_array_equal(got, want)
+        assert got.flags["C_CONTIGUOUS"] and got.flags["WRITEABLE"]
+    # ...and a different resolution or horizon gets its own
+    qc.ReachabilityOracle(clutter, dyn, resolution=0.02)
+    qc.ReachabilityOracle(clutter, qc.LinearTrackingDynamics.paper(horizon=4.0), resolution=0.01)
+    assert len(oracle_module._CHORD_GRIDS) == 3

@@ -28,6 +28,37 @@ from .validation import check_positive_float
 __all__ = ["OracleErrorModel", "ReachabilityOracle"]
 
 
+def chord_grid(
+    dynamics: LinearTrackingDynamics, max_error: float, resolution: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The check's time grid, per-chord curvature bounds and propagators expm(M t_i).
+
+    ``dynamics.curvature_bound_times(max_error, resolution)`` and ``dynamics.propagators`` of its
+    times, a pure function of M = A - B K, T, ``max_error`` and ``resolution``: computed once per
+    process for each distinct set (an experiment builds one predicate per trial, and the grid, a few
+    hundred small ``expm``, cost more than most trials' checks). Fresh copies are returned, so the
+    caller owns them.
+
+    Returns:
+        (times, bounds, propagators): shapes (K + 1,), (K,) and (K + 1, d, d), C-contiguous.
+    """
+    closed = np.ascontiguousarray(dynamics.closed_loop, dtype=float)
+    key = (closed.tobytes(), closed.shape, dynamics.horizon, float(max_error), float(resolution))
+    grid = _CHORD_GRIDS.get(key)
+    if grid is None:
+        times, bounds = dynamics.curvature_bound_times(max_error, resolution)
+        grid = (times, bounds, np.ascontiguousarray(dynamics.propagators(times)))
+        if len(_CHORD_GRIDS) >= _CHORD_GRIDS_KEPT:
+            _CHORD_GRIDS.clear()
+        _CHORD_GRIDS[key] = grid
+    return grid[0].copy(), grid[1].copy(), grid[2].copy()
+
+
+_ChordGridKey = tuple[bytes, tuple[int, ...], float, float, float]
+_CHORD_GRIDS: dict[_ChordGridKey, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+_CHORD_GRIDS_KEPT = 64
+
+
 class ReachabilityOracle:
     """The sound reachability predicate (DESIGN §2): the truth the quantum oracle marks by.
 
@@ -105,8 +136,7 @@ class ReachabilityOracle:
         self.evaluations = 0
         extent = env.bounds[:, 1] - env.bounds[:, 0]
         max_error = float(np.linalg.norm(extent)) * 1.0001
-        self._times, self._curvature = dynamics.curvature_bound_times(max_error, self.resolution)
-        self._phis = np.ascontiguousarray(dynamics.propagators(self._times))
+        self._times, self._curvature, self._phis = chord_grid(dynamics, max_error, self.resolution)
         self._index = env.grid_index
         self._lower = np.ascontiguousarray(env.boxes[:, 0])
         self._upper = np.ascontiguousarray(env.boxes[:, 1])

@@ -2,9 +2,10 @@
 
 Pool and Dask workers are forked from one *fork server* (``multiprocessing``'s ``forkserver``
 start method) that imports this module first: every experiment (and with them Qiskit, Aer, numba,
-scipy), and the default world ``paper_clutter`` (seed 0), whose construction loads the compiled
+scipy), the default world ``paper_clutter`` (seed 0), whose construction loads the compiled
 numba kernels of the collision checks from their on-disk cache and is then cached per process
-(``experiments.worlds.world``). A worker forked from the server starts with all of it in memory
+(``experiments.worlds.world``), and its exact predicate, whose chord grid for the paper's dynamics
+is then cached per process too (``oracle.chord_grid``). A worker forked from the server starts with all of it in memory
 instead of spending seconds of CPU importing and loading it; the fork server itself is a fresh,
 single-threaded interpreter (it never runs a simulator), so forking it is safe.
 
@@ -15,16 +16,18 @@ from __future__ import annotations
 
 from .experiments import EXPERIMENTS  # noqa: F401  (every experiment, planner and backend)
 from .experiments.worlds import world
+from .oracle import ReachabilityOracle
 
 #: the world built (and so cached) in every warm worker
 WARM_WORLD = ("paper_clutter", 0)
 
 
 def warm_up() -> None:
-    """Import everything a trial needs and build the default world (loading numba's kernels)."""
+    """Import everything a trial needs, build the default world (loading numba's kernels) and its
+    exact predicate (caching the paper dynamics' chord grid)."""
     import qiskit_aer  # noqa: F401  (the Aer backend's import, named: it is the heavy one)
 
-    world(*WARM_WORLD)
+    ReachabilityOracle(world(*WARM_WORLD))
 
 
 warm_up()
