@@ -3,8 +3,9 @@
     python benchmarks/bench_nearest.py [--quick] [--out FILE]
 
 One quantum round of the planners pairs 2^n = 256 candidates with their nearest tree nodes. This
-times ``Tree.nearest`` and a compiled 2-D brute force (every query against every node, a reference
-for what another structure could save) for 256 uniform queries on trees of 100 to 3 000 nodes
+times ``Tree.nearest`` (a brute force below ``tree.BRUTE_FORCE_BELOW`` nodes, the grid from there),
+``Tree.grid_nearest`` (the grid at every size) and a compiled 2-D brute force (every query against
+every node, the reference that placed the switch) for 256 uniform queries on trees of 100 to 3 000 nodes
 (``--quick``: up to 300): uniform in the 20 x 20 workspace, and the tree q-RRT grows on paper_clutter (which
 clusters around the start, so many queries lie far from every node). Medians of repeated calls;
 one thread. Prints a table and writes JSON.
@@ -81,14 +82,16 @@ def main() -> None:
                 brute_force(q, t.nodes, t.size, o)
 
             times = {"nearest_us": median_time(lambda t=tree, q=queries: t.nearest(q), repeats)[0] * 1e6,
+                     "grid_us": median_time(lambda t=tree, q=queries: t.grid_nearest(q), repeats)[0] * 1e6,
                      "brute_force_us": median_time(brute, repeats)[0] * 1e6}
             brute()
             assert np.array_equal(out, tree.nearest(queries)), "the kernels disagree"
+            assert np.array_equal(out, tree.grid_nearest(queries)), "the kernels disagree"
             rows.append({"layout": layout, "nodes": size, "queries": QUERIES, **times})
-            print(f"  {layout:8s} {size:5d} nodes: Tree.nearest {times['nearest_us']:7.1f} us, brute force "
-                  f"{times['brute_force_us']:8.1f} us ({QUERIES} queries)")
+            print(f"  {layout:8s} {size:5d} nodes: Tree.nearest {times['nearest_us']:7.1f} us (the grid "
+                  f"{times['grid_us']:7.1f} us), brute force {times['brute_force_us']:8.1f} us ({QUERIES} queries)")
     summary = {f"{row['layout']}_n{row['nodes']}_{key}": row[key]
-               for row in rows for key in ("nearest_us", "brute_force_us")}
+               for row in rows for key in ("nearest_us", "grid_us", "brute_force_us")}
     path = write_json("bench_nearest_quick" if args.quick else "bench_nearest",
                       {"machine": machine(), "quick": args.quick, "rows": rows, "summary": summary}, args.out)
     print(f"wrote {path}")

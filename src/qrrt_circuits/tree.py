@@ -9,7 +9,10 @@ with about one node per cell, each time the tree doubles; nodes added in between
 their cell's list (nodes outside the box go to the nearest border cell, which the stopping bound
 allows for). A query therefore costs about the nodes of a few cells however large the tree, and
 adding a node is O(1) (rebuilds are amortized O(1) per node). Up to ties at rounding level (distances
-equal to about 1e-14) it answers what a brute-force search does (tested).
+equal to about 1e-14) it answers what a brute-force search does (tested). Trees of fewer than
+``BRUTE_FORCE_BELOW`` nodes are searched by that compiled brute force instead (every query against
+every node), which is faster there: ``benchmarks/bench_nearest.py`` put the crossover between 150
+and 200 nodes for a round's 256 queries on two machines.
 """
 
 from __future__ import annotations
@@ -20,6 +23,8 @@ from numba import njit
 #: cells per node when the grid is (re)built, and the most cells one grid has
 _CELLS_PER_NODE = 1.0
 _MAX_CELLS = 1 << 22
+#: trees with fewer nodes answer nearest-node queries by brute force (see the module docstring)
+BRUTE_FORCE_BELOW = 160
 
 
 class Tree:
@@ -101,6 +106,24 @@ class Tree:
         """
         points = np.ascontiguousarray(np.atleast_2d(points), dtype=float)
         out = np.empty(points.shape[0], dtype=np.int64)
+        if self.size < BRUTE_FORCE_BELOW:
+            _brute_nearest(points, self._nodes, self.size, out)
+        else:
+            _grid_nearest(points, self._nodes, self._next, self._head, self._origin, self._cell, self._shape,
+                          self.size, self._low, self._high, out)
+        return out
+
+    def grid_nearest(self, points: np.ndarray) -> np.ndarray:
+        """``nearest`` through the grid whatever the tree's size (for tests and benchmarks).
+
+        Args:
+            points: Float (M, d) or (d,).
+
+        Returns:
+            Int array (M,) of node indices.
+        """
+        points = np.ascontiguousarray(np.atleast_2d(points), dtype=float)
+        out = np.empty(points.shape[0], dtype=np.int64)
         _grid_nearest(points, self._nodes, self._next, self._head, self._origin, self._cell, self._shape,
                       self.size, self._low, self._high, out)
         return out
@@ -171,6 +194,35 @@ def _visit_cell(point: np.ndarray, nodes: np.ndarray, next_node: np.ndarray, hea
                 best_index = node
         node = next_node[node]
     return best, best_index
+
+
+@njit(cache=True, nogil=True)
+def _brute_nearest(points: np.ndarray, nodes: np.ndarray, size: int, out: np.ndarray) -> None:
+    """For each point, the node with the smallest (squared distance, index), trying every node (the
+    squared distance summed over the axes in order, as ``_visit_cell`` does)."""
+    dim = points.shape[1]
+    for row in range(points.shape[0]):
+        best = np.inf
+        best_index = size
+        if dim == 2:  # the planners' case, unrolled (the same sum: 0.0 + dx^2 == dx^2 exactly)
+            x, y = points[row, 0], points[row, 1]
+            for node in range(size):
+                dx = x - nodes[node, 0]
+                dy = y - nodes[node, 1]
+                squared = dx * dx + dy * dy
+                if squared < best:
+                    best = squared
+                    best_index = node
+        else:
+            for node in range(size):
+                squared = 0.0
+                for axis in range(dim):
+                    delta = points[row, axis] - nodes[node, axis]
+                    squared += delta * delta
+                if squared < best:
+                    best = squared
+                    best_index = node
+        out[row] = best_index
 
 
 @njit(cache=True, nogil=True)
