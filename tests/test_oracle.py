@@ -135,7 +135,17 @@ def test_chord_grid_is_computed_once_per_dynamics_and_equals_the_direct_computat
     for got, want in ((second._times, times), (second._curvature, bounds), (second._phis, phis)):
         np.testing.assert_array_equal(got, want)
         assert got.flags["C_CONTIGUOUS"] and got.flags["WRITEABLE"]
-    # ...and a different resolution or horizon gets its own
+    # ...and a different resolution, horizon, workspace size (the largest tracking error the grid
+    # must cover) or closed loop gets its own, equal to the direct computation
     qc.ReachabilityOracle(clutter, dyn, resolution=0.02)
     qc.ReachabilityOracle(clutter, qc.LinearTrackingDynamics.paper(horizon=4.0), resolution=0.01)
-    assert len(oracle_module._CHORD_GRIDS) == 3
+    wide = Environment(clutter.bounds * 3.0, clutter.boxes)
+    faster = qc.LinearTrackingDynamics(dyn.A, dyn.B, dyn.K * 2.0)
+    for env, dynamics in ((wide, dyn), (clutter, faster)):
+        predicate = qc.ReachabilityOracle(env, dynamics, resolution=0.01)
+        extent = float(np.linalg.norm(env.bounds[:, 1] - env.bounds[:, 0])) * 1.0001
+        direct_times, direct_bounds = dynamics.curvature_bound_times(extent, 0.01)
+        np.testing.assert_array_equal(predicate._times, direct_times)
+        np.testing.assert_array_equal(predicate._curvature, direct_bounds)
+        np.testing.assert_array_equal(predicate._phis, dynamics.propagators(direct_times))
+    assert len(oracle_module._CHORD_GRIDS) == 5

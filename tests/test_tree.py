@@ -55,4 +55,75 @@ def test_nearest_agrees_with_the_grid_on_both_sides_of_the_brute_force_switch():
         tree.add(rng.random(2) * 20, 0)
         if tree.size in (tree_module.BRUTE_FORCE_BELOW - 1, tree_module.BRUTE_FORCE_BELOW):
             queries = rng.random((256, 2)) * 20
-            assert np.array_equal(tree.nearest(queries), tree.grid_nearest(queries))
+            want = np.argmin(((queries[:, None, :] - tree.nodes[None]) ** 2).sum(-1), axis=1)
+            assert np.array_equal(tree.nearest(queries), want)  # brute force, then the grid
+            assert np.array_equal(tree.grid_nearest(queries), want)
+
+
+@pytest.mark.parametrize("xs, query", [
+    # a node a rounding error below a cell edge is filed in the cell above it: the search must
+    # still find it (it is nearer by 2.5e-14) ...
+    ([3.1327023920027237, 49.03221452405565, 20.115521880862303, 40.311307218965595, 37.55733649104241,
+      30.67240967123448], 34.11487308113845),
+    # ... and a tie across such an edge goes to the lower index
+    ([-4.590264760638053, -0.8134658907971861, -3.1928491787969326, -1.5310576760669505, -1.7576656082574031,
+      -1.8520855800034244], -1.8048755941304138),
+])
+def test_the_grid_finds_nodes_filed_across_a_cell_edge_by_rounding(xs, query):
+    tree = Tree(np.array(xs[:1]))
+    for value in xs[1:]:
+        tree.add(np.array([value]), 0)
+    squared = (query - np.array(xs)) ** 2
+    assert tree.grid_nearest(np.array([[query]])).tolist() == [int(np.argmin(squared))]
+    assert tree.nearest(np.array([[query]])).tolist() == [int(np.argmin(squared))]
+
+
+def test_cell_edge_near_ties_in_two_dimensions_on_both_sides_of_the_switch():
+    rng = np.random.default_rng(3)
+    checked = 0
+    for _ in range(60):
+        base = rng.uniform(0, 20, (128, 2))
+        probe = Tree(base[0])
+        for point in base[1:]:
+            probe.add(point, 0)
+        origin, cell = probe._origin, probe._cell
+        y = float(rng.uniform(2, 18))
+        for k in range(1, int(probe._shape[0])):
+            edge = origin[0] + k * cell
+            x = np.nextafter(edge, -np.inf)
+            if int((x - origin[0]) / cell) < k:
+                continue  # filed below the edge: not the case under test
+            query = edge - 0.001 * cell
+            tree = Tree(base[0])
+            for point in base[1:]:
+                tree.add(point, 0)
+            tree.add(np.array([x, y]), 0)
+            angle = rng.uniform(np.pi / 2, 3 * np.pi / 2)  # a rival a hair farther, on the query's side
+            radius = (x - query) * (1 + 1e-13)
+            tree.add(np.array([query + radius * np.cos(angle), y + radius * np.sin(angle)]), 0)
+            while tree.size < 160:  # the grid of 128 nodes is kept: no rebuild before 256
+                tree.add(base[tree.size - 130], 0)
+            queries = np.array([[query, y]])
+            want = int(np.argmin(((queries[:, None] - tree.nodes[None]) ** 2).sum(-1)[0]))
+            assert tree.grid_nearest(queries).tolist() == [want]
+            assert tree.nearest(queries).tolist() == [want]
+            checked += 1
+    assert checked >= 20  # the construction produced cell-edge cases
+
+
+def test_queries_of_the_wrong_shape_or_not_finite_are_refused():
+    tree = Tree(np.array([1.0, 2.0]))
+    tree.add(np.array([3.0, 4.0]), 0)
+    for bad in (np.array([[1.0, 2.0, 3.0]]), np.array([[1.0]]), np.array([[np.nan, 1.0]]), np.array([np.inf, 0.0])):
+        for nearest in (tree.nearest, tree.grid_nearest):
+            with pytest.raises(ValueError, match="points"):
+                nearest(bad)
+
+
+def test_queries_whose_squared_distances_overflow_still_end():
+    rng = np.random.default_rng(1)
+    tree = Tree(rng.random(2))
+    for _ in range(300):
+        tree.add(rng.random(2), 0)
+    far = np.array([[1e200, 1.0], [-1e300, -1e300]])  # every squared distance is inf: the lowest index
+    assert tree.nearest(far).tolist() == [0, 0] and tree.grid_nearest(far).tolist() == [0, 0]

@@ -8,8 +8,9 @@ the best distance found (the cell technique of Bentley, Weide and Yao 1980). The
 with about one node per cell, each time the tree doubles; nodes added in between are appended to
 their cell's list (nodes outside the box go to the nearest border cell, which the stopping bound
 allows for). A query therefore costs about the nodes of a few cells however large the tree, and
-adding a node is O(1) (rebuilds are amortized O(1) per node). Up to ties at rounding level (distances
-equal to about 1e-14) it answers what a brute-force search does (tested). Trees of fewer than
+adding a node is O(1) (rebuilds are amortized O(1) per node). It answers what a brute-force search
+does, ties and rounding-level near-ties included: the stopping bound allows for the rounding of a
+node's cell (tested on adversarial cell-edge cases). Trees of fewer than
 ``BRUTE_FORCE_BELOW`` nodes are searched by that compiled brute force instead (every query against
 every node), which is faster there: ``benchmarks/bench_nearest.py`` put the crossover between 150
 and 200 nodes for a round's 256 queries on two machines.
@@ -25,6 +26,9 @@ _CELLS_PER_NODE = 1.0
 _MAX_CELLS = 1 << 22
 #: trees with fewer nodes answer nearest-node queries by brute force (see the module docstring)
 BRUTE_FORCE_BELOW = 160
+#: relative rounding allowance of the grid's stopping bound (a few units in the last place)
+_EDGE_SLACK = 16 * float(np.finfo(float).eps)
+_NOT_FINITE = "points must be finite (no NaN or infinity)"
 
 
 class Tree:
@@ -103,8 +107,11 @@ class Tree:
 
         Returns:
             Int array (M,) of node indices.
+
+        Raises:
+            ValueError: ``points`` not of shape (M, d) or (d,) for the tree's d, or not finite.
         """
-        points = np.ascontiguousarray(np.atleast_2d(points), dtype=float)
+        points = self._queries(points)
         out = np.empty(points.shape[0], dtype=np.int64)
         if self.size < BRUTE_FORCE_BELOW:
             _brute_nearest(points, self._nodes, self.size, out)
@@ -121,12 +128,21 @@ class Tree:
 
         Returns:
             Int array (M,) of node indices.
+
+        Raises:
+            ValueError: ``points`` not of shape (M, d) or (d,) for the tree's d, or not finite.
         """
-        points = np.ascontiguousarray(np.atleast_2d(points), dtype=float)
+        points = self._queries(points)
         out = np.empty(points.shape[0], dtype=np.int64)
         _grid_nearest(points, self._nodes, self._next, self._head, self._origin, self._cell, self._shape,
                       self.size, self._low, self._high, out)
         return out
+
+    def _queries(self, points: np.ndarray) -> np.ndarray:
+        points = np.ascontiguousarray(np.atleast_2d(points), dtype=float)
+        if points.ndim != 2 or points.shape[1] != self.dim:
+            raise ValueError(f"points must have shape (M, {self.dim}) (the tree's d), got {points.shape}")
+        return points  # the kernels refuse points that are not finite
 
     def _build_grid(self) -> None:
         nodes = self.nodes
@@ -202,8 +218,13 @@ def _brute_nearest(points: np.ndarray, nodes: np.ndarray, size: int, out: np.nda
     squared distance summed over the axes in order, as ``_visit_cell`` does)."""
     dim = points.shape[1]
     for row in range(points.shape[0]):
+        for axis in range(dim):
+            if not np.isfinite(points[row, axis]):
+                raise ValueError(_NOT_FINITE)
+        # node 0 first, then strictly nearer ones: the lowest index among equals, also when every
+        # squared distance overflows to inf (as _visit_cell's (squared distance, index) order)
         best = np.inf
-        best_index = size
+        best_index = 0
         if dim == 2:  # the planners' case, unrolled (the same sum: 0.0 + dx^2 == dx^2 exactly)
             x, y = points[row, 0], points[row, 1]
             for node in range(size):
@@ -237,8 +258,12 @@ def _grid_nearest(points: np.ndarray, nodes: np.ndarray, next_node: np.ndarray, 
     lower = np.empty(dim, dtype=np.int64)
     upper = np.empty(dim, dtype=np.int64)
     outside = np.empty(dim)  # the point's distance to the nodes' bounding box along each axis
+    slack = np.empty(dim)  # the rounding allowance of the cell edges along each axis (see below)
     for row in range(points.shape[0]):
         point = points[row]
+        for axis in range(dim):
+            if not np.isfinite(point[axis]):
+                raise ValueError(_NOT_FINITE)
         _cell_of(point, origin, cell, shape, centre)
         outside_total = 0.0
         for axis in range(dim):
@@ -246,6 +271,7 @@ def _grid_nearest(points: np.ndarray, nodes: np.ndarray, next_node: np.ndarray, 
             above = point[axis] - high[axis]
             outside[axis] = max(below, above, 0.0)
             outside_total += outside[axis] * outside[axis]
+            slack[axis] = _EDGE_SLACK * (abs(point[axis]) + abs(origin[axis]) + shape[axis] * cell)
         best = np.inf
         best_index = size
         ring = 0
@@ -289,16 +315,23 @@ def _grid_nearest(points: np.ndarray, nodes: np.ndarray, next_node: np.ndarray, 
             # block: beyond one side of one axis, the gap to that side plus, along the other axes,
             # the point's distance to the nodes' bounding box (nodes outside the grid's box sit in
             # its border cells, so the gaps hold for them too)
+            # Each gap is shortened by a few units in the last place of the coordinates involved:
+            # a node is filed by int((x - origin) / cell), which can put a node lying a rounding
+            # error below a computed edge origin + k * cell into cell k, and the search must not
+            # stop before reaching it (a node as near as the best, or a tie with a lower index).
             bound = np.inf
+            covers = True
             for axis in range(dim):
                 others = outside_total - outside[axis] * outside[axis]
                 if centre[axis] - ring - 1 >= 0:
-                    gap = max(point[axis] - (origin[axis] + (centre[axis] - ring) * cell), 0.0)
+                    covers = False
+                    gap = max(point[axis] - (origin[axis] + (centre[axis] - ring) * cell) - slack[axis], 0.0)
                     bound = min(bound, gap * gap + others)
                 if centre[axis] + ring + 1 <= shape[axis] - 1:
-                    gap = max(origin[axis] + (centre[axis] + ring + 1) * cell - point[axis], 0.0)
+                    covers = False
+                    gap = max(origin[axis] + (centre[axis] + ring + 1) * cell - point[axis] - slack[axis], 0.0)
                     bound = min(bound, gap * gap + others)
-            if bound > best:  # inf when the block covers the grid
+            if covers or bound > best * (1.0 + _EDGE_SLACK):  # every cell visited, or none left nearer
                 break
             ring += 1
         out[row] = best_index
