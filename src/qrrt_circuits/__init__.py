@@ -6,6 +6,7 @@ Lathrop, Boardman and Martinez, "Parallel Quantum Rapidly-Exploring Random Trees
 """
 
 from importlib import metadata as _metadata
+from typing import TYPE_CHECKING, Any
 
 from . import probability, registry, scenarios, termination
 from .authors_check import AuthorsCheck
@@ -16,20 +17,7 @@ from .oracle import ReachabilityOracle
 from .oracle_errors import OracleErrorModel
 from .planners import PQRRT, QRRT, RRT, Metrics, ParallelRRT, PlanResult
 from .predicate import ReachabilityPredicate
-from .search import (
-    AerBackend,
-    DatabaseSearch,
-    EstimatedOptimal,
-    FixedPointAmplification,
-    IterateSequence,
-    QuantumSearchBackend,
-    SamplerBackend,
-    SearchOutcome,
-    SearchRequest,
-    SearchResult,
-    StatevectorBackend,
-    circuits,
-)
+from .search.backend import QuantumSearchBackend, SearchRequest, SearchResult
 from .search.policies import (
     BBHT,
     Adaptive,
@@ -39,6 +27,7 @@ from .search.policies import (
     PaperSchedule,
     SearchPolicy,
 )
+from .search.problem import DatabaseSearch, SearchOutcome
 from .termination import (
     AnyOf,
     MaxCriticalPathCalls,
@@ -51,6 +40,35 @@ from .termination import (
     TerminationCondition,
 )
 from .time_sampled import TimeSampledCheck
+
+if TYPE_CHECKING:
+    from .search import circuits
+    from .search.aer import AerBackend
+    from .search.estimated_policy import EstimatedOptimal
+    from .search.fixed_point import IterateSequence
+    from .search.fixed_point_policy import FixedPointAmplification
+    from .search.sampler import SamplerBackend
+    from .search.statevector import StatevectorBackend
+
+#: the names imported on first use (PEP 562): their modules import Qiskit (the circuits, Aer, the
+#: sampler, amplitude estimation) or its circuit types, which a plan on the statevector never needs
+_LAZY = ("AerBackend", "EstimatedOptimal", "FixedPointAmplification", "IterateSequence", "SamplerBackend",
+         "StatevectorBackend", "circuits")
+
+
+def __getattr__(name: str) -> Any:
+    """``qrrt_circuits.search``'s lazily imported names, cached here on first use."""
+    if name in _LAZY:
+        from . import search
+
+        value = getattr(search, name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
 
 try:  # one source of the version: ``version`` in pyproject.toml, read from the installed metadata
     __version__ = _metadata.version("qrrt-circuits")

@@ -34,7 +34,6 @@ from ..environment import Environment
 from ..memory import MemoryEstimate, check_fits, database_bytes, database_resident_bytes
 from ..oracle_errors import OracleErrorModel
 from ..predicate import ReachabilityPredicate
-from ..search.aer import AerBackend
 from ..search.backend import QuantumSearchBackend
 from ..search.policies import IterationPolicy, PaperSchedule, PolicyState
 from ..search.problem import DatabaseSearch
@@ -187,7 +186,10 @@ class PQRRT(Planner):
     ) -> None:
         self.num_qubits = check_int(num_qubits, "num_qubits", 1)
         self.workers = check_int(workers, "workers", 1, MAX_WORKERS)
-        backend = AerBackend() if backend is None else backend
+        if backend is None:
+            from ..search.aer import AerBackend  # qiskit and Aer are imported only when used
+
+            backend = AerBackend()
         check_instance(backend, "backend", QuantumSearchBackend, "a QuantumSearchBackend")
         backend.check_qubits(self.num_qubits)
         if search_policy is not None and iterations is not None and search_policy is not iterations:

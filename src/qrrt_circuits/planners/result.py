@@ -4,12 +4,14 @@ from __future__ import annotations
 
 from collections.abc import KeysView
 from dataclasses import asdict, dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import networkx as nx
 import numpy as np
 
 from ..termination import PlanStatus
+
+if TYPE_CHECKING:
+    import networkx as nx
 
 
 @dataclass(frozen=True)
@@ -145,6 +147,8 @@ class PlanResult:
     @property
     def tree(self) -> nx.DiGraph:
         """The tree as a networkx DiGraph (edges parent -> child, node attribute ``pos``)."""
+        import networkx as nx
+
         graph = nx.DiGraph()
         for index, position in enumerate(self.nodes):
             graph.add_node(index, pos=tuple(position))

@@ -34,14 +34,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from qiskit import QuantumCircuit
-from qiskit.circuit.library import DiagonalGate
 
 from ..validation import check_float, check_int
 from .backend import MAX_ITERATIONS, validate_marks
+
+if TYPE_CHECKING:
+    from qiskit import QuantumCircuit
 
 LENGTH_RULES = ("paper", "tight")
 
@@ -391,6 +392,9 @@ def phase_oracle_beta(marks: np.ndarray, beta: float, synthesis: str = "diagonal
         raise ValueError(f"synthesis must be one of {SYNTHESES}, got {synthesis!r}")
     if synthesis == "auto":
         synthesis = choose_synthesis(marks)
+    from qiskit import QuantumCircuit
+    from qiskit.circuit.library import DiagonalGate
+
     circuit = QuantumCircuit(n, name=f"oracle({beta:.3f})")
     if synthesis == "diagonal":
         circuit.append(DiagonalGate(np.where(marks, np.exp(1j * beta), 1.0).tolist()), range(n))
@@ -452,6 +456,8 @@ def generalized_grover_circuit(marks: np.ndarray, sequence: IterateSequence, mea
     marks, n = validate_marks(marks)
     if not isinstance(sequence, IterateSequence):
         raise TypeError(f"sequence must be an IterateSequence, got {type(sequence).__name__}")
+    from qiskit import QuantumCircuit
+
     circuit = QuantumCircuit(n, name="fixed_point")
     circuit.h(range(n))
     for alpha, beta in zip(sequence.alphas, sequence.betas, strict=True):
