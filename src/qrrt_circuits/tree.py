@@ -111,27 +111,16 @@ class Tree:
         Raises:
             ValueError: ``points`` not of shape (M, d) or (d,) for the tree's d, or not finite.
         """
+        if self.size >= BRUTE_FORCE_BELOW:
+            return self.grid_nearest(points)
         points = self._queries(points)
         out = np.empty(points.shape[0], dtype=np.int64)
-        if self.size < BRUTE_FORCE_BELOW:
-            _brute_nearest(points, self._nodes, self.size, out)
-        else:
-            _grid_nearest(points, self._nodes, self._next, self._head, self._origin, self._cell, self._shape,
-                          self.size, self._low, self._high, out)
+        _brute_nearest(points, self._nodes, self.size, out)
         return out
 
     def grid_nearest(self, points: np.ndarray) -> np.ndarray:
-        """``nearest`` through the grid whatever the tree's size (for tests and benchmarks).
-
-        Args:
-            points: Float (M, d) or (d,).
-
-        Returns:
-            Int array (M,) of node indices.
-
-        Raises:
-            ValueError: ``points`` not of shape (M, d) or (d,) for the tree's d, or not finite.
-        """
+        """``nearest`` through the grid whatever the tree's size (for tests and benchmarks): the
+        same argument (float points, (M, d) or (d,)), result (int (M,) node indices) and errors."""
         points = self._queries(points)
         out = np.empty(points.shape[0], dtype=np.int64)
         _grid_nearest(points, self._nodes, self._next, self._head, self._origin, self._cell, self._shape,
