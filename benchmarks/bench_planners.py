@@ -80,14 +80,17 @@ class TimedPredicate:
 
 class PartTimer:
     """Times the main parts of a quantum planner's round by wrapping, for the duration of a
-    ``with`` block, the class methods that do them: the nearest-node query of the candidates
-    (``Tree.nearest``), the compiled candidate draws (``database.uniform_draws``) and the backend's
-    searches (``QuantumSearchBackend.search_many``, also ``search``). The predicate is timed by
-    ``TimedPredicate``; the rest of the round (the policy, verification, bookkeeping, the planner's
-    loop) is the plan's wall time minus these."""
+    ``with`` block, the functions that do them. Generic rounds: the nearest-node query of the
+    candidates (``Tree.nearest``), the compiled candidate draws (``database.uniform_draws``) and the
+    backend's searches (``QuantumSearchBackend.search_many``, also ``search``). Fused rounds
+    (``planners.fused_round``): the compiled call that draws the candidates and finds their nearest
+    nodes (``fused_candidates``) and the one that draws and verifies the measured indices
+    (``fused_search``). The predicate is timed by ``TimedPredicate``; the rest of the round (the
+    policy, verification, bookkeeping, the planner's loop) is the plan's wall time minus these."""
 
     def __init__(self) -> None:
-        self.seconds = {"nearest": 0.0, "candidate_draws": 0.0, "search": 0.0}
+        self.seconds = {"nearest": 0.0, "candidate_draws": 0.0, "search": 0.0, "fused_candidates": 0.0,
+                        "fused_search": 0.0}
         self._patched: list[tuple[object, str, object]] = []
 
     def _wrap(self, owner, attribute: str, part: str) -> None:
@@ -106,12 +109,15 @@ class PartTimer:
 
     def __enter__(self) -> PartTimer:
         from qrrt_circuits import database
+        from qrrt_circuits.planners import fused_round
         from qrrt_circuits.search.backend import QuantumSearchBackend
         from qrrt_circuits.tree import Tree
 
         self._wrap(Tree, "nearest", "nearest")
         self._wrap(database, "uniform_draws", "candidate_draws")
         self._wrap(QuantumSearchBackend, "search_many", "search")
+        self._wrap(fused_round, "_candidates", "fused_candidates")
+        self._wrap(fused_round, "_measure", "fused_search")
         return self
 
     def __exit__(self, *exc_info) -> None:
@@ -139,18 +145,23 @@ def breakdown(make, env, seed: int, nodes: int, big: bool) -> dict:
             "share": {k: v / wall for k, v in per_round.items()}}
 
 
-#: configurations whose round is broken down into parts (label, big)
-BREAKDOWN = (("QRRT statevector", False), ("QRRT statevector 3000 nodes", True),
-             ("PQRRT shared statevector", False))
+#: configurations whose round is broken down into parts (label, configuration, big, planner options): each
+#: quantum configuration with its default (fused) round and with the generic round, in one run
+BREAKDOWN = tuple((label + suffix, label, big, options)
+                  for label, big in (("QRRT statevector", False), ("QRRT statevector 3000 nodes", True),
+                                     ("PQRRT shared statevector", False))
+                  for suffix, options in (("", {}), (", generic round", {"fused_round": False})))
 
 
-def configurations():
-    """label -> planner factory (env, seed, predicate), every planner built through the registry."""
+def configurations(**options):
+    """label -> planner factory (env, seed, predicate), every planner built through the registry
+    (``options`` go to the quantum planners)."""
     from qrrt_circuits.experiments.planners import make_planner
 
     def factory(planner, backend, policy):
+        extra = options if backend is not None else {}
         return lambda env, seed, predicate: make_planner(planner, env, seed, backend or "statevector",
-                                                         search_policy=policy, predicate=predicate)
+                                                         search_policy=policy, predicate=predicate, **extra)
 
     return {label: factory(planner, backend, policy) for label, planner, backend, policy in CONFIGURATIONS}
 
@@ -255,18 +266,18 @@ def main() -> None:
     if not with_ompl:
         print("(ompl not importable: OMPL comparison skipped; pip install '.[ompl]')")
     parts = {}
-    makers = configurations()
-    print(f"\n{'round breakdown, us per round':32s} " + " ".join(f"{k:>15s}" for k in
-          ("predicate", "nearest", "candidate_draws", "search", "rest")))
-    for name, big in BREAKDOWN:
-        runs = [breakdown(makers[name], env, seed, big_nodes if big else nodes, big)
+    print(f"\n{'round breakdown, us per round':44s} " + " ".join(f"{k:>15s}" for k in
+          ("predicate", "nearest", "candidate_draws", "search", "fused_candidates", "fused_search", "rest")))
+    for name, configuration, big, options in BREAKDOWN:
+        make = configurations(**options)[configuration]
+        runs = [breakdown(make, env, seed, big_nodes if big else nodes, big)
                 for seed, env in enumerate(worlds[:big_seeds] if big else worlds)]
         medians = {k: float(np.median([r["us_per_round"][k] for r in runs])) for k in runs[0]["us_per_round"]}
         shares = {k: float(np.median([r["share"][k] for r in runs])) for k in runs[0]["share"]}
         parts[name] = {"runs": runs, "us_per_round": medians, "share": shares,
                        "reachable_fraction": float(np.median([r["reachable_fraction"] for r in runs])),
                        "predicate_us_per_pair": float(np.median([r["predicate_us_per_pair"] for r in runs]))}
-        print(f"{name:32s} " + " ".join(f"{medians[k]:8.1f} ({shares[k]:3.0%})" for k in medians)
+        print(f"{name:44s} " + " ".join(f"{medians[k]:8.1f} ({shares[k]:3.0%})" for k in medians)
               + f"   reachable {parts[name]['reachable_fraction']:.2f}, "
               f"predicate {parts[name]['predicate_us_per_pair']:.2f} us/pair")
     construction = predicate_construction(worlds[0])

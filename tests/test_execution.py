@@ -19,10 +19,14 @@ def dask_client(tmp_path_factory):
     from distributed import Client, LocalCluster
 
     scratch = tmp_path_factory.mktemp("dask")
+    import dask
+
     from qrrt_circuits.execution import NO_DASHBOARD
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      dashboard_address=NO_DASHBOARD, local_directory=str(scratch)) as cluster, \
+    # the scheduler, too, keeps its scratch space (and lock files) under "temporary-directory"
+    with dask.config.set({"temporary-directory": str(scratch)}), \
+            LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                         dashboard_address=NO_DASHBOARD, local_directory=str(scratch)) as cluster, \
             Client(cluster) as client:
         yield client
 

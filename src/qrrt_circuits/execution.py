@@ -221,7 +221,8 @@ def _local_dask(jobs: int, retries: int, local_directory: str | None) -> Iterato
     import dask
     from distributed import Client, LocalCluster
 
-    # Dask leaves lock files in its scratch directory: give it one of ours and remove it after
+    # Dask leaves lock files in its scratch directory: give it one of ours and remove it after (the
+    # workers get it as local_directory, the scheduler through "temporary-directory")
     scratch = None if local_directory is not None else tempfile.TemporaryDirectory(prefix="qrrt-dask-")
     local_directory = local_directory if scratch is None else scratch.name
     try:
@@ -229,7 +230,8 @@ def _local_dask(jobs: int, retries: int, local_directory: str | None) -> Iterato
         # started); only spawned ones need it in ours (a change of os.environ while another thread
         # runs trials would race with C code reading the environment)
         with _warm_fork_server(("distributed",)) as method, \
-                dask.config.set({**LOCAL_DASK_CONFIG, "distributed.worker.multiprocessing-method": method}), \
+                dask.config.set({**LOCAL_DASK_CONFIG, "distributed.worker.multiprocessing-method": method,
+                                 "temporary-directory": local_directory}), \
                 (_single_thread_environment() if method == "spawn" else contextlib.nullcontext()), \
                 LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, host="127.0.0.1",
                              dashboard_address=NO_DASHBOARD, local_directory=local_directory) as cluster, \

@@ -111,12 +111,19 @@ class Tree:
         Raises:
             ValueError: ``points`` not of shape (M, d) or (d,) for the tree's d, or not finite.
         """
-        if self.size >= BRUTE_FORCE_BELOW:
-            return self.grid_nearest(points)
         points = self._queries(points)
         out = np.empty(points.shape[0], dtype=np.int64)
-        _brute_nearest(points, self._nodes, self.size, out)
+        nearest_into(points, *self.search_arrays(), out)
         return out
+
+    def search_arrays(self) -> tuple[np.ndarray, int, np.ndarray, np.ndarray, np.ndarray, float, np.ndarray,
+                                     np.ndarray, np.ndarray]:
+        """The arguments of ``nearest_into`` after the points, for compiled callers (the planners'
+        fused round, ``planners.fused_round``): the node buffer, the size, the grid's lists
+        (next node, cell heads), origin, cell size, shape and the nodes' bounding box. The arrays
+        are the tree's own (not copies) and stay valid until the next ``add``."""
+        return (self._nodes, self.size, self._next, self._head, self._origin, self._cell, self._shape,
+                self._low, self._high)
 
     def grid_nearest(self, points: np.ndarray) -> np.ndarray:
         """``nearest`` through the grid whatever the tree's size (for tests and benchmarks): the
@@ -233,6 +240,18 @@ def _brute_nearest(points: np.ndarray, nodes: np.ndarray, size: int, out: np.nda
                     best = squared
                     best_index = node
         out[row] = best_index
+
+
+@njit(cache=True, nogil=True)
+def nearest_into(points: np.ndarray, nodes: np.ndarray, size: int, next_node: np.ndarray, head: np.ndarray,
+                 origin: np.ndarray, cell: float, shape: np.ndarray, low: np.ndarray, high: np.ndarray,
+                 out: np.ndarray) -> None:
+    """``Tree.nearest`` compiled: the brute force below ``BRUTE_FORCE_BELOW`` nodes, else the grid
+    (the arguments after ``points`` are ``Tree.search_arrays()``); writes the node indices into ``out``."""
+    if size < BRUTE_FORCE_BELOW:
+        _brute_nearest(points, nodes, size, out)
+    else:
+        _grid_nearest(points, nodes, next_node, head, origin, cell, shape, size, low, high, out)
 
 
 @njit(cache=True, nogil=True)

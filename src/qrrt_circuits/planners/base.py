@@ -37,6 +37,7 @@ from .run_state import RunState
 
 if TYPE_CHECKING:
     from ..search.policies import PolicyState
+    from .fused_round import FusedRound
 
 #: kept for 0.1 code that imports it from here; the value lives in ``qrrt_circuits.termination``
 DEFAULT_MAX_ROUNDS = _termination.DEFAULT_MAX_ROUNDS
@@ -193,6 +194,7 @@ class Planner:
         state = RunState(start, goal, goal_radius)
         state.policy_state = self._start_policy()
         state.context = self._context()
+        state.fused_round = self._fused_round()
         began = time.perf_counter()
         status = self._run(state, condition, began)
         elapsed = time.perf_counter() - began
@@ -253,6 +255,10 @@ class Planner:
 
     def _round(self, state: RunState) -> None:
         raise NotImplementedError
+
+    def _fused_round(self) -> FusedRound | None:
+        """The plan's ``FusedRound`` where the quantum planners can use one (None here)."""
+        return None
 
     def _context(self) -> WorkerContext:
         """What workers need for this plan (subclasses add their backend, schedule, sizes)."""

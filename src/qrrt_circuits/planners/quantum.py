@@ -41,6 +41,7 @@ from ..validation import check_bool, check_instance, check_int
 from .base import Planner
 from .classical import MAX_WORKERS
 from .context import RoundView, WorkerContext, map_tasks
+from .fused_round import FusedRound
 from .run_state import RunState
 from .workers import DatabaseOutcome, make_database, search_database
 
@@ -146,14 +147,20 @@ class PQRRT(Planner):
             error.
         iterations: Alias of ``search_policy`` kept from 0.1; giving both (as different objects) is
             an error.
+        fused_round: True (default): rounds that need no Python in between (no executor, annealing
+            or goal bias; a backend whose seeded search is the closed-form draw, i.e. the
+            ``StatevectorBackend``; a policy that fixes k before seeing the database) run in two
+            compiled calls around the predicate (``qrrt_circuits.planners.fused_round``), with the
+            same results bit for bit. False: every round takes the generic path (for tests and
+            benchmarks). Must be a ``bool``.
 
     Raises:
         TypeError: An argument of the wrong type: ``env`` not an ``Environment``, a non-integer
             ``num_qubits``, ``workers`` or ``seed``, a non-real ``goal_bias`` or ``resolution``,
             ``dynamics`` or ``oracle_errors`` of the wrong class, a ``backend`` that is not a
             ``QuantumSearchBackend``, a ``search_policy`` that is not an ``IterationPolicy``, an
-            ``annealing`` that is not an ``AnnealingSchedule``, a non-bool ``shared_database``, or a
-            ``predicate`` that lacks the members of the ``ReachabilityPredicate`` protocol.
+            ``annealing`` that is not an ``AnnealingSchedule``, a non-bool ``shared_database`` or
+            ``fused_round``, or a ``predicate`` that lacks the members of the ``ReachabilityPredicate`` protocol.
         ValueError: ``num_qubits`` < 1 or above the backend's ``max_qubits``, ``workers`` outside
             [1, 4096], ``goal_bias`` outside [0, 1), a non-positive or non-finite ``resolution``, a
             negative ``seed``, a dimension mismatch between ``env`` and ``predicate`` or
@@ -183,8 +190,10 @@ class PQRRT(Planner):
         seed: int | None = None,
         oracle: ReachabilityPredicate | None = None,
         iterations: IterationPolicy | None = None,
+        fused_round: bool = True,
     ) -> None:
         self.num_qubits = check_int(num_qubits, "num_qubits", 1)
+        self.fused_round = check_bool(fused_round, "fused_round")
         self.workers = check_int(workers, "workers", 1, MAX_WORKERS)
         if backend is None:
             from ..search.aer import AerBackend  # qiskit and Aer are imported only when used
@@ -253,6 +262,13 @@ class PQRRT(Planner):
         return WorkerContext(self.env, self.predicate, self.streams, self.goal_bias, self.oracle_errors,
                              self.backend, self.annealing, self.database_size)
 
+    def _fused_round(self) -> FusedRound | None:
+        """A ``FusedRound`` if this plan's rounds can be fused (see ``fused_round``), else None."""
+        if (not self.fused_round or self.executor is not None or self.annealing is not None or self.goal_bias > 0
+                or not self.backend.draws_closed_form(self.num_qubits)):
+            return None
+        return FusedRound(self.env, self.predicate, self.streams, self.oracle_errors, self.backend, self.num_qubits)
+
     def _worker_groups(self) -> list[tuple[int, int]]:
         """(first worker, workers) per database: one group of p on a shared database, p of one."""
         if self.shared_database:
@@ -266,10 +282,15 @@ class PQRRT(Planner):
         return self.annealing.temperature_index(state.rounds, state.nodes)
 
     def _round(self, state: RunState) -> None:
-        view = self._view(state, self._temperature_index(state))
-        if self.executor is None:  # the round's searches go to the backend together (same outcomes)
+        fused = state.fused_round
+        iterations = None if fused is None else state.search_policy_state.preset_iterations(state.nodes)
+        if fused is not None and iterations is not None:  # two compiled calls per database, the same outcomes
+            results = fused.search(state.tree, state.rounds, self._worker_groups(), iterations)
+        elif self.executor is None:  # the round's searches go to the backend together (same outcomes)
+            view = self._view(state, self._temperature_index(state))
             results = search_databases_together(state.worker_context, view, self._worker_groups())
         else:
+            view = self._view(state, self._temperature_index(state))
             results = map_tasks(self.executor, search_database, state.worker_context, view,
                                 self._worker_groups())
         longest = 0
@@ -380,14 +401,17 @@ class QRRT(PQRRT):
             error.
         iterations: Alias of ``search_policy`` kept from 0.1; giving both (as different objects) is
             an error.
+        fused_round: True (default) to run the rounds that allow it in compiled calls around the
+            predicate, with the same results; False for the generic round (see ``PQRRT``). Must be
+            a ``bool``.
 
     Raises:
         TypeError: An argument of the wrong type: ``env`` not an ``Environment``, a non-integer
             ``num_qubits`` or ``seed``, a non-real ``goal_bias`` or ``resolution``, ``dynamics`` or
             ``oracle_errors`` of the wrong class, a ``backend`` that is not a
             ``QuantumSearchBackend``, a ``search_policy`` that is not an ``IterationPolicy``, an
-            ``annealing`` that is not an ``AnnealingSchedule``, or a ``predicate`` that lacks the
-            members of the ``ReachabilityPredicate`` protocol.
+            ``annealing`` that is not an ``AnnealingSchedule``, a non-bool ``fused_round``, or a
+            ``predicate`` that lacks the members of the ``ReachabilityPredicate`` protocol.
         ValueError: ``num_qubits`` < 1 or above the backend's ``max_qubits``, ``goal_bias`` outside
             [0, 1), a non-positive or non-finite ``resolution``, a negative ``seed``, a dimension
             mismatch between ``env`` and ``predicate`` or ``dynamics``, both ``predicate`` and
@@ -414,8 +438,10 @@ class QRRT(PQRRT):
         seed: int | None = None,
         oracle: ReachabilityPredicate | None = None,
         iterations: IterationPolicy | None = None,
+        fused_round: bool = True,
     ) -> None:
         super().__init__(env, backend=backend, num_qubits=num_qubits, workers=1, shared_database=True,
                          search_policy=search_policy, annealing=annealing, predicate=predicate,
                          dynamics=dynamics, oracle_errors=oracle_errors, goal_bias=goal_bias,
-                         resolution=resolution, seed=seed, oracle=oracle, iterations=iterations)
+                         resolution=resolution, seed=seed, oracle=oracle, iterations=iterations,
+                         fused_round=fused_round)

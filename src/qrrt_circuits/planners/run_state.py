@@ -13,6 +13,7 @@ from ..tree import Tree
 if TYPE_CHECKING:  # annotations only (context imports the search modules)
     from ..search.policies import PolicyState
     from .context import WorkerContext
+    from .fused_round import FusedRound
 
 HISTORY_KEYS = ("oracle_calls", "critical_path", "nodes", "entries", "reachable")
 
@@ -41,6 +42,7 @@ class RunState:
         self._nodes_at_round_start = 0
         self.policy_state: PolicyState | None = None  # quantum planners only
         self.context: WorkerContext | None = None  # the plan's WorkerContext, built once
+        self.fused_round: FusedRound | None = None  # quantum planners whose rounds can be fused
 
     @property
     def worker_context(self) -> WorkerContext:

@@ -363,6 +363,23 @@ class QuantumSearchBackend(abc.ABC):
         raise NotImplementedError(f"backend {self.name!r} does not run generalized Grover iterates "
                                   "(search_sequence); use the aer, statevector or sampler backend")
 
+    def draws_closed_form(self, num_qubits: int) -> bool:
+        """Whether every seeded search of 2^n entries is the compiled two-level closed-form draw.
+
+        True means: ``search(marks, k, shots, seed)`` with an integer ``seed`` returns exactly the
+        indices of ``statevector._draw_two_level_seeded(marks, p, shots, integer_seed_words(seed))``
+        with p = sin^2((2k+1) theta), sin^2 theta = m / 2^n (Eq. 1, Lemma 1). The quantum planners'
+        fused round (``qrrt_circuits.planners.fused_round``) then draws and verifies the measured
+        indices in one compiled call instead of calling ``search``, with the same results.
+
+        Args:
+            num_qubits: n.
+
+        Returns:
+            False here; ``StatevectorBackend`` answers True for its closed form.
+        """
+        return False
+
     def labels(self) -> tuple[str, ...]:
         """Caveats every result that depends on this backend must carry (none by default)."""
         return ()

@@ -127,6 +127,20 @@ class StatevectorBackend(QuantumSearchBackend):
             state = 2.0 * state.mean() - state
         return state
 
+    def draws_closed_form(self, num_qubits: int) -> bool:
+        """True with ``closed_form`` for n <= 32 (the compiled draw's 32-bit bound), unless a subclass
+        changes how a search is validated or drawn (``QuantumSearchBackend.draws_closed_form``).
+
+        Args:
+            num_qubits: n.
+
+        Returns:
+            Whether a seeded search is ``_draw_two_level_seeded``.
+        """
+        own = all(getattr(type(self), name) is getattr(StatevectorBackend, name)
+                  for name in ("search", "search_many", "_prepare", "_sample_seeded", "_finish"))
+        return self.closed_form and num_qubits <= 32 and own
+
     def _sample_seeded(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
                        seed: int | np.random.Generator | None) -> np.ndarray:
         """The closed form with an integer seed draws in one compiled call (``_draw_two_level_seeded``:

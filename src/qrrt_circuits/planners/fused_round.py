@@ -1,0 +1,209 @@
+"""One quantum round in two compiled calls around the predicate (q-RRT Alg. 2, Pq-RRT Alg. 3).
+
+The generic round (``workers.make_database``, ``DatabaseSearch``, the policy's ``run``, the
+backend's ``search``) spends most of its non-oracle time in Python: building the keyed generators'
+seeds, the candidate draws, the nearest-node queries, the validated search request, the seeded
+draw and the verification are each a call of their own. When nothing in a round needs Python,
+``FusedRound`` does the same work in two compiled calls per database:
+
+1. ``_candidates``: the seed words of stream (round, worker, ``Stream.CANDIDATES``), the 2^n x d
+   uniform doubles, the samples low + (high - low) u, their nearest tree nodes
+   (``tree.nearest_into``) and the parents' positions (Alg. 1 lines 4-8);
+2. the predicate's own ``reachable`` on those pairs (the oracle; not fused, so it is timed and
+   counted as before), and the error model's flips if there is one;
+3. ``_measure``: the seed of stream (round, worker, ``Stream.SEARCH``), the backend's generator of
+   that seed, the two-level closed-form draw of ``shots`` measured indices
+   (``statevector._draw_two_level_seeded``, Eq. 1 / Lemma 1) and the classical verification of each
+   (the finalizer: 1 oracle call per worker).
+
+Every number is the one the generic round produces, bit for bit: the same draws in the same order
+from the same PCG64 states, the same nearest-node kernels, the same predicate calls in the same
+order, the same k, the same ``SearchOutcome`` objects handed to the planner's bookkeeping and to the
+policy's ``learn`` (tested against the generic round, and by the planner fingerprints). The fused
+round is used when the plan has no executor, no annealing and no goal bias, the backend's seeded
+search is the closed-form draw (``QuantumSearchBackend.draws_closed_form``: the
+``StatevectorBackend``) and, per round, the policy fixes k before seeing the database
+(``PolicyState.preset_iterations``: the paper's schedule, fixed k, ``Adaptive``); otherwise the
+round is the generic one.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ..environment import Environment
+from ..oracle_errors import OracleErrorModel
+from ..predicate import ReachabilityPredicate
+from ..probability import good_probability
+from ..randomness import RandomStreams, Stream, _next64, _next_double, _pcg_state, _seed_words
+from ..search.backend import QuantumSearchBackend, validate_iterations, validate_marks
+from ..search.problem import SearchOutcome
+from ..search.statevector import _draw_two_level_seeded
+from ..tree import Tree, nearest_into
+from .workers import DatabaseOutcome
+
+_MASK32 = np.uint64(0xFFFFFFFF)
+_CANDIDATES = int(Stream.CANDIDATES)
+_SEARCH = int(Stream.SEARCH)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _key(round_index: int, worker: int, stream: int) -> np.ndarray:
+    """The spawn key (round, worker, stream) as the (1, 3) array ``_seed_words`` takes."""
+    key = np.empty((1, 3), dtype=np.int64)
+    key[0, 0], key[0, 1], key[0, 2] = round_index, worker, stream
+    return key
+
+
+@njit(cache=True, nogil=True)
+def _candidates(run_entropy: np.ndarray, round_index: int, worker: int, size: int, low: np.ndarray,
+                high: np.ndarray, nodes: np.ndarray, tree_size: int, next_node: np.ndarray, head: np.ndarray,
+                origin: np.ndarray, cell: float, shape: np.ndarray, box_low: np.ndarray,
+                box_high: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``stream_database`` without goal bias or annealing, plus the parents' positions.
+
+    The samples are ``low + (high - low) * u`` with u the first ``size * d`` doubles of the
+    generator of (``round_index``, ``worker``, ``Stream.CANDIDATES``) (row-major, as
+    ``uniform_draws(...).reshape(size, d)``), the parents their nearest nodes (``nearest_into``: the
+    kernels of ``Tree.nearest``).
+
+    Returns:
+        (children (size, d), parents (size,), parent positions (size, d)).
+    """
+    state = _pcg_state(_seed_words(run_entropy, _key(round_index, worker, _CANDIDATES))[0])
+    dim = low.shape[0]
+    children = np.empty((size, dim))
+    for row in range(size):
+        for axis in range(dim):
+            children[row, axis] = low[axis] + (high[axis] - low[axis]) * _next_double(state)
+    parents = np.empty(size, dtype=np.int64)
+    nearest_into(children, nodes, tree_size, next_node, head, origin, cell, shape, box_low, box_high, parents)
+    positions = np.empty((size, dim))
+    for row in range(size):
+        for axis in range(dim):
+            positions[row, axis] = nodes[parents[row], axis]
+    return children, parents, positions
+
+
+@njit(cache=True, nogil=True)
+def _measure(run_entropy: np.ndarray, round_index: int, worker: int, marks: np.ndarray, truth: np.ndarray,
+             p_good: float, shots: int) -> tuple[np.ndarray, np.ndarray]:
+    """The measured indices of one closed-form search and their verification.
+
+    The search seed is ``RandomStreams.seed(round_index, worker, Stream.SEARCH)`` (the first
+    64-bit output of that key's generator, shifted right by 2, so below 2^62: two 32-bit entropy
+    words, zero-padded to numpy's pool of four as ``integer_seed_words`` does); the draw is
+    ``_draw_two_level_seeded`` with the words of that seed; each index is verified against
+    ``truth``.
+
+    Returns:
+        (indices (shots,), verified (shots,) bool).
+    """
+    key = _key(round_index, worker, _SEARCH)
+    seed = _next64(_pcg_state(_seed_words(run_entropy, key)[0])) >> np.uint64(2)
+    entropy = np.zeros(4, dtype=np.uint64)
+    entropy[0] = seed & _MASK32
+    entropy[1] = seed >> np.uint64(32)
+    words = _seed_words(entropy, np.empty((1, 0), dtype=np.int64))[0]
+    indices = _draw_two_level_seeded(marks, p_good, shots, words)
+    verified = np.empty(shots, dtype=np.bool_)
+    for shot in range(shots):
+        verified[shot] = truth[indices[shot]]
+    return indices, verified
+
+
+class FusedRound:
+    """The round of one plan in compiled calls (module docstring); built at the plan's start.
+
+    Args:
+        env: The plan's ``Environment`` (its bounds are sampled).
+        predicate: The plan's predicate (called once per database, as in the generic round).
+        streams: The plan's ``RandomStreams``.
+        oracle_errors: The plan's ``OracleErrorModel``, or None.
+        backend: The plan's backend, whose ``draws_closed_form(n)`` is True.
+        num_qubits: n (databases of 2^n entries).
+    """
+
+    def __init__(self, env: Environment, predicate: ReachabilityPredicate, streams: RandomStreams,
+                 oracle_errors: OracleErrorModel | None, backend: QuantumSearchBackend, num_qubits: int) -> None:
+        self.predicate = predicate
+        self.streams = streams
+        self.oracle_errors = oracle_errors
+        self.backend = backend
+        self.num_qubits = num_qubits
+        self.size = 1 << num_qubits
+        self._low = np.ascontiguousarray(env.bounds[:, 0], dtype=float)
+        self._high = np.ascontiguousarray(env.bounds[:, 1], dtype=float)
+        self._entropy = streams._run_entropy
+        self._checked: set[tuple[int, int]] = set()
+        self._missed_outcomes: dict[int, SearchOutcome] = {}
+
+    def search(self, tree: Tree, round_index: int, groups: list[tuple[int, int]],
+               iterations: int) -> list[DatabaseOutcome]:
+        """What ``search_databases_together`` returns for these groups at ``iterations``.
+
+        Args:
+            tree: The plan's tree (read only).
+            round_index: The round.
+            groups: (first worker, workers) per database.
+            iterations: k, from ``PolicyState.preset_iterations``.
+
+        Returns:
+            One ``DatabaseOutcome`` per group, in order.
+
+        Raises:
+            ValueError: A predicate answer that is not a 0/1 array of 2^n entries, or a k or a shot
+                count that the backend's ``search`` would refuse, before the search.
+        """
+        results = []
+        size, entropy = self.size, self._entropy
+        missed = self._missed(iterations)
+        for first, count in groups:
+            self._check_search(iterations, count)
+            children, parents, positions = _candidates(entropy, round_index, first, size, self._low, self._high,
+                                                       *tree.search_arrays())
+            truth = self._answers(self.predicate.reachable(positions, children))
+            marks = truth
+            if self.oracle_errors is not None:
+                marks = self._answers(self.oracle_errors.apply(
+                    truth, self.streams.generator(round_index, first, Stream.ORACLE_ERRORS)))
+            reachable = int(np.count_nonzero(truth))
+            marked = reachable if marks is truth else int(np.count_nonzero(marks))
+            indices, verified = _measure(entropy, round_index, first, marks, truth,
+                                         good_probability(size, marked, iterations), count)
+            outcomes = []
+            found: list[tuple[np.ndarray, int] | None] = []
+            for index, good in zip(indices.tolist(), verified.tolist(), strict=True):
+                if good:
+                    outcomes.append(SearchOutcome(index, iterations, 1, ((iterations, True),)))
+                    found.append((children[index], int(parents[index])))
+                else:
+                    outcomes.append(missed)
+                    found.append(None)
+            results.append(DatabaseOutcome(size, reachable, tuple(outcomes), tuple(found)))
+        return results
+
+    def _missed(self, iterations: int) -> SearchOutcome:
+        """The (frozen, shareable) outcome of a worker whose measurement did not verify."""
+        outcome = self._missed_outcomes.get(iterations)
+        if outcome is None:
+            outcome = self._missed_outcomes[iterations] = SearchOutcome(None, iterations, 1, ((iterations, False),))
+        return outcome
+
+    def _answers(self, answers: np.ndarray) -> np.ndarray:
+        """The predicate's (or the error model's) answers as the bool marks ``search`` would take:
+        ``validate_marks``'s errors for anything else, and the size a database has."""
+        if not (isinstance(answers, np.ndarray) and answers.dtype == np.bool_ and answers.ndim == 1):
+            answers, _ = validate_marks(answers)
+        if answers.shape[0] != self.size:
+            raise ValueError(f"the predicate answered {answers.shape[0]} pairs for a database of {self.size} "
+                             "entries (reachable must return one bool per pair)")
+        return answers
+
+    def _check_search(self, iterations: int, shots: int) -> None:
+        """The backend's checks of a search with this k and shot count (once per pair)."""
+        if (iterations, shots) not in self._checked:
+            validate_iterations(iterations)
+            self.backend.check_memory(self.num_qubits, shots, iterations)
+            self._checked.add((iterations, shots))

@@ -1,0 +1,195 @@
+"""The fused quantum round (planners/fused_round.py) gives the generic round's plans bit for bit,
+is taken exactly where it applies, and refuses what the generic round refuses."""
+
+from __future__ import annotations
+
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+import pytest
+from planner_checks import assert_tree_edges_valid
+from planner_fingerprints import fingerprint
+
+import qrrt_circuits as qc
+from qrrt_circuits.planners import fused_round
+from qrrt_circuits.search.policies import PolicyState
+
+
+@pytest.fixture()
+def fused_calls(monkeypatch):
+    """Counts the fused round's compiled calls (candidates, measurements)."""
+    calls = {"candidates": 0, "measure": 0}
+    candidates, measure = fused_round._candidates, fused_round._measure
+
+    def counted_candidates(*args):
+        calls["candidates"] += 1
+        return candidates(*args)
+
+    def counted_measure(*args):
+        calls["measure"] += 1
+        return measure(*args)
+
+    monkeypatch.setattr(fused_round, "_candidates", counted_candidates)
+    monkeypatch.setattr(fused_round, "_measure", counted_measure)
+    return calls
+
+
+def _sv(seed=5, **kw):
+    return qc.StatevectorBackend(seed=seed, **kw)
+
+
+class CountingPredicate:
+    """The exact check, recording every batch it is asked (to compare the two rounds' calls)."""
+
+    def __init__(self, env):
+        self.inner = qc.ReachabilityOracle(env)
+        self.batches = []
+
+    dim = property(lambda self: self.inner.dim)
+    name = property(lambda self: self.inner.name)
+
+    def describe(self):
+        return self.inner.describe()
+
+    def reachable(self, parents, children):
+        self.batches.append((np.array(parents), np.array(children)))
+        return self.inner.reachable(parents, children)
+
+
+#: planner factories (env, seed, fused) covering every feature the fused round handles
+CONFIGURATIONS = {
+    "qrrt-paper": lambda env, s, f: qc.QRRT(env, backend=_sv(), seed=s, fused_round=f),
+    "qrrt-n5-fixed": lambda env, s, f: qc.QRRT(env, backend=_sv(), num_qubits=5, seed=s,
+                                               search_policy=qc.FixedIterations(1), fused_round=f),
+    "qrrt-n3-fixed0": lambda env, s, f: qc.QRRT(env, backend=_sv(), num_qubits=3, seed=s,
+                                                search_policy=qc.FixedIterations(0), fused_round=f),
+    "qrrt-adaptive": lambda env, s, f: qc.QRRT(env, backend=_sv(), num_qubits=6, seed=s,
+                                               search_policy=qc.Adaptive(), fused_round=f),
+    "qrrt-errors": lambda env, s, f: qc.QRRT(env, backend=_sv(), num_qubits=5, seed=s, fused_round=f,
+                                             oracle_errors=qc.OracleErrorModel(0.1, 0.3)),
+    "pqrrt-shared": lambda env, s, f: qc.PQRRT(env, backend=_sv(), workers=8, seed=s, fused_round=f),
+    "pqrrt-shared-errors": lambda env, s, f: qc.PQRRT(env, backend=_sv(), workers=5, num_qubits=6, seed=s,
+                                                      oracle_errors=qc.OracleErrorModel(0.2, 0.1), fused_round=f),
+    "pqrrt-unshared": lambda env, s, f: qc.PQRRT(env, backend=_sv(), workers=3, shared_database=False, seed=s,
+                                                 fused_round=f),
+}
+
+
+@pytest.mark.parametrize("name", sorted(CONFIGURATIONS))
+@pytest.mark.parametrize("seed", range(4))
+def test_fused_round_gives_the_generic_plan(name, seed, fused_calls):
+    env = qc.scenarios.paper_clutter(seed=seed)
+    make = CONFIGURATIONS[name]
+    fused = make(env, seed, True).plan(max_nodes=40)
+    assert fused_calls["candidates"] == fused.metrics.databases > 0
+    assert fused_calls["measure"] == fused.metrics.databases
+    generic = make(env, seed, False).plan(max_nodes=40)
+    assert fused_calls["candidates"] == fused.metrics.databases  # the generic plan made none
+    assert fingerprint(fused) == fingerprint(generic)
+    counters = [{k: v for k, v in r.metrics.as_dict().items() if k != "wall_time_s"} for r in (fused, generic)]
+    assert counters[0] == counters[1]
+    assert fused.labels == generic.labels and fused.settings == generic.settings
+    assert_tree_edges_valid(env, qc.LinearTrackingDynamics.paper(), fused)
+
+
+def test_the_predicate_sees_the_same_batches():
+    env = qc.scenarios.paper_clutter(seed=2)
+    seen = {}
+    for fused in (True, False):
+        predicate = CountingPredicate(env)
+        qc.PQRRT(env, backend=_sv(), workers=4, shared_database=False, predicate=predicate, seed=2,
+                 fused_round=fused).plan(max_nodes=25)
+        seen[fused] = predicate.batches
+    assert len(seen[True]) == len(seen[False]) > 0
+    for (p1, c1), (p2, c2) in zip(seen[True], seen[False], strict=True):
+        assert np.array_equal(p1, p2) and np.array_equal(c1, c2)
+
+
+def test_large_trees_use_the_grid_and_still_agree(fused_calls):
+    """Past tree.BRUTE_FORCE_BELOW nodes the nearest nodes come from the grid inside the fused call."""
+    env = qc.scenarios.paper_clutter(seed=1)
+    nodes = qc.tree.BRUTE_FORCE_BELOW + 60
+    results = [qc.QRRT(env, backend=_sv(), num_qubits=5, seed=1, fused_round=fused).plan(max_nodes=nodes,
+                                                                                       goal_radius=1e-9)
+               for fused in (True, False)]
+    assert results[0].metrics.nodes == nodes
+    assert fingerprint(results[0]) == fingerprint(results[1])
+
+
+def _uses_fused(planner) -> bool:
+    return planner._fused_round() is not None
+
+
+def test_fused_round_taken_only_where_it_applies():
+    env = qc.scenarios.paper_clutter(seed=0)
+    assert _uses_fused(qc.QRRT(env, backend=_sv(), seed=0))
+    assert _uses_fused(qc.PQRRT(env, backend=_sv(), workers=4, shared_database=False, seed=0))
+    assert not _uses_fused(qc.QRRT(env, backend=_sv(), seed=0, fused_round=False))
+    assert not _uses_fused(qc.QRRT(env, backend=qc.AerBackend(seed=0), seed=0))
+    assert not _uses_fused(qc.QRRT(env, backend=_sv(closed_form=False), seed=0))
+    assert not _uses_fused(qc.QRRT(env, backend=_sv(), seed=0, goal_bias=0.1))
+    assert not _uses_fused(qc.QRRT(env, backend=_sv(), seed=0, annealing=qc.AnnealingSchedule.paper()))
+    with ThreadPoolExecutor(2) as pool:
+        assert not _uses_fused(qc.PQRRT(env, backend=_sv(), workers=2, shared_database=False, executor=pool,
+                                        seed=0))
+
+    class Tilted(qc.StatevectorBackend):  # a subclass that draws differently keeps its own search
+        def _sample_seeded(self, marks, num_qubits, iterations, shots, seed):
+            return np.zeros(shots, dtype=np.int64)
+
+    assert not _uses_fused(qc.QRRT(env, backend=Tilted(), seed=0))
+    assert qc.StatevectorBackend().draws_closed_form(32) and not qc.StatevectorBackend().draws_closed_form(33)
+
+
+def test_policies_say_whether_k_is_fixed_before_the_database():
+    assert qc.PaperSchedule().start(256).preset_iterations(5) == 5
+    assert qc.PaperSchedule().start(256).preset_iterations(11) == 3
+    assert qc.FixedIterations(2).start(64).preset_iterations(0) == 2
+    adaptive = qc.Adaptive().start(256)
+    assert adaptive.preset_iterations(3) == adaptive.choose_iterations(3)
+    for policy in (qc.KnownOptimal(), qc.BBHT(), qc.FixedPointAmplification(), qc.EstimatedOptimal()):
+        assert policy.start(256).preset_iterations(3) is None, policy
+
+    class OwnRun(PolicyState):
+        def run(self, problem, workers, tree_nodes):
+            return super().run(problem, workers, tree_nodes)
+
+    assert OwnRun(qc.PaperSchedule(), 256).preset_iterations(3) is None
+
+
+def test_policies_that_read_the_database_take_the_generic_round(fused_calls):
+    env = qc.scenarios.paper_clutter(seed=3)
+    result = qc.QRRT(env, backend=_sv(), seed=3, search_policy=qc.KnownOptimal()).plan(max_nodes=10)
+    assert result.metrics.nodes == 10 and fused_calls["candidates"] == 0
+
+
+class WrongLength:
+    """A predicate answering one pair too few."""
+
+    dim = 2
+    name = "wrong-length"
+
+    def describe(self):
+        return {"name": self.name}
+
+    def reachable(self, parents, children):
+        return np.ones(len(children) - 1, dtype=bool)
+
+
+class NotBoolean(WrongLength):
+    def reachable(self, parents, children):
+        return np.full(len(children), 0.5)
+
+
+@pytest.mark.parametrize("predicate", [WrongLength(), NotBoolean()], ids=["length", "values"])
+def test_bad_predicate_answers_are_refused(predicate):
+    env = qc.scenarios.paper_clutter(seed=0)
+    planner = qc.QRRT(env, backend=_sv(), num_qubits=4, predicate=predicate, seed=0)
+    with pytest.raises(ValueError, match="pairs for a database of 16|booleans"):
+        planner.plan(max_rounds=3)
+
+
+def test_fused_round_flag_is_checked():
+    env = qc.scenarios.paper_clutter(seed=0)
+    with pytest.raises(TypeError, match="fused_round"):
+        qc.QRRT(env, backend=_sv(), fused_round=1)
