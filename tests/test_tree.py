@@ -60,6 +60,30 @@ def test_nearest_agrees_with_the_grid_on_both_sides_of_the_brute_force_switch():
             assert np.array_equal(tree.grid_nearest(queries), want)
 
 
+def test_the_grid_built_when_the_tree_reaches_the_switch_answers_as_one_kept_from_the_start():
+    """Small trees keep no grid (built at BRUTE_FORCE_BELOW nodes, or by a first grid query):
+    both histories answer every query as the brute force does, at every size."""
+    from qrrt_circuits import tree as tree_module
+
+    rng = np.random.default_rng(11)
+    points = rng.random((700, 2)) * 20
+    lazy, early = Tree(points[0]), Tree(points[0])
+    early.grid_nearest(points[:1])  # the grid from the first node on
+    assert lazy._grid_built_at == 0 and early._grid_built_at == 1
+    for point in points[1:]:
+        lazy.add(point, 0)
+        early.add(point, 0)
+        if lazy.size in (tree_module.BRUTE_FORCE_BELOW - 1, tree_module.BRUTE_FORCE_BELOW, 161, 319, 320, 700):
+            queries = rng.random((128, 2)) * 24 - 2
+            want = np.argmin(((queries[:, None, :] - lazy.nodes[None]) ** 2).sum(-1), axis=1)
+            assert np.array_equal(lazy.nearest(queries), want)
+            assert np.array_equal(early.nearest(queries), want)
+            assert np.array_equal(early.grid_nearest(queries), want)
+            if lazy.size >= tree_module.BRUTE_FORCE_BELOW:  # (below, a grid query would build the grid)
+                assert np.array_equal(lazy.grid_nearest(queries), want)
+    assert lazy._grid_built_at == tree_module.BRUTE_FORCE_BELOW * 4  # built at 160, rebuilt at 320 and 640
+
+
 @pytest.mark.parametrize("xs, query", [
     # a node a rounding error below a cell edge is filed in the cell above it: the search must
     # still find it (it is nearer by 2.5e-14) ...
@@ -86,6 +110,7 @@ def test_cell_edge_near_ties_in_two_dimensions_on_both_sides_of_the_switch():
         probe = Tree(base[0])
         for point in base[1:]:
             probe.add(point, 0)
+        probe.grid_nearest(base[:1])  # a small tree builds its grid on the first grid query
         origin, cell = probe._origin, probe._cell
         y = float(rng.uniform(2, 18))
         for k in range(1, int(probe._shape[0])):
@@ -97,6 +122,7 @@ def test_cell_edge_near_ties_in_two_dimensions_on_both_sides_of_the_switch():
             tree = Tree(base[0])
             for point in base[1:]:
                 tree.add(point, 0)
+            tree.grid_nearest(base[:1])  # the probe's grid of 128 nodes, kept as nodes are added
             tree.add(np.array([x, y]), 0)
             angle = rng.uniform(np.pi / 2, 3 * np.pi / 2)  # a rival a hair farther, on the query's side
             radius = (x - query) * (1 + 1e-13)

@@ -60,7 +60,13 @@ class Tree:
         self._nodes[0] = root
         self._parents[0] = -1
         self.size = 1
-        self._build_grid()
+        # the grid (built once the tree reaches BRUTE_FORCE_BELOW nodes, see ``add``); until then
+        # placeholders of the grid's types, and _grid_built_at = 0 (the size at the last build)
+        self._grid_built_at = 0
+        self._origin, self._low, self._high = np.zeros(self.dim), np.zeros(self.dim), np.zeros(self.dim)
+        self._cell = 1.0
+        self._shape = np.ones(self.dim, dtype=np.int64)
+        self._head = np.full(1, -1, dtype=np.int64)
 
     @property
     def nodes(self) -> np.ndarray:
@@ -90,11 +96,14 @@ class Tree:
         self._nodes[index] = position
         self._parents[index] = parent
         self.size += 1
-        if self.size >= 2 * self._grid_built_at:
+        if self._grid_built_at:  # a grid exists: keep it current (rebuilt each time the tree doubles)
+            if self.size >= 2 * self._grid_built_at:
+                self._build_grid()
+            else:
+                _grid_insert(self._nodes, self._next, self._head, self._origin, self._cell, self._shape, index,
+                             self._low, self._high)
+        elif self.size >= BRUTE_FORCE_BELOW:  # queries use the grid from here on
             self._build_grid()
-        else:
-            _grid_insert(self._nodes, self._next, self._head, self._origin, self._cell, self._shape, index,
-                         self._low, self._high)
         return index
 
     def nearest(self, points: np.ndarray) -> np.ndarray:
@@ -121,7 +130,9 @@ class Tree:
         """The arguments of ``nearest_into`` after the points, for compiled callers (the planners'
         fused round, ``planners.fused_round``): the node buffer, the size, the grid's lists
         (next node, cell heads), origin, cell size, shape and the nodes' bounding box. The arrays
-        are the tree's own (not copies) and stay valid until the next ``add``."""
+        are the tree's own (not copies) and stay valid until the next ``add``. Below
+        ``BRUTE_FORCE_BELOW`` nodes the tree keeps no grid (``nearest_into`` does not read it) and
+        the grid arrays are placeholders."""
         return (self._nodes, self.size, self._next, self._head, self._origin, self._cell, self._shape,
                 self._low, self._high)
 
@@ -129,6 +140,8 @@ class Tree:
         """``nearest`` through the grid whatever the tree's size (for tests and benchmarks): the
         same argument (float points, (M, d) or (d,)), result (int (M,) node indices) and errors."""
         points = self._queries(points)
+        if not self._grid_built_at:
+            self._build_grid()
         out = np.empty(points.shape[0], dtype=np.int64)
         _grid_nearest(points, self._nodes, self._next, self._head, self._origin, self._cell, self._shape,
                       self.size, self._low, self._high, out)
@@ -156,8 +169,7 @@ class Tree:
         self._shape = shape
         self._head = np.full(int(np.prod(shape)), -1, dtype=np.int64)
         self._low, self._high = low.copy(), high.copy()  # the nodes' bounding box, kept up to date
-        for index in range(self.size):
-            _grid_insert(self._nodes, self._next, self._head, self._origin, self._cell, self._shape, index,
+        _grid_insert_all(self._nodes, self._next, self._head, self._origin, self._cell, self._shape, self.size,
                          self._low, self._high)
         self._grid_built_at = self.size
 
@@ -189,6 +201,14 @@ def _grid_insert(nodes: np.ndarray, next_node: np.ndarray, head: np.ndarray, ori
     flat = _cell_of(nodes[index], origin, cell, shape, coordinates)
     next_node[index] = head[flat]
     head[flat] = index
+
+
+@njit(cache=True, nogil=True)
+def _grid_insert_all(nodes: np.ndarray, next_node: np.ndarray, head: np.ndarray, origin: np.ndarray, cell: float,
+                     shape: np.ndarray, size: int, low: np.ndarray, high: np.ndarray) -> None:
+    """``_grid_insert`` of nodes 0 .. size - 1, in order, in one call."""
+    for index in range(size):
+        _grid_insert(nodes, next_node, head, origin, cell, shape, index, low, high)
 
 
 @njit(cache=True, nogil=True, inline="always")

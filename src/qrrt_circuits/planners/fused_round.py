@@ -1,30 +1,31 @@
-"""One quantum round in two compiled calls around the predicate (q-RRT Alg. 2, Pq-RRT Alg. 3).
+"""A quantum round in compiled calls around the predicate (q-RRT Alg. 2, Pq-RRT Alg. 3).
 
 The generic round (``workers.make_database``, ``DatabaseSearch``, the policy's ``run``, the
 backend's ``search``) spends most of its non-oracle time in Python: building the keyed generators'
 seeds, the candidate draws, the nearest-node queries, the validated search request, the seeded
-draw and the verification are each a call of their own. When nothing in a round needs Python,
-``FusedRound`` does the same work in two compiled calls per database:
+draw and the verification are each a call of their own. ``FusedRound`` does the same work in
+compiled calls:
 
-1. ``_candidates``: the seed words of stream (round, worker, ``Stream.CANDIDATES``), the 2^n x d
-   uniform doubles, the samples low + (high - low) u, their nearest tree nodes
-   (``tree.nearest_into``) and the parents' positions (Alg. 1 lines 4-8);
+1. ``_candidates`` (every backend and policy): the seed words of stream (round, worker,
+   ``Stream.CANDIDATES``), the 2^n x d uniform doubles, the samples low + (high - low) u, their
+   nearest tree nodes (``tree.nearest_into``) and the parents' positions (Alg. 1 lines 4-8);
 2. the predicate's own ``reachable`` on those pairs (the oracle; not fused, so it is timed and
    counted as before), and the error model's flips if there is one;
-3. ``_measure``: the seed of stream (round, worker, ``Stream.SEARCH``), the backend's generator of
-   that seed, the two-level closed-form draw of ``shots`` measured indices
+3. ``_measure``, where the backend's seeded search is the closed-form draw
+   (``QuantumSearchBackend.draws_closed_form``: the ``StatevectorBackend``) and the policy fixes k
+   before seeing the database (``PolicyState.preset_iterations``: the paper's schedule, fixed k,
+   ``Adaptive``): the seed of stream (round, worker, ``Stream.SEARCH``), the backend's generator of
+   that seed, the two-level closed-form draw of the workers' measured indices
    (``statevector._draw_two_level_seeded``, Eq. 1 / Lemma 1) and the classical verification of each
-   (the finalizer: 1 oracle call per worker).
+   (the finalizer: 1 oracle call per worker). Otherwise the databases go to the policy's
+   ``run_many`` (the backend's ``search_many``) as in the generic round.
 
 Every number is the one the generic round produces, bit for bit: the same draws in the same order
 from the same PCG64 states, the same nearest-node kernels, the same predicate calls in the same
 order, the same k, the same ``SearchOutcome`` objects handed to the planner's bookkeeping and to the
-policy's ``learn`` (tested against the generic round, and by the planner fingerprints). The fused
-round is used when the plan has no executor, no annealing and no goal bias, the backend's seeded
-search is the closed-form draw (``QuantumSearchBackend.draws_closed_form``: the
-``StatevectorBackend``) and, per round, the policy fixes k before seeing the database
-(``PolicyState.preset_iterations``: the paper's schedule, fixed k, ``Adaptive``); otherwise the
-round is the generic one.
+policy's ``learn`` (tested against the generic round, and by the planner fingerprints). A plan uses
+it unless it has an executor, annealing or goal bias (whose databases need the generator object)
+or was built with ``fused_round=False``.
 """
 
 from __future__ import annotations
@@ -38,7 +39,8 @@ from ..predicate import ReachabilityPredicate
 from ..probability import good_probability
 from ..randomness import RandomStreams, Stream, _next64, _next_double, _pcg_state, _seed_words
 from ..search.backend import QuantumSearchBackend, validate_iterations, validate_marks
-from ..search.problem import SearchOutcome
+from ..search.policies import PolicyState
+from ..search.problem import DatabaseSearch, SearchOutcome
 from ..search.statevector import _draw_two_level_seeded
 from ..tree import Tree, nearest_into
 from .workers import DatabaseOutcome
@@ -121,7 +123,7 @@ class FusedRound:
         predicate: The plan's predicate (called once per database, as in the generic round).
         streams: The plan's ``RandomStreams``.
         oracle_errors: The plan's ``OracleErrorModel``, or None.
-        backend: The plan's backend, whose ``draws_closed_form(n)`` is True.
+        backend: The plan's backend (its searches are drawn here if ``draws_closed_form(n)``).
         num_qubits: n (databases of 2^n entries).
     """
 
@@ -136,18 +138,26 @@ class FusedRound:
         self._low = np.ascontiguousarray(env.bounds[:, 0], dtype=float)
         self._high = np.ascontiguousarray(env.bounds[:, 1], dtype=float)
         self._entropy = streams._run_entropy
+        self.closed_form = backend.draws_closed_form(num_qubits)
         self._checked: set[tuple[int, int]] = set()
         self._missed_outcomes: dict[int, SearchOutcome] = {}
 
-    def search(self, tree: Tree, round_index: int, groups: list[tuple[int, int]],
-               iterations: int) -> list[DatabaseOutcome]:
-        """What ``search_databases_together`` returns for these groups at ``iterations``.
+    def search(self, tree: Tree, round_index: int, groups: list[tuple[int, int]], policy_state: PolicyState,
+               tree_nodes: int) -> list[DatabaseOutcome]:
+        """What ``search_databases_together`` returns for these groups, bit for bit.
+
+        Every database is built by ``_candidates`` and marked by the predicate (in group order, as
+        the generic round does). If the backend's seeded search is the closed-form draw and the
+        policy fixes k before the database (``PolicyState.preset_iterations``), each database's
+        workers are drawn and verified by ``_measure``; otherwise the databases go to the policy's
+        ``run_many`` as ``DatabaseSearch`` problems, as in the generic round.
 
         Args:
             tree: The plan's tree (read only).
             round_index: The round.
-            groups: (first worker, workers) per database.
-            iterations: k, from ``PolicyState.preset_iterations``.
+            groups: (first worker, workers) per database, all with the same worker count.
+            policy_state: The plan's ``PolicyState``.
+            tree_nodes: Nodes in the tree so far.
 
         Returns:
             One ``DatabaseOutcome`` per group, in order.
@@ -156,33 +166,45 @@ class FusedRound:
             ValueError: A predicate answer that is not a 0/1 array of 2^n entries, or a k or a shot
                 count that the backend's ``search`` would refuse, before the search.
         """
-        results = []
-        size, entropy = self.size, self._entropy
+        built = [self._database(tree, round_index, first) for first, _ in groups]
+        iterations = policy_state.preset_iterations(tree_nodes) if self.closed_form else None
+        if iterations is None:
+            problems = [DatabaseSearch(marks, truth, self.backend, self.streams, round_index, first)
+                        for (_, _, truth, marks), (first, _) in zip(built, groups, strict=True)]
+            searched = policy_state.run_many(problems, groups[0][1], tree_nodes) if groups else ()
+            return [self._outcome(database, outcomes) for database, outcomes in zip(built, searched, strict=True)]
+        return [self._outcome(database, self._measured(database, round_index, first, count, iterations))
+                for database, (first, count) in zip(built, groups, strict=True)]
+
+    def _database(self, tree: Tree, round_index: int,
+                  worker: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(children, parents, truth, marks) of worker ``worker``'s database (Alg. 1 lines 4-8)."""
+        children, parents, positions = _candidates(self._entropy, round_index, worker, self.size, self._low,
+                                                   self._high, *tree.search_arrays())
+        truth = self._answers(self.predicate.reachable(positions, children))
+        marks = truth
+        if self.oracle_errors is not None:
+            marks = self._answers(self.oracle_errors.apply(
+                truth, self.streams.generator(round_index, worker, Stream.ORACLE_ERRORS)))
+        return children, parents, truth, marks
+
+    def _measured(self, database: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], round_index: int,
+                  first: int, count: int, iterations: int) -> tuple[SearchOutcome, ...]:
+        """The default ``PolicyState.run`` at k = ``iterations`` for ``count`` workers, compiled."""
+        _, _, truth, marks = database
+        self._check_search(iterations, count)
+        p_good = good_probability(self.size, int(np.count_nonzero(marks)), iterations)
+        indices, verified = _measure(self._entropy, round_index, first, marks, truth, p_good, count)
         missed = self._missed(iterations)
-        for first, count in groups:
-            self._check_search(iterations, count)
-            children, parents, positions = _candidates(entropy, round_index, first, size, self._low, self._high,
-                                                       *tree.search_arrays())
-            truth = self._answers(self.predicate.reachable(positions, children))
-            marks = truth
-            if self.oracle_errors is not None:
-                marks = self._answers(self.oracle_errors.apply(
-                    truth, self.streams.generator(round_index, first, Stream.ORACLE_ERRORS)))
-            reachable = int(np.count_nonzero(truth))
-            marked = reachable if marks is truth else int(np.count_nonzero(marks))
-            indices, verified = _measure(entropy, round_index, first, marks, truth,
-                                         good_probability(size, marked, iterations), count)
-            outcomes = []
-            found: list[tuple[np.ndarray, int] | None] = []
-            for index, good in zip(indices.tolist(), verified.tolist(), strict=True):
-                if good:
-                    outcomes.append(SearchOutcome(index, iterations, 1, ((iterations, True),)))
-                    found.append((children[index], int(parents[index])))
-                else:
-                    outcomes.append(missed)
-                    found.append(None)
-            results.append(DatabaseOutcome(size, reachable, tuple(outcomes), tuple(found)))
-        return results
+        return tuple(SearchOutcome(index, iterations, 1, ((iterations, True),)) if good else missed
+                     for index, good in zip(indices.tolist(), verified.tolist(), strict=True))
+
+    def _outcome(self, database: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+                 outcomes: tuple[SearchOutcome, ...]) -> DatabaseOutcome:
+        children, parents, truth, _ = database
+        found = tuple(None if outcome.index is None else (children[outcome.index], int(parents[outcome.index]))
+                      for outcome in outcomes)
+        return DatabaseOutcome(self.size, int(np.count_nonzero(truth)), outcomes, found)
 
     def _missed(self, iterations: int) -> SearchOutcome:
         """The (frozen, shareable) outcome of a worker whose measurement did not verify."""

@@ -147,12 +147,12 @@ class PQRRT(Planner):
             error.
         iterations: Alias of ``search_policy`` kept from 0.1; giving both (as different objects) is
             an error.
-        fused_round: True (default): rounds that need no Python in between (no executor, annealing
-            or goal bias; a backend whose seeded search is the closed-form draw, i.e. the
-            ``StatevectorBackend``; a policy that fixes k before seeing the database) run in two
-            compiled calls around the predicate (``qrrt_circuits.planners.fused_round``), with the
-            same results bit for bit. False: every round takes the generic path (for tests and
-            benchmarks). Must be a ``bool``.
+        fused_round: True (default): without an executor, annealing or goal bias, each database is
+            drawn and paired with its nearest nodes in one compiled call, and where the backend's
+            seeded search is the closed-form draw (the ``StatevectorBackend``) and the policy fixes
+            k before seeing the database, its workers are drawn and verified in a second one
+            (``qrrt_circuits.planners.fused_round``); the same results bit for bit. False: every
+            round takes the generic path (for tests and benchmarks). Must be a ``bool``.
 
     Raises:
         TypeError: An argument of the wrong type: ``env`` not an ``Environment``, a non-integer
@@ -264,8 +264,7 @@ class PQRRT(Planner):
 
     def _fused_round(self) -> FusedRound | None:
         """A ``FusedRound`` if this plan's rounds can be fused (see ``fused_round``), else None."""
-        if (not self.fused_round or self.executor is not None or self.annealing is not None or self.goal_bias > 0
-                or not self.backend.draws_closed_form(self.num_qubits)):
+        if not self.fused_round or self.executor is not None or self.annealing is not None or self.goal_bias > 0:
             return None
         return FusedRound(self.env, self.predicate, self.streams, self.oracle_errors, self.backend, self.num_qubits)
 
@@ -282,10 +281,9 @@ class PQRRT(Planner):
         return self.annealing.temperature_index(state.rounds, state.nodes)
 
     def _round(self, state: RunState) -> None:
-        fused = state.fused_round
-        iterations = None if fused is None else state.search_policy_state.preset_iterations(state.nodes)
-        if fused is not None and iterations is not None:  # two compiled calls per database, the same outcomes
-            results = fused.search(state.tree, state.rounds, self._worker_groups(), iterations)
+        if state.fused_round is not None:  # compiled calls around the predicate, the same outcomes
+            results = state.fused_round.search(state.tree, state.rounds, self._worker_groups(),
+                                               state.search_policy_state, state.nodes)
         elif self.executor is None:  # the round's searches go to the backend together (same outcomes)
             view = self._view(state, self._temperature_index(state))
             results = search_databases_together(state.worker_context, view, self._worker_groups())
@@ -310,16 +308,17 @@ class PQRRT(Planner):
         added: set[int] = set()
         longest = 0
         for outcome, found in zip(result.outcomes, result.found, strict=True):
-            state.quantum_calls += outcome.quantum_calls
-            state.verification_calls += outcome.verifications
-            state.rejected += outcome.rejected
-            longest = max(longest, outcome.oracle_calls)
-            if found is None or outcome.index is None:
+            index, quantum, verifications = outcome.index, outcome.quantum_calls, outcome.verifications
+            state.quantum_calls += quantum
+            state.verification_calls += verifications
+            state.rejected += verifications - (index is not None)  # outcome.rejected
+            longest = max(longest, quantum + verifications)  # outcome.oracle_calls
+            if found is None or index is None:
                 continue
-            if outcome.index in added:
+            if index in added:
                 state.duplicates += 1
                 continue
-            added.add(outcome.index)
+            added.add(index)
             state.add_node(found[0], found[1])
         return longest
 
