@@ -13,7 +13,10 @@ The "3000 nodes" rows grow q-RRT trees to ``--big-nodes`` nodes on the first ``-
 with the goal made unreachable (goal radius 1e-9), so the per-round cost can be compared at 100
 and 3000 nodes. If ``ompl`` is importable (``pip install ".[ompl]"``), OMPL's RRT runs on the same
 worlds with our closed-loop motion check (a Python MotionValidator) right after our RRT, and the
-ratio of their median ms per node is printed. Writes JSON.
+ratio of their median ms per node is printed. Rows ending in ", generic round" run the quantum
+planner with ``fused_round=False`` (every part of the round a call of its own, as before
+``planners/fused_round.py``), beside the default, in the same run; the round breakdown times the
+parts of both. Writes JSON.
 """
 
 from __future__ import annotations
@@ -36,9 +39,12 @@ CONFIGURATIONS = (
     ("RRT", "rrt", None, None),
     ("ParallelRRT (8)", "prrt", None, None),
     ("QRRT statevector", "qrrt", "statevector", "paper"),
+    ("QRRT statevector, generic round", "qrrt", "statevector", "paper"),
     ("QRRT statevector 3000 nodes", "qrrt", "statevector", "paper"),
+    ("QRRT statevector 3000 nodes, generic round", "qrrt", "statevector", "paper"),
     ("QRRT aer", "qrrt", "aer", "paper"),
     ("PQRRT shared statevector", "pqrrt", "statevector", "paper"),
+    ("PQRRT shared statevector, generic round", "pqrrt", "statevector", "paper"),
     ("PQRRT shared aer", "pqrrt", "aer", "paper"),
     ("PQRRT unshared statevector", "pqrrt-unshared", "statevector", "paper"),
     ("QRRT adaptive statevector", "qrrt", "statevector", "adaptive"),
@@ -47,8 +53,12 @@ CONFIGURATIONS = (
 )
 
 
+#: planner options of some configurations: the quantum planners' generic round (``fused_round=False``:
+#: every part of the round a call of its own, as before the fused round) beside the default in one run
+OPTIONS = {label: {"fused_round": False} for label, *_ in CONFIGURATIONS if label.endswith(", generic round")}
+
 #: the configurations grown to --big-nodes nodes with an unreachable goal
-BIG = ("QRRT statevector 3000 nodes",)
+BIG = ("QRRT statevector 3000 nodes", "QRRT statevector 3000 nodes, generic round")
 
 
 class TimedPredicate:
@@ -158,12 +168,12 @@ def configurations(**options):
     (``options`` go to the quantum planners)."""
     from qrrt_circuits.experiments.planners import make_planner
 
-    def factory(planner, backend, policy):
-        extra = options if backend is not None else {}
+    def factory(planner, backend, policy, extra):
         return lambda env, seed, predicate: make_planner(planner, env, seed, backend or "statevector",
                                                          search_policy=policy, predicate=predicate, **extra)
 
-    return {label: factory(planner, backend, policy) for label, planner, backend, policy in CONFIGURATIONS}
+    return {label: factory(planner, backend, policy, {**OPTIONS.get(label, {}), **(options if backend else {})})
+            for label, planner, backend, policy in CONFIGURATIONS}
 
 
 def summarize(values: list[float]) -> dict:
@@ -232,7 +242,7 @@ def main() -> None:
     with_ompl = ompl_available is not None and ompl_available()
     rows = {}
     ompl_rows = None
-    print(f"{'planner':32s} {'calls/node':>18s} {'critical/node':>14s} {'ms/node':>18s} {'oracle':>7s} "
+    print(f"{'planner':40s} {'calls/node':>18s} {'critical/node':>14s} {'ms/node':>18s} {'oracle':>7s} "
           f"{'other us/rnd':>12s} {'reached':>8s}")
     for name, make in configurations().items():
         big = name in BIG
@@ -251,7 +261,7 @@ def main() -> None:
                "reached_fraction": float(np.mean([r["reached"] for r in runs]))}
         rows[name] = row
         c, k, t = row["calls_per_node"], row["critical_per_node"], row["ms_per_node"]
-        print(f"{name:32s} {c['median']:6.2f} [{c['p10']:5.2f},{c['p90']:6.2f}] {k['median']:14.2f} "
+        print(f"{name:40s} {c['median']:6.2f} [{c['p10']:5.2f},{c['p90']:6.2f}] {k['median']:14.2f} "
               f"{t['median']:7.3f} [{t['p10']:5.2f},{t['p90']:6.2f}] {row['oracle_share']['median']:7.2f} "
               f"{row['other_us_per_round']['median']:12.1f} {row['reached_fraction']:8.2f}")
         if name == "RRT" and with_ompl:  # side by side, right after ours
@@ -260,7 +270,7 @@ def main() -> None:
             ompl_rows = {"runs": ompl_runs, "ms_per_node": summarize([r["ms_per_node"] for r in ompl_runs])}
             t = ompl_rows["ms_per_node"]
             ompl_rows["ours_over_ompl"] = row["ms_per_node"]["median"] / t["median"]
-            print(f"{'OMPL RRT (our motion check)':32s} {'':>18s} {'':>14s} "
+            print(f"{'OMPL RRT (our motion check)':40s} {'':>18s} {'':>14s} "
                   f"{t['median']:7.3f} [{t['p10']:5.2f},{t['p90']:6.2f}]   (RRT / OMPL ms per node: "
                   f"{ompl_rows['ours_over_ompl']:.2f})")
     if not with_ompl:

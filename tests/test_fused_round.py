@@ -213,3 +213,23 @@ def test_fused_round_flag_is_checked():
     env = qc.scenarios.paper_clutter(seed=0)
     with pytest.raises(TypeError, match="fused_round"):
         qc.QRRT(env, backend=_sv(), fused_round=1)
+
+
+def test_learn_feeds_every_observation_to_a_state_that_observes():
+    """``learn`` skips its loop only for the no-op ``observe``; a state that observes sees them all, in order."""
+
+    class Recording(PolicyState):
+        def __init__(self, policy, num_items):
+            super().__init__(policy, num_items)
+            self.seen = []
+
+        def observe(self, iterations, success):
+            self.seen.append((iterations, success))
+
+    outcomes = [qc.SearchOutcome(3, 2, 1, ((2, True),)), qc.SearchOutcome(None, 4, 2, ((2, False), (2, False)))]
+    state = Recording(qc.FixedIterations(2), 64)
+    state.learn(iter(outcomes))
+    assert state.seen == [(2, True), (2, False), (2, False)]
+    consumed = []
+    PolicyState(qc.FixedIterations(2), 64).learn(consumed.append(o) or o for o in outcomes)
+    assert consumed == []  # the no-op observe: the outcomes are not even read

@@ -289,8 +289,11 @@ class PolicyState:
         """Feed a round's outcomes back, in worker order.
 
         Args:
-            outcomes: The round's ``SearchOutcome`` objects; each observation goes to ``observe``.
+            outcomes: The round's ``SearchOutcome`` objects; each observation goes to ``observe``
+                (not read at all when ``observe`` is this class's no-op).
         """
+        if type(self).observe is PolicyState.observe:  # nothing to learn: skip the loop
+            return
         for outcome in outcomes:
             for iterations, success in outcome.observations:
                 self.observe(iterations, success)
