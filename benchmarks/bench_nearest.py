@@ -7,7 +7,9 @@ times ``Tree.nearest`` (a brute force below ``tree.BRUTE_FORCE_BELOW`` nodes, th
 ``Tree.grid_nearest`` (the grid at every size) and a compiled 2-D brute force (every query against
 every node, the reference that placed the switch) for 256 uniform queries on trees of 100 to 3 000 nodes
 (``--quick``: up to 300): uniform in the 20 x 20 workspace, and the tree q-RRT grows on paper_clutter (which
-clusters around the start, so many queries lie far from every node). Medians of repeated calls;
+clusters around the start, so many queries lie far from every node). Medians of repeated calls
+on the same 256 queries, and (``*_fresh_us``) on a new set of 256 queries each call, as a planner's
+rounds ask (on one repeated set the processor's branch predictors learn the searches' branches);
 one thread. Prints a table and writes JSON.
 """
 
@@ -43,6 +45,12 @@ def brute_force(points: np.ndarray, nodes: np.ndarray, size: int, out: np.ndarra
                 best = squared
                 best_index = j
         out[i] = best_index
+
+
+def on_new_queries(kernel, query_sets):
+    """A function that calls ``kernel`` on the next of ``query_sets`` each time."""
+    sets = iter(query_sets)
+    return lambda: kernel(next(sets))
 
 
 def uniform_tree(size: int, rng: np.random.Generator) -> Tree:
@@ -81,17 +89,24 @@ def main() -> None:
             def brute(t=tree, q=queries, o=out):
                 brute_force(q, t.nodes, t.size, o)
 
+            fresh = [rng.random((QUERIES, 2)) * 20.0 for _ in range(repeats + 1)]  # one per call, warm-up too
             times = {"nearest_us": median_time(lambda t=tree, q=queries: t.nearest(q), repeats)[0] * 1e6,
                      "grid_us": median_time(lambda t=tree, q=queries: t.grid_nearest(q), repeats)[0] * 1e6,
-                     "brute_force_us": median_time(brute, repeats)[0] * 1e6}
+                     "brute_force_us": median_time(brute, repeats)[0] * 1e6,
+                     "nearest_fresh_us": median_time(on_new_queries(tree.nearest, fresh), repeats)[0] * 1e6,
+                     "grid_fresh_us": median_time(on_new_queries(tree.grid_nearest, fresh), repeats)[0] * 1e6,
+                     "brute_force_fresh_us": median_time(on_new_queries(
+                         lambda q, t=tree, o=out: brute_force(q, t.nodes, t.size, o), fresh), repeats)[0] * 1e6}
             brute()
             assert np.array_equal(out, tree.nearest(queries)), "the kernels disagree"
             assert np.array_equal(out, tree.grid_nearest(queries)), "the kernels disagree"
             rows.append({"layout": layout, "nodes": size, "queries": QUERIES, **times})
             print(f"  {layout:8s} {size:5d} nodes: Tree.nearest {times['nearest_us']:7.1f} us (the grid "
-                  f"{times['grid_us']:7.1f} us), brute force {times['brute_force_us']:8.1f} us ({QUERIES} queries)")
-    summary = {f"{row['layout']}_n{row['nodes']}_{key}": row[key]
-               for row in rows for key in ("nearest_us", "grid_us", "brute_force_us")}
+                  f"{times['grid_us']:7.1f} us), brute force {times['brute_force_us']:8.1f} us; new queries each "
+                  f"call: {times['nearest_fresh_us']:7.1f} / {times['grid_fresh_us']:7.1f} / "
+                  f"{times['brute_force_fresh_us']:8.1f} us ({QUERIES} queries)")
+    keys = ("nearest_us", "grid_us", "brute_force_us", "nearest_fresh_us", "grid_fresh_us", "brute_force_fresh_us")
+    summary = {f"{row['layout']}_n{row['nodes']}_{key}": row[key] for row in rows for key in keys}
     path = write_json("bench_nearest_quick" if args.quick else "bench_nearest",
                       {"machine": machine(), "quick": args.quick, "rows": rows, "summary": summary}, args.out)
     print(f"wrote {path}")
