@@ -4,6 +4,7 @@ is taken exactly where it applies, and refuses what the generic round refuses.""
 from __future__ import annotations
 
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
 
 import numpy as np
 import pytest
@@ -72,9 +73,9 @@ CONFIGURATIONS = {
                                                       oracle_errors=qc.OracleErrorModel(0.2, 0.1), fused_round=f),
     "pqrrt-unshared": lambda env, s, f: qc.PQRRT(env, backend=_sv(), workers=3, shared_database=False, seed=s,
                                                  fused_round=f),
-    # the databases fused, the searches through the policy and the backend
     "qrrt-known-optimal": lambda env, s, f: qc.QRRT(env, backend=_sv(), num_qubits=6, seed=s,
                                                     search_policy=qc.KnownOptimal(), fused_round=f),
+    # the databases fused, the searches through the policy and the backend
     "pqrrt-unshared-bbht": lambda env, s, f: qc.PQRRT(env, backend=_sv(), workers=3, num_qubits=5, seed=s,
                                                       shared_database=False, search_policy=qc.BBHT(), fused_round=f),
     "qrrt-iterated": lambda env, s, f: qc.QRRT(env, backend=_sv(closed_form=False), num_qubits=5, seed=s,
@@ -85,7 +86,7 @@ CONFIGURATIONS = {
 
 #: the configurations whose searches are drawn by the fused round itself
 CLOSED_FORM = {"qrrt-paper", "qrrt-n5-fixed", "qrrt-n3-fixed0", "qrrt-adaptive", "qrrt-errors", "pqrrt-shared",
-               "pqrrt-shared-errors", "pqrrt-unshared"}
+               "pqrrt-shared-errors", "pqrrt-unshared", "qrrt-known-optimal"}
 
 
 @pytest.mark.parametrize("name", sorted(CONFIGURATIONS))
@@ -160,27 +161,69 @@ def test_fused_round_taken_only_where_it_applies():
     assert qc.StatevectorBackend().draws_closed_form(32) and not qc.StatevectorBackend().draws_closed_form(33)
 
 
-def test_policies_say_whether_k_is_fixed_before_the_database():
-    assert qc.PaperSchedule().start(256).preset_iterations(5) == 5
-    assert qc.PaperSchedule().start(256).preset_iterations(11) == 3
-    assert qc.FixedIterations(2).start(64).preset_iterations(0) == 2
-    adaptive = qc.Adaptive().start(256)
-    assert adaptive.preset_iterations(3) == adaptive.choose_iterations(3)
-    for policy in (qc.KnownOptimal(), qc.BBHT(), qc.FixedPointAmplification(), qc.EstimatedOptimal()):
-        assert policy.start(256).preset_iterations(3) is None, policy
+def test_policy_states_say_whether_they_search_by_default():
+    for policy in (qc.PaperSchedule(), qc.FixedIterations(2), qc.KnownOptimal(), qc.Adaptive()):
+        assert policy.start(256).searches_by_default(), policy
+    for policy in (qc.BBHT(), qc.FixedPointAmplification(), qc.EstimatedOptimal()):
+        assert not policy.start(256).searches_by_default(), policy
 
     class OwnRun(PolicyState):
         def run(self, problem, workers, tree_nodes):
             return super().run(problem, workers, tree_nodes)
 
-    assert OwnRun(qc.PaperSchedule(), 256).preset_iterations(3) is None
+    class OwnRunMany(PolicyState):
+        def run_many(self, problems, workers, tree_nodes):
+            return super().run_many(problems, workers, tree_nodes)
+
+    assert not OwnRun(qc.PaperSchedule(), 256).searches_by_default()
+    assert not OwnRunMany(qc.PaperSchedule(), 256).searches_by_default()
 
 
-def test_policies_that_read_the_database_search_through_the_backend(fused_calls):
+def test_the_database_reading_policy_is_drawn_by_the_fused_round_too(fused_calls):
     env = qc.scenarios.paper_clutter(seed=3)
     result = qc.QRRT(env, backend=_sv(), seed=3, search_policy=qc.KnownOptimal()).plan(max_nodes=10)
     assert result.metrics.nodes == 10
-    assert fused_calls["candidates"] == result.metrics.databases and fused_calls["measure"] == 0
+    assert fused_calls["candidates"] == fused_calls["measure"] == result.metrics.databases
+
+
+@dataclass(frozen=True)
+class CyclingIterations(qc.FixedIterations):
+    """k = 0, 1, 2, 3, 0, ... each time the policy is asked (stands for any k drawn per database)."""
+
+    asked: list = field(default_factory=lambda: [0], compare=False)
+
+    def _iterations(self, num_items, tree_nodes, num_marked):
+        self.asked[0] += 1
+        return self.asked[0] % 4
+
+    def iterations_bound(self, num_items):
+        return 3
+
+
+class ChoosesOne(PolicyState):
+    """A state that overrides only ``choose_iterations`` (the default round never asks it)."""
+
+    def choose_iterations(self, tree_nodes, num_marked=None):
+        return 1
+
+
+@dataclass(frozen=True)
+class ChoosingOne(qc.PaperSchedule):
+    def start(self, num_items):
+        return ChoosesOne(self, num_items)
+
+
+@pytest.mark.parametrize("shared", [True, False], ids=["shared", "unshared"])
+@pytest.mark.parametrize("make_policy", [CyclingIterations, ChoosingOne], ids=["asked-per-database", "own-choice"])
+def test_k_is_asked_as_the_generic_round_asks_it(shared, make_policy):
+    """k comes from iterations_for on each database, in order, as run_many asks it: a policy with
+    state, or a state overriding another method, gives the generic round's plan."""
+    env = qc.scenarios.paper_clutter(seed=0)
+    results = [qc.PQRRT(env, backend=_sv(), num_qubits=5, workers=4, shared_database=shared,
+                        search_policy=make_policy(), seed=0, fused_round=fused).plan(max_nodes=30)
+               for fused in (True, False)]
+    assert results[0].metrics.nodes >= 30  # (an unshared round may add several)
+    assert fingerprint(results[0]) == fingerprint(results[1])
 
 
 class WrongLength:

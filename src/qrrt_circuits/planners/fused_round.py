@@ -12,9 +12,10 @@ compiled calls:
 2. the predicate's own ``reachable`` on those pairs (the oracle; not fused, so it is timed and
    counted as before), and the error model's flips if there is one;
 3. ``_measure``, where the backend's seeded search is the closed-form draw
-   (``QuantumSearchBackend.draws_closed_form``: the ``StatevectorBackend``) and the policy fixes k
-   before seeing the database (``PolicyState.preset_iterations``: the paper's schedule, fixed k,
-   ``Adaptive``): the seed of stream (round, worker, ``Stream.SEARCH``), the backend's generator of
+   (``QuantumSearchBackend.draws_closed_form``: the ``StatevectorBackend``) and the policy state
+   searches by default (``PolicyState.searches_by_default``: one search per database at the k of
+   its ``iterations_for``, as for the paper's schedule, fixed k, ``KnownOptimal``, ``Adaptive``):
+   the seed of stream (round, worker, ``Stream.SEARCH``), the backend's generator of
    that seed, the two-level closed-form draw of the workers' measured indices
    (``statevector._draw_two_level_seeded``, Eq. 1 / Lemma 1) and the classical verification of each
    (the finalizer: 1 oracle call per worker). Otherwise the databases go to the policy's
@@ -148,9 +149,10 @@ class FusedRound:
 
         Every database is built by ``_candidates`` and marked by the predicate (in group order, as
         the generic round does). If the backend's seeded search is the closed-form draw and the
-        policy fixes k before the database (``PolicyState.preset_iterations``), each database's
-        workers are drawn and verified by ``_measure``; otherwise the databases go to the policy's
-        ``run_many`` as ``DatabaseSearch`` problems, as in the generic round.
+        policy state searches by default (``PolicyState.searches_by_default``), k is the state's
+        ``iterations_for`` on each database, in order, as ``run_many`` asks it, and each database's
+        workers are drawn and verified by ``_measure``; otherwise the databases go to the state's
+        ``run_many``, as in the generic round.
 
         Args:
             tree: The plan's tree (read only).
@@ -164,17 +166,19 @@ class FusedRound:
 
         Raises:
             ValueError: A predicate answer that is not a 0/1 array of 2^n entries, or a k or a shot
-                count that the backend's ``search`` would refuse, before the search.
+                count that the backend's ``search`` would refuse, before any search.
         """
         built = [self._database(tree, round_index, first) for first, _ in groups]
-        iterations = policy_state.preset_iterations(tree_nodes) if self.closed_form else None
-        if iterations is None:
-            problems = [DatabaseSearch(marks, truth, self.backend, self.streams, round_index, first)
-                        for (_, _, truth, marks), (first, _) in zip(built, groups, strict=True)]
+        problems = [DatabaseSearch(marks, truth, self.backend, self.streams, round_index, first)
+                    for (_, _, truth, marks), (first, _) in zip(built, groups, strict=True)]
+        if not (self.closed_form and policy_state.searches_by_default()):
             searched = policy_state.run_many(problems, groups[0][1], tree_nodes) if groups else ()
             return [self._outcome(database, outcomes) for database, outcomes in zip(built, searched, strict=True)]
-        return [self._outcome(database, self._measured(database, round_index, first, count, iterations))
-                for database, (first, count) in zip(built, groups, strict=True)]
+        iterations = [policy_state.iterations_for(problem, tree_nodes) for problem in problems]
+        for k, (_, count) in zip(iterations, groups, strict=True):
+            self._check_search(k, count)  # every search checked before any runs, as search_many does
+        return [self._outcome(database, self._measured(database, round_index, first, count, k))
+                for database, (first, count), k in zip(built, groups, iterations, strict=True)]
 
     def _database(self, tree: Tree, round_index: int,
                   worker: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -192,7 +196,6 @@ class FusedRound:
                   first: int, count: int, iterations: int) -> tuple[SearchOutcome, ...]:
         """The default ``PolicyState.run`` at k = ``iterations`` for ``count`` workers, compiled."""
         _, _, truth, marks = database
-        self._check_search(iterations, count)
         p_good = good_probability(self.size, int(np.count_nonzero(marks)), iterations)
         indices, verified = _measure(self._entropy, round_index, first, marks, truth, p_good, count)
         missed = self._missed(iterations)

@@ -149,8 +149,9 @@ class PQRRT(Planner):
             an error.
         fused_round: True (default): without an executor, annealing or goal bias, each database is
             drawn and paired with its nearest nodes in one compiled call, and where the backend's
-            seeded search is the closed-form draw (the ``StatevectorBackend``) and the policy fixes
-            k before seeing the database, its workers are drawn and verified in a second one
+            seeded search is the closed-form draw (the ``StatevectorBackend``) and the policy
+            searches by default (one search per database at its k: every policy but ``BBHT``,
+            fixed-point and estimated ones), its workers are drawn and verified in a second one
             (``qrrt_circuits.planners.fused_round``); the same results bit for bit. False: every
             round takes the generic path (for tests and benchmarks). Must be a ``bool``.
 

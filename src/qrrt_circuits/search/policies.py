@@ -202,32 +202,18 @@ class PolicyState:
         """
         return self.policy.iterations_for(problem, tree_nodes)
 
-    def preset_iterations(self, tree_nodes: int) -> int | None:
-        """k if this state's next round is the default ``run`` at a k chosen before the database is
-        seen, else None.
+    def searches_by_default(self) -> bool:
+        """Whether this state's ``run`` and ``run_many`` are the defaults.
 
-        The quantum planners' fused round (``qrrt_circuits.planners.fused_round``) asks this before
-        it builds a database: with an int it draws, verifies and reports exactly what ``run``
-        would; with None the round goes through ``run`` / ``run_many``. None here when the state
-        overrides ``run`` or ``run_many`` (BBHT, fixed-point, estimated policies), when the policy
-        reads the true m (``uses_true_m``) or overrides ``iterations_for`` (it may read the
-        database), or when this state overrides ``iterations_for``; a state whose own
-        ``iterations_for`` ignores the database (``AdaptiveState``) overrides this method too.
-
-        Args:
-            tree_nodes: Nodes in the tree so far.
+        Then a round's outcomes are fixed by ``iterations_for`` on each database (in order) and one
+        backend search per database with ``shots = workers``, each worker verifying its own
+        measurement; the quantum planners' fused round (``qrrt_circuits.planners.fused_round``)
+        then draws those searches itself when the backend's are the closed-form draw. False for
+        states with their own loop (``BBHT``, fixed-point and estimated policies).
 
         Returns:
-            k >= 0, or None.
+            True if neither ``run`` nor ``run_many`` is overridden.
         """
-        if not self._default_round() or type(self).iterations_for is not PolicyState.iterations_for:
-            return None
-        if self.policy.uses_true_m or type(self.policy).iterations_for is not IterationPolicy.iterations_for:
-            return None
-        return self.choose_iterations(tree_nodes)
-
-    def _default_round(self) -> bool:
-        """Whether ``run`` and ``run_many`` are this class's own defaults."""
         return type(self).run is PolicyState.run and type(self).run_many is PolicyState.run_many
 
     def run(self, problem: DatabaseSearch, workers: int, tree_nodes: int) -> tuple[SearchOutcome, ...]:
@@ -656,17 +642,6 @@ class AdaptiveState(PolicyState):
             k >= 0.
         """
         return self.choose_iterations(tree_nodes)
-
-    def preset_iterations(self, tree_nodes: int) -> int | None:
-        """The posterior's k (it never reads the database), or None if ``run`` is overridden.
-
-        Args:
-            tree_nodes: Nodes in the tree so far.
-
-        Returns:
-            k >= 0, or None.
-        """
-        return self.choose_iterations(tree_nodes) if self._default_round() else None
 
     def observe(self, iterations: int, success: bool) -> None:
         theta = np.arcsin(np.sqrt(self.fractions))
