@@ -226,29 +226,65 @@ def test_k_is_asked_as_the_generic_round_asks_it(shared, make_policy):
     assert fingerprint(results[0]) == fingerprint(results[1])
 
 
-class WrongLength:
-    """A predicate answering one pair too few."""
+class Answering:
+    """The exact check, its answers passed through ``transform`` (a predicate that answers oddly)."""
 
-    dim = 2
-    name = "wrong-length"
+    def __init__(self, env, transform):
+        self.inner = qc.ReachabilityOracle(env)
+        self.transform = transform
+
+    dim = property(lambda self: self.inner.dim)
+    name = "answering"
 
     def describe(self):
         return {"name": self.name}
 
     def reachable(self, parents, children):
-        return np.ones(len(children) - 1, dtype=bool)
+        return self.transform(self.inner.reachable(parents, children))
 
 
-class NotBoolean(WrongLength):
-    def reachable(self, parents, children):
-        return np.full(len(children), 0.5)
+class ReusedBuffer:
+    """Answers written into one reused uint8 buffer (returned every call)."""
+
+    def __init__(self):
+        self.buffer = None
+
+    def __call__(self, answers):
+        if self.buffer is None or len(self.buffer) != len(answers):
+            self.buffer = np.empty(len(answers), dtype=np.uint8)
+        self.buffer[:] = answers
+        return self.buffer
 
 
-@pytest.mark.parametrize("predicate", [WrongLength(), NotBoolean()], ids=["length", "values"])
-def test_bad_predicate_answers_are_refused(predicate):
+#: answers both rounds accept (and plan alike with) ...
+ACCEPTED = {"list": lambda a: a.tolist(), "ints": lambda a: a.astype(np.int64), "floats": lambda a: a.astype(float),
+            "reused-uint8-buffer": ReusedBuffer()}
+#: ... and answers both refuse, with the message
+REFUSED = {"one-short": (lambda a: a[:-1], "shape"), "half": (lambda a: a[: len(a) // 2], "shape"),
+           "double": (lambda a: np.concatenate([a, a]), "shape"), "column": (lambda a: a[:, None], "shape"),
+           "scalar": (lambda a: True, "shape"), "halves": (lambda a: np.full(len(a), 0.5), "0/1")}
+
+
+@pytest.mark.parametrize("name", sorted(ACCEPTED))
+def test_both_rounds_accept_the_same_answers(name):
+    env = qc.scenarios.paper_clutter(seed=1)
+    results = [qc.PQRRT(env, backend=_sv(), num_qubits=5, workers=3, shared_database=False, seed=1,
+                        predicate=Answering(env, ACCEPTED[name]), fused_round=fused).plan(max_nodes=25)
+               for fused in (True, False)]
+    reference = qc.PQRRT(env, backend=_sv(), num_qubits=5, workers=3, shared_database=False, seed=1,
+                         fused_round=False).plan(max_nodes=25)
+    assert fingerprint(results[0]) == fingerprint(results[1]) == fingerprint(reference)
+
+
+@pytest.mark.parametrize("errors", [False, True], ids=["exact-marks", "oracle-errors"])
+@pytest.mark.parametrize("fused", [True, False], ids=["fused", "generic"])
+@pytest.mark.parametrize("name", sorted(REFUSED))
+def test_both_rounds_refuse_the_same_answers(name, fused, errors):
+    transform, message = REFUSED[name]
     env = qc.scenarios.paper_clutter(seed=0)
-    planner = qc.QRRT(env, backend=_sv(), num_qubits=4, predicate=predicate, seed=0)
-    with pytest.raises(ValueError, match="pairs for a database of 16|booleans"):
+    planner = qc.QRRT(env, backend=_sv(), num_qubits=4, predicate=Answering(env, transform), seed=0,
+                      oracle_errors=qc.OracleErrorModel(0.1, 0.1) if errors else None, fused_round=fused)
+    with pytest.raises(ValueError, match=f"predicate 'answering' answered.*{message}"):
         planner.plan(max_rounds=3)
 
 
@@ -276,3 +312,33 @@ def test_learn_feeds_every_observation_to_a_state_that_observes():
     consumed = []
     PolicyState(qc.FixedIterations(2), 64).learn(consumed.append(o) or o for o in outcomes)
     assert consumed == []  # the no-op observe: the outcomes are not even read
+
+
+@pytest.mark.parametrize("fused", [True, False], ids=["fused", "generic"])
+def test_bbht_ends_on_two_entry_databases_with_nothing_marked(fused):
+    """N = 2: BBHT's range [0, M) never reaches 1, so every attempt runs 0 iterations and the
+    iteration cap is never spent; each worker now stops after cap attempts (it looped forever)."""
+    env = qc.scenarios.paper_clutter(seed=0)
+    nothing = Answering(env, lambda answers: np.zeros_like(answers))
+    result = qc.QRRT(env, backend=_sv(), num_qubits=1, search_policy=qc.BBHT(), predicate=nothing, seed=0,
+                     fused_round=fused).plan(max_rounds=5)
+    cap = qc.BBHT().cap(2)
+    assert cap == 7 and result.metrics.rounds == 5 and result.metrics.nodes == 0
+    assert result.metrics.verification_calls == 5 * cap and result.metrics.quantum_oracle_calls == 0
+
+
+@dataclass(frozen=True)
+class NumpyIterations(qc.FixedIterations):
+    """k as a numpy uint8 (it used to leak into the counters, which then wrapped at 256)."""
+
+    def _iterations(self, num_items, tree_nodes, num_marked):
+        return np.uint8(self.k)
+
+
+@pytest.mark.parametrize("fused", [True, False], ids=["fused", "generic"])
+def test_a_numpy_integer_k_is_counted_as_an_int(fused):
+    env = qc.scenarios.paper_clutter(seed=2)
+    result = qc.QRRT(env, backend=_sv(), num_qubits=5, search_policy=NumpyIterations(3), seed=2,
+                     fused_round=fused).plan(max_rounds=200, goal_radius=1e-9)
+    assert type(result.metrics.quantum_oracle_calls) is int
+    assert result.metrics.quantum_oracle_calls == 3 * result.metrics.rounds == 600

@@ -147,6 +147,35 @@ def as_pairs(parents: np.ndarray, children: np.ndarray, dim: int) -> tuple[np.nd
     return parents, children
 
 
+def check_answers(answers: Any, count: int, source: str) -> np.ndarray:
+    """A predicate's (or an error model's) answers for ``count`` pairs as a bool array (M,).
+
+    Both quantum rounds (``planners.workers.make_database`` and ``planners.fused_round``) pass
+    every batch of answers through this, so they accept and refuse the same answers.
+
+    Args:
+        answers: What ``reachable`` (or ``OracleErrorModel.apply``) returned: any array-like of M
+            booleans or 0/1 values.
+        count: M, the pairs asked.
+        source: Who answered, for the error message (e.g. the predicate's name).
+
+    Returns:
+        The answers as a bool array of shape (M,) (the same array when it already is one).
+
+    Raises:
+        ValueError: Not one answer per pair (another shape), or values other than booleans or 0/1.
+    """
+    array = np.asarray(answers)
+    if array.shape != (count,):
+        raise ValueError(f"{source} answered an array of shape {array.shape} for {count} pairs: reachable must "
+                         "return one bool per pair")
+    if array.dtype != np.bool_:
+        if not np.all(np.isin(array, (0, 1))):
+            raise ValueError(f"{source} answered values other than booleans or 0/1")
+        array = array.astype(bool)
+    return array
+
+
 def can_leave(predicate: ReachabilityPredicate, point: np.ndarray) -> bool:
     """The predicate's own ``can_leave(point)`` if it has one, else True (not decidable).
 

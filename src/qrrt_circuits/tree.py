@@ -18,6 +18,8 @@ and 200 nodes for a round's 256 queries on two machines.
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 from numba import njit
 
@@ -29,6 +31,8 @@ BRUTE_FORCE_BELOW = 160
 #: relative rounding allowance of the grid's stopping bound (a few units in the last place)
 _EDGE_SLACK = 16 * float(np.finfo(float).eps)
 _NOT_FINITE = "points must be finite (no NaN or infinity)"
+#: serializes the lazy grid builds of ``grid_nearest`` (queries may come from several threads)
+_FIRST_GRID = threading.Lock()
 
 
 class Tree:
@@ -140,8 +144,10 @@ class Tree:
         """``nearest`` through the grid whatever the tree's size (for tests and benchmarks): the
         same argument (float points, (M, d) or (d,)), result (int (M,) node indices) and errors."""
         points = self._queries(points)
-        if not self._grid_built_at:
-            self._build_grid()
+        if not self._grid_built_at:  # a small tree's first grid query builds the grid, once
+            with _FIRST_GRID:
+                if not self._grid_built_at:  # (_build_grid sets it last: a built grid is complete)
+                    self._build_grid()
         out = np.empty(points.shape[0], dtype=np.int64)
         _grid_nearest(points, self._nodes, self._next, self._head, self._origin, self._cell, self._shape,
                       self.size, self._low, self._high, out)

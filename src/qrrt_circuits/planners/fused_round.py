@@ -36,15 +36,15 @@ from numba import njit
 
 from ..environment import Environment
 from ..oracle_errors import OracleErrorModel
-from ..predicate import ReachabilityPredicate
+from ..predicate import ReachabilityPredicate, check_answers
 from ..probability import good_probability
 from ..randomness import RandomStreams, Stream, _next64, _next_double, _pcg_state, _seed_words
-from ..search.backend import QuantumSearchBackend, validate_iterations, validate_marks
+from ..search.backend import QuantumSearchBackend, validate_iterations
 from ..search.policies import PolicyState
 from ..search.problem import DatabaseSearch, SearchOutcome
 from ..search.statevector import _draw_two_level_seeded
 from ..tree import Tree, nearest_into
-from .workers import DatabaseOutcome
+from .workers import DatabaseOutcome, database_outcome
 
 _MASK32 = np.uint64(0xFFFFFFFF)
 _CANDIDATES = int(Stream.CANDIDATES)
@@ -168,46 +168,45 @@ class FusedRound:
             ValueError: A predicate answer that is not a 0/1 array of 2^n entries, or a k or a shot
                 count that the backend's ``search`` would refuse, before any search.
         """
+        workers = groups[0][1]
+        if any(count != workers for _, count in groups):
+            raise ValueError("FusedRound.search needs groups of one size")
         built = [self._database(tree, round_index, first) for first, _ in groups]
         problems = [DatabaseSearch(marks, truth, self.backend, self.streams, round_index, first)
                     for (_, _, truth, marks), (first, _) in zip(built, groups, strict=True)]
         if not (self.closed_form and policy_state.searches_by_default()):
-            searched = policy_state.run_many(problems, groups[0][1], tree_nodes) if groups else ()
-            return [self._outcome(database, outcomes) for database, outcomes in zip(built, searched, strict=True)]
-        iterations = [policy_state.iterations_for(problem, tree_nodes) for problem in problems]
-        for k, (_, count) in zip(iterations, groups, strict=True):
-            self._check_search(k, count)  # every search checked before any runs, as search_many does
-        return [self._outcome(database, self._measured(database, round_index, first, count, k))
-                for database, (first, count), k in zip(built, groups, iterations, strict=True)]
+            searched = policy_state.run_many(problems, workers, tree_nodes)
+            return [database_outcome(children, parents, truth, outcomes)
+                    for (children, parents, truth, _), outcomes in zip(built, searched, strict=True)]
+        iterations = [validate_iterations(policy_state.iterations_for(problem, tree_nodes)) for problem in problems]
+        for k in iterations:
+            self._check_memory(k, workers)  # every search checked before any runs, as search_many does
+        return [database_outcome(children, parents, truth, self._measured(marks, truth, round_index, first, workers, k))
+                for (children, parents, truth, marks), (first, _), k in zip(built, groups, iterations, strict=True)]
 
     def _database(self, tree: Tree, round_index: int,
                   worker: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(children, parents, truth, marks) of worker ``worker``'s database (Alg. 1 lines 4-8)."""
         children, parents, positions = _candidates(self._entropy, round_index, worker, self.size, self._low,
                                                    self._high, *tree.search_arrays())
-        truth = self._answers(self.predicate.reachable(positions, children))
+        truth = check_answers(self.predicate.reachable(positions, children), self.size,
+                              f"the predicate {self.predicate.name!r}")
         marks = truth
         if self.oracle_errors is not None:
-            marks = self._answers(self.oracle_errors.apply(
-                truth, self.streams.generator(round_index, worker, Stream.ORACLE_ERRORS)))
+            marks = check_answers(self.oracle_errors.apply(
+                truth, self.streams.generator(round_index, worker, Stream.ORACLE_ERRORS)), self.size,
+                "the oracle error model")
         return children, parents, truth, marks
 
-    def _measured(self, database: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], round_index: int,
-                  first: int, count: int, iterations: int) -> tuple[SearchOutcome, ...]:
-        """The default ``PolicyState.run`` at k = ``iterations`` for ``count`` workers, compiled."""
-        _, _, truth, marks = database
+    def _measured(self, marks: np.ndarray, truth: np.ndarray, round_index: int, first: int, count: int,
+                  iterations: int) -> tuple[SearchOutcome, ...]:
+        """The outcomes of the default ``PolicyState.run`` at k = ``iterations`` for ``count``
+        workers (``policies._verified`` of the backend's ``search``), compiled."""
         p_good = good_probability(self.size, int(np.count_nonzero(marks)), iterations)
         indices, verified = _measure(self._entropy, round_index, first, marks, truth, p_good, count)
         missed = self._missed(iterations)
         return tuple(SearchOutcome(index, iterations, 1, ((iterations, True),)) if good else missed
                      for index, good in zip(indices.tolist(), verified.tolist(), strict=True))
-
-    def _outcome(self, database: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
-                 outcomes: tuple[SearchOutcome, ...]) -> DatabaseOutcome:
-        children, parents, truth, _ = database
-        found = tuple(None if outcome.index is None else (children[outcome.index], int(parents[outcome.index]))
-                      for outcome in outcomes)
-        return DatabaseOutcome(self.size, int(np.count_nonzero(truth)), outcomes, found)
 
     def _missed(self, iterations: int) -> SearchOutcome:
         """The (frozen, shareable) outcome of a worker whose measurement did not verify."""
@@ -216,19 +215,9 @@ class FusedRound:
             outcome = self._missed_outcomes[iterations] = SearchOutcome(None, iterations, 1, ((iterations, False),))
         return outcome
 
-    def _answers(self, answers: np.ndarray) -> np.ndarray:
-        """The predicate's (or the error model's) answers as the bool marks ``search`` would take:
-        ``validate_marks``'s errors for anything else, and the size a database has."""
-        if not (isinstance(answers, np.ndarray) and answers.dtype == np.bool_ and answers.ndim == 1):
-            answers, _ = validate_marks(answers)
-        if answers.shape[0] != self.size:
-            raise ValueError(f"the predicate answered {answers.shape[0]} pairs for a database of {self.size} "
-                             "entries (reachable must return one bool per pair)")
-        return answers
-
-    def _check_search(self, iterations: int, shots: int) -> None:
-        """The backend's checks of a search with this k and shot count (once per pair)."""
+    def _check_memory(self, iterations: int, shots: int) -> None:
+        """The backend's memory check of a search with this k and shot count (once per pair per
+        plan: a closed-form search needs (24 * 2^n + 64 * shots) bytes, checked at construction)."""
         if (iterations, shots) not in self._checked:
-            validate_iterations(iterations)
             self.backend.check_memory(self.num_qubits, shots, iterations)
             self._checked.add((iterations, shots))

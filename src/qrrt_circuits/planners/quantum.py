@@ -26,8 +26,6 @@ from __future__ import annotations
 
 from concurrent.futures import Executor
 
-import numpy as np
-
 from ..database import AnnealingSchedule
 from ..dynamics import LinearTrackingDynamics
 from ..environment import Environment
@@ -43,7 +41,7 @@ from .classical import MAX_WORKERS
 from .context import RoundView, WorkerContext, map_tasks
 from .fused_round import FusedRound
 from .run_state import RunState
-from .workers import DatabaseOutcome, make_database, search_database
+from .workers import DatabaseOutcome, database_outcome, make_database, search_database
 
 ORACLE_LOOKUP_LABEL = (
     "simulation: the phase oracle is built from a classical lookup of all 2^n database entries "
@@ -81,12 +79,8 @@ def search_databases_together(context: WorkerContext, view: RoundView,
     if any(count != workers for _, count in groups):
         raise ValueError("search_databases_together needs groups of one size")
     outcomes = view.search_policy_state.run_many(problems, workers, view.tree_nodes)
-    results = []
-    for (db, truth, _), found_by in zip(built, outcomes, strict=True):
-        found = tuple(None if outcome.index is None else (db.children[outcome.index], int(db.parents[outcome.index]))
-                      for outcome in found_by)
-        results.append(DatabaseOutcome(int(truth.shape[0]), int(np.count_nonzero(truth)), found_by, found))
-    return results
+    return [database_outcome(db.children, db.parents, truth, found_by)
+            for (db, truth, _), found_by in zip(built, outcomes, strict=True)]
 
 
 class PQRRT(Planner):
@@ -282,16 +276,16 @@ class PQRRT(Planner):
         return self.annealing.temperature_index(state.rounds, state.nodes)
 
     def _round(self, state: RunState) -> None:
+        groups = self._worker_groups()
         if state.fused_round is not None:  # compiled calls around the predicate, the same outcomes
-            results = state.fused_round.search(state.tree, state.rounds, self._worker_groups(),
-                                               state.search_policy_state, state.nodes)
-        elif self.executor is None:  # the round's searches go to the backend together (same outcomes)
-            view = self._view(state, self._temperature_index(state))
-            results = search_databases_together(state.worker_context, view, self._worker_groups())
+            results = state.fused_round.search(state.tree, state.rounds, groups, state.search_policy_state,
+                                               state.nodes)
         else:
             view = self._view(state, self._temperature_index(state))
-            results = map_tasks(self.executor, search_database, state.worker_context, view,
-                                self._worker_groups())
+            if self.executor is None:  # the round's searches go to the backend together (same outcomes)
+                results = search_databases_together(state.worker_context, view, groups)
+            else:
+                results = map_tasks(self.executor, search_database, state.worker_context, view, groups)
         longest = 0
         for result in results:
             longest = max(longest, self._integrate(state, result))

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..database import Database, stream_database
+from ..predicate import check_answers
 from ..randomness import Stream
 from ..search.problem import DatabaseSearch, SearchOutcome
 from .context import RoundView, WorkerContext
@@ -56,16 +57,28 @@ class DatabaseOutcome:
     found: tuple[tuple[np.ndarray, int] | None, ...]
 
 
+def database_outcome(children: np.ndarray, parents: np.ndarray, truth: np.ndarray,
+                     outcomes: tuple[SearchOutcome, ...]) -> DatabaseOutcome:
+    """One database's ``DatabaseOutcome``: its size, its reachable entries and, per worker, the
+    candidate (child position, parent index) its verified index names, or None."""
+    found = tuple(None if outcome.index is None else (children[outcome.index], int(parents[outcome.index]))
+                  for outcome in outcomes)
+    return DatabaseOutcome(int(truth.shape[0]), int(np.count_nonzero(truth)), outcomes, found)
+
+
 def make_database(context: WorkerContext, view: RoundView, worker: int) -> tuple[Database, np.ndarray, np.ndarray]:
     """Alg. 1 lines 4-8: the database, the true predicate on it, and the oracle's marks."""
     db = stream_database(view.tree, context.database_size, context.env, context.streams, view.round_index,
                          worker, view.goal, view.goal_radius, context.goal_bias, context.annealing,
                          view.temperature_index)
-    truth = context.predicate.reachable(view.tree.nodes[db.parents], db.children)
+    size = db.parents.shape[0]
+    truth = check_answers(context.predicate.reachable(view.tree.nodes[db.parents], db.children), size,
+                          f"the predicate {context.predicate.name!r}")
     marks = truth
     if context.oracle_errors is not None:
-        marks = context.oracle_errors.apply(
-            truth, context.streams.generator(view.round_index, worker, Stream.ORACLE_ERRORS))
+        marks = check_answers(context.oracle_errors.apply(
+            truth, context.streams.generator(view.round_index, worker, Stream.ORACLE_ERRORS)), size,
+            "the oracle error model")
     return db, truth, marks
 
 
@@ -74,7 +87,5 @@ def search_database(context: WorkerContext, view: RoundView, group: tuple[int, i
     first, count = group
     db, truth, marks = make_database(context, view, first)
     problem = DatabaseSearch(marks, truth, context.search_backend, context.streams, view.round_index, first)
-    outcomes = view.search_policy_state.run(problem, count, view.tree_nodes)
-    found = tuple(None if outcome.index is None else (db.children[outcome.index], int(db.parents[outcome.index]))
-                  for outcome in outcomes)
-    return DatabaseOutcome(int(truth.shape[0]), int(np.count_nonzero(truth)), outcomes, found)
+    return database_outcome(db.children, db.parents, truth, view.search_policy_state.run(problem, count,
+                                                                                        view.tree_nodes))

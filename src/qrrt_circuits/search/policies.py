@@ -47,6 +47,7 @@ import numpy as np
 
 from ..probability import optimal_iterations
 from ..validation import check_choice, check_float, check_int, check_optional_int
+from .backend import validate_iterations
 from .problem import DatabaseSearch, SearchOutcome, search_together
 
 __all__ = [
@@ -233,7 +234,7 @@ class PolicyState:
             One ``SearchOutcome`` per worker, in worker order: the verified index or None, the
             quantum calls and verifications spent, and the (k, success) observations.
         """
-        k = self.iterations_for(problem, tree_nodes)
+        k = validate_iterations(self.iterations_for(problem, tree_nodes))
         return _verified(problem, k, problem.search(k, workers, problem.shared_seed()))
 
     def run_many(self, problems: Sequence[DatabaseSearch], workers: int,
@@ -254,7 +255,7 @@ class PolicyState:
         """
         if type(self).run is not PolicyState.run:
             return tuple(self.run(problem, workers, tree_nodes) for problem in problems)
-        iterations = [self.iterations_for(problem, tree_nodes) for problem in problems]
+        iterations = [validate_iterations(self.iterations_for(problem, tree_nodes)) for problem in problems]
         requests = [problem.request(k, workers, problem.shared_seed())
                     for problem, k in zip(problems, iterations, strict=True)]
         results = search_together(problems, requests)
@@ -418,7 +419,8 @@ class BBHT(IterationPolicy):
     Boyer, Brassard, Hoyer and Tapp, "Tight bounds on quantum searching", Fortschr. Phys. 46, 493
     (1998), Thm. 3. Per worker: draw j uniformly in [0, M), run j iterations, measure, verify; on
     failure M <- min(lambda M, sqrt(N)), starting from M = 1. The loop stops at the first verified
-    success or once the iterations spent reach ``cap_factor * sqrt(N)`` (so m = 0 terminates).
+    success or once the iterations spent reach ``cap_factor * sqrt(N)`` (so m = 0 terminates; for
+    N = 2, where M < 2 and every j is 0, after that many attempts).
     Expected cost O(sqrt(N/m)) oracle calls. Each circuit costs j quantum calls + 1 verification.
 
     Args:
@@ -496,7 +498,8 @@ class BBHT(IterationPolicy):
             if good:
                 return BBHTOutcome(index, spent, len(attempts), tuple(attempts))
             bound = min(self.growth * bound, limit)
-            if spent >= cap:
+            if spent >= cap or (limit < 2.0 and len(attempts) >= cap):
+                # (N = 2: M never reaches 2, every j is 0 and spends nothing; stop after cap attempts)
                 return BBHTOutcome(None, spent, len(attempts), tuple(attempts))
 
     def describe(self) -> str:
