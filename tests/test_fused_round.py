@@ -127,6 +127,7 @@ def test_large_trees_use_the_grid_and_still_agree(fused_calls):
                                                                                        goal_radius=1e-9)
                for fused in (True, False)]
     assert results[0].metrics.nodes == nodes
+    assert fused_calls["candidates"] == results[0].metrics.databases  # the fused plan's rounds, all of them
     assert fingerprint(results[0]) == fingerprint(results[1])
 
 

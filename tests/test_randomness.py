@@ -50,7 +50,8 @@ def test_search_seeds_equal_numpy_integers(seed):
         assert streams.seed(*key) == int(expected)
 
 
-@pytest.mark.parametrize("seed", [0, 1, 2**31 - 1, 2**32, 2**62 - 1, 2**100 + 17, 2**128, 2**300 - 1])
+@pytest.mark.parametrize("seed", [0, 1, 2**31 - 1, 2**32 - 1, 2**32, 2**62 - 1, 2**64 - 1, 2**64, 2**100 + 17, 2**128,
+                                  2**300 - 1])
 def test_integer_seed_words_equal_default_rng(seed):
     from qrrt_circuits.randomness import integer_seed_words
 

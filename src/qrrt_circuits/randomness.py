@@ -265,8 +265,7 @@ class RandomStreams:
         key = (int(round_index), int(worker), int(stream))
         if min(key) < 0:
             raise ValueError(f"spawn keys must be non-negative, got {key}")
-        words = _seed_words(self._run_entropy, np.array([key], dtype=np.int64))
-        return int(_raw_outputs(words, 1)[0, 0] >> np.uint64(2))
+        return int(_stream_seed(self._run_entropy, np.array([key], dtype=np.int64)))
 
 
 # PCG64 (numpy's default bit generator, O'Neill 2014: 128-bit LCG, XSL-RR output) for the first
@@ -331,20 +330,25 @@ def _next64(state: np.ndarray) -> np.uint64:
 
 
 @njit(cache=True, nogil=True)
-def _next_double(state: np.ndarray) -> float:
-    """``Generator.random()``: the top 53 bits of one 64-bit output."""
-    return np.float64(_next64(state) >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+def _stream_seed(run_entropy: np.ndarray, key: np.ndarray) -> np.uint64:
+    """``RandomStreams.seed`` of one (1, 3) key: the first 64-bit output of its generator >> 2."""
+    return _next64(_pcg_state(_seed_words(run_entropy, key)[0])) >> np.uint64(2)
 
 
 @njit(cache=True, nogil=True)
-def _raw_outputs(words: np.ndarray, count: int) -> np.ndarray:
-    """(K, count) uint64: the first ``count`` outputs of ``PCG64(seed words)`` (``random_raw``)."""
-    out = np.empty((words.shape[0], count), dtype=np.uint64)
-    for row in range(words.shape[0]):
-        state = _pcg_state(words[row])
-        for column in range(count):
-            out[row, column] = _next64(state)
-    return out
+def _small_seed_words(seed: np.uint64) -> np.ndarray:
+    """``integer_seed_words`` of a seed below 2^64: its two 32-bit words (the high one 0 or not,
+    as numpy's zero padding to the pool of four makes them the same), mixed with no spawn key."""
+    entropy = np.zeros(_POOL_SIZE, dtype=np.uint64)
+    entropy[0] = seed & np.uint64(_MASK)
+    entropy[1] = seed >> np.uint64(32)
+    return _seed_words(entropy, np.empty((1, 0), dtype=np.int64))[0]
+
+
+@njit(cache=True, nogil=True)
+def _next_double(state: np.ndarray) -> float:
+    """``Generator.random()``: the top 53 bits of one 64-bit output."""
+    return np.float64(_next64(state) >> np.uint64(11)) * (1.0 / 9007199254740992.0)
 
 
 @njit(cache=True, nogil=True)
@@ -387,7 +391,10 @@ def integer_seed_words(seed: int) -> np.ndarray:
     """(4,) uint64: the words ``SeedSequence(seed).generate_state(4, np.uint64)`` returns, i.e.
     the seed of ``np.random.default_rng(seed)``'s PCG64, for any non-negative int (an entropy of at
     most four 32-bit words is mixed exactly as when it is zero-padded to the pool size)."""
-    words = _uint32_words(int(seed))
+    seed = int(seed)
+    if 0 <= seed < 1 << 64:
+        return _small_seed_words(np.uint64(seed))
+    words = _uint32_words(seed)
     words += [0] * max(0, _POOL_SIZE - len(words))  # longer entropy is mixed in after the pool
     return _seed_words(np.asarray(words, dtype=np.uint64), _NO_KEYS)[0]
 

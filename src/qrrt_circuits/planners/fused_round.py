@@ -38,7 +38,7 @@ from ..environment import Environment
 from ..oracle_errors import OracleErrorModel
 from ..predicate import ReachabilityPredicate, check_answers
 from ..probability import good_probability
-from ..randomness import RandomStreams, Stream, _next64, _next_double, _pcg_state, _seed_words
+from ..randomness import RandomStreams, Stream, _next_double, _pcg_state, _seed_words, _small_seed_words, _stream_seed
 from ..search.backend import QuantumSearchBackend, validate_iterations
 from ..search.policies import PolicyState
 from ..search.problem import DatabaseSearch, SearchOutcome
@@ -46,7 +46,6 @@ from ..search.statevector import _draw_two_level_seeded
 from ..tree import Tree, nearest_into
 from .workers import DatabaseOutcome, database_outcome
 
-_MASK32 = np.uint64(0xFFFFFFFF)
 _CANDIDATES = int(Stream.CANDIDATES)
 _SEARCH = int(Stream.SEARCH)
 
@@ -94,21 +93,15 @@ def _measure(run_entropy: np.ndarray, round_index: int, worker: int, marks: np.n
              p_good: float, shots: int) -> tuple[np.ndarray, np.ndarray]:
     """The measured indices of one closed-form search and their verification.
 
-    The search seed is ``RandomStreams.seed(round_index, worker, Stream.SEARCH)`` (the first
-    64-bit output of that key's generator, shifted right by 2, so below 2^62: two 32-bit entropy
-    words, zero-padded to numpy's pool of four as ``integer_seed_words`` does); the draw is
-    ``_draw_two_level_seeded`` with the words of that seed; each index is verified against
-    ``truth``.
+    The search seed is ``RandomStreams.seed(round_index, worker, Stream.SEARCH)``
+    (``randomness._stream_seed``), the draw ``_draw_two_level_seeded`` with that seed's
+    ``integer_seed_words`` (``randomness._small_seed_words``, the seed being below 2^62): the same
+    functions the generic round calls; each index is verified against ``truth``.
 
     Returns:
         (indices (shots,), verified (shots,) bool).
     """
-    key = _key(round_index, worker, _SEARCH)
-    seed = _next64(_pcg_state(_seed_words(run_entropy, key)[0])) >> np.uint64(2)
-    entropy = np.zeros(4, dtype=np.uint64)
-    entropy[0] = seed & _MASK32
-    entropy[1] = seed >> np.uint64(32)
-    words = _seed_words(entropy, np.empty((1, 0), dtype=np.int64))[0]
+    words = _small_seed_words(_stream_seed(run_entropy, _key(round_index, worker, _SEARCH)))
     indices = _draw_two_level_seeded(marks, p_good, shots, words)
     verified = np.empty(shots, dtype=np.bool_)
     for shot in range(shots):
