@@ -61,27 +61,53 @@ def test_nearest_agrees_with_the_grid_on_both_sides_of_the_brute_force_switch():
 
 
 def test_the_grid_built_when_the_tree_reaches_the_switch_answers_as_one_kept_from_the_start():
-    """Small trees keep no grid (built at BRUTE_FORCE_BELOW nodes, or by a first grid query):
-    both histories answer every query as the brute force does, at every size."""
+    """Small trees keep no grid (built at BRUTE_FORCE_BELOW nodes, or by a first grid query), and a
+    grid is rebuilt once the nodes added since its build reach ``_pending_limit``: both histories
+    answer every query as the brute force does, at every size, rebuilds on both sides."""
     from qrrt_circuits import tree as tree_module
 
+    switch = tree_module.BRUTE_FORCE_BELOW
+    rebuilds = [switch]  # the sizes at which the lazy tree (re)builds its grid
+    while rebuilds[-1] < 1200:
+        rebuilds.append(rebuilds[-1] + tree_module._pending_limit(rebuilds[-1]))
     rng = np.random.default_rng(11)
-    points = rng.random((700, 2)) * 20
+    points = rng.random((1200, 2)) * 20
     lazy, early = Tree(points[0]), Tree(points[0])
     early.grid_nearest(points[:1])  # the grid from the first node on
     assert lazy._grid_built_at == 0 and early._grid_built_at == 1
+    checked = {switch - 1, 1200} | {size + offset for size in rebuilds[:4] for offset in (-1, 0, 1)}
     for point in points[1:]:
         lazy.add(point, 0)
         early.add(point, 0)
-        if lazy.size in (tree_module.BRUTE_FORCE_BELOW - 1, tree_module.BRUTE_FORCE_BELOW, 161, 319, 320, 700):
+        assert lazy.size - lazy._grid_built_at < tree_module._pending_limit(lazy._grid_built_at) or \
+            lazy._grid_built_at == 0
+        if lazy.size in checked:
             queries = rng.random((128, 2)) * 24 - 2
             want = np.argmin(((queries[:, None, :] - lazy.nodes[None]) ** 2).sum(-1), axis=1)
             assert np.array_equal(lazy.nearest(queries), want)
             assert np.array_equal(early.nearest(queries), want)
             assert np.array_equal(early.grid_nearest(queries), want)
-            if lazy.size >= tree_module.BRUTE_FORCE_BELOW:  # (below, a grid query would build the grid)
+            if lazy.size >= switch:  # (below, a grid query would build the grid)
                 assert np.array_equal(lazy.grid_nearest(queries), want)
-    assert lazy._grid_built_at == tree_module.BRUTE_FORCE_BELOW * 4  # built at 160, rebuilt at 320 and 640
+    assert lazy._grid_built_at == max(size for size in rebuilds if size <= 1200)
+
+
+def test_nodes_added_since_the_grid_was_built_are_found_and_win_no_false_ties():
+    """The nodes the grid does not hold yet are scanned first: the nearest may be one of them, and
+    a grid node exactly as near (a lower index) still wins the tie."""
+    from qrrt_circuits import tree as tree_module
+
+    rng = np.random.default_rng(4)
+    tree = Tree(np.array([10.0, 10.0]))
+    while tree.size < tree_module.BRUTE_FORCE_BELOW:
+        tree.add(rng.random(2) * 20, 0)
+    assert tree._grid_built_at == tree.size
+    query = np.array([[3.25, 17.5]])
+    tree.add(query[0] + [0.0, 1e-9], 0)  # added after the build: the nearest
+    assert tree.nearest(query).tolist() == [tree.size - 1]
+    tree.add(tree.nodes[1].copy(), 0)  # a twin of node 1, added after the build
+    assert tree.nearest(tree.nodes[1][None]).tolist() == [1]  # node 1 and its later twin: the lower index
+    assert tree.size - tree._grid_built_at == 2
 
 
 @pytest.mark.parametrize("xs, query", [
@@ -102,13 +128,15 @@ def test_the_grid_finds_nodes_filed_across_a_cell_edge_by_rounding(xs, query):
     assert tree.nearest(np.array([[query]])).tolist() == [int(np.argmin(squared))]
 
 
-def test_cell_edge_near_ties_in_two_dimensions_on_both_sides_of_the_switch():
+def test_cell_edge_near_ties_in_two_dimensions():
+    """A node a rounding error below a cell edge filed in the cell above, with a rival a hair
+    farther on the query's side: the grid must visit the node's cell before stopping."""
     rng = np.random.default_rng(3)
     checked = 0
     for _ in range(60):
         base = rng.uniform(0, 20, (128, 2))
-        probe = Tree(base[0])
-        for point in base[1:]:
+        probe = Tree(base[0])  # the grid of 130 nodes in base's box: base and two nodes inside its box
+        for point in (*base[1:], base[1], base[2]):
             probe.add(point, 0)
         probe.grid_nearest(base[:1])  # a small tree builds its grid on the first grid query
         origin, cell = probe._origin, probe._cell
@@ -119,16 +147,15 @@ def test_cell_edge_near_ties_in_two_dimensions_on_both_sides_of_the_switch():
             if int((x - origin[0]) / cell) < k:
                 continue  # filed below the edge: not the case under test
             query = edge - 0.001 * cell
-            tree = Tree(base[0])
-            for point in base[1:]:
-                tree.add(point, 0)
-            tree.grid_nearest(base[:1])  # the probe's grid of 128 nodes, kept as nodes are added
-            tree.add(np.array([x, y]), 0)
             angle = rng.uniform(np.pi / 2, 3 * np.pi / 2)  # a rival a hair farther, on the query's side
             radius = (x - query) * (1 + 1e-13)
-            tree.add(np.array([query + radius * np.cos(angle), y + radius * np.sin(angle)]), 0)
-            while tree.size < 160:  # the grid of 128 nodes is kept: no rebuild before 256
-                tree.add(base[tree.size - 130], 0)
+            tree = Tree(base[0])
+            for point in (*base[1:], [x, y], [query + radius * np.cos(angle), y + radius * np.sin(angle)]):
+                tree.add(np.asarray(point), 0)
+            tree.grid_nearest(base[:1])  # the grid of these 130 nodes
+            if not (np.array_equal(tree._origin, origin) and tree._cell == cell):
+                continue  # the two nodes moved the box: another grid
+            assert int((x - origin[0]) / cell) == k  # the node is filed above the edge
             queries = np.array([[query, y]])
             want = int(np.argmin(((queries[:, None] - tree.nodes[None]) ** 2).sum(-1)[0]))
             assert tree.grid_nearest(queries).tolist() == [want]

@@ -1,23 +1,27 @@
 """The growing tree: node positions, parent indices and nearest-node queries.
 
 Node 0 is the root. Nearest-node queries are exact (Euclidean; among equally near nodes the
-lowest index) and compiled, on a uniform bucket grid over the nodes' bounding box: each cell keeps
-a linked list of its nodes, a query visits the cells ring by ring (Chebyshev rings around its own
-cell) and stops once the distance from the query to the part of the grid not yet visited exceeds
-the best distance found (the cell technique of Bentley, Weide and Yao 1980). The grid is rebuilt,
-with about one node per cell, each time the tree doubles; nodes added in between are appended to
-their cell's list (nodes outside the box go to the nearest border cell, which the stopping bound
-allows for). A query therefore costs about the nodes of a few cells however large the tree, and
-adding a node is O(1) (rebuilds are amortized O(1) per node). It answers what a brute-force search
-does, ties and rounding-level near-ties included: the stopping bound allows for the rounding of a
-node's cell (tested on adversarial cell-edge cases). Trees of fewer than
-``BRUTE_FORCE_BELOW`` nodes are searched by that compiled brute force instead (every query against
-every node), which is faster there: ``benchmarks/bench_nearest.py`` put the crossover between 150
-and 200 nodes for a round's 256 queries on two machines.
+lowest index) and compiled. Trees of fewer than ``BRUTE_FORCE_BELOW`` nodes are searched by brute
+force (every query against every node, one pass over the nodes for all the queries at once, so the
+inner loop over the queries vectorizes). From there the tree keeps a uniform bucket grid over the
+bounding box of the nodes it held at the grid's last build, about one node per cell, in compressed
+form: the nodes sorted by cell with their coordinates copied in that order, and the offset of each
+cell's first node (a cell's nodes, and a run of cells along the last axis, are one contiguous
+slice). A query first scans, by the same brute force, the nodes added since the build (fewer than
+``_pending_limit(built)``: max(32, sqrt(built))), then visits the grid's cells ring by ring
+(Chebyshev rings around its own cell) and stops once the distance from the query to the part of
+the grid not yet visited exceeds the best distance found (the cell technique of Bentley, Weide and
+Yao 1980). When the nodes added since the build reach that limit the grid is rebuilt (O(N), so
+O(sqrt N) amortized per node). A query therefore costs about the nodes of a few cells plus the
+recent nodes, however large the tree. It answers what a brute-force search does, ties and
+rounding-level near-ties included: the stopping bound allows for the rounding of a node's cell
+(tested on adversarial cell-edge cases). ``benchmarks/bench_nearest.py`` times both searches and
+placed ``BRUTE_FORCE_BELOW``.
 """
 
 from __future__ import annotations
 
+import math
 import threading
 
 import numpy as np
@@ -27,12 +31,20 @@ from numba import njit
 _CELLS_PER_NODE = 1.0
 _MAX_CELLS = 1 << 22
 #: trees with fewer nodes answer nearest-node queries by brute force (see the module docstring)
-BRUTE_FORCE_BELOW = 160
+BRUTE_FORCE_BELOW = 400
+#: the fewest nodes added since the grid's build that trigger a rebuild (see ``_pending_limit``)
+_PENDING_MIN = 32
 #: relative rounding allowance of the grid's stopping bound (a few units in the last place)
 _EDGE_SLACK = 16 * float(np.finfo(float).eps)
 _NOT_FINITE = "points must be finite (no NaN or infinity)"
 #: serializes the lazy grid builds of ``grid_nearest`` (queries may come from several threads)
 _FIRST_GRID = threading.Lock()
+
+
+def _pending_limit(built: int) -> int:
+    """Nodes added since a grid of ``built`` nodes was built at which it is rebuilt: max(32,
+    isqrt(built)) (queries scan those nodes by brute force; a rebuild costs O(built))."""
+    return max(_PENDING_MIN, math.isqrt(built))
 
 
 class Tree:
@@ -60,17 +72,18 @@ class Tree:
         self.dim = root.shape[0]
         self._nodes = np.empty((capacity, self.dim))
         self._parents = np.empty(capacity, dtype=np.int64)
-        self._next = np.empty(capacity, dtype=np.int64)  # next node in the same grid cell, or -1
         self._nodes[0] = root
         self._parents[0] = -1
         self.size = 1
         # the grid (built once the tree reaches BRUTE_FORCE_BELOW nodes, see ``add``); until then
-        # placeholders of the grid's types, and _grid_built_at = 0 (the size at the last build)
+        # empty arrays of the grid's types, and _grid_built_at = 0 (the nodes it holds)
         self._grid_built_at = 0
         self._origin, self._low, self._high = np.zeros(self.dim), np.zeros(self.dim), np.zeros(self.dim)
         self._cell = 1.0
         self._shape = np.ones(self.dim, dtype=np.int64)
-        self._head = np.full(1, -1, dtype=np.int64)
+        self._start = np.zeros(2, dtype=np.int64)  # offset of each cell's first node in _order, and the end
+        self._order = np.empty(0, dtype=np.int64)  # the grid's node indices sorted by cell
+        self._sorted = np.empty((0, self.dim))  # their positions, in that order
 
     @property
     def nodes(self) -> np.ndarray:
@@ -83,7 +96,7 @@ class Tree:
         return self._parents[: self.size]
 
     def add(self, position: np.ndarray, parent: int) -> int:
-        """Append a node (amortized O(1); the grid is rebuilt when the tree doubles).
+        """Append a node (amortized O(sqrt N): the grid is rebuilt after ``_pending_limit`` additions).
 
         Args:
             position: Float (d,), the new node.
@@ -95,17 +108,13 @@ class Tree:
         if self.size == self._nodes.shape[0]:
             self._nodes = np.concatenate([self._nodes, np.empty_like(self._nodes)])
             self._parents = np.concatenate([self._parents, np.empty_like(self._parents)])
-            self._next = np.concatenate([self._next, np.empty_like(self._next)])
         index = self.size
         self._nodes[index] = position
         self._parents[index] = parent
         self.size += 1
-        if self._grid_built_at:  # a grid exists: keep it current (rebuilt each time the tree doubles)
-            if self.size >= 2 * self._grid_built_at:
+        if self._grid_built_at:  # queries scan the nodes added since the build until there are too many
+            if self.size - self._grid_built_at >= _pending_limit(self._grid_built_at):
                 self._build_grid()
-            else:
-                _grid_insert(self._nodes, self._next, self._head, self._origin, self._cell, self._shape, index,
-                             self._low, self._high)
         elif self.size >= BRUTE_FORCE_BELOW:  # queries use the grid from here on
             self._build_grid()
         return index
@@ -129,16 +138,15 @@ class Tree:
         nearest_into(points, *self.search_arrays(), out)
         return out
 
-    def search_arrays(self) -> tuple[np.ndarray, int, np.ndarray, np.ndarray, np.ndarray, float, np.ndarray,
-                                     np.ndarray, np.ndarray]:
+    def search_arrays(self) -> tuple[np.ndarray, int, int, np.ndarray, np.ndarray, np.ndarray, np.ndarray, float,
+                                     np.ndarray, np.ndarray, np.ndarray]:
         """The arguments of ``nearest_into`` after the points, for compiled callers (the planners'
-        fused round, ``planners.fused_round``): the node buffer, the size, the grid's lists
-        (next node, cell heads), origin, cell size, shape and the nodes' bounding box. The arrays
-        are the tree's own (not copies) and stay valid until the next ``add``. Below
-        ``BRUTE_FORCE_BELOW`` nodes the tree keeps no grid (``nearest_into`` does not read it) and
-        the grid arrays are placeholders."""
-        return (self._nodes, self.size, self._next, self._head, self._origin, self._cell, self._shape,
-                self._low, self._high)
+        fused round, ``planners.fused_round``): the node buffer, the size, the nodes the grid holds
+        (0: no grid), the grid's cell offsets, sorted node indices and sorted positions, its origin,
+        cell size and shape, and the bounding box of its nodes. The arrays are the tree's own (not
+        copies) and stay valid until the next ``add``."""
+        return (self._nodes, self.size, self._grid_built_at, self._start, self._order, self._sorted, self._origin,
+                self._cell, self._shape, self._low, self._high)
 
     def grid_nearest(self, points: np.ndarray) -> np.ndarray:
         """``nearest`` through the grid whatever the tree's size (for tests and benchmarks): the
@@ -148,10 +156,7 @@ class Tree:
             with _FIRST_GRID:
                 if not self._grid_built_at:  # (_build_grid sets it last: a built grid is complete)
                     self._build_grid()
-        out = np.empty(points.shape[0], dtype=np.int64)
-        _grid_nearest(points, self._nodes, self._next, self._head, self._origin, self._cell, self._shape,
-                      self.size, self._low, self._high, out)
-        return out
+        return self.nearest(points)
 
     def _queries(self, points: np.ndarray) -> np.ndarray:
         points = np.ascontiguousarray(np.atleast_2d(points), dtype=float)
@@ -170,13 +175,12 @@ class Tree:
         while int(np.prod(shape)) > _MAX_CELLS:  # a very flat box: coarser cells
             cell *= 2.0
             shape = np.minimum(np.floor(extent / cell).astype(np.int64) + 1, 1 << 20)
-        self._origin = low.copy()
-        self._cell = cell
-        self._shape = shape
-        self._head = np.full(int(np.prod(shape)), -1, dtype=np.int64)
-        self._low, self._high = low.copy(), high.copy()  # the nodes' bounding box, kept up to date
-        _grid_insert_all(self._nodes, self._next, self._head, self._origin, self._cell, self._shape, self.size,
-                         self._low, self._high)
+        start = np.zeros(int(np.prod(shape)) + 1, dtype=np.int64)
+        order = np.empty(self.size, dtype=np.int64)
+        _file_by_cell(nodes, low, cell, shape, start, order)
+        self._origin, self._cell, self._shape = low.copy(), cell, shape
+        self._low, self._high = low.copy(), high.copy()
+        self._start, self._order, self._sorted = start, order, nodes[order]
         self._grid_built_at = self.size
 
 
@@ -197,107 +201,85 @@ def _cell_of(point: np.ndarray, origin: np.ndarray, cell: float, shape: np.ndarr
     return flat
 
 
+    return flat
+
+
 @njit(cache=True, nogil=True)
-def _grid_insert(nodes: np.ndarray, next_node: np.ndarray, head: np.ndarray, origin: np.ndarray, cell: float,
-                 shape: np.ndarray, index: int, low: np.ndarray, high: np.ndarray) -> None:
-    for axis in range(low.shape[0]):
-        low[axis] = min(low[axis], nodes[index, axis])
-        high[axis] = max(high[axis], nodes[index, axis])
+def _file_by_cell(nodes: np.ndarray, origin: np.ndarray, cell: float, shape: np.ndarray, start: np.ndarray,
+                  order: np.ndarray) -> None:
+    """A counting sort of the nodes by cell: ``order`` the node indices by cell (ascending within a
+    cell), ``start[c]`` the position in ``order`` of cell c's first node (``start`` has one entry
+    per cell plus the end, zero on entry)."""
+    size = nodes.shape[0]
     coordinates = np.empty(shape.shape[0], dtype=np.int64)
-    flat = _cell_of(nodes[index], origin, cell, shape, coordinates)
-    next_node[index] = head[flat]
-    head[flat] = index
-
-
-@njit(cache=True, nogil=True)
-def _grid_insert_all(nodes: np.ndarray, next_node: np.ndarray, head: np.ndarray, origin: np.ndarray, cell: float,
-                     shape: np.ndarray, size: int, low: np.ndarray, high: np.ndarray) -> None:
-    """``_grid_insert`` of nodes 0 .. size - 1, in order, in one call."""
+    cells = np.empty(size, dtype=np.int64)
     for index in range(size):
-        _grid_insert(nodes, next_node, head, origin, cell, shape, index, low, high)
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _visit_cell(point: np.ndarray, nodes: np.ndarray, next_node: np.ndarray, head: np.ndarray, flat: int, size: int,
-                best: float, best_index: int) -> tuple[float, int]:
-    node = head[flat]
-    while node >= 0:
-        if node < size:
-            squared = 0.0
-            for axis in range(point.shape[0]):
-                delta = point[axis] - nodes[node, axis]
-                squared += delta * delta
-            if squared < best or (squared == best and node < best_index):
-                best = squared
-                best_index = node
-        node = next_node[node]
-    return best, best_index
+        cells[index] = _cell_of(nodes[index], origin, cell, shape, coordinates)
+        start[cells[index] + 1] += 1
+    for flat in range(start.shape[0] - 1):
+        start[flat + 1] += start[flat]
+    filled = start[:-1].copy()
+    for index in range(size):
+        order[filled[cells[index]]] = index
+        filled[cells[index]] += 1
 
 
 @njit(cache=True, nogil=True)
-def _brute_nearest(points: np.ndarray, nodes: np.ndarray, size: int, out: np.ndarray) -> None:
-    """For each point, the node with the smallest (squared distance, index), trying every node (the
-    squared distance summed over the axes in order, as ``_visit_cell`` does)."""
-    dim = points.shape[1]
-    for row in range(points.shape[0]):
-        for axis in range(dim):
-            if not np.isfinite(points[row, axis]):
-                raise ValueError(_NOT_FINITE)
-        # node 0 first, then strictly nearer ones: the lowest index among equals, also when every
-        # squared distance overflows to inf (as _visit_cell's (squared distance, index) order)
-        best = np.inf
-        best_index = 0
-        if dim == 2:  # the planners' case, unrolled (the same sum: 0.0 + dx^2 == dx^2 exactly)
-            x, y = points[row, 0], points[row, 1]
-            for node in range(size):
-                dx = x - nodes[node, 0]
-                dy = y - nodes[node, 1]
-                squared = dx * dx + dy * dy
-                if squared < best:
-                    best = squared
-                    best_index = node
-        else:
-            for node in range(size):
-                squared = 0.0
-                for axis in range(dim):
-                    delta = points[row, axis] - nodes[node, axis]
-                    squared += delta * delta
-                if squared < best:
-                    best = squared
-                    best_index = node
-        out[row] = best_index
-
-
-@njit(cache=True, nogil=True)
-def nearest_into(points: np.ndarray, nodes: np.ndarray, size: int, next_node: np.ndarray, head: np.ndarray,
-                 origin: np.ndarray, cell: float, shape: np.ndarray, low: np.ndarray, high: np.ndarray,
+def _brute_block(points: np.ndarray, nodes: np.ndarray, first: int, stop: int, best: np.ndarray,
                  out: np.ndarray) -> None:
-    """``Tree.nearest`` compiled: the brute force below ``BRUTE_FORCE_BELOW`` nodes, else the grid
-    (the arguments after ``points`` are ``Tree.search_arrays()``); writes the node indices into ``out``."""
-    if size < BRUTE_FORCE_BELOW:
-        _brute_nearest(points, nodes, size, out)
-    else:
-        _grid_nearest(points, nodes, next_node, head, origin, cell, shape, size, low, high, out)
+    """For each point, the nearest of nodes ``first .. stop - 1`` (the smallest squared distance,
+    summed over the axes in order; among equals the lowest index) into ``best`` (squared distance)
+    and ``out`` (index); ``inf`` and ``first`` where there are no such nodes or every squared
+    distance overflows. One pass over the nodes for all points (the loop over the points is the
+    inner one, without branches, so it vectorizes)."""
+    count, dim = points.shape
+    for row in range(count):
+        best[row] = np.inf
+        out[row] = first
+    if dim == 2:  # the planners' case, unrolled (the same sum: 0.0 + dx^2 == dx^2 exactly)
+        xs = points[:, 0].copy()
+        ys = points[:, 1].copy()
+        for node in range(first, stop):
+            x, y = nodes[node, 0], nodes[node, 1]
+            for row in range(count):
+                dx = xs[row] - x
+                dy = ys[row] - y
+                squared = dx * dx + dy * dy
+                nearer = squared < best[row]
+                best[row] = squared if nearer else best[row]
+                out[row] = node if nearer else out[row]
+        return
+    coordinates = points.T.copy()
+    squared = np.empty(count)
+    for node in range(first, stop):
+        squared[:] = 0.0
+        for axis in range(dim):
+            value = nodes[node, axis]
+            for row in range(count):
+                delta = coordinates[axis, row] - value
+                squared[row] += delta * delta
+        for row in range(count):
+            nearer = squared[row] < best[row]
+            best[row] = squared[row] if nearer else best[row]
+            out[row] = node if nearer else out[row]
 
 
 @njit(cache=True, nogil=True)
-def _grid_nearest(points: np.ndarray, nodes: np.ndarray, next_node: np.ndarray, head: np.ndarray, origin: np.ndarray,
-                  cell: float, shape: np.ndarray, size: int, low: np.ndarray, high: np.ndarray,
-                  out: np.ndarray) -> None:
-    """Ring search: for each point, the node with the smallest (squared distance, index)."""
+def _grid_search(points: np.ndarray, start: np.ndarray, order: np.ndarray, ordered: np.ndarray, origin: np.ndarray,
+                 cell: float, shape: np.ndarray, low: np.ndarray, high: np.ndarray, best: np.ndarray,
+                 out: np.ndarray) -> None:
+    """Ring search of the grid, from the nearest (``best``, ``out``) found so far: for each point,
+    the node with the smallest (squared distance, index)."""
     dim = points.shape[1]
     last = dim - 1
     centre = np.empty(dim, dtype=np.int64)
     current = np.empty(dim, dtype=np.int64)
     lower = np.empty(dim, dtype=np.int64)
     upper = np.empty(dim, dtype=np.int64)
-    outside = np.empty(dim)  # the point's distance to the nodes' bounding box along each axis
+    outside = np.empty(dim)  # the point's distance to the grid nodes' bounding box along each axis
     slack = np.empty(dim)  # the rounding allowance of the cell edges along each axis (see below)
     for row in range(points.shape[0]):
         point = points[row]
-        for axis in range(dim):
-            if not np.isfinite(point[axis]):
-                raise ValueError(_NOT_FINITE)
         _cell_of(point, origin, cell, shape, centre)
         outside_total = 0.0
         for axis in range(dim):
@@ -306,13 +288,13 @@ def _grid_nearest(points: np.ndarray, nodes: np.ndarray, next_node: np.ndarray, 
             outside[axis] = max(below, above, 0.0)
             outside_total += outside[axis] * outside[axis]
             slack[axis] = _EDGE_SLACK * (abs(point[axis]) + abs(origin[axis]) + shape[axis] * cell)
-        best = np.inf
-        best_index = size
+        nearest = best[row]
+        nearest_index = out[row]
         ring = 0
         while True:
             # visit the cells at Chebyshev distance ``ring`` from the centre (clipped to the grid):
-            # an odometer over the first d - 1 axes; the last axis in full where the prefix is on
-            # the ring, else only its two ends
+            # an odometer over the first d - 1 axes; along the last axis the whole run of cells
+            # (one slice of the sorted nodes) where the prefix is on the ring, else its two ends
             for axis in range(dim):
                 lower[axis] = max(centre[axis] - ring, 0)
                 upper[axis] = min(centre[axis] + ring, shape[axis] - 1)
@@ -325,17 +307,24 @@ def _grid_nearest(points: np.ndarray, nodes: np.ndarray, next_node: np.ndarray, 
                         on_ring = True
                     prefix = prefix * shape[axis] + current[axis]
                 prefix *= shape[last]
-                if on_ring:
-                    for value in range(lower[last], upper[last] + 1):
-                        best, best_index = _visit_cell(point, nodes, next_node, head, prefix + value, size,
-                                                       best, best_index)
-                else:
-                    if centre[last] - ring >= 0:
-                        best, best_index = _visit_cell(point, nodes, next_node, head,
-                                                       prefix + centre[last] - ring, size, best, best_index)
-                    if centre[last] + ring <= shape[last] - 1:
-                        best, best_index = _visit_cell(point, nodes, next_node, head,
-                                                       prefix + centre[last] + ring, size, best, best_index)
+                for end in range(2):  # on the ring: the run [lower, upper] once; else its two end cells
+                    if on_ring:
+                        if end:
+                            break
+                        first, stop = start[prefix + lower[last]], start[prefix + upper[last] + 1]
+                    else:
+                        cell_last = centre[last] - ring if end == 0 else centre[last] + ring
+                        if cell_last < 0 or cell_last > shape[last] - 1:
+                            continue
+                        first, stop = start[prefix + cell_last], start[prefix + cell_last + 1]
+                    for slot in range(first, stop):  # the scan written out (an inlined helper was slower)
+                        squared = 0.0
+                        for axis in range(dim):
+                            delta = point[axis] - ordered[slot, axis]
+                            squared += delta * delta
+                        if squared < nearest or (squared == nearest and order[slot] < nearest_index):
+                            nearest = squared
+                            nearest_index = order[slot]
                 axis = last - 1  # odometer step over the prefix
                 while axis >= 0:
                     current[axis] += 1
@@ -347,8 +336,7 @@ def _grid_nearest(points: np.ndarray, nodes: np.ndarray, next_node: np.ndarray, 
                     break
             # a lower bound on the squared distance from the point to any cell outside the visited
             # block: beyond one side of one axis, the gap to that side plus, along the other axes,
-            # the point's distance to the nodes' bounding box (nodes outside the grid's box sit in
-            # its border cells, so the gaps hold for them too)
+            # the point's distance to the grid nodes' bounding box.
             # Each gap is shortened by a few units in the last place of the coordinates involved:
             # a node is filed by int((x - origin) / cell), which can put a node lying a rounding
             # error below a computed edge origin + k * cell into cell k, and the search must not
@@ -365,7 +353,98 @@ def _grid_nearest(points: np.ndarray, nodes: np.ndarray, next_node: np.ndarray, 
                     covers = False
                     gap = max(origin[axis] + (centre[axis] + ring + 1) * cell - point[axis] - slack[axis], 0.0)
                     bound = min(bound, gap * gap + others)
-            if covers or bound > best * (1.0 + _EDGE_SLACK):  # every cell visited, or none left nearer
+            if covers or bound > nearest * (1.0 + _EDGE_SLACK):  # every cell visited, or none left nearer
                 break
             ring += 1
-        out[row] = best_index
+        best[row] = nearest
+        out[row] = nearest_index
+
+
+@njit(cache=True, nogil=True)
+def _grid_search_2d(points: np.ndarray, start: np.ndarray, order: np.ndarray, ordered: np.ndarray,
+                    origin: np.ndarray, cell: float, shape: np.ndarray, low: np.ndarray, high: np.ndarray,
+                    best: np.ndarray, out: np.ndarray) -> None:
+    """``_grid_search`` in two dimensions (the planners' case), unrolled: the same cells visited in
+    the same rings, the same stopping bound, the same answers."""
+    columns, rows = shape[0], shape[1]
+    for row in range(points.shape[0]):
+        x, y = points[row, 0], points[row, 1]
+        u = (x - origin[0]) / cell  # the cell of the point, clamped to the grid (as ``_cell_of``)
+        v = (y - origin[1]) / cell
+        cx = 0 if u < 0.0 else (columns - 1 if u >= columns else min(int(u), columns - 1))
+        cy = 0 if v < 0.0 else (rows - 1 if v >= rows else min(int(v), rows - 1))
+        outside_x = max(low[0] - x, x - high[0], 0.0)
+        outside_y = max(low[1] - y, y - high[1], 0.0)
+        slack_x = _EDGE_SLACK * (abs(x) + abs(origin[0]) + columns * cell)
+        slack_y = _EDGE_SLACK * (abs(y) + abs(origin[1]) + rows * cell)
+        nearest = best[row]
+        nearest_index = out[row]
+        ring = 0
+        while True:
+            first_y, last_y = max(cy - ring, 0), min(cy + ring, rows - 1)
+            for column in range(max(cx - ring, 0), min(cx + ring, columns - 1) + 1):
+                prefix = column * rows
+                whole = ring == 0 or column == cx - ring or column == cx + ring  # the whole run is on the ring
+                for end in range(2):  # whole: the run [first_y, last_y], once; else its two end cells
+                    if whole:
+                        if end:
+                            break
+                        first, stop = start[prefix + first_y], start[prefix + last_y + 1]
+                    else:
+                        cell_y = cy - ring if end == 0 else cy + ring
+                        if cell_y < 0 or cell_y > rows - 1:
+                            continue
+                        first, stop = start[prefix + cell_y], start[prefix + cell_y + 1]
+                    for slot in range(first, stop):  # the scan written out (an inlined helper was 40 % slower)
+                        dx = x - ordered[slot, 0]
+                        dy = y - ordered[slot, 1]
+                        squared = dx * dx + dy * dy
+                        if squared < nearest or (squared == nearest and order[slot] < nearest_index):
+                            nearest = squared
+                            nearest_index = order[slot]
+            bound = np.inf  # as ``_grid_search``
+            covers = True
+            if cx - ring - 1 >= 0:
+                covers = False
+                gap = max(x - (origin[0] + (cx - ring) * cell) - slack_x, 0.0)
+                bound = min(bound, gap * gap + outside_y * outside_y)
+            if cx + ring + 1 <= columns - 1:
+                covers = False
+                gap = max(origin[0] + (cx + ring + 1) * cell - x - slack_x, 0.0)
+                bound = min(bound, gap * gap + outside_y * outside_y)
+            if cy - ring - 1 >= 0:
+                covers = False
+                gap = max(y - (origin[1] + (cy - ring) * cell) - slack_y, 0.0)
+                bound = min(bound, gap * gap + outside_x * outside_x)
+            if cy + ring + 1 <= rows - 1:
+                covers = False
+                gap = max(origin[1] + (cy + ring + 1) * cell - y - slack_y, 0.0)
+                bound = min(bound, gap * gap + outside_x * outside_x)
+            if covers or bound > nearest * (1.0 + _EDGE_SLACK):
+                break
+            ring += 1
+        best[row] = nearest
+        out[row] = nearest_index
+
+
+@njit(cache=True, nogil=True)
+def nearest_into(points: np.ndarray, nodes: np.ndarray, size: int, built: int, start: np.ndarray, order: np.ndarray,
+                 ordered: np.ndarray, origin: np.ndarray, cell: float, shape: np.ndarray, low: np.ndarray,
+                 high: np.ndarray, out: np.ndarray) -> None:
+    """``Tree.nearest`` compiled (the arguments after ``points`` are ``Tree.search_arrays()``): the
+    brute force over the nodes the grid does not hold (all of them without a grid), then the
+    grid's ring search from that best; writes the node indices into ``out``.
+
+    Raises:
+        ValueError: A point that is not finite.
+    """
+    for row in range(points.shape[0]):
+        for axis in range(points.shape[1]):
+            if not np.isfinite(points[row, axis]):
+                raise ValueError(_NOT_FINITE)
+    best = np.empty(points.shape[0])
+    _brute_block(points, nodes, built, size, best, out)
+    if built and points.shape[1] == 2:
+        _grid_search_2d(points, start, order, ordered, origin, cell, shape, low, high, best, out)
+    elif built:
+        _grid_search(points, start, order, ordered, origin, cell, shape, low, high, best, out)

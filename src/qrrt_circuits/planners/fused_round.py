@@ -60,9 +60,9 @@ def _key(round_index: int, worker: int, stream: int) -> np.ndarray:
 
 @njit(cache=True, nogil=True)
 def _candidates(run_entropy: np.ndarray, round_index: int, worker: int, size: int, low: np.ndarray,
-                high: np.ndarray, nodes: np.ndarray, tree_size: int, next_node: np.ndarray, head: np.ndarray,
-                origin: np.ndarray, cell: float, shape: np.ndarray, box_low: np.ndarray,
-                box_high: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                high: np.ndarray, nodes: np.ndarray, tree_size: int, built: int, start: np.ndarray,
+                order: np.ndarray, ordered: np.ndarray, origin: np.ndarray, cell: float, shape: np.ndarray,
+                box_low: np.ndarray, box_high: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``stream_database`` without goal bias or annealing, plus the parents' positions.
 
     The samples are ``low + (high - low) * u`` with u the first ``size * d`` doubles of the
@@ -80,7 +80,8 @@ def _candidates(run_entropy: np.ndarray, round_index: int, worker: int, size: in
         for axis in range(dim):
             children[row, axis] = low[axis] + (high[axis] - low[axis]) * _next_double(state)
     parents = np.empty(size, dtype=np.int64)
-    nearest_into(children, nodes, tree_size, next_node, head, origin, cell, shape, box_low, box_high, parents)
+    nearest_into(children, nodes, tree_size, built, start, order, ordered, origin, cell, shape, box_low, box_high,
+                 parents)
     positions = np.empty((size, dim))
     for row in range(size):
         for axis in range(dim):
