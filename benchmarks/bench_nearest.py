@@ -1,13 +1,14 @@
-"""Nearest-node queries: ``Tree.nearest`` (a compiled grid) against a compiled brute force.
+"""Nearest-node queries: ``Tree.nearest`` (a compiled grid) against the compiled brute force.
 
     python benchmarks/bench_nearest.py [--quick] [--out FILE]
 
 One quantum round of the planners pairs 2^n = 256 candidates with their nearest tree nodes. This
 times ``Tree.nearest`` (a brute force below ``tree.BRUTE_FORCE_BELOW`` nodes, the grid from there),
-``Tree.grid_nearest`` (the grid at every size) and a compiled 2-D brute force (every query against
-every node, the reference that placed the switch) for 256 uniform queries on trees of 100 to 3 000 nodes
-(``--quick``: up to 300): uniform in the 20 x 20 workspace, and the tree q-RRT grows on paper_clutter (which
-clusters around the start, so many queries lie far from every node). Medians of repeated calls
+``Tree.grid_nearest`` (the grid at every size) and the tree's brute force alone (``tree._brute_block``
+over every node: one pass over the nodes for all queries, the reference that placed the switch) for
+256 uniform queries on trees of 100 to 3 000 nodes (``--quick``: up to 400): uniform in the 20 x 20
+workspace, and the tree q-RRT grows on paper_clutter (which clusters around the start, so many
+queries lie far from every node). Medians of repeated calls
 on the same 256 queries, and (``*_fresh_us``) on a new set of 256 queries each call, as a planner's
 rounds ask (on one repeated set the processor's branch predictors learn the searches' branches);
 one thread. Prints a table and writes JSON.
@@ -22,29 +23,18 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
 import numpy as np
 from _common import machine, median_time, write_json
-from numba import njit
 
 import qrrt_circuits as qc
-from qrrt_circuits.tree import Tree
+from qrrt_circuits.tree import Tree, _brute_block
 
 QUERIES = 256
-SIZES = (100, 150, 200, 300, 1000, 3000)
+SIZES = (100, 200, 300, 400, 500, 1000, 3000)
 
 
-@njit(cache=True)
 def brute_force(points: np.ndarray, nodes: np.ndarray, size: int, out: np.ndarray) -> None:
-    """out[i] = the lowest index among the nodes nearest to points[i] (2-D, every pair)."""
-    for i in range(points.shape[0]):
-        best = np.inf
-        best_index = 0
-        px, py = points[i, 0], points[i, 1]
-        for j in range(size):
-            dx, dy = px - nodes[j, 0], py - nodes[j, 1]
-            squared = dx * dx + dy * dy
-            if squared < best:
-                best = squared
-                best_index = j
-        out[i] = best_index
+    """out[i] = the lowest index among the nodes nearest to points[i] (the tree's brute force over
+    every node)."""
+    _brute_block(points, nodes, 0, size, np.empty(points.shape[0]), out)
 
 
 def on_new_queries(kernel, query_sets):

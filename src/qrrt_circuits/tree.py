@@ -142,11 +142,16 @@ class Tree:
                                      np.ndarray, np.ndarray, np.ndarray]:
         """The arguments of ``nearest_into`` after the points, for compiled callers (the planners'
         fused round, ``planners.fused_round``): the node buffer, the size, the nodes the grid holds
-        (0: no grid), the grid's cell offsets, sorted node indices and sorted positions, its origin,
-        cell size and shape, and the bounding box of its nodes. The arrays are the tree's own (not
-        copies) and stay valid until the next ``add``."""
-        return (self._nodes, self.size, self._grid_built_at, self._start, self._order, self._sorted, self._origin,
-                self._cell, self._shape, self._low, self._high)
+        (0: no grid, or a tree below ``BRUTE_FORCE_BELOW`` nodes, searched by brute force even if a
+        ``grid_nearest`` call built one), the grid's cell offsets, sorted node indices and sorted
+        positions, its origin, cell size and shape, and the bounding box of its nodes. The arrays
+        are the tree's own (not copies) and stay valid until the next ``add``."""
+        return self._search_arrays(self.size >= BRUTE_FORCE_BELOW)
+
+    def _search_arrays(self, grid: bool) -> tuple[np.ndarray, int, int, np.ndarray, np.ndarray, np.ndarray,
+                                                   np.ndarray, float, np.ndarray, np.ndarray, np.ndarray]:
+        return (self._nodes, self.size, self._grid_built_at if grid else 0, self._start, self._order, self._sorted,
+                self._origin, self._cell, self._shape, self._low, self._high)
 
     def grid_nearest(self, points: np.ndarray) -> np.ndarray:
         """``nearest`` through the grid whatever the tree's size (for tests and benchmarks): the
@@ -156,7 +161,9 @@ class Tree:
             with _FIRST_GRID:
                 if not self._grid_built_at:  # (_build_grid sets it last: a built grid is complete)
                     self._build_grid()
-        return self.nearest(points)
+        out = np.empty(points.shape[0], dtype=np.int64)
+        nearest_into(points, *self._search_arrays(True), out)
+        return out
 
     def _queries(self, points: np.ndarray) -> np.ndarray:
         points = np.ascontiguousarray(np.atleast_2d(points), dtype=float)
