@@ -78,6 +78,7 @@ class Tree:
         # the grid (built once the tree reaches BRUTE_FORCE_BELOW nodes, see ``add``); until then
         # empty arrays of the grid's types, and _grid_built_at = 0 (the nodes it holds)
         self._grid_built_at = 0
+        self._rebuild_at = BRUTE_FORCE_BELOW  # the size at which ``add`` (re)builds the grid
         self._origin, self._low, self._high = np.zeros(self.dim), np.zeros(self.dim), np.zeros(self.dim)
         self._cell = 1.0
         self._shape = np.ones(self.dim, dtype=np.int64)
@@ -106,18 +107,45 @@ class Tree:
             The new node's index.
         """
         if self.size == self._nodes.shape[0]:
-            self._nodes = np.concatenate([self._nodes, np.empty_like(self._nodes)])
-            self._parents = np.concatenate([self._parents, np.empty_like(self._parents)])
+            self._grow(self.size + 1)
         index = self.size
         self._nodes[index] = position
         self._parents[index] = parent
         self.size += 1
-        if self._grid_built_at:  # queries scan the nodes added since the build until there are too many
-            if self.size - self._grid_built_at >= _pending_limit(self._grid_built_at):
-                self._build_grid()
-        elif self.size >= BRUTE_FORCE_BELOW:  # queries use the grid from here on
+        if self.size >= self._rebuild_at:  # BRUTE_FORCE_BELOW reached, or too many nodes since the build
             self._build_grid()
         return index
+
+    def add_many(self, positions: np.ndarray, parents: np.ndarray) -> int:
+        """Append nodes in order, as ``add`` one by one would (the same indices and arrays; the grid
+        is rebuilt at most once, after the last).
+
+        Args:
+            positions: Float (m, d), the new nodes.
+            parents: Int (m,), their parents' indices (unvalidated).
+
+        Returns:
+            The index of the first new node (the others follow it).
+        """
+        count = parents.shape[0]
+        first = self.size
+        if first + count > self._nodes.shape[0]:
+            self._grow(first + count)
+        self._nodes[first:first + count] = positions
+        self._parents[first:first + count] = parents
+        self.size += count
+        if self.size >= self._rebuild_at:
+            self._build_grid()
+        return first
+
+    def _grow(self, needed: int) -> None:
+        """Double the node buffers until they hold ``needed`` nodes."""
+        capacity = self._nodes.shape[0]
+        while capacity < needed:
+            capacity *= 2
+        nodes, parents = np.empty((capacity, self.dim)), np.empty(capacity, dtype=np.int64)
+        nodes[:self.size], parents[:self.size] = self._nodes[:self.size], self._parents[:self.size]
+        self._nodes, self._parents = nodes, parents
 
     def nearest(self, points: np.ndarray) -> np.ndarray:
         """Index of the nearest node (Euclidean) to each of ``points`` (M, d).
@@ -188,6 +216,7 @@ class Tree:
         self._origin, self._cell, self._shape = low.copy(), cell, shape
         self._low, self._high = low.copy(), high.copy()
         self._start, self._order, self._sorted = start, order, nodes[order]
+        self._rebuild_at = self.size + _pending_limit(self.size)
         self._grid_built_at = self.size
 
 

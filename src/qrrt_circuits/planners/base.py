@@ -33,7 +33,7 @@ from ..termination import PlanStatus, TerminationCondition, from_budgets, with_d
 from ..validation import check_float, check_instance, check_int, check_seed
 from .context import RoundView, WorkerContext
 from .result import Metrics, PlanResult
-from .run_state import RunState
+from .run_state import RunState, first_in_ball
 
 if TYPE_CHECKING:
     from ..search.policies import PolicyState
@@ -239,7 +239,7 @@ class Planner:
                 raise ValueError(f"{name} {point.tolist()} is in collision with an obstacle")
             checked.append(point)
         goal_radius = check_float(goal_radius, "goal_radius", 0.0, open_minimum=True)
-        reached = np.linalg.norm(checked[0] - checked[1]) <= goal_radius  # a start in the goal ball ends at once
+        reached = first_in_ball(checked[0][None], checked[1], goal_radius) == 0  # a start in the goal ball ends at once
         if not reached and not can_leave(self.predicate, checked[0]):
             raise ValueError(
                 f"start {checked[0].tolist()} lies on the workspace boundary {env.bounds.tolist()}: the "

@@ -31,6 +31,8 @@ or was built with ``fused_round=False``.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numba import njit
 
@@ -44,7 +46,7 @@ from ..search.policies import PolicyState
 from ..search.problem import DatabaseSearch, SearchOutcome
 from ..search.statevector import _draw_two_level_seeded
 from ..tree import Tree, nearest_into
-from .workers import DatabaseOutcome, database_outcome
+from .workers import DatabaseResult, Tally, database_outcome
 
 _CANDIDATES = int(Stream.CANDIDATES)
 _SEARCH = int(Stream.SEARCH)
@@ -91,8 +93,9 @@ def _candidates(run_entropy: np.ndarray, round_index: int, worker: int, size: in
 
 @njit(cache=True, nogil=True)
 def _measure(run_entropy: np.ndarray, round_index: int, worker: int, marks: np.ndarray, truth: np.ndarray,
-             p_good: float, shots: int) -> tuple[np.ndarray, np.ndarray]:
-    """The measured indices of one closed-form search and their verification.
+             p_good: float, shots: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The measured indices of one closed-form search, their verification, and the entries a
+    planner adds.
 
     The search seed is ``RandomStreams.seed(round_index, worker, Stream.SEARCH)``
     (``randomness._stream_seed``), the draw ``_draw_two_level_seeded`` with that seed's
@@ -100,14 +103,77 @@ def _measure(run_entropy: np.ndarray, round_index: int, worker: int, marks: np.n
     functions the generic round calls; each index is verified against ``truth``.
 
     Returns:
-        (indices (shots,), verified (shots,) bool).
+        (indices (shots,), verified (shots,) bool, added: the verified indices in worker order,
+        each entry once (its first verification), the candidates Alg. 3 adds).
     """
     words = _small_seed_words(_stream_seed(run_entropy, _key(round_index, worker, _SEARCH)))
     indices = _draw_two_level_seeded(marks, p_good, shots, words)
     verified = np.empty(shots, dtype=np.bool_)
+    seen = np.zeros(truth.shape[0], dtype=np.bool_)
+    added = np.empty(shots, dtype=np.int64)
+    count = 0
     for shot in range(shots):
-        verified[shot] = truth[indices[shot]]
-    return indices, verified
+        index = indices[shot]
+        verified[shot] = truth[index]
+        if verified[shot] and not seen[index]:
+            seen[index] = True
+            added[count] = index
+            count += 1
+    return indices, verified, added[:count].copy()
+
+
+@dataclass(frozen=True)
+class ClosedFormOutcome:
+    """One database searched by ``FusedRound``'s closed-form draw: what ``DatabaseOutcome`` holds,
+    as arrays (the ``SearchOutcome`` objects and found candidates are built only when asked for).
+
+    Each of the ``len(indices)`` workers ran k = ``iterations`` Grover iterations and verified its
+    measured index (DESIGN §2: k quantum calls + 1 verification per worker).
+
+    Args:
+        entries: N, the database's entries.
+        reachable_entries: Its truly reachable entries.
+        iterations: k.
+        indices: The workers' measured indices, in worker order.
+        verified: Whether each verified.
+        added: The verified indices in worker order, each entry once (the entries added).
+        children: The database's child positions (N, d).
+        parents: Their parent node indices (N,).
+        missed: The (shared) outcome of a worker whose measurement did not verify.
+    """
+
+    entries: int
+    reachable_entries: int
+    iterations: int
+    indices: np.ndarray
+    verified: np.ndarray
+    added: np.ndarray
+    children: np.ndarray
+    parents: np.ndarray
+    missed: SearchOutcome
+
+    @property
+    def outcomes(self) -> tuple[SearchOutcome, ...]:
+        """Per worker the ``SearchOutcome`` the default ``PolicyState.run`` gives (``policies._verified``)."""
+        k = self.iterations
+        return tuple(SearchOutcome(index, k, 1, ((k, True),)) if good else self.missed
+                     for index, good in zip(self.indices.tolist(), self.verified.tolist(), strict=True))
+
+    @property
+    def found(self) -> tuple[tuple[np.ndarray, int] | None, ...]:
+        """Per worker the verified candidate (child position, parent index), or None."""
+        return tuple((self.children[index], int(self.parents[index])) if good else None
+                     for index, good in zip(self.indices.tolist(), self.verified.tolist(), strict=True))
+
+    def tally(self) -> Tally:
+        """``DatabaseOutcome.tally`` from the arrays: every worker k quantum calls and one
+        verification, the longest k + 1, the first verification of each entry added in worker
+        order and the later ones counted as duplicates."""
+        workers = int(self.indices.shape[0])
+        good = int(np.count_nonzero(self.verified))
+        added = self.added
+        return (self.iterations * workers, workers, workers - good, self.iterations + 1 if workers else 0,
+                good - int(added.shape[0]), self.children[added], self.parents[added])
 
 
 class FusedRound:
@@ -135,11 +201,13 @@ class FusedRound:
         self._entropy = streams._run_entropy
         self.closed_form = backend.draws_closed_form(num_qubits)
         self._checked: set[tuple[int, int]] = set()
+        self._answers_of = f"the predicate {predicate.name!r}"  # (check_answers' name of the predicate)
         self._missed_outcomes: dict[int, SearchOutcome] = {}
 
     def search(self, tree: Tree, round_index: int, groups: list[tuple[int, int]], policy_state: PolicyState,
-               tree_nodes: int) -> list[DatabaseOutcome]:
-        """What ``search_databases_together`` returns for these groups, bit for bit.
+               tree_nodes: int) -> list[DatabaseResult]:
+        """What ``search_databases_together`` returns for these groups, bit for bit (as
+        ``ClosedFormOutcome`` arrays where this round draws the searches itself).
 
         Every database is built by ``_candidates`` and marked by the predicate (in group order, as
         the generic round does). If the backend's seeded search is the closed-form draw and the
@@ -156,14 +224,15 @@ class FusedRound:
             tree_nodes: Nodes in the tree so far.
 
         Returns:
-            One ``DatabaseOutcome`` per group, in order.
+            One ``DatabaseOutcome`` (``ClosedFormOutcome`` for the closed-form draws) per group, in
+            order: the same outcomes, found candidates and counts (``tally``).
 
         Raises:
             ValueError: A predicate answer that is not a 0/1 array of 2^n entries, or a k or a shot
                 count that the backend's ``search`` would refuse, before any search.
         """
         workers = groups[0][1]
-        if any(count != workers for _, count in groups):
+        if len(groups) > 1 and any(count != workers for _, count in groups):
             raise ValueError("FusedRound.search needs groups of one size")
         built = [self._database(tree, round_index, first) for first, _ in groups]
         problems = [DatabaseSearch(marks, truth, self.backend, self.streams, round_index, first)
@@ -175,7 +244,7 @@ class FusedRound:
         iterations = [validate_iterations(policy_state.iterations_for(problem, tree_nodes)) for problem in problems]
         for k in iterations:
             self._check_memory(k, workers)  # every search checked before any runs, as search_many does
-        return [database_outcome(children, parents, truth, self._measured(marks, truth, round_index, first, workers, k))
+        return [self._measured(children, parents, marks, truth, round_index, first, workers, k)
                 for (children, parents, truth, marks), (first, _), k in zip(built, groups, iterations, strict=True)]
 
     def _database(self, tree: Tree, round_index: int,
@@ -183,8 +252,7 @@ class FusedRound:
         """(children, parents, truth, marks) of worker ``worker``'s database (Alg. 1 lines 4-8)."""
         children, parents, positions = _candidates(self._entropy, round_index, worker, self.size, self._low,
                                                    self._high, *tree.search_arrays())
-        truth = check_answers(self.predicate.reachable(positions, children), self.size,
-                              f"the predicate {self.predicate.name!r}")
+        truth = check_answers(self.predicate.reachable(positions, children), self.size, self._answers_of)
         marks = truth
         if self.oracle_errors is not None:
             marks = check_answers(self.oracle_errors.apply(
@@ -192,15 +260,16 @@ class FusedRound:
                 "the oracle error model")
         return children, parents, truth, marks
 
-    def _measured(self, marks: np.ndarray, truth: np.ndarray, round_index: int, first: int, count: int,
-                  iterations: int) -> tuple[SearchOutcome, ...]:
-        """The outcomes of the default ``PolicyState.run`` at k = ``iterations`` for ``count``
+    def _measured(self, children: np.ndarray, parents: np.ndarray, marks: np.ndarray, truth: np.ndarray,
+                  round_index: int, first: int, count: int, iterations: int) -> ClosedFormOutcome:
+        """The outcome of the default ``PolicyState.run`` at k = ``iterations`` for ``count``
         workers (``policies._verified`` of the backend's ``search``), compiled."""
-        p_good = good_probability(self.size, int(np.count_nonzero(marks)), iterations)
-        indices, verified = _measure(self._entropy, round_index, first, marks, truth, p_good, count)
-        missed = self._missed(iterations)
-        return tuple(SearchOutcome(index, iterations, 1, ((iterations, True),)) if good else missed
-                     for index, good in zip(indices.tolist(), verified.tolist(), strict=True))
+        reachable = int(np.count_nonzero(truth))
+        marked = reachable if marks is truth else int(np.count_nonzero(marks))
+        indices, verified, added = _measure(self._entropy, round_index, first, marks, truth,
+                                            good_probability(self.size, marked, iterations), count)
+        return ClosedFormOutcome(self.size, reachable, iterations, indices, verified, added, children, parents,
+                                 self._missed(iterations))
 
     def _missed(self, iterations: int) -> SearchOutcome:
         """The (frozen, shareable) outcome of a worker whose measurement did not verify."""

@@ -24,6 +24,7 @@ largest number of oracle calls one worker made in it: the time of p parallel qua
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from concurrent.futures import Executor
 
 from ..database import AnnealingSchedule
@@ -41,7 +42,7 @@ from .classical import MAX_WORKERS
 from .context import RoundView, WorkerContext, map_tasks
 from .fused_round import FusedRound
 from .run_state import RunState
-from .workers import DatabaseOutcome, database_outcome, make_database, search_database
+from .workers import DatabaseOutcome, DatabaseResult, database_outcome, make_database, search_database
 
 ORACLE_LOOKUP_LABEL = (
     "simulation: the phase oracle is built from a classical lookup of all 2^n database entries "
@@ -277,6 +278,7 @@ class PQRRT(Planner):
 
     def _round(self, state: RunState) -> None:
         groups = self._worker_groups()
+        results: Sequence[DatabaseResult]
         if state.fused_round is not None:  # compiled calls around the predicate, the same outcomes
             results = state.fused_round.search(state.tree, state.rounds, groups, state.search_policy_state,
                                                state.nodes)
@@ -293,28 +295,19 @@ class PQRRT(Planner):
         state.critical_path += longest
 
     @staticmethod
-    def _integrate(state: RunState, result: DatabaseOutcome) -> int:
-        """Count one database's work and add its verified candidates; returns the largest oracle
-        calls of one of its workers."""
+    def _integrate(state: RunState, result: DatabaseResult) -> int:
+        """Count one database's work and add its verified candidates (``DatabaseResult.tally``);
+        returns the largest oracle calls of one of its workers."""
+        quantum, verifications, rejected, longest, duplicates, children, parents = result.tally()
         state.databases += 1
         state.simulation_checks += result.entries
         state.round_entries += result.entries
         state.round_reachable += result.reachable_entries
-        added: set[int] = set()
-        longest = 0
-        for outcome, found in zip(result.outcomes, result.found, strict=True):
-            index, quantum, verifications = outcome.index, outcome.quantum_calls, outcome.verifications
-            state.quantum_calls += quantum
-            state.verification_calls += verifications
-            state.rejected += verifications - (index is not None)  # outcome.rejected
-            longest = max(longest, quantum + verifications)  # outcome.oracle_calls
-            if found is None or index is None:
-                continue
-            if index in added:
-                state.duplicates += 1
-                continue
-            added.add(index)
-            state.add_node(found[0], found[1])
+        state.quantum_calls += quantum
+        state.verification_calls += verifications
+        state.rejected += rejected
+        state.duplicates += duplicates
+        state.add_nodes(children, parents)
         return longest
 
     # ------------------------------------------------------------------ reporting

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numba import njit
 
 from ..termination import Progress
 from ..tree import Tree
@@ -18,6 +18,27 @@ if TYPE_CHECKING:  # annotations only (context imports the search modules)
 HISTORY_KEYS = ("oracle_calls", "critical_path", "nodes", "entries", "reachable")
 
 
+@njit(cache=True, nogil=True)
+def first_in_ball(points: np.ndarray, centre: np.ndarray, radius: float) -> int:
+    """The first row of ``points`` within ``radius`` of ``centre``, or -1 (the goal test of every
+    planner, Alg. 1-4: a node reaches the goal if it lies in the closed goal ball).
+
+    The distance is sqrt(sum over the axes, in order, of (x_i - c_i)^2), each operation rounded
+    once: the same on every machine, where ``np.linalg.norm(x - c)`` (0.1's test) takes its dot
+    product from the BLAS, whose kernels may fuse a multiply and an add (on this project's AMD
+    machine numpy's dot differs from the plain sum in the last bit for about 8 % of 2-D offsets),
+    so a node within a rounding error of the goal radius could count as in or out depending on
+    the machine."""
+    for row in range(points.shape[0]):
+        squared = 0.0
+        for axis in range(points.shape[1]):
+            offset = points[row, axis] - centre[axis]
+            squared += offset * offset
+        if np.sqrt(squared) <= radius:
+            return row
+    return -1
+
+
 class RunState:
     """Counters of DESIGN §2 as a plan accumulates them; ``end_round`` appends the history."""
 
@@ -25,7 +46,7 @@ class RunState:
         self.tree = Tree(root)
         self.goal = goal
         self.goal_radius = goal_radius
-        self.goal_node: int | None = 0 if np.linalg.norm(root - goal) <= goal_radius else None
+        self.goal_node: int | None = 0 if first_in_ball(root.reshape(1, -1), goal, goal_radius) == 0 else None
         self.rounds = 0
         self.quantum_calls = 0
         self.verification_calls = 0
@@ -68,12 +89,21 @@ class RunState:
         return self.tree.size - 1
 
     def add_node(self, position: np.ndarray, parent: int) -> int:
+        """Add one node (``Tree.add``); the first node inside the goal ball becomes ``goal_node``."""
         index = self.tree.add(position, parent)
-        if self.goal_node is None:
-            offset = position - self.goal  # math.sqrt(offset @ offset) is np.linalg.norm's own formula
-            if math.sqrt(float(offset.dot(offset))) <= self.goal_radius:
-                self.goal_node = index
+        if self.goal_node is None and first_in_ball(position.reshape(1, -1), self.goal, self.goal_radius) == 0:
+            self.goal_node = index
         return index
+
+    def add_nodes(self, positions: np.ndarray, parents: np.ndarray) -> None:
+        """Add nodes in order (``Tree.add_many``), as ``add_node`` one by one would."""
+        if parents.shape[0] == 0:
+            return
+        first = self.tree.add_many(positions, parents)
+        if self.goal_node is None:
+            hit = first_in_ball(positions, self.goal, self.goal_radius)
+            if hit >= 0:
+                self.goal_node = first + hit
 
     def progress(self, elapsed_s: float) -> Progress:
         return Progress(self.oracle_calls, self.critical_path, self.nodes, self.rounds,

@@ -13,6 +13,7 @@ ran it or in what order.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 
@@ -46,6 +47,32 @@ def classical_extension(context: WorkerContext, view: RoundView, worker: int) ->
     return ExtensionOutcome(child, parent, answer, truth)
 
 
+#: what ``DatabaseResult.tally`` returns: (quantum oracle calls, verification calls, rejected
+#: measurements, the largest oracle calls of one worker, duplicates, and the candidates to add, in
+#: worker order, each distinct entry once: their child positions (m, d) and parent indices (m,))
+Tally = tuple[int, int, int, int, int, np.ndarray, np.ndarray]
+
+
+class DatabaseResult(Protocol):
+    """What a quantum planner integrates of one searched database (``DatabaseOutcome``, or the
+    fused round's ``ClosedFormOutcome``): its size, its reachable entries, per worker its
+    ``SearchOutcome`` and found candidate, and the round's counts (``tally``)."""
+
+    @property
+    def entries(self) -> int: ...
+
+    @property
+    def reachable_entries(self) -> int: ...
+
+    @property
+    def outcomes(self) -> tuple[SearchOutcome, ...]: ...
+
+    @property
+    def found(self) -> tuple[tuple[np.ndarray, int] | None, ...]: ...
+
+    def tally(self) -> Tally: ...
+
+
 @dataclass(frozen=True)
 class DatabaseOutcome:
     """One database's statistics and, per worker that searched it, its outcome and the candidate
@@ -55,6 +82,38 @@ class DatabaseOutcome:
     reachable_entries: int
     outcomes: tuple[SearchOutcome, ...]
     found: tuple[tuple[np.ndarray, int] | None, ...]
+
+    def tally(self) -> Tally:
+        """The database's counts as DESIGN §2 counts them, worker by worker: each worker's quantum
+        calls and verifications, its rejected measurements (verifications without a verified
+        index), the largest oracle calls of one worker (the database's share of the round's
+        critical path), and the verified candidates in worker order, a candidate measured by an
+        earlier worker counted as a duplicate instead of added again.
+
+        Returns:
+            A ``Tally``: (quantum calls, verifications, rejected, longest, duplicates, children to
+            add, their parents).
+        """
+        quantum = verifications = rejected = longest = duplicates = 0
+        added: set[int] = set()
+        additions: list[tuple[np.ndarray, int]] = []
+        for outcome, found in zip(self.outcomes, self.found, strict=True):
+            index = outcome.index
+            quantum += outcome.quantum_calls
+            verifications += outcome.verifications
+            rejected += outcome.verifications - (index is not None)  # outcome.rejected
+            longest = max(longest, outcome.quantum_calls + outcome.verifications)  # outcome.oracle_calls
+            if found is None or index is None:
+                continue
+            if index in added:
+                duplicates += 1
+                continue
+            added.add(index)
+            additions.append(found)
+        dim = additions[0][0].shape[0] if additions else 0
+        children = np.array([child for child, _ in additions], dtype=float).reshape(len(additions), dim)
+        parents = np.array([parent for _, parent in additions], dtype=np.int64)
+        return quantum, verifications, rejected, longest, duplicates, children, parents
 
 
 def database_outcome(children: np.ndarray, parents: np.ndarray, truth: np.ndarray,
