@@ -343,3 +343,32 @@ def test_a_numpy_integer_k_is_counted_as_an_int(fused):
                      fused_round=fused).plan(max_rounds=200, goal_radius=1e-9)
     assert type(result.metrics.quantum_oracle_calls) is int
     assert result.metrics.quantum_oracle_calls == 3 * result.metrics.rounds == 600
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_closed_form_tally_is_the_worker_by_worker_tally(seed):
+    """``ClosedFormOutcome.tally`` (arrays) counts what ``DatabaseOutcome.tally`` counts from the
+    same workers' ``SearchOutcome`` objects: calls, rejections, the longest worker, duplicates and
+    the candidates added in worker order."""
+    from qrrt_circuits.planners.workers import DatabaseOutcome
+    from qrrt_circuits.randomness import RandomStreams
+    from qrrt_circuits.search.problem import SearchOutcome
+
+    rng = np.random.default_rng(seed)
+    size = 16
+    truth = rng.random(size) < 0.3
+    truth[0] = True
+    marks = truth ^ (rng.random(size) < 0.2)  # some wrong marks: measured entries that do not verify
+    marks[0] = True
+    entropy = RandomStreams.from_seed(seed)._run_entropy
+    workers, k = 40, int(rng.integers(0, 4))
+    indices, verified, added = fused_round._measure(entropy, 3, 0, marks, truth, 0.7, workers)
+    children, parents = rng.random((size, 2)), rng.integers(0, 50, size)
+    outcome = fused_round.ClosedFormOutcome(size, int(truth.sum()), k, indices, verified, added, children, parents,
+                                            SearchOutcome(None, k, 1, ((k, False),)))
+    assert verified.any() and not verified.all() and len(set(indices[verified].tolist())) < verified.sum()
+    generic = DatabaseOutcome(size, int(truth.sum()), outcome.outcomes, outcome.found)
+    fast, slow = outcome.tally(), generic.tally()
+    assert fast[:5] == slow[:5]
+    assert np.array_equal(fast[5], slow[5]) and np.array_equal(fast[6], slow[6])
+    assert fast[0] == workers * k and fast[1] == workers and fast[3] == k + 1

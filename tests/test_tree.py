@@ -208,3 +208,29 @@ def test_first_grid_queries_from_several_threads_agree_with_the_brute_force():
         for thread in threads:
             thread.join()
         assert all(np.array_equal(result, want) for result in results)
+
+
+def test_add_many_builds_the_tree_add_builds_one_node_at_a_time():
+    """``add_many`` appends as ``add`` does (indices, positions, parents, buffers grown), with
+    the grid rebuilt once at most, and queries answer as the brute force does on both trees."""
+    from qrrt_circuits import tree as tree_module
+
+    rng = np.random.default_rng(9)
+    points = rng.random((1500, 2)) * 20
+    parents = rng.integers(0, 10, 1500)
+    one, many = Tree(points[0], capacity=4), Tree(points[0], capacity=4)
+    for index in range(1, 1500):
+        assert one.add(points[index], int(parents[index])) == index
+    position = 1
+    for count in (0, 1, 3, 250, 7, 1, 500):  # batches across the switch, rebuilds and buffer growth
+        assert many.add_many(points[position:position + count], parents[position:position + count]) == position
+        position += count
+        built = many._grid_built_at
+        assert many.size == position
+        assert (built == 0 and position < tree_module.BRUTE_FORCE_BELOW) or \
+            position - built < tree_module._pending_limit(built)  # a batch that reaches the limit rebuilds
+    assert many.add_many(points[position:], parents[position:]) == position
+    assert np.array_equal(one.nodes, many.nodes) and np.array_equal(one.parents[1:], many.parents[1:])
+    queries = rng.random((300, 2)) * 24 - 2
+    want = np.argmin(((queries[:, None, :] - one.nodes[None]) ** 2).sum(-1), axis=1)
+    assert np.array_equal(one.nearest(queries), want) and np.array_equal(many.nearest(queries), want)
