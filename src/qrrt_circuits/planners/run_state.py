@@ -25,10 +25,9 @@ def first_in_ball(points: np.ndarray, centre: np.ndarray, radius: float) -> int:
 
     The distance is sqrt(sum over the axes, in order, of (x_i - c_i)^2), each operation rounded
     once: the same on every machine, where ``np.linalg.norm(x - c)`` (0.1's test) takes its dot
-    product from the BLAS, whose kernels may fuse a multiply and an add (on this project's AMD
-    machine numpy's dot differs from the plain sum in the last bit for about 8 % of 2-D offsets),
-    so a node within a rounding error of the goal radius could count as in or out depending on
-    the machine."""
+    product from the BLAS, whose kernels may fuse a multiply and an add (they do on this project's
+    machine), so a node within a rounding error of the goal radius could count as in or out
+    depending on the machine."""
     for row in range(points.shape[0]):
         squared = 0.0
         for axis in range(points.shape[1]):
