@@ -41,7 +41,7 @@ from ..oracle_errors import OracleErrorModel
 from ..predicate import ReachabilityPredicate, check_answers
 from ..probability import good_probability
 from ..randomness import RandomStreams, Stream, _next_double, _pcg_state, _seed_words, _small_seed_words, _stream_seed
-from ..search.backend import QuantumSearchBackend, validate_iterations
+from ..search.backend import MAX_ITERATIONS, QuantumSearchBackend, validate_iterations
 from ..search.policies import PolicyState
 from ..search.problem import DatabaseSearch, SearchOutcome
 from ..search.statevector import _draw_two_level_seeded
@@ -172,8 +172,17 @@ class ClosedFormOutcome:
         workers = int(self.indices.shape[0])
         good = int(np.count_nonzero(self.verified))
         added = self.added
+        if added.shape[0]:
+            children, parents = self.children[added], self.parents[added]
+        else:  # (most rounds add nothing: empty views, no gather)
+            children, parents = self.children[:0], self.parents[:0]
         return (self.iterations * workers, workers, workers - good, self.iterations + 1 if workers else 0,
-                good - int(added.shape[0]), self.children[added], self.parents[added])
+                good - int(added.shape[0]), children, parents)
+
+
+def _iterations(k: int) -> int:
+    """``validate_iterations(k)``, its checks skipped for a Python int in range (the usual k)."""
+    return k if type(k) is int and 0 <= k <= MAX_ITERATIONS else validate_iterations(k)
 
 
 class FusedRound:
@@ -241,7 +250,7 @@ class FusedRound:
             searched = policy_state.run_many(problems, workers, tree_nodes)
             return [database_outcome(children, parents, truth, outcomes)
                     for (children, parents, truth, _), outcomes in zip(built, searched, strict=True)]
-        iterations = [validate_iterations(policy_state.iterations_for(problem, tree_nodes)) for problem in problems]
+        iterations = [_iterations(policy_state.iterations_for(problem, tree_nodes)) for problem in problems]
         for k in iterations:
             self._check_memory(k, workers)  # every search checked before any runs, as search_many does
         return [self._measured(children, parents, marks, truth, round_index, first, workers, k)

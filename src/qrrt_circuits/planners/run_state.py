@@ -110,12 +110,13 @@ class RunState:
 
     def end_round(self) -> None:
         self.rounds += 1
-        added = self.nodes - self._nodes_at_round_start
-        self.rounds_without_new_node = 0 if added else self.rounds_without_new_node + 1
-        self._nodes_at_round_start = self.nodes
-        self.history["oracle_calls"].append(self.oracle_calls)
-        self.history["critical_path"].append(self.critical_path)
-        self.history["nodes"].append(self.nodes)
-        self.history["entries"].append(self.round_entries)
-        self.history["reachable"].append(self.round_reachable)
+        nodes = self.tree.size - 1
+        self.rounds_without_new_node = 0 if nodes > self._nodes_at_round_start else self.rounds_without_new_node + 1
+        self._nodes_at_round_start = nodes
+        history = self.history
+        history["oracle_calls"].append(self.quantum_calls + self.verification_calls)
+        history["critical_path"].append(self.critical_path)
+        history["nodes"].append(nodes)
+        history["entries"].append(self.round_entries)
+        history["reachable"].append(self.round_reachable)
         self.round_entries = self.round_reachable = 0
