@@ -104,6 +104,15 @@ CASES["pqrrt-shared-bbht-errors"] = (lambda: _clutter(10),
                                                           search_policy=qc.BBHT(), oracle_errors=_errors()),
                                      {"max_oracle_calls": 200})
 
+# trees past tree.BRUTE_FORCE_BELOW (400 since the grid's rewrite), so the grid answers the queries
+# (references computed at 9c3c6d4, before that rewrite)
+CASES["rrt-large"] = (lambda: _clutter(13), lambda env: qc.RRT(env, seed=13), {"max_nodes": 700, "goal_radius": 1e-9})
+CASES["qrrt-sv-large"] = (lambda: _clutter(11), lambda env: qc.QRRT(env, backend=_sv(), num_qubits=6, seed=11),
+                          {"max_nodes": 700, "goal_radius": 1e-9})
+CASES["pqrrt-shared-large"] = (lambda: _clutter(12), lambda env: qc.PQRRT(env, backend=_sv(), workers=8, num_qubits=6,
+                                                                        seed=12),
+                               {"max_nodes": 700, "goal_radius": 1e-9})
+
 
 def run_case(name: str):
     world, make, budgets = CASES[name]

@@ -43,6 +43,10 @@ REFERENCE = {
     'pqrrt-shared': '1296a53e146622426363256d',
     'pqrrt-unshared': '555b287dbdc572e9a433c8a8',
     'pqrrt-shared-bbht-errors': 'b54899a40973d66a0d367c40',
+    # computed at 9c3c6d4 (before the nearest-node grid's rewrite; trees past BRUTE_FORCE_BELOW)
+    'rrt-large': '478ce7395cc265441b68f9ab',
+    'qrrt-sv-large': '95c5fc912b8654362fb38aee',
+    'pqrrt-shared-large': '24da12a8e8a9eb181b3321b0',
 }
 
 

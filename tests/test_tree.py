@@ -174,12 +174,37 @@ def test_queries_of_the_wrong_shape_or_not_finite_are_refused():
 
 
 def test_queries_whose_squared_distances_overflow_still_end():
+    """Every squared distance inf: the lowest index, from the brute force, from the grid, and from
+    the grid with nodes added since its build (whose inf ties the grid's lower indices must win)."""
+    from qrrt_circuits import tree as tree_module
+
     rng = np.random.default_rng(1)
     tree = Tree(rng.random(2))
-    for _ in range(300):
+    far = np.array([[1e200, 1.0], [-1e300, -1e300]])
+    while tree.size < tree_module.BRUTE_FORCE_BELOW + 10:
         tree.add(rng.random(2), 0)
-    far = np.array([[1e200, 1.0], [-1e300, -1e300]])  # every squared distance is inf: the lowest index
-    assert tree.nearest(far).tolist() == [0, 0] and tree.grid_nearest(far).tolist() == [0, 0]
+        if tree.size in (300, tree_module.BRUTE_FORCE_BELOW + 10):
+            assert tree.nearest(far).tolist() == [0, 0] and tree.grid_nearest(far).tolist() == [0, 0]
+    assert tree.size > tree._grid_built_at > 0  # the last check had nodes the grid does not hold
+
+
+@pytest.mark.parametrize("dim", [1, 2, 3])
+def test_a_tree_growing_outward_past_its_grid_box(dim):
+    """Planner trees grow outward: the nodes added since the grid's build lie outside the box of
+    the nodes it holds, and queries near them, beyond the box and on exact nodes agree with the
+    brute force."""
+    rng = np.random.default_rng(20 + dim)
+    tree = Tree(np.zeros(dim))
+    for step in range(1, 1500):
+        radius = 0.02 * step  # each node a little farther out than the last
+        direction = rng.normal(size=dim)
+        tree.add(direction / np.linalg.norm(direction) * radius * rng.uniform(0.9, 1.0), int(rng.integers(0, step)))
+        if step % 61 == 0 or step in (399, 400, 401):
+            newest = tree.nodes[-5:]
+            queries = np.concatenate([newest, newest * 1.05, rng.normal(size=(30, dim)) * radius * 1.5])
+            want = np.argmin(((queries[:, None, :] - tree.nodes[None]) ** 2).sum(-1), axis=1)
+            assert np.array_equal(tree.nearest(queries), want)
+            assert np.array_equal(tree.grid_nearest(queries), want)
 
 
 def test_first_grid_queries_from_several_threads_agree_with_the_brute_force():

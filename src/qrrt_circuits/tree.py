@@ -75,8 +75,9 @@ class Tree:
         self._nodes[0] = root
         self._parents[0] = -1
         self.size = 1
-        # the grid (built once the tree reaches BRUTE_FORCE_BELOW nodes, see ``add``); until then
-        # empty arrays of the grid's types, and _grid_built_at = 0 (the nodes it holds)
+        # the grid (built once the tree reaches BRUTE_FORCE_BELOW nodes, see ``add``, or by a first
+        # ``grid_nearest`` call); until then empty arrays of the grid's types, and _grid_built_at = 0
+        # (the nodes it holds)
         self._grid_built_at = 0
         self._rebuild_at = BRUTE_FORCE_BELOW  # the size at which ``add`` (re)builds the grid
         self._origin, self._low, self._high = np.zeros(self.dim), np.zeros(self.dim), np.zeros(self.dim)
@@ -173,7 +174,7 @@ class Tree:
         (0: no grid, or a tree below ``BRUTE_FORCE_BELOW`` nodes, searched by brute force even if a
         ``grid_nearest`` call built one), the grid's cell offsets, sorted node indices and sorted
         positions, its origin, cell size and shape, and the bounding box of its nodes. The arrays
-        are the tree's own (not copies) and stay valid until the next ``add``."""
+        are the tree's own (not copies) and stay valid until the next ``add`` or ``add_many``."""
         return self._search_arrays(self.size >= BRUTE_FORCE_BELOW)
 
     def _search_arrays(self, grid: bool) -> tuple[np.ndarray, int, int, np.ndarray, np.ndarray, np.ndarray,
@@ -234,9 +235,6 @@ def _cell_of(point: np.ndarray, origin: np.ndarray, cell: float, shape: np.ndarr
             coordinate = min(int(value), shape[axis] - 1)
         out[axis] = coordinate
         flat = flat * shape[axis] + coordinate
-    return flat
-
-
     return flat
 
 
@@ -401,7 +399,9 @@ def _grid_search_2d(points: np.ndarray, start: np.ndarray, order: np.ndarray, or
                     origin: np.ndarray, cell: float, shape: np.ndarray, low: np.ndarray, high: np.ndarray,
                     best: np.ndarray, out: np.ndarray) -> None:
     """``_grid_search`` in two dimensions (the planners' case), unrolled: the same cells visited in
-    the same rings, the same stopping bound, the same answers."""
+    the same rings and the same answers; the stopping bound is the same up to rounding (it adds the
+    other axis's squared distance to the box directly, where ``_grid_search`` subtracts from the
+    total), which its slack covers."""
     columns, rows = shape[0], shape[1]
     for row in range(points.shape[0]):
         x, y = points[row, 0], points[row, 1]

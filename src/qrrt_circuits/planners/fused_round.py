@@ -17,14 +17,17 @@ compiled calls:
    its ``iterations_for``, as for the paper's schedule, fixed k, ``KnownOptimal``, ``Adaptive``):
    the seed of stream (round, worker, ``Stream.SEARCH``), the backend's generator of
    that seed, the two-level closed-form draw of the workers' measured indices
-   (``statevector._draw_two_level_seeded``, Eq. 1 / Lemma 1) and the classical verification of each
-   (the finalizer: 1 oracle call per worker). Otherwise the databases go to the policy's
-   ``run_many`` (the backend's ``search_many``) as in the generic round.
+   (``statevector._draw_two_level_seeded``, Eq. 1 / Lemma 1), the classical verification of each
+   (the finalizer: 1 oracle call per worker), the entries the planner adds (each verified entry
+   once, in worker order) and the database's reachable entries, returned as a
+   ``ClosedFormOutcome`` whose ``tally`` the planner integrates. Otherwise the databases go to the
+   policy's ``run_many`` (the backend's ``search_many``) as in the generic round.
 
 Every number is the one the generic round produces, bit for bit: the same draws in the same order
 from the same PCG64 states, the same nearest-node kernels, the same predicate calls in the same
-order, the same k, the same ``SearchOutcome`` objects handed to the planner's bookkeeping and to the
-policy's ``learn`` (tested against the generic round, and by the planner fingerprints). A plan uses
+order, the same k, the same counts for the planner's bookkeeping (``tally``) and the same
+``SearchOutcome`` objects for a policy's ``learn``, built only when it learns (tested against the
+generic round, and by the planner fingerprints). A plan uses
 it unless it has an executor, annealing or goal bias (whose databases need the generator object)
 or was built with ``fused_round=False``.
 """
