@@ -259,3 +259,13 @@ def test_add_many_builds_the_tree_add_builds_one_node_at_a_time():
     queries = rng.random((300, 2)) * 24 - 2
     want = np.argmin(((queries[:, None, :] - one.nodes[None]) ** 2).sum(-1), axis=1)
     assert np.array_equal(one.nearest(queries), want) and np.array_equal(many.nearest(queries), want)
+
+
+def test_add_many_refuses_positions_that_do_not_match_the_parents():
+    tree = Tree(np.zeros(2))
+    three, one = np.zeros(3, dtype=np.int64), np.zeros(1, dtype=np.int64)
+    for positions, parents in ((np.zeros((1, 2)), three),  # one row would be broadcast to three parents
+                               (np.zeros((3, 3)), three), (np.zeros(2), one)):
+        with pytest.raises(ValueError, match="positions must have shape"):
+            tree.add_many(positions, parents)
+    assert tree.size == 1

@@ -127,8 +127,15 @@ class Tree:
 
         Returns:
             The index of the first new node (the others follow it).
+
+        Raises:
+            ValueError: ``positions`` not of shape (m, d) for the m entries of ``parents`` and the
+                tree's d.
         """
         count = parents.shape[0]
+        if positions.shape != (count, self.dim):
+            raise ValueError(f"positions must have shape ({count}, {self.dim}) (one row per parent, the tree's d), "
+                             f"got {positions.shape}")
         first = self.size
         if first + count > self._nodes.shape[0]:
             self._grow(first + count)
