@@ -96,7 +96,7 @@ def _candidates(run_entropy: np.ndarray, round_index: int, worker: int, size: in
 
 @njit(cache=True, nogil=True)
 def _measure(run_entropy: np.ndarray, round_index: int, worker: int, marks: np.ndarray, truth: np.ndarray,
-             p_good: float, shots: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, int, int]:
+             p_good: float, shots: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
     """The measured indices of one closed-form search, their verification, and the entries a
     planner adds.
 
@@ -108,7 +108,7 @@ def _measure(run_entropy: np.ndarray, round_index: int, worker: int, marks: np.n
     Returns:
         (indices (shots,), verified (shots,) bool, added: the verified indices in worker order,
         each entry once (its first verification), the candidates Alg. 3 adds; the reachable
-        entries of ``truth``; the verified shots).
+        entries of ``truth``).
     """
     words = _small_seed_words(_stream_seed(run_entropy, _key(round_index, worker, _SEARCH)))
     indices = _draw_two_level_seeded(marks, p_good, shots, words)
@@ -116,20 +116,17 @@ def _measure(run_entropy: np.ndarray, round_index: int, worker: int, marks: np.n
     seen = np.zeros(truth.shape[0], dtype=np.bool_)
     added = np.empty(shots, dtype=np.int64)
     count = 0
-    good = 0
     for shot in range(shots):
         index = indices[shot]
         verified[shot] = truth[index]
-        if verified[shot]:
-            good += 1
-            if not seen[index]:
-                seen[index] = True
-                added[count] = index
-                count += 1
+        if verified[shot] and not seen[index]:
+            seen[index] = True
+            added[count] = index
+            count += 1
     reachable = 0
     for entry in range(truth.shape[0]):
         reachable += truth[entry]
-    return indices, verified, added[:count].copy(), reachable, good
+    return indices, verified, added[:count].copy(), reachable
 
 
 class ClosedFormOutcome(NamedTuple):
@@ -148,7 +145,6 @@ class ClosedFormOutcome(NamedTuple):
         indices: The workers' measured indices, in worker order.
         verified: Whether each verified.
         added: The verified indices in worker order, each entry once (the entries added).
-        verified_count: The workers whose measurement verified.
         children: The database's child positions (N, d).
         parents: Their parent node indices (N,).
         missed: The (shared) outcome of a worker whose measurement did not verify.
@@ -160,7 +156,6 @@ class ClosedFormOutcome(NamedTuple):
     indices: np.ndarray
     verified: np.ndarray
     added: np.ndarray
-    verified_count: int
     children: np.ndarray
     parents: np.ndarray
     missed: SearchOutcome
@@ -183,7 +178,7 @@ class ClosedFormOutcome(NamedTuple):
         verification, the longest k + 1, the first verification of each entry added in worker
         order and the later ones counted as duplicates."""
         workers = int(self.indices.shape[0])
-        good = self.verified_count
+        good = int(np.count_nonzero(self.verified))
         added = self.added
         if added.shape[0]:
             children, parents = self.children[added], self.parents[added]
@@ -287,9 +282,8 @@ class FusedRound:
         """The outcome of the default ``PolicyState.run`` at k = ``iterations`` for ``count``
         workers (``policies._verified`` of the backend's ``search``), compiled."""
         p_good = good_probability(self.size, int(np.count_nonzero(marks)), iterations)
-        indices, verified, added, reachable, good = _measure(self._entropy, round_index, first, marks, truth, p_good,
-                                                             count)
-        return ClosedFormOutcome(self.size, reachable, iterations, indices, verified, added, good, children, parents,
+        indices, verified, added, reachable = _measure(self._entropy, round_index, first, marks, truth, p_good, count)
+        return ClosedFormOutcome(self.size, reachable, iterations, indices, verified, added, children, parents,
                                  self._missed(iterations))
 
     def _missed(self, iterations: int) -> SearchOutcome:
