@@ -362,11 +362,14 @@ def test_a_closed_form_tally_is_the_worker_by_worker_tally(seed):
     marks[0] = True
     entropy = RandomStreams.from_seed(seed)._run_entropy
     workers, k = 40, int(rng.integers(0, 4))
-    indices, verified, added, reachable = fused_round._measure(entropy, 3, 0, marks, truth, 0.7, workers)
-    assert reachable == int(truth.sum())
     children, parents = rng.random((size, 2)), rng.integers(0, 50, size)
+    indices, verified, added, reachable, good, added_children, added_parents = fused_round._measure(
+        entropy, 3, 0, marks, truth, 0, workers, children, parents)  # k = 0: P(G) = m/N, many verify
+    assert reachable == int(truth.sum()) and good == int(verified.sum())
+    assert np.array_equal(added_children, children[added]) and np.array_equal(added_parents, parents[added])
     outcome = fused_round.ClosedFormOutcome(size, reachable, k, indices, verified, added, children, parents,
-                                            SearchOutcome(None, k, 1, ((k, False),)))
+                                            SearchOutcome(None, k, 1, ((k, False),)), good, added_children,
+                                            added_parents)
     assert verified.any() and not verified.all() and len(set(indices[verified].tolist())) < verified.sum()
     generic = DatabaseOutcome(size, int(truth.sum()), outcome.outcomes, outcome.found)
     fast, slow = outcome.tally(), generic.tally()

@@ -15,6 +15,7 @@ compiled calls:
    (``QuantumSearchBackend.draws_closed_form``: the ``StatevectorBackend``) and the policy state
    searches by default (``PolicyState.searches_by_default``: one search per database at the k of
    its ``iterations_for``, as for the paper's schedule, fixed k, ``KnownOptimal``, ``Adaptive``):
+   P(G) of Eq. 1 from the database's marked count (``probability.compiled_good_probability``),
    the seed of stream (round, worker, ``Stream.SEARCH``), the backend's generator of
    that seed, the two-level closed-form draw of the workers' measured indices
    (``statevector._draw_two_level_seeded``, Eq. 1 / Lemma 1), the classical verification of each
@@ -42,7 +43,7 @@ from numba import njit
 from ..environment import Environment
 from ..oracle_errors import OracleErrorModel
 from ..predicate import ReachabilityPredicate, check_answers
-from ..probability import good_probability
+from ..probability import compiled_good_probability
 from ..randomness import RandomStreams, Stream, _next_double, _pcg_state, _seed_words, _small_seed_words, _stream_seed
 from ..search.backend import MAX_ITERATIONS, QuantumSearchBackend, validate_iterations
 from ..search.policies import PolicyState
@@ -96,37 +97,52 @@ def _candidates(run_entropy: np.ndarray, round_index: int, worker: int, size: in
 
 @njit(cache=True, nogil=True)
 def _measure(run_entropy: np.ndarray, round_index: int, worker: int, marks: np.ndarray, truth: np.ndarray,
-             p_good: float, shots: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+             iterations: int, shots: int, children: np.ndarray,
+             parents: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, int, int, np.ndarray, np.ndarray]:
     """The measured indices of one closed-form search, their verification, and the entries a
     planner adds.
 
-    The search seed is ``RandomStreams.seed(round_index, worker, Stream.SEARCH)``
-    (``randomness._stream_seed``), the draw ``_draw_two_level_seeded`` with that seed's
-    ``integer_seed_words`` (``randomness._small_seed_words``, the seed being below 2^62): the same
-    functions the generic round calls; each index is verified against ``truth``.
+    P(G) = sin^2((2k+1) theta), sin^2 theta = m/N with m the marked entries of ``marks`` (Eq. 1,
+    ``compiled_good_probability``: the double ``good_probability`` gives). The search seed is
+    ``RandomStreams.seed(round_index, worker, Stream.SEARCH)`` (``randomness._stream_seed``), the
+    draw ``_draw_two_level_seeded`` with that seed's ``integer_seed_words``
+    (``randomness._small_seed_words``, the seed being below 2^62): the same functions the generic
+    round calls; each index is verified against ``truth``.
 
     Returns:
         (indices (shots,), verified (shots,) bool, added: the verified indices in worker order,
         each entry once (its first verification), the candidates Alg. 3 adds; the reachable
-        entries of ``truth``).
+        entries of ``truth``; the verified shots; the added entries' children and parents).
     """
+    size = marks.shape[0]
+    marked = 0
+    for entry in range(size):
+        marked += marks[entry]
+    p_good = compiled_good_probability(size, marked, iterations)
     words = _small_seed_words(_stream_seed(run_entropy, _key(round_index, worker, _SEARCH)))
     indices = _draw_two_level_seeded(marks, p_good, shots, words)
     verified = np.empty(shots, dtype=np.bool_)
-    seen = np.zeros(truth.shape[0], dtype=np.bool_)
+    seen = np.zeros(size, dtype=np.bool_)
     added = np.empty(shots, dtype=np.int64)
-    count = 0
+    count = good = 0
     for shot in range(shots):
         index = indices[shot]
         verified[shot] = truth[index]
-        if verified[shot] and not seen[index]:
-            seen[index] = True
-            added[count] = index
-            count += 1
+        if verified[shot]:
+            good += 1
+            if not seen[index]:
+                seen[index] = True
+                added[count] = index
+                count += 1
     reachable = 0
-    for entry in range(truth.shape[0]):
+    for entry in range(size):
         reachable += truth[entry]
-    return indices, verified, added[:count].copy(), reachable
+    added_children = np.empty((count, children.shape[1]))
+    added_parents = np.empty(count, dtype=np.int64)
+    for slot in range(count):
+        added_children[slot] = children[added[slot]]
+        added_parents[slot] = parents[added[slot]]
+    return indices, verified, added[:count].copy(), reachable, good, added_children, added_parents
 
 
 class ClosedFormOutcome(NamedTuple):
@@ -148,6 +164,9 @@ class ClosedFormOutcome(NamedTuple):
         children: The database's child positions (N, d).
         parents: Their parent node indices (N,).
         missed: The (shared) outcome of a worker whose measurement did not verify.
+        verified_count: The workers whose measurement verified.
+        added_children: The added entries' child positions, ``children[added]``.
+        added_parents: Their parents, ``parents[added]``.
     """
 
     entries: int
@@ -159,6 +178,9 @@ class ClosedFormOutcome(NamedTuple):
     children: np.ndarray
     parents: np.ndarray
     missed: SearchOutcome
+    verified_count: int
+    added_children: np.ndarray
+    added_parents: np.ndarray
 
     @property
     def outcomes(self) -> tuple[SearchOutcome, ...]:
@@ -174,18 +196,13 @@ class ClosedFormOutcome(NamedTuple):
                      for index, good in zip(self.indices.tolist(), self.verified.tolist(), strict=True))
 
     def tally(self) -> Tally:
-        """``DatabaseOutcome.tally`` from the arrays: every worker k quantum calls and one
-        verification, the longest k + 1, the first verification of each entry added in worker
-        order and the later ones counted as duplicates."""
-        workers = int(self.indices.shape[0])
-        good = int(np.count_nonzero(self.verified))
-        added = self.added
-        if added.shape[0]:
-            children, parents = self.children[added], self.parents[added]
-        else:  # (most rounds add nothing: empty views, no gather)
-            children, parents = self.children[:0], self.parents[:0]
+        """``DatabaseOutcome.tally`` from the compiled draw's counts: every worker k quantum calls
+        and one verification, the longest k + 1, the first verification of each entry added in
+        worker order and the later ones counted as duplicates."""
+        workers = self.indices.shape[0]
+        good = self.verified_count
         return (self.iterations * workers, workers, workers - good, self.iterations + 1 if workers else 0,
-                good - int(added.shape[0]), children, parents)
+                good - self.added.shape[0], self.added_children, self.added_parents)
 
 
 def _iterations(k: int) -> int:
@@ -229,7 +246,8 @@ class FusedRound:
         Every database is built by ``_candidates`` and marked by the predicate (in group order, as
         the generic round does). If the backend's seeded search is the closed-form draw and the
         policy state searches by default (``PolicyState.searches_by_default``), k is the state's
-        ``iterations_for`` on each database, in order, as ``run_many`` asks it, and each database's
+        ``iterations_for`` on each database, in order, as ``run_many`` asks it (its
+        ``iterations_by_size`` where it ``reads_problem()`` no further than N), and each database's
         workers are drawn and verified by ``_measure``; otherwise the databases go to the state's
         ``run_many``, as in the generic round.
 
@@ -252,13 +270,17 @@ class FusedRound:
         if len(groups) > 1 and any(count != workers for _, count in groups):
             raise ValueError("FusedRound.search needs groups of one size")
         built = [self._database(tree, round_index, first) for first, _ in groups]
-        problems = [DatabaseSearch(marks, truth, self.backend, self.streams, round_index, first)
-                    for (_, _, truth, marks), (first, _) in zip(built, groups, strict=True)]
-        if not (self.closed_form and policy_state.searches_by_default()):
-            searched = policy_state.run_many(problems, workers, tree_nodes)
-            return [database_outcome(children, parents, truth, outcomes)
-                    for (children, parents, truth, _), outcomes in zip(built, searched, strict=True)]
-        iterations = [_iterations(policy_state.iterations_for(problem, tree_nodes)) for problem in problems]
+        closed_form = self.closed_form and policy_state.searches_by_default()
+        if closed_form and not policy_state.reads_problem():  # k from N and the tree: no DatabaseSearch needed
+            iterations = [_iterations(policy_state.iterations_by_size(tree_nodes)) for _ in groups]
+        else:
+            problems = [DatabaseSearch(marks, truth, self.backend, self.streams, round_index, first)
+                        for (_, _, truth, marks), (first, _) in zip(built, groups, strict=True)]
+            if not closed_form:
+                searched = policy_state.run_many(problems, workers, tree_nodes)
+                return [database_outcome(children, parents, truth, outcomes)
+                        for (children, parents, truth, _), outcomes in zip(built, searched, strict=True)]
+            iterations = [_iterations(policy_state.iterations_for(problem, tree_nodes)) for problem in problems]
         for k in iterations:
             self._check_memory(k, workers)  # every search checked before any runs, as search_many does
         return [self._measured(children, parents, marks, truth, round_index, first, workers, k)
@@ -281,10 +303,10 @@ class FusedRound:
                   round_index: int, first: int, count: int, iterations: int) -> ClosedFormOutcome:
         """The outcome of the default ``PolicyState.run`` at k = ``iterations`` for ``count``
         workers (``policies._verified`` of the backend's ``search``), compiled."""
-        p_good = good_probability(self.size, int(np.count_nonzero(marks)), iterations)
-        indices, verified, added, reachable = _measure(self._entropy, round_index, first, marks, truth, p_good, count)
+        indices, verified, added, reachable, good, added_children, added_parents = _measure(
+            self._entropy, round_index, first, marks, truth, iterations, count, children, parents)
         return ClosedFormOutcome(self.size, reachable, iterations, indices, verified, added, children, parents,
-                                 self._missed(iterations))
+                                 self._missed(iterations), good, added_children, added_parents)
 
     def _missed(self, iterations: int) -> SearchOutcome:
         """The (frozen, shareable) outcome of a worker whose measurement did not verify."""

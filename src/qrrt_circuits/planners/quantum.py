@@ -291,7 +291,8 @@ class PQRRT(Planner):
         longest = 0
         for result in results:
             longest = max(longest, self._integrate(state, result))
-        state.search_policy_state.learn(outcome for result in results for outcome in result.outcomes)
+        if state.search_policy_state.learns():  # (skips building the outcomes when nothing learns)
+            state.search_policy_state.learn(outcome for result in results for outcome in result.outcomes)
         state.critical_path += longest
 
     @staticmethod

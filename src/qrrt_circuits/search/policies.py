@@ -203,6 +203,40 @@ class PolicyState:
         """
         return self.policy.iterations_for(problem, tree_nodes)
 
+    def reads_problem(self) -> bool:
+        """Whether ``iterations_for`` may read more of a database than its size N.
+
+        False where neither this state's class nor its policy's overrides ``iterations_for``: k is
+        then ``iterations_by_size(tree_nodes)`` for every database of ``num_items`` entries, and a
+        caller may skip building the ``DatabaseSearch`` (the planners' fused round does).
+
+        Returns:
+            True if ``iterations_for`` is overridden (``KnownOptimal`` reads the marked count).
+        """
+        return not (type(self).iterations_for is PolicyState.iterations_for
+                    and type(self.policy).iterations_for is IterationPolicy.iterations_for)
+
+    def iterations_by_size(self, tree_nodes: int) -> int:
+        """The default ``iterations_for`` of a database of ``num_items`` entries: the policy's k
+        from N and the tree alone (what ``iterations_for`` returns when ``reads_problem()`` is False).
+
+        Args:
+            tree_nodes: Nodes in the tree so far.
+
+        Returns:
+            k >= 0.
+        """
+        return self.policy._iterations(self.num_items, tree_nodes, None)
+
+    def learns(self) -> bool:
+        """Whether ``learn`` does anything (False where neither ``learn`` nor ``observe`` is
+        overridden: callers may skip building the outcomes it would be given).
+
+        Returns:
+            True for learning states (``Adaptive``'s).
+        """
+        return type(self).learn is not PolicyState.learn or type(self).observe is not PolicyState.observe
+
     def searches_by_default(self) -> bool:
         """Whether this state's ``run`` and ``run_many`` are the defaults.
 
