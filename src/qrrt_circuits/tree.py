@@ -9,7 +9,8 @@ form: the nodes sorted by cell with their coordinates copied in that order, and 
 cell's first node (a cell's nodes, and a run of cells along the last axis, are one contiguous
 slice). A query first scans, by the same brute force, the nodes added since the build (fewer than
 ``_pending_limit(built)``: max(32, sqrt(built))), then visits the grid's cells ring by ring
-(Chebyshev rings around its own cell) and stops once the distance from the query to the part of
+(Chebyshev rings around its own cell, the first visit the block of 3^d cells around it; a
+nearer node replaces the best by selects, not branches) and stops once the distance from the query to the part of
 the grid not yet visited exceeds the best distance found (the cell technique of Bentley, Weide and
 Yao 1980). When the nodes added since the build reach that limit the grid is rebuilt (O(N), so
 O(sqrt N) amortized per node). A query therefore costs about the nodes of a few cells plus the
@@ -331,17 +332,18 @@ def _grid_search(points: np.ndarray, start: np.ndarray, order: np.ndarray, order
             slack[axis] = _EDGE_SLACK * (abs(point[axis]) + abs(origin[axis]) + shape[axis] * cell)
         nearest = best[row]
         nearest_index = out[row]
-        ring = 0
+        ring = 1  # the first visit covers rings 0 and 1 (the block of 3^d cells around the centre)
         while True:
-            # visit the cells at Chebyshev distance ``ring`` from the centre (clipped to the grid):
-            # an odometer over the first d - 1 axes; along the last axis the whole run of cells
-            # (one slice of the sorted nodes) where the prefix is on the ring, else its two ends
+            # visit the cells at Chebyshev distance ``ring`` from the centre (clipped to the grid),
+            # on the first visit every cell of the block: an odometer over the first d - 1 axes;
+            # along the last axis the whole run of cells (one slice of the sorted nodes) where the
+            # prefix is on the ring (or on the first visit), else its two ends
             for axis in range(dim):
                 lower[axis] = max(centre[axis] - ring, 0)
                 upper[axis] = min(centre[axis] + ring, shape[axis] - 1)
                 current[axis] = lower[axis]
             while True:
-                on_ring = ring == 0
+                on_ring = ring == 1
                 prefix = 0
                 for axis in range(last):
                     if abs(current[axis] - centre[axis]) == ring:
@@ -363,9 +365,10 @@ def _grid_search(points: np.ndarray, start: np.ndarray, order: np.ndarray, order
                         for axis in range(dim):
                             delta = point[axis] - ordered[slot, axis]
                             squared += delta * delta
-                        if squared < nearest or (squared == nearest and order[slot] < nearest_index):
-                            nearest = squared
-                            nearest_index = order[slot]
+                        candidate = order[slot]  # the update without branches (see _grid_search_2d)
+                        nearer = (squared < nearest) | ((squared == nearest) & (candidate < nearest_index))
+                        nearest = squared if nearer else nearest
+                        nearest_index = candidate if nearer else nearest_index
                 axis = last - 1  # odometer step over the prefix
                 while axis >= 0:
                     current[axis] += 1
@@ -422,12 +425,12 @@ def _grid_search_2d(points: np.ndarray, start: np.ndarray, order: np.ndarray, or
         slack_y = _EDGE_SLACK * (abs(y) + abs(origin[1]) + rows * cell)
         nearest = best[row]
         nearest_index = out[row]
-        ring = 0
+        ring = 1  # as ``_grid_search``: the first visit is the block of 3 x 3 cells
         while True:
             first_y, last_y = max(cy - ring, 0), min(cy + ring, rows - 1)
             for column in range(max(cx - ring, 0), min(cx + ring, columns - 1) + 1):
                 prefix = column * rows
-                whole = ring == 0 or column == cx - ring or column == cx + ring  # the whole run is on the ring
+                whole = ring == 1 or column == cx - ring or column == cx + ring  # the whole run is unvisited
                 for end in range(2):  # whole: the run [first_y, last_y], once; else its two end cells
                     if whole:
                         if end:
@@ -442,9 +445,10 @@ def _grid_search_2d(points: np.ndarray, start: np.ndarray, order: np.ndarray, or
                         dx = x - ordered[slot, 0]
                         dy = y - ordered[slot, 1]
                         squared = dx * dx + dy * dy
-                        if squared < nearest or (squared == nearest and order[slot] < nearest_index):
-                            nearest = squared
-                            nearest_index = order[slot]
+                        candidate = order[slot]  # the update as selects, without a branch to mispredict
+                        nearer = (squared < nearest) | ((squared == nearest) & (candidate < nearest_index))
+                        nearest = squared if nearer else nearest
+                        nearest_index = candidate if nearer else nearest_index
             bound = np.inf  # as ``_grid_search``
             covers = True
             if cx - ring - 1 >= 0:
