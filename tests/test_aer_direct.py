@@ -202,3 +202,35 @@ def test_threads_searching_at_once_measure_what_one_thread_does():
         together = list(pool.map(lambda item: aer_direct.execute(SIMULATOR, item[1], 16, item[0], 1),
                                  enumerate(circuits)))
     assert together == alone
+
+
+@pytest.mark.parametrize("num_qubits", [1, 2, 3, 6, 8])
+@pytest.mark.parametrize("synthesis", ["auto", "diagonal", "mcz"])
+def test_assemble_grover_makes_the_programs_circuit(num_qubits, synthesis):
+    """``execute_grover`` (the diagonal form assembled from cached call arguments, AerBackend's
+    path) measures the words ``execute`` measures on ``aer_grover_program`` of the same marks, for
+    every k, including k = 0 and k = 1 (one oracle phase list)."""
+    for iterations in (0, 1, 2, 5):
+        for seed in range(3):
+            marks = random_marks(num_qubits, 10 * iterations + seed)
+            program = aer_grover_program(marks, iterations, synthesis)
+            assert (aer_direct.execute_grover(SIMULATOR, marks, iterations, synthesis, 48, seed, 1)
+                    == aer_direct.execute(SIMULATOR, program, 48, seed, 1))
+
+
+def test_assemble_grover_refuses_a_noisy_simulator():
+    from qiskit_aer.noise import NoiseModel, depolarizing_error
+
+    noise = NoiseModel()
+    noise.add_all_qubit_quantum_error(depolarizing_error(0.1, 1), ["h"])
+    with pytest.raises(ValueError, match="noise_model"):
+        aer_direct.execute_grover(AerSimulator(noise_model=noise), random_marks(3, 0), 1, "diagonal", 4, 1, 1)
+
+
+def test_max_qubits_follows_the_simulators_method():
+    """``AerBackend.max_qubits`` is kept between searches but read again when the method changes."""
+    backend = qc.AerBackend()
+    statevector = backend.max_qubits
+    assert statevector == backend.simulator.configuration().n_qubits
+    backend.simulator.set_options(method="density_matrix")
+    assert backend.max_qubits == backend.simulator.configuration().n_qubits == statevector // 2

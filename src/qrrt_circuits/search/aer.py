@@ -7,7 +7,7 @@ circuit (``aer_literal_grover_circuit``: h, x, mcphase) is run instead, so per-g
 the paper's gates. Each shot is an independent preparation, k Grover iterations and a measurement
 (``memory=True`` keeps them per shot).
 
-Without a noise model the circuit's instructions (``aer_grover_program``) go to the simulator's
+Without a noise model the circuit's instructions (``aer_direct.assemble_grover``) go to the simulator's
 C++ controller directly (``aer_direct``): the same simulation, the same configuration and the same
 measured words as ``AerSimulator.run`` (tested seed by seed), without the job thread, Aer's generic
 assembler and the ``Result`` conversion, which cost more than simulating these small circuits.
@@ -30,7 +30,7 @@ from qiskit_aer import AerSimulator
 
 from ..validation import check_int
 from . import aer_direct
-from .aer_circuits import GroverProgram, aer_grover_program
+from .aer_circuits import GroverProgram
 from .backend import QuantumSearchBackend, seed_stream
 from .circuits import SYNTHESES, aer_grover_circuit, aer_literal_grover_circuit
 from .fixed_point import generalized_grover_circuit
@@ -131,11 +131,22 @@ class AerBackend(QuantumSearchBackend):
         self._build = aer_grover_circuit if noise_model is None else aer_literal_grover_circuit
         #: False sends every circuit through AerSimulator.run (the benchmarks' before/after figures)
         self._use_controller = True
+        #: (the simulator's method, its n_qubits), see ``max_qubits``
+        self._max_qubits: tuple[str | None, int] | None = None
 
     @property
     def max_qubits(self) -> int:
-        """The largest n the simulator's configuration accepts (``n_qubits``, memory-limited)."""
-        return int(self.simulator.configuration().n_qubits)
+        """The largest n the simulator's configuration accepts (``n_qubits``, memory-limited).
+
+        ``AerSimulator.configuration()`` copies the whole configuration (tens of microseconds, and
+        every search checks n), so the value is kept for the simulator's current method (Aer sets
+        ``n_qubits`` from the method, ``AerSimulator._set_method_config``) and read again when the
+        method changes."""
+        method = getattr(self.simulator.options, "method", None)
+        cached = getattr(self, "_max_qubits", None)
+        if cached is None or cached[0] != method:
+            cached = self._max_qubits = (method, int(self.simulator.configuration().n_qubits))
+        return cached[1]
 
     #: calibrated on ``benchmarks/bench_memory.py`` (peak RSS of a round with many marked entries,
     #: so the oracle is one diagonal): the oracle's 2^n phases, Aer's complex128 state and its
@@ -196,7 +207,7 @@ class AerBackend(QuantumSearchBackend):
             if not result.success:
                 raise RuntimeError(f"AerSimulator failed: {result.status}")
             words = result.results[0].data.memory
-        return np.fromiter((int(word, 16) for word in words), dtype=np.int64, count=len(words))
+        return _indices(words)
 
     def _sample_seeded(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
                        seed: int | np.random.Generator | None) -> np.ndarray:
@@ -204,8 +215,9 @@ class AerBackend(QuantumSearchBackend):
         ``integers(0, 2**31 - 1)`` of the search's generator."""
         seed_simulator = self._first_integer(seed, 2**31 - 1)
         if self._direct:  # the circuit's instructions straight to the controller
-            return self._run(aer_grover_program(marks, iterations, self.synthesis), num_qubits, shots,
-                             seed_simulator)
+            words = aer_direct.execute_grover(self.simulator, marks, iterations, self.synthesis, shots,
+                                              seed_simulator, self.threads_for(num_qubits))
+            return _indices(words)
         circuit = self._build(marks, iterations, measure=True, synthesis=self.synthesis)
         return self._run(circuit, num_qubits, shots, seed_simulator)
 
@@ -218,3 +230,8 @@ class AerBackend(QuantumSearchBackend):
         """Fixed-point amplification: the generalized iterates of ``sequence`` as one circuit."""
         circuit = generalized_grover_circuit(marks, sequence, measure=True, synthesis=self.synthesis)
         return self._run(circuit, num_qubits, shots, int(rng.integers(0, 2**31 - 1)))
+
+
+def _indices(words: list[str]) -> np.ndarray:
+    """The measured indices of Aer's hexadecimal memory words."""
+    return np.fromiter((int(word, 16) for word in words), dtype=np.int64, count=len(words))

@@ -160,7 +160,11 @@ def simulation_synthesis(marks: np.ndarray) -> str:
     Raises:
         ValueError: ``marks`` not of length 2^n or not boolean.
     """
-    marks, n = validate_marks(marks)
+    return choose_simulation_synthesis(validate_marks(marks)[0])
+
+
+def choose_simulation_synthesis(marks: np.ndarray) -> str:
+    """``simulation_synthesis`` of marks already validated (a bool array of length 2^n)."""
     marked = int(np.count_nonzero(marks))
     flipped = min(marked, marks.shape[0] - marked)
     return "diagonal" if marks.shape[0] <= ENTRIES_PER_INSTRUCTION * (2 * flipped + 1) else "mcz"
@@ -311,7 +315,7 @@ def aer_grover_program(marks: np.ndarray, iterations: int, synthesis: str = "aut
         raise ValueError(f"synthesis must be one of {AER_SYNTHESES}, got {synthesis!r}")
     block = check_int(block, "block", 1, 10)
     if synthesis == "auto":
-        synthesis = simulation_synthesis(marks)
+        synthesis = choose_simulation_synthesis(marks)
     parts = _parts(n, block)
     steps: list[Step] = list(parts.walsh)
     phase = 0.0

@@ -14,7 +14,13 @@ whoever makes it.
 ``barrier``, which becomes nothing) with the same controller-wrapper calls and arguments as Aer's
 assembler (one call per instruction, the phases of a ``diagonal`` handed over as the list they
 already are), and falls back to Aer's own
-assembler for anything else (parameters, control flow, other instructions). ``execute`` builds
+assembler for anything else (parameters, control flow, other instructions). ``assemble_grover`` makes the
+diagonal-form Grover circuit ``AerBackend`` runs for small n with the same calls as
+``assemble_program`` of its program, from arguments cached per n (the Walsh-Hadamard matrices,
+qubit lists, labels, header), so that per search only the oracle's two phase lists are new
+(``benchmarks/bench_search.py`` times ``assemble_grover`` beside ``build`` + ``assemble``, the
+program's path); what is left is mostly the controller wrappers' own cost per call, a few
+microseconds per ``unitary``, ``mcphase`` or ``AerCircuit()``. ``execute`` builds
 the run configuration with Aer's ``generate_aer_config`` from the simulator's options and the
 run options (once per thread, circuit width, shots and thread count, and again whenever the
 simulator's options change; only the seed changes between searches), calls the simulator's
@@ -31,15 +37,17 @@ circuits through ``AerSimulator.run``.
 
 from __future__ import annotations
 
+import functools
 import threading
 import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
 from qiskit import QuantumCircuit
 
-from .aer_circuits import GroverProgram
+from .aer_circuits import WALSH_HADAMARD_BLOCK, GroverProgram, _parts, aer_grover_program, choose_simulation_synthesis
 
 try:  # qiskit-aer internals (checked with 0.18.2); without them AerBackend uses AerSimulator.run
     from qiskit_aer import AerSimulator
@@ -174,6 +182,98 @@ def assemble_program(program: GroverProgram) -> Any:
     return aer
 
 
+@dataclass(frozen=True, eq=False)
+class _DiagonalCalls:
+    """The controller-wrapper calls of a diagonal-form Grover circuit on n qubits that no search
+    changes (made once per n and block width): the header, the Walsh-Hadamard blocks (qubit
+    indices, matrix, label), the reflection ``mcphase`` (``p`` for n = 1), the final Z^n and the
+    signs (-1)^popcount(i) folded into the first oracle call."""
+
+    num_qubits: int
+    qubits: list[int]
+    header: Any
+    walsh: tuple[tuple[list[int], np.ndarray, str], ...]
+    reflection: tuple[str, list[float], str]
+    parity: list[str]
+    signs: np.ndarray
+
+
+@functools.lru_cache(maxsize=32)
+def _diagonal_calls(num_qubits: int, block: int) -> _DiagonalCalls:
+    parts = _parts(num_qubits, block)
+    reflection, _ = parts.reflection
+    parity, _ = parts.parity
+    header = CircuitHeader(  # as _header makes it (set_header copies it into each circuit)
+        n_qubits=num_qubits,
+        qreg_sizes=[[register.name, register.size] for register in parts.qregs],
+        memory_slots=num_qubits,
+        creg_sizes=[[register.name, register.size] for register in parts.cregs],
+        name="grover_aer",
+        global_phase=0.0,
+    )
+    return _DiagonalCalls(
+        num_qubits, list(range(num_qubits)), header,
+        tuple((parts.indices_of(group), gate.params[0], gate.label or "unitary") for gate, group in parts.walsh),
+        (reflection.name, [float(p) for p in reflection.params], reflection.label or reflection.name),
+        list(parity.params), parts.signs)
+
+
+def assemble_grover(marks: np.ndarray, iterations: int, synthesis: str = "auto",
+                    block: int = WALSH_HADAMARD_BLOCK) -> Any:
+    """The ``AerCircuit`` of ``aer_grover_program(marks, iterations, synthesis, block)`` with its
+    measurements: ``assemble_program`` of that program, the same calls with the same arguments in
+    the same order (tested instruction by instruction through the measured words).
+
+    For the diagonal form (the one ``AerBackend`` takes for small n) the calls are made here from
+    cached arguments, without building the program's operations: per search only the two phase
+    lists of the oracle (the first call carries the folded Z^n, ``aer_circuits``) are new. The
+    ``mcz`` form goes through ``assemble_program``. The arguments are not validated here: this is
+    ``AerBackend``'s path, behind its own checks.
+
+    Args:
+        marks: Bool array of length 2^n (n >= 1), already validated.
+        iterations: k >= 0, already validated.
+        synthesis: ``"auto"``, ``"diagonal"`` or ``"mcz"`` (``aer_circuits.AER_SYNTHESES``).
+        block: The widest Walsh-Hadamard block (1 .. 10).
+
+    Returns:
+        A ``qiskit_aer.backends.controller_wrappers.AerCircuit`` with experiment id 0.
+    """
+    if synthesis == "auto":
+        synthesis = choose_simulation_synthesis(marks)
+    if synthesis != "diagonal":
+        return assemble_program(aer_grover_program(marks, iterations, synthesis, block))
+    n = marks.shape[0].bit_length() - 1
+    calls = _diagonal_calls(n, block)
+    qubits = calls.qubits
+    aer = AerCircuit()
+    aer.set_header(calls.header)
+    aer.num_qubits = n
+    aer.num_memory = n
+    aer.global_phase_angle = 0.0
+    unitary = aer.unitary
+    walsh = calls.walsh
+    for group, matrix, label in walsh:
+        unitary(group, matrix, _UNCONDITIONAL, None, label)
+    if iterations:
+        signs = np.where(marks, -1.0, 1.0)
+        first = (signs * calls.signs).astype(complex).tolist()
+        rest = signs.astype(complex).tolist() if iterations > 1 else first
+        diagonal, gate = aer.diagonal, aer.gate
+        name, params, label = calls.reflection
+        for call in range(iterations):
+            diagonal(qubits, rest if call else first, _UNCONDITIONAL, "diagonal")
+            for group, matrix, walsh_label in walsh:
+                unitary(group, matrix, _UNCONDITIONAL, None, walsh_label)
+            gate(name, qubits, params, [], _UNCONDITIONAL, None, label)
+            for group, matrix, walsh_label in walsh:
+                unitary(group, matrix, _UNCONDITIONAL, None, walsh_label)
+        gate("pauli", qubits, [], calls.parity, _UNCONDITIONAL, None, "pauli")
+    aer.measure(qubits, qubits, [])
+    aer.circ_id = 0
+    return aer
+
+
 @dataclass(frozen=True)
 class _Width:
     """What ``generate_aer_config`` reads of its circuits: their qubits and classical bits."""
@@ -239,15 +339,36 @@ def execute(simulator: Any, circuit: QuantumCircuit | GroverProgram, shots: int,
         ValueError: The simulator has a noise model.
         RuntimeError: The controller reports a failure.
     """
-    if getattr(simulator.options, "noise_model", None) is not None:
-        raise ValueError("aer_direct.execute runs noiseless simulators only; a simulator with a noise_model "
-                         "goes through AerSimulator.run, whose compile step prepares the model")
+    _refuse_noise(simulator)
     if isinstance(circuit, GroverProgram):
         aer = assemble_program(circuit)
         width = _Width(circuit.num_qubits, circuit.num_qubits)
     else:
         aer = assemble(circuit)
         width = _Width(circuit.num_qubits, circuit.num_clbits)
+    return _run(simulator, aer, width, shots, seed, threads)
+
+
+def execute_grover(simulator: Any, marks: np.ndarray, iterations: int, synthesis: str, shots: int, seed: int,
+                   threads: int) -> list[str]:
+    """``execute(simulator, aer_grover_program(marks, iterations, synthesis), shots, seed,
+    threads)``: the same words, the circuit assembled by ``assemble_grover`` (the same calls, made
+    from cached arguments); ``AerBackend``'s path. ``marks`` (a bool array of length 2^n) and
+    ``iterations`` are not validated here: the backend has checked them. Raises what ``execute``
+    raises."""
+    _refuse_noise(simulator)
+    n = marks.shape[0].bit_length() - 1
+    return _run(simulator, assemble_grover(marks, iterations, synthesis), _Width(n, n), shots, seed, threads)
+
+
+def _refuse_noise(simulator: Any) -> None:
+    if getattr(simulator.options, "noise_model", None) is not None:
+        raise ValueError("aer_direct.execute runs noiseless simulators only; a simulator with a noise_model "
+                         "goes through AerSimulator.run, whose compile step prepares the model")
+
+
+def _run(simulator: Any, aer: Any, width: _Width, shots: int, seed: int, threads: int) -> list[str]:
+    """The controller's run of the assembled circuit ``aer``; its per-shot memory."""
     output = simulator._execute_circuits([aer], None, _configuration(simulator, width, shots, seed, threads))
     if not isinstance(output, dict) or not output.get("success", False):
         status = output.get("status") if isinstance(output, dict) else output
