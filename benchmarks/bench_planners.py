@@ -16,7 +16,10 @@ worlds with our closed-loop motion check (a Python MotionValidator) right after 
 ratio of their median ms per node is printed. Rows ending in ", generic round" run the quantum
 planner with ``fused_round=False`` (every part of the round a call of its own, as before
 ``planners/fused_round.py``), beside the default, in the same run; the round breakdown times the
-parts of both. Writes JSON.
+parts of both. The ratio targets (q-RRT on Aer over the statevector planner, with its fused
+and its generic round) are also measured interleaved: per world the two planners one right after
+the other (``interleaved``), so that a drift of the machine's speed between sections does not
+enter the ratio. Writes JSON.
 """
 
 from __future__ import annotations
@@ -201,6 +204,29 @@ def run_one(make, env, seed: int, nodes: int, big: bool) -> dict:
             "reached": result.status == "reached", "labels": list(result.labels)}
 
 
+#: the issue's ratio targets, each measured seed by seed with the two planners run one right after
+#: the other (numerator, denominator): a machine whose speed drifts over minutes (seen here: the
+#: same planner 1.5x slower from one section of a run to the next) moves both sides alike
+INTERLEAVED = (("QRRT aer", "QRRT statevector"), ("QRRT aer", "QRRT statevector, generic round"))
+
+
+def interleaved_ratios(worlds, nodes: int) -> dict:
+    """For each pair of ``INTERLEAVED``: per world both planners (numerator first) to ``nodes``
+    nodes; the median ms per node of each and the ratio of the medians."""
+    factories = configurations()
+    out = {}
+    for numerator, denominator in INTERLEAVED:
+        times: dict[str, list[float]] = {numerator: [], denominator: []}
+        for seed, env in enumerate(worlds):
+            for name in (numerator, denominator):
+                times[name].append(run_one(factories[name], env, seed, nodes, False)["ms_per_node"])
+        medians = {name: float(np.median(values)) for name, values in times.items()}
+        out[f"{numerator} / {denominator}"] = {
+            "numerator_ms_per_node": medians[numerator], "denominator_ms_per_node": medians[denominator],
+            "ratio_of_medians": medians[numerator] / medians[denominator]}
+    return out
+
+
 def predicate_construction(env, repeats: int = 20) -> dict:
     """Milliseconds to build the exact predicate (every trial of an experiment builds one): its
     chord grid computed (the process-wide cache emptied first) and taken from the cache."""
@@ -290,13 +316,18 @@ def main() -> None:
         print(f"{name:44s} " + " ".join(f"{medians[k]:8.1f} ({shares[k]:3.0%})" for k in medians)
               + f"   reachable {parts[name]['reachable_fraction']:.2f}, "
               f"predicate {parts[name]['predicate_us_per_pair']:.2f} us/pair")
+    ratios = interleaved_ratios(worlds, nodes)
+    print()
+    for name, row in ratios.items():
+        print(f"interleaved seed by seed, {name}: {row['numerator_ms_per_node']:.3f} / "
+              f"{row['denominator_ms_per_node']:.3f} ms per node = {row['ratio_of_medians']:.2f}")
     construction = predicate_construction(worlds[0])
     print(f"\nexact predicate built: {construction['grid_computed_ms']:.2f} ms computing its chord grid, "
           f"{construction['grid_cached_ms']:.2f} ms with the grid cached")
     path = write_json("bench_planners" + ("_quick" if args.quick else ""),
                       {"machine": machine(), "seeds": seeds, "max_nodes": nodes, "big_nodes": big_nodes,
                        "big_seeds": big_seeds, "planners": rows, "ompl_rrt": ompl_rows,
-                       "round_breakdown": parts, "predicate_construction": construction,
+                       "round_breakdown": parts, "interleaved": ratios, "predicate_construction": construction,
                        "note": "quantum planners: phase oracle built from a classical lookup of all "
                                "2^n entries (simulation_checks); shared Pq-RRT: one search with p "
                                "shots stands for p workers; 'known-optimal' uses the true m; "
