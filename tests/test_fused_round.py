@@ -18,9 +18,11 @@ from qrrt_circuits.search.policies import PolicyState
 
 @pytest.fixture()
 def fused_calls(monkeypatch):
-    """Counts the fused round's compiled calls (candidates, measurements)."""
-    calls = {"candidates": 0, "measure": 0}
+    """Counts the fused round's compiled calls (candidates, measurements) and the databases it
+    hands to the backend's search_many."""
+    calls = {"candidates": 0, "measure": 0, "searched": 0}
     candidates, measure = fused_round._candidates, fused_round._measure
+    searched = fused_round.FusedRound._searched
 
     def counted_candidates(*args):
         calls["candidates"] += 1
@@ -30,8 +32,13 @@ def fused_calls(monkeypatch):
         calls["measure"] += 1
         return measure(*args)
 
+    def counted_searched(self, built, *args):
+        calls["searched"] += len(built)
+        return searched(self, built, *args)
+
     monkeypatch.setattr(fused_round, "_candidates", counted_candidates)
     monkeypatch.setattr(fused_round, "_measure", counted_measure)
+    monkeypatch.setattr(fused_round.FusedRound, "_searched", counted_searched)
     return calls
 
 
@@ -82,11 +89,19 @@ CONFIGURATIONS = {
                                                fused_round=f),
     "pqrrt-aer": lambda env, s, f: qc.PQRRT(env, backend=qc.AerBackend(seed=1), workers=4, num_qubits=4, seed=s,
                                             fused_round=f),
+    "pqrrt-unshared-aer": lambda env, s, f: qc.PQRRT(env, backend=qc.AerBackend(seed=1), workers=3, num_qubits=4,
+                                                     shared_database=False, seed=s, fused_round=f),
+    "qrrt-aer-errors": lambda env, s, f: qc.QRRT(env, backend=qc.AerBackend(seed=1), num_qubits=5, seed=s,
+                                                 search_policy=qc.KnownOptimal(), fused_round=f,
+                                                 oracle_errors=qc.OracleErrorModel(0.1, 0.3)),
 }
 
 #: the configurations whose searches are drawn by the fused round itself
 CLOSED_FORM = {"qrrt-paper", "qrrt-n5-fixed", "qrrt-n3-fixed0", "qrrt-adaptive", "qrrt-errors", "pqrrt-shared",
                "pqrrt-shared-errors", "pqrrt-unshared", "qrrt-known-optimal"}
+#: the configurations whose backend searches (its search_many called by the fused round) and whose
+#: measured indices the fused round verifies
+BACKEND_SEARCHED = {"qrrt-iterated", "pqrrt-aer", "pqrrt-unshared-aer", "qrrt-aer-errors"}
 
 
 @pytest.mark.parametrize("name", sorted(CONFIGURATIONS))
@@ -97,6 +112,7 @@ def test_fused_round_gives_the_generic_plan(name, seed, fused_calls):
     fused = make(env, seed, True).plan(max_nodes=40)
     assert fused_calls["candidates"] == fused.metrics.databases > 0
     assert fused_calls["measure"] == (fused.metrics.databases if name in CLOSED_FORM else 0)
+    assert fused_calls["searched"] == (fused.metrics.databases if name in BACKEND_SEARCHED else 0)
     generic = make(env, seed, False).plan(max_nodes=40)
     assert fused_calls["candidates"] == fused.metrics.databases  # the generic plan made none
     assert fingerprint(fused) == fingerprint(generic)

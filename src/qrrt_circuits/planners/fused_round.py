@@ -21,8 +21,12 @@ compiled calls:
    (``statevector._draw_two_level_seeded``, Eq. 1 / Lemma 1), the classical verification of each
    (the finalizer: 1 oracle call per worker), the entries the planner adds (each verified entry
    once, in worker order) and the database's reachable entries, returned as a
-   ``ClosedFormOutcome`` whose ``tally`` the planner integrates. Otherwise the databases go to the
-   policy's ``run_many`` (the backend's ``search_many``) as in the generic round.
+   ``ClosedFormOutcome`` whose ``tally`` the planner integrates. Where the policy state searches
+   by default but the backend searches itself (``AerBackend``, the iterated statevector), the
+   round hands the backend's ``search_many`` the requests the policy's ``run_many`` would (same
+   marks, k, shots and seeds) and verifies the measured indices with ``_verify`` (the second half
+   of ``_measure``), into the same kind of outcome. Otherwise (BBHT, fixed-point amplification,
+   ``EstimatedOptimal``) the databases go to the policy's ``run_many`` as in the generic round.
 
 Every number is the one the generic round produces, bit for bit: the same draws in the same order
 from the same PCG64 states, the same nearest-node kernels, the same predicate calls in the same
@@ -45,7 +49,7 @@ from ..oracle_errors import OracleErrorModel
 from ..predicate import ReachabilityPredicate, check_answers
 from ..probability import compiled_good_probability
 from ..randomness import RandomStreams, Stream, _next_double, _pcg_state, _seed_words, _small_seed_words, _stream_seed
-from ..search.backend import MAX_ITERATIONS, QuantumSearchBackend, validate_iterations
+from ..search.backend import MAX_ITERATIONS, QuantumSearchBackend, SearchRequest, validate_iterations
 from ..search.policies import PolicyState
 from ..search.problem import DatabaseSearch, SearchOutcome
 from ..search.statevector import _draw_two_level_seeded
@@ -107,12 +111,10 @@ def _measure(run_entropy: np.ndarray, round_index: int, worker: int, marks: np.n
     ``RandomStreams.seed(round_index, worker, Stream.SEARCH)`` (``randomness._stream_seed``), the
     draw ``_draw_two_level_seeded`` with that seed's ``integer_seed_words``
     (``randomness._small_seed_words``, the seed being below 2^62): the same functions the generic
-    round calls; each index is verified against ``truth``.
+    round calls; the indices are verified by ``_verify``.
 
     Returns:
-        (indices (shots,), verified (shots,) bool, added: the verified indices in worker order,
-        each entry once (its first verification), the candidates Alg. 3 adds; the reachable
-        entries of ``truth``; the verified shots; the added entries' children and parents).
+        (indices (shots,), then what ``_verify`` returns for them).
     """
     size = marks.shape[0]
     marked = 0
@@ -121,6 +123,23 @@ def _measure(run_entropy: np.ndarray, round_index: int, worker: int, marks: np.n
     p_good = compiled_good_probability(size, marked, iterations)
     words = _small_seed_words(_stream_seed(run_entropy, _key(round_index, worker, _SEARCH)))
     indices = _draw_two_level_seeded(marks, p_good, shots, words)
+    verified, added, reachable, good, added_children, added_parents = _verify(indices, truth, children, parents)
+    return indices, verified, added, reachable, good, added_children, added_parents
+
+
+@njit(cache=True, nogil=True)
+def _verify(indices: np.ndarray, truth: np.ndarray, children: np.ndarray,
+            parents: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, int, np.ndarray, np.ndarray]:
+    """Each worker's classical verification of its measured index (the finalizer, 1 oracle call
+    per worker, against ``truth``) and the entries a planner adds.
+
+    Returns:
+        (verified (shots,) bool, added: the verified indices in worker order, each entry once (its
+        first verification), the candidates Alg. 3 adds; the reachable entries of ``truth``; the
+        verified shots; the added entries' children and parents).
+    """
+    size = truth.shape[0]
+    shots = indices.shape[0]
     verified = np.empty(shots, dtype=np.bool_)
     seen = np.zeros(size, dtype=np.bool_)
     added = np.empty(shots, dtype=np.int64)
@@ -142,12 +161,13 @@ def _measure(run_entropy: np.ndarray, round_index: int, worker: int, marks: np.n
     for slot in range(count):
         added_children[slot] = children[added[slot]]
         added_parents[slot] = parents[added[slot]]
-    return indices, verified, added[:count].copy(), reachable, good, added_children, added_parents
+    return verified, added[:count].copy(), reachable, good, added_children, added_parents
 
 
 class ClosedFormOutcome(NamedTuple):
-    """One database searched by ``FusedRound``'s closed-form draw: what ``DatabaseOutcome`` holds,
-    as arrays (the ``SearchOutcome`` objects and found candidates are built only when asked for).
+    """One database searched by ``FusedRound`` at one k for all its workers (its closed-form draw,
+    or the backend's search verified by ``_verify``): what ``DatabaseOutcome`` holds, as arrays
+    (the ``SearchOutcome`` objects and found candidates are built only when asked for).
     Immutable: a named tuple, made once per database per round at about a third of a frozen
     dataclass's cost.
 
@@ -270,21 +290,41 @@ class FusedRound:
         if len(groups) > 1 and any(count != workers for _, count in groups):
             raise ValueError("FusedRound.search needs groups of one size")
         built = [self._database(tree, round_index, first) for first, _ in groups]
-        closed_form = self.closed_form and policy_state.searches_by_default()
-        if closed_form and not policy_state.reads_problem():  # k from N and the tree: no DatabaseSearch needed
+        by_default = policy_state.searches_by_default()
+        if by_default and not policy_state.reads_problem():  # k from N and the tree: no DatabaseSearch needed
             iterations = [_iterations(policy_state.iterations_by_size(tree_nodes)) for _ in groups]
         else:
             problems = [DatabaseSearch(marks, truth, self.backend, self.streams, round_index, first)
                         for (_, _, truth, marks), (first, _) in zip(built, groups, strict=True)]
-            if not closed_form:
+            if not by_default:
                 searched = policy_state.run_many(problems, workers, tree_nodes)
                 return [database_outcome(children, parents, truth, outcomes)
                         for (children, parents, truth, _), outcomes in zip(built, searched, strict=True)]
             iterations = [_iterations(policy_state.iterations_for(problem, tree_nodes)) for problem in problems]
+        if not self.closed_form:  # the backend searches (search_many checks every request before any runs)
+            return self._searched(built, groups, iterations, round_index, workers)
         for k in iterations:
             self._check_memory(k, workers)  # every search checked before any runs, as search_many does
         return [self._measured(children, parents, marks, truth, round_index, first, workers, k)
                 for (children, parents, truth, marks), (first, _), k in zip(built, groups, iterations, strict=True)]
+
+    def _searched(self, built: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]],
+                  groups: list[tuple[int, int]], iterations: list[int], round_index: int,
+                  workers: int) -> list[DatabaseResult]:
+        """The default ``PolicyState.run_many`` on a backend that searches itself (Aer, the
+        iterated statevector): the same requests (the marks, k, one shot per worker, the seed of
+        stream (round, first worker, ``Stream.SEARCH``)) handed to the backend's ``search_many``
+        at once, each database's measured indices verified by ``_verify``."""
+        requests = [SearchRequest(marks, k, workers, self.streams.seed(round_index, first, Stream.SEARCH))
+                    for (_, _, _, marks), (first, _), k in zip(built, groups, iterations, strict=True)]
+        results = self.backend.search_many(requests)
+        outcomes: list[DatabaseResult] = []
+        for (children, parents, truth, _), k, result in zip(built, iterations, results, strict=True):
+            verified, added, reachable, good, added_children, added_parents = _verify(
+                result.indices, truth, children, parents)
+            outcomes.append(ClosedFormOutcome(self.size, reachable, k, result.indices, verified, added, children,
+                                              parents, self._missed(k), good, added_children, added_parents))
+        return outcomes
 
     def _database(self, tree: Tree, round_index: int,
                   worker: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
