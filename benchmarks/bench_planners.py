@@ -18,8 +18,8 @@ planner with ``fused_round=False`` (every part of the round a call of its own, a
 ``planners/fused_round.py``), beside the default, in the same run; the round breakdown times the
 parts of both. The ratio targets (q-RRT on Aer over the statevector planner, with its fused
 and its generic round) are also measured interleaved: per world the two planners one right after
-the other (``interleaved``), so that a drift of the machine's speed between sections does not
-enter the ratio. Writes JSON.
+the other (``interleaved``, the two in alternating order), so that a drift of the machine's speed between
+sections does not enter the ratio. Writes JSON.
 """
 
 from __future__ import annotations
@@ -204,21 +204,23 @@ def run_one(make, env, seed: int, nodes: int, big: bool) -> dict:
             "reached": result.status == "reached", "labels": list(result.labels)}
 
 
-#: the issue's ratio targets, each measured seed by seed with the two planners run one right after
-#: the other (numerator, denominator): a machine whose speed drifts over minutes (seen here: the
-#: same planner 1.5x slower from one section of a run to the next) moves both sides alike
+#: the ratio targets of the performance work (README, *Benchmarks*: q-RRT on Aer over the
+#: statevector planner), each measured world by world with the two planners run one right after
+#: the other (numerator, denominator): a machine whose speed drifts over minutes (seen: the same
+#: planner 1.5x slower from one section of a run to the next) moves both sides alike
 INTERLEAVED = (("QRRT aer", "QRRT statevector"), ("QRRT aer", "QRRT statevector, generic round"))
 
 
-def interleaved_ratios(worlds, nodes: int) -> dict:
-    """For each pair of ``INTERLEAVED``: per world both planners (numerator first) to ``nodes``
-    nodes; the median ms per node of each and the ratio of the medians."""
+def interleaved_ratios(worlds: list[qc.Environment], nodes: int) -> dict:
+    """For each pair of ``INTERLEAVED``: per world both planners to ``nodes`` nodes, the numerator
+    first on even worlds and second on odd ones (so neither always runs first); the median ms per
+    node of each and the ratio of the medians."""
     factories = configurations()
     out = {}
     for numerator, denominator in INTERLEAVED:
         times: dict[str, list[float]] = {numerator: [], denominator: []}
         for seed, env in enumerate(worlds):
-            for name in (numerator, denominator):
+            for name in ((numerator, denominator) if seed % 2 == 0 else (denominator, numerator)):
                 times[name].append(run_one(factories[name], env, seed, nodes, False)["ms_per_node"])
         medians = {name: float(np.median(values)) for name, values in times.items()}
         out[f"{numerator} / {denominator}"] = {

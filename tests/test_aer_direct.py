@@ -227,10 +227,37 @@ def test_assemble_grover_refuses_a_noisy_simulator():
         aer_direct.execute_grover(AerSimulator(noise_model=noise), random_marks(3, 0), 1, "diagonal", 4, 1, 1)
 
 
-def test_max_qubits_follows_the_simulators_method():
-    """``AerBackend.max_qubits`` is kept between searches but read again when the method changes."""
+def test_max_qubits_follows_the_simulators_configuration():
+    """``AerBackend.max_qubits`` (read without copying Aer's configuration) is
+    ``configuration().n_qubits`` after every way of changing it, and after a pickle round trip;
+    a search above it is refused."""
+    import pickle
+
     backend = qc.AerBackend()
-    statevector = backend.max_qubits
-    assert statevector == backend.simulator.configuration().n_qubits
+    assert backend.max_qubits == backend.simulator.configuration().n_qubits
     backend.simulator.set_options(method="density_matrix")
-    assert backend.max_qubits == backend.simulator.configuration().n_qubits == statevector // 2
+    assert backend.max_qubits == backend.simulator.configuration().n_qubits
+    backend.simulator.set_options(method="statevector")
+    backend.simulator.set_max_qubits(3)
+    assert backend.max_qubits == backend.simulator.configuration().n_qubits == 3
+    marks = np.zeros(16, dtype=bool)
+    marks[3] = True
+    with pytest.raises(ValueError, match="1..3 qubits"):
+        backend.search(marks, 1, 2, seed=1)
+    again = pickle.loads(pickle.dumps(backend))
+    assert again.max_qubits == again.simulator.configuration().n_qubits == 3
+    backend.simulator.clear_options()
+    assert backend.max_qubits == backend.simulator.configuration().n_qubits
+
+
+@pytest.mark.parametrize(("marks", "iterations"), [
+    (np.array([0, 1, 0, 0], dtype=np.uint8), 1),  # not bool: 2 would have counted as marked
+    (np.array([True, False, False]), 1),            # not a power of two
+    (np.array([True]), 1),                          # n = 0
+    (np.array([[True, False]]), 1),                 # not 1-D
+    (np.array([True, False]), -1),
+    (np.array([True, False]), np.int64(1)),         # not coerced
+])
+def test_execute_grover_refuses_what_the_backend_would_have_refused(marks, iterations):
+    with pytest.raises(ValueError, match="marks|iterations"):
+        aer_direct.execute_grover(SIMULATOR, marks, iterations, "diagonal", 4, 1, 1)

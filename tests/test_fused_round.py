@@ -392,3 +392,25 @@ def test_a_closed_form_tally_is_the_worker_by_worker_tally(seed):
     assert fast[:5] == slow[:5]
     assert np.array_equal(fast[5], slow[5]) and np.array_equal(fast[6], slow[6])
     assert fast[0] == workers * k and fast[1] == workers and fast[3] == k + 1
+
+
+class OutOfRange(qc.StatevectorBackend):
+    """A backend whose search measures an index outside the database (a faulty subclass)."""
+
+    def __init__(self, index):
+        super().__init__(seed=0)
+        self.index = index
+
+    def _sample_seeded(self, marks, num_qubits, iterations, shots, seed):
+        return np.full(shots, self.index, dtype=np.int64)
+
+
+@pytest.mark.parametrize("index", [16, -1, 100_000_000])
+@pytest.mark.parametrize("fused", [True, False])
+def test_a_backend_measuring_outside_the_database_is_refused(index, fused):
+    """Both rounds refuse indices outside [0, 2^n) with the backend named (the fused round used to
+    read them inside a compiled call: a wrong plan, or a crash for a far index)."""
+    env = qc.scenarios.paper_clutter(seed=0)
+    planner = qc.QRRT(env, backend=OutOfRange(index), num_qubits=4, seed=0, fused_round=fused)
+    with pytest.raises(RuntimeError, match=r"outside \[0, 16\)"):
+        planner.plan(max_nodes=5)

@@ -261,15 +261,17 @@ class FusedRound:
     def search(self, tree: Tree, round_index: int, groups: list[tuple[int, int]], policy_state: PolicyState,
                tree_nodes: int) -> list[DatabaseResult]:
         """What ``search_databases_together`` returns for these groups, bit for bit (as
-        ``ClosedFormOutcome`` arrays where this round draws the searches itself).
+        ``ClosedFormOutcome`` arrays where the policy state searches by default).
 
         Every database is built by ``_candidates`` and marked by the predicate (in group order, as
-        the generic round does). If the backend's seeded search is the closed-form draw and the
-        policy state searches by default (``PolicyState.searches_by_default``), k is the state's
-        ``iterations_for`` on each database, in order, as ``run_many`` asks it (its
-        ``iterations_by_size`` where it ``reads_problem()`` no further than N), and each database's
-        workers are drawn and verified by ``_measure``; otherwise the databases go to the state's
-        ``run_many``, as in the generic round.
+        the generic round does). If the policy state searches by default
+        (``PolicyState.searches_by_default``), k is the state's ``iterations_for`` on each
+        database, in order, as ``run_many`` asks it (its ``iterations_by_size`` where it
+        ``reads_problem()`` no further than N); then, if the backend's seeded search is the
+        closed-form draw, each database's workers are drawn and verified by ``_measure``, else the
+        backend's ``search_many`` runs the searches ``run_many`` would ask for and ``_verify``
+        verifies them (``_searched``). Otherwise the databases go to the state's ``run_many``, as
+        in the generic round.
 
         Args:
             tree: The plan's tree (read only).
@@ -279,12 +281,14 @@ class FusedRound:
             tree_nodes: Nodes in the tree so far.
 
         Returns:
-            One ``DatabaseOutcome`` (``ClosedFormOutcome`` for the closed-form draws) per group, in
-            order: the same outcomes, found candidates and counts (``tally``).
+            One ``DatabaseOutcome`` (``ClosedFormOutcome`` where the policy searches by default)
+            per group, in order: the same outcomes, found candidates and counts (``tally``).
 
         Raises:
             ValueError: A predicate answer that is not a 0/1 array of 2^n entries, or a k or a shot
                 count that the backend's ``search`` would refuse, before any search.
+            RuntimeError: A backend whose search returned indices outside the database
+                (``search.backend.check_measured``).
         """
         workers = groups[0][1]
         if len(groups) > 1 and any(count != workers for _, count in groups):

@@ -131,22 +131,22 @@ class AerBackend(QuantumSearchBackend):
         self._build = aer_grover_circuit if noise_model is None else aer_literal_grover_circuit
         #: False sends every circuit through AerSimulator.run (the benchmarks' before/after figures)
         self._use_controller = True
-        #: (the simulator's method, its n_qubits), see ``max_qubits``
-        self._max_qubits: tuple[str | None, int] | None = None
 
     @property
     def max_qubits(self) -> int:
         """The largest n the simulator's configuration accepts (``n_qubits``, memory-limited).
 
-        ``AerSimulator.configuration()`` copies the whole configuration (tens of microseconds, and
-        every search checks n), so the value is kept for the simulator's current method (Aer sets
-        ``n_qubits`` from the method, ``AerSimulator._set_method_config``) and read again when the
-        method changes."""
-        method = getattr(self.simulator.options, "method", None)
-        cached = getattr(self, "_max_qubits", None)
-        if cached is None or cached[0] != method:
-            cached = self._max_qubits = (method, int(self.simulator.configuration().n_qubits))
-        return cached[1]
+        Read on every call, as ``simulator.configuration().n_qubits`` gives it, but without that
+        method's copy of the whole configuration (tens of microseconds, and every search checks n):
+        Aer's configuration is its ``_configuration`` with the ``_options_configuration`` entries
+        (``set_options``, ``set_max_qubits``) set on it; an Aer without those attributes is asked
+        through ``configuration()``."""
+        simulator = self.simulator
+        overrides = getattr(simulator, "_options_configuration", None)
+        base_qubits = getattr(getattr(simulator, "_configuration", None), "n_qubits", None)
+        if isinstance(overrides, dict) and base_qubits is not None:
+            return int(overrides.get("n_qubits", base_qubits))
+        return int(simulator.configuration().n_qubits)
 
     #: calibrated on ``benchmarks/bench_memory.py`` (peak RSS of a round with many marked entries,
     #: so the oracle is one diagonal): the oracle's 2^n phases, Aer's complex128 state and its

@@ -189,7 +189,6 @@ class _DiagonalCalls:
     indices, matrix, label), the reflection ``mcphase`` (``p`` for n = 1), the final Z^n and the
     signs (-1)^popcount(i) folded into the first oracle call."""
 
-    num_qubits: int
     qubits: list[int]
     header: Any
     walsh: tuple[tuple[list[int], np.ndarray, str], ...]
@@ -200,6 +199,8 @@ class _DiagonalCalls:
 
 @functools.lru_cache(maxsize=32)
 def _diagonal_calls(num_qubits: int, block: int) -> _DiagonalCalls:
+    """The ``_DiagonalCalls`` of n qubits and Walsh-Hadamard blocks of at most ``block`` qubits,
+    from the same cached parts as ``aer_grover_program`` (``aer_circuits._parts``)."""
     parts = _parts(num_qubits, block)
     reflection, _ = parts.reflection
     parity, _ = parts.parity
@@ -212,7 +213,7 @@ def _diagonal_calls(num_qubits: int, block: int) -> _DiagonalCalls:
         global_phase=0.0,
     )
     return _DiagonalCalls(
-        num_qubits, list(range(num_qubits)), header,
+        list(range(num_qubits)), header,
         tuple((parts.indices_of(group), gate.params[0], gate.label or "unitary") for gate, group in parts.walsh),
         (reflection.name, [float(p) for p in reflection.params], reflection.label or reflection.name),
         list(parity.params), parts.signs)
@@ -353,12 +354,25 @@ def execute_grover(simulator: Any, marks: np.ndarray, iterations: int, synthesis
                    threads: int) -> list[str]:
     """``execute(simulator, aer_grover_program(marks, iterations, synthesis), shots, seed,
     threads)``: the same words, the circuit assembled by ``assemble_grover`` (the same calls, made
-    from cached arguments); ``AerBackend``'s path. ``marks`` (a bool array of length 2^n) and
-    ``iterations`` are not validated here: the backend has checked them. Raises what ``execute``
-    raises."""
+    from cached arguments); ``AerBackend``'s path, after the backend's own checks. ``marks`` must
+    be a bool array of length 2^n and ``iterations`` an int >= 0 (``ValueError`` otherwise; no
+    coercion); raises what ``execute`` raises."""
     _refuse_noise(simulator)
+    _check_grover(marks, iterations)
     n = marks.shape[0].bit_length() - 1
     return _run(simulator, assemble_grover(marks, iterations, synthesis), _Width(n, n), shots, seed, threads)
+
+
+def _check_grover(marks: np.ndarray, iterations: int) -> None:
+    """The cheap checks ``execute_grover`` makes itself (the backend has made the full ones): a bool
+    array of length 2^n >= 2 and an int k >= 0."""
+    if not (isinstance(marks, np.ndarray) and marks.dtype == np.bool_ and marks.ndim == 1):
+        raise ValueError(f"marks must be a 1-D bool array (validate_marks), got {marks!r}")
+    size = marks.shape[0]
+    if size < 2 or size & (size - 1):
+        raise ValueError(f"marks must have length 2**n with n >= 1, got length {size}")
+    if type(iterations) is not int or iterations < 0:
+        raise ValueError(f"iterations must be an int >= 0 (validate_iterations), got {iterations!r}")
 
 
 def _refuse_noise(simulator: Any) -> None:

@@ -100,6 +100,25 @@ def validate_marks(marks: np.ndarray) -> tuple[np.ndarray, int]:
     return array, size.bit_length() - 1
 
 
+def check_measured(indices: np.ndarray, shots: int, size: int, backend: str) -> None:
+    """Refuse measured indices that are not ``shots`` integers in [0, ``size``).
+
+    Args:
+        indices: What a backend's sampling returned.
+        shots: The shots asked for.
+        size: N = 2^n, the database's entries.
+        backend: The backend's name (for the message).
+
+    Raises:
+        RuntimeError: A shape other than (shots,), a non-integer dtype, or an index out of range.
+    """
+    if not (isinstance(indices, np.ndarray) and indices.shape == (shots,) and indices.dtype.kind in "iu"):
+        raise RuntimeError(f"the {backend} backend returned {indices!r} for {shots} shots: expected an integer "
+                           f"array of shape ({shots},)")
+    if shots and (int(indices.min()) < 0 or int(indices.max()) >= size):
+        raise RuntimeError(f"the {backend} backend measured an index outside [0, {size}): {indices.tolist()}")
+
+
 #: generous upper limits: far beyond any useful search (the optimal k for N = 2^30 and m = 1 is
 #: 25 735), small enough that a circuit or a result never exhausts memory
 MAX_ITERATIONS = 100_000
@@ -269,9 +288,12 @@ class QuantumSearchBackend(abc.ABC):
         without building a Generator overrides this (same indices)."""
         return self._sample(marks, num_qubits, iterations, shots, self._generator(seed))
 
-    @staticmethod
-    def _finish(prepared: _Prepared, indices: np.ndarray) -> SearchResult:
-        _, _, iterations, shots, _ = prepared
+    def _finish(self, prepared: _Prepared, indices: np.ndarray) -> SearchResult:
+        """The ``SearchResult`` of a search's measured indices, refused (``RuntimeError``) unless
+        they are one integer index in [0, 2^n) per shot: a backend (a subclass, a sampler) that
+        returns anything else would otherwise have the planners read outside the database."""
+        marks, _, iterations, shots, _ = prepared
+        check_measured(indices, shots, marks.shape[0], self.name)
         return SearchResult(indices, iterations, shots, iterations * shots)
 
     #: generic footprint of one search (subclasses report their own, calibrated): a complex128 state
@@ -354,6 +376,7 @@ class QuantumSearchBackend(abc.ABC):
         self.check_memory(num_qubits, shots, len(sequence))
         rng = self._rng if seed is None else seed_stream(seed)
         indices = self._sample_sequence(marks, num_qubits, sequence, shots, rng)
+        check_measured(indices, shots, marks.shape[0], self.name)
         return SearchResult(indices, len(sequence), shots, sequence.oracle_calls * shots)
 
     def _sample_sequence(self, marks: np.ndarray, num_qubits: int, sequence: IterateSequence, shots: int,
