@@ -1,0 +1,102 @@
+"""One planner's milliseconds per node on this checkout's code against another checkout's, in
+alternating processes (a developer's A/B tool; not run by ``run.py``, which runs ``bench_*.py``).
+
+    python benchmarks/ab_planner.py --baseline-src OTHER_CHECKOUT/src [--planner qrrt]
+                                    [--backend aer] [--pairs 4] [--worlds 6] [--nodes 100]
+                                    [--out FILE]
+
+A machine whose speed drifts over minutes (seen on this project's: 1.5x) makes two benchmark runs
+taken one after the other a poor comparison of two versions of the code. Here each pair is two
+fresh interpreters run back to back, one importing ``qrrt_circuits`` from ``--baseline-src`` (put
+first on ``PYTHONPATH``), the other from this checkout's ``src``; which one runs first alternates
+from pair to pair. Each interpreter plans on ``paper_clutter`` worlds 0 .. W-1 (planner seed =
+world seed, built through the registry as ``bench_planners.py`` builds them) to ``--nodes`` nodes
+after one warm-up plan, and reports its total wall time over its total nodes. Prints each pair,
+the medians and their ratio (baseline / ours: above 1 means ours is faster) and the median of
+the pairs' own ratios (less sensitive to a drift between pairs); writes JSON.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+from _common import machine, write_json
+
+HERE = Path(__file__).resolve().parent
+OURS = HERE.parent / "src"
+
+#: what each interpreter runs (argv: planner, backend, worlds, nodes); prints one JSON line
+CHILD = """
+import json, sys, time
+import qrrt_circuits as qc
+from qrrt_circuits.experiments.planners import make_planner
+planner, backend, worlds, nodes = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
+envs = [qc.scenarios.paper_clutter(seed=seed) for seed in range(worlds)]
+make_planner(planner, envs[0], 0, backend).plan(max_rounds=5)  # compile and warm up
+began, total = time.perf_counter(), 0
+for seed, env in enumerate(envs):
+    total += make_planner(planner, env, seed, backend).plan(max_nodes=nodes).metrics.nodes
+elapsed = time.perf_counter() - began
+print(json.dumps({"ms_per_node": elapsed * 1e3 / max(total, 1), "nodes": total, "module": qc.__file__}))
+"""
+
+
+def run_child(src: Path, planner: str, backend: str, worlds: int, nodes: int) -> dict:
+    """One interpreter importing ``qrrt_circuits`` from ``src``; its JSON line."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(src), os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep))
+    done = subprocess.run([sys.executable, "-c", CHILD, planner, backend, str(worlds), str(nodes)], env=env,
+                          capture_output=True, text=True, check=True)
+    result = json.loads(done.stdout.strip().splitlines()[-1])
+    if not Path(result["module"]).resolve().is_relative_to(src.resolve()):
+        raise RuntimeError(f"the child imported {result['module']}, not the code under {src}")
+    return result
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--baseline-src", required=True, metavar="SRC", help="another checkout's src directory")
+    parser.add_argument("--planner", default="qrrt")
+    parser.add_argument("--backend", default="aer")
+    parser.add_argument("--pairs", type=int, default=4)
+    parser.add_argument("--worlds", type=int, default=6)
+    parser.add_argument("--nodes", type=int, default=100)
+    parser.add_argument("--out", default=None)
+    args = parser.parse_args()
+    baseline = Path(args.baseline_src)
+    if not (baseline / "qrrt_circuits" / "__init__.py").is_file():
+        parser.error(f"--baseline-src must be a checkout's src directory (holding qrrt_circuits/), got {baseline}")
+    for name in ("pairs", "worlds", "nodes"):
+        if getattr(args, name) < 1:
+            parser.error(f"--{name} must be >= 1, got {getattr(args, name)}")
+    pairs = []
+    for pair in range(args.pairs):
+        order = ("baseline", "ours") if pair % 2 == 0 else ("ours", "baseline")
+        row = {"first": order[0]}
+        for side in order:
+            row[side] = run_child(baseline if side == "baseline" else OURS, args.planner, args.backend,
+                                  args.worlds, args.nodes)
+        pairs.append(row)
+        print(f"pair {pair}: baseline {row['baseline']['ms_per_node']:.3f}  ours {row['ours']['ms_per_node']:.3f} "
+              f"ms per node ({order[0]} first)")
+    medians = {side: float(np.median([row[side]["ms_per_node"] for row in pairs])) for side in ("baseline", "ours")}
+    pair_ratio = float(np.median([row["baseline"]["ms_per_node"] / row["ours"]["ms_per_node"] for row in pairs]))
+    print(f"medians: baseline {medians['baseline']:.3f}, ours {medians['ours']:.3f} ms per node; "
+          f"baseline / ours = {medians['baseline'] / medians['ours']:.2f}; median of the pairs' ratios "
+          f"{pair_ratio:.2f}")
+    path = write_json(f"ab_{args.planner}_{args.backend}",
+                      {"machine": machine(), "baseline_src": str(baseline), "planner": args.planner,
+                       "backend": args.backend, "worlds": args.worlds, "nodes": args.nodes, "pairs": pairs,
+                       "median_ms_per_node": medians,
+                       "baseline_over_ours": medians["baseline"] / medians["ours"],
+                       "median_pair_baseline_over_ours": pair_ratio}, args.out)
+    print(f"wrote {path}")
+
+
+if __name__ == "__main__":
+    main()
