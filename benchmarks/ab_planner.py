@@ -58,7 +58,7 @@ def run_child(src: Path, planner: str, backend: str, worlds: int, nodes: int) ->
     return result
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--baseline-src", required=True, metavar="SRC", help="another checkout's src directory")
     parser.add_argument("--planner", default="qrrt")
@@ -67,7 +67,7 @@ def main() -> None:
     parser.add_argument("--worlds", type=int, default=6)
     parser.add_argument("--nodes", type=int, default=100)
     parser.add_argument("--out", default=None)
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     baseline = Path(args.baseline_src)
     if not (baseline / "qrrt_circuits" / "__init__.py").is_file():
         parser.error(f"--baseline-src must be a checkout's src directory (holding qrrt_circuits/), got {baseline}")

@@ -12,6 +12,7 @@ BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
 sys.path.insert(0, str(BENCHMARKS))
 
 import _figures  # noqa: E402
+import ab_planner  # noqa: E402
 import compare  # noqa: E402
 import run  # noqa: E402
 
@@ -83,3 +84,15 @@ def test_compare_of_a_faster_run_reports_no_regression(tmp_path):
     old = _write(tmp_path / "old.json", {"search.n12.ms": 10.0, "search.pairs_per_s": 1000.0})
     new = _write(tmp_path / "new.json", {"search.n12.ms": 5.0, "search.pairs_per_s": 1000.0})
     assert compare.main([new, old]) == 0
+
+
+@pytest.mark.parametrize(("argv", "message"), [
+    (["--baseline-src", "/no/such/checkout/src"], "must be a checkout's src directory"),
+    (["--baseline-src", str(BENCHMARKS.parent / "src"), "--pairs", "0"], "--pairs must be >= 1"),
+    (["--baseline-src", str(BENCHMARKS.parent / "src"), "--nodes", "-3"], "--nodes must be >= 1"),
+])
+def test_ab_planner_refuses_bad_arguments_before_running_anything(argv, message, capsys, monkeypatch):
+    monkeypatch.setattr(ab_planner, "run_child", lambda *args: pytest.fail("a child was started"))
+    with pytest.raises(SystemExit):
+        ab_planner.main(argv)
+    assert message in capsys.readouterr().err
