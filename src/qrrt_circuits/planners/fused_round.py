@@ -322,13 +322,8 @@ class FusedRound:
         requests = [SearchRequest(marks, k, workers, self.streams.seed(round_index, first, Stream.SEARCH))
                     for (_, _, _, marks), (first, _), k in zip(built, groups, iterations, strict=True)]
         results = self.backend.search_many(requests)
-        outcomes: list[DatabaseResult] = []
-        for (children, parents, truth, _), k, result in zip(built, iterations, results, strict=True):
-            verified, added, reachable, good, added_children, added_parents = _verify(
-                result.indices, truth, children, parents)
-            outcomes.append(ClosedFormOutcome(self.size, reachable, k, result.indices, verified, added, children,
-                                              parents, self._missed(k), good, added_children, added_parents))
-        return outcomes
+        return [self._outcome(children, parents, k, result.indices, *_verify(result.indices, truth, children, parents))
+                for (children, parents, truth, _), k, result in zip(built, iterations, results, strict=True)]
 
     def _database(self, tree: Tree, round_index: int,
                   worker: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -347,8 +342,14 @@ class FusedRound:
                   round_index: int, first: int, count: int, iterations: int) -> ClosedFormOutcome:
         """The outcome of the default ``PolicyState.run`` at k = ``iterations`` for ``count``
         workers (``policies._verified`` of the backend's ``search``), compiled."""
-        indices, verified, added, reachable, good, added_children, added_parents = _measure(
-            self._entropy, round_index, first, marks, truth, iterations, count, children, parents)
+        return self._outcome(children, parents, iterations, *_measure(
+            self._entropy, round_index, first, marks, truth, iterations, count, children, parents))
+
+    def _outcome(self, children: np.ndarray, parents: np.ndarray, iterations: int, indices: np.ndarray,
+                 verified: np.ndarray, added: np.ndarray, reachable: int, good: int, added_children: np.ndarray,
+                 added_parents: np.ndarray) -> ClosedFormOutcome:
+        """The ``ClosedFormOutcome`` of a database's measured ``indices`` and what ``_verify`` made
+        of them (``_measure`` returns the indices and those, in this order)."""
         return ClosedFormOutcome(self.size, reachable, iterations, indices, verified, added, children, parents,
                                  self._missed(iterations), good, added_children, added_parents)
 
