@@ -261,3 +261,40 @@ def test_max_qubits_follows_the_simulators_configuration():
 def test_execute_grover_refuses_what_the_backend_would_have_refused(marks, iterations):
     with pytest.raises(ValueError, match="marks|iterations"):
         aer_direct.execute_grover(SIMULATOR, marks, iterations, "diagonal", 4, 1, 1)
+
+
+def test_the_recycled_circuit_measures_what_a_new_one_does():
+    """``execute_grover`` refills one ``AerCircuit`` per thread (``_recycled``); over a sequence of
+    searches whose n, k, marks, shots and seeds all change from one to the next (so the recycled
+    circuit switches header, length and phases), every search measures the words of a new circuit
+    (``assemble_grover``) run with the same configuration."""
+    assert aer_direct.RECYCLABLE  # with the installed qiskit-aer the recycled path is the one taken
+    rng = np.random.default_rng(7)
+    for case in range(60):
+        num_qubits = int(rng.integers(1, 9))
+        iterations = int(rng.integers(0, 6))
+        shots = int(rng.integers(1, 33))
+        marks = random_marks(num_qubits, case)
+        seed = int(rng.integers(0, 2**31 - 1))
+        fresh = aer_direct._run(SIMULATOR, aer_direct.assemble_grover(marks, iterations, "diagonal"),
+                                aer_direct._Width(num_qubits, num_qubits), shots, seed, 1)
+        assert aer_direct.execute_grover(SIMULATOR, marks, iterations, "diagonal", shots, seed, 1) == fresh
+    # the recycled circuit is the same object from one search to the next (it is not rebuilt)
+    first = aer_direct._recycled(random_marks(4, 0), 2, aer_direct.WALSH_HADAMARD_BLOCK)
+    assert aer_direct._recycled(random_marks(5, 1), 1, aer_direct.WALSH_HADAMARD_BLOCK) is first
+
+
+def test_threads_each_refill_their_own_recycled_circuit():
+    """Searches of several threads at once (each thread its own recycled circuit) measure what
+    one thread measures alone."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    cases = [(random_marks(3 + seed % 4, seed), seed % 4) for seed in range(24)]
+
+    def one(item):
+        seed, (marks, iterations) = item
+        return aer_direct.execute_grover(SIMULATOR, marks, iterations, "diagonal", 16, seed, 1)
+
+    alone = [one(item) for item in enumerate(cases)]
+    with ThreadPoolExecutor(max_workers=4) as pool:
+        assert list(pool.map(one, enumerate(cases))) == alone

@@ -19,8 +19,9 @@ diagonal-form Grover circuit ``AerBackend`` runs for small n with the same calls
 ``assemble_program`` of its program, from arguments cached per n (the Walsh-Hadamard matrices,
 qubit lists, labels, header), so that per search only the oracle's two phase lists are new
 (``benchmarks/bench_search.py`` times ``assemble_grover`` beside ``build`` + ``assemble``, the
-program's path); what is left is mostly the controller wrappers' own cost per call, a few
-microseconds per ``unitary``, ``mcphase`` or ``AerCircuit()``. ``execute`` builds
+program's path); ``execute_grover`` makes those calls into one ``AerCircuit`` per thread, emptied
+and refilled for every search, instead of a new one; what is left is mostly the controller
+wrappers' own cost per call, a few microseconds per ``unitary``, ``mcphase`` or ``AerCircuit()``. ``execute`` builds
 the run configuration with Aer's ``generate_aer_config`` from the simulator's options and the
 run options (once per thread, circuit width, shots and thread count, and again whenever the
 simulator's options change; only the seed changes between searches), calls the simulator's
@@ -57,6 +58,21 @@ try:  # qiskit-aer internals (checked with 0.18.2); without them AerBackend uses
     DIRECT_AVAILABLE = hasattr(AerSimulator, "_execute_circuits")
 except ImportError:  # pragma: no cover - depends on the installed qiskit-aer
     DIRECT_AVAILABLE = False
+
+
+def _can_recycle() -> bool:
+    """Whether an ``AerCircuit``'s operations can be emptied (``ops = []``, qiskit-aer 0.18.2)."""
+    if not DIRECT_AVAILABLE:
+        return False
+    try:
+        AerCircuit().ops = []
+    except (AttributeError, TypeError):  # pragma: no cover - depends on the installed qiskit-aer
+        return False
+    return True
+
+
+#: ``execute_grover`` refills one ``AerCircuit`` per thread (``_recycled``) when this is True
+RECYCLABLE = _can_recycle()
 
 #: the register of no condition, as Aer's assembler passes it
 _UNCONDITIONAL = -1
@@ -244,11 +260,17 @@ def assemble_grover(marks: np.ndarray, iterations: int, synthesis: str = "auto",
         synthesis = choose_simulation_synthesis(marks)
     if synthesis != "diagonal":
         return assemble_program(aer_grover_program(marks, iterations, synthesis, block))
+    return _fill_grover(AerCircuit(), marks, iterations, block, fresh=True)
+
+
+def _fill_grover(aer: Any, marks: np.ndarray, iterations: int, block: int, fresh: bool) -> Any:
+    """Make the diagonal-form Grover circuit's calls on ``aer``, an empty ``AerCircuit``: a new one
+    (``fresh``) or a recycled one whose header is already that of n qubits (``_recycled``)."""
     n = marks.shape[0].bit_length() - 1
     calls = _diagonal_calls(n, block)
     qubits = calls.qubits
-    aer = AerCircuit()
-    aer.set_header(calls.header)
+    if fresh:
+        aer.set_header(calls.header)
     aer.num_qubits = n
     aer.num_memory = n
     aer.global_phase_angle = 0.0
@@ -272,6 +294,37 @@ def assemble_grover(marks: np.ndarray, iterations: int, synthesis: str = "auto",
         gate("pauli", qubits, [], calls.parity, _UNCONDITIONAL, None, "pauli")
     aer.measure(qubits, qubits, [])
     aer.circ_id = 0
+    return aer
+
+
+#: per thread: one ``AerCircuit`` that ``execute_grover`` empties and refills for every search, and
+#: the (n, block) whose header it carries. A new ``AerCircuit`` draws its seed from
+#: ``std::random_device`` (qiskit-aer's ``Circuit()`` constructor), about 12 us on this project's
+#: virtual machine (a C++ loop of ``std::random_device()()``: 12.2 us; AerCircuit(): 11.6 us), a
+#: cost the controller's run pays again itself; the seed is overwritten by ``seed_simulator``
+#: anyway. The controller recomputes everything it derives from the operations
+#: (``Circuit::set_params``, ``set_metadata``) on every run, so an emptied circuit refilled with
+#: the same calls runs exactly like a new one (tested word for word, ``tests/test_aer_direct.py``).
+_RECYCLED = threading.local()
+
+
+def _recycled(marks: np.ndarray, iterations: int, block: int) -> Any:
+    """The diagonal-form Grover circuit of ``marks`` in this thread's recycled ``AerCircuit``
+    (valid until this thread's next ``execute_grover``); a new one when Aer does not let its
+    operations be emptied (``RECYCLABLE``)."""
+    if not RECYCLABLE:
+        return _fill_grover(AerCircuit(), marks, iterations, block, fresh=True)
+    shape = (marks.shape[0], block)
+    aer = getattr(_RECYCLED, "circuit", None)
+    if aer is None:
+        aer = _RECYCLED.circuit = AerCircuit()
+        _RECYCLED.shape = None
+    else:
+        aer.ops = []
+    fresh = _RECYCLED.shape != shape
+    _RECYCLED.shape = None  # until the calls below complete
+    _fill_grover(aer, marks, iterations, block, fresh)
+    _RECYCLED.shape = shape
     return aer
 
 
@@ -353,14 +406,22 @@ def execute(simulator: Any, circuit: QuantumCircuit | GroverProgram, shots: int,
 def execute_grover(simulator: Any, marks: np.ndarray, iterations: int, synthesis: str, shots: int, seed: int,
                    threads: int) -> list[str]:
     """``execute(simulator, aer_grover_program(marks, iterations, synthesis), shots, seed,
-    threads)``: the same words, the circuit assembled by ``assemble_grover`` (the same calls, made
-    from cached arguments); ``AerBackend``'s path, after the backend's own checks. ``marks`` must
+    threads)``: the same words, the circuit assembled as ``assemble_grover`` assembles it (the same
+    calls, made from cached arguments), for the diagonal form into this thread's recycled
+    ``AerCircuit`` (``_recycled``: no new circuit, hence no ``std::random_device`` seed, per
+    search); ``AerBackend``'s path, after the backend's own checks. ``marks`` must
     be a bool array of length 2^n and ``iterations`` an int >= 0 (``ValueError`` otherwise; no
     coercion); raises what ``execute`` raises."""
     _refuse_noise(simulator)
     _check_grover(marks, iterations)
     n = marks.shape[0].bit_length() - 1
-    return _run(simulator, assemble_grover(marks, iterations, synthesis), _Width(n, n), shots, seed, threads)
+    if synthesis == "auto":
+        synthesis = choose_simulation_synthesis(marks)
+    if synthesis == "diagonal":
+        aer = _recycled(marks, iterations, WALSH_HADAMARD_BLOCK)
+    else:
+        aer = assemble_program(aer_grover_program(marks, iterations, synthesis))
+    return _run(simulator, aer, _Width(n, n), shots, seed, threads)
 
 
 def _check_grover(marks: np.ndarray, iterations: int) -> None:
