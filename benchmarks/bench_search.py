@@ -32,6 +32,14 @@ One job for a round's databases (``one_job``): the p = 8 databases of an unshare
 would be), interleaved; and whether such a call can give each database its own seed (Aer sets
 circuit i's seed to seed_simulator + 2113 i, whatever the circuit carries).
 
+A q-RRT round's search (``round_search``): n = 8, k = 3, one shot, a fifth of the entries marked,
+the search a q-RRT round on Aer makes, taken apart, interleaved: ``AerBackend.search``,
+``aer_direct.execute_grover`` (assembly into the recycled circuit and the controller's run),
+``assemble_grover`` (assembly into a new circuit), the controller's call on an assembled circuit
+(``controller_call``) and, from its output, the controller's own C++ time for the circuit
+(``time_taken``, k = 3 and k = 0), a new ``AerCircuit()`` alone (its ``std::random_device`` seed),
+and ``StatevectorBackend.search`` of the same marks.
+
 Search table: Aer for n = 4..16, the exact statevector for n = 4..20. Reachability: one core,
 batches of pairs on paper_clutter and annealing_field, for two pair distributions (``uniform``: a
 free parent and a uniform child anywhere; ``local``: child = parent + N(0, 1.5^2) per axis, like a
@@ -229,6 +237,51 @@ def bench_one_job(quick: bool) -> dict:
     return row
 
 
+def bench_round_search(quick: bool) -> dict:
+    """The parts of one q-RRT round's search on Aer (n = 8, k = 3, one shot), median microseconds."""
+    from qiskit_aer.backends.controller_wrappers import AerCircuit
+
+    n, k = 8, 3
+    marks = np.random.default_rng(5).random(2**n) < 0.2
+    backend = qc.AerBackend(seed=0, max_parallel_threads=1)
+    statevector = qc.StatevectorBackend(seed=0)
+    simulator = backend.simulator
+    assembled = {iterations: aer_direct.assemble_grover(marks, iterations, "diagonal") for iterations in (k, 0)}
+    width = aer_direct._Width(n, n)
+    cpp_us: dict[int, list[float]] = {k: [], 0: []}
+
+    def controller(iterations: int) -> None:
+        config = aer_direct._configuration(simulator, width, 1, 1, 1)
+        output = simulator._execute_circuits([assembled[iterations]], None, config)
+        cpp_us[iterations].append(output["results"][0]["time_taken"] * 1e6)
+
+    runs = {"search": lambda: backend.search(marks, k, 1, seed=1),
+            "execute_grover": lambda: aer_direct.execute_grover(simulator, marks, k, "diagonal", 1, 1, 1),
+            "assemble_grover": lambda: aer_direct.assemble_grover(marks, k, "diagonal"),
+            "controller_call": lambda: controller(k),
+            "controller_call_k0": lambda: controller(0),
+            "new_aer_circuit": AerCircuit,
+            "statevector_search": lambda: statevector.search(marks, k, 1, seed=1)}
+    for run in runs.values():
+        run()
+    cpp_us = {k: [], 0: []}
+    repeats = 200 if quick else 2000
+    times: dict[str, list[float]] = {name: [] for name in runs}
+    names = list(runs)
+    for repeat in range(repeats):
+        shift = repeat % len(names)
+        for name in names[shift:] + names[:shift]:
+            start = time.perf_counter()
+            runs[name]()
+            times[name].append(time.perf_counter() - start)
+    medians = {name: float(np.median(values)) * 1e6 for name, values in times.items()}
+    medians["controller_cpp"] = float(np.median(cpp_us[k]))
+    medians["controller_cpp_k0"] = float(np.median(cpp_us[0]))
+    print(f"  n={n}, k={k}, 1 shot: " + "  ".join(f"{name} {value:.1f} us" for name, value in medians.items()))
+    return {"qubits": n, "iterations": k, "shots": 1, "marked": int(marks.sum()), "repeats": repeats,
+            "median_us": medians}
+
+
 def _one_call_words(simulator, marks, k: int, synthesis: str, seed: int, shots: int,
                     circuit_seeds: list[int] | None = None) -> list[list[str]]:
     """The measured words of one controller call with one Grover circuit per marks array, with
@@ -347,6 +400,8 @@ def main() -> None:
     floor = bench_floor(args.quick)
     print("A round's databases in one Aer job:")
     one_job = bench_one_job(args.quick)
+    print("A q-RRT round's search on Aer, taken apart (medians):")
+    round_search = bench_round_search(args.quick)
     print("Grover search, time per search (k = 12, 8 shots):")
     search = bench_search(args.quick)
     print("Oracle forms for Aer (k = 12, 8 shots) and simulation_synthesis's choice:")
@@ -373,6 +428,8 @@ def main() -> None:
         summary[f"ours_ms_n{n}"] = row["median_ms"]["ours"]
         summary[f"build_share_n{n}"] = row["build_share"]
         summary[f"assemble_share_n{n}"] = row["assemble_share"]
+    for name, value in round_search["median_us"].items():
+        summary[f"round_search_{name}_us"] = value
     summary["one_job_over_search_many"] = one_job["one_call_over_search_many"]
     summary["one_job_circuit_seeds_own"] = one_job["circuit_seeds_are_their_own"]
     summary["synthesis_worst_choice_over_faster"] = synthesis["worst_choice_over_faster"]
@@ -380,7 +437,7 @@ def main() -> None:
     print("summary:", {k: (round(v, 3) if isinstance(v, float) else v) for k, v in summary.items()})
     path = write_json("bench_search" + ("_quick" if args.quick else ""),
                       {"machine": machine(), "quick": args.quick, "against_floor": floor, "one_job": one_job,
-                       "search": search,
+                       "round_search": round_search, "search": search,
                        "synthesis": synthesis, "reachability": reach, "summary": summary,
                        "note": "phase oracle built from a classical lookup of all 2^n marks; "
                                "one circuit with 8 shots stands for 8 workers"}, args.out)
