@@ -299,10 +299,9 @@ def _fill_grover(aer: Any, marks: np.ndarray, iterations: int, block: int, fresh
 
 #: per thread: one ``AerCircuit`` that ``execute_grover`` empties and refills for every search, and
 #: the (n, block) whose header it carries. A new ``AerCircuit`` draws its seed from
-#: ``std::random_device`` (qiskit-aer's ``Circuit()`` constructor), about 12 us on this project's
-#: virtual machine (a C++ loop of ``std::random_device()()``: 12.2 us; AerCircuit(): 11.6 us), a
-#: cost the controller's run pays again itself; the seed is overwritten by ``seed_simulator``
-#: anyway. The controller recomputes everything it derives from the operations
+#: ``std::random_device`` (qiskit-aer's ``Circuit()`` constructor), about 14 us per ``AerCircuit()``
+#: on this project's virtual machine (``benchmarks/bench_search.py``, ``round_search``), for a seed
+#: that ``seed_simulator`` overwrites anyway. The controller recomputes everything it derives from the operations
 #: (``Circuit::set_params``, ``set_metadata``) on every run, so an emptied circuit refilled with
 #: the same calls runs exactly like a new one (tested word for word, ``tests/test_aer_direct.py``).
 _RECYCLED = threading.local()
