@@ -263,11 +263,20 @@ def test_execute_grover_refuses_what_the_backend_would_have_refused(marks, itera
         aer_direct.execute_grover(SIMULATOR, marks, iterations, "diagonal", 4, 1, 1)
 
 
+def _controller_output(aer, num_qubits: int, shots: int, seed: int) -> dict:
+    """The controller's result for ``aer`` without its timings (header, data, shots, seed, status)."""
+    config = aer_direct._configuration(SIMULATOR, aer_direct._Width(num_qubits, num_qubits), shots, seed, 1)
+    result = SIMULATOR._execute_circuits([aer], None, config)["results"][0]
+    return {key: value for key, value in result.items() if key not in ("time_taken", "metadata")}
+
+
 def test_the_recycled_circuit_measures_what_a_new_one_does():
     """``execute_grover`` refills one ``AerCircuit`` per thread (``_recycled``); over a sequence of
     searches whose n, k, marks, shots and seeds all change from one to the next (so the recycled
     circuit switches header, length and phases), every search measures the words of a new circuit
-    (``assemble_grover``) run with the same configuration."""
+    (``assemble_grover``) run with the same configuration, and the controller's whole result
+    (header included, which the words do not show) is that of the program's circuit
+    (``assemble_program``, assembled without ``_fill_grover``)."""
     assert aer_direct.RECYCLABLE  # with the installed qiskit-aer the recycled path is the one taken
     rng = np.random.default_rng(7)
     for case in range(60):
@@ -276,17 +285,46 @@ def test_the_recycled_circuit_measures_what_a_new_one_does():
         shots = int(rng.integers(1, 33))
         marks = random_marks(num_qubits, case)
         seed = int(rng.integers(0, 2**31 - 1))
-        fresh = aer_direct._run(SIMULATOR, aer_direct.assemble_grover(marks, iterations, "diagonal"),
-                                aer_direct._Width(num_qubits, num_qubits), shots, seed, 1)
-        assert aer_direct.execute_grover(SIMULATOR, marks, iterations, "diagonal", shots, seed, 1) == fresh
+        fresh = aer_direct.assemble_grover(marks, iterations, "diagonal")
+        words = aer_direct._run(SIMULATOR, fresh, aer_direct._Width(num_qubits, num_qubits), shots, seed, 1)
+        assert aer_direct.execute_grover(SIMULATOR, marks, iterations, "diagonal", shots, seed, 1) == words
+        if case % 3 == 0:
+            recycled = aer_direct._recycled(marks, iterations, aer_direct.WALSH_HADAMARD_BLOCK)
+            program = aer_direct.assemble_program(aer_grover_program(marks, iterations, "diagonal"))
+            assert (_controller_output(recycled, num_qubits, shots, seed)
+                    == _controller_output(program, num_qubits, shots, seed))
     # the recycled circuit is the same object from one search to the next (it is not rebuilt)
     first = aer_direct._recycled(random_marks(4, 0), 2, aer_direct.WALSH_HADAMARD_BLOCK)
     assert aer_direct._recycled(random_marks(5, 1), 1, aer_direct.WALSH_HADAMARD_BLOCK) is first
 
 
+def test_the_recycled_circuit_is_emptied_after_each_search():
+    """After ``execute_grover`` the thread's circuit holds no operations (its phases, k x 2^n
+    complex numbers, are not kept until the next search): run as it is, it measures nothing."""
+    marks = random_marks(6, 3)
+    aer_direct.execute_grover(SIMULATOR, marks, 3, "diagonal", 4, 1, 1)
+    output = _controller_output(aer_direct._RECYCLED.circuit, 6, 4, 1)
+    assert "memory" not in output.get("data", {})
+
+
+def test_without_recycling_execute_grover_builds_new_circuits(monkeypatch):
+    """Where Aer does not let a circuit be emptied (``RECYCLABLE`` False), each search gets a new
+    circuit and measures the same words."""
+    rng = np.random.default_rng(11)
+    cases = [(random_marks(int(rng.integers(1, 8)), case), int(rng.integers(0, 5)), int(rng.integers(0, 2**31 - 1)))
+             for case in range(12)]
+    recycled = [aer_direct.execute_grover(SIMULATOR, marks, k, "diagonal", 8, seed, 1) for marks, k, seed in cases]
+    monkeypatch.setattr(aer_direct, "RECYCLABLE", False)
+    assert [aer_direct.execute_grover(SIMULATOR, marks, k, "diagonal", 8, seed, 1)
+            for marks, k, seed in cases] == recycled
+
+
 def test_threads_each_refill_their_own_recycled_circuit():
     """Searches of several threads at once (each thread its own recycled circuit) measure what
-    one thread measures alone."""
+    one thread measures alone; the interpreter switches threads every microsecond (Aer's run holds
+    the GIL, so threads interleave only between Python steps: with the default 5 ms switch interval
+    a circuit shared by the threads would rarely be caught), ten times over."""
+    import sys
     from concurrent.futures import ThreadPoolExecutor
 
     cases = [(random_marks(3 + seed % 4, seed), seed % 4) for seed in range(24)]
@@ -296,5 +334,11 @@ def test_threads_each_refill_their_own_recycled_circuit():
         return aer_direct.execute_grover(SIMULATOR, marks, iterations, "diagonal", 16, seed, 1)
 
     alone = [one(item) for item in enumerate(cases)]
-    with ThreadPoolExecutor(max_workers=4) as pool:
-        assert list(pool.map(one, enumerate(cases))) == alone
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(1e-6)
+    try:
+        with ThreadPoolExecutor(max_workers=4) as pool:
+            for _ in range(10):
+                assert list(pool.map(one, enumerate(cases))) == alone
+    finally:
+        sys.setswitchinterval(interval)

@@ -304,6 +304,7 @@ def _fill_grover(aer: Any, marks: np.ndarray, iterations: int, block: int, fresh
 #: that ``seed_simulator`` overwrites anyway. The controller recomputes everything it derives from the operations
 #: (``Circuit::set_params``, ``set_metadata``) on every run, so an emptied circuit refilled with
 #: the same calls runs exactly like a new one (tested word for word, ``tests/test_aer_direct.py``).
+#: ``execute_grover`` empties it again right after the run, so no search's operations outlive it.
 _RECYCLED = threading.local()
 
 
@@ -416,11 +417,17 @@ def execute_grover(simulator: Any, marks: np.ndarray, iterations: int, synthesis
     n = marks.shape[0].bit_length() - 1
     if synthesis == "auto":
         synthesis = choose_simulation_synthesis(marks)
-    if synthesis == "diagonal":
-        aer = _recycled(marks, iterations, WALSH_HADAMARD_BLOCK)
-    else:
+    if synthesis != "diagonal":
         aer = assemble_program(aer_grover_program(marks, iterations, synthesis))
-    return _run(simulator, aer, _Width(n, n), shots, seed, threads)
+        return _run(simulator, aer, _Width(n, n), shots, seed, threads)
+    aer = _recycled(marks, iterations, WALSH_HADAMARD_BLOCK)
+    try:
+        return _run(simulator, aer, _Width(n, n), shots, seed, threads)
+    finally:
+        # emptied at once, so the thread's circuit holds no phases between searches (Aer copies
+        # the oracle's 2^n phases once per iteration: k x 16 x 2^n bytes, as a new circuit would
+        # hold only until it is dropped here)
+        aer.ops = []
 
 
 def _check_grover(marks: np.ndarray, iterations: int) -> None:
