@@ -13,7 +13,8 @@ from pair to pair. Each interpreter plans on ``paper_clutter`` worlds 0 .. W-1 (
 world seed, built through the registry as ``bench_planners.py`` builds them) to ``--nodes`` nodes
 after one warm-up plan, and reports its total wall time over its total nodes. Prints each pair,
 the medians and their ratio (baseline / ours: above 1 means ours is faster) and the median of
-the pairs' own ratios (less sensitive to a drift between pairs); writes JSON.
+the pairs' own ratios (less sensitive to a drift between pairs); writes JSON, with the baseline
+checkout's git commit and whether its tree differs from it (``baseline_checkout``).
 """
 
 from __future__ import annotations
@@ -58,6 +59,18 @@ def run_child(src: Path, planner: str, backend: str, worlds: int, nodes: int) ->
     return result
 
 
+def checkout_commit(source: Path) -> dict:
+    """The git commit of the checkout holding ``source`` and whether its tree differs from it
+    (``None`` for each when ``source`` is not in a git checkout), so a result names its baseline."""
+    def git(*args: str) -> str | None:
+        done = subprocess.run(["git", "-C", str(source), *args], capture_output=True, text=True)
+        return done.stdout.strip() if done.returncode == 0 else None
+
+    commit = git("rev-parse", "HEAD")
+    status = git("status", "--porcelain", "--untracked-files=no") if commit else None
+    return {"commit": commit, "dirty": None if status is None else bool(status)}
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--baseline-src", required=True, metavar="SRC", help="another checkout's src directory")
@@ -90,7 +103,8 @@ def main(argv: list[str] | None = None) -> None:
           f"baseline / ours = {medians['baseline'] / medians['ours']:.2f}; median of the pairs' ratios "
           f"{pair_ratio:.2f}")
     path = write_json(f"ab_{args.planner}_{args.backend}",
-                      {"machine": machine(), "baseline_src": str(baseline), "planner": args.planner,
+                      {"machine": machine(), "baseline_src": str(baseline),
+                       "baseline_checkout": checkout_commit(baseline), "planner": args.planner,
                        "backend": args.backend, "worlds": args.worlds, "nodes": args.nodes, "pairs": pairs,
                        "median_ms_per_node": medians,
                        "baseline_over_ours": medians["baseline"] / medians["ours"],

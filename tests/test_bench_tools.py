@@ -96,3 +96,18 @@ def test_ab_planner_refuses_bad_arguments_before_running_anything(argv, message,
     with pytest.raises(SystemExit):
         ab_planner.main(argv)
     assert message in capsys.readouterr().err
+
+
+def test_ab_planner_names_the_baseline_checkouts_commit(tmp_path):
+    """``checkout_commit`` gives the commit of the checkout holding a src folder (this
+    repository's own, when the tests run from a git checkout) and None outside any checkout."""
+    import subprocess
+
+    source = Path(ab_planner.__file__).resolve().parent.parent / "src"
+    head = subprocess.run(["git", "-C", str(source), "rev-parse", "HEAD"], capture_output=True, text=True)
+    if head.returncode != 0:
+        pytest.skip("the tests do not run from a git checkout")
+    found = ab_planner.checkout_commit(source)
+    assert found["commit"] == head.stdout.strip()
+    assert isinstance(found["dirty"], bool)
+    assert ab_planner.checkout_commit(tmp_path) == {"commit": None, "dirty": None}
