@@ -310,10 +310,7 @@ _RECYCLED = threading.local()
 
 def _recycled(marks: np.ndarray, iterations: int, block: int) -> Any:
     """The diagonal-form Grover circuit of ``marks`` in this thread's recycled ``AerCircuit``
-    (valid until this thread's next ``execute_grover``); a new one when Aer does not let its
-    operations be emptied (``RECYCLABLE``)."""
-    if not RECYCLABLE:
-        return _fill_grover(AerCircuit(), marks, iterations, block, fresh=True)
+    (valid until this thread's next ``execute_grover``); only where ``RECYCLABLE``."""
     shape = (marks.shape[0], block)
     aer = getattr(_RECYCLED, "circuit", None)
     if aer is None:
@@ -417,9 +414,8 @@ def execute_grover(simulator: Any, marks: np.ndarray, iterations: int, synthesis
     n = marks.shape[0].bit_length() - 1
     if synthesis == "auto":
         synthesis = choose_simulation_synthesis(marks)
-    if synthesis != "diagonal":
-        aer = assemble_program(aer_grover_program(marks, iterations, synthesis))
-        return _run(simulator, aer, _Width(n, n), shots, seed, threads)
+    if synthesis != "diagonal" or not RECYCLABLE:  # a new circuit, as assemble_grover makes it
+        return _run(simulator, assemble_grover(marks, iterations, synthesis), _Width(n, n), shots, seed, threads)
     aer = _recycled(marks, iterations, WALSH_HADAMARD_BLOCK)
     try:
         return _run(simulator, aer, _Width(n, n), shots, seed, threads)
