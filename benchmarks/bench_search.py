@@ -145,6 +145,20 @@ def _qiskit_algorithms_grover(n: int, marks: np.ndarray):
     return run
 
 
+def _interleaved_times(runs: dict, repeats: int) -> dict[str, list[float]]:
+    """Seconds of each of ``runs`` (name -> function) over ``repeats`` rounds, each round in a
+    different (rotated) order, so no contender always follows the same one."""
+    times: dict[str, list[float]] = {name: [] for name in runs}
+    names = list(runs)
+    for repeat in range(repeats):
+        shift = repeat % len(names)
+        for name in names[shift:] + names[:shift]:
+            start = time.perf_counter()
+            runs[name]()
+            times[name].append(time.perf_counter() - start)
+    return times
+
+
 def bench_floor(quick: bool) -> list[dict]:
     """Each contender's median time and its ratio to Aer's floor, measured interleaved."""
     rows = []
@@ -155,16 +169,9 @@ def bench_floor(quick: bool) -> list[dict]:
         for run in runs.values():  # warm-up (imports, caches, the pass manager)
             run()
         repeats = (5 if quick else 30) if n <= 8 else (3 if quick else (12 if n == 12 else 8))
-        times: dict[str, list[float]] = {name: [] for name in runs}
-        names = list(runs)
-        for repeat in range(repeats):
-            # a different order in each repeat, so no contender always follows the same one (the
-            # all-threads floor leaves OpenMP threads that can slow whatever runs right after it)
-            shift = repeat % len(names)
-            for name in names[shift:] + names[:shift]:
-                start = time.perf_counter()
-                runs[name]()
-                times[name].append(time.perf_counter() - start)
+        # rotated order (the all-threads floor leaves OpenMP threads that can slow whatever runs
+        # right after it)
+        times = _interleaved_times(runs, repeats)
         medians = {name: float(np.median(values)) for name, values in times.items()}
         minimums = {name: float(np.min(values)) for name, values in times.items()}
         floor = medians["floor"]
@@ -209,14 +216,7 @@ def bench_one_job(quick: bool) -> dict:
     for run in runs.values():
         run()
     repeats = 10 if quick else 60
-    times: dict[str, list[float]] = {name: [] for name in runs}
-    names = list(runs)
-    for repeat in range(repeats):
-        shift = repeat % len(names)
-        for name in names[shift:] + names[:shift]:
-            start = time.perf_counter()
-            runs[name]()
-            times[name].append(time.perf_counter() - start)
+    times = _interleaved_times(runs, repeats)
     medians = {name: float(np.median(values)) * 1e3 for name, values in times.items()}
     # the seeds of one call: circuit i ran with seeds[0] + 2113 i, not with its own seeds[i]
     own = [aer_direct.execute(simulator, aer_grover_program(mk, k, synthesis), 64, seed, 1)
@@ -264,16 +264,10 @@ def bench_round_search(quick: bool) -> dict:
             "statevector_search": lambda: statevector.search(marks, k, 1, seed=1)}
     for run in runs.values():
         run()
-    cpp_us = {k: [], 0: []}
+    for samples in cpp_us.values():  # drop the warm-up's
+        samples.clear()
     repeats = 200 if quick else 2000
-    times: dict[str, list[float]] = {name: [] for name in runs}
-    names = list(runs)
-    for repeat in range(repeats):
-        shift = repeat % len(names)
-        for name in names[shift:] + names[:shift]:
-            start = time.perf_counter()
-            runs[name]()
-            times[name].append(time.perf_counter() - start)
+    times = _interleaved_times(runs, repeats)
     medians = {name: float(np.median(values)) * 1e6 for name, values in times.items()}
     medians["controller_cpp"] = float(np.median(cpp_us[k]))
     medians["controller_cpp_k0"] = float(np.median(cpp_us[0]))
