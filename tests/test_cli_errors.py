@@ -27,6 +27,7 @@ CASES = [
     (["plan", "--goal-bias", "1.5"], "goal_bias must be"),
     (["search", "--shots", "1000000000"], "shots must be an integer in [1, 10000000]"),
     (["search", "--iterations", "1000000"], "iterations must be an integer in [0, 100000]"),
+    (["search", "--qubits", "1000000000000"], "num_qubits = 1000000000000 is outside the range"),
     (["reproduce", "heatmaps", "--trials", "1000000000"], "trials must be an integer in [1, 100000]"),
     (["reproduce", "lemmas", "--predicate", "authors"], "does not take a predicate"),
     (["reproduce", "nope"], "EXPERIMENT must be one of"),
@@ -65,3 +66,41 @@ def test_non_utf8_scenario_file(tmp_path):
     run = subprocess.run([sys.executable, "-m", "qrrt_circuits.cli", "plan", "--scenario-file", str(path)],
                          capture_output=True, text=True, timeout=120)
     assert run.returncode == 2 and "not a UTF-8 text file" in run.stderr and "Traceback" not in run.stderr
+
+
+def _numba_style_interrupt(args):
+    """What a Ctrl-C inside a compiled function looks like from Python: a SystemError whose cause
+    is the KeyboardInterrupt."""
+    try:
+        raise KeyboardInterrupt
+    except KeyboardInterrupt as interrupt:
+        raise SystemError("CPUDispatcher(<function f>) returned a result with an exception set") from interrupt
+
+
+def _other_system_error(args):
+    raise SystemError("not an interrupt")
+
+
+@pytest.mark.parametrize("command", ["plan", "reproduce"])
+def test_an_interrupt_inside_compiled_code_is_reported_like_any_interrupt(command, monkeypatch, capsys):
+    from qrrt_circuits import cli
+
+    parser = cli.build_parser()
+    argv = ["plan"] if command == "plan" else ["reproduce", "lemmas"]
+    args = parser.parse_args(argv)
+    args.func = _numba_style_interrupt
+    monkeypatch.setattr(cli.argparse.ArgumentParser, "parse_args", lambda self, argv=None: args)
+    assert cli.main(argv) == 130
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"qrrt {command}: interrupted" in err
+    assert ("resume" in err) == (command == "reproduce")
+
+
+def test_a_system_error_without_an_interrupt_is_not_swallowed(monkeypatch):
+    from qrrt_circuits import cli
+
+    args = cli.build_parser().parse_args(["plan"])
+    args.func = _other_system_error
+    monkeypatch.setattr(cli.argparse.ArgumentParser, "parse_args", lambda self, argv=None: args)
+    with pytest.raises(SystemError, match="not an interrupt"):
+        cli.main(["plan"])

@@ -305,6 +305,36 @@ def test_both_rounds_refuse_the_same_answers(name, fused, errors):
         planner.plan(max_rounds=3)
 
 
+@pytest.mark.parametrize("name", sorted(REFUSED) + ["strings", "nans"])
+@pytest.mark.parametrize("planner", ["rrt", "rrt-goal-bias", "prrt", "prrt-executor"])
+def test_classical_planners_refuse_the_answers_the_quantum_rounds_refuse(planner, name):
+    """RRT and ParallelRRT (batched rounds, and the extensions an executor runs) check a predicate's
+    answers as the quantum rounds do (before, answers of "no" or NaN counted as reachable and added
+    nodes)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    transform, message = {**REFUSED, "strings": (lambda a: np.array(["no"] * len(a)), "0/1"),
+                          "nans": (lambda a: np.full(len(a), np.nan), "0/1")}[name]
+    env = qc.scenarios.paper_clutter(seed=0)
+    predicate = Answering(env, transform)
+    with ThreadPoolExecutor(2) as pool:
+        made = {"rrt": lambda: qc.RRT(env, predicate=predicate, seed=0),
+                "rrt-goal-bias": lambda: qc.RRT(env, predicate=predicate, seed=0, goal_bias=0.2),
+                "prrt": lambda: qc.ParallelRRT(env, workers=3, predicate=predicate, seed=0),
+                "prrt-executor": lambda: qc.ParallelRRT(env, workers=3, predicate=predicate, seed=0, executor=pool),
+                }[planner]()
+        with pytest.raises(ValueError, match=f"predicate 'answering' answered.*{message}"):
+            made.plan(max_rounds=3)
+
+
+@pytest.mark.parametrize("name", sorted(ACCEPTED))
+def test_classical_planners_accept_what_the_quantum_rounds_accept(name):
+    env = qc.scenarios.paper_clutter(seed=1)
+    result = qc.ParallelRRT(env, workers=3, predicate=Answering(env, ACCEPTED[name]), seed=1).plan(max_nodes=15)
+    reference = qc.ParallelRRT(env, workers=3, seed=1).plan(max_nodes=15)
+    assert fingerprint(result) == fingerprint(reference)
+
+
 def test_fused_round_flag_is_checked():
     env = qc.scenarios.paper_clutter(seed=0)
     with pytest.raises(TypeError, match="fused_round"):

@@ -55,11 +55,11 @@ def _registered(registry: Registry) -> Callable[[str], str]:
 
 # ----------------------------------------------------------------------------------------- search
 def cmd_search(args: argparse.Namespace) -> int:
+    backend = BACKENDS.create(args.backend, seed=args.seed)
+    backend.check_qubits(args.qubits)  # before 2**qubits is computed (a huge --qubits is refused, not allocated)
     num_items = 1 << args.qubits
     if args.marked > num_items:
         raise ValueError(f"--marked must be in [0, 2**qubits = {num_items}], got {args.marked}")
-    backend = BACKENDS.create(args.backend, seed=args.seed)
-    backend.check_qubits(args.qubits)
     iterations = (probability.optimal_iterations(num_items, args.marked)
                   if args.iterations is None else args.iterations)
     from .search.backend import validate_iterations, validate_shots
@@ -338,16 +338,39 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _interrupted(command: str) -> int:
+    """Report an interrupted command in one line; the exit status 130 (128 + SIGINT)."""
+    kept = ("finished trials are kept in records.csv; run the same command again to resume"
+            if command == "reproduce" else "nothing was written")
+    print(f"qrrt {command}: interrupted; {kept}", file=sys.stderr)
+    return 130
+
+
+def _caused_by_interrupt(exc: BaseException) -> bool:
+    """Whether a ``KeyboardInterrupt`` is in ``exc``'s chain of causes and contexts (numba wraps one
+    raised while a compiled function runs in ``SystemError: ... returned a result with an exception
+    set``)."""
+    seen: set[int] = set()
+    current: BaseException | None = exc
+    while current is not None and id(current) not in seen:
+        if isinstance(current, KeyboardInterrupt):
+            return True
+        seen.add(id(current))
+        current = current.__cause__ or current.__context__
+    return False
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
         return args.func(args)
     except KeyboardInterrupt:
-        kept = ("finished trials are kept in records.csv; run the same command again to resume"
-                if args.command == "reproduce" else "nothing was written")
-        print(f"qrrt {args.command}: interrupted; {kept}", file=sys.stderr)
-        return 130
+        return _interrupted(args.command)
+    except SystemError as exc:  # Ctrl-C inside a compiled (numba) function reaches Python as a SystemError
+        if not _caused_by_interrupt(exc):
+            raise
+        return _interrupted(args.command)
     except (ValueError, TypeError) as exc:
         parser.exit(2, f"qrrt {args.command}: error: {exc}\n")
     except OSError as exc:  # unreadable files, an unreachable Dask scheduler, a full disk

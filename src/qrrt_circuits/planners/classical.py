@@ -35,7 +35,7 @@ from ..database import sample_ball
 from ..dynamics import LinearTrackingDynamics
 from ..environment import Environment
 from ..oracle_errors import OracleErrorModel
-from ..predicate import ReachabilityPredicate
+from ..predicate import ReachabilityPredicate, check_answers
 from ..randomness import Stream, uniform_draws
 from ..termination import PlanStatus, TerminationCondition
 from ..validation import check_int
@@ -168,7 +168,8 @@ class ParallelRRT(Planner):
             keys[:, 2] = int(Stream.CANDIDATES)
             children = self._candidates(state, keys)
             parents = state.tree.nearest(children)
-            truth = np.asarray(self.predicate.reachable(state.tree.nodes[parents], children), dtype=bool)
+            truth = check_answers(self.predicate.reachable(state.tree.nodes[parents], children), children.shape[0],
+                                  f"the predicate {self.predicate.name!r}")
             for offset in range(ahead):
                 ended = condition.ended_by(state.progress(time.perf_counter() - began))
                 if ended is not None:

@@ -39,7 +39,8 @@ def classical_extension(context: WorkerContext, view: RoundView, worker: int) ->
     db = stream_database(view.tree, 1, context.env, context.streams, view.round_index, worker, view.goal,
                          view.goal_radius, context.goal_bias)
     child, parent = db.children[0], int(db.parents[0])
-    truth = bool(context.predicate.reachable(view.tree.nodes[parent][None], child[None])[0])
+    truth = bool(check_answers(context.predicate.reachable(view.tree.nodes[parent][None], child[None]), 1,
+                               f"the predicate {context.predicate.name!r}")[0])
     answer = truth
     if context.oracle_errors is not None:
         flips = context.streams.generator(view.round_index, worker, Stream.ORACLE_ERRORS)
