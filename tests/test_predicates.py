@@ -132,3 +132,42 @@ def test_bad_predicates_are_refused_with_the_reason(clutter):
         qc.RRT(clutter, predicate=StraightLine(clutter), dynamics=qc.LinearTrackingDynamics.paper())
     with pytest.raises(ValueError, match="give predicate= or its alias oracle=, not both"):
         qc.RRT(clutter, predicate=StraightLine(clutter), oracle=qc.ReachabilityOracle(clutter))
+
+
+@pytest.mark.parametrize("time_samples", [7, 30])
+def test_time_sampled_check_in_chunks_answers_as_in_one_piece(clutter, time_samples, monkeypatch):
+    from qrrt_circuits import time_sampled
+
+    rng = np.random.default_rng(3)
+    parents, children = clutter.sample_free(301, rng), clutter.sample_uniform(301, rng)
+    whole = qc.TimeSampledCheck(clutter, time_samples=time_samples).reachable(parents, children)
+    monkeypatch.setattr(time_sampled, "CHUNK_POINTS", 3 * time_samples + 1)  # 3 pairs a chunk, a remainder
+    chunked = qc.TimeSampledCheck(clutter, time_samples=time_samples)
+    assert np.array_equal(chunked.reachable(parents, children), whole)
+    assert chunked.evaluations == 301 and 0 < whole.sum() < 301
+
+
+def test_time_sampled_check_memory_does_not_grow_with_pairs_times_samples(clutter):
+    """128 pairs x 100 000 samples: 205 MB for the sample points in one piece; in chunks a few tens."""
+    import tracemalloc
+
+    rng = np.random.default_rng(4)
+    parents, children = clutter.sample_free(128, rng), clutter.sample_uniform(128, rng)
+    check = qc.TimeSampledCheck(clutter, time_samples=100_000)
+    tracemalloc.start()
+    try:
+        check.reachable(parents, children)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 100 * 2**20, peak
+
+
+def test_time_sampled_check_refuses_propagators_that_do_not_fit():
+    d = 64
+    env = qc.Environment([[0.0, 1.0]] * d, [])
+    dynamics = qc.LinearTrackingDynamics(-np.eye(d), np.eye(d), np.zeros((d, d)))
+    message = r"time_samples = 1000000 in d = 64 needs 31250 MiB.*at most 8192 time samples"
+    with pytest.raises(ValueError, match=message):
+        qc.TimeSampledCheck(env, dynamics, time_samples=1_000_000)
+    assert qc.TimeSampledCheck(env, dynamics, time_samples=8192).time_samples == 8192

@@ -16,6 +16,12 @@ from .environment import Environment
 from .predicate import as_pairs
 from .validation import check_int
 
+#: sample points of one chunk of ``TimeSampledCheck.reachable`` (pairs x K; with their coordinates
+#: and the obstacle test's scratch, tens of MiB whatever M and K)
+CHUNK_POINTS = 1 << 20
+#: the largest K x d x d propagators (doubles) a ``TimeSampledCheck`` keeps
+MAX_PROPAGATOR_BYTES = 256 << 20
+
 
 class TimeSampledCheck:
     """Reachability predicate testing only ``time_samples`` evenly spaced samples of x(t) (unsound).
@@ -27,14 +33,17 @@ class TimeSampledCheck:
     Args:
         env: The ``Environment``.
         dynamics: ``LinearTrackingDynamics`` of the same dimension (default: the paper's).
-        time_samples: K, 2 .. 1 000 000 (keyword only).
+        time_samples: K, 2 .. 1 000 000 (keyword only), with the K x d x d propagators within
+            ``MAX_PROPAGATOR_BYTES`` (256 MiB). ``reachable`` samples ``CHUNK_POINTS`` points at a
+            time, so its memory does not grow with M x K.
 
     Attributes:
         time_samples: K.
         evaluations: Pairs evaluated so far.
 
     Raises:
-        ValueError: A dynamics dimension other than ``env.dim``, or K out of range.
+        ValueError: A dynamics dimension other than ``env.dim``, K out of range, or propagators
+            larger than ``MAX_PROPAGATOR_BYTES``.
         TypeError: A non-integer K.
 
     Example:
@@ -58,6 +67,12 @@ class TimeSampledCheck:
         self.env = env
         self.dynamics = dynamics
         self.time_samples = check_int(time_samples, "time_samples", 2, 1_000_000)
+        propagator_bytes = 8 * self.time_samples * env.dim * env.dim
+        if propagator_bytes > MAX_PROPAGATOR_BYTES:
+            raise ValueError(
+                f"time_samples = {self.time_samples} in d = {env.dim} needs {propagator_bytes / 2**20:.0f} MiB of "
+                f"propagators (K x d x d doubles), more than the {MAX_PROPAGATOR_BYTES >> 20} MiB allowed: use at "
+                f"most {MAX_PROPAGATOR_BYTES // (8 * env.dim * env.dim)} time samples")
         self.evaluations = 0
         times = np.linspace(0.0, dynamics.horizon, self.time_samples)
         self._phis = dynamics.propagators(times)  # (K, d, d)
@@ -86,7 +101,13 @@ class TimeSampledCheck:
             ValueError: Shapes other than (M, d), different shapes, or non-finite coordinates.
         """
         parents, children = as_pairs(parents, children, self.dim)
-        points = children[:, None, :] + np.einsum("kij,mj->mki", self._phis, parents - children)
-        free = self.env.is_free(points.reshape(-1, self.dim)).reshape(points.shape[:2])
-        self.evaluations += int(parents.shape[0])
-        return free.all(axis=1) & self.env.is_free(children)
+        count = parents.shape[0]
+        samples_free = np.empty(count, dtype=bool)
+        step = max(1, CHUNK_POINTS // self.time_samples)  # pairs per chunk: the K samples of each, bounded memory
+        for first in range(0, count, step):
+            rows = slice(first, first + step)
+            points = children[rows, None, :] + np.einsum("kij,mj->mki", self._phis, parents[rows] - children[rows])
+            free = self.env.is_free(points.reshape(-1, self.dim)).reshape(points.shape[:2])
+            samples_free[rows] = free.all(axis=1)
+        self.evaluations += int(count)
+        return samples_free & self.env.is_free(children)
