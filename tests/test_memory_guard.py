@@ -4,6 +4,8 @@ and the largest n that fits."""
 
 import re
 import resource
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -63,6 +65,49 @@ def test_the_estimate_grows_with_what_the_run_holds(env):
     shot = sv.peak_bytes(20, 2) - sv.peak_bytes(20, 1)
     assert shot > 0 and sv.peak_bytes(21, 1) - shot == 2 * (sv.peak_bytes(20, 1) - shot)
     assert qc.Adaptive(grid_size=100_000, max_iterations=1_000_000).state_bytes(1 << 10) > 1 << 40
+
+
+_UNSHARED_PEAK = """
+import resource, sys
+import numpy as np
+import qrrt_circuits as qc
+
+class Nowhere:  # a predicate that costs nothing: the round's memory is its databases and searches
+    dim, name = 2, "nowhere"
+    def describe(self):
+        return {"name": self.name}
+    def reachable(self, parents, children):
+        return np.zeros(len(children), dtype=bool)
+
+env = qc.scenarios.paper_clutter(seed=0)
+def planner(n, workers):
+    return qc.PQRRT(env, backend=qc.StatevectorBackend(0), num_qubits=n, workers=workers, shared_database=False,
+                    search_policy=qc.FixedIterations(1), seed=0, predicate=Nowhere())
+planner(8, 2).plan(max_rounds=1)  # compiled code loaded before the measurement
+big = planner(20, int(sys.argv[1]))
+before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+big.plan(max_rounds=1)
+after = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+print(after - before, big.memory_estimate().total_bytes)
+"""
+
+
+def test_unshared_databases_are_counted_once_per_worker_without_an_executor(env):
+    """A round builds every worker's database before searching them, so the estimate grows with p
+    (it counted one database without an executor: 122 MiB at n = 20 for any p, against a measured
+    1.8 GiB at p = 64), and it covers the peak a round adds at n = 20, measured in a fresh process
+    (a high-water mark: what the round adds beyond the imports' peak, so a lower bound)."""
+    def estimate(workers):
+        return qc.PQRRT(env, backend=qc.StatevectorBackend(0), num_qubits=16, workers=workers,
+                        shared_database=False, seed=0).memory_estimate()
+
+    one, eight = estimate(1), estimate(8)
+    assert eight.database_bytes == 8 * one.database_bytes and eight.search_bytes == 8 * one.search_bytes
+    for workers in (4, 16):
+        run = subprocess.run([sys.executable, "-c", _UNSHARED_PEAK, str(workers)], capture_output=True, text=True,
+                             timeout=300, check=True)
+        added, estimated = map(int, run.stdout.split())
+        assert 0 < added <= estimated, (workers, added, estimated)
 
 
 def test_adaptive_with_a_huge_table_is_refused_before_allocating_it(env):

@@ -217,8 +217,9 @@ class PQRRT(Planner):
     def memory_estimate(self, num_qubits: int | None = None) -> MemoryEstimate:
         """Estimated peak memory of one round (``qrrt_circuits.memory``); checked at construction.
 
-        Counts the databases alive at once (one, or one per worker when unshared databases run on
-        an executor), each with its backend search at the policy's largest iteration count
+        Counts the databases alive at once (one shared database, or one per worker when the
+        databases are unshared: a round builds every worker's database before it searches them, on
+        an executor or not), each with its backend search at the policy's largest iteration count
         (``IterationPolicy.iterations_bound``), plus the policy's state.
 
         Args:
@@ -230,7 +231,7 @@ class PQRRT(Planner):
         """
         n = self.num_qubits if num_qubits is None else num_qubits
         size = 1 << n
-        concurrent = self.workers if (self.executor is not None and not self.shared_database) else 1
+        concurrent = 1 if self.shared_database else self.workers
         shots = self.workers if self.shared_database else 1
         search = self.backend.peak_bytes(n, shots, self.search_policy.iterations_bound(size))
         return MemoryEstimate(
