@@ -149,3 +149,47 @@ def test_chord_grid_is_computed_once_per_dynamics_and_equals_the_direct_computat
         np.testing.assert_array_equal(predicate._curvature, direct_bounds)
         np.testing.assert_array_equal(predicate._phis, dynamics.propagators(direct_times))
     assert len(oracle_module._CHORD_GRIDS) == 5
+
+
+NON_NORMAL = qc.LinearTrackingDynamics(np.array([[0.0, 30.0], [0.0, 0.0]]), np.eye(2), np.eye(2))
+
+
+@pytest.mark.parametrize("dynamics", [qc.LinearTrackingDynamics.paper(), NON_NORMAL], ids=["paper", "non-normal"])
+@pytest.mark.parametrize("max_error, resolution", [(28.3, 0.01), (28.3, 1e-4), (2.83e4, 0.01)])
+def test_chord_count_estimate_is_close_below_the_grid(dynamics, max_error, resolution):
+    """The estimate the oracle refuses by: the grid has 1-1.43x as many chords (its steps are
+    max_step x 0.7^j), so estimate / 0.7 bounds it."""
+    estimate = dynamics.chord_count_estimate(max_error, resolution)
+    chords = len(dynamics.curvature_bound_times(max_error, resolution)[0]) - 1
+    assert estimate <= chords <= estimate / 0.7, (estimate, chords)
+
+
+def test_a_resolution_too_fine_for_the_workspace_is_refused_before_the_grid_is_built(clutter, monkeypatch):
+    from qrrt_circuits import oracle
+
+    monkeypatch.setattr(oracle, "MAX_CHORDS", 500)
+    monkeypatch.setattr(oracle, "_CHORD_GRIDS", {})
+    with pytest.raises(ValueError, match=r"resolution = 0\.0001 on a workspace 28\.2843 across needs about .* "
+                                         r"chords per trajectory, more than the 500 allowed.*at least ([0-9.e-]+)"):
+        qc.ReachabilityOracle(clutter, resolution=1e-4)
+    assert oracle._CHORD_GRIDS == {}  # refused before any grid was built
+    try:
+        qc.ReachabilityOracle(clutter, resolution=1e-4)
+    except ValueError as error:
+        finest = float(str(error).rsplit("at least ", 1)[1].split(",")[0])
+    fitting = qc.ReachabilityOracle(clutter, resolution=finest)  # the suggestion (as printed) is accepted
+    assert len(fitting._times) - 1 <= 500
+    assert oracle.max_chords(512) == 127 < oracle.max_chords(2) == 500  # d x d propagators limit large d
+
+
+def test_a_workspace_too_large_for_the_default_resolution_is_refused():
+    huge = qc.Environment([[-1e12, 1e12], [-1e12, 1e12]], [])
+    with pytest.raises(ValueError, match="resolution = 0.01 on a workspace 2.82843e\\+12 across needs about"):
+        qc.ReachabilityOracle(huge)
+    with pytest.raises(ValueError, match="resolution = 0.01"):
+        qc.RRT(huge)
+
+
+def test_the_chord_grid_refuses_more_intervals_than_asked():
+    with pytest.raises(ValueError, match="more than 10 intervals for resolution = 0.0001"):
+        qc.LinearTrackingDynamics.paper().curvature_bound_times(28.3, 1e-4, max_intervals=10)

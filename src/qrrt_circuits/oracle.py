@@ -14,6 +14,7 @@ re-exported here.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -29,7 +30,7 @@ __all__ = ["OracleErrorModel", "ReachabilityOracle"]
 
 
 def chord_grid(
-    dynamics: LinearTrackingDynamics, max_error: float, resolution: float
+    dynamics: LinearTrackingDynamics, max_error: float, resolution: float, max_intervals: int | None = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The check's time grid, per-chord curvature bounds and propagators expm(M t_i).
 
@@ -46,12 +47,45 @@ def chord_grid(
     key = (closed.tobytes(), closed.shape, dynamics.horizon, float(max_error), float(resolution))
     grid = _CHORD_GRIDS.get(key)
     if grid is None:
-        times, bounds = dynamics.curvature_bound_times(max_error, resolution)
+        times, bounds = dynamics.curvature_bound_times(max_error, resolution, max_intervals=max_intervals)
         grid = (times, bounds, np.ascontiguousarray(dynamics.propagators(times)))
         if len(_CHORD_GRIDS) >= _CHORD_GRIDS_KEPT:
             _CHORD_GRIDS.clear()
         _CHORD_GRIDS[key] = grid
     return grid[0].copy(), grid[1].copy(), grid[2].copy()
+
+
+#: the most chords (time-grid intervals) one exact check's trajectories are cut into: building the
+#: grid costs about 40 us per chord (one ``expm`` each), so 100 000 take a few seconds
+MAX_CHORDS = 100_000
+#: the largest (chords + 1) x d x d propagators (doubles) an exact check keeps
+MAX_PROPAGATOR_BYTES = 256 << 20
+
+
+def max_chords(dim: int) -> int:
+    """The chord limit in d = ``dim`` dimensions: ``MAX_CHORDS``, or fewer where their propagators
+    would exceed ``MAX_PROPAGATOR_BYTES``."""
+    return max(1, min(MAX_CHORDS, MAX_PROPAGATOR_BYTES // (8 * dim * dim) - 1))
+
+
+def _chords_bound(dynamics: LinearTrackingDynamics, max_error: float, resolution: float) -> float:
+    """``chord_count_estimate`` / 0.7: the grid's steps are ``max_step`` x 0.7^j, so it has at most
+    1 / 0.7 times the estimated chords (tested)."""
+    return dynamics.chord_count_estimate(max_error, resolution) / 0.7
+
+
+def _finest_fitting(dynamics: LinearTrackingDynamics, max_error: float, resolution: float, limit: int) -> float:
+    """A resolution (rounded up to 3 significant digits) whose chord bound is within ``limit``:
+    chords grow as 1 / sqrt(resolution) where the grid's longest step does not cap them, so the
+    resolution is scaled by (bound / limit)^2 until the bound fits."""
+    for _ in range(64):
+        bound = _chords_bound(dynamics, max_error, resolution)
+        if bound <= limit:
+            break
+        resolution *= max((bound / limit) ** 2, 1.01)
+        unit = 10.0 ** (math.floor(math.log10(resolution)) - 2)
+        resolution = math.ceil(resolution / unit) * unit
+    return resolution
 
 
 _ChordGridKey = tuple[bytes, tuple[int, ...], float, float, float]
@@ -88,8 +122,11 @@ class ReachabilityOracle:
         evaluations: Pairs evaluated so far.
 
     Raises:
-        ValueError: An unknown ``check``, a dynamics dimension other than ``env.dim``, or a
-            ``resolution`` that is not a finite number > 0.
+        ValueError: An unknown ``check``, a dynamics dimension other than ``env.dim``, a
+            ``resolution`` that is not a finite number > 0, or one so fine for the workspace's
+            extent that the chord grid would exceed ``max_chords(d)`` chords (estimated by
+            ``LinearTrackingDynamics.chord_count_estimate`` before it is built; the message gives
+            the finest resolution that fits).
         TypeError: A non-numeric ``resolution``.
 
     Example:
@@ -136,7 +173,15 @@ class ReachabilityOracle:
         self.evaluations = 0
         extent = env.bounds[:, 1] - env.bounds[:, 0]
         max_error = float(np.linalg.norm(extent)) * 1.0001
-        self._times, self._curvature, self._phis = chord_grid(dynamics, max_error, self.resolution)
+        limit = max_chords(env.dim)
+        estimate = _chords_bound(dynamics, max_error, self.resolution)
+        if estimate > limit:
+            raise ValueError(
+                f"resolution = {self.resolution:g} on a workspace {max_error / 1.0001:.6g} across needs about "
+                f"{estimate:.3g} chords per trajectory, more than the {limit} allowed (MAX_CHORDS, and "
+                "MAX_PROPAGATOR_BYTES of d x d propagators): use a resolution of at least "
+                f"{_finest_fitting(dynamics, max_error, self.resolution, limit):.3g}, or a smaller workspace")
+        self._times, self._curvature, self._phis = chord_grid(dynamics, max_error, self.resolution, 2 * limit)
         self._index = env.grid_index
         self._lower = np.ascontiguousarray(env.boxes[:, 0])
         self._upper = np.ascontiguousarray(env.boxes[:, 1])
