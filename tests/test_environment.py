@@ -62,6 +62,11 @@ def _write(tmp_path, data):
         ({"boxes": [[[0, float("nan")], [1, 1]]]}, "finite"),
         ({"format": "other"}, "'format' must be"),
         ({"boxes": [[[0, 0, 0], [1, 1, 1]]]}, r"boxes must have shape \(k, 2, 2\)"),
+        ({"bounds": [["0", "10"], [0, 10]]}, "bounds must hold real numbers, got '10'"),
+        ({"bounds": [[False, True], [0, 10]]}, "bounds must hold real numbers, got True"),
+        ({"boxes": [[[1, 1], [2, "2"]]]}, "boxes must hold real numbers"),
+        ({"start": [True, 1.5], "goal": [5, 5], "goal_radius": 1.0}, "start must hold real numbers"),
+        ({"version": True}, "'version' must be 1, got True"),
     ],
 )
 def test_bad_scenario_files_are_rejected(tmp_path, patch, message):
@@ -69,6 +74,35 @@ def test_bad_scenario_files_are_rejected(tmp_path, patch, message):
     data.update(patch)
     with pytest.raises(ValueError, match=message):
         Environment.load(_write(tmp_path, data))
+
+
+def test_deeply_nested_json_is_rejected_without_a_recursion_error(tmp_path):
+    path = tmp_path / "deep.json"
+    path.write_text("[" * 100_000 + "]" * 100_000)
+    with pytest.raises(ValueError, match="nested too deeply"):
+        Environment.load(path)
+
+
+@pytest.mark.parametrize("value", [[[0, 10], [0, True]], np.array([[0, 10], [0, 1]], dtype=bool),
+                                   [[0, 10], [0, "1"]], np.array([["0", "1"], ["0", "1"]]),
+                                   [[0, 10], [0, np.bool_(True)]]])
+def test_bounds_refuse_booleans_and_strings_that_numpy_would_read_as_numbers(value):
+    with pytest.raises(ValueError, match="bounds must hold real numbers"):
+        Environment(value, [])
+
+
+def test_integer_and_float_arrays_of_any_width_are_accepted():
+    env = Environment(np.array([[0, 10], [0, 10]], dtype=np.int32), [[[1, 1], [2.5, 2.5]]],
+                      start=np.array([0.5, 0.5], dtype=np.float32), goal=(9, 9), goal_radius=1)
+    assert env.bounds.dtype == float and env.boxes.tolist() == [[[1.0, 1.0], [2.5, 2.5]]]
+
+
+@pytest.mark.parametrize("start", [[True, True], ["1", "1.5"], np.array([1, 1], dtype=bool)])
+def test_a_plan_refuses_a_start_of_booleans_or_strings(clutter, start):
+    import qrrt_circuits as qc
+
+    with pytest.raises(ValueError, match="start must be 2 numbers"):
+        qc.RRT(clutter, seed=0).plan(start=start, max_nodes=2)
 
 
 def test_not_json_is_rejected(tmp_path):

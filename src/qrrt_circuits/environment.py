@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .validation import check_float, check_int
+from .validation import check_float, check_int, check_real_array
 
 if TYPE_CHECKING:
     from .collision import GridIndex
@@ -37,11 +37,7 @@ MAX_EXTENT = 1e12
 def _as_float_array(value: Any, name: str) -> np.ndarray:
     if value is None or isinstance(value, str | bytes):
         raise ValueError(f"{name} must be an array of numbers, got {value!r}")
-    try:
-        array = np.asarray(value, dtype=float)
-    except (TypeError, ValueError, OverflowError) as exc:
-        shown = repr(value)
-        raise ValueError(f"{name} must be numeric, got {shown[:80]}{'...' if len(shown) > 80 else ''}") from exc
+    array = check_real_array(value, name)  # booleans and strings refused, not read as numbers
     if not np.all(np.isfinite(array)):
         raise ValueError(f"{name} must contain only finite numbers (no NaN or inf)")
     return array
@@ -330,7 +326,7 @@ class Environment:
             raise ValueError("environment JSON must be an object")
         if data.get("format") != FORMAT_NAME:
             raise ValueError(f"'format' must be {FORMAT_NAME!r}, got {data.get('format')!r}")
-        if data.get("version") != FORMAT_VERSION:
+        if type(data.get("version")) is not int or data.get("version") != FORMAT_VERSION:  # (true == 1 in Python)
             raise ValueError(f"'version' must be {FORMAT_VERSION}, got {data.get('version')!r}")
         for key in ("bounds", "boxes"):
             if key not in data:
@@ -389,6 +385,8 @@ class Environment:
             raise ValueError(f"{path}: not a UTF-8 text file ({exc.reason} at byte {exc.start})") from exc
         except (json.JSONDecodeError, ValueError) as exc:
             raise ValueError(f"{path}: not valid JSON ({exc})") from exc
+        except RecursionError as exc:  # nesting deeper than the parser's recursion limit
+            raise ValueError(f"{path}: not a scenario file (JSON nested too deeply)") from exc
         try:
             return cls.from_dict(data)
         except (ValueError, TypeError) as exc:

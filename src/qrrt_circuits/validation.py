@@ -222,3 +222,45 @@ def check_instance(value: Any, name: str, kind: type | tuple[type, ...], what: s
     if not isinstance(value, kind):
         raise TypeError(f"{name} must be {what}, got {type(value).__name__}")
     return value
+
+
+def check_real_array(value: Any, name: str) -> np.ndarray:
+    """``value`` as a float array, refusing what ``np.asarray(value, dtype=float)`` would coerce:
+    booleans and strings (anywhere in a nested sequence, where numpy would turn ``True`` into 1.0
+    and ``"2"`` into 2.0), and arrays of other dtypes than integers and floats.
+
+    Args:
+        value: An array or a (nested) sequence of real numbers.
+        name: The argument's name, for the error message.
+
+    Returns:
+        A new float array (shape as numpy reads it).
+
+    Raises:
+        ValueError: Booleans, strings, or other non-real values.
+    """
+    if isinstance(value, np.ndarray):
+        if value.dtype.kind not in "iuf":
+            raise ValueError(f"{name} must hold real numbers, got an array of dtype {value.dtype}")
+    else:
+        _check_real_leaves(value, name)
+    try:
+        return np.array(value, dtype=float)
+    except (TypeError, ValueError, OverflowError) as exc:
+        shown = repr(value)
+        raise ValueError(f"{name} must be numeric, got {shown[:80]}{'...' if len(shown) > 80 else ''}") from exc
+
+
+def _check_real_leaves(value: Any, name: str) -> None:
+    """Refuse a bool or a string anywhere in a nested sequence (iteratively: deep nesting is not a
+    RecursionError)."""
+    pending = [value]
+    while pending:
+        item = pending.pop()
+        if isinstance(item, bool | np.bool_ | str | bytes):
+            raise ValueError(f"{name} must hold real numbers, got {item!r}")
+        if isinstance(item, np.ndarray):
+            if item.dtype.kind not in "iuf":
+                raise ValueError(f"{name} must hold real numbers, got an array of dtype {item.dtype}")
+        elif isinstance(item, list | tuple):
+            pending.extend(item)

@@ -30,7 +30,7 @@ from ..oracle_errors import OracleErrorModel
 from ..predicate import ReachabilityPredicate, can_leave, check_predicate
 from ..randomness import RandomStreams, Stream
 from ..termination import PlanStatus, TerminationCondition, from_budgets, with_defaults
-from ..validation import check_float, check_instance, check_int, check_seed
+from ..validation import check_float, check_instance, check_int, check_real_array, check_seed
 from .context import RoundView, WorkerContext
 from .result import Metrics, PlanResult
 from .run_state import RunState, first_in_ball
@@ -222,9 +222,11 @@ class Planner:
             raise ValueError("start, goal and goal_radius are required (the environment sets none)")
         checked = []
         for name, point in (("start", start), ("goal", goal)):
+            if point is None or isinstance(point, str | bytes):
+                raise ValueError(f"{name} must be {env.dim} numbers, got {point!r}")
             try:
-                point = np.asarray(point, dtype=float).reshape(-1)
-            except (TypeError, ValueError) as exc:
+                point = check_real_array(point, name).reshape(-1)  # booleans and strings refused
+            except ValueError as exc:
                 raise ValueError(f"{name} must be {env.dim} numbers, got {point!r}") from exc
             if point.shape != (env.dim,):
                 raise ValueError(
