@@ -56,3 +56,16 @@ def test_curvature_bound_dominates_sampled_curvature():
         fine = np.linspace(times[i], times[i + 1], 20)
         actual = max(np.linalg.norm(m2 @ dyn.propagators([t])[0], 2) for t in fine)
         assert actual <= bounds[i] * (1 + 1e-9)
+
+
+@pytest.mark.parametrize("horizon", [1e300, 1.000001e6, float("inf"), 0.0, -1.0])
+def test_horizon_outside_its_range_is_refused(horizon):
+    """A huge horizon overflowed deep in the chord grid (step ** 2); it is refused up front."""
+    with pytest.raises(ValueError, match=r"horizon must be a finite number in \(0.0, 1000000.0\]"):
+        qc.LinearTrackingDynamics.paper(horizon=horizon)
+
+
+def test_the_longest_horizon_builds_an_exact_check(clutter):
+    dynamics = qc.LinearTrackingDynamics.paper(horizon=1e6)
+    oracle = qc.ReachabilityOracle(clutter, dynamics)
+    assert oracle.reachable(np.array([[1.0, 1.0]]), np.array([[1.5, 1.2]])).shape == (1,)

@@ -24,6 +24,11 @@ PAPER_B = ((0.5, 0.25), (0.0, 1.0))
 PAPER_K = ((1.9, -7.5), (1.0, 7.0))
 
 
+#: the longest motion duration T accepted (time units; the paper's is 5): far beyond any closed
+#: loop's settling time, and small enough that T / 16 squared and the chord grid stay finite
+MAX_HORIZON = 1e6
+
+
 @dataclass(frozen=True, eq=False)
 class LinearTrackingDynamics:
     """Closed-loop linear tracking dynamics (paper §V, DESIGN §2).
@@ -35,11 +40,11 @@ class LinearTrackingDynamics:
         A: Float (d, d), d >= 1, finite.
         B: Float (d, m), finite.
         K: Float (m, d), finite.
-        horizon: T, the motion's duration (> 0; the authors integrate over 5 s).
+        horizon: T, the motion's duration, in (0, ``MAX_HORIZON``] (the authors integrate over 5 s).
 
     Raises:
         TypeError: A, B or K not a real numeric matrix (bool included).
-        ValueError: Mismatched shapes, non-finite entries, ``horizon`` <= 0, or a closed loop
+        ValueError: Mismatched shapes, non-finite entries, ``horizon`` outside (0, 1e6], or a closed loop
             A - B K with an eigenvalue of non-negative real part.
     """
 
@@ -66,7 +71,7 @@ class LinearTrackingDynamics:
         for name, mat in (("A", A), ("B", B), ("K", K)):
             if not np.all(np.isfinite(mat)):
                 raise ValueError(f"{name} must contain only finite numbers")
-        check_float(self.horizon, "horizon", 0.0, open_minimum=True)
+        check_float(self.horizon, "horizon", 0.0, MAX_HORIZON, open_minimum=True)
         closed = A - B @ K
         eigenvalues = np.linalg.eigvals(closed)
         if np.max(eigenvalues.real) >= 0:
@@ -85,13 +90,13 @@ class LinearTrackingDynamics:
         K = [[1.9, -7.5], [1, 7]]; closed loop A - B K = diag(-2.7, -4).
 
         Args:
-            horizon: T, > 0 (the authors' code integrates over 5 s).
+            horizon: T, in (0, ``MAX_HORIZON``] (the authors' code integrates over 5 s).
 
         Returns:
             The ``LinearTrackingDynamics`` in d = 2.
 
         Raises:
-            ValueError: ``horizon`` <= 0 or not finite.
+            ValueError: ``horizon`` outside (0, ``MAX_HORIZON``].
             TypeError: A non-numeric ``horizon``.
         """
         return cls(np.array(PAPER_A), np.array(PAPER_B), np.array(PAPER_K), horizon=horizon)
