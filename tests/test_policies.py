@@ -147,3 +147,12 @@ def test_every_policy_inside_the_planners(name, shared, clutter):
 def test_policy_settings_are_checked_at_construction(build, error, message):
     with pytest.raises(error, match=message):
         build()
+
+
+@pytest.mark.parametrize("make", [lambda: qc.FixedIterations(100_001), lambda: qc.PaperSchedule(early=100_001),
+                                  lambda: qc.PaperSchedule(late=100_001)])
+def test_iteration_counts_beyond_what_a_search_runs_are_refused_at_construction(make):
+    """A plan with k = 200 000 was refused at its first search with that k, after the work before it."""
+    with pytest.raises(ValueError, match=r"must be an integer in \[0, 100000\], got 100001"):
+        make()
+    assert qc.PaperSchedule(switch_nodes=1_000_000).switch_nodes == 1_000_000  # a node count, not k

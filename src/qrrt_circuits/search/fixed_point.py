@@ -126,7 +126,8 @@ def check_fraction(fraction: Any, name: str = "min_fraction") -> float:
 def fixed_point_iterates(delta: float, min_fraction: float, length_rule: str = "paper") -> int:
     """The number l of generalized iterates (oracle calls) for error ``delta`` and marked fraction
     >= ``min_fraction``: the smallest l with L = 2l + 1 >= log(2/delta)/sqrt(w) (``"paper"``), or the
-    smallest with 1 - gamma(L)^2 <= w (``"tight"``; never larger than the paper's).
+    smallest with 1 - gamma(L)^2 <= w (``"tight"``; never larger than the paper's; searched up to
+    ``MAX_ITERATIONS``, beyond which it is the paper's l).
 
     Args:
         delta: The target error delta in (0, 1): P >= 1 - delta^2 for every fraction >= w.
@@ -154,7 +155,7 @@ def fixed_point_iterates(delta: float, min_fraction: float, length_rule: str = "
     paper = max(0, math.ceil((bound - 1.0) / 2.0))
     if length_rule == "paper":
         return paper
-    for iterates in range(paper + 1):
+    for iterates in range(min(paper, MAX_ITERATIONS) + 1):  # (no search runs more than MAX_ITERATIONS)
         if 1.0 - gamma(delta, 2 * iterates + 1) ** 2 <= w:
             return iterates
     return paper

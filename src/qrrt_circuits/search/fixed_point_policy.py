@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from .backend import MAX_ITERATIONS
 from .fixed_point import (
     LENGTH_RULES,
     IterateSequence,
@@ -50,8 +51,8 @@ class FixedPointAmplification(IterationPolicy):
 
     Raises:
         TypeError: A non-real ``delta`` or ``min_fraction``.
-        ValueError: ``delta`` outside (0, 1), ``min_fraction`` outside (0, 1], or an unknown
-            ``length_rule``.
+        ValueError: ``delta`` outside (0, 1), ``min_fraction`` outside (0, 1], an unknown
+            ``length_rule``, or more than ``MAX_ITERATIONS`` iterates (a small ``min_fraction``).
 
     Example:
         >>> from qrrt_circuits import FixedPointAmplification
@@ -72,6 +73,11 @@ class FixedPointAmplification(IterationPolicy):
         check_fraction(self.min_fraction)
         if self.length_rule not in LENGTH_RULES:
             raise ValueError(f"length_rule must be one of {LENGTH_RULES}, got {self.length_rule!r}")
+        if self.iterates > MAX_ITERATIONS:  # refused here, not at the plan's first search
+            raise ValueError(
+                f"delta = {self.delta} and min_fraction = {self.min_fraction} need l = {self.iterates} iterates "
+                f"per search, more than the {MAX_ITERATIONS} a search runs (MAX_ITERATIONS): raise min_fraction "
+                "or delta")
 
     @property
     def iterates(self) -> int:

@@ -47,7 +47,7 @@ import numpy as np
 
 from ..probability import optimal_iterations
 from ..validation import check_choice, check_float, check_int, check_optional_int
-from .backend import validate_iterations
+from .backend import MAX_ITERATIONS, validate_iterations
 from .problem import DatabaseSearch, SearchOutcome, search_together
 
 __all__ = [
@@ -330,7 +330,9 @@ def _verified(problem: DatabaseSearch, k: int, measured: np.ndarray) -> tuple[Se
 
 
 def _check_iteration_count(value: Any, name: str) -> int:
-    return check_int(value, name, 0, 1_000_000)
+    """A Grover iteration count k a backend's search accepts: 0 .. ``MAX_ITERATIONS`` (so a plan is
+    not refused halfway through, at the first search with that k)."""
+    return check_int(value, name, 0, MAX_ITERATIONS)
 
 
 @dataclass(frozen=True)
@@ -347,7 +349,8 @@ class PaperSchedule(IterationPolicy):
 
     Raises:
         TypeError: A non-integer field.
-        ValueError: A field outside [0, 1000000].
+        ValueError: ``early`` or ``late`` outside [0, 100000] (``MAX_ITERATIONS``, what a search
+            accepts), or ``switch_nodes`` outside [0, 1000000].
     """
 
     early: int = 5
@@ -356,8 +359,9 @@ class PaperSchedule(IterationPolicy):
     name = "paper"
 
     def __post_init__(self) -> None:
-        for key in ("early", "late", "switch_nodes"):
+        for key in ("early", "late"):
             _check_iteration_count(getattr(self, key), key)
+        check_int(self.switch_nodes, "switch_nodes", 0, 1_000_000)
 
     def _iterations(self, num_items: int, tree_nodes: int, num_marked: int | None) -> int:
         return self.late if tree_nodes > self.switch_nodes else self.early
@@ -378,7 +382,7 @@ class FixedIterations(IterationPolicy):
 
     Raises:
         TypeError: A non-integer ``k``.
-        ValueError: ``k`` outside [0, 1000000].
+        ValueError: ``k`` outside [0, 100000] (``MAX_ITERATIONS``, what a search accepts).
     """
 
     k: int = 2
