@@ -32,6 +32,8 @@ CASES = [
     (["reproduce", "lemmas", "--predicate", "authors"], "does not take a predicate"),
     (["reproduce", "nope"], "EXPERIMENT must be one of"),
     (["reproduce", "lemmas", "--out", ""], "--out must name a folder"),
+    (["reproduce", "lemmas", "--jobs", "4"], "--jobs needs --executor process or dask"),
+    (["reproduce", "lemmas", "--executor", "process", "--jobs", "100000"], "jobs must be an integer in [1, "),
 ]
 
 

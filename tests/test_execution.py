@@ -279,3 +279,15 @@ def test_reproducing_several_experiments_makes_each_summary_while_the_next_trial
         assert written == (tmp_path / "serial" / name / "summary.json").read_text(), name
         assert ours["figures"] and all((tmp_path / "pool" / name / figure).stat().st_size
                                        for figure in ours["figures"])
+
+
+def test_local_workers_are_limited_per_core():
+    """100 000 local workers were accepted (each a Python process with Qiskit, Aer and numba)."""
+    from qrrt_circuits.execution import JOBS_PER_CORE, check_executor_args, max_local_jobs
+
+    limit = max_local_jobs()
+    assert limit == JOBS_PER_CORE * (os.cpu_count() or 1)
+    assert check_executor_args("process", limit, None) == limit
+    with pytest.raises(ValueError, match=rf"jobs must be an integer in \[1, {limit}\] for local workers"):
+        check_executor_args("process", limit + 1, None)
+    assert check_executor_args("serial", limit + 1, None) == limit + 1  # unused by the serial executor

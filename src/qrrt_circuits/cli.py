@@ -229,6 +229,8 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         raise ValueError(f"--out: {args.out!r} exists and is not a folder")
     if args.experiment != "all" and args.experiment not in EXPERIMENTS:
         raise ValueError(f"EXPERIMENT must be one of {sorted(EXPERIMENTS)} or 'all', got {args.experiment!r}")
+    if args.jobs is not None and args.executor == "serial":
+        raise ValueError("--jobs needs --executor process or dask (the serial executor runs every trial here)")
     names = sorted(EXPERIMENTS) if args.experiment == "all" else [args.experiment]
     if args.predicate != "exact":  # 'all' with another check: the experiments that plan with one
         names = [name for name in names if EXPERIMENTS[name].uses_predicate or args.experiment != "all"]

@@ -166,6 +166,17 @@ def _stop_fork_server(server: Any, wait_s: float = 5.0) -> None:  # a multiproce
         time.sleep(0.02)
 
 
+#: local worker processes per core at most (more only share the cores, each a Python process with
+#: the library, Qiskit, Aer and numba loaded)
+JOBS_PER_CORE = 4
+
+
+def max_local_jobs() -> int:
+    """The most local worker processes ``get_executor`` / ``WorkerPool`` start:
+    ``JOBS_PER_CORE`` x ``os.cpu_count()``."""
+    return JOBS_PER_CORE * (os.cpu_count() or 1)
+
+
 def check_executor_args(kind: str, jobs: int | None, scheduler: str | None) -> int:
     """Validate the executor arguments of ``get_executor`` and ``WorkerPool`` before any work.
 
@@ -178,8 +189,9 @@ def check_executor_args(kind: str, jobs: int | None, scheduler: str | None) -> i
         The number of jobs: ``jobs``, or the machine's CPU count for None.
 
     Raises:
-        ValueError: An unknown ``kind``, ``jobs`` < 1, a ``scheduler`` without ``kind="dask"``, or
-            ``kind="dask"`` without the ``dask`` extra installed.
+        ValueError: An unknown ``kind``, ``jobs`` < 1 (or above ``max_local_jobs()`` for local
+            workers), a ``scheduler`` without ``kind="dask"``, or ``kind="dask"`` without the
+            ``dask`` extra installed.
         TypeError: A non-integer ``jobs``.
 
     Example:
@@ -196,6 +208,11 @@ def check_executor_args(kind: str, jobs: int | None, scheduler: str | None) -> i
     check_optional_int(jobs, "jobs", 1)
     if scheduler is not None and kind != "dask":
         raise ValueError("scheduler is only used with executor='dask'")
+    local_limit = max_local_jobs()
+    if jobs is not None and kind != "serial" and scheduler is None and jobs > local_limit:
+        raise ValueError(f"jobs must be an integer in [1, {local_limit}] for local workers (each is a process of "
+                         f"its own; {JOBS_PER_CORE} per core at most on this machine's {os.cpu_count() or 1}), "
+                         f"got {jobs}")
     if kind == "dask":
         try:
             import distributed  # noqa: F401
