@@ -126,7 +126,9 @@ def _check_output_file(path: str | None, option: str, suffixes: tuple[str, ...] 
     import os
 
     target = Path(path)
-    if str(path) == "" or target.is_dir():
+    if str(path) == "":
+        raise ValueError(f"{option} must name a file, got ''")
+    if target.is_dir():
         raise ValueError(f"{option}: {path!r} is a folder, not a file name")
     if not target.resolve().parent.is_dir():
         raise ValueError(f"{option}: the folder of {path!r} does not exist")
@@ -146,6 +148,8 @@ def _load_environment(args: argparse.Namespace) -> Environment:
     if args.scenario_file:
         from .environment import Environment
 
+        if Path(args.scenario_file).is_dir():
+            raise ValueError(f"--scenario-file: {args.scenario_file!r} is a folder, not a scenario file")
         if not Path(args.scenario_file).is_file():
             raise ValueError(f"--scenario-file: no such file {args.scenario_file!r}")
         return Environment.load(args.scenario_file)
@@ -207,6 +211,8 @@ def _write_plan_outputs(args: argparse.Namespace, result: PlanResult, env: Envir
 def cmd_plan(args: argparse.Namespace) -> int:
     _check_output_file(args.json, "--json")
     _check_output_file(args.plot, "--plot", PLOT_FORMATS)
+    if args.json and args.plot and Path(args.json).resolve() == Path(args.plot).resolve():
+        raise ValueError(f"--json and --plot name the same file {args.plot!r} (the plot would overwrite the JSON)")
     env = _load_environment(args)
     planner = build_planner(args, env)
     result = planner.plan(max_nodes=args.max_nodes, max_oracle_calls=args.max_oracle_calls,

@@ -92,9 +92,13 @@ class Planner:
         check_instance(env, "env", Environment, "an Environment")
         self.env = env
         self.predicate = resolve_predicate(env, predicate, oracle, dynamics, resolution)
-        self.goal_bias = check_float(goal_bias, "goal_bias", 0.0, 1.0)
-        if self.goal_bias >= 1.0:
-            raise ValueError(f"goal_bias must be in [0, 1), got {goal_bias!r}")
+        try:
+            bias: float | None = check_float(goal_bias, "goal_bias", 0.0, 1.0)
+        except ValueError:
+            bias = None
+        if bias is None or bias >= 1.0:  # one message for 1, 1.5, -0.5 and NaN: the range is [0, 1)
+            raise ValueError(f"goal_bias must be a finite number in [0.0, 1.0), got {goal_bias!r}")
+        self.goal_bias = bias
         if oracle_errors is not None:
             check_instance(oracle_errors, "oracle_errors", OracleErrorModel, "an OracleErrorModel or None")
         self.oracle_errors = oracle_errors
