@@ -30,7 +30,7 @@ __all__ = ["OracleErrorModel", "ReachabilityOracle"]
 
 
 def chord_grid(
-    dynamics: LinearTrackingDynamics, max_error: float, resolution: float, max_intervals: int | None = None
+    dynamics: LinearTrackingDynamics, max_error: float, resolution: float, limit: int | None = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The check's time grid, per-chord curvature bounds and propagators expm(M t_i).
 
@@ -38,16 +38,30 @@ def chord_grid(
     times, a pure function of M = A - B K, T, ``max_error`` and ``resolution``: computed once per
     process for each distinct set (an experiment builds one predicate per trial, and the grid, a few
     hundred small ``expm``, cost more than most trials' checks). Fresh copies are returned, so the
-    caller owns them.
+    caller owns them. With a ``limit``, a grid not yet computed is first estimated
+    (``chord_count_estimate``) and refused if it would have more than ``limit`` chords (and
+    ``curvature_bound_times`` stops at twice that).
 
     Returns:
         (times, bounds, propagators): shapes (K + 1,), (K,) and (K + 1, d, d), C-contiguous.
+
+    Raises:
+        ValueError: More than ``limit`` chords (the message gives the finest resolution that fits).
     """
     closed = np.ascontiguousarray(dynamics.closed_loop, dtype=float)
     key = (closed.tobytes(), closed.shape, dynamics.horizon, float(max_error), float(resolution))
     grid = _CHORD_GRIDS.get(key)
     if grid is None:
-        times, bounds = dynamics.curvature_bound_times(max_error, resolution, max_intervals=max_intervals)
+        if limit is not None:
+            estimate = _chords_bound(dynamics, max_error, resolution)
+            if estimate > limit:
+                raise ValueError(
+                    f"resolution = {resolution:g} on a workspace {max_error / 1.0001:.6g} across needs about "
+                    f"{estimate:.3g} chords per trajectory, more than the {limit} allowed (MAX_CHORDS, and "
+                    "MAX_PROPAGATOR_BYTES of d x d propagators): use a resolution of at least "
+                    f"{_finest_fitting(dynamics, max_error, resolution, limit):.3g}, or a smaller workspace")
+        times, bounds = dynamics.curvature_bound_times(max_error, resolution,
+                                                       max_intervals=None if limit is None else 2 * limit)
         grid = (times, bounds, np.ascontiguousarray(dynamics.propagators(times)))
         if len(_CHORD_GRIDS) >= _CHORD_GRIDS_KEPT:
             _CHORD_GRIDS.clear()
@@ -173,15 +187,8 @@ class ReachabilityOracle:
         self.evaluations = 0
         extent = env.bounds[:, 1] - env.bounds[:, 0]
         max_error = float(np.linalg.norm(extent)) * 1.0001
-        limit = max_chords(env.dim)
-        estimate = _chords_bound(dynamics, max_error, self.resolution)
-        if estimate > limit:
-            raise ValueError(
-                f"resolution = {self.resolution:g} on a workspace {max_error / 1.0001:.6g} across needs about "
-                f"{estimate:.3g} chords per trajectory, more than the {limit} allowed (MAX_CHORDS, and "
-                "MAX_PROPAGATOR_BYTES of d x d propagators): use a resolution of at least "
-                f"{_finest_fitting(dynamics, max_error, self.resolution, limit):.3g}, or a smaller workspace")
-        self._times, self._curvature, self._phis = chord_grid(dynamics, max_error, self.resolution, 2 * limit)
+        self._times, self._curvature, self._phis = chord_grid(dynamics, max_error, self.resolution,
+                                                              max_chords(env.dim))
         self._index = env.grid_index
         self._lower = np.ascontiguousarray(env.boxes[:, 0])
         self._upper = np.ascontiguousarray(env.boxes[:, 1])
