@@ -227,14 +227,14 @@ class LinearTrackingDynamics:
     def chord_count_estimate(self, max_error: float, resolution: float, max_step: float | None = None,
                              samples: int = 64) -> float:
         """About how many intervals ``curvature_bound_times(max_error, resolution, max_step)``
-        makes, from ``samples`` evaluations of ||M^2 expm(M t)||_2 instead of one per interval:
+        makes, from ``samples`` evaluations of ``||M^2 expm(M t)||_2`` instead of one per interval:
         the integral over [0, T] of 1 / h(t), h(t) = min(``max_step``, sqrt(8 ``resolution`` /
-        (``max_error`` ||M^2 expm(M t)||))), the interval that keeps the chord error within
+        (``max_error`` ``||M^2 expm(M t)||``))), the interval that keeps the chord error within
         ``resolution`` (the grid's own intervals are up to 1 / 0.7 shorter, its steps being
-        ``max_step`` x 0.7^j; measured 1.1-1.4x this estimate).
+        ``max_step`` x 0.7^j; measured 1.2-1.4x this estimate).
 
         Args:
-            max_error: The largest tracking error |e| to cover.
+            max_error: The largest tracking error ``|e|`` to cover.
             resolution: The chord error to keep below (> 0).
             max_step: The longest interval (default T / 16).
             samples: Evaluation times, evenly spaced (midpoints).
