@@ -184,7 +184,7 @@ def test_registry_names_and_bad_settings():
 
 
 @pytest.mark.parametrize("length_rule", ["paper", "tight"])
-@pytest.mark.parametrize("delta, min_fraction", [(0.5, 1e-12), (1e-300, 1e-6)])
+@pytest.mark.parametrize("delta, min_fraction", [(0.5, 1e-12), (1e-300, 1e-6), (0.5, 1e-300)])
 def test_more_iterates_than_a_search_runs_are_refused_at_construction(delta, min_fraction, length_rule):
     """Refused when the policy is made, not at the plan's first search (where it was)."""
     with pytest.raises(ValueError, match=rf"delta = {delta} and min_fraction = {min_fraction} need l = \d+ "

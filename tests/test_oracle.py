@@ -169,8 +169,8 @@ def test_a_resolution_too_fine_for_the_workspace_is_refused_before_the_grid_is_b
 
     monkeypatch.setattr(oracle, "MAX_CHORDS", 500)
     monkeypatch.setattr(oracle, "_CHORD_GRIDS", {})
-    with pytest.raises(ValueError, match=r"resolution = 0\.0001 on a workspace 28\.2843 across needs about .* "
-                                         r"chords per trajectory, more than the 500 allowed.*at least ([0-9.e-]+)"):
+    with pytest.raises(ValueError, match=r"resolution = 0\.0001 on a workspace 28\.2843 across needs up to about "
+                                         r".* chords per trajectory .*more than the 500 allowed.*at least ([0-9.e-]+)"):
         qc.ReachabilityOracle(clutter, resolution=1e-4)
     assert oracle._CHORD_GRIDS == {}  # refused before any grid was built
     try:
@@ -184,7 +184,7 @@ def test_a_resolution_too_fine_for_the_workspace_is_refused_before_the_grid_is_b
 
 def test_a_workspace_too_large_for_the_default_resolution_is_refused():
     huge = qc.Environment([[-1e12, 1e12], [-1e12, 1e12]], [])
-    with pytest.raises(ValueError, match="resolution = 0.01 on a workspace 2.82843e\\+12 across needs about"):
+    with pytest.raises(ValueError, match="resolution = 0.01 on a workspace 2.82843e\\+12 across needs up to about"):
         qc.ReachabilityOracle(huge)
     with pytest.raises(ValueError, match="resolution = 0.01"):
         qc.RRT(huge)
@@ -193,3 +193,14 @@ def test_a_workspace_too_large_for_the_default_resolution_is_refused():
 def test_the_chord_grid_refuses_more_intervals_than_asked():
     with pytest.raises(ValueError, match="more than 10 intervals for resolution = 0.0001"):
         qc.LinearTrackingDynamics.paper().curvature_bound_times(28.3, 1e-4, max_intervals=10)
+
+
+def test_a_dimension_too_large_for_any_grid_says_so(monkeypatch):
+    """Below 16 / 0.7 chords no resolution fits (the grid's longest step is T / 16): the error names
+    d instead of suggesting a resolution that would fail again."""
+    from qrrt_circuits import oracle
+
+    d = 1200
+    with pytest.raises(ValueError, match=r"an exact check in d = 1200 needs at least 17 propagators"):
+        oracle.chord_grid(qc.LinearTrackingDynamics(-np.eye(d), np.eye(d), np.zeros((d, d))), 2.0, 0.01,
+                          oracle.max_chords(d))

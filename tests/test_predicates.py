@@ -141,7 +141,7 @@ def test_time_sampled_check_in_chunks_answers_as_in_one_piece(clutter, time_samp
     rng = np.random.default_rng(3)
     parents, children = clutter.sample_free(301, rng), clutter.sample_uniform(301, rng)
     whole = qc.TimeSampledCheck(clutter, time_samples=time_samples).reachable(parents, children)
-    monkeypatch.setattr(time_sampled, "CHUNK_POINTS", 3 * time_samples + 1)  # 3 pairs a chunk, a remainder
+    monkeypatch.setattr(time_sampled, "CHUNK_COORDINATES", 2 * (3 * time_samples + 1))  # 3 pairs a chunk, a remainder
     chunked = qc.TimeSampledCheck(clutter, time_samples=time_samples)
     assert np.array_equal(chunked.reachable(parents, children), whole)
     assert chunked.evaluations == 301 and 0 < whole.sum() < 301

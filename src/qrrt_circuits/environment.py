@@ -326,7 +326,7 @@ class Environment:
             raise ValueError("environment JSON must be an object")
         if data.get("format") != FORMAT_NAME:
             raise ValueError(f"'format' must be {FORMAT_NAME!r}, got {data.get('format')!r}")
-        if type(data.get("version")) is not int or data.get("version") != FORMAT_VERSION:  # (true == 1 in Python)
+        if isinstance(data.get("version"), bool) or data.get("version") != FORMAT_VERSION:  # (true == 1 in Python)
             raise ValueError(f"'version' must be {FORMAT_VERSION}, got {data.get('version')!r}")
         for key in ("bounds", "boxes"):
             if key not in data:

@@ -53,13 +53,18 @@ def chord_grid(
     grid = _CHORD_GRIDS.get(key)
     if grid is None:
         if limit is not None:
+            if limit < _FEWEST_CHORDS_BOUND:  # even the coarsest grid's d x d propagators do not fit
+                dim = closed.shape[0]
+                raise ValueError(f"an exact check in d = {dim} needs at least 17 propagators of d x d doubles "
+                                 f"({17 * 8 * dim * dim / 2**20:.0f} MiB), more than MAX_PROPAGATOR_BYTES "
+                                 f"({MAX_PROPAGATOR_BYTES >> 20} MiB) allows")
             estimate = _chords_bound(dynamics, max_error, resolution)
             if estimate > limit:
                 raise ValueError(
-                    f"resolution = {resolution:g} on a workspace {max_error / 1.0001:.6g} across needs about "
-                    f"{estimate:.3g} chords per trajectory, more than the {limit} allowed (MAX_CHORDS, and "
-                    "MAX_PROPAGATOR_BYTES of d x d propagators): use a resolution of at least "
-                    f"{_finest_fitting(dynamics, max_error, resolution, limit):.3g}, or a smaller workspace")
+                    f"resolution = {resolution:g} on a workspace {max_error / 1.0001:.6g} across needs up to about "
+                    f"{estimate:.3g} chords per trajectory (bounded by the estimate / 0.7), more than the {limit} "
+                    "allowed (MAX_CHORDS, and MAX_PROPAGATOR_BYTES of d x d propagators): use a resolution of at "
+                    f"least {_finest_fitting(dynamics, max_error, resolution, limit):.3g}, or a smaller workspace")
         times, bounds = dynamics.curvature_bound_times(max_error, resolution,
                                                        max_intervals=None if limit is None else 2 * limit)
         grid = (times, bounds, np.ascontiguousarray(dynamics.propagators(times)))
@@ -80,6 +85,10 @@ def max_chords(dim: int) -> int:
     """The chord limit in d = ``dim`` dimensions: ``MAX_CHORDS``, or fewer where their propagators
     would exceed ``MAX_PROPAGATOR_BYTES``."""
     return max(1, min(MAX_CHORDS, MAX_PROPAGATOR_BYTES // (8 * dim * dim) - 1))
+
+
+#: the bound ``_chords_bound`` never goes below: the grid's longest step is T / 16, so 16 chords / 0.7
+_FEWEST_CHORDS_BOUND = 16 / 0.7
 
 
 def _chords_bound(dynamics: LinearTrackingDynamics, max_error: float, resolution: float) -> float:

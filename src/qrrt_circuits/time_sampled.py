@@ -16,9 +16,9 @@ from .environment import Environment
 from .predicate import as_pairs
 from .validation import check_int
 
-#: sample points of one chunk of ``TimeSampledCheck.reachable`` (pairs x K; with their coordinates
-#: and the obstacle test's scratch, tens of MiB whatever M and K)
-CHUNK_POINTS = 1 << 20
+#: sample coordinates (pairs x K x d doubles: 16 MiB) of one chunk of ``TimeSampledCheck.reachable``;
+#: with the obstacle test's scratch a few times that, whatever M, K and d
+CHUNK_COORDINATES = 1 << 21
 #: the largest K x d x d propagators (doubles) a ``TimeSampledCheck`` keeps
 MAX_PROPAGATOR_BYTES = 256 << 20
 
@@ -34,8 +34,8 @@ class TimeSampledCheck:
         env: The ``Environment``.
         dynamics: ``LinearTrackingDynamics`` of the same dimension (default: the paper's).
         time_samples: K, 2 .. 1 000 000 (keyword only), with the K x d x d propagators within
-            ``MAX_PROPAGATOR_BYTES`` (256 MiB). ``reachable`` samples ``CHUNK_POINTS`` points at a
-            time, so its memory does not grow with M x K.
+            ``MAX_PROPAGATOR_BYTES`` (256 MiB). ``reachable`` samples ``CHUNK_COORDINATES``
+            coordinates at a time, so its memory does not grow with M x K.
 
     Attributes:
         time_samples: K.
@@ -103,7 +103,7 @@ class TimeSampledCheck:
         parents, children = as_pairs(parents, children, self.dim)
         count = parents.shape[0]
         samples_free = np.empty(count, dtype=bool)
-        step = max(1, CHUNK_POINTS // self.time_samples)  # pairs per chunk: the K samples of each, bounded memory
+        step = max(1, CHUNK_COORDINATES // (self.time_samples * self.dim))  # pairs per chunk: bounded memory
         for first in range(0, count, step):
             rows = slice(first, first + step)
             points = children[rows, None, :] + np.einsum("kij,mj->mki", self._phis, parents[rows] - children[rows])

@@ -227,7 +227,8 @@ def check_instance(value: Any, name: str, kind: type | tuple[type, ...], what: s
 def check_real_array(value: Any, name: str) -> np.ndarray:
     """``value`` as a float array, refusing what ``np.asarray(value, dtype=float)`` would coerce:
     booleans and strings (anywhere in a nested sequence, where numpy would turn ``True`` into 1.0
-    and ``"2"`` into 2.0), and arrays of other dtypes than integers and floats.
+    and ``"2"`` into 2.0), and arrays of other dtypes than integers, floats and objects that are
+    real numbers.
 
     Args:
         value: An array or a (nested) sequence of real numbers.
@@ -237,30 +238,27 @@ def check_real_array(value: Any, name: str) -> np.ndarray:
         A new float array (shape as numpy reads it).
 
     Raises:
-        ValueError: Booleans, strings, or other non-real values.
+        ValueError: Booleans, strings, ragged or other non-real values.
     """
-    if isinstance(value, np.ndarray):
-        if value.dtype.kind not in "iuf":
-            raise ValueError(f"{name} must hold real numbers, got an array of dtype {value.dtype}")
-    else:
-        _check_real_leaves(value, name)
-    try:
+    if isinstance(value, np.ndarray) and value.dtype.kind in "iuf":
         return np.array(value, dtype=float)
+    if isinstance(value, np.ndarray) and value.dtype.kind != "O":
+        raise ValueError(f"{name} must hold real numbers, got an array of dtype {value.dtype}")
+    try:
+        objects = np.array(value, dtype=object)  # one pass in numpy; a ragged or cyclic list leaves lists
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be numeric, got {_shown(value)}") from exc
+    for kind in set(map(type, objects.ravel())):
+        if issubclass(kind, bool | np.bool_ | str | bytes | list | tuple | dict | np.ndarray):
+            bad = next(item for item in objects.ravel() if type(item) is kind)
+            raise ValueError(f"{name} must hold real numbers, got {_shown(bad)}")
+    try:
+        return objects.astype(float)
     except (TypeError, ValueError, OverflowError) as exc:
-        shown = repr(value)
-        raise ValueError(f"{name} must be numeric, got {shown[:80]}{'...' if len(shown) > 80 else ''}") from exc
+        raise ValueError(f"{name} must be numeric, got {_shown(value)}") from exc
 
 
-def _check_real_leaves(value: Any, name: str) -> None:
-    """Refuse a bool or a string anywhere in a nested sequence (iteratively: deep nesting is not a
-    RecursionError)."""
-    pending = [value]
-    while pending:
-        item = pending.pop()
-        if isinstance(item, bool | np.bool_ | str | bytes):
-            raise ValueError(f"{name} must hold real numbers, got {item!r}")
-        if isinstance(item, np.ndarray):
-            if item.dtype.kind not in "iuf":
-                raise ValueError(f"{name} must hold real numbers, got an array of dtype {item.dtype}")
-        elif isinstance(item, list | tuple):
-            pending.extend(item)
+def _shown(value: Any) -> str:
+    """``repr(value)``, cut to 80 characters."""
+    shown = repr(value)
+    return f"{shown[:80]}{'...' if len(shown) > 80 else ''}"
