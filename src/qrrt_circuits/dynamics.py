@@ -27,6 +27,9 @@ PAPER_K = ((1.9, -7.5), (1.0, 7.0))
 #: the longest motion duration T accepted (time units; the paper's is 5): far beyond any closed
 #: loop's settling time, and small enough that T / 16 squared and the chord grid stay finite
 MAX_HORIZON = 1e6
+#: the largest array of K x d x d propagators expm(M t_k) (doubles) a predicate keeps: the exact
+#: check's chord grid (``oracle.max_chords``) and ``TimeSampledCheck``'s samples
+MAX_PROPAGATOR_BYTES = 256 << 20
 
 
 @dataclass(frozen=True, eq=False)

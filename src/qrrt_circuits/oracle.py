@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from .collision import trajectories_free
-from .dynamics import LinearTrackingDynamics
+from .dynamics import MAX_PROPAGATOR_BYTES, LinearTrackingDynamics
 from .environment import Environment
 from .oracle_errors import OracleErrorModel
 from .predicate import as_pairs
@@ -77,8 +77,6 @@ def chord_grid(
 #: the most chords (time-grid intervals) one exact check's trajectories are cut into: building the
 #: grid costs about 40 us per chord (one ``expm`` each), so 100 000 take a few seconds
 MAX_CHORDS = 100_000
-#: the largest (chords + 1) x d x d propagators (doubles) an exact check keeps
-MAX_PROPAGATOR_BYTES = 256 << 20
 
 
 def max_chords(dim: int) -> int:

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .dynamics import LinearTrackingDynamics
+from .dynamics import MAX_PROPAGATOR_BYTES, LinearTrackingDynamics
 from .environment import Environment
 from .predicate import as_pairs
 from .validation import check_int
@@ -19,8 +19,6 @@ from .validation import check_int
 #: sample coordinates (pairs x K x d doubles: 16 MiB) of one chunk of ``TimeSampledCheck.reachable``;
 #: with the obstacle test's scratch a few times that, whatever M, K and d
 CHUNK_COORDINATES = 1 << 21
-#: the largest K x d x d propagators (doubles) a ``TimeSampledCheck`` keeps
-MAX_PROPAGATOR_BYTES = 256 << 20
 
 
 class TimeSampledCheck:
