@@ -10,7 +10,12 @@ Cases:
   on each backend for several n; the estimate is ``QRRT.memory_estimate()``;
 - ``--database``: one database build and predicate evaluation alone, in d = 2, 4, 6, with and
   without annealing, at n = 20 (the constants ``DATABASE_*`` / ``ANNEALING_*`` come from these);
-- ``--aer-iterations``: one Aer round at n = 18 for k = 1, 2, 5, 10 (the per-iteration constant).
+- ``--aer-iterations``: one Aer round at n = 18 for k = 1, 2, 5, 10 (the per-iteration constant);
+- ``--plan-limits``: what a plan's node and round limits let it hold (``memory.plan_bytes``): a
+  tree of 200 000 / 600 000 nodes grown by 4 096 parallel-RRT workers in a world whose goal is
+  walled in (d = 2 and 4), and 1 000 000 RRT rounds from a start walled in a small cube (the
+  round history; the tree stays small);
+  the constants ``TREE_*`` and ``HISTORY_BYTES_PER_ROUND`` come from these.
 
     python benchmarks/bench_memory.py            # n = 16, 18, 20, 22 on both backends (a few minutes)
     python benchmarks/bench_memory.py --quick    # n = 16, 18, 20
@@ -26,6 +31,7 @@ import json
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 from _common import RESULTS, machine
@@ -88,6 +94,58 @@ def run_database_case(n: int, d: int, annealing: bool) -> dict:
             "measured_bytes_per_entry": (_peak() - base) / (1 << n)}
 
 
+def _walled_world(dim: int, around: float):
+    """A 20^d world with a wall (0.5 thick) around the corner cube [16, 20]^d, whose centre 18 is
+    walled in: around the goal (``around`` = goal) or the start."""
+    import numpy as np
+
+    import qrrt_circuits as qc
+
+    boxes = []
+    for axis in range(dim):
+        low, high = np.full(dim, 16.0), np.full(dim, 20.0)
+        high[axis] = 16.5
+        boxes.append([low, high])
+    env = qc.Environment(np.array([[0.0, 20.0]] * dim), np.array(boxes))
+    inside, outside = np.full(dim, around), np.full(dim, 2.0)
+    return env, inside, outside
+
+
+def run_plan_limits_case(kind: str, dim: int, limit: int) -> dict:
+    import numpy as np
+
+    import qrrt_circuits as qc
+    from qrrt_circuits.memory import plan_bytes
+
+    env, walled_in, outside = _walled_world(dim, 18.0)
+    dynamics = None if dim == 2 else qc.LinearTrackingDynamics(-np.eye(dim), np.eye(dim), np.eye(dim))
+    if kind == "tree":  # 4 096 workers fill the world outside the wall; the goal is unreachable
+        planner = qc.ParallelRRT(env, workers=4096, seed=0, dynamics=dynamics)
+        qc.ParallelRRT(env, workers=8, seed=0, dynamics=dynamics).plan(outside, walled_in, 0.5, max_rounds=3)
+        base = _rss()
+        began = time.perf_counter()
+        result = planner.plan(outside, walled_in, 0.5, max_nodes=limit)
+        nodes_per_round, rounds = 4096, result.metrics.rounds
+    else:  # RRT rounds from a walled-in start: nodes only inside the small walled cube, the history grows
+        planner = qc.RRT(env, seed=0, dynamics=dynamics)
+        planner.plan(walled_in, outside, 0.5, max_rounds=3)  # warm up
+        base = _rss()
+        began = time.perf_counter()
+        result = planner.plan(walled_in, outside, 0.5, max_rounds=limit, stall_rounds=limit)
+        nodes_per_round, rounds = 1, limit
+    tree, history = plan_bytes(limit if kind == "tree" else qc.termination.DEFAULT_MAX_NODES, nodes_per_round,
+                               rounds, dim)
+    seconds = time.perf_counter() - began
+    measured = _peak() - base
+    return {"case": f"plan-{kind}", "seconds": round(seconds, 2), "dim": dim, "num_qubits": 0, "limit": limit,
+            "nodes": result.metrics.nodes,
+            "rounds": result.metrics.rounds, "measured_bytes": measured,
+            "estimated_bytes": tree + history if kind == "tree" else history,
+            "measured_bytes_per_node": measured / max(result.metrics.nodes, 1),
+            "measured_bytes_per_round": measured / result.metrics.rounds,
+            "note": "the rounds case's estimate is the history alone (its tree stays small)"}
+
+
 def in_subprocess(*args: str) -> dict:
     env = dict(os.environ, OMP_NUM_THREADS="1")
     out = subprocess.run([sys.executable, __file__, "--case", *args], capture_output=True, text=True,
@@ -100,6 +158,9 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--database", action="store_true", help="also the database cases (d = 2, 4, 6)")
     parser.add_argument("--aer-iterations", action="store_true", help="also Aer at n = 18 for k = 1..10")
+    parser.add_argument("--plan-limits", action="store_true",
+                        help="also a plan's tree (d = 2, 4) and round history against memory.plan_bytes")
+    parser.add_argument("--only-plan-limits", action="store_true", help="only the --plan-limits cases")
     parser.add_argument("--out", default=None, help="the JSON to write (default benchmarks/results/bench_memory.json)")
     parser.add_argument("--case", nargs="+", help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -107,6 +168,8 @@ def main() -> None:
         kind, *rest = args.case
         if kind == "plan":
             result = run_plan_case(rest[0], int(rest[1]), None if rest[2] == "paper" else int(rest[2]))
+        elif kind == "limits":
+            result = run_plan_limits_case(rest[0], int(rest[1]), int(rest[2]))
         else:
             result = run_database_case(int(rest[0]), int(rest[1]), rest[2] == "1")
         print(json.dumps(result))
@@ -117,6 +180,12 @@ def main() -> None:
         cases += [("plan", "aer", "18", str(k)) for k in (1, 2, 5, 10)]
     if args.database:
         cases += [("database", "20", str(d), a) for d in (2, 4, 6) for a in ("0", "1")]
+    limits = [("limits", "tree", str(d), str(nodes)) for d in (2, 4) for nodes in (200_000, 600_000)]
+    limits += [("limits", "rounds", "2", "1000000")]
+    if args.only_plan_limits:
+        cases = limits
+    elif args.plan_limits:
+        cases += limits
     rows = []
     print(f"{'case':9s} {'backend':12s} {'n':>3s} {'d':>2s} {'k':>3s} {'estimated MiB':>14s} "
           f"{'measured MiB':>13s} {'est/meas':>9s}")

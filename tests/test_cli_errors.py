@@ -4,6 +4,7 @@ before any work is done (a table of the cases the reliability review found)."""
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -38,6 +39,12 @@ CASES = [
     (["reproduce", "lemmas", "--out", ""], "--out must name a folder"),
     (["reproduce", "lemmas", "--jobs", "4"], "--jobs needs --executor process or dask"),
     (["reproduce", "lemmas", "--executor", "process", "--jobs", "100000"], "jobs must be an integer in [1, "),
+    (["plan", "--planner", "rrt", "--qubits", "30"], "--qubits does not apply to --planner rrt"),
+    (["plan", "--planner", "rrt", "--backend", "statevector"], "--backend does not apply to --planner rrt"),
+    (["plan", "--planner", "prrt", "--policy", "bbht"], "--policy does not apply to --planner prrt"),
+    (["plan", "--planner", "qrrt", "--workers", "4"], "--workers does not apply to --planner qrrt"),
+    (["plan", "--planner", "rrt", "--max-rounds", "10000000000000", "--stall-rounds", "10000000000000"],
+     "max_rounds = 10000000000000: this plan's round history could need"),
 ]
 
 
@@ -110,3 +117,25 @@ def test_a_system_error_without_an_interrupt_is_not_swallowed(monkeypatch):
     monkeypatch.setattr(cli.argparse.ArgumentParser, "parse_args", lambda self, argv=None: args)
     with pytest.raises(SystemError, match="not an interrupt"):
         cli.main(["plan"])
+
+
+def test_planner_specific_options_take_their_defaults_where_they_apply(capsys):
+    """--qubits, --workers, --backend and --policy default to 8, 8, aer and paper for the planners
+    that take them (they are no longer defaults that other planners silently ignore)."""
+    from qrrt_circuits.cli import main
+
+    assert main(["plan", "--planner", "pqrrt", "--max-nodes", "3"]) == 0
+    settings = dict(line.split(None, 1) for line in capsys.readouterr().out.splitlines()[1:12] if line.strip())
+    assert settings["num_qubits"] == "8" and settings["workers"] == "8" and settings["backend"] == "aer"
+    assert settings["search_policy"].startswith("paper")
+    assert main(["plan", "--planner", "prrt", "--max-nodes", "3"]) == 0
+    assert "workers                  8" in capsys.readouterr().out
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full (a device whose writes fail)")
+def test_a_failed_json_write_says_the_plan_finished(tmp_path):
+    run = subprocess.run([sys.executable, "-m", "qrrt_circuits.cli", "plan", "--planner", "rrt", "--max-nodes", "3",
+                          "--json", "/dev/full"], capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert run.returncode == 1 and "Traceback" not in run.stderr
+    assert "--json: writing '/dev/full' failed (No space left on device); the plan finished" in run.stderr
+    assert "metrics:" in run.stdout

@@ -213,3 +213,42 @@ def test_the_sampler_backends_estimate_covers_a_million_shots():
                          check=True)
     added, estimated = map(int, run.stdout.split())
     assert 100 * 1_000_000 < added <= estimated, (added, estimated)
+
+
+_TREE_PEAK = _PEAK_OF + """
+import sys
+import numpy as np
+import qrrt_circuits as qc
+from qrrt_circuits.memory import plan_bytes
+
+dim, nodes = int(sys.argv[1]), int(sys.argv[2])
+boxes = []
+for axis in range(dim):  # a wall around the corner cube [16, 20]^d: the goal (18, ..., 18) is walled in
+    low, high = np.full(dim, 16.0), np.full(dim, 20.0)
+    high[axis] = 16.5
+    boxes.append([low, high])
+env = qc.Environment(np.array([[0.0, 20.0]] * dim), np.array(boxes))
+dynamics = None if dim == 2 else qc.LinearTrackingDynamics(-np.eye(dim), np.eye(dim), np.eye(dim))
+def plan(workers, **limits):
+    return qc.ParallelRRT(env, workers=workers, seed=0, dynamics=dynamics).plan(
+        np.full(dim, 2.0), np.full(dim, 18.0), 0.5, **limits)
+plan(8, max_rounds=3)  # compiled code loaded before the measurement
+results = []
+added = added_peak(lambda: results.append(plan(4096, max_nodes=nodes)))
+result = results[0]
+tree, history = plan_bytes(nodes, 4096, result.metrics.rounds, dim)
+print(result.status, result.metrics.nodes, added, tree + history)
+"""
+
+
+@pytest.mark.skipif(not _can_reset_peak(), reason="needs Linux's /proc/self/clear_refs to reset the peak RSS")
+@pytest.mark.parametrize("dim", [2, 4])
+def test_the_tree_estimate_covers_a_tree_grown_to_its_node_limit(dim):
+    """4 096 parallel-RRT workers fill a world whose goal is walled in up to a node limit of
+    100 000 (``plan_bytes`` is what ``check_plan_fits`` compares with the available memory): the
+    peak the plan adds, measured in a fresh process, is within the estimate, and not far below it."""
+    run = subprocess.run([sys.executable, "-c", _TREE_PEAK, str(dim), "100000"], capture_output=True, text=True,
+                         timeout=300, check=True)
+    status, nodes, added, estimated = run.stdout.split()
+    assert status == "max_nodes" and 100_000 <= int(nodes) < 100_000 + 4096
+    assert 0.25 * int(estimated) < int(added) <= int(estimated), (added, estimated)

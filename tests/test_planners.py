@@ -155,7 +155,8 @@ def test_default_round_limit_ends_a_plan_with_no_budget(monkeypatch):
     env = Environment(np.array([[0, 20], [0, 20]]), boxes)
     result = qc.RRT(env, seed=0).plan([1, 1], [16, 16], 0.5)
     assert result.status == "max_rounds" and result.metrics.rounds == 17
-    assert result.settings["termination"] == {"max_rounds": 17, "stall_rounds": termination.DEFAULT_STALL_ROUNDS}
+    assert result.settings["termination"] == {"max_rounds": 17, "stall_rounds": termination.DEFAULT_STALL_ROUNDS,
+                                              "max_nodes": termination.DEFAULT_MAX_NODES}
 
 
 def test_bbht_terminates_with_no_solution_and_respects_its_bound():

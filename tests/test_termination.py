@@ -8,7 +8,14 @@ import pytest
 
 import qrrt_circuits as qc
 from qrrt_circuits.environment import Environment
-from qrrt_circuits.termination import DEFAULT_STALL_ROUNDS, Progress, from_budgets, with_defaults, with_round_limit
+from qrrt_circuits.termination import (
+    DEFAULT_MAX_NODES,
+    DEFAULT_STALL_ROUNDS,
+    Progress,
+    from_budgets,
+    with_defaults,
+    with_round_limit,
+)
 
 WALLED_GOAL = np.array([[[14, 14], [18, 14.5]], [[14, 17.5], [18, 18]], [[14, 14], [14.5, 18]],
                         [[17.5, 14], [18, 18]]], dtype=float)
@@ -123,7 +130,8 @@ def test_termination_argument_combines_with_the_shorthands(walled):
                                          max_oracle_calls=12)
     assert result.status == "max_oracle_calls" and result.metrics.rounds == 12
     assert result.settings["termination"] == {"max_rounds": 30, "max_oracle_calls": 12,
-                                              "stall_rounds": DEFAULT_STALL_ROUNDS}
+                                              "stall_rounds": DEFAULT_STALL_ROUNDS,
+                                              "max_nodes": DEFAULT_MAX_NODES}
     with pytest.raises(TypeError, match="termination must be a TerminationCondition"):
         qc.RRT(walled).plan([1, 1], [16, 16], 0.5, termination=30)
 
@@ -168,8 +176,11 @@ def test_default_stall_ends_a_plan_given_only_a_node_budget(monkeypatch, boxed_i
     monkeypatch.setattr(termination, "DEFAULT_STALL_ROUNDS", 25)
     result = qc.RRT(boxed_in, seed=0).plan([5, 5], [15, 15], 0.5, max_nodes=5)
     assert result.status == "stalled" and result.metrics.rounds == 25
-    assert with_defaults(qc.Stall(3)) == qc.Stall(3) | qc.MaxRounds(termination.DEFAULT_MAX_ROUNDS)
-    assert with_defaults(qc.MaxRounds(3)) == qc.MaxRounds(3) | qc.Stall(25)
+    assert with_defaults(qc.Stall(3)) == (qc.Stall(3) | qc.MaxRounds(termination.DEFAULT_MAX_ROUNDS)
+                                          | qc.MaxNodes(termination.DEFAULT_MAX_NODES))
+    assert with_defaults(qc.MaxRounds(3)) == qc.MaxRounds(3) | qc.Stall(25) | qc.MaxNodes(termination.DEFAULT_MAX_NODES)
+    complete = qc.MaxRounds(3) | qc.MaxNodes(4) | qc.Stall(2)
+    assert with_defaults(complete) == complete
 
 
 def _tiled(cells: int = 317, gap: float = 0.004) -> tuple[Environment, np.ndarray, np.ndarray]:
@@ -248,3 +259,63 @@ def test_a_start_just_inside_the_boundary_margin_ends_stalled(planner_name, wall
     planner = PLANNERS.create(planner_name, env=walled, **PLANNERS.applicable(planner_name, options))
     result = planner.plan([1e-7, 5.0], [10, 10], 0.5, max_nodes=5, stall_rounds=20)
     assert result.status == "stalled" and result.metrics.nodes == 0
+
+
+def test_a_node_limit_is_always_in_force(walled, monkeypatch):
+    """Without a node limit of the caller's, DEFAULT_MAX_NODES ends a plan that keeps growing (8
+    workers fill the world outside the walled goal): the status says max_nodes and the tree
+    overshoots by fewer than p nodes; a caller's own node limit replaces the default."""
+    from qrrt_circuits import termination
+
+    monkeypatch.setattr(termination, "DEFAULT_MAX_NODES", 40)
+    result = qc.ParallelRRT(walled, workers=8, seed=0).plan([1, 1], [16, 16], 0.5)
+    assert result.status == "max_nodes" and 40 <= result.metrics.nodes < 40 + 8
+    assert result.settings["termination"]["max_nodes"] == 40
+    own = qc.ParallelRRT(walled, workers=8, seed=0).plan([1, 1], [16, 16], 0.5, max_nodes=60)
+    assert own.status == "max_nodes" and 60 <= own.metrics.nodes < 68
+    assert own.settings["termination"]["max_nodes"] == 60
+
+
+def test_node_and_round_limits_of_composed_conditions():
+    condition = qc.MaxNodes(50) | qc.MaxRounds(100) | qc.MaxNodes(20) | qc.Stall(5)
+    assert condition.node_limit == 20 and condition.round_limit == 100
+    assert qc.Stall(5).node_limit is None and qc.Stall(5).round_limit is None
+    assert (qc.MaxOracleCalls(5) | qc.Stall(3)).node_limit is None
+    defaults = with_defaults(None)
+    assert defaults.node_limit == DEFAULT_MAX_NODES and defaults.round_limit == 20000
+    assert with_defaults(qc.MaxNodes(7)).node_limit == 7
+
+
+def test_limits_whose_tree_or_history_exceed_memory_are_refused_before_any_work(walled, monkeypatch):
+    """A round limit of 10^9 would let a plan that cannot grow keep about 240 GiB of round history
+    (RRT's rounds take microseconds, so it would get there); a node limit of 10^9 the same of tree.
+    Both are refused before the first round, naming the limit and the largest value that fits."""
+    from qrrt_circuits import memory
+
+    monkeypatch.setattr(memory, "available_memory_bytes", lambda: 1 << 30)
+    planner = qc.RRT(walled, seed=0)
+    with pytest.raises(ValueError, match=r"max_rounds = 1000000000: .* the largest max_rounds that fits is about"):
+        planner.plan([16, 16], [1, 1], 0.5, max_rounds=10**9, stall_rounds=10**9)
+    with pytest.raises(ValueError, match=r"max_nodes = 1000000000: .* the largest max_nodes that fits is about"):
+        qc.ParallelRRT(walled, workers=8, seed=0).plan([1, 1], [16, 16], 0.5, max_nodes=10**9)
+    assert planner.plan([16, 16], [1, 1], 0.5, max_rounds=50, stall_rounds=50).metrics.rounds == 50
+
+
+@pytest.mark.parametrize("dim", [2, 4])
+def test_check_plan_fits_names_the_largest_limit_that_fits(dim):
+    """The largest value the message names fits, and one more than it does not."""
+    import re
+
+    from qrrt_circuits.memory import check_plan_fits, plan_bytes
+
+    available = 1 << 30
+    for limit_name, call in (("max_nodes", lambda v: check_plan_fits(v, 8, 20000, dim, available)),
+                             ("max_rounds", lambda v: check_plan_fits(1000, 1, v, dim, available))):
+        with pytest.raises(ValueError, match=limit_name) as refused:
+            call(10**10)
+        largest = int(re.search(r"fits is about (\d+)", str(refused.value)).group(1))
+        call(largest)
+        with pytest.raises(ValueError, match=limit_name):
+            call(largest + 1)
+    tree, history = plan_bytes(1000, 8, 20000, dim)
+    assert tree == 1008 * (96 + 48 * dim) and history == 20000 * 256

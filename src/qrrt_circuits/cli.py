@@ -156,13 +156,48 @@ def _load_environment(args: argparse.Namespace) -> Environment:
     return SCENARIOS.create(args.scenario, seed=args.scenario_seed)
 
 
+#: ``qrrt plan``'s options that only some planners take: option -> (the planner's keyword, the
+#: default used where the planner takes it and the option is not given)
+PLANNER_SPECIFIC_OPTIONS: dict[str, tuple[str, Any]] = {
+    "qubits": ("num_qubits", 8),
+    "workers": ("workers", 8),
+    "backend": ("backend", "aer"),
+    "policy": ("search_policy", "paper"),
+}
+
+
+def _planner_specific(args: argparse.Namespace) -> dict[str, Any]:
+    """The planner-specific options of ``args`` (``PLANNER_SPECIFIC_OPTIONS``), defaults filled in
+    for the ones the planner takes; one that was given but that the planner does not take is
+    refused (``ValueError``) instead of being ignored."""
+    accepted = PLANNERS.resolve(args.planner).options()
+    given = vars(args)
+    chosen: dict[str, Any] = {}
+    for option, (keyword, default) in PLANNER_SPECIFIC_OPTIONS.items():
+        value = given.get(option)
+        if keyword in accepted:
+            chosen[option] = default if value is None else value
+        elif value is not None:
+            takers = [name for name in PLANNERS.names() if keyword in PLANNERS.resolve(name).options()]
+            raise ValueError(f"--{option} does not apply to --planner {args.planner} (it applies to "
+                             f"{', '.join(takers)}); leave it out")
+    return chosen
+
+
 def build_planner(args: argparse.Namespace, env: Environment) -> Planner:
-    """The planner the arguments name, with only the options that apply to it."""
-    options: dict[str, Any] = {"goal_bias": args.goal_bias, "seed": args.seed, "workers": args.workers,
-               "num_qubits": args.qubits, "predicate": PREDICATES.create(args.predicate, env=env)}
-    if "quantum" in PLANNERS.resolve(args.planner).tags:
-        options["backend"] = BACKENDS.create(args.backend, seed=args.seed)
-        options["search_policy"] = POLICIES.create(args.policy)
+    """The planner the arguments name, with only the options that apply to it; a planner-specific
+    option given to a planner that does not take it (``--qubits`` with ``rrt``) is refused."""
+    specific = _planner_specific(args)
+    options: dict[str, Any] = {"goal_bias": args.goal_bias, "seed": args.seed,
+                               "predicate": PREDICATES.create(args.predicate, env=env)}
+    if "qubits" in specific:
+        options["num_qubits"] = specific["qubits"]
+    if "workers" in specific:
+        options["workers"] = specific["workers"]
+    if "backend" in specific:
+        options["backend"] = BACKENDS.create(specific["backend"], seed=args.seed)
+    if "policy" in specific:
+        options["search_policy"] = POLICIES.create(specific["policy"])
     planner: Planner = PLANNERS.create(args.planner, env=env, **PLANNERS.applicable(args.planner, options))
     return planner
 
@@ -191,7 +226,12 @@ def _print_plan(result: PlanResult, env: Environment, seed: int) -> None:
 
 def _write_plan_outputs(args: argparse.Namespace, result: PlanResult, env: Environment) -> None:
     if args.json:
-        Path(args.json).write_text(json.dumps(result.to_dict(), indent=1))
+        text = json.dumps(result.to_dict(), indent=1)
+        try:
+            Path(args.json).write_text(text)
+        except OSError as exc:  # e.g. a full disk: checked writable before the plan, failed now
+            raise OSError(f"--json: writing {args.json!r} failed ({exc.strerror}); the plan "
+                          "finished (its metrics are printed above) but its JSON was not written") from None
         print(f"wrote {args.json}")
     if args.plot:
         import matplotlib
@@ -291,13 +331,18 @@ def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
     plan.add_argument("--scenario-seed", type=_nonnegative_int, default=0)
     plan.add_argument("--planner", type=_registered(PLANNERS), choices=PLANNERS.names(), default="pqrrt",
                       help=PLANNERS.help_text())
-    plan.add_argument("--backend", type=_registered(BACKENDS), choices=BACKENDS.names(), default="aer",
-                      help=f"(quantum planners) {BACKENDS.help_text()}")
-    plan.add_argument("--qubits", type=_positive_int, default=8, help="database of 2^qubits (quantum planners)")
-    plan.add_argument("--workers", type=_positive_int, default=8, help="workers (prrt, pqrrt, pqrrt-unshared)")
-    plan.add_argument("--policy", "--schedule", dest="policy", type=_registered(POLICIES), default="paper",
+    # the planner-specific options are absent unless given (their defaults are PLANNER_SPECIFIC_OPTIONS'),
+    # so that one given to a planner that does not take it is refused instead of ignored
+    plan.add_argument("--backend", type=_registered(BACKENDS), choices=BACKENDS.names(), default=argparse.SUPPRESS,
+                      help=f"(quantum planners; default aer) {BACKENDS.help_text()}")
+    plan.add_argument("--qubits", type=_positive_int, default=argparse.SUPPRESS,
+                      help="database of 2^qubits (quantum planners; default 8)")
+    plan.add_argument("--workers", type=_positive_int, default=argparse.SUPPRESS,
+                      help="workers (prrt, pqrrt, pqrrt-unshared; default 8)")
+    plan.add_argument("--policy", "--schedule", dest="policy", type=_registered(POLICIES), default=argparse.SUPPRESS,
                       metavar="|".join(POLICIES.labels()),
-                      help=f"search policy (quantum planners; --schedule is its old name): {POLICIES.help_text()}")
+                      help=f"search policy (quantum planners, default paper; --schedule is its old name): "
+                           f"{POLICIES.help_text()}")
     plan.add_argument("--predicate", type=_registered(PREDICATES), default="exact",
                       metavar="|".join(PREDICATES.labels()), help=f"reachability check: {PREDICATES.help_text()}")
     plan.add_argument("--goal-bias", type=float, default=0.0)

@@ -249,3 +249,93 @@ def check_fits(estimate_for: Callable[[int], MemoryEstimate], num_qubits: int, w
         f"({estimate.breakdown()}), more than the {_size(available)} of memory available "
         f"(MemAvailable); the largest num_qubits that fits is {largest}"
         f"{' (none does)' if largest == 0 else ''}")
+
+
+#: a plan's tree, bytes per node besides its coordinates (parents in the tree and the result, the
+#: nearest-node grid's order, the history of nodes, allocator slack). Measured with
+#: ``python benchmarks/bench_memory.py --only-plan-limits`` (4 096 parallel-RRT workers filling a
+#: world whose goal is walled in, 200 000 and 600 000 nodes): 127-130 B per node at d = 2 and
+#: 193-216 at d = 4; the estimate, 96 + 48 d, is 1.3-1.5 times that.
+TREE_BYTES_PER_NODE = 96
+#: a plan's tree, bytes per node and coordinate (positions in the tree, the grid and the result)
+TREE_BYTES_PER_COORDINATE = 48
+#: a plan's round history (``RunState.end_round``: five Python integers a round in lists, and the
+#: result's copies), bytes per round: 180 measured over 10^6 RRT rounds from a start walled in a
+#: small cube (the same command; 3 % of the rounds added a node there), rounded up
+HISTORY_BYTES_PER_ROUND = 256
+
+
+def plan_bytes(max_nodes: int, nodes_per_round: int, max_rounds: int | None, dim: int) -> tuple[int, int]:
+    """The most a plan's tree and its round history can hold, in bytes: (tree, history).
+
+    A round adds at most ``nodes_per_round`` nodes (1, or p workers) and the node limit is checked
+    before each round, so the tree ends with at most ``max_nodes + nodes_per_round - 1`` nodes
+    besides the root.
+
+    Args:
+        max_nodes: The node limit in force (``TerminationCondition.node_limit``).
+        nodes_per_round: The most nodes one round adds.
+        max_rounds: The round limit in force; None where a condition bounds rounds without saying
+            how many (a user's own condition): the history is then not counted.
+        dim: The workspace dimension d.
+
+    Returns:
+        ``(tree_bytes, history_bytes)``.
+
+    Example:
+        >>> from qrrt_circuits.memory import plan_bytes
+        >>> plan_bytes(1000, 1, 20000, 2)
+        (192192, 5120000)
+    """
+    tree = (max_nodes + nodes_per_round) * (TREE_BYTES_PER_NODE + TREE_BYTES_PER_COORDINATE * dim)
+    history = 0 if max_rounds is None else max_rounds * HISTORY_BYTES_PER_ROUND
+    return tree, history
+
+
+def check_plan_fits(max_nodes: int, nodes_per_round: int, max_rounds: int | None, dim: int,
+                    available: int | None = None) -> None:
+    """Refuse (``ValueError``) limits whose tree and round history could exceed the available
+    memory, naming the limit that needs the most (``max_nodes`` or ``max_rounds``), the estimate,
+    the available memory and the largest value of that limit that fits.
+
+    Estimates up to ``ALWAYS_FITS_BYTES`` are accepted without reading the available memory; so is
+    any estimate when the available memory is unknown.
+
+    Args:
+        max_nodes: The node limit in force.
+        nodes_per_round: The most nodes one round adds.
+        max_rounds: The round limit in force (None: not counted, see ``plan_bytes``).
+        dim: The workspace dimension d.
+        available: The available bytes; None (default) for ``available_memory_bytes()``.
+
+    Raises:
+        ValueError: The estimate exceeds the available memory.
+
+    Example:
+        >>> from qrrt_circuits.memory import check_plan_fits
+        >>> check_plan_fits(10**6, 1, 20000, 2, available=2**30)
+        >>> check_plan_fits(10**6, 1, 10**9, 2, available=2**30)  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        ValueError: max_rounds = 1000000000: this plan's round history could need about 238.4 GiB ...
+    """
+    tree, history = plan_bytes(max_nodes, nodes_per_round, max_rounds, dim)
+    if tree + history <= ALWAYS_FITS_BYTES:
+        return
+    available = available_memory_bytes() if available is None else available
+    if available is None or tree + history <= available:
+        return
+    if history > tree:
+        assert max_rounds is not None  # history is 0 without a round limit
+        largest = max(0, (available - tree) // HISTORY_BYTES_PER_ROUND)
+        raise ValueError(
+            f"max_rounds = {max_rounds}: this plan's round history could need about {_size(history)} "
+            f"(and its tree {_size(tree)}), more than the {_size(available)} of memory available (MemAvailable); "
+            f"the largest max_rounds that fits is about {largest}")
+    per_node = TREE_BYTES_PER_NODE + TREE_BYTES_PER_COORDINATE * dim
+    largest = max(0, (available - history) // per_node - nodes_per_round)
+    raise ValueError(
+        f"max_nodes = {max_nodes}: this plan's tree could need about {_size(tree)} "
+        f"(and its round history {_size(history)}), more than the {_size(available)} of memory available "
+        f"(MemAvailable); the largest max_nodes that fits is about {largest}")
+

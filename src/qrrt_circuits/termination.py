@@ -11,11 +11,14 @@ cut-offs behave the same way).
 Every plan terminates: ``Planner.plan`` always adds ``MaxRounds(DEFAULT_MAX_ROUNDS)`` unless the
 condition it is given already limits rounds, and ``Stall(DEFAULT_STALL_ROUNDS)`` unless it already
 has a stall condition, so a plan that can add no node (a start boxed in) ends as ``"stalled"``.
+It also adds ``MaxNodes(DEFAULT_MAX_NODES)`` unless the condition limits nodes, so no plan's tree
+outgrows memory (``memory.check_plan_fits`` checks the limits in force before the first round).
 """
 
 from __future__ import annotations
 
 import abc
+from collections.abc import Iterable
 from dataclasses import dataclass
 from enum import StrEnum
 
@@ -28,6 +31,13 @@ DEFAULT_MAX_ROUNDS = 20000
 #: per-round success rate measured there (RRT, about 0.7 % in 1000-box worlds) 5000 failures in a
 #: row have probability 0.993^5000 < 1e-15.
 DEFAULT_STALL_ROUNDS = 5000
+#: the node limit in force whenever the caller gives none. Without it the round limit alone bounds
+#: the tree: 4 096 parallel-RRT workers filling a world whose goal is walled in add about 3 900
+#: nodes a round (``python benchmarks/bench_memory.py --only-plan-limits``), so 20 000 rounds would
+#: make about 80 million nodes (about 9.5 GiB at the 127 bytes per node measured there, and many
+#: hours: 600 000 nodes took 35 s). A million nodes is about 120 MiB there, and far beyond any tree
+#: of the paper's experiments (thousands of nodes).
+DEFAULT_MAX_NODES = 1_000_000
 
 
 class PlanStatus(StrEnum):
@@ -132,6 +142,16 @@ class TerminationCondition(abc.ABC):
         """Whether this condition ends a plan that stopped adding nodes."""
         return False
 
+    @property
+    def node_limit(self) -> int | None:
+        """The node count at which this condition ends the plan, if it sets one (else None)."""
+        return None
+
+    @property
+    def round_limit(self) -> int | None:
+        """The round count at which this condition ends the plan, if it sets one (else None)."""
+        return None
+
     def __or__(self, other: TerminationCondition) -> AnyOf:
         """``AnyOf((self, other))``: ends the plan when either does (nested ``AnyOf`` flattened)."""
         if not isinstance(other, TerminationCondition):
@@ -224,6 +244,11 @@ class MaxNodes(_Limit):
     def _value(self, progress: Progress) -> float:
         return progress.nodes
 
+    @property
+    def node_limit(self) -> int:
+        """``limit``."""
+        return self.limit
+
 
 @dataclass(frozen=True)
 class MaxRounds(_Limit):
@@ -249,6 +274,11 @@ class MaxRounds(_Limit):
     def limits_rounds(self) -> bool:
         """True: a round limit."""
         return True
+
+    @property
+    def round_limit(self) -> int:
+        """``limit``."""
+        return self.limit
 
 
 @dataclass(frozen=True)
@@ -369,6 +399,21 @@ class AnyOf(TerminationCondition):
         """Whether any part detects a stall."""
         return any(condition.detects_stall for condition in self.conditions)
 
+    @property
+    def node_limit(self) -> int | None:
+        """The smallest node limit of the parts (None if none sets one)."""
+        return _smallest(condition.node_limit for condition in self.conditions)
+
+    @property
+    def round_limit(self) -> int | None:
+        """The smallest round limit of the parts (None if none sets one)."""
+        return _smallest(condition.round_limit for condition in self.conditions)
+
+
+def _smallest(limits: Iterable[int | None]) -> int | None:
+    present = [limit for limit in limits if limit is not None]
+    return min(present) if present else None
+
 
 def from_budgets(max_oracle_calls: int | None = None, max_nodes: int | None = None,
                  max_rounds: int | None = None, max_time_s: float | None = None,
@@ -418,19 +463,22 @@ def from_budgets(max_oracle_calls: int | None = None, max_nodes: int | None = No
 
 
 def with_defaults(condition: TerminationCondition | None, default_max_rounds: int | None = None,
-                  default_stall_rounds: int | None = None) -> TerminationCondition:
+                  default_stall_rounds: int | None = None,
+                  default_max_nodes: int | None = None) -> TerminationCondition:
     """``condition`` with ``MaxRounds(DEFAULT_MAX_ROUNDS)`` added unless it already limits rounds,
-    and ``Stall(DEFAULT_STALL_ROUNDS)`` unless it already has a stall condition: the guarantee
-    that every plan ends, and soon when it cannot grow.
+    ``Stall(DEFAULT_STALL_ROUNDS)`` unless it already has a stall condition, and
+    ``MaxNodes(DEFAULT_MAX_NODES)`` unless it already limits nodes: the guarantee that every plan
+    ends, soon when it cannot grow, and with a tree of bounded size.
 
     Args:
         condition: The caller's condition, or None.
         default_max_rounds: The round limit to add; None means ``DEFAULT_MAX_ROUNDS``.
         default_stall_rounds: The stall limit to add; None means ``DEFAULT_STALL_ROUNDS``.
+        default_max_nodes: The node limit to add; None means ``DEFAULT_MAX_NODES``.
 
     Returns:
-        ``condition`` itself if it already limits rounds and detects a stall, else an ``AnyOf`` with
-        the missing defaults appended.
+        ``condition`` itself if it already limits rounds and nodes and detects a stall, else an
+        ``AnyOf`` with the missing defaults appended (rounds, stall, nodes).
 
     Raises:
         TypeError: A non-integer default that has to be added.
@@ -440,14 +488,19 @@ def with_defaults(condition: TerminationCondition | None, default_max_rounds: in
         >>> from qrrt_circuits.termination import MaxNodes, with_defaults
         >>> with_defaults(MaxNodes(50))
         AnyOf(conditions=(MaxNodes(limit=50), MaxRounds(limit=20000), Stall(limit=5000)))
+        >>> with_defaults(None).node_limit
+        1000000
     """
     rounds = DEFAULT_MAX_ROUNDS if default_max_rounds is None else default_max_rounds
     stall = DEFAULT_STALL_ROUNDS if default_stall_rounds is None else default_stall_rounds
+    nodes = DEFAULT_MAX_NODES if default_max_nodes is None else default_max_nodes
     parts = [] if condition is None else [condition]
     if condition is None or not condition.limits_rounds:
         parts.append(MaxRounds(rounds))
     if condition is None or not condition.detects_stall:
         parts.append(Stall(stall))
+    if condition is None or condition.node_limit is None:
+        parts.append(MaxNodes(nodes))
     return parts[0] if len(parts) == 1 else AnyOf(tuple(parts))
 
 

@@ -25,6 +25,7 @@ import numpy as np
 from .. import termination as _termination
 from ..dynamics import LinearTrackingDynamics
 from ..environment import Environment
+from ..memory import check_plan_fits
 from ..oracle import ReachabilityOracle
 from ..oracle_errors import OracleErrorModel
 from ..predicate import ReachabilityPredicate, can_leave, check_predicate
@@ -155,8 +156,10 @@ class Planner:
 
         The ``max_*`` and ``stall_rounds`` keywords are shorthands for the conditions of
         ``qrrt_circuits.termination``; they combine (any of them ends the plan) with
-        ``termination``. A round limit (``DEFAULT_MAX_ROUNDS``) and a stall limit
-        (``DEFAULT_STALL_ROUNDS``) are added unless the condition has its own, so every plan ends.
+        ``termination``. A round limit (``DEFAULT_MAX_ROUNDS``), a stall limit
+        (``DEFAULT_STALL_ROUNDS``) and a node limit (``DEFAULT_MAX_NODES``) are added unless the
+        condition has its own, so every plan ends; limits whose tree and round history could
+        exceed the available memory are refused (``memory.check_plan_fits``).
         Conditions are checked before each round, so a round may overshoot an oracle-call budget
         by less than one round's cost.
 
@@ -183,7 +186,8 @@ class Planner:
 
         Raises:
             ValueError: A point outside the workspace or inside an obstacle, a boundary start, a
-                non-positive radius or budget, or a dimension mismatch, before any work.
+                non-positive radius or budget, a node or round limit whose tree or history could
+                exceed the available memory, or a dimension mismatch, before any work.
             TypeError: An argument of the wrong type (e.g. a ``termination`` that is not a
                 ``TerminationCondition``).
         """
@@ -193,8 +197,12 @@ class Planner:
         if termination is not None:
             check_instance(termination, "termination", TerminationCondition, "a TerminationCondition")
             condition = termination if condition is None else termination | condition
-        condition = with_defaults(condition, _termination.DEFAULT_MAX_ROUNDS, _termination.DEFAULT_STALL_ROUNDS)
+        condition = with_defaults(condition, _termination.DEFAULT_MAX_ROUNDS, _termination.DEFAULT_STALL_ROUNDS,
+                                  _termination.DEFAULT_MAX_NODES)
         self._check_ready()
+        node_limit = condition.node_limit
+        assert node_limit is not None  # with_defaults adds one
+        check_plan_fits(node_limit, self._max_new_nodes_per_round(), condition.round_limit, self.env.dim)
         state = RunState(start, goal, goal_radius)
         state.policy_state = self._start_policy()
         state.context = self._context()
@@ -255,6 +263,10 @@ class Planner:
 
     def _check_ready(self) -> None:
         """Subclasses validate their own settings before any work."""
+
+    def _max_new_nodes_per_round(self) -> int:
+        """The most nodes one round can add (1 here; p for p workers)."""
+        return 1
 
     def _start_policy(self) -> PolicyState | None:
         return None

@@ -230,6 +230,10 @@ class ParallelRRT(Planner):
     def settings(self) -> dict:
         return super().settings() | {"workers": self.workers}
 
+    def _max_new_nodes_per_round(self) -> int:
+        """p: each worker adds at most one node a round."""
+        return self.workers
+
 
 class RRT(ParallelRRT):
     """Classical RRT (paper Alg. 1): one sample, nearest node and reachability test per round.

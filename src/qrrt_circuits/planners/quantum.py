@@ -255,6 +255,10 @@ class PQRRT(Planner):
     def _start_policy(self) -> PolicyState:
         return self.search_policy.start(self.database_size)
 
+    def _max_new_nodes_per_round(self) -> int:
+        """p: each worker adds at most one node a round."""
+        return self.workers
+
     def _context(self) -> WorkerContext:
         return WorkerContext(self.env, self.predicate, self.streams, self.goal_bias, self.oracle_errors,
                              self.backend, self.annealing, self.database_size)
