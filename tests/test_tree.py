@@ -269,3 +269,33 @@ def test_add_many_refuses_positions_that_do_not_match_the_parents():
         with pytest.raises(ValueError, match="positions must have shape"):
             tree.add_many(positions, parents)
     assert tree.size == 1
+
+
+@pytest.mark.parametrize("dim", [20, 63, 64, 100])
+def test_high_dimensional_trees_past_the_switch(dim):
+    """In high d every axis of the grid got 2 cells: 2^64 cells wrapped to 0 in int64 and the grid was
+    filed out of bounds (a segmentation fault at d >= 64, a numpy error at d = 63), and at d = 20 a
+    query visited all 2^20 cells. Where a query's first block (3^d cells) would exceed the node
+    count the grid is one cell: answers as brute force, in bounded work."""
+    rng = np.random.default_rng(dim)
+    tree = Tree(rng.uniform(0, 20, dim))
+    for point in rng.uniform(0, 20, (450, dim)):
+        tree.add(point, 0)
+    assert tree.size == 451 and tree._grid_built_at >= 400 and tree._shape.tolist() == [1] * dim
+    queries = rng.uniform(0, 20, (64, dim))
+    brute = np.argmin(((queries[:, None, :] - tree.nodes[None, :, :]) ** 2).sum(axis=2), axis=1)
+    assert np.array_equal(tree.nearest(queries), brute)
+    assert np.array_equal(tree.grid_nearest(queries), brute)
+
+
+def test_a_six_dimensional_grid_has_cells_once_the_nodes_outnumber_a_query_block():
+    """3^6 = 729: one cell below 729 nodes, a real grid above (the same answers either way)."""
+    rng = np.random.default_rng(6)
+    tree = Tree(rng.uniform(0, 20, 6))
+    tree.add_many(rng.uniform(0, 20, (500, 6)), np.zeros(500, dtype=np.int64))
+    assert tree._shape.tolist() == [1] * 6
+    tree.add_many(rng.uniform(0, 20, (1500, 6)), np.zeros(1500, dtype=np.int64))
+    assert int(np.prod(tree._shape)) > 1
+    queries = rng.uniform(0, 20, (64, 6))
+    brute = np.argmin(((queries[:, None, :] - tree.nodes[None, :, :]) ** 2).sum(axis=2), axis=1)
+    assert np.array_equal(tree.nearest(queries), brute)

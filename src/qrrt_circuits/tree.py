@@ -216,10 +216,15 @@ class Tree:
         cell = float(np.prod(extent) / cells) ** (1.0 / self.dim)
         cell = max(cell, float(extent.max()) / _MAX_CELLS ** (1.0 / self.dim), 1e-12)
         shape = np.minimum(np.floor(extent / cell).astype(np.int64) + 1, 1 << 20)
-        while int(np.prod(shape)) > _MAX_CELLS:  # a very flat box: coarser cells
+        # the most cells: _MAX_CELLS; or one cell (a scan of every node, as brute force) where a
+        # query's first visit, the block of 3^d cells around its own, would exceed the node count
+        # (high d: at d = 20 every axis got 2 cells and a query visited all 2^20). Products in
+        # Python integers: in int64, 2^64 wrapped to 0 and the grid was filed out of bounds.
+        most = 1 if 3 ** self.dim > self.size else _MAX_CELLS
+        while math.prod(int(count) for count in shape) > most:  # a very flat box, or high d: coarser cells
             cell *= 2.0
             shape = np.minimum(np.floor(extent / cell).astype(np.int64) + 1, 1 << 20)
-        start = np.zeros(int(np.prod(shape)) + 1, dtype=np.int64)
+        start = np.zeros(math.prod(int(count) for count in shape) + 1, dtype=np.int64)
         order = np.empty(self.size, dtype=np.int64)
         _file_by_cell(nodes, low, cell, shape, start, order)
         self._origin, self._cell, self._shape = low.copy(), cell, shape
