@@ -15,7 +15,9 @@ Cases:
   tree of 200 000 / 600 000 nodes grown by 4 096 parallel-RRT workers in a world whose goal is
   walled in (d = 2 and 4), and 1 000 000 RRT rounds from a start walled in a small cube (the
   round history; the tree stays small);
-  the constants ``TREE_*`` and ``HISTORY_BYTES_PER_ROUND`` come from these.
+  the constants ``TREE_*`` and ``HISTORY_BYTES_PER_ROUND`` come from these; and the batches of
+  4 096 parallel-RRT workers whose every test fails (d = 2, 6, 64: ``plan-batch``, the constants
+  ``BATCH_BYTES_*`` of ``planners.classical``).
 
     python benchmarks/bench_memory.py            # n = 16, 18, 20, 22 on both backends (a few minutes)
     python benchmarks/bench_memory.py --quick    # n = 16, 18, 20
@@ -146,6 +148,56 @@ def run_plan_limits_case(kind: str, dim: int, limit: int) -> dict:
             "note": "the rounds case's estimate is the history alone (its tree stays small)"}
 
 
+class _Nowhere:
+    """A predicate that rejects every motion at no cost: a plan's batches are all it holds."""
+
+    name = "nowhere"
+
+    def __init__(self, dim: int) -> None:
+        self.dim = dim
+
+    def describe(self) -> dict:
+        return {"name": self.name}
+
+    def reachable(self, parents, children):
+        import numpy as np
+
+        return np.zeros(len(children), dtype=bool)
+
+
+def run_plan_batch_case(check: str, dim: int, rounds: int) -> dict:
+    """4 096 parallel-RRT workers whose tests (almost) all fail, for ``rounds`` rounds: batches of
+    ``batch_round_limit`` rounds (``MAX_BATCH_BYTES``). ``check`` "nowhere": a predicate that
+    rejects everything at no cost, in an empty world; "exact": the exact check, from a start walled
+    in a small cube (``_walled_world``)."""
+    import numpy as np
+
+    import qrrt_circuits as qc
+    from qrrt_circuits.planners import classical
+
+    if check == "nowhere":
+        env, start, goal = qc.Environment(np.array([[0.0, 20.0]] * dim), np.zeros((0, 2, dim))), None, None
+        options: dict = {"predicate": _Nowhere(dim)}
+        start, goal = np.full(dim, 2.0), np.full(dim, 18.0)
+    else:
+        env, start, goal = _walled_world(dim, 18.0)
+        options = {"dynamics": None if dim == 2 else qc.LinearTrackingDynamics(-np.eye(dim), np.eye(dim), np.eye(dim))}
+    qc.ParallelRRT(env, workers=8, seed=0, **options).plan(start, goal, 0.5, max_rounds=3)
+    base = _rss()
+    began = time.perf_counter()
+    result = qc.ParallelRRT(env, workers=4096, seed=0, **options).plan(start, goal, 0.5, max_rounds=rounds,
+                                                                      stall_rounds=rounds)
+    seconds = time.perf_counter() - began
+    measured = _peak() - base
+    candidates = classical.batch_round_limit(4096, dim) * 4096
+    return {"case": f"plan-batch-{check}", "seconds": round(seconds, 2), "dim": dim, "num_qubits": 0,
+            "limit": rounds, "rounds": result.metrics.rounds, "nodes": result.metrics.nodes,
+            "batch_candidates": candidates, "measured_bytes": measured,
+            "estimated_bytes": candidates * (classical.BATCH_BYTES_PER_CANDIDATE
+                                             + classical.BATCH_BYTES_PER_COORDINATE * dim),
+            "measured_bytes_per_candidate": measured / candidates}
+
+
 def in_subprocess(*args: str) -> dict:
     env = dict(os.environ, OMP_NUM_THREADS="1")
     out = subprocess.run([sys.executable, __file__, "--case", *args], capture_output=True, text=True,
@@ -170,6 +222,8 @@ def main() -> None:
             result = run_plan_case(rest[0], int(rest[1]), None if rest[2] == "paper" else int(rest[2]))
         elif kind == "limits":
             result = run_plan_limits_case(rest[0], int(rest[1]), int(rest[2]))
+        elif kind == "batch":
+            result = run_plan_batch_case(rest[0], int(rest[1]), int(rest[2]))
         else:
             result = run_database_case(int(rest[0]), int(rest[1]), rest[2] == "1")
         print(json.dumps(result))
@@ -182,6 +236,7 @@ def main() -> None:
         cases += [("database", "20", str(d), a) for d in (2, 4, 6) for a in ("0", "1")]
     limits = [("limits", "tree", str(d), str(nodes)) for d in (2, 4) for nodes in (200_000, 600_000)]
     limits += [("limits", "rounds", "2", "1000000")]
+    limits += [("batch", "nowhere", str(d), "300") for d in (2, 6, 64)] + [("batch", "exact", "6", "300")]
     if args.only_plan_limits:
         cases = limits
     elif args.plan_limits:

@@ -44,7 +44,7 @@ CASES = [
     (["plan", "--planner", "prrt", "--policy", "bbht"], "--policy does not apply to --planner prrt"),
     (["plan", "--planner", "qrrt", "--workers", "4"], "--workers does not apply to --planner qrrt"),
     (["plan", "--planner", "rrt", "--max-rounds", "10000000000000", "--stall-rounds", "10000000000000"],
-     "max_rounds = 10000000000000: this plan's round history could need"),
+     "max_rounds = 10000000000000: this plan's tree and round history could need"),
 ]
 
 
@@ -139,3 +139,46 @@ def test_a_failed_json_write_says_the_plan_finished(tmp_path):
     assert run.returncode == 1 and "Traceback" not in run.stderr
     assert "--json: writing '/dev/full' failed (No space left on device); the plan finished" in run.stderr
     assert "metrics:" in run.stdout
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full (a device whose writes fail)")
+def test_a_failed_plot_write_is_named_and_the_json_is_still_written(tmp_path):
+    (tmp_path / "full.png").symlink_to("/dev/full")
+    run = subprocess.run([sys.executable, "-m", "qrrt_circuits.cli", "plan", "--planner", "rrt", "--max-nodes", "3",
+                          "--plot", "full.png", "--json", "tree.json"], capture_output=True, text=True,
+                         cwd=tmp_path, timeout=120)
+    assert run.returncode == 1 and "Traceback" not in run.stderr
+    assert "--plot: writing 'full.png' failed (No space left on device); the plan finished" in run.stderr
+    assert json.loads((tmp_path / "tree.json").read_text())["status"] == "max_nodes"
+
+
+def test_outputs_replace_files_whole_and_leave_no_temporary_file(tmp_path, monkeypatch):
+    """A write that fails midway leaves the old file as it was and no temporary file beside it;
+    one that succeeds replaces it (through a symbolic link: the file it names) with the mode a
+    new file gets."""
+    from qrrt_circuits import cli
+
+    target = tmp_path / "out.json"
+    target.write_text("old")
+
+    def failing(handle):
+        handle.write("partial")
+        raise OSError(28, "No space left on device")
+
+    with pytest.raises(OSError):
+        cli._write_replacing(target, failing)
+    assert target.read_text() == "old" and sorted(p.name for p in tmp_path.iterdir()) == ["out.json"]
+    link = tmp_path / "link.json"
+    link.symlink_to(target)
+    cli._write_replacing(link, lambda handle: handle.write("new"))
+    assert link.is_symlink() and target.read_text() == "new"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link.json", "out.json"]
+    assert target.stat().st_mode & 0o777 == 0o666 & ~_umask()
+
+
+def _umask() -> int:
+    import os
+
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask

@@ -297,7 +297,7 @@ def test_limits_whose_tree_or_history_exceed_memory_are_refused_before_any_work(
     with pytest.raises(ValueError, match=r"max_rounds = 1000000000: .* the largest max_rounds that fits is about"):
         planner.plan([16, 16], [1, 1], 0.5, max_rounds=10**9, stall_rounds=10**9)
     with pytest.raises(ValueError, match=r"max_nodes = 1000000000: .* the largest max_nodes that fits is about"):
-        qc.ParallelRRT(walled, workers=8, seed=0).plan([1, 1], [16, 16], 0.5, max_nodes=10**9)
+        qc.ParallelRRT(walled, workers=4096, seed=0).plan([1, 1], [16, 16], 0.5, max_nodes=10**9)
     assert planner.plan([16, 16], [1, 1], 0.5, max_rounds=50, stall_rounds=50).metrics.rounds == 50
 
 
@@ -309,7 +309,7 @@ def test_check_plan_fits_names_the_largest_limit_that_fits(dim):
     from qrrt_circuits.memory import check_plan_fits, plan_bytes
 
     available = 1 << 30
-    for limit_name, call in (("max_nodes", lambda v: check_plan_fits(v, 8, 20000, dim, available)),
+    for limit_name, call in (("max_nodes", lambda v: check_plan_fits(v, 4096, 20000, dim, available)),
                              ("max_rounds", lambda v: check_plan_fits(1000, 1, v, dim, available))):
         with pytest.raises(ValueError, match=limit_name) as refused:
             call(10**10)
@@ -319,3 +319,79 @@ def test_check_plan_fits_names_the_largest_limit_that_fits(dim):
             call(largest + 1)
     tree, history = plan_bytes(1000, 8, 20000, dim)
     assert tree == 1008 * (96 + 48 * dim) and history == 20000 * 256
+
+
+def test_a_round_limit_bounds_the_tree_the_memory_check_counts():
+    """At most max_rounds * p nodes: a plan of 10 rounds in d = 600 is not refused for the default
+    node limit's million nodes (it was: 26.9 GiB), and the message says when the limit to lower is
+    the default one, or that no value fits."""
+    from qrrt_circuits.memory import check_plan_fits, plan_bytes
+
+    assert plan_bytes(10**6, 8, 10, 600) == (81 * (96 + 48 * 600), 10 * 256)
+    check_plan_fits(10**6, 1, 10, 600, available=1 << 20)
+    with pytest.raises(ValueError, match=r"max_nodes = 1000000 \(the default: the plan was given none\)"):
+        check_plan_fits(10**6, 4096, 20000, 600, available=1 << 30, default_nodes=True)
+    with pytest.raises(ValueError, match=r"max_rounds = 20000: .* no max_rounds fits"):
+        check_plan_fits(10**6, 4096, 20000, 600, available=1000)
+
+
+class _OwnLimit(qc.TerminationCondition):
+    """A user's condition reporting any node limit."""
+
+    def __init__(self, value):
+        self.value = value
+
+    def ended_by(self, progress):
+        return None
+
+    def describe(self):
+        return {"own": 1}
+
+    @property
+    def node_limit(self):
+        return self.value
+
+
+@pytest.mark.parametrize("value, error, message", [
+    (-5, ValueError, r"_OwnLimit.node_limit must be an integer >= 1, got -5"),
+    (0, ValueError, r"_OwnLimit.node_limit must be an integer >= 1"),
+    (2.5, TypeError, r"_OwnLimit.node_limit"),
+    (True, TypeError, r"_OwnLimit.node_limit"),
+    ("100", TypeError, r"_OwnLimit.node_limit"),
+    (float("nan"), TypeError, r"_OwnLimit.node_limit"),
+])
+def test_a_user_condition_with_a_bad_node_limit_is_refused(walled, value, error, message):
+    with pytest.raises(error, match=message):
+        qc.RRT(walled, seed=0).plan([1, 1], [16, 16], 0.5, termination=_OwnLimit(value), max_rounds=30)
+    with pytest.raises(error, match=message):
+        qc.RRT(walled, seed=0).plan([1, 1], [16, 16], 0.5, termination=_OwnLimit(value) | qc.Stall(5))
+
+
+def test_numpy_limits_are_python_ints_and_the_memory_check_sees_them(walled, monkeypatch):
+    """MaxRounds(np.int64(2**56)) overflowed the estimate in int64 and passed the check, and its
+    settings could not be written as JSON."""
+    import json
+
+    from qrrt_circuits import memory
+
+    limit = qc.MaxRounds(np.int64(2**56))
+    assert type(limit.limit) is int
+    monkeypatch.setattr(memory, "available_memory_bytes", lambda: 1 << 30)
+    with pytest.raises(ValueError, match="max_rounds = 72057594037927936"):
+        qc.RRT(walled, seed=0).plan([1, 1], [16, 16], 0.5, termination=limit, max_nodes=5)
+    with pytest.raises(ValueError, match="max_nodes = 288230376151711744"):
+        qc.ParallelRRT(walled, workers=4096, seed=0).plan([1, 1], [16, 16], 0.5,
+                                                          termination=qc.MaxNodes(np.int64(2**58)))
+    result = qc.RRT(walled, seed=0).plan([1, 1], [16, 16], 0.5, termination=qc.MaxRounds(np.int64(7)))
+    assert result.metrics.rounds == 7 and json.dumps(result.settings["termination"])
+
+
+def test_settings_record_the_limit_that_applies():
+    """Where two parts set the same limit, the smaller ends the plan and is the one recorded."""
+    assert (qc.MaxNodes(10) | qc.MaxNodes(20)).describe() == {"max_nodes": 10}
+    assert (qc.MaxRounds(20000) | qc.MaxRounds(10) | qc.Stall(3)).describe() == {"max_rounds": 10, "stall_rounds": 3}
+
+
+def test_with_defaults_names_a_bad_default():
+    with pytest.raises(ValueError, match="default_max_nodes must be an integer >= 1"):
+        with_defaults(None, default_max_nodes=0)

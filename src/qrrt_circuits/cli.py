@@ -12,7 +12,7 @@ import math
 import sys
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TypeAlias
+from typing import IO, TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
 
@@ -224,15 +224,41 @@ def _print_plan(result: PlanResult, env: Environment, seed: int) -> None:
         print(f"note: {label}")
 
 
+def _write_replacing(path: Path, write: Callable[[IO[Any]], None], binary: bool = False) -> None:
+    """``write`` into ``path`` so that a failed write leaves no partial file: into a temporary file
+    beside it, then renamed over it (a device or a pipe, e.g. ``/dev/stdout``, is written
+    directly)."""
+    import os
+    import tempfile
+
+    if path.exists() and not path.is_file():  # a device or a pipe: nothing to replace
+        with path.open("wb" if binary else "w") as handle:
+            write(handle)
+        return
+    path = path.resolve()  # through a symbolic link: the file it names is replaced, not the link
+    descriptor, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(descriptor, "wb" if binary else "w") as handle:
+            write(handle)
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(temporary, 0o666 & ~mask)  # the mode a new file gets (mkstemp makes it 0600)
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+
+
 def _write_plan_outputs(args: argparse.Namespace, result: PlanResult, env: Environment) -> None:
+    """Write ``--json`` and ``--plot``; if a write fails (a full disk), the other is still written
+    and one ``OSError`` names every failed output and says the plan finished."""
+    failures = []
     if args.json:
-        text = json.dumps(result.to_dict(), indent=1)
-        try:
-            Path(args.json).write_text(text)
-        except OSError as exc:  # e.g. a full disk: checked writable before the plan, failed now
-            raise OSError(f"--json: writing {args.json!r} failed ({exc.strerror}); the plan "
-                          "finished (its metrics are printed above) but its JSON was not written") from None
-        print(f"wrote {args.json}")
+        try:  # streamed (json.dump), not built as one string
+            _write_replacing(Path(args.json), lambda handle: json.dump(result.to_dict(), handle, indent=1))
+            print(f"wrote {args.json}")
+        except OSError as exc:
+            failures.append(f"--json: writing {args.json!r} failed ({exc.strerror or exc})")
     if args.plot:
         import matplotlib
 
@@ -242,10 +268,19 @@ def _write_plan_outputs(args: argparse.Namespace, result: PlanResult, env: Envir
         from .plotting import plot_tree
 
         fig, ax = plt.subplots(figsize=(7, 7))
-        plot_tree(env, result, ax=ax)
-        fig.savefig(args.plot, dpi=130, bbox_inches="tight")
-        plt.close(fig)
-        print(f"wrote {args.plot}")
+        try:
+            plot_tree(env, result, ax=ax)
+            suffix = Path(args.plot).suffix.lower().lstrip(".")
+            _write_replacing(Path(args.plot), lambda handle: fig.savefig(handle, format=suffix, dpi=130,
+                                                                         bbox_inches="tight"), binary=True)
+            print(f"wrote {args.plot}")
+        except OSError as exc:
+            failures.append(f"--plot: writing {args.plot!r} failed ({exc.strerror or exc})")
+        finally:
+            plt.close(fig)
+    if failures:
+        raise OSError(f"{'; '.join(failures)}; the plan finished (its metrics are printed above) but "
+                      f"{'these outputs were' if len(failures) > 1 else 'this output was'} not written")
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
@@ -347,7 +382,8 @@ def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
                       metavar="|".join(PREDICATES.labels()), help=f"reachability check: {PREDICATES.help_text()}")
     plan.add_argument("--goal-bias", type=float, default=0.0)
     plan.add_argument("--seed", type=_nonnegative_int, default=0)
-    plan.add_argument("--max-nodes", type=_positive_int, default=None)
+    plan.add_argument("--max-nodes", type=_positive_int, default=None,
+                      help="node limit (default: 1000000 nodes are always in force)")
     plan.add_argument("--max-oracle-calls", type=_positive_int, default=None)
     plan.add_argument("--max-critical-path-calls", type=_positive_int, default=None,
                       help="stop on the critical path (the time of p parallel devices)")

@@ -254,8 +254,9 @@ def check_fits(estimate_for: Callable[[int], MemoryEstimate], num_qubits: int, w
 #: a plan's tree, bytes per node besides its coordinates (parents in the tree and the result, the
 #: nearest-node grid's order, the history of nodes, allocator slack). Measured with
 #: ``python benchmarks/bench_memory.py --only-plan-limits`` (4 096 parallel-RRT workers filling a
-#: world whose goal is walled in, 200 000 and 600 000 nodes): 127-130 B per node at d = 2 and
-#: 193-216 at d = 4; the estimate, 96 + 48 d, is 1.3-1.5 times that.
+#: world whose goal is walled in, 200 000 and 600 000 nodes): 126-128 B per node at d = 2 and
+#: 182-183 at d = 4 in the committed run (up to 216 at d = 4 in an earlier one); the estimate,
+#: 96 + 48 d, is 1.3-1.6 times that.
 TREE_BYTES_PER_NODE = 96
 #: a plan's tree, bytes per node and coordinate (positions in the tree, the grid and the result)
 TREE_BYTES_PER_COORDINATE = 48
@@ -269,8 +270,8 @@ def plan_bytes(max_nodes: int, nodes_per_round: int, max_rounds: int | None, dim
     """The most a plan's tree and its round history can hold, in bytes: (tree, history).
 
     A round adds at most ``nodes_per_round`` nodes (1, or p workers) and the node limit is checked
-    before each round, so the tree ends with at most ``max_nodes + nodes_per_round - 1`` nodes
-    besides the root.
+    before each round, so the tree ends with at most min(``max_nodes + nodes_per_round - 1``,
+    ``max_rounds * nodes_per_round``) nodes besides the root (counted as that bound + 1).
 
     Args:
         max_nodes: The node limit in force (``TerminationCondition.node_limit``).
@@ -286,17 +287,39 @@ def plan_bytes(max_nodes: int, nodes_per_round: int, max_rounds: int | None, dim
         >>> from qrrt_circuits.memory import plan_bytes
         >>> plan_bytes(1000, 1, 20000, 2)
         (192192, 5120000)
+        >>> plan_bytes(1000, 8, 10, 2)  # 10 rounds of 8 workers: at most 80 nodes
+        (15552, 2560)
     """
-    tree = (max_nodes + nodes_per_round) * (TREE_BYTES_PER_NODE + TREE_BYTES_PER_COORDINATE * dim)
+    nodes = max_nodes + nodes_per_round
+    if max_rounds is not None:
+        nodes = min(nodes, max_rounds * nodes_per_round + 1)
+    tree = nodes * (TREE_BYTES_PER_NODE + TREE_BYTES_PER_COORDINATE * dim)
     history = 0 if max_rounds is None else max_rounds * HISTORY_BYTES_PER_ROUND
     return tree, history
 
 
+def _largest(fits: Callable[[int], bool], upto: int) -> int:
+    """The largest v in [1, upto] with ``fits(v)`` (``fits`` monotone: true up to some v), else 0."""
+    if not fits(1):
+        return 0
+    low, high = 1, upto  # fits(low) holds
+    while low < high:
+        middle = (low + high + 1) // 2
+        if fits(middle):
+            low = middle
+        else:
+            high = middle - 1
+    return low
+
+
 def check_plan_fits(max_nodes: int, nodes_per_round: int, max_rounds: int | None, dim: int,
-                    available: int | None = None) -> None:
+                    available: int | None = None, *, default_nodes: bool = False,
+                    default_rounds: bool = False) -> None:
     """Refuse (``ValueError``) limits whose tree and round history could exceed the available
-    memory, naming the limit that needs the most (``max_nodes`` or ``max_rounds``), the estimate,
-    the available memory and the largest value of that limit that fits.
+    memory (``plan_bytes``), naming the limit to lower (``max_nodes`` where the tree needs at least
+    as much as the history and lowering it alone can make the plan fit, else ``max_rounds``),
+    whether that limit is the default one, the estimate, the available memory and the largest value
+    of that limit that fits.
 
     Estimates up to ``ALWAYS_FITS_BYTES`` are accepted without reading the available memory; so is
     any estimate when the available memory is unknown.
@@ -307,6 +330,8 @@ def check_plan_fits(max_nodes: int, nodes_per_round: int, max_rounds: int | None
         max_rounds: The round limit in force (None: not counted, see ``plan_bytes``).
         dim: The workspace dimension d.
         available: The available bytes; None (default) for ``available_memory_bytes()``.
+        default_nodes: Whether ``max_nodes`` is the default limit (the caller gave none).
+        default_rounds: Whether ``max_rounds`` is the default limit.
 
     Raises:
         ValueError: The estimate exceeds the available memory.
@@ -317,7 +342,7 @@ def check_plan_fits(max_nodes: int, nodes_per_round: int, max_rounds: int | None
         >>> check_plan_fits(10**6, 1, 10**9, 2, available=2**30)  # doctest: +ELLIPSIS
         Traceback (most recent call last):
         ...
-        ValueError: max_rounds = 1000000000: this plan's round history could need about 238.4 GiB ...
+        ValueError: max_rounds = 1000000000: this plan's tree and round history could need about 238.6 GiB ...
     """
     tree, history = plan_bytes(max_nodes, nodes_per_round, max_rounds, dim)
     if tree + history <= ALWAYS_FITS_BYTES:
@@ -325,17 +350,20 @@ def check_plan_fits(max_nodes: int, nodes_per_round: int, max_rounds: int | None
     available = available_memory_bytes() if available is None else available
     if available is None or tree + history <= available:
         return
-    if history > tree:
-        assert max_rounds is not None  # history is 0 without a round limit
-        largest = max(0, (available - tree) // HISTORY_BYTES_PER_ROUND)
-        raise ValueError(
-            f"max_rounds = {max_rounds}: this plan's round history could need about {_size(history)} "
-            f"(and its tree {_size(tree)}), more than the {_size(available)} of memory available (MemAvailable); "
-            f"the largest max_rounds that fits is about {largest}")
-    per_node = TREE_BYTES_PER_NODE + TREE_BYTES_PER_COORDINATE * dim
-    largest = max(0, (available - history) // per_node - nodes_per_round)
-    raise ValueError(
-        f"max_nodes = {max_nodes}: this plan's tree could need about {_size(tree)} "
-        f"(and its round history {_size(history)}), more than the {_size(available)} of memory available "
-        f"(MemAvailable); the largest max_nodes that fits is about {largest}")
 
+    def total(nodes: int, rounds: int | None) -> int:
+        return sum(plan_bytes(nodes, nodes_per_round, rounds, dim))
+
+    if max_rounds is None or (tree >= history and total(1, max_rounds) <= available):  # the tree's limit
+        name, value, default = "max_nodes", max_nodes, default_nodes
+        largest = _largest(lambda nodes: total(nodes, max_rounds) <= available, max_nodes)
+    else:  # the history's limit (a lower one also bounds the tree)
+        name, value, default = "max_rounds", max_rounds, default_rounds
+        largest = _largest(lambda rounds: total(max_nodes, rounds) <= available, max_rounds)
+    given = " (the default: the plan was given none)" if default else ""
+    fits = (f"the largest {name} that fits is about {largest}" if largest else
+            f"no {name} fits ({_size(available)} is less than one round needs)")
+    raise ValueError(
+        f"{name} = {value}{given}: this plan's tree and round history could need about "
+        f"{_size(tree + history)} (tree {_size(tree)}, history {_size(history)}), more than the "
+        f"{_size(available)} of memory available (MemAvailable); {fits}")

@@ -34,8 +34,8 @@ DEFAULT_STALL_ROUNDS = 5000
 #: the node limit in force whenever the caller gives none. Without it the round limit alone bounds
 #: the tree: 4 096 parallel-RRT workers filling a world whose goal is walled in add about 3 900
 #: nodes a round (``python benchmarks/bench_memory.py --only-plan-limits``), so 20 000 rounds would
-#: make about 80 million nodes (about 9.5 GiB at the 127 bytes per node measured there, and many
-#: hours: 600 000 nodes took 35 s). A million nodes is about 120 MiB there, and far beyond any tree
+#: make about 80 million nodes (about 9.5 GiB at the 126-128 bytes per node measured there, and many
+#: hours: 600 000 nodes took 37 s). A million nodes is about 120 MiB there, and far beyond any tree
 #: of the paper's experiments (thousands of nodes).
 DEFAULT_MAX_NODES = 1_000_000
 
@@ -164,8 +164,8 @@ class _Limit(TerminationCondition):
     limit: int
     status = PlanStatus.MAX_ROUNDS
 
-    def __post_init__(self) -> None:
-        check_int(self.limit, f"{type(self).__name__}.limit", 1)
+    def __post_init__(self) -> None:  # kept as a Python int (a numpy integer wrapped in limit arithmetic)
+        object.__setattr__(self, "limit", check_int(self.limit, f"{type(self).__name__}.limit", 1))
 
     def _value(self, progress: Progress) -> float:
         raise NotImplementedError
@@ -384,9 +384,12 @@ class AnyOf(TerminationCondition):
         return None
 
     def describe(self) -> dict:
+        """The parts' settings merged; where two parts set the same limit, the smaller (the one
+        that ends the plan)."""
         out: dict = {}
         for condition in self.conditions:
-            out.update(condition.describe())
+            for key, value in condition.describe().items():
+                out[key] = value if key not in out else min(out[key], value)
         return out
 
     @property
@@ -402,17 +405,36 @@ class AnyOf(TerminationCondition):
     @property
     def node_limit(self) -> int | None:
         """The smallest node limit of the parts (None if none sets one)."""
-        return _smallest(condition.node_limit for condition in self.conditions)
+        return _smallest(checked_limit(part, "node_limit") for part in self.conditions)
 
     @property
     def round_limit(self) -> int | None:
         """The smallest round limit of the parts (None if none sets one)."""
-        return _smallest(condition.round_limit for condition in self.conditions)
+        return _smallest(checked_limit(part, "round_limit") for part in self.conditions)
 
 
 def _smallest(limits: Iterable[int | None]) -> int | None:
     present = [limit for limit in limits if limit is not None]
     return min(present) if present else None
+
+
+def checked_limit(condition: TerminationCondition, which: str) -> int | None:
+    """``condition.node_limit`` or ``condition.round_limit`` (``which``), checked: None or an
+    integer >= 1 (a user's own condition may return anything).
+
+    Args:
+        condition: A ``TerminationCondition``.
+        which: ``"node_limit"`` or ``"round_limit"``.
+
+    Returns:
+        None, or the limit as a Python int.
+
+    Raises:
+        TypeError: A limit that is not None or an integer.
+        ValueError: A limit < 1.
+    """
+    value = getattr(condition, which)
+    return None if value is None else check_int(value, f"{type(condition).__name__}.{which}", 1)
 
 
 def from_budgets(max_oracle_calls: int | None = None, max_nodes: int | None = None,
@@ -491,15 +513,18 @@ def with_defaults(condition: TerminationCondition | None, default_max_rounds: in
         >>> with_defaults(None).node_limit
         1000000
     """
-    rounds = DEFAULT_MAX_ROUNDS if default_max_rounds is None else default_max_rounds
-    stall = DEFAULT_STALL_ROUNDS if default_stall_rounds is None else default_stall_rounds
-    nodes = DEFAULT_MAX_NODES if default_max_nodes is None else default_max_nodes
+    def default(value: int | None, fallback: int, name: str) -> int:
+        return fallback if value is None else check_int(value, name, 1)
+
+    rounds = default(default_max_rounds, DEFAULT_MAX_ROUNDS, "default_max_rounds")
+    stall = default(default_stall_rounds, DEFAULT_STALL_ROUNDS, "default_stall_rounds")
+    nodes = default(default_max_nodes, DEFAULT_MAX_NODES, "default_max_nodes")
     parts = [] if condition is None else [condition]
     if condition is None or not condition.limits_rounds:
         parts.append(MaxRounds(rounds))
     if condition is None or not condition.detects_stall:
         parts.append(Stall(stall))
-    if condition is None or condition.node_limit is None:
+    if condition is None or checked_limit(condition, "node_limit") is None:
         parts.append(MaxNodes(nodes))
     return parts[0] if len(parts) == 1 else AnyOf(tuple(parts))
 

@@ -10,8 +10,10 @@ calls.
 
 A plan runs rounds until the goal is reached or its termination condition ends it
 (``qrrt_circuits.termination``); the condition is checked before each round, and a round limit
-(``DEFAULT_MAX_ROUNDS``) and a stall limit (``DEFAULT_STALL_ROUNDS``) are always in force unless the
-caller gives their own, so every plan ends.
+(``DEFAULT_MAX_ROUNDS``), a stall limit (``DEFAULT_STALL_ROUNDS``) and a node limit
+(``DEFAULT_MAX_NODES``) are always in force unless the caller gives their own, so every plan ends;
+the node and round limits in force are checked against the available memory before the first round
+(``memory.check_plan_fits``).
 """
 
 from __future__ import annotations
@@ -30,7 +32,7 @@ from ..oracle import ReachabilityOracle
 from ..oracle_errors import OracleErrorModel
 from ..predicate import ReachabilityPredicate, can_leave, check_predicate
 from ..randomness import RandomStreams, Stream
-from ..termination import PlanStatus, TerminationCondition, from_budgets, with_defaults
+from ..termination import PlanStatus, TerminationCondition, checked_limit, from_budgets, with_defaults
 from ..validation import check_float, check_instance, check_int, check_real_array, check_seed
 from .context import RoundView, WorkerContext
 from .result import Metrics, PlanResult
@@ -197,12 +199,15 @@ class Planner:
         if termination is not None:
             check_instance(termination, "termination", TerminationCondition, "a TerminationCondition")
             condition = termination if condition is None else termination | condition
+        given = condition
         condition = with_defaults(condition, _termination.DEFAULT_MAX_ROUNDS, _termination.DEFAULT_STALL_ROUNDS,
                                   _termination.DEFAULT_MAX_NODES)
         self._check_ready()
-        node_limit = condition.node_limit
+        node_limit = checked_limit(condition, "node_limit")
         assert node_limit is not None  # with_defaults adds one
-        check_plan_fits(node_limit, self._max_new_nodes_per_round(), condition.round_limit, self.env.dim)
+        check_plan_fits(node_limit, self._max_new_nodes_per_round(), checked_limit(condition, "round_limit"),
+                        self.env.dim, default_nodes=given is None or checked_limit(given, "node_limit") is None,
+                        default_rounds=given is None or not given.limits_rounds)
         state = RunState(start, goal, goal_radius)
         state.policy_state = self._start_policy()
         state.context = self._context()

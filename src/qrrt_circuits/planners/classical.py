@@ -19,7 +19,9 @@ rounds are drawn again next time. Trees, counters and statuses are therefore exa
 sequential ones (tested bit for bit). B adapts to the observed rate at which rounds add a node:
 B = ceil(1 / rate) with rate = (rounds that added + 1) / (rounds recorded + 2), at most
 ``MAX_BATCH_ROUNDS``, the expected number of rounds up to the next success, so about one batch per
-node and, on average, about as many wasted tests as useful ones at worst. With an ``executor`` the
+node and, on average, about as many wasted tests as useful ones at worst; and at most
+``batch_round_limit(workers, d)`` rounds, so that a batch's candidates take at most
+``MAX_BATCH_BYTES`` (or one round). With an ``executor`` the
 planners keep one task per worker per round.
 """
 
@@ -47,6 +49,30 @@ from .workers import classical_extension
 MAX_WORKERS = 4096
 #: the most rounds one batch tests ahead
 MAX_BATCH_ROUNDS = 256
+#: the most memory one batch's candidates may take (at least one round is tested whatever its size):
+#: with 4 096 workers, 256 rounds ahead held a million candidates, 264 MiB at d = 6 and 2.1 GiB at
+#: d = 64, more than the plan's own limits allowed for (a helper's review)
+MAX_BATCH_BYTES = 64 << 20
+#: a batch's bytes per candidate: its keys, the candidate and its parent's position, the parent
+#: index, the answers and the predicate's scratch. ``python benchmarks/bench_memory.py
+#: --only-plan-limits`` (``plan-batch`` cases, a predicate that rejects everything) measured 123,
+#: 272 and 2 631 B per candidate at d = 2, 6 and 64 (about 30 + 40 d); the constants, 64 + 48 d,
+#: are 1.2-1.3 times that
+BATCH_BYTES_PER_CANDIDATE = 64
+BATCH_BYTES_PER_COORDINATE = 48
+
+
+def batch_round_limit(workers: int, dim: int) -> int:
+    """The most rounds one batch may test: ``MAX_BATCH_ROUNDS``, fewer where their candidates would
+    take more than ``MAX_BATCH_BYTES`` (many workers in high d), at least 1.
+
+    Example:
+        >>> from qrrt_circuits.planners.classical import batch_round_limit
+        >>> batch_round_limit(8, 2), batch_round_limit(4096, 6), batch_round_limit(4096, 1000)
+        (256, 46, 1)
+    """
+    per_round = workers * (BATCH_BYTES_PER_CANDIDATE + BATCH_BYTES_PER_COORDINATE * dim)
+    return max(1, min(MAX_BATCH_ROUNDS, MAX_BATCH_BYTES // per_round))
 
 
 def batch_rounds(changed_rounds: int, recorded_rounds: int) -> int:
@@ -159,8 +185,9 @@ class ParallelRRT(Planner):
             return super()._run(state, condition, began)
         workers = self.workers
         changed = recorded = 0
+        most = batch_round_limit(workers, self.env.dim)
         while state.goal_node is None:
-            ahead = batch_rounds(changed, recorded)
+            ahead = min(batch_rounds(changed, recorded), most)
             first = state.rounds
             keys = np.empty((ahead * workers, 3), dtype=np.int64)
             keys[:, 0] = np.repeat(np.arange(first, first + ahead), workers)
