@@ -17,7 +17,8 @@ Cases:
   round history; the tree stays small);
   the constants ``TREE_*`` and ``HISTORY_BYTES_PER_ROUND`` come from these; and the batches of
   4 096 parallel-RRT workers whose every test fails (d = 2, 6, 64: ``plan-batch``, the constants
-  ``BATCH_BYTES_*`` of ``planners.classical``).
+  ``BATCH_BYTES_*`` of ``planners.classical``); and what writing a 200 000-node plan's JSON adds
+  (``output``: streamed with ``json.dump``, as ``qrrt plan --json`` does, against ``json.dumps``).
 
     python benchmarks/bench_memory.py            # n = 16, 18, 20, 22 on both backends (a few minutes)
     python benchmarks/bench_memory.py --quick    # n = 16, 18, 20
@@ -198,6 +199,35 @@ def run_plan_batch_case(check: str, dim: int, rounds: int) -> dict:
             "measured_bytes_per_candidate": measured / candidates}
 
 
+def run_output_case(how: str, nodes: int) -> dict:
+    """What writing a plan's JSON adds to the peak: ``qrrt plan --json``'s ``json.dump`` to the file
+    (``how`` = "dump") against ``json.dumps`` then one write (``how`` = "dumps"), for a result of
+    ``nodes`` nodes (4 096 parallel-RRT workers, the walled-goal world, d = 2)."""
+    import json
+    import tempfile
+
+    import qrrt_circuits as qc
+
+    env, walled_in, outside = _walled_world(2, 18.0)
+    result = qc.ParallelRRT(env, workers=4096, seed=0).plan(outside, walled_in, 0.5, max_nodes=nodes)
+    with open("/proc/self/clear_refs", "w") as handle:  # the peak from here on (Linux)
+        handle.write("5")
+    base = _rss()
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "plan.json"
+        with path.open("w") as handle:
+            if how == "dump":
+                json.dump(result.to_dict(), handle, indent=1)
+            else:
+                handle.write(json.dumps(result.to_dict(), indent=1))
+        size = path.stat().st_size
+    with open("/proc/self/status") as status:
+        peak = next(int(line.split()[1]) * 1024 for line in status if line.startswith("VmHWM:"))
+    return {"case": f"output-{how}", "dim": 2, "num_qubits": 0, "nodes": result.metrics.nodes,
+            "measured_bytes": peak - base, "estimated_bytes": 0, "file_bytes": size,
+            "note": "no estimate: the output is not part of the plan's memory check"}
+
+
 def in_subprocess(*args: str) -> dict:
     env = dict(os.environ, OMP_NUM_THREADS="1")
     out = subprocess.run([sys.executable, __file__, "--case", *args], capture_output=True, text=True,
@@ -222,6 +252,8 @@ def main() -> None:
             result = run_plan_case(rest[0], int(rest[1]), None if rest[2] == "paper" else int(rest[2]))
         elif kind == "limits":
             result = run_plan_limits_case(rest[0], int(rest[1]), int(rest[2]))
+        elif kind == "output":
+            result = run_output_case(rest[0], int(rest[1]))
         elif kind == "batch":
             result = run_plan_batch_case(rest[0], int(rest[1]), int(rest[2]))
         else:
@@ -237,6 +269,7 @@ def main() -> None:
     limits = [("limits", "tree", str(d), str(nodes)) for d in (2, 4) for nodes in (200_000, 600_000)]
     limits += [("limits", "rounds", "2", "1000000")]
     limits += [("batch", "nowhere", str(d), "300") for d in (2, 6, 64)] + [("batch", "exact", "6", "300")]
+    limits += [("output", how, "200000") for how in ("dump", "dumps")]
     if args.only_plan_limits:
         cases = limits
     elif args.plan_limits:

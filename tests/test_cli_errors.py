@@ -41,7 +41,7 @@ CASES = [
     (["reproduce", "lemmas", "--executor", "process", "--jobs", "100000"], "jobs must be an integer in [1, "),
     (["plan", "--planner", "rrt", "--qubits", "30"], "--qubits does not apply to --planner rrt"),
     (["plan", "--planner", "rrt", "--backend", "statevector"], "--backend does not apply to --planner rrt"),
-    (["plan", "--planner", "prrt", "--policy", "bbht"], "--policy does not apply to --planner prrt"),
+    (["plan", "--planner", "prrt", "--policy", "bbht"], "--policy (--schedule) does not apply to --planner prrt"),
     (["plan", "--planner", "qrrt", "--workers", "4"], "--workers does not apply to --planner qrrt"),
     (["plan", "--planner", "rrt", "--max-rounds", "10000000000000", "--stall-rounds", "10000000000000"],
      "max_rounds = 10000000000000: this plan's tree and round history could need"),
@@ -182,3 +182,31 @@ def _umask() -> int:
     mask = os.umask(0)
     os.umask(mask)
     return mask
+
+
+def test_outputs_in_place_where_a_rename_would_lose_something(tmp_path):
+    """A file with a hard link is written in place (the link keeps seeing it); a replaced file
+    keeps its permission bits; a long name still fits (the temporary name is short)."""
+    from qrrt_circuits import cli
+
+    target = tmp_path / "m.json"
+    target.write_text("old")
+    target.chmod(0o600)
+    (tmp_path / "hard.json").hardlink_to(target)
+    cli._write_replacing(target, lambda handle: handle.write("new"))
+    assert (tmp_path / "hard.json").read_text() == "new" and target.stat().st_nlink == 2
+    private = tmp_path / "private.json"
+    private.write_text("old")
+    private.chmod(0o600)
+    cli._write_replacing(private, lambda handle: handle.write("new"))
+    assert private.read_text() == "new" and private.stat().st_mode & 0o777 == 0o600
+    long_name = tmp_path / ("a" * 245 + ".json")
+    cli._write_replacing(long_name, lambda handle: handle.write("{}"))
+    assert long_name.read_text() == "{}"
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == []
+
+
+def test_schedule_is_named_with_policy_when_refused():
+    run = subprocess.run([sys.executable, "-m", "qrrt_circuits.cli", "plan", "--planner", "rrt", "--schedule", "bbht"],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 2 and "--policy (--schedule) does not apply to --planner rrt" in run.stderr

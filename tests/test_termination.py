@@ -335,21 +335,28 @@ def test_a_round_limit_bounds_the_tree_the_memory_check_counts():
         check_plan_fits(10**6, 4096, 20000, 600, available=1000)
 
 
-class _OwnLimit(qc.TerminationCondition):
-    """A user's condition reporting any node limit."""
+class _UserCondition(qc.TerminationCondition):
+    """A user's condition that never ends a plan, with any settings note and any node limit."""
 
-    def __init__(self, value):
-        self.value = value
+    def __init__(self, note=None, node_limit=None):
+        self.note, self.limit = note, node_limit
 
     def ended_by(self, progress):
         return None
 
     def describe(self):
-        return {"own": 1}
+        return {"user_note": self.note}
 
     @property
     def node_limit(self):
-        return self.value
+        return self.limit
+
+
+class _OwnLimit(_UserCondition):
+    """A user's condition reporting any node limit."""
+
+    def __init__(self, value):
+        super().__init__(node_limit=value)
 
 
 @pytest.mark.parametrize("value, error, message", [
@@ -395,3 +402,19 @@ def test_settings_record_the_limit_that_applies():
 def test_with_defaults_names_a_bad_default():
     with pytest.raises(ValueError, match="default_max_nodes must be an integer >= 1"):
         with_defaults(None, default_max_nodes=0)
+
+
+def test_describe_merges_user_settings_without_comparing_them(walled):
+    """Only this module's limits take the smaller value; a user's keys keep the last value (a
+    minimum over None or dicts raised after the plan had run)."""
+    for first, last in ((None, None), ({"x": 1}, {"x": 2}), ([1], "s")):
+        result = qc.RRT(walled, seed=0).plan([1, 1], [16, 16], 0.5, max_rounds=5,
+                                             termination=_UserCondition(first) | _UserCondition(last))
+        assert result.settings["termination"]["user_note"] == last
+
+
+def test_a_limit_too_large_for_a_float_is_refused_in_words():
+    from qrrt_circuits.memory import check_plan_fits
+
+    with pytest.raises(ValueError, match=r"max_rounds = 1000+: .* about 10\^40[0-9] bytes"):
+        check_plan_fits(10**6, 1, 10**400, 2, available=1 << 30)

@@ -282,6 +282,7 @@ def test_high_dimensional_trees_past_the_switch(dim):
     for point in rng.uniform(0, 20, (450, dim)):
         tree.add(point, 0)
     assert tree.size == 451 and tree._grid_built_at >= 400 and tree._shape.tolist() == [1] * dim
+    assert tree.search_arrays()[2] == 0  # one cell: searched by the (vectorized) brute-force block
     queries = rng.uniform(0, 20, (64, dim))
     brute = np.argmin(((queries[:, None, :] - tree.nodes[None, :, :]) ** 2).sum(axis=2), axis=1)
     assert np.array_equal(tree.nearest(queries), brute)

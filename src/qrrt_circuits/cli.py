@@ -179,7 +179,8 @@ def _planner_specific(args: argparse.Namespace) -> dict[str, Any]:
             chosen[option] = default if value is None else value
         elif value is not None:
             takers = [name for name in PLANNERS.names() if keyword in PLANNERS.resolve(name).options()]
-            raise ValueError(f"--{option} does not apply to --planner {args.planner} (it applies to "
+            shown = "--policy (--schedule)" if option == "policy" else f"--{option}"
+            raise ValueError(f"{shown} does not apply to --planner {args.planner} (it applies to "
                              f"{', '.join(takers)}); leave it out")
     return chosen
 
@@ -226,23 +227,35 @@ def _print_plan(result: PlanResult, env: Environment, seed: int) -> None:
 
 def _write_replacing(path: Path, write: Callable[[IO[Any]], None], binary: bool = False) -> None:
     """``write`` into ``path`` so that a failed write leaves no partial file: into a temporary file
-    beside it, then renamed over it (a device or a pipe, e.g. ``/dev/stdout``, is written
-    directly)."""
+    beside it (keeping an existing file's permission bits), then renamed over it. Written in place
+    instead: a device, a pipe or anything under ``/dev/`` or ``/proc/`` (``/dev/stdout``), a file
+    with hard links (a rename would break them), and a file whose folder takes no new file."""
     import os
     import tempfile
 
-    if path.exists() and not path.is_file():  # a device or a pipe: nothing to replace
+    def in_place() -> None:
         with path.open("wb" if binary else "w") as handle:
             write(handle)
+
+    special = str(path).startswith(("/dev/", "/proc/"))  # /dev/stdout may name a shell's redirection
+    if special or (path.exists() and not path.is_file()) or (path.is_file() and path.stat().st_nlink > 1):
+        in_place()  # a device, a pipe or a stream; or a file with hard links, which a rename would break
         return
     path = path.resolve()  # through a symbolic link: the file it names is replaced, not the link
-    descriptor, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        descriptor, temporary = tempfile.mkstemp(dir=path.parent, prefix=".qrrt-", suffix=".tmp")
+    except OSError:  # a folder that takes no new file (the file itself was checked writable)
+        in_place()
+        return
     try:
         with os.fdopen(descriptor, "wb" if binary else "w") as handle:
             write(handle)
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(temporary, 0o666 & ~mask)  # the mode a new file gets (mkstemp makes it 0600)
+        if path.exists():  # the replaced file's permission bits
+            os.chmod(temporary, path.stat().st_mode & 0o7777)
+        else:  # the mode a new file gets (mkstemp makes it 0600)
+            mask = os.umask(0)
+            os.umask(mask)
+            os.chmod(temporary, 0o666 & ~mask)
         os.replace(temporary, path)
     except BaseException:
         Path(temporary).unlink(missing_ok=True)
@@ -363,7 +376,8 @@ def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
     plan.add_argument("--scenario", type=_registered(SCENARIOS), choices=SCENARIOS.names(),
                       default="paper_clutter", help=SCENARIOS.help_text())
     plan.add_argument("--scenario-file", default=None, help="an environment JSON file instead")
-    plan.add_argument("--scenario-seed", type=_nonnegative_int, default=0)
+    plan.add_argument("--scenario-seed", type=_nonnegative_int, default=0,
+                      help="seed of the scenario's random world")
     plan.add_argument("--planner", type=_registered(PLANNERS), choices=PLANNERS.names(), default="pqrrt",
                       help=PLANNERS.help_text())
     # the planner-specific options are absent unless given (their defaults are PLANNER_SPECIFIC_OPTIONS'),
@@ -380,17 +394,20 @@ def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
                            f"{POLICIES.help_text()}")
     plan.add_argument("--predicate", type=_registered(PREDICATES), default="exact",
                       metavar="|".join(PREDICATES.labels()), help=f"reachability check: {PREDICATES.help_text()}")
-    plan.add_argument("--goal-bias", type=float, default=0.0)
-    plan.add_argument("--seed", type=_nonnegative_int, default=0)
+    plan.add_argument("--goal-bias", type=float, default=0.0, help="probability of sampling the goal, in [0, 1)")
+    plan.add_argument("--seed", type=_nonnegative_int, default=0, help="the plan's seed")
+    # (a help text with %(default)s keeps argparse from appending "(default: None)" after it)
     plan.add_argument("--max-nodes", type=_positive_int, default=None,
-                      help="node limit (default: 1000000 nodes are always in force)")
-    plan.add_argument("--max-oracle-calls", type=_positive_int, default=None)
+                      help="node limit (default %(default)s: the limit of 1000000 nodes always in force)")
+    plan.add_argument("--max-oracle-calls", type=_positive_int, default=None,
+                      help="oracle-call budget (DESIGN section 2 counting)")
     plan.add_argument("--max-critical-path-calls", type=_positive_int, default=None,
                       help="stop on the critical path (the time of p parallel devices)")
     plan.add_argument("--max-rounds", type=_positive_int, default=None,
-                      help="round limit (default: 20000 rounds are always in force)")
+                      help="round limit (default %(default)s: the limit of 20000 rounds always in force)")
     plan.add_argument("--stall-rounds", type=_positive_int, default=None,
-                      help="stop after this many consecutive rounds without a new node")
+                      help="stop after this many consecutive rounds without a new node (default "
+                           "%(default)s: the limit of 5000 always in force)")
     plan.add_argument("--plot", default=None, help="write a PNG of the tree")
     plan.add_argument("--json", default=None, help="write the result as JSON")
     plan.set_defaults(func=cmd_plan)

@@ -165,6 +165,8 @@ class MemoryEstimate:
 
 
 def _size(value: float) -> str:
+    if value >= 1 << 1000:  # (an integer this large overflows a float division)
+        return f"about 10^{len(str(int(value))) - 1} bytes"
     if value >= 1 << 30:
         return f"{value / (1 << 30):.1f} GiB"
     return f"{value / MIB:.0f} MiB"
@@ -254,8 +256,8 @@ def check_fits(estimate_for: Callable[[int], MemoryEstimate], num_qubits: int, w
 #: a plan's tree, bytes per node besides its coordinates (parents in the tree and the result, the
 #: nearest-node grid's order, the history of nodes, allocator slack). Measured with
 #: ``python benchmarks/bench_memory.py --only-plan-limits`` (4 096 parallel-RRT workers filling a
-#: world whose goal is walled in, 200 000 and 600 000 nodes): 126-128 B per node at d = 2 and
-#: 182-183 at d = 4 in the committed run (up to 216 at d = 4 in an earlier one); the estimate,
+#: world whose goal is walled in, 200 000 and 600 000 nodes): 126-130 B per node at d = 2 and
+#: 194-198 at d = 4 in the committed run (182-216 at d = 4 in earlier ones); the estimate,
 #: 96 + 48 d, is 1.3-1.6 times that.
 TREE_BYTES_PER_NODE = 96
 #: a plan's tree, bytes per node and coordinate (positions in the tree, the grid and the result)

@@ -34,8 +34,8 @@ DEFAULT_STALL_ROUNDS = 5000
 #: the node limit in force whenever the caller gives none. Without it the round limit alone bounds
 #: the tree: 4 096 parallel-RRT workers filling a world whose goal is walled in add about 3 900
 #: nodes a round (``python benchmarks/bench_memory.py --only-plan-limits``), so 20 000 rounds would
-#: make about 80 million nodes (about 9.5 GiB at the 126-128 bytes per node measured there, and many
-#: hours: 600 000 nodes took 37 s). A million nodes is about 120 MiB there, and far beyond any tree
+#: make about 80 million nodes (about 9.5 GiB at the 126-130 bytes per node measured there, and many
+#: hours: 600 000 nodes took 43 s). A million nodes is about 120 MiB there, and far beyond any tree
 #: of the paper's experiments (thousands of nodes).
 DEFAULT_MAX_NODES = 1_000_000
 
@@ -144,7 +144,9 @@ class TerminationCondition(abc.ABC):
 
     @property
     def node_limit(self) -> int | None:
-        """The node count at which this condition ends the plan, if it sets one (else None)."""
+        """The node count at which this condition ends the plan, if it sets one (else None). A
+        user's condition that reports one must end the plan there: the default node limit is not
+        added then, and the memory check trusts it."""
         return None
 
     @property
@@ -384,12 +386,14 @@ class AnyOf(TerminationCondition):
         return None
 
     def describe(self) -> dict:
-        """The parts' settings merged; where two parts set the same limit, the smaller (the one
-        that ends the plan)."""
+        """The parts' settings merged; where two parts set the same limit of this module (the
+        keys of ``_LIMIT_KEYS``), the smaller (the one that ends the plan); for any other key the
+        last part's value."""
         out: dict = {}
         for condition in self.conditions:
             for key, value in condition.describe().items():
-                out[key] = value if key not in out else min(out[key], value)
+                both_limits = key in _LIMIT_KEYS and key in out and _is_real(out[key]) and _is_real(value)
+                out[key] = min(out[key], value) if both_limits else value
         return out
 
     @property
@@ -411,6 +415,15 @@ class AnyOf(TerminationCondition):
     def round_limit(self) -> int | None:
         """The smallest round limit of the parts (None if none sets one)."""
         return _smallest(checked_limit(part, "round_limit") for part in self.conditions)
+
+
+#: the ``describe`` keys of this module's limits (a smaller value ends a plan sooner)
+_LIMIT_KEYS = frozenset({"max_oracle_calls", "max_critical_path_calls", "max_nodes", "max_rounds", "max_time_s",
+                         "stall_rounds"})
+
+
+def _is_real(value: object) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)
 
 
 def _smallest(limits: Iterable[int | None]) -> int | None:

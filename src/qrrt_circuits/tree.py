@@ -183,7 +183,9 @@ class Tree:
         ``grid_nearest`` call built one), the grid's cell offsets, sorted node indices and sorted
         positions, its origin, cell size and shape, and the bounding box of its nodes. The arrays
         are the tree's own (not copies) and stay valid until the next ``add`` or ``add_many``."""
-        return self._search_arrays(self.size >= BRUTE_FORCE_BELOW)
+        # a one-cell grid (high d, see _build_grid) is searched by the brute-force block instead,
+        # which scans the same nodes faster (vectorized over the queries)
+        return self._search_arrays(self.size >= BRUTE_FORCE_BELOW and bool(np.any(self._shape > 1)))
 
     def _search_arrays(self, grid: bool) -> tuple[np.ndarray, int, int, np.ndarray, np.ndarray, np.ndarray,
                                                    np.ndarray, float, np.ndarray, np.ndarray, np.ndarray]:

@@ -50,13 +50,13 @@ MAX_WORKERS = 4096
 #: the most rounds one batch tests ahead
 MAX_BATCH_ROUNDS = 256
 #: the most memory one batch's candidates may take (at least one round is tested whatever its size):
-#: with 4 096 workers, 256 rounds ahead held a million candidates, 264 MiB at d = 6 and 2.1 GiB at
-#: d = 64, more than the plan's own limits allowed for (a helper's review)
+#: with 4 096 workers, 256 rounds ahead are a million candidates: about 272 MiB at d = 6 and 2.6 GiB
+#: at d = 64 at the bytes per candidate measured below, more than the plan's own limits allow for
 MAX_BATCH_BYTES = 64 << 20
 #: a batch's bytes per candidate: its keys, the candidate and its parent's position, the parent
 #: index, the answers and the predicate's scratch. ``python benchmarks/bench_memory.py
 #: --only-plan-limits`` (``plan-batch`` cases, a predicate that rejects everything) measured 123,
-#: 272 and 2 631 B per candidate at d = 2, 6 and 64 (about 30 + 40 d); the constants, 64 + 48 d,
+#: 272 and 2 628 B per candidate at d = 2, 6 and 64 (about 30 + 40 d); the constants, 64 + 48 d,
 #: are 1.2-1.3 times that
 BATCH_BYTES_PER_CANDIDATE = 64
 BATCH_BYTES_PER_COORDINATE = 48
