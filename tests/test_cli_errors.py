@@ -210,3 +210,11 @@ def test_schedule_is_named_with_policy_when_refused():
     run = subprocess.run([sys.executable, "-m", "qrrt_circuits.cli", "plan", "--planner", "rrt", "--schedule", "bbht"],
                          capture_output=True, text=True, timeout=120)
     assert run.returncode == 2 and "--policy (--schedule) does not apply to --planner rrt" in run.stderr
+
+
+def test_a_symbolic_link_loop_as_output_is_refused_in_one_line(tmp_path):
+    (tmp_path / "loop.json").symlink_to("loop.json")
+    run = subprocess.run([sys.executable, "-m", "qrrt_circuits.cli", "plan", "--planner", "rrt", "--max-nodes", "3",
+                          "--json", "loop.json"], capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert run.returncode == 2 and "Traceback" not in run.stderr
+    assert "--json: 'loop.json' cannot be resolved" in run.stderr and "metrics:" not in run.stdout

@@ -130,7 +130,11 @@ def _check_output_file(path: str | None, option: str, suffixes: tuple[str, ...] 
         raise ValueError(f"{option} must name a file, got ''")
     if target.is_dir():
         raise ValueError(f"{option}: {path!r} is a folder, not a file name")
-    if not target.resolve().parent.is_dir():
+    try:
+        resolved = target.resolve()
+    except (RuntimeError, OSError) as exc:  # a loop of symbolic links (RuntimeError before Python 3.13)
+        raise ValueError(f"{option}: {path!r} cannot be resolved ({exc})") from None
+    if not resolved.parent.is_dir():
         raise ValueError(f"{option}: the folder of {path!r} does not exist")
     existed = target.exists()
     try:  # open it now, so an unwritable path fails before the work, not after

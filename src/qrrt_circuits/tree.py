@@ -84,6 +84,7 @@ class Tree:
         self._origin, self._low, self._high = np.zeros(self.dim), np.zeros(self.dim), np.zeros(self.dim)
         self._cell = 1.0
         self._shape = np.ones(self.dim, dtype=np.int64)
+        self._several_cells = False  # whether the grid has more than one cell (see search_arrays)
         self._start = np.zeros(2, dtype=np.int64)  # offset of each cell's first node in _order, and the end
         self._order = np.empty(0, dtype=np.int64)  # the grid's node indices sorted by cell
         self._sorted = np.empty((0, self.dim))  # their positions, in that order
@@ -185,7 +186,7 @@ class Tree:
         are the tree's own (not copies) and stay valid until the next ``add`` or ``add_many``."""
         # a one-cell grid (high d, see _build_grid) is searched by the brute-force block instead,
         # which scans the same nodes faster (vectorized over the queries)
-        return self._search_arrays(self.size >= BRUTE_FORCE_BELOW and bool(np.any(self._shape > 1)))
+        return self._search_arrays(self.size >= BRUTE_FORCE_BELOW and self._several_cells)
 
     def _search_arrays(self, grid: bool) -> tuple[np.ndarray, int, int, np.ndarray, np.ndarray, np.ndarray,
                                                    np.ndarray, float, np.ndarray, np.ndarray, np.ndarray]:
@@ -230,6 +231,7 @@ class Tree:
         order = np.empty(self.size, dtype=np.int64)
         _file_by_cell(nodes, low, cell, shape, start, order)
         self._origin, self._cell, self._shape = low.copy(), cell, shape
+        self._several_cells = math.prod(int(count) for count in shape) > 1  # (read by search_arrays every round)
         self._low, self._high = low.copy(), high.copy()
         self._start, self._order, self._sorted = start, order, nodes[order]
         self._rebuild_at = self.size + _pending_limit(self.size)
