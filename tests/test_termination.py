@@ -418,3 +418,16 @@ def test_a_limit_too_large_for_a_float_is_refused_in_words():
 
     with pytest.raises(ValueError, match=r"max_rounds = 1000+: .* about 10\^40[0-9] bytes"):
         check_plan_fits(10**6, 1, 10**400, 2, available=1 << 30)
+
+
+class _DescribesMaxNodes(_UserCondition):
+    """A user's condition that describes the max_nodes key with anything."""
+
+    def describe(self):
+        return {"max_nodes": self.note}
+
+
+@pytest.mark.parametrize("value", [None, float("nan"), "five"])
+def test_a_limit_key_keeps_its_finite_number_whatever_a_user_part_describes(value):
+    for parts in ((qc.MaxNodes(5), _DescribesMaxNodes(value)), (_DescribesMaxNodes(value), qc.MaxNodes(5))):
+        assert qc.AnyOf(parts).describe()["max_nodes"] == 5

@@ -12,11 +12,12 @@ import math
 import sys
 from collections.abc import Callable
 from pathlib import Path
-from typing import IO, TYPE_CHECKING, Any, TypeAlias
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
 
 from . import __version__, probability
+from .output_files import check_output_file, same_file, write_replacing
 from .registry import BACKENDS, PLANNERS, POLICIES, PREDICATES, SCENARIOS
 
 if TYPE_CHECKING:
@@ -119,35 +120,6 @@ def _print_search(args: argparse.Namespace, marks: np.ndarray, iterations: int, 
 PLOT_FORMATS = (".png", ".pdf", ".svg", ".jpg", ".jpeg")
 
 
-def _check_output_file(path: str | None, option: str, suffixes: tuple[str, ...] | None = None) -> None:
-    """Refuse an output path that cannot be written, before any work is done."""
-    if path is None:
-        return
-    import os
-
-    target = Path(path)
-    if str(path) == "":
-        raise ValueError(f"{option} must name a file, got ''")
-    if target.is_dir():
-        raise ValueError(f"{option}: {path!r} is a folder, not a file name")
-    try:
-        resolved = target.resolve()
-    except (RuntimeError, OSError) as exc:  # a loop of symbolic links (RuntimeError before Python 3.13)
-        raise ValueError(f"{option}: {path!r} cannot be resolved ({exc})") from None
-    if not resolved.parent.is_dir():
-        raise ValueError(f"{option}: the folder of {path!r} does not exist")
-    existed = target.exists()
-    try:  # open it now, so an unwritable path fails before the work, not after
-        with target.open("a"):
-            pass
-    except OSError as exc:
-        raise ValueError(f"{option}: {path!r} cannot be written ({exc.strerror})") from None
-    if not existed:
-        os.remove(target)
-    if suffixes is not None and target.suffix.lower() not in suffixes:
-        raise ValueError(f"{option}: {path!r} must end in one of {', '.join(suffixes)}")
-
-
 def _load_environment(args: argparse.Namespace) -> Environment:
     if args.scenario_file:
         from .environment import Environment
@@ -229,50 +201,13 @@ def _print_plan(result: PlanResult, env: Environment, seed: int) -> None:
         print(f"note: {label}")
 
 
-def _write_replacing(path: Path, write: Callable[[IO[Any]], None], binary: bool = False) -> None:
-    """``write`` into ``path`` so that a failed write leaves no partial file: into a temporary file
-    beside it (keeping an existing file's permission bits), then renamed over it. Written in place
-    instead: a device, a pipe or anything under ``/dev/`` or ``/proc/`` (``/dev/stdout``), a file
-    with hard links (a rename would break them), and a file whose folder takes no new file."""
-    import os
-    import tempfile
-
-    def in_place() -> None:
-        with path.open("wb" if binary else "w") as handle:
-            write(handle)
-
-    special = str(path).startswith(("/dev/", "/proc/"))  # /dev/stdout may name a shell's redirection
-    if special or (path.exists() and not path.is_file()) or (path.is_file() and path.stat().st_nlink > 1):
-        in_place()  # a device, a pipe or a stream; or a file with hard links, which a rename would break
-        return
-    path = path.resolve()  # through a symbolic link: the file it names is replaced, not the link
-    try:
-        descriptor, temporary = tempfile.mkstemp(dir=path.parent, prefix=".qrrt-", suffix=".tmp")
-    except OSError:  # a folder that takes no new file (the file itself was checked writable)
-        in_place()
-        return
-    try:
-        with os.fdopen(descriptor, "wb" if binary else "w") as handle:
-            write(handle)
-        if path.exists():  # the replaced file's permission bits
-            os.chmod(temporary, path.stat().st_mode & 0o7777)
-        else:  # the mode a new file gets (mkstemp makes it 0600)
-            mask = os.umask(0)
-            os.umask(mask)
-            os.chmod(temporary, 0o666 & ~mask)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
-
-
 def _write_plan_outputs(args: argparse.Namespace, result: PlanResult, env: Environment) -> None:
     """Write ``--json`` and ``--plot``; if a write fails (a full disk), the other is still written
     and one ``OSError`` names every failed output and says the plan finished."""
     failures = []
     if args.json:
         try:  # streamed (json.dump), not built as one string
-            _write_replacing(Path(args.json), lambda handle: json.dump(result.to_dict(), handle, indent=1))
+            write_replacing(Path(args.json), lambda handle: json.dump(result.to_dict(), handle, indent=1))
             print(f"wrote {args.json}")
         except OSError as exc:
             failures.append(f"--json: writing {args.json!r} failed ({exc.strerror or exc})")
@@ -288,7 +223,7 @@ def _write_plan_outputs(args: argparse.Namespace, result: PlanResult, env: Envir
         try:
             plot_tree(env, result, ax=ax)
             suffix = Path(args.plot).suffix.lower().lstrip(".")
-            _write_replacing(Path(args.plot), lambda handle: fig.savefig(handle, format=suffix, dpi=130,
+            write_replacing(Path(args.plot), lambda handle: fig.savefig(handle, format=suffix, dpi=130,
                                                                          bbox_inches="tight"), binary=True)
             print(f"wrote {args.plot}")
         except OSError as exc:
@@ -297,13 +232,13 @@ def _write_plan_outputs(args: argparse.Namespace, result: PlanResult, env: Envir
             plt.close(fig)
     if failures:
         raise OSError(f"{'; '.join(failures)}; the plan finished (its metrics are printed above) but "
-                      f"{'these outputs were' if len(failures) > 1 else 'this output was'} not written")
+                      f"{'these outputs were' if len(failures) > 1 else 'this output was'} not (completely) written")
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
-    _check_output_file(args.json, "--json")
-    _check_output_file(args.plot, "--plot", PLOT_FORMATS)
-    if args.json and args.plot and Path(args.json).resolve() == Path(args.plot).resolve():
+    check_output_file(args.json, "--json")
+    check_output_file(args.plot, "--plot", PLOT_FORMATS)
+    if args.json and args.plot and same_file(args.json, args.plot):
         raise ValueError(f"--json and --plot name the same file {args.plot!r} (the plot would overwrite the JSON)")
     env = _load_environment(args)
     planner = build_planner(args, env)
@@ -412,8 +347,9 @@ def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
     plan.add_argument("--stall-rounds", type=_positive_int, default=None,
                       help="stop after this many consecutive rounds without a new node (default "
                            "%(default)s: the limit of 5000 always in force)")
-    plan.add_argument("--plot", default=None, help="write a PNG of the tree")
-    plan.add_argument("--json", default=None, help="write the result as JSON")
+    plan.add_argument("--plot", default=None,
+                      help=f"write a figure of the tree ({', '.join(PLOT_FORMATS)}; default %(default)s: none)")
+    plan.add_argument("--json", default=None, help="write the result as JSON (default %(default)s: none)")
     plan.set_defaults(func=cmd_plan)
 
 

@@ -18,6 +18,7 @@ outgrows memory (``memory.check_plan_fits`` checks the limits in force before th
 from __future__ import annotations
 
 import abc
+import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 from enum import StrEnum
@@ -387,13 +388,17 @@ class AnyOf(TerminationCondition):
 
     def describe(self) -> dict:
         """The parts' settings merged; where two parts set the same limit of this module (the
-        keys of ``_LIMIT_KEYS``), the smaller (the one that ends the plan); for any other key the
-        last part's value."""
+        keys of ``_LIMIT_KEYS``), the smaller finite number (the one that ends the plan); for any
+        other key the last part's value."""
         out: dict = {}
         for condition in self.conditions:
             for key, value in condition.describe().items():
-                both_limits = key in _LIMIT_KEYS and key in out and _is_real(out[key]) and _is_real(value)
-                out[key] = min(out[key], value) if both_limits else value
+                if key not in _LIMIT_KEYS or key not in out:
+                    out[key] = value
+                elif _is_real(out[key]) and _is_real(value):
+                    out[key] = min(out[key], value)
+                elif _is_real(value):  # a user's part that described a limit key with a non-number
+                    out[key] = value
         return out
 
     @property
@@ -423,7 +428,8 @@ _LIMIT_KEYS = frozenset({"max_oracle_calls", "max_critical_path_calls", "max_nod
 
 
 def _is_real(value: object) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool)
+    """A finite real number (``bool``, NaN and infinities excluded)."""
+    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
 
 
 def _smallest(limits: Iterable[int | None]) -> int | None:

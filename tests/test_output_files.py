@@ -1,0 +1,138 @@
+"""The command line's output files (``qrrt_circuits.output_files``): checked before the work without
+changing anything, written whole after it, and written in place wherever a rename would lose
+something."""
+
+import errno
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from qrrt_circuits import output_files
+from qrrt_circuits.output_files import check_output_file, same_file, write_replacing
+
+
+def _names(folder: Path) -> list[str]:
+    return sorted(path.name for path in folder.iterdir())
+
+
+def _failing(handle):
+    handle.write("partial")
+    raise OSError(errno.ENOSPC, "No space left on device")
+
+
+def test_a_failed_write_leaves_the_old_file_and_no_temporary_file(tmp_path):
+    target = tmp_path / "out.json"
+    target.write_text("old")
+    with pytest.raises(OSError):
+        write_replacing(target, _failing)
+    assert target.read_text() == "old" and _names(tmp_path) == ["out.json"]
+
+
+def test_a_replaced_file_keeps_its_mode_and_its_symbolic_link(tmp_path):
+    target = tmp_path / "out.json"
+    target.write_text("old")
+    target.chmod(0o604)  # a mode no usual umask gives a new file
+    link = tmp_path / "link.json"
+    link.symlink_to(target)
+    write_replacing(link, lambda handle: handle.write("new"))
+    assert link.is_symlink() and target.read_text() == "new" and target.stat().st_mode & 0o777 == 0o604
+    assert _names(tmp_path) == ["link.json", "out.json"]
+
+
+def test_hard_links_are_written_in_place_and_a_failure_says_the_file_may_be_partial(tmp_path):
+    target = tmp_path / "m.json"
+    target.write_text("old")
+    (tmp_path / "hard.json").hardlink_to(target)
+    write_replacing(target, lambda handle: handle.write("new"))
+    assert (tmp_path / "hard.json").read_text() == "new" and target.stat().st_nlink == 2
+    with pytest.raises(OSError, match="written in place, so the file may be left partial"):
+        write_replacing(target, _failing)
+
+
+def test_a_long_name_fits_the_temporary_name(tmp_path):
+    long_name = tmp_path / ("a" * 245 + ".json")
+    write_replacing(long_name, lambda handle: handle.write("{}"))
+    assert long_name.read_text() == "{}" and _names(tmp_path) == [long_name.name]
+
+
+def test_a_refused_rename_or_temporary_file_falls_back_to_writing_in_place(tmp_path, monkeypatch):
+    """A sticky folder or a bind mount refuses the rename (EPERM, EBUSY); a folder that takes no new
+    file refuses the temporary file: the file was checked writable, so it is written in place."""
+    target = tmp_path / "out.json"
+    target.write_text("old")
+
+    def refused(*args, **kwargs):
+        raise PermissionError(errno.EPERM, "Operation not permitted")
+
+    monkeypatch.setattr(output_files.os, "replace", refused)
+    write_replacing(target, lambda handle: handle.write("renamed"))
+    assert target.read_text() == "renamed" and _names(tmp_path) == ["out.json"]
+    monkeypatch.undo()
+    monkeypatch.setattr(output_files.tempfile, "mkstemp", refused)
+    write_replacing(target, lambda handle: handle.write("in place"))
+    assert target.read_text() == "in place" and _names(tmp_path) == ["out.json"]
+
+
+def test_json_to_a_redirected_standard_output_follows_what_it_holds(tmp_path):
+    """``--json /dev/stdout > log`` writes the JSON through the standard output, after the metrics
+    (opening /dev/stdout again truncated the log and the later lines landed inside the JSON)."""
+    log = tmp_path / "log.txt"
+    with log.open("w") as out:
+        run = subprocess.run([sys.executable, "-m", "qrrt_circuits.cli", "plan", "--planner", "rrt",
+                              "--max-nodes", "3", "--json", "/dev/stdout"], stdout=out, stderr=subprocess.PIPE,
+                             text=True, cwd=tmp_path, timeout=120)
+    assert run.returncode == 0, run.stderr
+    text = log.read_text()
+    start = text.index("\n{") + 1
+    result, end = json.JSONDecoder().raw_decode(text[start:])
+    assert "metrics:" in text[:start] and result["status"] == "max_nodes"
+    assert text[start + end:].strip() == "wrote /dev/stdout"
+
+
+def test_the_check_changes_nothing_it_finds(tmp_path):
+    """A dangling link keeps pointing where it did (the check removed the link and left an empty
+    file at its target); a new path is left absent; an existing file keeps its content."""
+    link = tmp_path / "link.json"
+    link.symlink_to(tmp_path / "missing" / "target.json")
+    (tmp_path / "missing").mkdir()
+    check_output_file(str(link), "--json")
+    assert link.is_symlink() and not (tmp_path / "missing" / "target.json").exists()
+    check_output_file(str(tmp_path / "new.json"), "--json")
+    assert not (tmp_path / "new.json").exists()
+    kept = tmp_path / "kept.json"
+    kept.write_text("old")
+    check_output_file(str(kept), "--json")
+    assert kept.read_text() == "old"
+
+
+@pytest.mark.parametrize("path, message", [("", "must name a file"), ("-", "must name a file"),
+                                           ("nowhere/x.json", "does not exist")])
+def test_paths_refused_before_the_work(tmp_path, path, message):
+    with pytest.raises(ValueError, match=message):
+        check_output_file(path if not path.startswith("nowhere") else str(tmp_path / path), "--json")
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs named pipes")
+def test_a_pipe_is_checked_without_opening_it(tmp_path):
+    """Opening a pipe blocks until a reader comes, and hands a waiting reader an end of file: the
+    check only asks for write permission (run in a child, so a regression cannot hang the suite)."""
+    pipe = tmp_path / "out.json"
+    os.mkfifo(pipe)
+    code = f"from qrrt_circuits.output_files import check_output_file; check_output_file({str(pipe)!r}, '--json')"
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=60)
+
+
+def test_same_file_through_a_hard_link(tmp_path):
+    first = tmp_path / "a.png"
+    first.write_text("x")
+    (tmp_path / "b.png").hardlink_to(first)
+    assert same_file(str(first), str(tmp_path / "b.png"))
+    assert same_file(str(first), str(tmp_path / "." / "a.png"))
+    assert not same_file(str(first), str(tmp_path / "c.png"))
+    run = subprocess.run([sys.executable, "-m", "qrrt_circuits.cli", "plan", "--json", "a.png", "--plot", "b.png"],
+                         capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert run.returncode == 2 and "name the same file" in run.stderr
