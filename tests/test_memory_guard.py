@@ -252,3 +252,81 @@ def test_the_tree_estimate_covers_a_tree_grown_to_its_node_limit(dim):
     status, nodes, added, estimated = run.stdout.split()
     assert status == "max_nodes" and 100_000 <= int(nodes) < 100_000 + 4096
     assert 0.25 * int(estimated) < int(added) <= int(estimated), (added, estimated)
+
+
+def _cgroup(tmp_path, monkeypatch, limit: str, usage: int, stat: str, version: int = 2, parent_limit=None):
+    """Fake control-group files of ``version`` for a process in group ``/box`` (parent: the root),
+    and point ``memory`` at them."""
+    from qrrt_circuits import memory
+
+    root = tmp_path / "cgroup"
+    names = ("memory.max", "memory.current", "memory.stat") if version == 2 else (
+        "memory.limit_in_bytes", "memory.usage_in_bytes", "memory.stat")
+    mount = root if version == 2 else root / "memory"
+    for folder, group_limit in ((mount / "box", limit), (mount, parent_limit)):
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / names[0]).write_text((group_limit or ("max" if version == 2 else "9223372036854771712")) + "\n")
+        (folder / names[1]).write_text(f"{usage}\n")
+        (folder / names[2]).write_text(stat)
+    proc = tmp_path / "cgroup.txt"
+    proc.write_text("0::/box\n" if version == 2 else "5:cpu,cpuacct:/box\n4:memory:/box\n0::/\n")
+    monkeypatch.setattr(memory, "CGROUP_ROOT", str(root))
+    monkeypatch.setattr(memory, "PROC_CGROUP", str(proc))
+
+
+@pytest.mark.parametrize("version", [2, 1])
+def test_a_control_group_limit_bounds_the_available_memory(tmp_path, monkeypatch, version):
+    """In a container the kernel kills the process at its group's limit, whatever the machine has
+    free: the room is the limit less the usage, the inactive page cache not counted as used."""
+    from qrrt_circuits import memory
+
+    stat = f"active_file 5\n{'inactive_file' if version == 2 else 'total_inactive_file'} {100 * MIB}\nanon 7\n"
+    _cgroup(tmp_path, monkeypatch, str(1024 * MIB), 400 * MIB, stat, version)
+    assert memory.cgroup_available_bytes() == (1024 - 300) * MIB
+    monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 20 * 1024 * MIB)
+    assert memory.available_memory_bytes() == 724 * MIB
+    monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 500 * MIB)
+    assert memory.available_memory_bytes() == 500 * MIB
+    monkeypatch.setattr(memory, "_machine_available_bytes", lambda: None)
+    assert memory.available_memory_bytes() == 724 * MIB
+
+
+@pytest.mark.parametrize("limit, version", [("max", 2), (str(9223372036854771712), 1), ("garbage", 2)])
+def test_no_control_group_limit_leaves_the_machine_figure(tmp_path, monkeypatch, limit, version):
+    from qrrt_circuits import memory
+
+    _cgroup(tmp_path, monkeypatch, limit, 400 * MIB, "", version)
+    assert memory.cgroup_available_bytes() is None
+    monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 3 * MIB)
+    assert memory.available_memory_bytes() == 3 * MIB
+
+
+def test_a_plan_in_a_small_control_group_is_refused(tmp_path, monkeypatch, env):
+    """q-RRT at n = 24 needs over a GiB: refused in a 512 MiB group on a machine with 20 GiB free."""
+    from qrrt_circuits import memory
+
+    _cgroup(tmp_path, monkeypatch, str(512 * MIB), 100 * MIB, "")
+    monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 20 * 1024 * MIB)
+    with pytest.raises(ValueError, match=r"num_qubits = 24: .* more than the 412 MiB of memory available"):
+        qc.QRRT(env, backend=qc.StatevectorBackend(0, max_qubits=24), num_qubits=24, seed=0)
+
+
+@pytest.mark.parametrize("version", [2, 1])
+def test_an_ancestor_group_with_less_room_bounds_the_available_memory(tmp_path, monkeypatch, version):
+    """A group without a limit inside a parent with one (or a tighter parent): the smallest room."""
+    from qrrt_circuits import memory
+
+    _cgroup(tmp_path, monkeypatch, str(1024 * MIB), 100 * MIB, "", version, parent_limit=str(300 * MIB))
+    assert memory.cgroup_available_bytes() == 200 * MIB
+    _cgroup(tmp_path, monkeypatch, "max" if version == 2 else "9223372036854771712", 100 * MIB, "", version,
+            parent_limit=str(300 * MIB))
+    assert memory.cgroup_available_bytes() == 200 * MIB
+
+
+def test_without_control_group_files_the_machine_figure_stands(tmp_path, monkeypatch):
+    from qrrt_circuits import memory
+
+    monkeypatch.setattr(memory, "PROC_CGROUP", str(tmp_path / "absent"))
+    assert memory.cgroup_available_bytes() is None
+    monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 5 * MIB)
+    assert memory.available_memory_bytes() == 5 * MIB

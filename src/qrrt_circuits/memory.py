@@ -12,7 +12,11 @@ missing from the available memory).
 Available memory is ``MemAvailable`` from ``/proc/meminfo`` (Linux: free memory plus the page cache
 and slabs the kernel can reclaim, i.e. what can be allocated without swapping); elsewhere
 ``os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")`` (free pages only, a lower figure); if
-neither exists, no check is made. ``psutil`` is not a runtime dependency, so it is not used.
+neither exists, no check is made. Inside a container or any memory-limited control group, the
+machine's figure overstates what the process may use (the kernel kills it at the group's limit),
+so the group's room is taken where it is smaller (``cgroup_available_bytes``: the limit less the
+usage, the usage without the inactive page cache the kernel reclaims first; cgroup v2 and v1).
+``psutil`` is not a runtime dependency, so it is not used.
 
 The per-entry constants are calibrated, not derived: ``benchmarks/bench_memory.py`` measures the
 peak resident set of real runs (``resource.getrusage``, in a fresh subprocess per case) against
@@ -25,6 +29,7 @@ from __future__ import annotations
 import os
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 
 MIB = 1 << 20
 
@@ -45,9 +50,15 @@ def available_memory_bytes() -> int | None:
     """Memory that can still be allocated without swapping, in bytes (None if unknown).
 
     Returns:
-        ``MemAvailable`` of ``/proc/meminfo`` (Linux), else free pages times the page size, else
-        None.
+        The smaller of the machine's figure (``MemAvailable`` of ``/proc/meminfo`` on Linux, else
+        free pages times the page size) and the room left in the process's memory control group
+        (``cgroup_available_bytes``), whichever are known; None if neither is.
     """
+    figures = [figure for figure in (_machine_available_bytes(), cgroup_available_bytes()) if figure is not None]
+    return min(figures) if figures else None
+
+
+def _machine_available_bytes() -> int | None:
     try:
         with open("/proc/meminfo", encoding="ascii") as meminfo:
             for line in meminfo:
@@ -59,6 +70,85 @@ def available_memory_bytes() -> int | None:
         return int(os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
     except (ValueError, OSError, AttributeError):
         return None
+
+
+#: the process's control groups (``hierarchy:controllers:path`` lines) and where their file systems
+#: are mounted (cgroup v2 at the root, or at ``unified`` beside v1's ``memory``)
+PROC_CGROUP = "/proc/self/cgroup"
+CGROUP_ROOT = "/sys/fs/cgroup"
+#: per version: the limit, the usage, the statistics and the statistic of the inactive page cache
+_V2_FILES = ("memory.max", "memory.current", "memory.stat", "inactive_file")
+_V1_FILES = ("memory.limit_in_bytes", "memory.usage_in_bytes", "memory.stat", "total_inactive_file")
+#: a cgroup v1 limit at or above this is "no limit" (the kernel writes about 2^63)
+_UNLIMITED = 1 << 60
+
+
+def cgroup_available_bytes() -> int | None:
+    """The room left in the process's memory control group and its ancestors: for each group with
+    a limit, its limit less its usage, the usage counted without the inactive page cache (which the
+    kernel reclaims before it would kill); the smallest, in bytes. None without any limit (``max``
+    in v2, about 2^63 in v1) or where the groups cannot be read (not Linux, no memory controller).
+
+    The groups are found from ``/proc/self/cgroup`` (in a container with its own cgroup
+    namespace, the container's group is the mount's root).
+
+    Returns:
+        The smallest ``max(limit - (usage - inactive_file), 0)``, or None.
+    """
+    rooms = [room for folder, files in _memory_groups() if (room := _room(folder, files)) is not None]
+    return min(rooms) if rooms else None
+
+
+def _memory_groups() -> list[tuple[Path, tuple[str, str, str, str]]]:
+    """(folder, file names) of the process's memory groups, from its own up to the mount's root."""
+    try:
+        with open(PROC_CGROUP, encoding="utf-8") as handle:
+            lines = handle.read().splitlines()
+    except OSError:
+        return []
+    groups = []
+    for line in lines:
+        parts = line.split(":", 2)
+        if len(parts) != 3:
+            continue
+        controllers, path = parts[1], parts[2].lstrip("/")
+        if controllers == "":  # the v2 hierarchy
+            mounts = [(Path(CGROUP_ROOT), _V2_FILES), (Path(CGROUP_ROOT) / "unified", _V2_FILES)]
+        elif "memory" in controllers.split(","):
+            mounts = [(Path(CGROUP_ROOT) / "memory", _V1_FILES)]
+        else:
+            continue
+        for root, files in mounts:
+            folder = root / path
+            while True:
+                groups.append((folder, files))
+                if folder == root or root not in folder.parents:
+                    break
+                folder = folder.parent
+    return groups
+
+
+def _room(folder: Path, files: tuple[str, str, str, str]) -> int | None:
+    """One group's room (``cgroup_available_bytes``), or None (no limit, or unreadable)."""
+    limit_name, usage_name, stat_name, inactive_key = files
+    try:
+        limit_text = (folder / limit_name).read_text(encoding="ascii").strip()
+        usage = int((folder / usage_name).read_text(encoding="ascii").split()[0])
+        limit = int(limit_text)
+    except (OSError, ValueError, IndexError):  # absent, or "max" (v2: no limit)
+        return None
+    if limit >= _UNLIMITED:
+        return None
+    inactive = 0
+    try:
+        for line in (folder / stat_name).read_text(encoding="ascii").splitlines():
+            key, _, value = line.partition(" ")
+            if key == inactive_key:
+                inactive = int(value)
+                break
+    except (OSError, ValueError):
+        pass
+    return max(limit - max(usage - inactive, 0), 0)
 
 
 def database_bytes(num_qubits: int, dim: int, annealing: bool = False) -> int:
@@ -249,7 +339,8 @@ def check_fits(estimate_for: Callable[[int], MemoryEstimate], num_qubits: int, w
     raise ValueError(
         f"num_qubits = {num_qubits}: {what} needs about {_size(estimate.total_bytes)} at its peak "
         f"({estimate.breakdown()}), more than the {_size(available)} of memory available "
-        f"(MemAvailable); the largest num_qubits that fits is {largest}"
+        f"(MemAvailable, or the memory control group's room where smaller); the largest num_qubits "
+        f"that fits is {largest}"
         f"{' (none does)' if largest == 0 else ''}")
 
 
@@ -368,4 +459,5 @@ def check_plan_fits(max_nodes: int, nodes_per_round: int, max_rounds: int | None
     raise ValueError(
         f"{name} = {value}{given}: this plan's tree and round history could need about "
         f"{_size(tree + history)} (tree {_size(tree)}, history {_size(history)}), more than the "
-        f"{_size(available)} of memory available (MemAvailable); {fits}")
+        f"{_size(available)} of memory available (MemAvailable, or the memory control group's room where "
+        f"smaller); {fits}")

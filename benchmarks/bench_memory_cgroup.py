@@ -1,0 +1,110 @@
+"""The memory guard inside a memory-limited control group (a container's situation).
+
+Makes a cgroup (v2, or v1's memory controller) with a 600 MiB limit, which needs root and a
+writable cgroup file system, and runs in it, in fresh processes: a q-RRT construction and one
+round at n = 22, 23 and 24 with the guard as it is (the room of the group,
+``memory.cgroup_available_bytes``), and n = 24 with the group ignored (the guard before it read the
+group: the machine's ``MemAvailable`` only). Records for each: refused (the message), ran, or
+killed (exit status, the group's failure count).
+
+    python benchmarks/bench_memory_cgroup.py
+
+Writes ``benchmarks/results/bench_memory_cgroup.json``; where no group can be made, the JSON says
+why under ``missing``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import uuid
+from pathlib import Path
+
+from _common import RESULTS, machine
+
+LIMIT = 600 << 20
+
+CHILD = """
+import sys
+import qrrt_circuits as qc
+from qrrt_circuits import memory
+n, guarded = int(sys.argv[1]), sys.argv[2] == "guarded"
+if not guarded:
+    memory.cgroup_available_bytes = lambda: None
+env = qc.scenarios.paper_clutter(seed=0)
+try:
+    planner = qc.QRRT(env, backend=qc.StatevectorBackend(0, max_qubits=24), num_qubits=n, seed=0)
+except ValueError as error:
+    print("refused:", error)
+else:
+    planner.plan(max_rounds=1)
+    print("ran")
+"""
+
+
+def make_group() -> tuple[Path, str] | str:
+    """A new group with the limit: (its folder, the file that takes a process id), or why not."""
+    name = f"qrrt-bench-{uuid.uuid4().hex[:8]}"
+    reason = "no cgroup memory controller mounted at /sys/fs/cgroup"
+    for root, limit_file in ((Path("/sys/fs/cgroup/memory"), "memory.limit_in_bytes"),
+                             (Path("/sys/fs/cgroup"), "memory.max")):
+        if not (root / limit_file).exists() and not (root / "cgroup.controllers").exists():
+            continue
+        folder = root / name
+        try:
+            folder.mkdir()
+            (folder / limit_file).write_text(str(LIMIT))
+            return folder, "cgroup.procs"
+        except OSError as exc:
+            if folder.exists():
+                folder.rmdir()
+            reason = f"cannot make a group under {root}: {exc}"
+    return reason
+
+
+def run_in(folder: Path, procs: str, n: int, mode: str) -> dict:
+    command = f'echo $$ > {folder / procs} && exec "$0" -c "$1" {n} {mode}'
+    run = subprocess.run(["sh", "-c", command, sys.executable, CHILD], capture_output=True, text=True,
+                         timeout=600, cwd=Path(__file__).resolve().parent.parent)
+    out = run.stdout.strip().splitlines()
+    outcome = "killed" if run.returncode in (-9, 137) else (out[-1].split(":")[0] if out else "no output")
+    return {"num_qubits": n, "guard": mode, "returncode": run.returncode, "outcome": outcome,
+            "message": out[-1] if out else run.stderr.strip()[-300:]}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="accepted for benchmarks/run.py (the same cases)")
+    parser.add_argument("--out", default=None, help="the JSON to write (default: results/bench_memory_cgroup.json)")
+    args = parser.parse_args()
+    path = Path(args.out) if args.out else RESULTS / "bench_memory_cgroup.json"
+    made = make_group()
+    if isinstance(made, str):
+        print(f"skipped: {made}")
+        RESULTS.mkdir(exist_ok=True)
+        path.write_text(json.dumps({"machine": machine(), "missing": made}, indent=1))
+        return
+    folder, procs = made
+    try:
+        rows = [run_in(folder, procs, n, "guarded") for n in (22, 23, 24)] + [run_in(folder, procs, 24, "unguarded")]
+        failures = (folder / "memory.failcnt") if (folder / "memory.failcnt").exists() else folder / "memory.events"
+        events = failures.read_text().strip()
+    finally:
+        try:
+            os.rmdir(folder)
+        except OSError:
+            pass
+    for row in rows:
+        print(f"n = {row['num_qubits']} {row['guard']:9s} {row['outcome']:8s} rc {row['returncode']}  "
+              f"{row['message'][:110]}")
+    RESULTS.mkdir(exist_ok=True)
+    path.write_text(json.dumps({"machine": machine(), "limit_bytes": LIMIT, "rows": rows,
+                                "group_failures": events}, indent=1))
+    print(f"wrote {path}")
+
+
+if __name__ == "__main__":
+    main()
