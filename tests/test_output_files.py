@@ -136,3 +136,22 @@ def test_same_file_through_a_hard_link(tmp_path):
     run = subprocess.run([sys.executable, "-m", "qrrt_circuits.cli", "plan", "--json", "a.png", "--plot", "b.png"],
                          capture_output=True, text=True, cwd=tmp_path, timeout=120)
     assert run.returncode == 2 and "name the same file" in run.stderr
+
+
+def test_an_append_only_file_is_refused_before_the_work(tmp_path):
+    """An append-only file (chattr +a) opened for appending passed the check; the write, which must
+    replace it, then failed after the plan."""
+    target = tmp_path / "log.json"
+    target.write_text("old")
+    try:
+        made = subprocess.run(["chattr", "+a", str(target)], capture_output=True)
+    except FileNotFoundError:  # no chattr
+        made = None
+    if made is None or made.returncode != 0:
+        pytest.skip("chattr +a is not available here (needs root and a file system with attributes)")
+    try:
+        with pytest.raises(ValueError, match="cannot be written"):
+            check_output_file(str(target), "--json")
+        assert target.read_text() == "old"
+    finally:
+        subprocess.run(["chattr", "-a", str(target)], capture_output=True)

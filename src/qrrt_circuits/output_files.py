@@ -3,8 +3,9 @@
 ``check_output_file`` refuses, before a plan runs, a path that cannot be written (a folder, a
 missing folder, a loop of symbolic links, a file without write permission), by opening it the way
 the write will, without changing it: a new file is created exclusively and removed again, an
-existing regular file is opened for appending, and a device or a pipe is only checked for write
-permission (opening a pipe would hand its reader an end of file).
+existing regular file is opened for writing without truncation (so an append-only file, which the
+write could not replace, is refused), and a device or a pipe is only checked for write permission
+(opening a pipe would hand its reader an end of file).
 
 ``write_replacing`` writes a finished result so that a failed write (a full disk) leaves no partial
 file: into a temporary file beside the target, which keeps the target's permission bits and is then
@@ -72,11 +73,13 @@ def _probe(real: Path) -> None:
         return
     try:
         descriptor = os.open(real, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
-    except FileExistsError:  # an existing file (or one made meanwhile): appending changes nothing
-        with real.open("a"):
-            return
+    except FileExistsError:  # an existing file (or one made meanwhile): opened for writing, unchanged
+        descriptor = os.open(real, os.O_WRONLY)  # (not O_APPEND: an append-only file is refused here)
+    else:
+        os.close(descriptor)
+        os.remove(real)  # only the file this call created
+        return
     os.close(descriptor)
-    os.remove(real)  # only the file this call created
 
 
 def same_file(first: str, second: str) -> bool:
