@@ -9,8 +9,10 @@ killed (exit status, the group's failure count).
 
     python benchmarks/bench_memory_cgroup.py
 
-Writes ``benchmarks/results/bench_memory_cgroup.json``; where no group can be made, the JSON says
-why under ``missing``.
+Writes ``benchmarks/results/bench_memory_cgroup.json``. Where no group can be made (not root) it
+says why and writes only to an ``--out`` it is given (``missing``), never over the committed
+results. On Ctrl-C or SIGTERM the child is killed and the group removed. The group limits memory
+only, not swap: on a machine with swap the unguarded run may swap instead of being killed.
 """
 
 from __future__ import annotations
@@ -18,8 +20,10 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import signal
 import subprocess
 import sys
+import time
 import uuid
 from pathlib import Path
 
@@ -66,13 +70,38 @@ def make_group() -> tuple[Path, str] | str:
 
 
 def run_in(folder: Path, procs: str, n: int, mode: str) -> dict:
+    """One child in the group; it is killed and waited for on any interruption, so the group can be
+    removed."""
     command = f'echo $$ > {folder / procs} && exec "$0" -c "$1" {n} {mode}'
-    run = subprocess.run(["sh", "-c", command, sys.executable, CHILD], capture_output=True, text=True,
-                         timeout=600, cwd=Path(__file__).resolve().parent.parent)
-    out = run.stdout.strip().splitlines()
-    outcome = "killed" if run.returncode in (-9, 137) else (out[-1].split(":")[0] if out else "no output")
-    return {"num_qubits": n, "guard": mode, "returncode": run.returncode, "outcome": outcome,
-            "message": out[-1] if out else run.stderr.strip()[-300:]}
+    child = subprocess.Popen(["sh", "-c", command, sys.executable, CHILD], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True, cwd=Path(__file__).resolve().parent.parent)
+    try:
+        stdout, stderr = child.communicate(timeout=600)
+    finally:
+        if child.poll() is None:
+            child.kill()
+            child.wait()
+    out = stdout.strip().splitlines()
+    outcome = "killed" if child.returncode in (-9, 137) else (out[-1].split(":")[0] if out else "no output")
+    return {"num_qubits": n, "guard": mode, "returncode": child.returncode, "outcome": outcome,
+            "message": out[-1] if out else stderr.strip()[-300:]}
+
+
+def remove_group(folder: Path) -> None:
+    """rmdir the group (retried while its last process exits); say so if it stays."""
+    for _ in range(50):
+        try:
+            os.rmdir(folder)
+            return
+        except FileNotFoundError:
+            return
+        except OSError:
+            time.sleep(0.1)
+    print(f"could not remove the cgroup {folder}; remove it with: rmdir {folder}", file=sys.stderr)
+
+
+def _terminate(signum, frame):  # SIGTERM as Ctrl-C: the finally blocks clean up
+    raise KeyboardInterrupt
 
 
 def main() -> None:
@@ -84,19 +113,17 @@ def main() -> None:
     made = make_group()
     if isinstance(made, str):
         print(f"skipped: {made}")
-        RESULTS.mkdir(exist_ok=True)
-        path.write_text(json.dumps({"machine": machine(), "missing": made}, indent=1))
+        if args.out:  # (benchmarks/run.py's file; the committed results are not overwritten)
+            path.write_text(json.dumps({"machine": machine(), "missing": made}, indent=1))
         return
     folder, procs = made
+    signal.signal(signal.SIGTERM, _terminate)
     try:
         rows = [run_in(folder, procs, n, "guarded") for n in (22, 23, 24)] + [run_in(folder, procs, 24, "unguarded")]
         failures = (folder / "memory.failcnt") if (folder / "memory.failcnt").exists() else folder / "memory.events"
         events = failures.read_text().strip()
     finally:
-        try:
-            os.rmdir(folder)
-        except OSError:
-            pass
+        remove_group(folder)
     for row in rows:
         print(f"n = {row['num_qubits']} {row['guard']:9s} {row['outcome']:8s} rc {row['returncode']}  "
               f"{row['message'][:110]}")

@@ -6,6 +6,7 @@ import re
 import resource
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -272,6 +273,7 @@ def _cgroup(tmp_path, monkeypatch, limit: str, usage: int, stat: str, version: i
     proc.write_text("0::/box\n" if version == 2 else "5:cpu,cpuacct:/box\n4:memory:/box\n0::/\n")
     monkeypatch.setattr(memory, "CGROUP_ROOT", str(root))
     monkeypatch.setattr(memory, "PROC_CGROUP", str(proc))
+    memory._smallest_limit_cached.cache_clear()  # (read once per process)
 
 
 @pytest.mark.parametrize("version", [2, 1])
@@ -280,9 +282,10 @@ def test_a_control_group_limit_bounds_the_available_memory(tmp_path, monkeypatch
     free: the room is the limit less the usage, the inactive page cache not counted as used."""
     from qrrt_circuits import memory
 
-    stat = f"active_file 5\n{'inactive_file' if version == 2 else 'total_inactive_file'} {100 * MIB}\nanon 7\n"
-    _cgroup(tmp_path, monkeypatch, str(1024 * MIB), 400 * MIB, stat, version)
-    assert memory.cgroup_available_bytes() == (1024 - 300) * MIB
+    prefix = "" if version == 2 else "total_"
+    stat = f"{prefix}active_file {50 * MIB}\n{prefix}inactive_file {100 * MIB}\nanon 7\n"
+    _cgroup(tmp_path, monkeypatch, str(1024 * MIB), 450 * MIB, stat, version)
+    assert memory.cgroup_available_bytes() == (1024 - 300) * MIB  # the page cache (150 MiB) is not used memory
     monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 20 * 1024 * MIB)
     assert memory.available_memory_bytes() == 724 * MIB
     monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 500 * MIB)
@@ -330,3 +333,48 @@ def test_without_control_group_files_the_machine_figure_stands(tmp_path, monkeyp
     assert memory.cgroup_available_bytes() is None
     monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 5 * MIB)
     assert memory.available_memory_bytes() == 5 * MIB
+
+
+@pytest.fixture(autouse=True)
+def _fresh_group_limit():
+    """The smallest group limit is read once per process: each test starts and ends without it."""
+    from qrrt_circuits import memory
+
+    memory._smallest_limit_cached.cache_clear()
+    yield
+    memory._smallest_limit_cached.cache_clear()
+
+
+def test_v1_hidden_ancestor_and_swap_limits_bound_the_room(tmp_path, monkeypatch):
+    """A container's v1 mount hides its parent's limit except as ``hierarchical_memory_limit``; with
+    swap accounting the kernel kills at the memory + swap limit."""
+    from qrrt_circuits import memory
+
+    _cgroup(tmp_path, monkeypatch, "9223372036854771712", 100 * MIB, f"hierarchical_memory_limit {600 * MIB}\n", 1)
+    assert memory.cgroup_available_bytes() == 500 * MIB
+    box = tmp_path / "cgroup" / "memory" / "box"
+    (box / "memory.limit_in_bytes").write_text(f"{600 * MIB}\n")
+    (box / "memory.memsw.limit_in_bytes").write_text(f"{600 * MIB}\n")
+    (box / "memory.memsw.usage_in_bytes").write_text(f"{550 * MIB}\n")  # 450 MiB of it in swap
+    assert memory.cgroup_available_bytes() == 50 * MIB
+
+
+def test_a_small_group_lowers_the_size_accepted_unchecked(tmp_path, monkeypatch):
+    """In a 130 MB group an estimate of 180 MiB was accepted without a look and the kernel killed
+    the run: up to an eighth of the group's limit is accepted unchecked, not 256 MiB."""
+    from qrrt_circuits import memory
+
+    _cgroup(tmp_path, monkeypatch, str(130 * 10**6), 50 * MIB, "")
+    assert memory.always_fits_bytes() == 130 * 10**6 // 8
+    estimate = memory.MemoryEstimate(21, database_bytes=180 * MIB)
+    with pytest.raises(ValueError, match="num_qubits = 21"):
+        memory.check_fits(lambda n: estimate, 21, "this plan")
+
+
+def test_a_group_name_that_is_not_utf8_is_read(tmp_path, monkeypatch):
+    from qrrt_circuits import memory
+
+    _cgroup(tmp_path, monkeypatch, str(1024 * MIB), 100 * MIB, "")
+    proc = Path(memory.PROC_CGROUP)
+    proc.write_bytes(b"0::/box\xff\n")
+    assert memory.cgroup_available_bytes() is None  # no such folder: no limit read, and no error

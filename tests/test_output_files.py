@@ -155,3 +155,45 @@ def test_an_append_only_file_is_refused_before_the_work(tmp_path):
         assert target.read_text() == "old"
     finally:
         subprocess.run(["chattr", "-a", str(target)], capture_output=True)
+
+
+def _plan(argv, tmp_path, **streams):
+    return subprocess.run([sys.executable, "-m", "qrrt_circuits.cli", "plan", "--planner", "rrt", "--max-nodes", "3",
+                           *argv], text=True, cwd=tmp_path, timeout=120, **streams)
+
+
+def test_an_inherited_descriptor_is_written_after_what_it_holds(tmp_path):
+    """``--json /dev/fd/3 3>>log`` appended nothing: /dev/fd/3 was opened again and truncated."""
+    log = tmp_path / "log"
+    log.write_text("earlier line\n")
+    run = subprocess.run(["sh", "-c", 'exec "$0" -m qrrt_circuits.cli plan --planner rrt --max-nodes 3 '
+                                      '--json /dev/fd/3 3>>"$1"', sys.executable, str(log)],
+                         capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert run.returncode == 0, run.stderr
+    text = log.read_text()
+    assert text.startswith("earlier line\n") and json.loads(text[len("earlier line\n"):])["status"] == "max_nodes"
+
+
+def test_paths_that_would_clash_or_name_nothing_are_refused_before_the_work(tmp_path):
+    with (tmp_path / "f.json").open("w") as out:  # --json f.json > f.json: the two would overwrite each other
+        run = _plan(["--json", "f.json"], tmp_path, stdout=out, stderr=subprocess.PIPE)
+    assert run.returncode == 2 and "is the file the standard output goes to" in run.stderr
+    run = _plan(["--json", str(tmp_path / "newdir") + "/"], tmp_path, capture_output=True)
+    assert run.returncode == 2 and "names a folder (it ends in a slash)" in run.stderr
+    assert not (tmp_path / "newdir").exists()
+    run = _plan(["--json", "/dev/fd/9"], tmp_path, capture_output=True)
+    assert run.returncode == 2 and "names descriptor 9, which is not open" in run.stderr
+
+
+def test_a_file_of_another_group_in_a_set_group_id_folder_is_replaced_whole(tmp_path, monkeypatch):
+    """A rename keeps a set-group-ID folder's group, so such a file is not written in place."""
+    folder = tmp_path / "shared"
+    folder.mkdir()
+    folder.chmod(0o2775)
+    target = folder / "out.json"
+    target.write_text("old")
+    real_getegid = os.getegid
+    monkeypatch.setattr(output_files.os, "getegid", lambda: real_getegid() + 1)  # "another group"
+    assert not output_files._write_in_place(target)
+    folder.chmod(0o775)
+    assert output_files._write_in_place(target)

@@ -26,6 +26,7 @@ entry rounded up (d = 2, 4, 6 fitted linearly in d for the database).
 
 from __future__ import annotations
 
+import functools
 import os
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -76,42 +77,72 @@ def _machine_available_bytes() -> int | None:
 #: are mounted (cgroup v2 at the root, or at ``unified`` beside v1's ``memory``)
 PROC_CGROUP = "/proc/self/cgroup"
 CGROUP_ROOT = "/sys/fs/cgroup"
-#: per version: the limit, the usage, the statistics and the statistic of the inactive page cache
-_V2_FILES = ("memory.max", "memory.current", "memory.stat", "inactive_file")
-_V1_FILES = ("memory.limit_in_bytes", "memory.usage_in_bytes", "memory.stat", "total_inactive_file")
+#: per version: the limit, the usage, the statistics, the statistics of the page cache (which the
+#: kernel reclaims before it kills), and the limit and usage of memory + swap (v1 only)
+_V2_FILES = ("memory.max", "memory.current", "memory.stat", ("active_file", "inactive_file"), None)
+_V1_FILES = ("memory.limit_in_bytes", "memory.usage_in_bytes", "memory.stat",
+             ("total_active_file", "total_inactive_file"),
+             ("memory.memsw.limit_in_bytes", "memory.memsw.usage_in_bytes"))
 #: a cgroup v1 limit at or above this is "no limit" (the kernel writes about 2^63)
 _UNLIMITED = 1 << 60
+
+_GroupFiles = tuple[str, str, str, tuple[str, str], "tuple[str, str] | None"]
 
 
 def cgroup_available_bytes() -> int | None:
     """The room left in the process's memory control group and its ancestors: for each group with
-    a limit, its limit less its usage, the usage counted without the inactive page cache (which the
-    kernel reclaims before it would kill); the smallest, in bytes. None without any limit (``max``
-    in v2, about 2^63 in v1) or where the groups cannot be read (not Linux, no memory controller).
+    a limit, its limit less its usage, the usage counted without the page cache (active and
+    inactive file pages, which the kernel reclaims before it would kill); in v1 also the limit of
+    memory and swap less their usage, and the ``hierarchical_memory_limit`` of ancestors the
+    process cannot see (a container's mount). The smallest, in bytes; None without any limit
+    (``max`` in v2, about 2^63 in v1) or where the groups cannot be read (not Linux, no memory
+    controller).
 
     The groups are found from ``/proc/self/cgroup`` (in a container with its own cgroup
     namespace, the container's group is the mount's root).
 
     Returns:
-        The smallest ``max(limit - (usage - inactive_file), 0)``, or None.
+        The smallest room, or None.
     """
     rooms = [room for folder, files in _memory_groups() if (room := _room(folder, files)) is not None]
     return min(rooms) if rooms else None
 
 
-def _memory_groups() -> list[tuple[Path, tuple[str, str, str, str]]]:
+def smallest_cgroup_limit() -> int | None:
+    """The smallest memory limit among the process's groups and their ancestors (None without
+    one), read once per process: it decides how large an estimate is accepted without reading the
+    available memory (``always_fits_bytes``)."""
+    return _smallest_limit_cached()
+
+
+@functools.lru_cache(maxsize=1)
+def _smallest_limit_cached() -> int | None:
+    limits = [limit for folder, files in _memory_groups() if (limit := _limit(folder, files)) is not None]
+    return min(limits) if limits else None
+
+
+def always_fits_bytes() -> int:
+    """Estimates up to this are accepted without reading the available memory: ``ALWAYS_FITS_BYTES``,
+    or an eighth of the smallest control-group limit where that is less (in a 130 MB container a
+    180 MiB estimate went unchecked and the kernel killed the run)."""
+    limit = smallest_cgroup_limit()
+    return ALWAYS_FITS_BYTES if limit is None else min(ALWAYS_FITS_BYTES, limit // 8)
+
+
+def _memory_groups() -> list[tuple[Path, _GroupFiles]]:
     """(folder, file names) of the process's memory groups, from its own up to the mount's root."""
     try:
-        with open(PROC_CGROUP, encoding="utf-8") as handle:
+        with open(PROC_CGROUP, encoding="utf-8", errors="surrogateescape") as handle:  # any group name
             lines = handle.read().splitlines()
     except OSError:
         return []
-    groups = []
+    groups: list[tuple[Path, _GroupFiles]] = []
     for line in lines:
         parts = line.split(":", 2)
         if len(parts) != 3:
             continue
         controllers, path = parts[1], parts[2].lstrip("/")
+        mounts: list[tuple[Path, _GroupFiles]]
         if controllers == "":  # the v2 hierarchy
             mounts = [(Path(CGROUP_ROOT), _V2_FILES), (Path(CGROUP_ROOT) / "unified", _V2_FILES)]
         elif "memory" in controllers.split(","):
@@ -128,27 +159,48 @@ def _memory_groups() -> list[tuple[Path, tuple[str, str, str, str]]]:
     return groups
 
 
-def _room(folder: Path, files: tuple[str, str, str, str]) -> int | None:
-    """One group's room (``cgroup_available_bytes``), or None (no limit, or unreadable)."""
-    limit_name, usage_name, stat_name, inactive_key = files
+def _read_int(path: Path) -> int | None:
     try:
-        limit_text = (folder / limit_name).read_text(encoding="ascii").strip()
-        usage = int((folder / usage_name).read_text(encoding="ascii").split()[0])
-        limit = int(limit_text)
+        return int(path.read_text(encoding="ascii").split()[0])
     except (OSError, ValueError, IndexError):  # absent, or "max" (v2: no limit)
         return None
-    if limit >= _UNLIMITED:
-        return None
-    inactive = 0
+
+
+def _statistics(folder: Path, files: _GroupFiles) -> dict[str, int]:
+    values: dict[str, int] = {}
     try:
-        for line in (folder / stat_name).read_text(encoding="ascii").splitlines():
+        for line in (folder / files[2]).read_text(encoding="ascii").splitlines():
             key, _, value = line.partition(" ")
-            if key == inactive_key:
-                inactive = int(value)
-                break
-    except (OSError, ValueError):
+            if value.strip().isdigit():
+                values[key] = int(value)
+    except (OSError, UnicodeDecodeError):
         pass
-    return max(limit - max(usage - inactive, 0), 0)
+    return values
+
+
+def _limit(folder: Path, files: _GroupFiles) -> int | None:
+    """One group's memory limit (v1: also its ``hierarchical_memory_limit``), or None."""
+    limits = [_read_int(folder / files[0])]
+    if files[4] is not None:
+        limits.append(_statistics(folder, files).get("hierarchical_memory_limit"))
+    present = [limit for limit in limits if limit is not None and limit < _UNLIMITED]
+    return min(present) if present else None
+
+
+def _room(folder: Path, files: _GroupFiles) -> int | None:
+    """One group's room (``cgroup_available_bytes``), or None (no limit, or unreadable)."""
+    limit = _limit(folder, files)
+    usage = _read_int(folder / files[1])
+    if limit is None or usage is None:
+        return None
+    statistics = _statistics(folder, files)
+    cache = sum(statistics.get(key, 0) for key in files[3])
+    room = max(limit - max(usage - cache, 0), 0)
+    if files[4] is not None:  # v1 with swap accounting: memory + swap have their own limit
+        swap_limit, swap_usage = _read_int(folder / files[4][0]), _read_int(folder / files[4][1])
+        if swap_limit is not None and swap_usage is not None and swap_limit < _UNLIMITED:
+            room = min(room, max(swap_limit - max(swap_usage - cache, 0), 0))
+    return room
 
 
 def database_bytes(num_qubits: int, dim: int, annealing: bool = False) -> int:
@@ -302,8 +354,8 @@ def check_fits(estimate_for: Callable[[int], MemoryEstimate], num_qubits: int, w
     ``num_qubits``, the estimate, the available memory and the largest n that fits. ``what`` names
     the run ("this plan", "this search"). Returns the estimate when it fits.
 
-    Estimates up to ``ALWAYS_FITS_BYTES`` (256 MiB) are accepted without reading the available
-    memory; so is any estimate when the available memory is unknown.
+    Estimates up to ``always_fits_bytes()`` (256 MiB, less in a small container) are accepted
+    without reading the available memory; so is any estimate when the available memory is unknown.
 
     Args:
         estimate_for: The run's ``MemoryEstimate`` as a function of n.
@@ -330,7 +382,7 @@ def check_fits(estimate_for: Callable[[int], MemoryEstimate], num_qubits: int, w
         ValueError: num_qubits = 26: this plan needs about 3.7 GiB ...; the largest num_qubits that fits is 24
     """
     estimate = estimate_for(num_qubits)
-    if estimate.total_bytes <= ALWAYS_FITS_BYTES:
+    if estimate.total_bytes <= always_fits_bytes():
         return estimate
     available = available_memory_bytes() if available is None else available
     if available is None or estimate.total_bytes <= available:
@@ -414,7 +466,7 @@ def check_plan_fits(max_nodes: int, nodes_per_round: int, max_rounds: int | None
     whether that limit is the default one, the estimate, the available memory and the largest value
     of that limit that fits.
 
-    Estimates up to ``ALWAYS_FITS_BYTES`` are accepted without reading the available memory; so is
+    Estimates up to ``always_fits_bytes()`` are accepted without reading the available memory; so is
     any estimate when the available memory is unknown.
 
     Args:
@@ -438,7 +490,7 @@ def check_plan_fits(max_nodes: int, nodes_per_round: int, max_rounds: int | None
         ValueError: max_rounds = 1000000000: this plan's tree and round history could need about 238.6 GiB ...
     """
     tree, history = plan_bytes(max_nodes, nodes_per_round, max_rounds, dim)
-    if tree + history <= ALWAYS_FITS_BYTES:
+    if tree + history <= always_fits_bytes():
         return
     available = available_memory_bytes() if available is None else available
     if available is None or tree + history <= available:

@@ -12,18 +12,23 @@ file: into a temporary file beside the target, which keeps the target's permissi
 renamed over it. Where a rename would lose something the file is written in place instead (and a
 failed in-place write says that the file may be left partial):
 
-- the file is the process's own standard output or error (``--json /dev/stdout > log``): written
-  through that stream, after what it already holds;
-- a device, a pipe, anything under ``/dev/`` or ``/proc/``;
-- a file with hard links (a rename would detach them), or owned by another user or group (a
-  rename would make it the writer's);
+- a descriptor the process inherited (``/dev/stdout``, ``/dev/stderr``, ``/dev/fd/N``,
+  ``/proc/self/fd/N``: ``--json /dev/stdout > log``, ``--json /dev/fd/3 3>>log``): written through
+  that descriptor, after what it already holds;
+- a device or a pipe;
+- a file with hard links (a rename would detach them), or owned by another user, or by another
+  group outside a set-group-ID folder (a rename would make it the writer's);
 - a folder that takes no new file, or a rename the system refuses (a sticky folder, a bind mount).
+
+A path that is the file the standard output or error already goes to (``--json log > log``) is
+refused before the work: the two would overwrite each other.
 """
 
 from __future__ import annotations
 
 import errno
 import os
+import re
 import sys
 import tempfile
 from collections.abc import Callable
@@ -51,7 +56,21 @@ def check_output_file(path: str | None, option: str, suffixes: tuple[str, ...] |
         return
     if str(path) in ("", "-"):
         raise ValueError(f"{option} must name a file (for the standard output, /dev/stdout), got {path!r}")
+    if str(path).endswith(("/", os.sep)):
+        raise ValueError(f"{option}: {path!r} names a folder (it ends in a slash), not a file")
+    descriptor = _descriptor_of(path)
+    if descriptor is not None:  # an inherited descriptor: it must be open
+        try:
+            os.fstat(descriptor)
+        except OSError:
+            raise ValueError(f"{option}: {path!r} names descriptor {descriptor}, which is not open") from None
+        return
     target = Path(path)
+    stream = _standard_stream(target)
+    if stream is not None:
+        name, label = ("/dev/stdout", "output") if stream is sys.stdout else ("/dev/stderr", "error")
+        raise ValueError(f"{option}: {path!r} is the file the standard {label} goes to (the two would "
+                         f"overwrite each other); name {name} to write the output there")
     if target.is_dir():
         raise ValueError(f"{option}: {path!r} is a folder, not a file name")
     real = Path(os.path.realpath(target))  # (a loop of links stays a path that cannot be opened)
@@ -106,11 +125,9 @@ def write_replacing(path: Path, write: Callable[[IO[Any]], None], binary: bool =
         OSError: The write failed; an in-place write's message says that the file may be left
             partial.
     """
-    stream = _standard_stream(path)
-    if stream is not None:
-        stream.flush()
-        _in_place_guarded(lambda: write(stream.buffer if binary else stream))
-        stream.flush()
+    descriptor = _descriptor_of(path)
+    if descriptor is not None:
+        _through_descriptor(descriptor, write, binary)
         return
     if _write_in_place(path):
         _in_place(path, write, binary)
@@ -124,6 +141,8 @@ def write_replacing(path: Path, write: Callable[[IO[Any]], None], binary: bool =
     try:
         with os.fdopen(descriptor, "wb" if binary else "w") as handle:
             write(handle)
+            handle.flush()
+            os.fsync(handle.fileno())  # on disk before it replaces the old file
         os.chmod(temporary, _mode_for(real))
         try:
             os.replace(temporary, real)
@@ -135,6 +154,36 @@ def write_replacing(path: Path, write: Callable[[IO[Any]], None], binary: bool =
     except BaseException:
         Path(temporary).unlink(missing_ok=True)
         raise
+
+
+#: /dev/fd/N and /proc/self/fd/N; /dev/stdout and /dev/stderr
+_DESCRIPTOR_PATH = re.compile(r"^/(?:dev/fd|proc/self/fd)/(\d+)$")
+_STANDARD_PATHS = {"/dev/stdout": 1, "/dev/stderr": 2}
+
+
+def _descriptor_of(path: str | Path) -> int | None:
+    """The descriptor a path names (``/dev/stdout`` 1, ``/dev/fd/3`` 3, ...), else None."""
+    text = str(path)
+    if text in _STANDARD_PATHS:
+        return _STANDARD_PATHS[text]
+    match = _DESCRIPTOR_PATH.match(text)
+    return int(match.group(1)) if match else None
+
+
+def _through_descriptor(descriptor: int, write: Callable[[IO[Any]], None], binary: bool) -> None:
+    """Write through a copy of an inherited descriptor, after what it holds (never truncated)."""
+    for stream in (sys.stdout, sys.stderr):  # what Python has buffered goes first
+        stream.flush()
+    duplicate = os.dup(descriptor)
+
+    def run() -> None:
+        with os.fdopen(duplicate, "wb" if binary else "w") as handle:
+            write(handle)
+
+    if Path(f"/proc/self/fd/{descriptor}").is_file() or os.path.isfile(f"/dev/fd/{descriptor}"):
+        _in_place_guarded(run)
+    else:
+        run()
 
 
 def _standard_stream(path: Path) -> Any:
@@ -154,15 +203,16 @@ def _standard_stream(path: Path) -> Any:
 
 def _write_in_place(path: Path) -> bool:
     """Whether ``path`` is written in place rather than replaced (the module docstring's cases)."""
-    if str(path).startswith(("/dev/", "/proc/")):
-        return True
     try:
         status = os.stat(path)
     except OSError:  # a new file
         return False
-    if not Path(path).is_file():
+    if not Path(path).is_file():  # a device or a pipe
         return True
-    return status.st_nlink > 1 or status.st_uid != os.geteuid() or status.st_gid != os.getegid()
+    if status.st_nlink > 1 or status.st_uid != os.geteuid():
+        return True
+    folder_setgid = bool(os.stat(Path(os.path.realpath(path)).parent).st_mode & 0o2000)
+    return status.st_gid != os.getegid() and not folder_setgid  # (a set-group-ID folder gives its group)
 
 
 def _mode_for(real: Path) -> int:
