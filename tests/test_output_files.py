@@ -197,3 +197,23 @@ def test_a_file_of_another_group_in_a_set_group_id_folder_is_replaced_whole(tmp_
     assert not output_files._write_in_place(target)
     folder.chmod(0o775)
     assert output_files._write_in_place(target)
+
+
+def test_json_output_is_counted_before_the_plan(tmp_path, monkeypatch, capsys):
+    """The JSON's lists take about as much memory as the tree: with --json, limits whose tree and
+    output could exceed the available memory are refused before the plan, though the plan alone fits."""
+    from qrrt_circuits import memory
+    from qrrt_circuits.cli import main
+    from qrrt_circuits.memory import JSON_BYTES_PER_COORDINATE, JSON_BYTES_PER_NODE, check_plan_fits
+
+    monkeypatch.setattr(memory, "available_memory_bytes", lambda: 300 << 20)
+    check_plan_fits(10**6, 4096, 20000, 2)  # the plan alone: about 188 MiB
+    with pytest.raises(ValueError, match="its JSON output"):
+        check_plan_fits(10**6, 4096, 20000, 2,
+                        output_bytes_per_node=JSON_BYTES_PER_NODE + 2 * JSON_BYTES_PER_COORDINATE)
+    with pytest.raises(SystemExit) as exited:
+        main(["plan", "--planner", "prrt", "--workers", "4096", "--max-nodes", "1000000",
+              "--json", str(tmp_path / "out.json")])
+    assert exited.value.code == 2
+    assert "max_nodes = 1000000: this plan's tree and its JSON output" in capsys.readouterr().err
+    assert not (tmp_path / "out.json").exists()

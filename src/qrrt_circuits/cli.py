@@ -235,6 +235,19 @@ def _write_plan_outputs(args: argparse.Namespace, result: PlanResult, env: Envir
                       f"{'these outputs were' if len(failures) > 1 else 'this output was'} not (completely) written")
 
 
+def _check_json_fits(args: argparse.Namespace, planner: Planner, dim: int) -> None:
+    """Refuse, before the plan, limits whose tree, history and JSON output could exceed the
+    available memory (the JSON's lists take about as much as the tree; ``Planner.plan`` counts
+    the tree and the history alone)."""
+    from .memory import JSON_BYTES_PER_COORDINATE, JSON_BYTES_PER_NODE, check_plan_fits
+    from .termination import DEFAULT_MAX_NODES, DEFAULT_MAX_ROUNDS
+
+    check_plan_fits(args.max_nodes or DEFAULT_MAX_NODES, planner._max_new_nodes_per_round(),
+                    args.max_rounds or DEFAULT_MAX_ROUNDS, dim, default_nodes=args.max_nodes is None,
+                    default_rounds=args.max_rounds is None,
+                    output_bytes_per_node=JSON_BYTES_PER_NODE + JSON_BYTES_PER_COORDINATE * dim)
+
+
 def cmd_plan(args: argparse.Namespace) -> int:
     check_output_file(args.json, "--json")
     check_output_file(args.plot, "--plot", PLOT_FORMATS)
@@ -242,6 +255,8 @@ def cmd_plan(args: argparse.Namespace) -> int:
         raise ValueError(f"--json and --plot name the same file {args.plot!r} (the plot would overwrite the JSON)")
     env = _load_environment(args)
     planner = build_planner(args, env)
+    if args.json:
+        _check_json_fits(args, planner, env.dim)
     result = planner.plan(max_nodes=args.max_nodes, max_oracle_calls=args.max_oracle_calls,
                           max_rounds=args.max_rounds, max_critical_path_calls=args.max_critical_path_calls,
                           stall_rounds=args.stall_rounds)

@@ -411,7 +411,15 @@ TREE_BYTES_PER_COORDINATE = 48
 HISTORY_BYTES_PER_ROUND = 256
 
 
-def plan_bytes(max_nodes: int, nodes_per_round: int, max_rounds: int | None, dim: int) -> tuple[int, int]:
+#: writing a plan's result as JSON (``qrrt plan --json``: ``PlanResult.to_dict`` and ``json.dump``),
+#: bytes per node besides the tree's: 176 measured at d = 2 (``bench_memory.py --only-plan-limits``,
+#: ``output-dump``) and about 232 at d = 4 (a helper's tracemalloc); 128 + 48 d is 1.3-1.4 times that
+JSON_BYTES_PER_NODE = 128
+JSON_BYTES_PER_COORDINATE = 48
+
+
+def plan_bytes(max_nodes: int, nodes_per_round: int, max_rounds: int | None, dim: int,
+               output_bytes_per_node: int = 0) -> tuple[int, int]:
     """The most a plan's tree and its round history can hold, in bytes: (tree, history).
 
     A round adds at most ``nodes_per_round`` nodes (1, or p workers) and the node limit is checked
@@ -424,6 +432,9 @@ def plan_bytes(max_nodes: int, nodes_per_round: int, max_rounds: int | None, dim
         max_rounds: The round limit in force; None where a condition bounds rounds without saying
             how many (a user's own condition): the history is then not counted.
         dim: The workspace dimension d.
+        output_bytes_per_node: What writing the result adds per node (``JSON_BYTES_PER_NODE +
+            JSON_BYTES_PER_COORDINATE * d`` for ``qrrt plan --json``; 0 by default), counted
+            with the tree.
 
     Returns:
         ``(tree_bytes, history_bytes)``.
@@ -438,7 +449,7 @@ def plan_bytes(max_nodes: int, nodes_per_round: int, max_rounds: int | None, dim
     nodes = max_nodes + nodes_per_round
     if max_rounds is not None:
         nodes = min(nodes, max_rounds * nodes_per_round + 1)
-    tree = nodes * (TREE_BYTES_PER_NODE + TREE_BYTES_PER_COORDINATE * dim)
+    tree = nodes * (TREE_BYTES_PER_NODE + TREE_BYTES_PER_COORDINATE * dim + output_bytes_per_node)
     history = 0 if max_rounds is None else max_rounds * HISTORY_BYTES_PER_ROUND
     return tree, history
 
@@ -459,7 +470,7 @@ def _largest(fits: Callable[[int], bool], upto: int) -> int:
 
 def check_plan_fits(max_nodes: int, nodes_per_round: int, max_rounds: int | None, dim: int,
                     available: int | None = None, *, default_nodes: bool = False,
-                    default_rounds: bool = False) -> None:
+                    default_rounds: bool = False, output_bytes_per_node: int = 0) -> None:
     """Refuse (``ValueError``) limits whose tree and round history could exceed the available
     memory (``plan_bytes``), naming the limit to lower (``max_nodes`` where the tree needs at least
     as much as the history and lowering it alone can make the plan fit, else ``max_rounds``),
@@ -477,6 +488,7 @@ def check_plan_fits(max_nodes: int, nodes_per_round: int, max_rounds: int | None
         available: The available bytes; None (default) for ``available_memory_bytes()``.
         default_nodes: Whether ``max_nodes`` is the default limit (the caller gave none).
         default_rounds: Whether ``max_rounds`` is the default limit.
+        output_bytes_per_node: What writing the result adds per node (``plan_bytes``).
 
     Raises:
         ValueError: The estimate exceeds the available memory.
@@ -489,7 +501,7 @@ def check_plan_fits(max_nodes: int, nodes_per_round: int, max_rounds: int | None
         ...
         ValueError: max_rounds = 1000000000: this plan's tree and round history could need about 238.6 GiB ...
     """
-    tree, history = plan_bytes(max_nodes, nodes_per_round, max_rounds, dim)
+    tree, history = plan_bytes(max_nodes, nodes_per_round, max_rounds, dim, output_bytes_per_node)
     if tree + history <= always_fits_bytes():
         return
     available = available_memory_bytes() if available is None else available
@@ -497,7 +509,7 @@ def check_plan_fits(max_nodes: int, nodes_per_round: int, max_rounds: int | None
         return
 
     def total(nodes: int, rounds: int | None) -> int:
-        return sum(plan_bytes(nodes, nodes_per_round, rounds, dim))
+        return sum(plan_bytes(nodes, nodes_per_round, rounds, dim, output_bytes_per_node))
 
     if max_rounds is None or (tree >= history and total(1, max_rounds) <= available):  # the tree's limit
         name, value, default = "max_nodes", max_nodes, default_nodes
@@ -508,8 +520,9 @@ def check_plan_fits(max_nodes: int, nodes_per_round: int, max_rounds: int | None
     given = " (the default: the plan was given none)" if default else ""
     fits = (f"the largest {name} that fits is about {largest}" if largest else
             f"no {name} fits ({_size(available)} is less than one round needs)")
+    output = " and its JSON output" if output_bytes_per_node else ""
     raise ValueError(
-        f"{name} = {value}{given}: this plan's tree and round history could need about "
+        f"{name} = {value}{given}: this plan's tree{output} and round history could need about "
         f"{_size(tree + history)} (tree {_size(tree)}, history {_size(history)}), more than the "
         f"{_size(available)} of memory available (MemAvailable, or the memory control group's room where "
         f"smaller); {fits}")
