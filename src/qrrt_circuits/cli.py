@@ -167,14 +167,10 @@ def build_planner(args: argparse.Namespace, env: Environment) -> Planner:
     specific = _planner_specific(args)
     options: dict[str, Any] = {"goal_bias": args.goal_bias, "seed": args.seed,
                                "predicate": PREDICATES.create(args.predicate, env=env)}
-    if "qubits" in specific:
-        options["num_qubits"] = specific["qubits"]
-    if "workers" in specific:
-        options["workers"] = specific["workers"]
-    if "backend" in specific:
-        options["backend"] = BACKENDS.create(specific["backend"], seed=args.seed)
-    if "policy" in specific:
-        options["search_policy"] = POLICIES.create(specific["policy"])
+    made: dict[str, Callable[[Any], Any]] = {"backend": lambda name: BACKENDS.create(name, seed=args.seed),
+                                             "policy": POLICIES.create}
+    for option, value in specific.items():  # each under the planner's keyword, backends and policies made
+        options[PLANNER_SPECIFIC_OPTIONS[option][0]] = made[option](value) if option in made else value
     planner: Planner = PLANNERS.create(args.planner, env=env, **PLANNERS.applicable(args.planner, options))
     return planner
 
@@ -240,11 +236,14 @@ def _check_json_fits(args: argparse.Namespace, planner: Planner, dim: int) -> No
     available memory (the JSON's lists take about as much as the tree; ``Planner.plan`` counts
     the tree and the history alone)."""
     from .memory import JSON_BYTES_PER_COORDINATE, JSON_BYTES_PER_NODE, check_plan_fits
-    from .termination import DEFAULT_MAX_NODES, DEFAULT_MAX_ROUNDS
+    from .termination import from_budgets, limits_in_force
 
-    check_plan_fits(args.max_nodes or DEFAULT_MAX_NODES, planner._max_new_nodes_per_round(),
-                    args.max_rounds or DEFAULT_MAX_ROUNDS, dim, default_nodes=args.max_nodes is None,
-                    default_rounds=args.max_rounds is None,
+    limits = limits_in_force(from_budgets(max_oracle_calls=args.max_oracle_calls, max_nodes=args.max_nodes,
+                                          max_rounds=args.max_rounds,
+                                          max_critical_path_calls=args.max_critical_path_calls,
+                                          stall_rounds=args.stall_rounds))
+    check_plan_fits(limits.node_limit, planner._max_new_nodes_per_round(), limits.round_limit, dim,
+                    default_nodes=limits.default_nodes, default_rounds=limits.default_rounds,
                     output_bytes_per_node=JSON_BYTES_PER_NODE + JSON_BYTES_PER_COORDINATE * dim)
 
 

@@ -29,6 +29,7 @@ from __future__ import annotations
 import errno
 import os
 import re
+import stat
 import sys
 import tempfile
 from collections.abc import Callable
@@ -180,7 +181,7 @@ def _through_descriptor(descriptor: int, write: Callable[[IO[Any]], None], binar
         with os.fdopen(duplicate, "wb" if binary else "w") as handle:
             write(handle)
 
-    if Path(f"/proc/self/fd/{descriptor}").is_file() or os.path.isfile(f"/dev/fd/{descriptor}"):
+    if stat.S_ISREG(os.fstat(duplicate).st_mode):  # a file (a redirection) may be left partial
         _in_place_guarded(run)
     else:
         run()

@@ -456,6 +456,35 @@ def checked_limit(condition: TerminationCondition, which: str) -> int | None:
     return None if value is None else check_int(value, f"{type(condition).__name__}.{which}", 1)
 
 
+@dataclass(frozen=True)
+class LimitsInForce:
+    """The node and round limits a plan runs under once the defaults are added (``with_defaults``),
+    and whether each is the default one (the caller's condition set none)."""
+
+    node_limit: int
+    round_limit: int | None
+    default_nodes: bool
+    default_rounds: bool
+
+
+def limits_in_force(given: TerminationCondition | None) -> LimitsInForce:
+    """The ``LimitsInForce`` of a plan given ``given`` (None: no condition): what ``Planner.plan``
+    checks against the available memory (``memory.check_plan_fits``), and ``qrrt plan --json`` with
+    its output.
+
+    Example:
+        >>> from qrrt_circuits.termination import MaxNodes, limits_in_force
+        >>> limits_in_force(MaxNodes(50))
+        LimitsInForce(node_limit=50, round_limit=20000, default_nodes=False, default_rounds=True)
+    """
+    condition = with_defaults(given)
+    node_limit = checked_limit(condition, "node_limit")
+    assert node_limit is not None  # with_defaults adds one
+    return LimitsInForce(node_limit, checked_limit(condition, "round_limit"),
+                         given is None or checked_limit(given, "node_limit") is None,
+                         given is None or not given.limits_rounds)
+
+
 def from_budgets(max_oracle_calls: int | None = None, max_nodes: int | None = None,
                  max_rounds: int | None = None, max_time_s: float | None = None,
                  max_critical_path_calls: int | None = None,

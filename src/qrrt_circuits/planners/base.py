@@ -32,7 +32,7 @@ from ..oracle import ReachabilityOracle
 from ..oracle_errors import OracleErrorModel
 from ..predicate import ReachabilityPredicate, can_leave, check_predicate
 from ..randomness import RandomStreams, Stream
-from ..termination import PlanStatus, TerminationCondition, checked_limit, from_budgets, with_defaults
+from ..termination import PlanStatus, TerminationCondition, from_budgets, limits_in_force, with_defaults
 from ..validation import check_float, check_instance, check_int, check_real_array, check_seed
 from .context import RoundView, WorkerContext
 from .result import Metrics, PlanResult
@@ -199,15 +199,12 @@ class Planner:
         if termination is not None:
             check_instance(termination, "termination", TerminationCondition, "a TerminationCondition")
             condition = termination if condition is None else termination | condition
-        given = condition
+        limits = limits_in_force(condition)
         condition = with_defaults(condition, _termination.DEFAULT_MAX_ROUNDS, _termination.DEFAULT_STALL_ROUNDS,
                                   _termination.DEFAULT_MAX_NODES)
         self._check_ready()
-        node_limit = checked_limit(condition, "node_limit")
-        assert node_limit is not None  # with_defaults adds one
-        check_plan_fits(node_limit, self._max_new_nodes_per_round(), checked_limit(condition, "round_limit"),
-                        self.env.dim, default_nodes=given is None or checked_limit(given, "node_limit") is None,
-                        default_rounds=given is None or not given.limits_rounds)
+        check_plan_fits(limits.node_limit, self._max_new_nodes_per_round(), limits.round_limit, self.env.dim,
+                        default_nodes=limits.default_nodes, default_rounds=limits.default_rounds)
         state = RunState(start, goal, goal_radius)
         state.policy_state = self._start_policy()
         state.context = self._context()
