@@ -128,7 +128,10 @@ def main() -> None:
         print(f"n = {row['num_qubits']} {row['guard']:9s} {row['outcome']:8s} rc {row['returncode']}  "
               f"{row['message'][:110]}")
     RESULTS.mkdir(exist_ok=True)
-    path.write_text(json.dumps({"machine": machine(), "limit_bytes": LIMIT, "rows": rows,
+    from qrrt_circuits.memory import _machine_available_bytes  # the machine's figure, outside any group
+
+    path.write_text(json.dumps({"machine": machine(), "machine_available_bytes": _machine_available_bytes(),
+                                "limit_bytes": LIMIT, "rows": rows,
                                 "group_failures": events}, indent=1))
     print(f"wrote {path}")
 
