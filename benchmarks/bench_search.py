@@ -8,8 +8,12 @@ k = 12 iterations, 8 shots, Aer on one thread; in each repeat, one after the oth
   ``floor_all_threads``: the same with Aer's default thread count, all cores);
 - ``floor_controller``: that 1-qubit circuit on Aer's controller directly (``aer_direct``), the
   floor of the path ``AerBackend`` takes;
+- ``floor_state``: the floor of Aer's state (``aer_state``): a 1-qubit state reset, one h and 8
+  samples;
 - ``ours``: ``AerBackend.search`` (the compact circuit of ``aer_grover_circuit``, its instructions
-  handed to Aer's controller), ``build`` its construction per search (the ``GroverProgram``: its
+  applied to Aer's state below 14 qubits, ``aer_state``, else handed to Aer's controller),
+  ``ours_controller`` the same searches on the controller (``aer_direct``, the path before
+  ``aer_state``), ``build`` its construction per search (the ``GroverProgram``: its
   share of the search), ``assemble`` the program's conversion into Aer's circuit object (which
   Aer's own assembler did inside ``AerSimulator.run`` before), ``build_circuit`` the same circuit as
   a ``QuantumCircuit``, and ``ours_via_run`` the same searches through ``AerSimulator.run`` (the
@@ -38,7 +42,9 @@ the search a q-RRT round on Aer makes, taken apart, interleaved: ``AerBackend.se
 ``assemble_grover`` (assembly into a new circuit), the controller's call on an assembled circuit
 (``controller_call``) and, from its output, the controller's own C++ time for the circuit
 (``time_taken``, k = 3 and k = 0), a new ``AerCircuit()`` alone (its ``std::random_device`` seed),
-and ``StatevectorBackend.search`` of the same marks.
+``aer_state.execute_grover`` (the circuit on Aer's state, ``AerBackend``'s path since ``aer_state``),
+``search_on_controller`` (``AerBackend.search`` kept on the controller) and
+``StatevectorBackend.search`` of the same marks.
 
 Search table: Aer for n = 4..16, the exact statevector for n = 4..20. Reachability: one core,
 batches of pairs on paper_clutter and annealing_field, for two pair distributions (``uniform``: a
@@ -60,7 +66,7 @@ from _common import machine, median_time, write_json
 
 import qrrt_circuits as qc
 from qrrt_circuits.registry import BACKENDS
-from qrrt_circuits.search import aer_direct, circuits
+from qrrt_circuits.search import aer_direct, aer_state, circuits
 from qrrt_circuits.search.aer_circuits import aer_grover_program
 
 FLOOR_QUBITS = (4, 8, 12, 16)
@@ -84,6 +90,9 @@ def _contenders(n: int, marks: np.ndarray) -> dict:
     ours = qc.AerBackend(seed=1, max_parallel_threads=1)
     via_run = qc.AerBackend(seed=1, max_parallel_threads=1)
     via_run._use_controller = False  # the same circuits through AerSimulator.run (the path before aer_direct)
+    on_controller = qc.AerBackend(seed=1, max_parallel_threads=1)
+    on_controller._use_state = False  # the same circuits on the controller (the path before aer_state)
+    state_floor = np.zeros(2, dtype=bool)  # k = 0: the state's reset, W (one h) and 8 samples
     program = aer_grover_program(marks, 12)
     seeds = np.random.default_rng(2)
 
@@ -102,7 +111,11 @@ def _contenders(n: int, marks: np.ndarray) -> dict:
         # the same 1-qubit circuit on Aer's controller directly (aer_direct): the floor of the
         # path AerBackend takes without a noise model
         "floor_controller": lambda: aer_direct.execute(simulator, floor, 8, 1, 1),
+        # a 1-qubit circuit (h, 8 samples) on Aer's state: the floor of the path AerBackend takes
+        # below 14 qubits
+        "floor_state": lambda: aer_state.execute_grover(state_floor, 0, "diagonal", 8, 1),
         "ours": lambda: ours.search(marks, 12, shots=8),
+        "ours_controller": lambda: on_controller.search(marks, 12, shots=8),
         # the circuit's construction (its GroverProgram: what AerBackend builds per search), and
         # its conversion into Aer's circuit object (what Aer's own assembler did inside run)
         "build": lambda: aer_grover_program(marks, 12),
@@ -245,6 +258,8 @@ def bench_round_search(quick: bool) -> dict:
     marks = np.random.default_rng(5).random(2**n) < 0.2
     backend = qc.AerBackend(seed=0, max_parallel_threads=1)
     statevector = qc.StatevectorBackend(seed=0)
+    on_controller = qc.AerBackend(seed=0, max_parallel_threads=1)
+    on_controller._use_state = False
     simulator = backend.simulator
     assembled = {iterations: aer_direct.assemble_grover(marks, iterations, "diagonal") for iterations in (k, 0)}
     width = aer_direct._Width(n, n)
@@ -261,6 +276,8 @@ def bench_round_search(quick: bool) -> dict:
             "controller_call": lambda: controller(k),
             "controller_call_k0": lambda: controller(0),
             "new_aer_circuit": AerCircuit,
+            "state_execute_grover": lambda: aer_state.execute_grover(marks, k, "diagonal", 1, 1),
+            "search_on_controller": lambda: on_controller.search(marks, k, 1, seed=1),
             "statevector_search": lambda: statevector.search(marks, k, 1, seed=1)}
     for run in runs.values():
         run()
@@ -415,7 +432,7 @@ def main() -> None:
     for row in floor:
         n = row["qubits"]
         summary[f"aer_floor_ms_n{n}"] = row["median_ms"]["floor"]
-        for name in ("ours", "gate_by_gate", "qiskit_algorithms"):
+        for name in ("ours", "ours_controller", "floor_state", "gate_by_gate", "qiskit_algorithms"):
             if name in row["ratio_to_floor"]:
                 summary[f"{name}_over_floor_n{n}"] = row["ratio_to_floor"][name]
                 summary[f"{name}_min_over_floor_min_n{n}"] = row["ratio_of_minimums_to_floor"][name]

@@ -1,0 +1,217 @@
+"""Running the package's Grover circuits on qiskit-aer's own statevector state (``AerState``).
+
+qiskit-aer offers two ways to simulate a circuit: its controller, which takes a whole circuit and
+a run configuration (``AerSimulator.run``, or ``aer_direct``, which calls it directly), and
+``AerState``, the native state behind ``qiskit_aer.quantum_info.AerStatevector``, to which a caller
+applies the instructions one by one (``apply_unitary``, ``apply_diagonal``, ``apply_mcphase``, ...)
+and then samples (``sample_memory``). Both apply the same C++ kernels of Aer's ``QubitVector`` to
+the same ``complex128`` amplitudes and sample them with the same sampler.
+
+A small Grover circuit costs the controller a fixed time per run beyond its arithmetic:
+each run constructs three ``std::random_device`` (about 11 us each on this project's machine,
+``benchmarks/bench_aer_overhead.py``) and converts its configuration and result through JSON.
+``AerState`` pays one ``std::random_device`` per flush, and ``execute_grover`` flushes once per
+search (when it samples), on a state that is kept per thread and reset to |0> between searches.
+
+What runs is the circuit of ``aer_circuits.aer_grover_program``, instruction for instruction:
+the Walsh-Hadamard blocks as ``apply_unitary`` of their matrices, the oracle's ``diagonal`` as
+``apply_diagonal`` (or, in the ``mcz`` form, its X-strings as ``apply_x`` on their qubits and its
+``mcphase`` gates as ``apply_mcphase``), the reflection as ``apply_mcphase``, the final Z^n as
+``apply_z`` on every qubit, the circuit's global phase first (where the controller applies it).
+The seed is set with ``set_seed(seed_simulator)``, as the controller seeds a run of one circuit.
+The controller returns a run's samples last to first, ``sample_memory`` first to last, so
+the words are reversed here. The measured words are those of ``AerSimulator.run`` on
+``aer_grover_circuit`` with ``seed_simulator``, word for word, for every n, k, shot count, oracle
+form and seed tested (``tests/test_aer_state.py``).
+
+Only where the two are the same simulation: ``statevector`` method on the CPU, no noise model,
+the simulator's options as ``AerBackend`` made them, and fewer than ``STATE_BELOW_QUBITS`` (14)
+qubits. From 14 qubits on the controller fuses gates (Aer's ``fusion_threshold``) and runs on
+several threads, which the state does not. ``AerBackend`` takes the controller path elsewhere.
+
+These are qiskit-aer internals (``controller_wrappers.AerStateWrapper``, checked with qiskit-aer
+0.18.2); if the installed qiskit-aer lacks them, ``STATE_AVAILABLE`` is False and ``AerBackend``
+uses the controller.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Any
+
+import numpy as np
+
+from .aer_circuits import WALSH_HADAMARD_BLOCK, GroverProgram, aer_grover_program, choose_simulation_synthesis
+from .aer_direct import DIRECT_AVAILABLE, _diagonal_calls
+
+try:  # qiskit-aer internals (checked with 0.18.2); without them AerBackend uses the controller
+    from qiskit_aer.backends.controller_wrappers import AerStateWrapper
+    _NEEDED = ("configure", "allocate_qubits", "initialize", "clear", "apply_initialize", "apply_unitary",
+               "apply_diagonal", "apply_mcphase", "apply_x", "apply_z", "apply_h", "apply_global_phase",
+               "set_seed", "sample_memory")
+    # (the diagonal form's cached arguments come from aer_direct, which needs Aer's CircuitHeader)
+    STATE_AVAILABLE = DIRECT_AVAILABLE and all(hasattr(AerStateWrapper, name) for name in _NEEDED)
+except ImportError:  # pragma: no cover - depends on the installed qiskit-aer
+    STATE_AVAILABLE = False
+
+#: circuits on fewer qubits may run on the state (Aer's fusion_threshold and
+#: statevector_parallel_threshold are both 14: below them the controller runs the instructions one
+#: by one on one thread, as the state does)
+STATE_BELOW_QUBITS = 14
+#: below this width the state is reset to |0> with ``apply_initialize`` of a cached list, from it on
+#: by clearing and reallocating it (``python benchmarks/bench_aer_overhead.py``, ``state_reset``:
+#: the list's conversion grows with 2^n, 26 us at n = 12 and 66 at 13 in its quick run, while the
+#: reallocation costs about 31-35 us whatever n, mostly ``std::random_device`` constructions)
+_RESET_BY_INITIALIZE_BELOW = 13
+
+
+class _ThreadState:
+    """One thread's ``AerStateWrapper``, allocated for ``num_qubits`` qubits (0: none yet)."""
+
+    def __init__(self) -> None:
+        self.wrapper: Any = None
+        self.num_qubits = 0
+        self.zero: list[complex] = []
+
+    def reset(self, num_qubits: int) -> Any:
+        """The thread's state on ``num_qubits`` qubits, in |0> (a new one for a new width)."""
+        wrapper = self.wrapper
+        if wrapper is not None and num_qubits == self.num_qubits and num_qubits < _RESET_BY_INITIALIZE_BELOW:
+            wrapper.apply_initialize(list(range(num_qubits)), self.zero)
+            return wrapper
+        self.num_qubits = 0  # until the state below is allocated
+        if wrapper is None:
+            wrapper = self.wrapper = AerStateWrapper()
+        else:
+            wrapper.clear()
+        wrapper.configure("method", "statevector")
+        wrapper.configure("device", "CPU")
+        wrapper.configure("precision", "double")
+        wrapper.configure("max_parallel_threads", "1")
+        wrapper.allocate_qubits(num_qubits)
+        wrapper.initialize()
+        if num_qubits < _RESET_BY_INITIALIZE_BELOW:
+            self.zero = [1.0 + 0.0j] + [0.0j] * ((1 << num_qubits) - 1)
+        self.num_qubits = num_qubits
+        return wrapper
+
+    def release(self) -> None:
+        """Drop the state (after a failed call, whose state may be half-applied)."""
+        wrapper, self.wrapper, self.num_qubits, self.zero = self.wrapper, None, 0, []
+        if wrapper is not None:
+            try:
+                wrapper.clear()
+            except RuntimeError:  # pragma: no cover - depends on the failure
+                pass
+
+
+_THREAD = threading.local()
+
+
+def _thread_state() -> _ThreadState:
+    state = getattr(_THREAD, "state", None)
+    if state is None:
+        state = _THREAD.state = _ThreadState()
+    return state
+
+
+def execute_grover(marks: np.ndarray, iterations: int, synthesis: str, shots: int, seed: int) -> np.ndarray:
+    """The measured indices of ``aer_grover_circuit(marks, iterations, synthesis=synthesis)``
+    with ``shots`` shots and ``seed_simulator = seed``, run on this thread's ``AerState``: the
+    indices of the words ``AerSimulator(method="statevector").run`` measures, in its order.
+
+    ``AerBackend``'s path for n < ``STATE_BELOW_QUBITS``, after the backend's own checks: ``marks``
+    must be a bool array of length 2^n (n >= 1) and ``iterations`` an int >= 0, not validated
+    again here.
+
+    Args:
+        marks: The oracle's marks.
+        iterations: k.
+        synthesis: ``"auto"``, ``"diagonal"`` or ``"mcz"``.
+        shots: Shots (>= 1).
+        seed: The simulator seed.
+
+    Returns:
+        Int array (shots,) of measured indices.
+
+    Raises:
+        ValueError: n outside 1 .. ``STATE_BELOW_QUBITS`` - 1.
+    """
+    num_qubits = marks.shape[0].bit_length() - 1
+    if not 1 <= num_qubits < STATE_BELOW_QUBITS:
+        raise ValueError(f"aer_state runs circuits of 1 to {STATE_BELOW_QUBITS - 1} qubits, got {num_qubits}")
+    if synthesis == "auto":
+        synthesis = choose_simulation_synthesis(marks)
+    thread = _thread_state()
+    try:
+        state = thread.reset(num_qubits)
+        state.set_seed(seed)
+        if synthesis == "diagonal":
+            _apply_diagonal_form(state, marks, iterations)
+        else:
+            _apply_program(state, aer_grover_program(marks, iterations, synthesis))
+        words = state.sample_memory(list(range(num_qubits)), shots)
+    except BaseException:
+        thread.release()
+        raise
+    return np.fromiter((int(word, 2) for word in reversed(words)), dtype=np.int64, count=shots)
+
+
+def _apply_diagonal_form(state: Any, marks: np.ndarray, iterations: int) -> None:
+    """The diagonal-form program's instructions (``aer_grover_program(..., "diagonal")``), from
+    the arguments ``aer_direct`` caches per n: W, then per iteration the oracle's ``diagonal``
+    (the first with Z^n folded in), W, the reflection and W, then Z^n."""
+    n = marks.shape[0].bit_length() - 1
+    calls = _diagonal_calls(n, WALSH_HADAMARD_BLOCK)
+    qubits = calls.qubits
+    unitary = state.apply_unitary
+    walsh = calls.walsh
+    for group, matrix, _ in walsh:
+        unitary(group, matrix)
+    if not iterations:
+        return
+    signs = np.where(marks, -1.0, 1.0)
+    first = (signs * calls.signs).astype(complex).tolist()
+    rest = signs.astype(complex).tolist() if iterations > 1 else first
+    diagonal, mcphase = state.apply_diagonal, state.apply_mcphase
+    _, (angle,), _ = calls.reflection
+    for call in range(iterations):
+        diagonal(qubits, rest if call else first)
+        for group, matrix, _ in walsh:
+            unitary(group, matrix)
+        mcphase(qubits, angle)
+        for group, matrix, _ in walsh:
+            unitary(group, matrix)
+    for qubit in qubits:  # the final Z^n (one pauli instruction in the circuit)
+        state.apply_z(qubit)
+
+
+def _apply_program(state: Any, program: GroverProgram) -> None:
+    """Every instruction of ``program`` in order, after its global phase."""
+    if program.global_phase:
+        state.apply_global_phase(float(program.global_phase))
+    indices_of = program.parts.indices_of
+    for operation, qubit_tuple in program.steps:
+        qubits = indices_of(qubit_tuple)
+        name = operation.name
+        if name == "unitary":
+            state.apply_unitary(qubits, operation.params[0])
+        elif name == "diagonal":
+            state.apply_diagonal(qubits, [complex(value) for value in operation.params])
+        elif name in ("mcphase", "p"):
+            state.apply_mcphase(qubits, float(operation.params[0]))
+        elif name == "pauli":
+            _apply_pauli(state, qubits, operation.params[0])
+        else:  # pragma: no cover - aer_grover_program makes no other instruction
+            raise ValueError(f"aer_state cannot apply the instruction {name!r}")
+
+
+def _apply_pauli(state: Any, qubits: list[int], label: str) -> None:
+    """A Pauli string of X, Z and I (big-endian label, qubit 0 last), one qubit at a time."""
+    for qubit, letter in zip(qubits, reversed(label), strict=True):
+        if letter == "X":
+            state.apply_x(qubit)
+        elif letter == "Z":
+            state.apply_z(qubit)
+        elif letter != "I":  # pragma: no cover - the package's circuits use X and Z strings only
+            raise ValueError(f"aer_state applies X, Z and I Pauli strings, got {label!r}")
