@@ -17,8 +17,9 @@ Cases:
   round history; the tree stays small);
   the constants ``TREE_*`` and ``HISTORY_BYTES_PER_ROUND`` come from these; and the batches of
   4 096 parallel-RRT workers whose every test fails (d = 2, 6, 64: ``plan-batch``, the constants
-  ``BATCH_BYTES_*`` of ``planners.classical``); and what writing a 200 000-node plan's JSON adds
-  (``output``: streamed with ``json.dump``, as ``qrrt plan --json`` does, against ``json.dumps``).
+  ``BATCH_BYTES_*`` of ``planners.classical``); and what writing a plan's JSON of 200 000 and
+  1 000 000 nodes adds, and its seconds (``output``: ``PlanResult.write_json``, as ``qrrt plan
+  --json`` does, against ``json.dump`` and ``json.dumps`` of ``to_dict()``).
 
     python benchmarks/bench_memory.py            # n = 16, 18, 20, 22 on both backends (a few minutes)
     python benchmarks/bench_memory.py --quick    # n = 16, 18, 20
@@ -200,9 +201,11 @@ def run_plan_batch_case(check: str, dim: int, rounds: int) -> dict:
 
 
 def run_output_case(how: str, nodes: int) -> dict:
-    """What writing a plan's JSON adds to the peak: ``qrrt plan --json``'s ``json.dump`` to the file
-    (``how`` = "dump") against ``json.dumps`` then one write (``how`` = "dumps"), for a result of
-    ``nodes`` nodes (4 096 parallel-RRT workers, the walled-goal world, d = 2)."""
+    """What writing a plan's JSON adds to the peak, and how long it takes, for a result of
+    ``nodes`` nodes (4 096 parallel-RRT workers, the walled-goal world, d = 2): ``qrrt plan
+    --json``'s ``PlanResult.write_json`` (``how`` = "stream": the arrays chunk by chunk through
+    the C encoder) against ``json.dump(result.to_dict(), handle, indent=1)`` ("dump", the writer
+    before it) and ``json.dumps`` then one write ("dumps")."""
     import json
     import tempfile
 
@@ -215,17 +218,22 @@ def run_output_case(how: str, nodes: int) -> dict:
     base = _rss()
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "plan.json"
+        began = time.perf_counter()
         with path.open("w") as handle:
-            if how == "dump":
+            if how == "stream":
+                result.write_json(handle)
+            elif how == "dump":
                 json.dump(result.to_dict(), handle, indent=1)
             else:
                 handle.write(json.dumps(result.to_dict(), indent=1))
+        seconds = time.perf_counter() - began
         size = path.stat().st_size
-    with open("/proc/self/status") as status:
-        peak = next(int(line.split()[1]) * 1024 for line in status if line.startswith("VmHWM:"))
+        with open("/proc/self/status") as status:
+            peak = next(int(line.split()[1]) * 1024 for line in status if line.startswith("VmHWM:"))
+        assert json.loads(path.read_text())["nodes"] == result.nodes.tolist()  # (after the peak is read)
     return {"case": f"output-{how}", "dim": 2, "num_qubits": 0, "nodes": result.metrics.nodes,
-            "measured_bytes": peak - base, "estimated_bytes": 0, "file_bytes": size,
-            "note": "no estimate: the output is not part of the plan's memory check"}
+            "measured_bytes": peak - base, "estimated_bytes": 0, "file_bytes": size, "seconds": seconds,
+            "note": "no estimate: the plan's memory check charges no output"}
 
 
 def in_subprocess(*args: str) -> dict:
@@ -269,7 +277,7 @@ def main() -> None:
     limits = [("limits", "tree", str(d), str(nodes)) for d in (2, 4) for nodes in (200_000, 600_000)]
     limits += [("limits", "rounds", "2", "1000000")]
     limits += [("batch", "nowhere", str(d), "300") for d in (2, 6, 64)] + [("batch", "exact", "6", "300")]
-    limits += [("output", how, "200000") for how in ("dump", "dumps")]
+    limits += [("output", how, nodes) for how in ("stream", "dump", "dumps") for nodes in ("200000", "1000000")]
     if args.only_plan_limits:
         cases = limits
     elif args.plan_limits:

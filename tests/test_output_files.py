@@ -199,11 +199,10 @@ def test_a_file_of_another_group_in_a_set_group_id_folder_is_replaced_whole(tmp_
     assert output_files._write_in_place(target)
 
 
-def test_json_output_is_counted_before_the_plan(tmp_path, monkeypatch, capsys):
-    """The JSON's lists take about as much memory as the tree: with --json, limits whose tree and
-    output could exceed the available memory are refused before the plan, though the plan alone fits."""
+def test_the_to_dict_output_can_be_counted_before_a_plan(monkeypatch):
+    """``to_dict``'s lists take about as much memory as the tree: a caller that writes them can
+    have them counted (``output_bytes_per_node``), and a plan that fits alone is then refused."""
     from qrrt_circuits import memory
-    from qrrt_circuits.cli import main
     from qrrt_circuits.memory import JSON_BYTES_PER_COORDINATE, JSON_BYTES_PER_NODE, check_plan_fits
 
     monkeypatch.setattr(memory, "available_memory_bytes", lambda: 300 << 20)
@@ -211,9 +210,20 @@ def test_json_output_is_counted_before_the_plan(tmp_path, monkeypatch, capsys):
     with pytest.raises(ValueError, match="its JSON output"):
         check_plan_fits(10**6, 4096, 20000, 2,
                         output_bytes_per_node=JSON_BYTES_PER_NODE + 2 * JSON_BYTES_PER_COORDINATE)
-    with pytest.raises(SystemExit) as exited:
-        main(["plan", "--planner", "prrt", "--workers", "4096", "--max-nodes", "1000000",
+
+
+def test_a_plan_too_large_for_memory_is_refused_before_it_runs_and_json_adds_nothing(tmp_path, monkeypatch, capsys):
+    """``qrrt plan --json``: the plan's own check refuses limits whose tree could exceed the
+    available memory, before the plan and before any output file exists; the streamed JSON is not
+    charged per node (``PlanResult.write_json``)."""
+    from qrrt_circuits import memory
+    from qrrt_circuits.cli import main
+
+    monkeypatch.setattr(memory, "available_memory_bytes", lambda: 300 << 20)
+    with pytest.raises(SystemExit) as exited:  # a tree of about 380 MiB (above always_fits_bytes)
+        main(["plan", "--planner", "prrt", "--workers", "4096", "--max-nodes", "2000000",
               "--json", str(tmp_path / "out.json")])
     assert exited.value.code == 2
-    assert "max_nodes = 1000000: this plan's tree and its JSON output" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "max_nodes = 2000000: this plan's tree" in err and "JSON output" not in err
     assert not (tmp_path / "out.json").exists()

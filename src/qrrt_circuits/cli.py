@@ -7,7 +7,6 @@ from ``qrrt_circuits.registry``, so the command line and the library mean the sa
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 from collections.abc import Callable
@@ -202,8 +201,8 @@ def _write_plan_outputs(args: argparse.Namespace, result: PlanResult, env: Envir
     and one ``OSError`` names every failed output and says the plan finished."""
     failures = []
     if args.json:
-        try:  # streamed (json.dump), not built as one string
-            write_replacing(Path(args.json), lambda handle: json.dump(result.to_dict(), handle, indent=1))
+        try:  # streamed chunk by chunk (PlanResult.write_json), not built as one string
+            write_replacing(Path(args.json), result.write_json)
             print(f"wrote {args.json}")
         except OSError as exc:
             failures.append(f"--json: writing {args.json!r} failed ({exc.strerror or exc})")
@@ -231,22 +230,6 @@ def _write_plan_outputs(args: argparse.Namespace, result: PlanResult, env: Envir
                       f"{'these outputs were' if len(failures) > 1 else 'this output was'} not (completely) written")
 
 
-def _check_json_fits(args: argparse.Namespace, planner: Planner, dim: int) -> None:
-    """Refuse, before the plan, limits whose tree, history and JSON output could exceed the
-    available memory (the JSON's lists take about as much as the tree; ``Planner.plan`` counts
-    the tree and the history alone)."""
-    from .memory import JSON_BYTES_PER_COORDINATE, JSON_BYTES_PER_NODE, check_plan_fits
-    from .termination import from_budgets, limits_in_force
-
-    limits = limits_in_force(from_budgets(max_oracle_calls=args.max_oracle_calls, max_nodes=args.max_nodes,
-                                          max_rounds=args.max_rounds,
-                                          max_critical_path_calls=args.max_critical_path_calls,
-                                          stall_rounds=args.stall_rounds))
-    check_plan_fits(limits.node_limit, planner._max_new_nodes_per_round(), limits.round_limit, dim,
-                    default_nodes=limits.default_nodes, default_rounds=limits.default_rounds,
-                    output_bytes_per_node=JSON_BYTES_PER_NODE + JSON_BYTES_PER_COORDINATE * dim)
-
-
 def cmd_plan(args: argparse.Namespace) -> int:
     check_output_file(args.json, "--json")
     check_output_file(args.plot, "--plot", PLOT_FORMATS)
@@ -254,8 +237,8 @@ def cmd_plan(args: argparse.Namespace) -> int:
         raise ValueError(f"--json and --plot name the same file {args.plot!r} (the plot would overwrite the JSON)")
     env = _load_environment(args)
     planner = build_planner(args, env)
-    if args.json:
-        _check_json_fits(args, planner, env.dim)
+    # (the plan checks its tree and history against the available memory before its first round;
+    # --json adds no memory per node: PlanResult.write_json streams the arrays chunk by chunk)
     result = planner.plan(max_nodes=args.max_nodes, max_oracle_calls=args.max_oracle_calls,
                           max_rounds=args.max_rounds, max_critical_path_calls=args.max_critical_path_calls,
                           stall_rounds=args.stall_rounds)

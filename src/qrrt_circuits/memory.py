@@ -399,9 +399,9 @@ def check_fits(estimate_for: Callable[[int], MemoryEstimate], num_qubits: int, w
 #: a plan's tree, bytes per node besides its coordinates (parents in the tree and the result, the
 #: nearest-node grid's order, the history of nodes, allocator slack). Measured with
 #: ``python benchmarks/bench_memory.py --only-plan-limits`` (4 096 parallel-RRT workers filling a
-#: world whose goal is walled in, 200 000 and 600 000 nodes): 126-130 B per node at d = 2 and
-#: 194-198 at d = 4 in the committed run (182-216 at d = 4 in earlier ones); the estimate,
-#: 96 + 48 d, is 1.3-1.6 times that.
+#: world whose goal is walled in, 200 000 and 600 000 nodes): 122-126 B per node at d = 2 and
+#: 200-211 at d = 4 in the committed run (182-216 at d = 4 in earlier ones); the estimate,
+#: 96 + 48 d, is 1.4-1.6 times that.
 TREE_BYTES_PER_NODE = 96
 #: a plan's tree, bytes per node and coordinate (positions in the tree, the grid and the result)
 TREE_BYTES_PER_COORDINATE = 48
@@ -411,9 +411,12 @@ TREE_BYTES_PER_COORDINATE = 48
 HISTORY_BYTES_PER_ROUND = 256
 
 
-#: writing a plan's result as JSON (``qrrt plan --json``: ``PlanResult.to_dict`` and ``json.dump``),
+#: writing a plan's result as ``json.dump(result.to_dict(), ...)`` (the Python lists of ``to_dict``),
 #: bytes per node besides the tree's: 176 measured at d = 2 (``bench_memory.py --only-plan-limits``,
-#: ``output-dump``) and about 232 at d = 4 (a helper's tracemalloc); 128 + 48 d is 1.3-1.4 times that
+#: ``output-dump``) and about 232 at d = 4 (a helper's tracemalloc); 128 + 48 d is 1.3-1.4 times that.
+#: For callers that write ``to_dict()`` themselves (``plan_bytes``' ``output_bytes_per_node``);
+#: ``qrrt plan --json`` writes with ``PlanResult.write_json``, which adds about 2 MiB whatever the
+#: node count (``output-stream``), so it charges nothing per node.
 JSON_BYTES_PER_NODE = 128
 JSON_BYTES_PER_COORDINATE = 48
 
@@ -433,7 +436,7 @@ def plan_bytes(max_nodes: int, nodes_per_round: int, max_rounds: int | None, dim
             how many (a user's own condition): the history is then not counted.
         dim: The workspace dimension d.
         output_bytes_per_node: What writing the result adds per node (``JSON_BYTES_PER_NODE +
-            JSON_BYTES_PER_COORDINATE * d`` for ``qrrt plan --json``; 0 by default), counted
+            JSON_BYTES_PER_COORDINATE * d`` for ``json.dump`` of ``to_dict()``; 0 by default), counted
             with the tree.
 
     Returns:

@@ -35,8 +35,8 @@ DEFAULT_STALL_ROUNDS = 5000
 #: the node limit in force whenever the caller gives none. Without it the round limit alone bounds
 #: the tree: 4 096 parallel-RRT workers filling a world whose goal is walled in add about 3 900
 #: nodes a round (``python benchmarks/bench_memory.py --only-plan-limits``), so 20 000 rounds would
-#: make about 80 million nodes (about 9.5 GiB at the 126-130 bytes per node measured there, and
-#: about an hour and a half at the rate measured there, 600 000 nodes in 43 s, if it stays linear).
+#: make about 80 million nodes (about 9-9.4 GiB at the 122-126 bytes per node measured there, and
+#: about 1.2 h at the rate measured there, 600 000 nodes in 33 s, if it stays linear).
 #: A million nodes is about 120 MiB there, and far beyond any tree of the paper's experiments
 #: (thousands of nodes).
 DEFAULT_MAX_NODES = 1_000_000

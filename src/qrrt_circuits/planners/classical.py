@@ -56,7 +56,7 @@ MAX_BATCH_BYTES = 64 << 20
 #: a batch's bytes per candidate: its keys, the candidate and its parent's position, the parent
 #: index, the answers and the predicate's scratch. ``python benchmarks/bench_memory.py
 #: --only-plan-limits`` (``plan-batch`` cases, a predicate that rejects everything) measured 123,
-#: 272 and 2 628 B per candidate at d = 2, 6 and 64 (about 30 + 40 d); the constants, 64 + 48 d,
+#: 272 and 2 630 B per candidate at d = 2, 6 and 64 (about 30 + 40 d); the constants, 64 + 48 d,
 #: are 1.2-1.3 times that
 BATCH_BYTES_PER_CANDIDATE = 64
 BATCH_BYTES_PER_COORDINATE = 48

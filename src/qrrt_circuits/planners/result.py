@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from collections.abc import KeysView
+from collections.abc import Callable, KeysView
 from dataclasses import asdict, dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -164,15 +164,31 @@ class PlanResult:
             A dict with keys ``status``, ``planner``, ``settings``, ``labels``, ``metrics``,
             ``nodes``, ``parents``, ``path``, ``goal_node`` and ``history``.
         """
+        return self._data(np.ndarray.tolist)
+
+    def write_json(self, handle: IO[str]) -> None:
+        """Write ``to_dict()`` as JSON to ``handle``, its arrays chunk by chunk
+        (``json_stream.dump_streamed``: the same value after ``json.load``, written by the C
+        encoder, without the whole tree as Python lists; ``qrrt plan --json``'s writer).
+
+        Args:
+            handle: A text file open for writing.
+        """
+        from ..json_stream import dump_streamed
+
+        dump_streamed(self._data(lambda array: array), handle)
+
+    def _data(self, arrays: Callable[[np.ndarray], Any]) -> dict:
+        """``to_dict``'s keys and values, each array passed through ``arrays``."""
         return {
             "status": str(self.status),
             "planner": self.planner,
             "settings": self.settings,
             "labels": list(self.labels),
             "metrics": self.metrics.as_dict(),
-            "nodes": self.nodes.tolist(),
-            "parents": self.parents.tolist(),
-            "path": None if self.path is None else self.path.tolist(),
+            "nodes": arrays(self.nodes),
+            "parents": arrays(self.parents),
+            "path": None if self.path is None else arrays(self.path),
             "goal_node": self.goal_node,
-            "history": {key: value.tolist() for key, value in self.history.items()},
+            "history": {key: arrays(value) for key, value in self.history.items()},
         }
