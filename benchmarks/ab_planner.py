@@ -14,7 +14,8 @@ world seed, built through the registry as ``bench_planners.py`` builds them) to 
 after one warm-up plan, and reports its total wall time over its total nodes. Prints each pair,
 the medians and their ratio (baseline / ours: above 1 means ours is faster) and the median of
 the pairs' own ratios (less sensitive to a drift between pairs); writes JSON, with the baseline
-checkout's git commit and whether its tree differs from it (``baseline_checkout``).
+checkout's git commit and whether its tree differs from it (``baseline_checkout``), and the same
+for this checkout (``ours_checkout``).
 """
 
 from __future__ import annotations
@@ -104,7 +105,8 @@ def main(argv: list[str] | None = None) -> None:
           f"{pair_ratio:.2f}")
     path = write_json(f"ab_{args.planner}_{args.backend}",
                       {"machine": machine(), "baseline_src": str(baseline),
-                       "baseline_checkout": checkout_commit(baseline), "planner": args.planner,
+                       "baseline_checkout": checkout_commit(baseline), "ours_src": str(OURS),
+                       "ours_checkout": checkout_commit(OURS), "planner": args.planner,
                        "backend": args.backend, "worlds": args.worlds, "nodes": args.nodes, "pairs": pairs,
                        "median_ms_per_node": medians,
                        "baseline_over_ours": medians["baseline"] / medians["ours"],

@@ -128,7 +128,10 @@ def controller_times(repeats: int) -> dict:
 def _fresh_state(wrapper, n: int) -> None:
     """Configure, allocate and initialize ``wrapper`` as ``aer_state`` does, on n qubits."""
     wrapper.configure("method", "statevector")
+    wrapper.configure("device", "CPU")
+    wrapper.configure("precision", "double")
     wrapper.configure("max_parallel_threads", "1")
+    wrapper.configure("parallel_state_update", "1")
     wrapper.allocate_qubits(n)
     wrapper.initialize()
 

@@ -34,7 +34,7 @@ def random_marks(num_qubits: int, seed: int, fraction: float = 0.2) -> np.ndarra
     return marks
 
 
-@pytest.mark.parametrize("num_qubits", [1, 2, 3, 5, 8, 10, 11, 12, 13])
+@pytest.mark.parametrize("num_qubits", [1, 2, 3, 5, 8, 9, 10, 11, 12, 13])
 @pytest.mark.parametrize("synthesis", ["diagonal", "mcz", "auto"])
 def test_the_state_measures_the_words_aersimulator_run_measures(num_qubits, synthesis):
     """Word for word, over seeds, k = 0 .. 4 and shot counts 1 (Aer's single-shot measurement)
@@ -84,7 +84,7 @@ def test_a_failed_call_leaves_a_usable_state(monkeypatch):
     def fail(*args):
         raise RuntimeError("injected")
 
-    monkeypatch.setattr(aer_state, "_apply_diagonal_form", fail)
+    monkeypatch.setattr(aer_state._StateTarget, "diagonal", fail)
     with pytest.raises(RuntimeError, match="injected"):
         aer_state.execute_grover(marks, 2, "diagonal", 4, 1)
     monkeypatch.undo()
@@ -100,10 +100,21 @@ def test_threads_each_use_their_own_state():
     assert together == alone
 
 
-@pytest.mark.parametrize("num_qubits", [0, 14])
-def test_widths_outside_the_state_path_are_refused(num_qubits):
-    with pytest.raises(ValueError, match="1 to 13 qubits"):
-        aer_state.execute_grover(np.ones(1 << num_qubits, dtype=bool), 1, "diagonal", 1, 0)
+@pytest.mark.parametrize(("marks", "iterations", "shots", "seed", "message"), [
+    (np.ones(1, dtype=bool), 1, 1, 0, "length 2\\*\\*n with n >= 1"),
+    (np.ones(1 << 14, dtype=bool), 1, 1, 0, "1 to 13 qubits, got 14"),
+    (np.ones(6, dtype=bool), 1, 1, 0, "length 2\\*\\*n"),
+    (np.array([0, 2, 0, 0]), 1, 1, 0, "marks must be a 1-D bool array"),
+    (np.ones(4, dtype=bool), -1, 1, 0, "iterations must be an int >= 0"),
+    (np.ones(4, dtype=bool), 1.0, 1, 0, "iterations must be an int >= 0"),
+    (np.ones(4, dtype=bool), 1, 0, 0, "shots must be an int >= 1"),
+    (np.ones(4, dtype=bool), 1, 2.0, 0, "shots must be an int >= 1"),
+    (np.ones(4, dtype=bool), 1, 1, -1, "seed must be an int in"),
+    (np.ones(4, dtype=bool), 1, 1, 1 << 64, "seed must be an int in"),
+])
+def test_bad_arguments_are_refused_before_any_work(marks, iterations, shots, seed, message):
+    with pytest.raises(ValueError, match=message):
+        aer_state.execute_grover(marks, iterations, "diagonal", shots, seed)
 
 
 def test_the_backend_runs_small_circuits_on_the_state_with_the_controllers_results():
@@ -152,3 +163,62 @@ def test_a_noise_model_keeps_the_gate_by_gate_path():
     later = qc.AerBackend(seed=1)
     later.simulator.set_options(noise_model=noise)
     assert not later._on_state(5)
+
+
+def test_a_process_forked_after_searches_searches_too():
+    """The state's sampler runs on one thread (``parallel_state_update``): with an OpenMP team
+    started by a multi-shot search, a process forked afterwards hung at its next sampling."""
+    import multiprocessing
+
+    marks = random_marks(6, 2)
+    parent = aer_state.execute_grover(marks, 2, "diagonal", 8, 11).tolist()
+    with multiprocessing.get_context("fork").Pool(2) as pool:
+        children = pool.starmap_async(_search_words, [(marks, 11)] * 2).get(timeout=120)
+    assert children == [parent, parent]
+
+
+def _search_words(marks: np.ndarray, seed: int) -> list[int]:
+    return aer_state.execute_grover(marks, 2, "diagonal", 8, seed).tolist()
+
+
+@pytest.mark.skipif(not __import__("os").path.isdir("/proc/self/task"), reason="counts threads in /proc (Linux)")
+def test_searches_start_no_threads():
+    """In a fresh interpreter (OpenMP's threads, once started, stay): multi-shot searches on the
+    state leave the process's thread count as it was (the sampler started min(shots, cores) - 1
+    more before ``parallel_state_update``)."""
+    import subprocess
+    import sys
+
+    code = ("import os, numpy as np\n"
+            "from qrrt_circuits.search import aer_state\n"
+            "marks = np.zeros(256, dtype=bool); marks[[3, 7]] = True\n"
+            "aer_state.execute_grover(marks, 0, 'diagonal', 1, 0)\n"
+            "before = len(os.listdir('/proc/self/task'))\n"
+            "for seed in range(4): aer_state.execute_grover(marks, 2, 'diagonal', 64, seed)\n"
+            "print(before, len(os.listdir('/proc/self/task')))\n")
+    env = {**__import__("os").environ, "OMP_NUM_THREADS": "4"}
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, env=env)
+    before, after = map(int, run.stdout.split())
+    assert after == before
+
+
+@pytest.mark.parametrize("make", [
+    lambda env, backend: qc.QRRT(env, backend=backend, seed=4),
+    lambda env, backend: qc.QRRT(env, backend=backend, num_qubits=11, seed=4),
+    lambda env, backend: qc.PQRRT(env, workers=4, shared_database=False, backend=backend, seed=4),
+])
+def test_plans_on_the_state_are_the_plans_on_the_controller(make):
+    """Every node, parent, counter and per-round record of a plan on Aer is the same on the state
+    as on the controller (the path before ``aer_state``)."""
+    env = qc.scenarios.paper_clutter(seed=4)
+    on_controller = qc.AerBackend(seed=0)
+    on_controller._use_state = False
+    results = [make(env, backend).plan(max_nodes=40) for backend in (qc.AerBackend(seed=0), on_controller)]
+    state, controller = results
+    np.testing.assert_array_equal(state.nodes, controller.nodes)
+    np.testing.assert_array_equal(state.parents, controller.parents)
+    assert ({**state.metrics.as_dict(), "wall_time_s": 0} == {**controller.metrics.as_dict(), "wall_time_s": 0})
+    assert state.history.keys() == controller.history.keys()
+    for key in state.history:
+        np.testing.assert_array_equal(state.history[key], controller.history[key])
+    assert state.metrics.quantum_oracle_calls > 0

@@ -39,6 +39,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 from qiskit import QuantumCircuit
@@ -335,3 +336,95 @@ def aer_grover_program(marks: np.ndarray, iterations: int, synthesis: str = "aut
             steps += parts.walsh
         steps.append(parts.parity)
     return GroverProgram(parts, tuple(steps), phase * iterations)
+
+
+def check_grover_arguments(marks: np.ndarray, iterations: int) -> None:
+    """The cheap checks the direct paths (``aer_direct.execute_grover``, ``aer_state.execute_grover``)
+    make themselves, behind ``AerBackend``'s full ones: a 1-D bool array of length 2^n >= 2 and an
+    int k >= 0 (no coercion).
+
+    Raises:
+        ValueError: Either argument is not of that form, naming it.
+    """
+    if not (isinstance(marks, np.ndarray) and marks.dtype == np.bool_ and marks.ndim == 1):
+        raise ValueError(f"marks must be a 1-D bool array (validate_marks), got {marks!r}")
+    size = marks.shape[0]
+    if size < 2 or size & (size - 1):
+        raise ValueError(f"marks must have length 2**n with n >= 1, got length {size}")
+    if type(iterations) is not int or iterations < 0:
+        raise ValueError(f"iterations must be an int >= 0 (validate_iterations), got {iterations!r}")
+
+class DiagonalFormTarget(Protocol):
+    """Where ``DiagonalForm.emit`` puts the instructions: Aer's circuit object (``aer_direct``) or
+    Aer's statevector state (``aer_state``); qubits as register indices."""
+
+    def unitary(self, qubits: list[int], matrix: np.ndarray, label: str) -> None:
+        """A ``unitary`` instruction (a Walsh-Hadamard block)."""
+
+    def diagonal(self, qubits: list[int], phases: list[complex]) -> None:
+        """A ``diagonal`` instruction of 2^n phases (the oracle)."""
+
+    def gate(self, name: str, qubits: list[int], params: list[float], label: str) -> None:
+        """The reflection: ``mcphase`` (``p`` for n = 1) with its angle."""
+
+    def pauli(self, qubits: list[int], label: str) -> None:
+        """A ``pauli`` instruction (the final Z^n; big-endian label)."""
+
+
+@dataclass(frozen=True, eq=False)
+class DiagonalForm:
+    """The instructions of ``aer_grover_program(marks, k, "diagonal", block)`` that no search
+    changes, as the arguments of Aer's calls (register indices, matrices, labels), made once per n
+    and block width (``diagonal_form``): the Walsh-Hadamard blocks, the reflection, the final Z^n
+    and the signs (-1)^popcount(i) folded into the first oracle call.
+
+    ``emit`` gives a target the program's instructions in order, with only the oracle's two phase
+    lists made per search, without building the program's operations."""
+
+    qubits: list[int]
+    walsh: tuple[tuple[list[int], np.ndarray, str], ...]
+    reflection: tuple[str, list[float], str]
+    parity: str
+    signs: np.ndarray
+
+    def emit(self, target: DiagonalFormTarget, marks: np.ndarray, iterations: int) -> None:
+        """W, then per iteration the oracle's ``diagonal`` (the first with Z^n folded in), W, the
+        reflection and W, then Z^n (none of these for k = 0 but W): the program's steps, in order.
+
+        Args:
+            target: Where the instructions go.
+            marks: Bool array of length 2^n (validated by the caller).
+            iterations: k >= 0 (validated by the caller).
+        """
+        qubits = self.qubits
+        walsh = self.walsh
+        for group, matrix, label in walsh:
+            target.unitary(group, matrix, label)
+        if not iterations:
+            return
+        signs = np.where(marks, -1.0, 1.0)
+        first = (signs * self.signs).astype(complex).tolist()
+        rest = signs.astype(complex).tolist() if iterations > 1 else first
+        name, params, reflection_label = self.reflection
+        for call in range(iterations):
+            target.diagonal(qubits, rest if call else first)
+            for group, matrix, label in walsh:
+                target.unitary(group, matrix, label)
+            target.gate(name, qubits, params, reflection_label)
+            for group, matrix, label in walsh:
+                target.unitary(group, matrix, label)
+        target.pauli(qubits, self.parity)
+
+
+@functools.lru_cache(maxsize=32)
+def diagonal_form(num_qubits: int, block: int) -> DiagonalForm:
+    """The ``DiagonalForm`` of n qubits and Walsh-Hadamard blocks of at most ``block`` qubits,
+    from the cached parts ``aer_grover_program`` uses (``_parts``)."""
+    parts = _parts(num_qubits, block)
+    reflection, _ = parts.reflection
+    parity, _ = parts.parity
+    return DiagonalForm(
+        list(range(num_qubits)),
+        tuple((parts.indices_of(group), gate.params[0], gate.label or "unitary") for gate, group in parts.walsh),
+        (reflection.name, [float(p) for p in reflection.params], reflection.label or reflection.name),
+        str(parity.params[0]), parts.signs)

@@ -48,7 +48,15 @@ from typing import Any
 import numpy as np
 from qiskit import QuantumCircuit
 
-from .aer_circuits import WALSH_HADAMARD_BLOCK, GroverProgram, _parts, aer_grover_program, choose_simulation_synthesis
+from .aer_circuits import (
+    WALSH_HADAMARD_BLOCK,
+    GroverProgram,
+    _parts,
+    aer_grover_program,
+    check_grover_arguments,
+    choose_simulation_synthesis,
+    diagonal_form,
+)
 
 try:  # qiskit-aer internals (checked with 0.18.2); without them AerBackend uses AerSimulator.run
     from qiskit_aer import AerSimulator
@@ -198,29 +206,12 @@ def assemble_program(program: GroverProgram) -> Any:
     return aer
 
 
-@dataclass(frozen=True, eq=False)
-class _DiagonalCalls:
-    """The controller-wrapper calls of a diagonal-form Grover circuit on n qubits that no search
-    changes (made once per n and block width): the header, the Walsh-Hadamard blocks (qubit
-    indices, matrix, label), the reflection ``mcphase`` (``p`` for n = 1), the final Z^n and the
-    signs (-1)^popcount(i) folded into the first oracle call."""
-
-    qubits: list[int]
-    header: Any
-    walsh: tuple[tuple[list[int], np.ndarray, str], ...]
-    reflection: tuple[str, list[float], str]
-    parity: list[str]
-    signs: np.ndarray
-
-
 @functools.lru_cache(maxsize=32)
-def _diagonal_calls(num_qubits: int, block: int) -> _DiagonalCalls:
-    """The ``_DiagonalCalls`` of n qubits and Walsh-Hadamard blocks of at most ``block`` qubits,
-    from the same cached parts as ``aer_grover_program`` (``aer_circuits._parts``)."""
-    parts = _parts(num_qubits, block)
-    reflection, _ = parts.reflection
-    parity, _ = parts.parity
-    header = CircuitHeader(  # as _header makes it (set_header copies it into each circuit)
+def _grover_header(num_qubits: int) -> Any:
+    """The header ``_header`` gives a diagonal-form Grover circuit on n qubits (``set_header``
+    copies it into each circuit)."""
+    parts = _parts(num_qubits, WALSH_HADAMARD_BLOCK)  # (the registers do not depend on the block)
+    return CircuitHeader(
         n_qubits=num_qubits,
         qreg_sizes=[[register.name, register.size] for register in parts.qregs],
         memory_slots=num_qubits,
@@ -228,11 +219,28 @@ def _diagonal_calls(num_qubits: int, block: int) -> _DiagonalCalls:
         name="grover_aer",
         global_phase=0.0,
     )
-    return _DiagonalCalls(
-        list(range(num_qubits)), header,
-        tuple((parts.indices_of(group), gate.params[0], gate.label or "unitary") for gate, group in parts.walsh),
-        (reflection.name, [float(p) for p in reflection.params], reflection.label or reflection.name),
-        list(parity.params), parts.signs)
+
+
+class _CircuitTarget:
+    """``DiagonalFormTarget`` on an ``AerCircuit``: the controller-wrapper calls Aer's assembler
+    makes for each instruction (``_convert``), with the same arguments."""
+
+    __slots__ = ("aer",)
+
+    def __init__(self, aer: Any) -> None:
+        self.aer = aer
+
+    def unitary(self, qubits: list[int], matrix: np.ndarray, label: str) -> None:
+        self.aer.unitary(qubits, matrix, _UNCONDITIONAL, None, label)
+
+    def diagonal(self, qubits: list[int], phases: list[complex]) -> None:
+        self.aer.diagonal(qubits, phases, _UNCONDITIONAL, "diagonal")
+
+    def gate(self, name: str, qubits: list[int], params: list[float], label: str) -> None:
+        self.aer.gate(name, qubits, params, [], _UNCONDITIONAL, None, label)
+
+    def pauli(self, qubits: list[int], label: str) -> None:
+        self.aer.gate("pauli", qubits, [], [label], _UNCONDITIONAL, None, "pauli")
 
 
 def assemble_grover(marks: np.ndarray, iterations: int, synthesis: str = "auto",
@@ -267,32 +275,14 @@ def _fill_grover(aer: Any, marks: np.ndarray, iterations: int, block: int, fresh
     """Make the diagonal-form Grover circuit's calls on ``aer``, an empty ``AerCircuit``: a new one
     (``fresh``) or a recycled one whose header is already that of n qubits (``_recycled``)."""
     n = marks.shape[0].bit_length() - 1
-    calls = _diagonal_calls(n, block)
-    qubits = calls.qubits
     if fresh:
-        aer.set_header(calls.header)
+        aer.set_header(_grover_header(n))
     aer.num_qubits = n
     aer.num_memory = n
     aer.global_phase_angle = 0.0
-    unitary = aer.unitary
-    walsh = calls.walsh
-    for group, matrix, label in walsh:
-        unitary(group, matrix, _UNCONDITIONAL, None, label)
-    if iterations:
-        signs = np.where(marks, -1.0, 1.0)
-        first = (signs * calls.signs).astype(complex).tolist()
-        rest = signs.astype(complex).tolist() if iterations > 1 else first
-        diagonal, gate = aer.diagonal, aer.gate
-        name, params, label = calls.reflection
-        for call in range(iterations):
-            diagonal(qubits, rest if call else first, _UNCONDITIONAL, "diagonal")
-            for group, matrix, walsh_label in walsh:
-                unitary(group, matrix, _UNCONDITIONAL, None, walsh_label)
-            gate(name, qubits, params, [], _UNCONDITIONAL, None, label)
-            for group, matrix, walsh_label in walsh:
-                unitary(group, matrix, _UNCONDITIONAL, None, walsh_label)
-        gate("pauli", qubits, [], calls.parity, _UNCONDITIONAL, None, "pauli")
-    aer.measure(qubits, qubits, [])
+    form = diagonal_form(n, block)
+    form.emit(_CircuitTarget(aer), marks, iterations)
+    aer.measure(form.qubits, form.qubits, [])
     aer.circ_id = 0
     return aer
 
@@ -410,7 +400,7 @@ def execute_grover(simulator: Any, marks: np.ndarray, iterations: int, synthesis
     be a bool array of length 2^n and ``iterations`` an int >= 0 (``ValueError`` otherwise; no
     coercion); raises what ``execute`` raises."""
     _refuse_noise(simulator)
-    _check_grover(marks, iterations)
+    check_grover_arguments(marks, iterations)
     n = marks.shape[0].bit_length() - 1
     if synthesis == "auto":
         synthesis = choose_simulation_synthesis(marks)
@@ -424,18 +414,6 @@ def execute_grover(simulator: Any, marks: np.ndarray, iterations: int, synthesis
         # the oracle's 2^n phases once per iteration: k x 16 x 2^n bytes, as a new circuit would
         # hold only until it is dropped here)
         aer.ops = []
-
-
-def _check_grover(marks: np.ndarray, iterations: int) -> None:
-    """The cheap checks ``execute_grover`` makes itself (the backend has made the full ones): a bool
-    array of length 2^n >= 2 and an int k >= 0."""
-    if not (isinstance(marks, np.ndarray) and marks.dtype == np.bool_ and marks.ndim == 1):
-        raise ValueError(f"marks must be a 1-D bool array (validate_marks), got {marks!r}")
-    size = marks.shape[0]
-    if size < 2 or size & (size - 1):
-        raise ValueError(f"marks must have length 2**n with n >= 1, got length {size}")
-    if type(iterations) is not int or iterations < 0:
-        raise ValueError(f"iterations must be an int >= 0 (validate_iterations), got {iterations!r}")
 
 
 def _refuse_noise(simulator: Any) -> None:

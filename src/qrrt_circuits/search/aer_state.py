@@ -11,7 +11,9 @@ A small Grover circuit costs the controller a fixed time per run beyond its arit
 each run constructs three ``std::random_device`` (about 11 us each on this project's machine,
 ``benchmarks/bench_aer_overhead.py``) and converts its configuration and result through JSON.
 ``AerState`` pays one ``std::random_device`` per flush, and ``execute_grover`` flushes once per
-search (when it samples), on a state that is kept per thread and reset to |0> between searches.
+search (when it samples), on a state that is kept per thread and reset to |0> between searches
+(at n = 13 the reset reallocates the state, which constructs two more: three per search there,
+as on the controller, but still no assembly).
 
 What runs is the circuit of ``aer_circuits.aer_grover_program``, instruction for instruction:
 the Walsh-Hadamard blocks as ``apply_unitary`` of their matrices, the oracle's ``diagonal`` as
@@ -41,16 +43,21 @@ from typing import Any
 
 import numpy as np
 
-from .aer_circuits import WALSH_HADAMARD_BLOCK, GroverProgram, aer_grover_program, choose_simulation_synthesis
-from .aer_direct import DIRECT_AVAILABLE, _diagonal_calls
+from .aer_circuits import (
+    WALSH_HADAMARD_BLOCK,
+    GroverProgram,
+    aer_grover_program,
+    check_grover_arguments,
+    choose_simulation_synthesis,
+    diagonal_form,
+)
 
 try:  # qiskit-aer internals (checked with 0.18.2); without them AerBackend uses the controller
     from qiskit_aer.backends.controller_wrappers import AerStateWrapper
     _NEEDED = ("configure", "allocate_qubits", "initialize", "clear", "apply_initialize", "apply_unitary",
-               "apply_diagonal", "apply_mcphase", "apply_x", "apply_z", "apply_h", "apply_global_phase",
-               "set_seed", "sample_memory")
-    # (the diagonal form's cached arguments come from aer_direct, which needs Aer's CircuitHeader)
-    STATE_AVAILABLE = DIRECT_AVAILABLE and all(hasattr(AerStateWrapper, name) for name in _NEEDED)
+               "apply_diagonal", "apply_mcphase", "apply_x", "apply_z", "apply_global_phase", "set_seed",
+               "sample_memory")
+    STATE_AVAILABLE = all(hasattr(AerStateWrapper, name) for name in _NEEDED)
 except ImportError:  # pragma: no cover - depends on the installed qiskit-aer
     STATE_AVAILABLE = False
 
@@ -59,9 +66,10 @@ except ImportError:  # pragma: no cover - depends on the installed qiskit-aer
 #: by one on one thread, as the state does)
 STATE_BELOW_QUBITS = 14
 #: below this width the state is reset to |0> with ``apply_initialize`` of a cached list, from it on
-#: by clearing and reallocating it (``python benchmarks/bench_aer_overhead.py``, ``state_reset``:
-#: the list's conversion grows with 2^n, 26 us at n = 12 and 66 at 13 in its quick run, while the
-#: reallocation costs about 31-35 us whatever n, mostly ``std::random_device`` constructions)
+#: by clearing and reallocating it (``python benchmarks/bench_aer_overhead.py``, ``state_reset``, in
+#: ``benchmarks/results/run_ea39ee7.json``: the list's conversion grows with 2^n, 25.4 us at n = 12
+#: and 48.4 at 13, while the reallocation costs 31-34 us whatever n, mostly its two
+#: ``std::random_device`` constructions)
 _RESET_BY_INITIALIZE_BELOW = 13
 
 
@@ -88,6 +96,10 @@ class _ThreadState:
         wrapper.configure("device", "CPU")
         wrapper.configure("precision", "double")
         wrapper.configure("max_parallel_threads", "1")
+        # one thread for the sampler too: without this, sample_memory starts an OpenMP team of up
+        # to min(shots, OMP_NUM_THREADS) threads (max_parallel_threads does not reach it), whose
+        # threads a process forked after it lacks, so a forked child's next sampling hung
+        wrapper.configure("parallel_state_update", "1")
         wrapper.allocate_qubits(num_qubits)
         wrapper.initialize()
         if num_qubits < _RESET_BY_INITIALIZE_BELOW:
@@ -120,26 +132,31 @@ def execute_grover(marks: np.ndarray, iterations: int, synthesis: str, shots: in
     with ``shots`` shots and ``seed_simulator = seed``, run on this thread's ``AerState``: the
     indices of the words ``AerSimulator(method="statevector").run`` measures, in its order.
 
-    ``AerBackend``'s path for n < ``STATE_BELOW_QUBITS``, after the backend's own checks: ``marks``
-    must be a bool array of length 2^n (n >= 1) and ``iterations`` an int >= 0, not validated
-    again here.
+    ``AerBackend``'s path for n < ``STATE_BELOW_QUBITS``, after the backend's own checks; the
+    cheap ones are made again here (``check_grover_arguments``, the shots and the seed; no
+    coercion), the rest (the synthesis name) is the backend's.
 
     Args:
-        marks: The oracle's marks.
-        iterations: k.
+        marks: The oracle's marks: a 1-D bool array of length 2^n, 1 <= n < ``STATE_BELOW_QUBITS``.
+        iterations: k, an int >= 0.
         synthesis: ``"auto"``, ``"diagonal"`` or ``"mcz"``.
-        shots: Shots (>= 1).
-        seed: The simulator seed.
+        shots: Shots, an int >= 1.
+        seed: The simulator seed, an int in [0, 2^64).
 
     Returns:
         Int array (shots,) of measured indices.
 
     Raises:
-        ValueError: n outside 1 .. ``STATE_BELOW_QUBITS`` - 1.
+        ValueError: An argument outside those ranges, naming it.
     """
+    check_grover_arguments(marks, iterations)
     num_qubits = marks.shape[0].bit_length() - 1
-    if not 1 <= num_qubits < STATE_BELOW_QUBITS:
+    if num_qubits >= STATE_BELOW_QUBITS:
         raise ValueError(f"aer_state runs circuits of 1 to {STATE_BELOW_QUBITS - 1} qubits, got {num_qubits}")
+    if type(shots) is not int or shots < 1:
+        raise ValueError(f"shots must be an int >= 1, got {shots!r}")
+    if type(seed) is not int or not 0 <= seed < 1 << 64:
+        raise ValueError(f"seed must be an int in [0, 2**64), got {seed!r}")
     if synthesis == "auto":
         synthesis = choose_simulation_synthesis(marks)
     thread = _thread_state()
@@ -147,7 +164,7 @@ def execute_grover(marks: np.ndarray, iterations: int, synthesis: str, shots: in
         state = thread.reset(num_qubits)
         state.set_seed(seed)
         if synthesis == "diagonal":
-            _apply_diagonal_form(state, marks, iterations)
+            diagonal_form(num_qubits, WALSH_HADAMARD_BLOCK).emit(_StateTarget(state), marks, iterations)
         else:
             _apply_program(state, aer_grover_program(marks, iterations, synthesis))
         words = state.sample_memory(list(range(num_qubits)), shots)
@@ -157,33 +174,25 @@ def execute_grover(marks: np.ndarray, iterations: int, synthesis: str, shots: in
     return np.fromiter((int(word, 2) for word in reversed(words)), dtype=np.int64, count=shots)
 
 
-def _apply_diagonal_form(state: Any, marks: np.ndarray, iterations: int) -> None:
-    """The diagonal-form program's instructions (``aer_grover_program(..., "diagonal")``), from
-    the arguments ``aer_direct`` caches per n: W, then per iteration the oracle's ``diagonal``
-    (the first with Z^n folded in), W, the reflection and W, then Z^n."""
-    n = marks.shape[0].bit_length() - 1
-    calls = _diagonal_calls(n, WALSH_HADAMARD_BLOCK)
-    qubits = calls.qubits
-    unitary = state.apply_unitary
-    walsh = calls.walsh
-    for group, matrix, _ in walsh:
-        unitary(group, matrix)
-    if not iterations:
-        return
-    signs = np.where(marks, -1.0, 1.0)
-    first = (signs * calls.signs).astype(complex).tolist()
-    rest = signs.astype(complex).tolist() if iterations > 1 else first
-    diagonal, mcphase = state.apply_diagonal, state.apply_mcphase
-    _, (angle,), _ = calls.reflection
-    for call in range(iterations):
-        diagonal(qubits, rest if call else first)
-        for group, matrix, _ in walsh:
-            unitary(group, matrix)
-        mcphase(qubits, angle)
-        for group, matrix, _ in walsh:
-            unitary(group, matrix)
-    for qubit in qubits:  # the final Z^n (one pauli instruction in the circuit)
-        state.apply_z(qubit)
+class _StateTarget:
+    """``DiagonalFormTarget`` on Aer's state: each instruction applied as its ``AerState`` call."""
+
+    __slots__ = ("state",)
+
+    def __init__(self, state: Any) -> None:
+        self.state = state
+
+    def unitary(self, qubits: list[int], matrix: np.ndarray, label: str) -> None:
+        self.state.apply_unitary(qubits, matrix)
+
+    def diagonal(self, qubits: list[int], phases: list[complex]) -> None:
+        self.state.apply_diagonal(qubits, phases)
+
+    def gate(self, name: str, qubits: list[int], params: list[float], label: str) -> None:
+        self.state.apply_mcphase(qubits, params[0])  # mcphase, or p on one qubit: the same phase
+
+    def pauli(self, qubits: list[int], label: str) -> None:
+        _apply_pauli(self.state, qubits, label)
 
 
 def _apply_program(state: Any, program: GroverProgram) -> None:
