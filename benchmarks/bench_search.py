@@ -376,6 +376,34 @@ def bench_synthesis(quick: bool) -> dict:
             "mean_choice_over_faster": float(np.mean(regrets))}
 
 
+def bench_state_paths(quick: bool) -> dict:
+    """The two paths of ``AerBackend`` for the same search: ``aer_state.execute_grover`` (Aer's
+    state) against ``aer_direct.execute_grover`` (Aer's controller, one thread), both oracle forms,
+    n = 10..13, m = 1 and 12, k = 12, 8 shots, interleaved; per case the medians and state /
+    controller (the data that ``aer.STATE_CHOSEN_BELOW_QUBITS`` rests on)."""
+    rng = np.random.default_rng(4)
+    rows = []
+    repeats = 6 if quick else 20
+    simulator = qc.AerBackend(seed=1, max_parallel_threads=1).simulator
+    widths = (10, 11, 12, 13)
+    for n in widths:
+        for marked in (1, 12):
+            marks = np.zeros(2**n, dtype=bool)
+            marks[rng.choice(2**n, marked, replace=False)] = True
+            for form in ("diagonal", "mcz"):
+                runs = {"state": lambda mk=marks, f=form: aer_state.execute_grover(mk, 12, f, 8, 1),
+                        "controller": lambda mk=marks, f=form: aer_direct.execute_grover(simulator, mk, 12, f, 8, 1, 1)}
+                times = _interleaved_times(runs, repeats)
+                medians = {name: float(np.median(values)) * 1e3 for name, values in times.items()}
+                rows.append({"qubits": n, "marked": marked, "synthesis": form, "median_ms": medians,
+                             "state_over_controller": medians["state"] / medians["controller"]})
+                print(f"  n={n:2d} m={marked:2d} {form:8s} state {medians['state']:7.3f} ms  controller "
+                      f"{medians['controller']:7.3f} ms  ratio {rows[-1]['state_over_controller']:.2f}")
+    return {"rows": rows, "repeats": repeats,
+            "worst_state_over_controller_by_qubits": {
+                str(n): max(row["state_over_controller"] for row in rows if row["qubits"] == n) for n in widths}}
+
+
 def bench_reachability(quick: bool) -> list[dict]:
     rows = []
     count = 20000 if quick else 200000
@@ -417,6 +445,8 @@ def main() -> None:
     search = bench_search(args.quick)
     print("Oracle forms for Aer (k = 12, 8 shots) and simulation_synthesis's choice:")
     synthesis = bench_synthesis(args.quick)
+    print("AerBackend.search on Aer's state against the controller (k = 12, 8 shots, medians):")
+    state_paths = bench_state_paths(args.quick)
     print("Reachability (one core):")
     reach = bench_reachability(args.quick)
     aer12 = next((r["median_s"] for r in search if r["backend"] == "aer" and r["qubits"] == 12), None)
@@ -443,12 +473,14 @@ def main() -> None:
         summary[f"round_search_{name}_us"] = value
     summary["one_job_over_search_many"] = one_job["one_call_over_search_many"]
     summary["one_job_circuit_seeds_own"] = one_job["circuit_seeds_are_their_own"]
+    for n, ratio in state_paths["worst_state_over_controller_by_qubits"].items():
+        summary[f"state_worst_over_controller_n{n}"] = ratio
     summary["synthesis_worst_choice_over_faster"] = synthesis["worst_choice_over_faster"]
     summary["synthesis_mean_choice_over_faster"] = synthesis["mean_choice_over_faster"]
     print("summary:", {k: (round(v, 3) if isinstance(v, float) else v) for k, v in summary.items()})
     path = write_json("bench_search" + ("_quick" if args.quick else ""),
                       {"machine": machine(), "quick": args.quick, "against_floor": floor, "one_job": one_job,
-                       "round_search": round_search, "search": search,
+                       "round_search": round_search, "search": search, "state_paths": state_paths,
                        "synthesis": synthesis, "reachability": reach, "summary": summary,
                        "note": "phase oracle built from a classical lookup of all 2^n marks; "
                                "one circuit with 8 shots stands for 8 workers"}, args.out)

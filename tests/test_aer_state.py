@@ -136,7 +136,8 @@ def test_the_backend_runs_small_circuits_on_the_state_with_the_controllers_resul
 
 def test_the_backend_keeps_the_controller_where_the_simulation_would_differ(monkeypatch):
     backend = qc.AerBackend(seed=1)
-    assert backend._on_state(13) and not backend._on_state(14)  # fusion and threads from 14 qubits
+    assert backend._on_state(12) and not backend._on_state(13)  # STATE_CHOSEN_BELOW_QUBITS (measured)
+    assert not backend._on_state(14)  # fusion and threads from 14 qubits
     assert not qc.AerBackend(method="automatic")._on_state(8)  # Aer may pick another method
     changed = qc.AerBackend(seed=1)
     changed.simulator.set_options(precision="single")  # options changed after construction

@@ -11,7 +11,8 @@ Without a noise model the circuit's instructions (``aer_direct.assemble_grover``
 C++ controller directly (``aer_direct``): the same simulation, the same configuration and the same
 measured words as ``AerSimulator.run`` (tested seed by seed), without the job thread, Aer's generic
 assembler and the ``Result`` conversion, which cost more than simulating these small circuits.
-Circuits on fewer than 14 qubits (``aer_state.STATE_BELOW_QUBITS``), on the statevector method and
+Circuits on fewer than 13 qubits (``STATE_CHOSEN_BELOW_QUBITS``; ``aer_state`` simulates what the
+controller does up to 13), on the statevector method and
 the CPU with the simulator's options as made here, run instead on Aer's own statevector state
 (``aer_state``: the circuit's instructions applied one by one to ``AerState``, the state behind
 ``AerStatevector``, then Aer's sampler with the same seed): again the same measured words as
@@ -49,6 +50,12 @@ if TYPE_CHECKING:
 METHODS = ("statevector", "automatic")
 #: circuits on fewer qubits run single-threaded (Aer's default statevector_parallel_threshold)
 SERIAL_BELOW_QUBITS = 14
+#: circuits on fewer qubits run on Aer's state (``aer_state``, which simulates what the controller
+#: does below 14 qubits): ``python benchmarks/bench_search.py``'s ``state_paths`` (both oracle
+#: forms, n = 10-13, m = 1 and 12, k = 12, 8 shots) found the state faster in every case up to
+#: n = 12 (0.65-0.92 times the controller's time) and the mcz form slower at n = 13 (1.16 times,
+#: its X-strings one ``apply_x`` per qubit where the controller runs one ``pauli``)
+STATE_CHOSEN_BELOW_QUBITS = 13
 #: methods AerSimulator offers that these circuits cannot run, and why (refused at construction)
 UNSUPPORTED_METHODS = {
     "density_matrix": "its instruction set lacks the mcphase gate of aer_grover_circuit (and it "
@@ -61,7 +68,7 @@ class AerBackend(QuantumSearchBackend):
     """Gate-level Grover search (paper Alg. 2, lines 4-8) on ``AerSimulator(method=...)``.
 
     Each search runs the Grover circuit of the marks (``aer_grover_circuit``, applied to Aer's
-    state instruction by instruction below 14 qubits, ``aer_state``, or handed to Aer's
+    state instruction by instruction below 13 qubits, ``aer_state``, or handed to Aer's
     controller as its instructions, ``aer_direct``; with a noise model the gate-by-gate
     ``aer_literal_grover_circuit`` through ``AerSimulator.run``) with ``shots`` shots; a
     marked index is measured with probability sin^2((2k+1) theta), sin^2 theta = m / 2^n (paper
@@ -204,9 +211,9 @@ class AerBackend(QuantumSearchBackend):
     def _on_state(self, num_qubits: int) -> bool:
         """Whether a Grover circuit on ``num_qubits`` qubits runs on Aer's state (``aer_state``):
         the same simulation as the controller's, there (the statevector method on the CPU, no
-        noise model, the simulator's options as made here, fewer than ``STATE_BELOW_QUBITS``
+        noise model, the simulator's options as made here, fewer than ``STATE_CHOSEN_BELOW_QUBITS``
         qubits), and a qiskit-aer with the internals."""
-        return (num_qubits < aer_state.STATE_BELOW_QUBITS and self._use_state and self._direct
+        return (num_qubits < STATE_CHOSEN_BELOW_QUBITS and self._use_state and self._direct
                 and aer_state.STATE_AVAILABLE and self.method == "statevector" and self.device == "CPU"
                 and self._options_unchanged())
 
