@@ -159,13 +159,17 @@ def _qiskit_algorithms_grover(n: int, marks: np.ndarray):
 
 
 def _interleaved_times(runs: dict, repeats: int) -> dict[str, list[float]]:
-    """Seconds of each of ``runs`` (name -> function) over ``repeats`` rounds, each round in a
-    different (rotated) order, so no contender always follows the same one."""
+    """Seconds of each of ``runs`` (name -> function) over ``repeats`` rounds, each round in its
+    own shuffled order (seeded), so no contender always follows the same one. (A rotated order,
+    used before, keeps every contender behind the same neighbour: ``ours`` always ran shortly
+    after ``floor_all_threads``, whose OpenMP threads keep spinning on the cores for a while, and
+    measured 7 or 11 ms at n = 12 where the same search alone took 7.)"""
     times: dict[str, list[float]] = {name: [] for name in runs}
     names = list(runs)
-    for repeat in range(repeats):
-        shift = repeat % len(names)
-        for name in names[shift:] + names[:shift]:
+    order = np.random.default_rng(2026)
+    for _ in range(repeats):
+        for index in order.permutation(len(names)):
+            name = names[index]
             start = time.perf_counter()
             runs[name]()
             times[name].append(time.perf_counter() - start)
@@ -182,7 +186,7 @@ def bench_floor(quick: bool) -> list[dict]:
         for run in runs.values():  # warm-up (imports, caches, the pass manager)
             run()
         repeats = (5 if quick else 30) if n <= 8 else (3 if quick else (12 if n == 12 else 8))
-        # rotated order (the all-threads floor leaves OpenMP threads that can slow whatever runs
+        # shuffled order (the all-threads floor leaves OpenMP threads that can slow whatever runs
         # right after it)
         times = _interleaved_times(runs, repeats)
         medians = {name: float(np.median(values)) for name, values in times.items()}
