@@ -52,9 +52,10 @@ METHODS = ("statevector", "automatic")
 SERIAL_BELOW_QUBITS = 14
 #: circuits on fewer qubits run on Aer's state (``aer_state``, which simulates what the controller
 #: does below 14 qubits): ``python benchmarks/bench_search.py``'s ``state_paths`` (both oracle
-#: forms, n = 10-13, m = 1 and 12, k = 12, 8 shots) found the state faster in every case up to
-#: n = 12 (0.65-0.92 times the controller's time) and the mcz form slower at n = 13 (1.16 times,
-#: its X-strings one ``apply_x`` per qubit where the controller runs one ``pauli``)
+#: forms, n = 10-13, m = 1 and 12, k = 12, 8 shots; ``benchmarks/results/run_c22abd7.json``) found
+#: the state faster in every case up to n = 12 (0.68-0.91 times the controller's time) and the mcz
+#: form slower at n = 13 (1.19 times: its X-strings one ``apply_x`` per qubit where the controller
+#: runs one ``pauli``)
 STATE_CHOSEN_BELOW_QUBITS = 13
 #: methods AerSimulator offers that these circuits cannot run, and why (refused at construction)
 UNSUPPORTED_METHODS = {

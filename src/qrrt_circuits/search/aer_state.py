@@ -67,8 +67,8 @@ except ImportError:  # pragma: no cover - depends on the installed qiskit-aer
 STATE_BELOW_QUBITS = 14
 #: below this width the state is reset to |0> with ``apply_initialize`` of a cached list, from it on
 #: by clearing and reallocating it (``python benchmarks/bench_aer_overhead.py``, ``state_reset``, in
-#: ``benchmarks/results/run_ea39ee7.json``: the list's conversion grows with 2^n, 25.4 us at n = 12
-#: and 48.4 at 13, while the reallocation costs 31-34 us whatever n, mostly its two
+#: ``benchmarks/results/run_c22abd7.json``: the list's conversion grows with 2^n, 25.6 us at n = 12
+#: and 66.4 at 13, while the reallocation costs 33-37 us whatever n, mostly its two
 #: ``std::random_device`` constructions)
 _RESET_BY_INITIALIZE_BELOW = 13
 
