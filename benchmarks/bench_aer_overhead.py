@@ -22,10 +22,11 @@ circuit of Hadamards and measurements). This script measures one cause of that f
 Then ``random_device_per_run_us`` = inits per run x one construction, and its share of the
 controller's C++ time at k = 0.
 
-The same for Aer's state (``aer_state``, the path ``AerBackend`` takes below 14 qubits):
+The same for Aer's state (``aer_state``, the path ``AerBackend`` takes below 13 qubits):
 4. ``state``: ``aer_state.execute_grover`` of the same circuit at k = 0 and k = 3 (the state reset
    to |0>, the instructions applied, one sample), interleaved with the controller's calls of 1.,
-   and ``state_inits_per_search_k0`` / ``_k3``, counted as in 3.;
+   and ``state_inits_per_search_k0`` / ``_k3``, counted as in 3., and at n = 13 (k = 3), where the
+   state is reallocated for each search (``state_inits_per_search_n13_k3``);
 5. ``state_reset``: the two ways ``aer_state`` resets its state between searches, per n: applying a
    cached |0> list (``apply_initialize``) and clearing and reallocating it, each followed by one h
    and a flush so that the reset is carried out, less that h and flush alone; medians in
@@ -50,6 +51,8 @@ import numpy as np
 from _common import machine, write_json
 
 QUBITS = 8
+#: the widest circuit aer_state runs, where its reset reallocates the state (``state13`` below)
+WIDEST_STATE_QUBITS = 13
 
 _CPP_LOOP = r"""
 #include <chrono>
@@ -215,8 +218,9 @@ def child(path: str, iterations: int, runs: int) -> None:
     """The process gdb runs: warm up, stop, ``runs`` runs on ``path``, stop (gdb counts between)."""
     from qrrt_circuits.search import aer_direct, aer_state
 
-    if path == "state":
-        marks = _marks()
+    if path in ("state", "state13"):
+        width = QUBITS if path == "state" else WIDEST_STATE_QUBITS
+        marks = np.random.default_rng(5).random(2**width) < 0.2
 
         def run() -> None:
             aer_state.execute_grover(marks, iterations, "diagonal", 1, 1)
@@ -247,6 +251,7 @@ def main() -> None:
     counted = {k: count_inits("controller", k, runs) for k in (0, 3)}
     inits = {f"k{k}": (count / runs if count is not None else None) for k, (count, _) in counted.items()}
     state_counted = {k: count_inits("state", k, runs) for k in (0, 3)}
+    widest_counted = count_inits("state13", 3, runs)
     resets = state_reset_times(200 if args.quick else 2000)
     per_run = inits["k0"] * device_us if inits["k0"] is not None and device_us is not None else None
     figures = {**{f"controller_k{k}_{kind}_us": times[f"k{k}_{kind}_us"] for k in (0, 3) for kind in ("wall", "cpp")},
@@ -256,9 +261,11 @@ def main() -> None:
                "random_device_per_run_us": per_run,
                "random_device_share_of_cpp_k0": per_run / times["k0_cpp_us"] if per_run is not None else None,
                **{f"state_inits_per_search_k{k}": (count / runs if count is not None else None)
-                  for k, (count, _) in state_counted.items()}}
+                  for k, (count, _) in state_counted.items()},
+               "state_inits_per_search_n13_k3": widest_counted[0] / runs if widest_counted[0] is not None else None}
     why = {"random_device_us": device_why, **{f"inits_per_run_k{k}": reason for k, (_, reason) in counted.items()},
-           **{f"state_inits_per_search_k{k}": reason for k, (_, reason) in state_counted.items()}}
+           **{f"state_inits_per_search_k{k}": reason for k, (_, reason) in state_counted.items()},
+           "state_inits_per_search_n13_k3": widest_counted[1]}
     print(f"  controller call, n = {QUBITS}, one shot: k = 0 {times['k0_wall_us']:.1f} us (C++ "
           f"{times['k0_cpp_us']:.1f}), k = 3 {times['k3_wall_us']:.1f} us (C++ {times['k3_cpp_us']:.1f})")
     print(f"  std::random_device: {device_us if device_us is not None else device_why} us per construction; "
@@ -271,7 +278,8 @@ def main() -> None:
                        else why[f"state_inits_per_search_k{k}"]) for k in (0, 3)}
     print(f"  Aer's state (aer_state.execute_grover): k = 0 {times['k0_state_us']:.1f} us, k = 3 "
           f"{times['k3_state_us']:.1f} us; std::random_device per search: k = 0 {state_inits[0]}, "
-          f"k = 3 {state_inits[3]}")
+          f"k = 3 {state_inits[3]}; at n = {WIDEST_STATE_QUBITS}, k = 3: "
+          f"{figures['state_inits_per_search_n13_k3'] or why['state_inits_per_search_n13_k3']}")
     print("  state reset (us), apply_initialize of a cached |0> list / clear and reallocate: "
           + "  ".join(f"{n} {row['initialize_us']:.1f} / {row['reallocate_us']:.1f}" for n, row in resets.items()))
     path = write_json("bench_aer_overhead_quick" if args.quick else "bench_aer_overhead",

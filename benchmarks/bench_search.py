@@ -7,11 +7,11 @@ k = 12 iterations, 8 shots, Aer on one thread; in each repeat, one after the oth
 - ``floor``: Aer's own floor, a 1-qubit circuit (h, measure) run with 8 shots (and
   ``floor_all_threads``: the same with Aer's default thread count, all cores);
 - ``floor_controller``: that 1-qubit circuit on Aer's controller directly (``aer_direct``), the
-  floor of the path ``AerBackend`` takes;
+  floor of the path ``AerBackend`` takes from 13 qubits on;
 - ``floor_state``: the floor of Aer's state (``aer_state``): a 1-qubit state reset, one h and 8
   samples;
 - ``ours``: ``AerBackend.search`` (the compact circuit of ``aer_grover_circuit``, its instructions
-  applied to Aer's state below 14 qubits, ``aer_state``, else handed to Aer's controller),
+  applied to Aer's state below 13 qubits, ``aer_state``, else handed to Aer's controller),
   ``ours_controller`` the same searches on the controller (``aer_direct``, the path before
   ``aer_state``), ``build`` its construction per search (the ``GroverProgram``: its
   share of the search), ``assemble`` the program's conversion into Aer's circuit object (which
@@ -109,10 +109,10 @@ def _contenders(n: int, marks: np.ndarray) -> dict:
         # every circuit before it kept circuits under 14 qubits on one thread
         "floor_all_threads": lambda: all_threads.run(floor, shots=8, seed_simulator=1, memory=True).result(),
         # the same 1-qubit circuit on Aer's controller directly (aer_direct): the floor of the
-        # path AerBackend takes without a noise model
+        # path AerBackend takes without a noise model from 13 qubits on
         "floor_controller": lambda: aer_direct.execute(simulator, floor, 8, 1, 1),
         # a 1-qubit circuit (h, 8 samples) on Aer's state: the floor of the path AerBackend takes
-        # below 14 qubits
+        # below 13 qubits
         "floor_state": lambda: aer_state.execute_grover(state_floor, 0, "diagonal", 8, 1),
         "ours": lambda: ours.search(marks, 12, shots=8),
         "ours_controller": lambda: on_controller.search(marks, 12, shots=8),
@@ -161,9 +161,10 @@ def _qiskit_algorithms_grover(n: int, marks: np.ndarray):
 def _interleaved_times(runs: dict, repeats: int) -> dict[str, list[float]]:
     """Seconds of each of ``runs`` (name -> function) over ``repeats`` rounds, each round in its
     own shuffled order (seeded), so no contender always follows the same one. (A rotated order,
-    used before, keeps every contender behind the same neighbour: ``ours`` always ran shortly
-    after ``floor_all_threads``, whose OpenMP threads keep spinning on the cores for a while, and
-    measured 7 or 11 ms at n = 12 where the same search alone took 7.)"""
+    used before, keeps every contender behind the same neighbour: ``ours`` always ran a few calls
+    after ``floor_all_threads``, the one contender that starts OpenMP threads, and its n = 12
+    median was 11.00 and 10.65 ms in two runs, ``run_ed52c13.json`` and ``run_54c2b9a.json``,
+    against 7.05 with the order shuffled, ``run_c22abd7.json``.)"""
     times: dict[str, list[float]] = {name: [] for name in runs}
     names = list(runs)
     order = np.random.default_rng(2026)

@@ -62,9 +62,9 @@ WALSH_HADAMARD_BLOCK = 3
 #: was faster up to 2^n / (2m + 1) = 252 at every n, the mcz form from 341 on for n = 10-12, while
 #: at n = 14 the two crossed near 500 (the arithmetic of the X strings grows with 2^n); 300 lies
 #: between (through ``AerSimulator.run``, whose assembler handles each phase in Python, the
-#: crossover was 100-200 and this constant 128). Below 14 qubits ``AerBackend`` now runs on Aer's
-#: state (``aer_state``); there the same sweep's choice took at most 1.054 times the faster form's
-#: time, 1.002 on average (``benchmarks/results/run_ea39ee7.json``, ``search.synthesis``)
+#: crossover was 100-200 and this constant 128). Below 13 qubits ``AerBackend`` now runs on Aer's
+#: state (``aer_state``); with it the same sweep's choice took at most 1.048 times the faster form's
+#: time, 1.002 on average (``benchmarks/results/run_c22abd7.json``, ``search.synthesis``)
 ENTRIES_PER_INSTRUCTION = 300
 
 #: one instruction of a Grover program: an operation and the qubits it acts on (a

@@ -12,8 +12,8 @@ each run constructs three ``std::random_device`` (about 11 us each on this proje
 ``benchmarks/bench_aer_overhead.py``) and converts its configuration and result through JSON.
 ``AerState`` pays one ``std::random_device`` per flush, and ``execute_grover`` flushes once per
 search (when it samples), on a state that is kept per thread and reset to |0> between searches
-(at n = 13 the reset reallocates the state, which constructs two more: three per search there,
-as on the controller, but still no assembly).
+(at n = 13 the reset reallocates the state: three per search there, as on the controller, counted
+by the same benchmark, but still no assembly).
 
 What runs is the circuit of ``aer_circuits.aer_grover_program``, instruction for instruction:
 the Walsh-Hadamard blocks as ``apply_unitary`` of their matrices, the oracle's ``diagonal`` as
@@ -29,7 +29,9 @@ form and seed tested (``tests/test_aer_state.py``).
 Only where the two are the same simulation: ``statevector`` method on the CPU, no noise model,
 the simulator's options as ``AerBackend`` made them, and fewer than ``STATE_BELOW_QUBITS`` (14)
 qubits. From 14 qubits on the controller fuses gates (Aer's ``fusion_threshold``) and runs on
-several threads, which the state does not. ``AerBackend`` takes the controller path elsewhere.
+several threads, which the state does not. ``AerBackend`` takes the state below 13 qubits only
+(``aer.STATE_CHOSEN_BELOW_QUBITS``: at 13 the state's mcz form is slower than the controller) and
+the controller path elsewhere.
 
 These are qiskit-aer internals (``controller_wrappers.AerStateWrapper``, checked with qiskit-aer
 0.18.2); if the installed qiskit-aer lacks them, ``STATE_AVAILABLE`` is False and ``AerBackend``
@@ -68,8 +70,7 @@ STATE_BELOW_QUBITS = 14
 #: below this width the state is reset to |0> with ``apply_initialize`` of a cached list, from it on
 #: by clearing and reallocating it (``python benchmarks/bench_aer_overhead.py``, ``state_reset``, in
 #: ``benchmarks/results/run_c22abd7.json``: the list's conversion grows with 2^n, 25.6 us at n = 12
-#: and 66.4 at 13, while the reallocation costs 33-37 us whatever n, mostly its two
-#: ``std::random_device`` constructions)
+#: and 66.4 at 13, while the reallocation costs 33-37 us whatever n)
 _RESET_BY_INITIALIZE_BELOW = 13
 
 
@@ -132,7 +133,7 @@ def execute_grover(marks: np.ndarray, iterations: int, synthesis: str, shots: in
     with ``shots`` shots and ``seed_simulator = seed``, run on this thread's ``AerState``: the
     indices of the words ``AerSimulator(method="statevector").run`` measures, in its order.
 
-    ``AerBackend``'s path for n < ``STATE_BELOW_QUBITS``, after the backend's own checks; the
+    ``AerBackend``'s path for n < ``aer.STATE_CHOSEN_BELOW_QUBITS`` (13), after its own checks; the
     cheap ones are made again here (``check_grover_arguments``, the shots and the seed; no
     coercion), the rest (the synthesis name) is the backend's.
 
