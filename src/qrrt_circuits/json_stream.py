@@ -28,8 +28,9 @@ VALUES_PER_LINE = 16
 
 def dump_streamed(data: Mapping[str, Any], handle: IO[str]) -> None:
     """Write ``data`` as a JSON object to ``handle``; numpy arrays anywhere in nested mappings are
-    written chunk by chunk (see the module docstring); every other value must be what
-    ``json.dumps`` accepts.
+    written chunk by chunk (see the module docstring), as their ``tolist()``; every other value
+    must be what ``json.dumps`` accepts, and keys what it accepts as keys (strings, or ints,
+    floats, booleans and None, written as strings).
 
     Args:
         data: A mapping with string keys; values JSON-serialisable, numpy arrays (of numbers or
@@ -50,9 +51,16 @@ def _write_mapping(data: Mapping[str, Any], handle: IO[str], level: int) -> None
         return
     handle.write("{")
     for index, (key, value) in enumerate(data.items()):
-        handle.write(("," if index else "") + "\n" + inner + json.dumps(key) + ": ")
+        handle.write(("," if index else "") + "\n" + inner + _key(key) + ": ")
         _write_value(value, handle, level + 1)
     handle.write("\n" + " " * level + "}")
+
+
+def _key(key: Any) -> str:
+    """A mapping key as ``json`` writes it: a string as itself, an int, float, bool or None as its
+    JSON text in quotes; any other key raises ``TypeError``, as in ``json.dumps``."""
+    text = json.dumps({key: None})
+    return text[1:text.rindex(":")]
 
 
 def _write_value(value: Any, handle: IO[str], level: int) -> None:
@@ -83,7 +91,8 @@ def _write_array(array: np.ndarray, handle: IO[str], level: int) -> None:
     handle.write("[")
     for start in range(0, rows, CHUNK_ROWS):
         values = array[start:start + CHUNK_ROWS].tolist()
-        if array.ndim == 2:  # one encoding of the chunk, split into rows ("], [" occurs only between them)
+        if array.ndim == 2 and array.dtype.kind in "biuf":  # one encoding of the chunk, split into rows
+            # (in a chunk of numbers "], [" occurs only between rows; strings could hold it)
             text = json.dumps(values)[1:-1].replace("], [", "]," + inner + "[")
         elif array.ndim == 1:
             text = ("," + inner).join(json.dumps(values[first:first + VALUES_PER_LINE])[1:-1]

@@ -470,8 +470,7 @@ class LimitsInForce:
 
 def limits_in_force(given: TerminationCondition | None) -> LimitsInForce:
     """The ``LimitsInForce`` of a plan given ``given`` (None: no condition): what ``Planner.plan``
-    checks against the available memory (``memory.check_plan_fits``), and ``qrrt plan --json`` with
-    its output.
+    checks against the available memory (``memory.check_plan_fits``) before its first round.
 
     Example:
         >>> from qrrt_circuits.termination import MaxNodes, limits_in_force

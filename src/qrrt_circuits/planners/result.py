@@ -164,19 +164,23 @@ class PlanResult:
             A dict with keys ``status``, ``planner``, ``settings``, ``labels``, ``metrics``,
             ``nodes``, ``parents``, ``path``, ``goal_node`` and ``history``.
         """
-        return self._data(np.ndarray.tolist)
+        return self._data(lambda array: array.tolist())
 
     def write_json(self, handle: IO[str]) -> None:
         """Write ``to_dict()`` as JSON to ``handle``, its arrays chunk by chunk
         (``json_stream.dump_streamed``: the same value after ``json.load``, written by the C
-        encoder, without the whole tree as Python lists; ``qrrt plan --json``'s writer).
+        encoder, without the whole tree as Python lists; ``qrrt plan --json``'s writer). A numpy
+        array that ``to_dict`` leaves as it is (inside ``settings``, which ``json.dumps`` would
+        refuse) is written as its ``tolist()``.
 
         Args:
             handle: A text file open for writing.
         """
         from ..json_stream import dump_streamed
 
-        dump_streamed(self._data(lambda array: array), handle)
+        # arrays streamed as they are; anything else with tolist() (a numpy scalar in the history)
+        # converted as to_dict converts it
+        dump_streamed(self._data(lambda value: value if isinstance(value, np.ndarray) else value.tolist()), handle)
 
     def _data(self, arrays: Callable[[np.ndarray], Any]) -> dict:
         """``to_dict``'s keys and values, each array passed through ``arrays``."""

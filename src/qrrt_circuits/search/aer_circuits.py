@@ -356,6 +356,7 @@ def check_grover_arguments(marks: np.ndarray, iterations: int) -> None:
     if type(iterations) is not int or iterations < 0:
         raise ValueError(f"iterations must be an int >= 0 (validate_iterations), got {iterations!r}")
 
+
 class DiagonalFormTarget(Protocol):
     """Where ``DiagonalForm.emit`` puts the instructions: Aer's circuit object (``aer_direct``) or
     Aer's statevector state (``aer_state``); qubits as register indices."""
