@@ -15,7 +15,7 @@ after one warm-up plan, and reports its total wall time over its total nodes. Pr
 the medians and their ratio (baseline / ours: above 1 means ours is faster) and the median of
 the pairs' own ratios (less sensitive to a drift between pairs); writes JSON, with the baseline
 checkout's git commit and whether its tree differs from it (``baseline_checkout``), and the same
-for this checkout (``ours_checkout``).
+for this checkout (``ours_checkout``), and the load average when it started.
 """
 
 from __future__ import annotations
@@ -85,6 +85,7 @@ def main(argv: list[str] | None = None) -> None:
     baseline = Path(args.baseline_src)
     if not (baseline / "qrrt_circuits" / "__init__.py").is_file():
         parser.error(f"--baseline-src must be a checkout's src directory (holding qrrt_circuits/), got {baseline}")
+    load_at_start = list(os.getloadavg()) if hasattr(os, "getloadavg") else None  # (how busy the machine was)
     for name in ("pairs", "worlds", "nodes"):
         if getattr(args, name) < 1:
             parser.error(f"--{name} must be >= 1, got {getattr(args, name)}")
@@ -104,7 +105,7 @@ def main(argv: list[str] | None = None) -> None:
           f"baseline / ours = {medians['baseline'] / medians['ours']:.2f}; median of the pairs' ratios "
           f"{pair_ratio:.2f}")
     path = write_json(f"ab_{args.planner}_{args.backend}",
-                      {"machine": machine(), "baseline_src": str(baseline),
+                      {"machine": machine(), "load_average_at_start": load_at_start, "baseline_src": str(baseline),
                        "baseline_checkout": checkout_commit(baseline), "ours_src": str(OURS),
                        "ours_checkout": checkout_commit(OURS), "planner": args.planner,
                        "backend": args.backend, "worlds": args.worlds, "nodes": args.nodes, "pairs": pairs,
