@@ -33,8 +33,8 @@ def dump_streamed(data: Mapping[str, Any], handle: IO[str]) -> None:
     floats, booleans and None, written as strings).
 
     Args:
-        data: A mapping with string keys; values JSON-serialisable, numpy arrays (of numbers or
-            booleans, any shape) or nested such mappings.
+        data: A mapping with keys as above; values JSON-serialisable, numpy arrays (any shape;
+            2-D arrays of numbers or booleans are split into rows fastest) or nested such mappings.
         handle: A text file open for writing.
 
     Raises:
