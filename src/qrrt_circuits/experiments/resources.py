@@ -160,7 +160,8 @@ class Resources(Experiment):
                 "assumptions": {"toffoli_s": settings["toffoli_s"], "two_qubit_gate_s": settings["two_qubit_gate_s"],
                                 "t_gate": "a quarter of a Toffoli time (4 T per And)", "cliffords": "free",
                                 "near_term_time": "two-qubit depth x two_qubit_gate_s, errors ignored (lower bound)"},
-                "labels": ["classical times measured on a busy machine (RRT wall time / its reachability tests)",
+                "labels": ["classical times measured on the machine that ran the trials (RRT wall time / its "
+                           "reachability tests; they move with its load and speed)",
                            "q-RRT plans on the exact statevector backend (same statistics as Aer)",
                            f"fault-tolerant counts from {settings['ft_source']}"]}
 
