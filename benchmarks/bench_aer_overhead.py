@@ -128,19 +128,10 @@ def controller_times(repeats: int) -> dict:
             for kind, values in (("wall", wall), ("cpp", cpp), ("state", state))}
 
 
-def _fresh_state(wrapper, n: int) -> None:
-    """Configure, allocate and initialize ``wrapper`` as ``aer_state`` does, on n qubits."""
-    wrapper.configure("method", "statevector")
-    wrapper.configure("device", "CPU")
-    wrapper.configure("precision", "double")
-    wrapper.configure("max_parallel_threads", "1")
-    wrapper.configure("parallel_state_update", "1")
-    wrapper.allocate_qubits(n)
-    wrapper.initialize()
-
-
 def _reset_samples(wrapper, n: int, repeats: int) -> dict[str, list[float]]:
     """Microseconds of (reset, h, flush) for no reset and the two resets, interleaved."""
+    from qrrt_circuits.search import aer_state
+
     qubits = list(range(n))
     zero = [1.0 + 0.0j] + [0.0j] * ((1 << n) - 1)
     samples: dict[str, list[float]] = {"alone": [], "initialize": [], "reallocate": []}
@@ -151,7 +142,7 @@ def _reset_samples(wrapper, n: int, repeats: int) -> dict[str, list[float]]:
                 wrapper.apply_initialize(qubits, zero)
             elif name == "reallocate":
                 wrapper.clear()
-                _fresh_state(wrapper, n)
+                aer_state.allocate(wrapper, n)
             wrapper.apply_h(0)
             wrapper.flush()
             if repeat >= 20:
@@ -163,10 +154,12 @@ def state_reset_times(repeats: int) -> dict[str, dict[str, float]]:
     """Per n, median microseconds of the two resets of ``aer_state`` (see the module docstring)."""
     from qiskit_aer.backends.controller_wrappers import AerStateWrapper
 
+    from qrrt_circuits.search import aer_state
+
     figures = {}
     for n in (4, 8, 10, 11, 12, 13):
         wrapper = AerStateWrapper()
-        _fresh_state(wrapper, n)
+        aer_state.allocate(wrapper, n)
         samples = _reset_samples(wrapper, n, repeats)
         alone = float(np.median(samples["alone"]))
         figures[f"n{n}"] = {"initialize_us": float(np.median(samples["initialize"])) - alone,

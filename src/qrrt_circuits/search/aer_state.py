@@ -93,16 +93,7 @@ class _ThreadState:
             wrapper = self.wrapper = AerStateWrapper()
         else:
             wrapper.clear()
-        wrapper.configure("method", "statevector")
-        wrapper.configure("device", "CPU")
-        wrapper.configure("precision", "double")
-        wrapper.configure("max_parallel_threads", "1")
-        # one thread for the sampler too: without this, sample_memory starts an OpenMP team of up
-        # to min(shots, OMP_NUM_THREADS) threads (max_parallel_threads does not reach it), whose
-        # threads a process forked after it lacks, so a forked child's next sampling hung
-        wrapper.configure("parallel_state_update", "1")
-        wrapper.allocate_qubits(num_qubits)
-        wrapper.initialize()
+        allocate(wrapper, num_qubits)
         if num_qubits < _RESET_BY_INITIALIZE_BELOW:
             self.zero = [1.0 + 0.0j] + [0.0j] * ((1 << num_qubits) - 1)
         self.num_qubits = num_qubits
@@ -116,6 +107,22 @@ class _ThreadState:
                 wrapper.clear()
             except RuntimeError:  # pragma: no cover - depends on the failure
                 pass
+
+
+def allocate(wrapper: Any, num_qubits: int) -> None:
+    """Configure a new (or cleared) ``AerStateWrapper`` as ``execute_grover`` runs it (statevector,
+    CPU, double precision, one thread) and allocate and initialize it on ``num_qubits`` qubits,
+    in |0>."""
+    wrapper.configure("method", "statevector")
+    wrapper.configure("device", "CPU")
+    wrapper.configure("precision", "double")
+    wrapper.configure("max_parallel_threads", "1")
+    # one thread for the sampler too: without this, sample_memory starts an OpenMP team of up to
+    # min(shots, OMP_NUM_THREADS) threads (max_parallel_threads does not reach it), whose threads a
+    # process forked after it lacks, so a forked child's next sampling hung
+    wrapper.configure("parallel_state_update", "1")
+    wrapper.allocate_qubits(num_qubits)
+    wrapper.initialize()
 
 
 _THREAD = threading.local()
