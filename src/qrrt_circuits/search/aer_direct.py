@@ -119,9 +119,10 @@ class _Unconvertible(Exception):
     """An instruction this module does not convert (the circuit goes to Aer's assembler)."""
 
 
-def _header(aer: Any, circuit_name: str, num_qubits: int, num_memory: int, qregs: Any, cregs: Any,
-            global_phase: float) -> None:
-    header = CircuitHeader(
+def _circuit_header(circuit_name: str, num_qubits: int, num_memory: int, qregs: Any, cregs: Any,
+                    global_phase: float) -> Any:
+    """The ``CircuitHeader`` Aer's assembler makes for a circuit of these registers."""
+    return CircuitHeader(
         n_qubits=num_qubits,
         qreg_sizes=[[register.name, register.size] for register in qregs],
         memory_slots=num_memory,
@@ -129,7 +130,11 @@ def _header(aer: Any, circuit_name: str, num_qubits: int, num_memory: int, qregs
         name=circuit_name,
         global_phase=global_phase,
     )
-    aer.set_header(header)
+
+
+def _header(aer: Any, circuit_name: str, num_qubits: int, num_memory: int, qregs: Any, cregs: Any,
+            global_phase: float) -> None:
+    aer.set_header(_circuit_header(circuit_name, num_qubits, num_memory, qregs, cregs, global_phase))
     aer.num_qubits = num_qubits
     aer.num_memory = num_memory
     aer.global_phase_angle = global_phase
@@ -211,14 +216,7 @@ def _grover_header(num_qubits: int) -> Any:
     """The header ``_header`` gives a diagonal-form Grover circuit on n qubits (``set_header``
     copies it into each circuit)."""
     parts = _parts(num_qubits, WALSH_HADAMARD_BLOCK)  # (the registers do not depend on the block)
-    return CircuitHeader(
-        n_qubits=num_qubits,
-        qreg_sizes=[[register.name, register.size] for register in parts.qregs],
-        memory_slots=num_qubits,
-        creg_sizes=[[register.name, register.size] for register in parts.cregs],
-        name="grover_aer",
-        global_phase=0.0,
-    )
+    return _circuit_header("grover_aer", num_qubits, num_qubits, parts.qregs, parts.cregs, 0.0)
 
 
 class _CircuitTarget:

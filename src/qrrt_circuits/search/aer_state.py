@@ -204,7 +204,9 @@ class _StateTarget:
 
 
 def _apply_program(state: Any, program: GroverProgram) -> None:
-    """Every instruction of ``program`` in order, after its global phase."""
+    """Every instruction of an ``mcz``-form ``program`` (Walsh-Hadamard ``unitary`` blocks, ``pauli``
+    strings, ``mcphase``; the diagonal form goes through ``DiagonalForm.emit``) in order, after its
+    global phase."""
     if program.global_phase:
         state.apply_global_phase(float(program.global_phase))
     indices_of = program.parts.indices_of
@@ -213,13 +215,11 @@ def _apply_program(state: Any, program: GroverProgram) -> None:
         name = operation.name
         if name == "unitary":
             state.apply_unitary(qubits, operation.params[0])
-        elif name == "diagonal":
-            state.apply_diagonal(qubits, [complex(value) for value in operation.params])
         elif name in ("mcphase", "p"):
             state.apply_mcphase(qubits, float(operation.params[0]))
         elif name == "pauli":
             _apply_pauli(state, qubits, operation.params[0])
-        else:  # pragma: no cover - aer_grover_program makes no other instruction
+        else:  # pragma: no cover - the mcz form has no other instruction
             raise ValueError(f"aer_state cannot apply the instruction {name!r}")
 
 
