@@ -19,7 +19,11 @@ Cases:
   4 096 parallel-RRT workers whose every test fails (d = 2, 6, 64: ``plan-batch``, the constants
   ``BATCH_BYTES_*`` of ``planners.classical``); and what writing a plan's JSON of 200 000 and
   1 000 000 nodes adds, and its seconds (``output``: ``PlanResult.write_json``, as ``qrrt plan
-  --json`` does, against ``json.dump`` and ``json.dumps`` of ``to_dict()``).
+  --json`` does, against ``json.dump`` and ``json.dumps`` of ``to_dict()``);
+- ``--mcz``: one ``AerBackend.search`` (8 shots) whose oracle takes the ``mcz`` form: 12 marked
+  entries at n = 20, 22 (k = 1, 12) and 24 (k = 1), and 100 marked entries at n = 16 with k = 1 and
+  400 (80 200 instructions); the estimate is ``AerBackend.memory_estimate(n, 8, k, marked)`` (the
+  constants ``AER_MCZ_BYTES_PER_ENTRY`` and ``AER_BYTES_PER_MCZ_INSTRUCTION`` come from these).
 
     python benchmarks/bench_memory.py            # n = 16, 18, 20, 22 on both backends (a few minutes)
     python benchmarks/bench_memory.py --quick    # n = 16, 18, 20
@@ -236,6 +240,28 @@ def run_output_case(how: str, nodes: int) -> dict:
             "note": "no estimate: the plan's memory check charges no output"}
 
 
+def run_mcz_search_case(n: int, marked: int, k: int) -> dict:
+    """One Aer search of ``marked`` random entries among 2^n (the ``mcz`` oracle), 8 shots."""
+    import numpy as np
+
+    import qrrt_circuits as qc
+    from qrrt_circuits.search.aer_circuits import simulation_synthesis
+
+    backend = qc.AerBackend(seed=0)
+    marks = np.zeros(1 << n, dtype=bool)
+    marks[np.random.default_rng(0).choice(1 << n, marked, replace=False)] = True
+    warm = np.zeros(1 << 14, dtype=bool)
+    warm[:marked] = True
+    backend.search(warm, 1, shots=8)  # warm up (the controller path, n >= 13)
+    base = _rss()
+    backend.search(marks, k, shots=8)
+    estimate = backend.memory_estimate(n, 8, k, marked)
+    return {"case": "search-mcz", "backend": "aer", "num_qubits": n, "marked": marked, "iterations": k,
+            "synthesis": simulation_synthesis(marks), "measured_bytes": _peak() - base,
+            "estimated_bytes": estimate.total_bytes,
+            "measured_bytes_per_entry": (_peak() - base) / (1 << n)}
+
+
 def in_subprocess(*args: str) -> dict:
     env = dict(os.environ, OMP_NUM_THREADS="1")
     out = subprocess.run([sys.executable, __file__, "--case", *args], capture_output=True, text=True,
@@ -251,6 +277,8 @@ def main() -> None:
     parser.add_argument("--plan-limits", action="store_true",
                         help="also a plan's tree (d = 2, 4) and round history against memory.plan_bytes")
     parser.add_argument("--only-plan-limits", action="store_true", help="only the --plan-limits cases")
+    parser.add_argument("--mcz", action="store_true", help="also Aer searches with the mcz oracle")
+    parser.add_argument("--only-mcz", action="store_true", help="only the --mcz cases")
     parser.add_argument("--out", default=None, help="the JSON to write (default benchmarks/results/bench_memory.json)")
     parser.add_argument("--case", nargs="+", help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -264,6 +292,8 @@ def main() -> None:
             result = run_output_case(rest[0], int(rest[1]))
         elif kind == "batch":
             result = run_plan_batch_case(rest[0], int(rest[1]), int(rest[2]))
+        elif kind == "mcz":
+            result = run_mcz_search_case(int(rest[0]), int(rest[1]), int(rest[2]))
         else:
             result = run_database_case(int(rest[0]), int(rest[1]), rest[2] == "1")
         print(json.dumps(result))
@@ -278,10 +308,14 @@ def main() -> None:
     limits += [("limits", "rounds", "2", "1000000")]
     limits += [("batch", "nowhere", str(d), "300") for d in (2, 6, 64)] + [("batch", "exact", "6", "300")]
     limits += [("output", how, nodes) for how in ("stream", "dump", "dumps") for nodes in ("200000", "1000000")]
+    mcz = [("mcz", str(n), "12", str(k)) for n in (20, 22) for k in (1, 12)] + [("mcz", "24", "12", "1")]
+    mcz += [("mcz", "16", "100", str(k)) for k in (1, 400)]
     if args.only_plan_limits:
         cases = limits
-    elif args.plan_limits:
-        cases += limits
+    elif args.only_mcz:
+        cases = mcz
+    else:
+        cases += (limits if args.plan_limits else []) + (mcz if args.mcz else [])
     rows = []
     print(f"{'case':9s} {'backend':12s} {'n':>3s} {'d':>2s} {'k':>3s} {'estimated MiB':>14s} "
           f"{'measured MiB':>13s} {'est/meas':>9s}")

@@ -149,9 +149,44 @@ def test_direct_search_refused(small_memory, make_backend):
     backend = make_backend()
     marks = np.zeros(1 << 24, dtype=bool)
     marks[::3] = True
-    with pytest.raises(ValueError, match=r"num_qubits = 24: this .* search \(1 shots, 5 iterations\) needs "
+    with pytest.raises(ValueError, match=r"num_qubits = 24: this .* search \(1 shots, 5 iterations"
+                                         r"(, 5592406 marked)?\) needs "
                                          r"about .*the largest num_qubits that fits is \d+"):
         backend.search(marks, 5)
+
+
+def test_an_aer_search_with_the_mcz_oracle_is_held_to_its_own_footprint(small_memory):
+    """The diagonal form's bound (320 MiB at n = 20, k = 1) does not fit in 300 MiB; 12 marked
+    entries take the mcz form (the state, about 48 MiB): accepted and run. All entries but a third
+    unmarked take the diagonal form: refused, naming the marked count."""
+    backend = qc.AerBackend(0)
+    assert backend.peak_bytes(20, 8, 1) > small_memory
+    sparse = np.zeros(1 << 20, dtype=bool)
+    sparse[np.random.default_rng(0).choice(1 << 20, 12, replace=False)] = True
+    assert backend.oracle_form(20, 12) == "mcz"
+    assert backend.peak_bytes(20, 8, 1, marked=12) < 64 * MIB
+    result = backend.search(sparse, 1, shots=8)
+    assert result.indices.shape == (8,)
+    dense = np.zeros(1 << 20, dtype=bool)
+    dense[::3] = True
+    with pytest.raises(ValueError, match=r"num_qubits = 20: this aer search \(8 shots, 1 iterations, "
+                                         r"349526 marked\) needs about"):
+        backend.search(dense, 1, shots=8)
+    assert qc.AerBackend(0, synthesis="diagonal").peak_bytes(20, 8, 1, marked=12) == backend.peak_bytes(20, 8, 1)
+
+
+@pytest.mark.parametrize("num_qubits", [4, 10, 16, 24, 30])
+def test_the_mcz_estimate_stays_below_the_bound_for_every_m(num_qubits):
+    """``peak_bytes`` without a count is a bound for every marked count m and every k: the mcz
+    form's estimate (state plus instructions) never exceeds it where ``simulation_synthesis``
+    chooses that form."""
+    backend = qc.AerBackend(0)
+    entries = 1 << num_qubits
+    counts = {0, 1, 12, entries // 601, entries // 600, entries // 2, entries - 1, entries}
+    for marked in sorted(count for count in counts if 0 <= count <= entries):
+        for iterations in (0, 1, 12, 1000):
+            bound = backend.peak_bytes(num_qubits, 8, iterations)
+            assert backend.peak_bytes(num_qubits, 8, iterations, marked) <= bound
 
 
 def test_cli_search_refused_before_the_marks(small_memory, capsys):

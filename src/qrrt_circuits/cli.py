@@ -64,7 +64,8 @@ def cmd_search(args: argparse.Namespace) -> int:
                   if args.iterations is None else args.iterations)
     from .search.backend import validate_iterations, validate_shots
 
-    _check_search_memory(backend, args.qubits, validate_shots(args.shots), validate_iterations(iterations))
+    _check_search_memory(backend, args.qubits, validate_shots(args.shots), validate_iterations(iterations),
+                         args.marked)
     rng = np.random.default_rng(args.seed)
     marks = np.zeros(num_items, dtype=bool)
     marks[rng.choice(num_items, args.marked, replace=False)] = True
@@ -77,17 +78,20 @@ def cmd_search(args: argparse.Namespace) -> int:
 SEARCH_MARKS_BYTES_PER_ENTRY = 9
 
 
-def _check_search_memory(backend: QuantumSearchBackend, num_qubits: int, shots: int, iterations: int) -> None:
-    """Refuse before allocating the marks when the marks and the search would not fit."""
+def _check_search_memory(backend: QuantumSearchBackend, num_qubits: int, shots: int, iterations: int,
+                         marked: int) -> None:
+    """Refuse before allocating the marks when the marks and the search of ``marked`` entries would
+    not fit."""
     from dataclasses import replace
 
     from .memory import check_fits
 
     def estimate(n: int) -> MemoryEstimate:
-        search = backend.memory_estimate(n, shots, iterations)
+        search = backend.memory_estimate(n, shots, iterations, marked)
         return replace(search, resident_bytes=SEARCH_MARKS_BYTES_PER_ENTRY << n)
 
-    check_fits(estimate, num_qubits, f"this {backend.name} search ({shots} shots, {iterations} iterations)")
+    check_fits(estimate, num_qubits,
+               f"this {backend.name} search ({shots} shots, {iterations} iterations, {marked} marked)")
 
 
 def _print_search(args: argparse.Namespace, marks: np.ndarray, iterations: int, result: SearchResult) -> None:

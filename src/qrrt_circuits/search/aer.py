@@ -37,7 +37,7 @@ from qiskit_aer import AerSimulator
 
 from ..validation import check_int
 from . import aer_direct, aer_state
-from .aer_circuits import GroverProgram
+from .aer_circuits import GroverProgram, simulation_synthesis_for
 from .backend import QuantumSearchBackend, seed_stream
 from .circuits import SYNTHESES, aer_grover_circuit, aer_literal_grover_circuit
 from .fixed_point import generalized_grover_circuit
@@ -176,20 +176,54 @@ class AerBackend(QuantumSearchBackend):
     #: per shot: the measured word kept by ``memory=True`` and its conversion to an index
     BYTES_PER_SHOT = 200
 
-    def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1) -> int:
-        """Upper bound of one search's peak memory, with the diagonal oracle (the larger form).
+    #: the ``mcz`` oracle's footprint, from ``benchmarks/bench_memory.py``'s ``mcz`` rows (peak RSS of
+    #: one search over the process before it, 12 marked entries, n = 20-24, k = 1 and 12: 33-36 bytes
+    #: per entry whatever k, i.e. Aer's complex128 state and one more 16-byte array); 48 leaves a margin
+    AER_MCZ_BYTES_PER_ENTRY = 48
+    #: per ``mcphase`` / ``pauli`` instruction of the ``mcz`` form (2 per flipped entry per iteration):
+    #: the program's step and Aer's operation, 2.4 KB measured (``bench_memory.py``'s ``mcz`` rows:
+    #: n = 16, 100 marked entries, k = 400, 80 200 instructions); 3 KB leaves a margin. Below the
+    #: diagonal form's bound whenever ``simulation_synthesis`` picks ``mcz`` (f < 2^n / 600)
+    AER_BYTES_PER_MCZ_INSTRUCTION = 3072
+
+    def oracle_form(self, num_qubits: int, marked: int) -> str:
+        """The oracle form a search of m = ``marked`` entries among 2^n runs with: the
+        constructor's ``synthesis``, or for ``"auto"`` without a noise model
+        ``simulation_synthesis``'s choice (``"mcz"`` when 2^n > ENTRIES_PER_INSTRUCTION (2 min(m,
+        2^n - m) + 1)); with a noise model ``"auto"`` counts as ``"diagonal"`` (its CX-based choice
+        transpiles an MCZ, more work than a memory estimate should do; the diagonal bound holds for
+        both forms)."""
+        if self.synthesis != "auto":
+            return self.synthesis
+        if getattr(self.simulator.options, "noise_model", None) is not None:
+            return "diagonal"
+        return simulation_synthesis_for(num_qubits, marked)
+
+    def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1, marked: int | None = None) -> int:
+        """Upper bound of one search's peak memory.
 
         Args:
             num_qubits: n, the index register's width.
             shots: Measurements of the search.
-            iterations: k, the Grover iterations (Aer copies the oracle's phases once per iteration).
+            iterations: k, the Grover iterations (Aer copies the diagonal oracle's phases once per
+                iteration).
+            marked: m, or None (default): the diagonal form's bound, the larger one for every m.
 
         Returns:
+            The diagonal form (``marked`` None or ``oracle_form`` ``"diagonal"``):
             ``(AER_BYTES_PER_ENTRY + AER_BYTES_PER_ENTRY_PER_ITERATION * k) * 2^n +
-            BYTES_PER_SHOT * shots`` bytes (used by the memory guard, ``qrrt_circuits.memory``).
+            BYTES_PER_SHOT * shots`` bytes; the ``mcz`` form: ``AER_MCZ_BYTES_PER_ENTRY * 2^n +
+            AER_BYTES_PER_MCZ_INSTRUCTION * 2 f (k + 1) + BYTES_PER_SHOT * shots``, f = min(m,
+            2^n - m) (used by the memory guard, ``qrrt_circuits.memory``).
         """
+        shot_bytes = self.BYTES_PER_SHOT * shots
+        if marked is not None and self.oracle_form(num_qubits, marked) == "mcz":
+            flipped = min(marked, (1 << num_qubits) - marked)
+            instructions = 2 * flipped * (iterations + 1)
+            return ((self.AER_MCZ_BYTES_PER_ENTRY << num_qubits)
+                    + self.AER_BYTES_PER_MCZ_INSTRUCTION * instructions + shot_bytes)
         per_entry = self.AER_BYTES_PER_ENTRY + self.AER_BYTES_PER_ENTRY_PER_ITERATION * iterations
-        return (per_entry << num_qubits) + self.BYTES_PER_SHOT * shots
+        return (per_entry << num_qubits) + shot_bytes
 
     def threads_for(self, num_qubits: int) -> int:
         """The ``max_parallel_threads`` a circuit on ``num_qubits`` qubits runs with.

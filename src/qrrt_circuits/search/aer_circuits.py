@@ -168,9 +168,15 @@ def simulation_synthesis(marks: np.ndarray) -> str:
 
 def choose_simulation_synthesis(marks: np.ndarray) -> str:
     """``simulation_synthesis`` of marks already validated (a bool array of length 2^n)."""
-    marked = int(np.count_nonzero(marks))
-    flipped = min(marked, marks.shape[0] - marked)
-    return "diagonal" if marks.shape[0] <= ENTRIES_PER_INSTRUCTION * (2 * flipped + 1) else "mcz"
+    return simulation_synthesis_for(marks.shape[0].bit_length() - 1, int(np.count_nonzero(marks)))
+
+
+def simulation_synthesis_for(num_qubits: int, marked: int) -> str:
+    """``simulation_synthesis`` of any marks with m = ``marked`` entries among 2^n: ``"diagonal"``
+    if 2^n <= ``ENTRIES_PER_INSTRUCTION`` (2 min(m, 2^n - m) + 1), else ``"mcz"``."""
+    entries = 1 << num_qubits
+    flipped = min(marked, entries - marked)
+    return "diagonal" if entries <= ENTRIES_PER_INSTRUCTION * (2 * flipped + 1) else "mcz"
 
 
 def _sparse_oracles(parts: _Parts, marks: np.ndarray, iterations: int) -> tuple[list[list[Step]], float]:

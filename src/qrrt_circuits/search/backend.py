@@ -265,7 +265,7 @@ class QuantumSearchBackend(abc.ABC):
         iterations = validate_iterations(request.iterations)
         shots = validate_shots(request.shots)
         self.check_qubits(num_qubits)
-        self.check_memory(num_qubits, shots, iterations)
+        self.check_search_memory(marks, shots, iterations)
         seed = request.seed
         if not isinstance(seed, np.random.Generator):
             seed = check_seed(seed)
@@ -301,7 +301,7 @@ class QuantumSearchBackend(abc.ABC):
     BYTES_PER_ENTRY: int = 16
     BYTES_PER_SHOT: int = 64
 
-    def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1) -> int:
+    def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1, marked: int | None = None) -> int:
         """Peak bytes one ``search`` of a 2^n-entry database adds to the process, beyond the marks
         the caller holds (used by the memory guard, ``qrrt_circuits.memory``).
 
@@ -309,39 +309,66 @@ class QuantumSearchBackend(abc.ABC):
             num_qubits: n.
             shots: Preparations (default 1).
             iterations: k (default 1; the generic estimate ignores it).
+            marked: m, the number of marked entries, or None (default) for a bound over every m
+                (the generic estimate ignores it; ``AerBackend``'s depends on its oracle's form).
 
         Returns:
             ``BYTES_PER_ENTRY * 2^n + BYTES_PER_SHOT * shots`` here; subclasses report their own.
         """
         return (self.BYTES_PER_ENTRY << num_qubits) + self.BYTES_PER_SHOT * shots
 
-    def memory_estimate(self, num_qubits: int, shots: int = 1, iterations: int = 1) -> MemoryEstimate:
+    def memory_estimate(self, num_qubits: int, shots: int = 1, iterations: int = 1,
+                        marked: int | None = None) -> MemoryEstimate:
         """This backend's search alone, as a ``MemoryEstimate``.
 
         Args:
             num_qubits: n.
             shots: Preparations (default 1).
             iterations: k (default 1).
+            marked: m, or None (default) for a bound over every m.
 
         Returns:
-            A ``MemoryEstimate`` with ``search_bytes = peak_bytes(n, shots, iterations)``.
+            A ``MemoryEstimate`` with ``search_bytes = peak_bytes(n, shots, iterations, marked)``.
         """
-        return MemoryEstimate(num_qubits, search_bytes=self.peak_bytes(num_qubits, shots, iterations),
+        return MemoryEstimate(num_qubits, search_bytes=self.peak_bytes(num_qubits, shots, iterations, marked),
                               scratch_bytes=0)
 
-    def check_memory(self, num_qubits: int, shots: int = 1, iterations: int = 1) -> None:
+    def check_memory(self, num_qubits: int, shots: int = 1, iterations: int = 1, marked: int | None = None) -> None:
         """Refuse a search whose estimated peak exceeds the available memory (before allocating).
 
         Args:
             num_qubits: n.
             shots: Preparations (default 1).
             iterations: k (default 1).
+            marked: m, or None (default) for a bound over every m.
 
         Raises:
             ValueError: The estimate does not fit in the available memory.
         """
-        check_fits(lambda n: self.memory_estimate(n, shots, iterations), num_qubits,
-                   f"this {self.name} search ({shots} shots, {iterations} iterations)")
+        marks_text = "" if marked is None else f", {marked} marked"
+        check_fits(lambda n: self.memory_estimate(n, shots, iterations, marked), num_qubits,
+                   f"this {self.name} search ({shots} shots, {iterations} iterations{marks_text})")
+
+    def check_search_memory(self, marks: np.ndarray, shots: int = 1, iterations: int = 1) -> None:
+        """Refuse the search of these marks if its estimated peak exceeds the available memory.
+
+        First ``check_memory`` of their width with the bound over every m (no pass over the
+        marks); only where that bound does not fit, again with their count m (a backend whose
+        footprint depends on m, ``AerBackend`` with its ``mcz`` oracle, may still fit).
+
+        Args:
+            marks: The validated boolean array of length 2^n.
+            shots: Preparations (default 1).
+            iterations: k (default 1).
+
+        Raises:
+            ValueError: The estimate does not fit in the available memory.
+        """
+        num_qubits = int(marks.shape[0]).bit_length() - 1
+        try:
+            self.check_memory(num_qubits, shots, iterations)
+        except ValueError:
+            self.check_memory(num_qubits, shots, iterations, int(np.count_nonzero(marks)))
 
     def search_sequence(self, marks: np.ndarray, sequence: IterateSequence, shots: int = 1,
                         seed: int | None = None) -> SearchResult:

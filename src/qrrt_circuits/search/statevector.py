@@ -83,7 +83,7 @@ class StatevectorBackend(QuantumSearchBackend):
     #: per shot: the uniform draws, the good/unmarked split, the ranks and the measured indices
     BYTES_PER_SHOT = 64
 
-    def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1) -> int:
+    def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1, marked: int | None = None) -> int:
         """Upper bound of one search's peak memory.
 
         Closed form: the marked indices and their rank table (at most 8 + 16 bytes per entry
@@ -94,6 +94,7 @@ class StatevectorBackend(QuantumSearchBackend):
             num_qubits: n, the index register's width.
             shots: Measurements of the search.
             iterations: k (unused: the footprint does not grow with k).
+            marked: m (unused: the bound holds for every m).
 
         Returns:
             ``(24 or 40) * 2^n + BYTES_PER_SHOT * shots`` bytes.

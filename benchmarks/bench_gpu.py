@@ -1,0 +1,171 @@
+"""``AerBackend(device="GPU")`` (Aer's GPU build) against the CPU, n = 16-28 (issue 11, item 6).
+
+    python benchmarks/bench_gpu.py [--qubits 8,12,16,...] [--cpu-budget 150] [--out FILE]
+    python benchmarks/bench_gpu.py --cpu-only      # a dry run where Aer offers no GPU
+
+Needs qiskit-aer-gpu and an NVIDIA GPU (``benchmarks/gpu/on_device.sh`` installs the wheel on a
+machine without a package index); without a GPU it stops with a message, unless ``--cpu-only``.
+
+For each n: 12 marked entries (the ``mcz`` oracle from n = 12 on: ``simulation_synthesis``), k = 12
+iterations, 8 shots (the searches of ``bench_search.py``'s floor table), ``AerBackend(seed=1,
+device=...)`` with ``max_parallel_threads=0`` (all cores; circuits under 14 qubits run on one thread,
+and under 13 on the CPU on Aer's state, ``aer_state``; the GPU runs every width on Aer's controller).
+Each repeat searches with the same seed on both devices and records whether they measured the same
+indices. Medians and minimums of the repeats; ``speedup`` = the CPU's median over the GPU's. The
+GPU's first search (CUDA's context, Aer's kernels) is timed apart (``gpu_first_search_s``) and not
+counted. The CPU is measured while the time its next size is predicted to take (the last median
+times 4 per 2 more qubits, times its repeats) fits what is left of ``--cpu-budget`` seconds; the
+sizes it skips say so. A check of the sampled distribution on each device: n = 20, m = 2^n / 256
+(k = 12 is then optimal, sin^2(25 theta) = 0.99995, the diagonal oracle), 256 shots: the fraction of
+marked indices and its binomial standard deviation (before the sizes, so a size that fails
+leaves it measured).
+
+Writes the JSON after every size (a run cut short keeps what it measured), with the machine (CPU
+count, ``nvidia-smi``'s GPU name, memory and driver, Aer's devices and version).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+from _common import RESULTS, machine
+
+import qrrt_circuits as qc
+from qrrt_circuits.search.aer_circuits import simulation_synthesis
+
+ITERATIONS = 12
+SHOTS = 8
+MARKED = 12
+DEFAULT_QUBITS = (8, 12, 16, 18, 20, 22, 24, 26, 28)
+
+
+def _gpu_description() -> dict:
+    """``nvidia-smi``'s name, memory and driver of each GPU (empty where there is none)."""
+    try:
+        out = subprocess.run(["nvidia-smi", "--query-gpu=name,memory.total,driver_version",
+                              "--format=csv,noheader"], capture_output=True, text=True, timeout=30, check=True)
+    except (OSError, subprocess.SubprocessError):
+        return {"gpus": []}
+    return {"gpus": [line.strip() for line in out.stdout.splitlines() if line.strip()]}
+
+
+def _marks(n: int, marked: int, rng: np.random.Generator) -> np.ndarray:
+    marks = np.zeros(1 << n, dtype=bool)
+    marks[rng.choice(1 << n, marked, replace=False)] = True
+    return marks
+
+
+def _timed(backend: qc.AerBackend, marks: np.ndarray, seed: int, shots: int = SHOTS,
+           iterations: int = ITERATIONS) -> tuple[float, np.ndarray]:
+    start = time.perf_counter()
+    result = backend.search(marks, iterations, shots=shots, seed=seed)
+    return time.perf_counter() - start, result.indices
+
+
+def _summary(times: list[float]) -> dict:
+    return {"median_s": float(np.median(times)), "min_s": float(np.min(times)), "repeats": len(times)}
+
+
+def distribution_check(backend: qc.AerBackend, n: int = 20, shots: int = 256) -> dict:
+    """The fraction of marked indices among ``shots`` of k = 12 with m = 2^n / 256 (sin^2(25
+    theta) = 0.99995), and how many binomial standard deviations it lies from that."""
+    marks = _marks(n, (1 << n) // 256, np.random.default_rng(5))
+    seconds, indices = _timed(backend, marks, 11, shots=shots)
+    theta = math.asin(math.sqrt(1 / 256))
+    expected = math.sin((2 * ITERATIONS + 1) * theta) ** 2
+    observed = float(marks[indices].mean())
+    sigma = math.sqrt(expected * (1 - expected) / shots)
+    return {"qubits": n, "marked": int(marks.sum()), "shots": shots, "synthesis": simulation_synthesis(marks),
+            "expected": expected, "observed": observed, "sigma": sigma,
+            "within_5_sigma_or_1_miss": abs(observed - expected) <= max(5 * sigma, 1 / shots), "seconds": seconds}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--qubits", default=",".join(map(str, DEFAULT_QUBITS)),
+                        help="comma-separated n (default %(default)s)")
+    parser.add_argument("--cpu-budget", type=float, default=150.0,
+                        help="seconds of CPU searches at most (default %(default)s)")
+    parser.add_argument("--cpu-only", action="store_true", help="measure the CPU alone (no GPU needed)")
+    parser.add_argument("--out", default=None, help="JSON to write (default benchmarks/results/bench_gpu.json)")
+    args = parser.parse_args()
+    sizes = [int(text) for text in args.qubits.split(",")]
+    if any(not 1 <= n <= 34 for n in sizes):
+        parser.error(f"--qubits must be integers in [1, 34], got {args.qubits!r}")
+    if args.cpu_budget < 0:
+        parser.error(f"--cpu-budget must be >= 0 seconds, got {args.cpu_budget}")
+    from qiskit_aer import AerSimulator
+
+    devices = list(AerSimulator().available_devices())
+    if "GPU" not in devices and not args.cpu_only:
+        raise SystemExit(f"this qiskit-aer offers the devices {devices}: device='GPU' needs qiskit-aer-gpu "
+                         "and an NVIDIA GPU (benchmarks/gpu/on_device.sh); --cpu-only measures the CPU alone")
+    path = Path(args.out) if args.out else RESULTS / "bench_gpu.json"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    payload: dict = {
+        "machine": {**machine(), "cpu_count": os.cpu_count(), **_gpu_description(), "aer_devices": devices},
+        "settings": {"marked": MARKED, "iterations": ITERATIONS, "shots": SHOTS, "max_parallel_threads": 0,
+                     "cpu_budget_s": args.cpu_budget, "cpu_only": args.cpu_only},
+        "rows": [], "checks": [],
+    }
+    cpu = qc.AerBackend(seed=1, device="CPU")
+    gpu = None if args.cpu_only else qc.AerBackend(seed=1, device="GPU")
+    if gpu is not None:
+        start = time.perf_counter()
+        gpu.search(_marks(8, MARKED, np.random.default_rng(9)), ITERATIONS, shots=SHOTS, seed=0)
+        payload["gpu_first_search_s"] = time.perf_counter() - start
+        print(f"GPU first search (CUDA context, kernels): {payload['gpu_first_search_s']:.2f} s", flush=True)
+    cpu.search(_marks(8, MARKED, np.random.default_rng(9)), ITERATIONS, shots=SHOTS, seed=0)  # warm-up
+    for name, backend in (("gpu", gpu), ("cpu", cpu)):
+        if backend is not None:
+            payload["checks"].append({"device": name, **distribution_check(backend)})
+            check = payload["checks"][-1]
+            print(f"distribution check on {name}: {check['observed']:.4f} marked (expected "
+                  f"{check['expected']:.5f}, sigma {check['sigma']:.4f}), {check['seconds']:.2f} s", flush=True)
+    path.write_text(json.dumps(payload, indent=1))
+    cpu_left = args.cpu_budget
+    last_cpu: tuple[int, float] | None = None
+    rng = np.random.default_rng(0)
+    print(f"{'n':>3s} {'form':8s} {'GPU median ms':>14s} {'CPU median ms':>14s} {'CPU/GPU':>8s} {'same':>5s}",
+          flush=True)
+    for n in sizes:
+        marks = _marks(n, MARKED, rng)
+        row: dict = {"qubits": n, "marked": MARKED, "synthesis": simulation_synthesis(marks)}
+        seeds = list(range(100, 105 if n <= 24 else 103))
+        if gpu is not None:
+            _timed(gpu, marks, 99)  # this width's first run (allocation)
+            gpu_runs = [_timed(gpu, marks, seed) for seed in seeds]
+            row["gpu"] = _summary([t for t, _ in gpu_runs])
+        cpu_repeats = 3 if n <= 22 else 1
+        predicted = None if last_cpu is None else last_cpu[1] * 4.0 ** ((n - last_cpu[0]) / 2) * cpu_repeats
+        if predicted is not None and predicted > cpu_left:
+            row["cpu"] = {"skipped": f"predicted {predicted:.0f} s > the {cpu_left:.0f} s left of --cpu-budget"}
+        else:
+            cpu_runs = [_timed(cpu, marks, seed) for seed in seeds[:cpu_repeats]]
+            cpu_left -= sum(t for t, _ in cpu_runs)
+            row["cpu"] = _summary([t for t, _ in cpu_runs])
+            last_cpu = (n, row["cpu"]["median_s"])
+            if gpu is not None:
+                pairs = zip(cpu_runs, gpu_runs, strict=False)  # the CPU may have fewer repeats
+                row["same_indices"] = all(np.array_equal(c, g) for (_, c), (_, g) in pairs)
+                row["speedup"] = row["cpu"]["median_s"] / row["gpu"]["median_s"]
+        payload["rows"].append(row)
+        path.write_text(json.dumps(payload, indent=1))
+        gpu_ms = f"{row['gpu']['median_s'] * 1e3:14.2f}" if "gpu" in row else f"{'-':>14s}"
+        cpu_ms = f"{row['cpu']['median_s'] * 1e3:14.2f}" if "median_s" in row["cpu"] else f"{'skipped':>14s}"
+        ratio = f"{row['speedup']:8.2f}" if "speedup" in row else f"{'-':>8s}"
+        print(f"{n:3d} {row['synthesis']:8s} {gpu_ms} {cpu_ms} {ratio} {str(row.get('same_indices', '-')):>5s}",
+              flush=True)
+    path.write_text(json.dumps(payload, indent=1))
+    print(f"wrote {path}")
+
+
+if __name__ == "__main__":
+    main()
