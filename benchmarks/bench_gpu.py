@@ -15,10 +15,13 @@ indices. Medians and minimums of the repeats; ``speedup`` = the CPU's median ove
 GPU's first search (CUDA's context, Aer's kernels) is timed apart (``gpu_first_search_s``) and not
 counted. The CPU is measured while the time its next size is predicted to take (the last median
 times 4 per 2 more qubits, times its repeats) fits what is left of ``--cpu-budget`` seconds; the
-sizes it skips say so. A check of the sampled distribution on each device: n = 20, m = 2^n / 256
-(k = 12 is then optimal, sin^2(25 theta) = 0.99995, the diagonal oracle), 256 shots: the fraction of
-marked indices and its binomial standard deviation (before the sizes, so a size that fails
-leaves it measured).
+sizes it skips say so. A check of the sampled distribution on each device: n = 16, m = 2^n / 256
+(k = 12 is then optimal, sin^2(25 theta) = 0.99995; the mcz oracle), 256 shots: the fraction of
+marked indices and its binomial standard deviation; and a probe of the diagonal oracle on the GPU
+(k = 1, 8 shots, n = 10-20), where Aer's GPU build ran out of memory at n = 20 on an H200 (a failed
+run is recorded with Aer's error and the benchmark goes on). ``--dense``: a q-RRT round's search
+instead (a fifth of the entries marked, k = 3, 1 shot), where the CPU takes the diagonal oracle and
+the GPU, above ``GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS``, the mcz form (``AerBackend.synthesis_for``).
 
 Writes the JSON after every size (a run cut short keeps what it measured), with the machine (CPU
 count, ``nvidia-smi``'s GPU name, memory and driver, Aer's devices and version).
@@ -44,6 +47,15 @@ ITERATIONS = 12
 SHOTS = 8
 MARKED = 12
 DEFAULT_QUBITS = (8, 12, 16, 18, 20, 22, 24, 26, 28)
+DIAGONAL_PROBE_QUBITS = (10, 12, 14, 16, 18, 20)
+
+
+def _attempt(measure) -> dict:
+    """``measure()``, or the error Aer raised (a failed run is recorded, the benchmark goes on)."""
+    try:
+        return measure()
+    except RuntimeError as error:
+        return {"error": str(error)[:300]}
 
 
 def _gpu_description() -> dict:
@@ -73,16 +85,18 @@ def _summary(times: list[float]) -> dict:
     return {"median_s": float(np.median(times)), "min_s": float(np.min(times)), "repeats": len(times)}
 
 
-def distribution_check(backend: qc.AerBackend, n: int = 20, shots: int = 256) -> dict:
+def distribution_check(device: str, n: int = 16, shots: int = 256) -> dict:
     """The fraction of marked indices among ``shots`` of k = 12 with m = 2^n / 256 (sin^2(25
-    theta) = 0.99995), and how many binomial standard deviations it lies from that."""
+    theta) = 0.99995), the ``mcz`` oracle (2 m instructions per iteration), and how many binomial
+    standard deviations it lies from that."""
+    backend = qc.AerBackend(seed=1, device=device, synthesis="mcz")
     marks = _marks(n, (1 << n) // 256, np.random.default_rng(5))
     seconds, indices = _timed(backend, marks, 11, shots=shots)
     theta = math.asin(math.sqrt(1 / 256))
     expected = math.sin((2 * ITERATIONS + 1) * theta) ** 2
     observed = float(marks[indices].mean())
     sigma = math.sqrt(expected * (1 - expected) / shots)
-    return {"qubits": n, "marked": int(marks.sum()), "shots": shots, "synthesis": simulation_synthesis(marks),
+    return {"qubits": n, "marked": int(marks.sum()), "shots": shots, "synthesis": "mcz",
             "expected": expected, "observed": observed, "sigma": sigma,
             "within_5_sigma_or_1_miss": abs(observed - expected) <= max(5 * sigma, 1 / shots), "seconds": seconds}
 
@@ -94,6 +108,9 @@ def main() -> None:
     parser.add_argument("--cpu-budget", type=float, default=150.0,
                         help="seconds of CPU searches at most (default %(default)s)")
     parser.add_argument("--cpu-only", action="store_true", help="measure the CPU alone (no GPU needed)")
+    parser.add_argument("--dense", action="store_true",
+                        help="a q-RRT round's search instead: a fifth of the entries marked, k = 3, 1 shot "
+                             "(no distribution check or diagonal probe)")
     parser.add_argument("--out", default=None, help="JSON to write (default benchmarks/results/bench_gpu.json)")
     args = parser.parse_args()
     sizes = [int(text) for text in args.qubits.split(",")]
@@ -107,13 +124,18 @@ def main() -> None:
     if "GPU" not in devices and not args.cpu_only:
         raise SystemExit(f"this qiskit-aer offers the devices {devices}: device='GPU' needs qiskit-aer-gpu "
                          "and an NVIDIA GPU (benchmarks/gpu/on_device.sh); --cpu-only measures the CPU alone")
-    path = Path(args.out) if args.out else RESULTS / "bench_gpu.json"
+    path = Path(args.out) if args.out else RESULTS / ("bench_gpu_dense.json" if args.dense else "bench_gpu.json")
     path.parent.mkdir(parents=True, exist_ok=True)
+    iterations, shots = (3, 1) if args.dense else (ITERATIONS, SHOTS)
+
+    def marked_for(n: int) -> int:
+        return (1 << n) // 5 if args.dense else MARKED
+
     payload: dict = {
         "machine": {**machine(), "cpu_count": os.cpu_count(), **_gpu_description(), "aer_devices": devices},
-        "settings": {"marked": MARKED, "iterations": ITERATIONS, "shots": SHOTS, "max_parallel_threads": 0,
-                     "cpu_budget_s": args.cpu_budget, "cpu_only": args.cpu_only},
-        "rows": [], "checks": [],
+        "settings": {"marked": "2^n / 5" if args.dense else MARKED, "iterations": iterations, "shots": shots,
+                     "max_parallel_threads": 0, "cpu_budget_s": args.cpu_budget, "cpu_only": args.cpu_only},
+        "rows": [], "checks": [], "diagonal_probe": [],
     }
     cpu = qc.AerBackend(seed=1, device="CPU")
     gpu = None if args.cpu_only else qc.AerBackend(seed=1, device="GPU")
@@ -123,36 +145,48 @@ def main() -> None:
         payload["gpu_first_search_s"] = time.perf_counter() - start
         print(f"GPU first search (CUDA context, kernels): {payload['gpu_first_search_s']:.2f} s", flush=True)
     cpu.search(_marks(8, MARKED, np.random.default_rng(9)), ITERATIONS, shots=SHOTS, seed=0)  # warm-up
-    for name, backend in (("gpu", gpu), ("cpu", cpu)):
-        if backend is not None:
-            payload["checks"].append({"device": name, **distribution_check(backend)})
-            check = payload["checks"][-1]
-            print(f"distribution check on {name}: {check['observed']:.4f} marked (expected "
-                  f"{check['expected']:.5f}, sigma {check['sigma']:.4f}), {check['seconds']:.2f} s", flush=True)
+    for name, backend in (("GPU", gpu), ("CPU", cpu)):
+        if backend is not None and not args.dense:
+            payload["checks"].append({"device": name, **_attempt(lambda d=name: distribution_check(d))})
+            print(f"distribution check on {name}: {payload['checks'][-1]}", flush=True)
+    if gpu is not None and not args.dense:  # where the diagonal oracle runs on the GPU (k = 1, 8 shots)
+        for n in DIAGONAL_PROBE_QUBITS:
+            probe = qc.AerBackend(seed=1, device="GPU", synthesis="diagonal")
+            marks = _marks(n, MARKED, np.random.default_rng(n))
+            outcome = _attempt(lambda b=probe, m=marks: {"seconds": _timed(b, m, 7, iterations=1)[0]})
+            payload["diagonal_probe"].append({"qubits": n, **outcome})
+            print(f"diagonal oracle on the GPU, n = {n}: {outcome}", flush=True)
     path.write_text(json.dumps(payload, indent=1))
     cpu_left = args.cpu_budget
     last_cpu: tuple[int, float] | None = None
     rng = np.random.default_rng(0)
-    print(f"{'n':>3s} {'form':8s} {'GPU median ms':>14s} {'CPU median ms':>14s} {'CPU/GPU':>8s} {'same':>5s}",
+    print(f"{'n':>3s} {'GPU form':8s} {'GPU median ms':>14s} {'CPU median ms':>14s} {'CPU/GPU':>8s} {'same':>5s}",
           flush=True)
     for n in sizes:
-        marks = _marks(n, MARKED, rng)
-        row: dict = {"qubits": n, "marked": MARKED, "synthesis": simulation_synthesis(marks)}
-        seeds = list(range(100, 105 if n <= 24 else 103))
+        marks = _marks(n, marked_for(n), rng)
+        row: dict = {"qubits": n, "marked": marked_for(n), "synthesis": simulation_synthesis(marks),
+                     "cpu_synthesis": cpu.oracle_form(n, marked_for(n))}
         if gpu is not None:
-            _timed(gpu, marks, 99)  # this width's first run (allocation)
-            gpu_runs = [_timed(gpu, marks, seed) for seed in seeds]
-            row["gpu"] = _summary([t for t, _ in gpu_runs])
+            row["gpu_synthesis"] = gpu.oracle_form(n, marked_for(n))
+        seeds = list(range(100, 105 if n <= 24 and not args.dense else 103))
+        gpu_runs: list = []
+        if gpu is not None:
+            try:
+                _timed(gpu, marks, 99, shots, iterations)  # this width's first run (allocation)
+                gpu_runs = [_timed(gpu, marks, seed, shots, iterations) for seed in seeds]
+                row["gpu"] = _summary([t for t, _ in gpu_runs])
+            except RuntimeError as error:
+                row["gpu_error"] = str(error)[:300]
         cpu_repeats = 3 if n <= 22 else 1
         predicted = None if last_cpu is None else last_cpu[1] * 4.0 ** ((n - last_cpu[0]) / 2) * cpu_repeats
         if predicted is not None and predicted > cpu_left:
             row["cpu"] = {"skipped": f"predicted {predicted:.0f} s > the {cpu_left:.0f} s left of --cpu-budget"}
         else:
-            cpu_runs = [_timed(cpu, marks, seed) for seed in seeds[:cpu_repeats]]
+            cpu_runs = [_timed(cpu, marks, seed, shots, iterations) for seed in seeds[:cpu_repeats]]
             cpu_left -= sum(t for t, _ in cpu_runs)
             row["cpu"] = _summary([t for t, _ in cpu_runs])
             last_cpu = (n, row["cpu"]["median_s"])
-            if gpu is not None:
+            if gpu_runs:
                 pairs = zip(cpu_runs, gpu_runs, strict=False)  # the CPU may have fewer repeats
                 row["same_indices"] = all(np.array_equal(c, g) for (_, c), (_, g) in pairs)
                 row["speedup"] = row["cpu"]["median_s"] / row["gpu"]["median_s"]
@@ -161,8 +195,8 @@ def main() -> None:
         gpu_ms = f"{row['gpu']['median_s'] * 1e3:14.2f}" if "gpu" in row else f"{'-':>14s}"
         cpu_ms = f"{row['cpu']['median_s'] * 1e3:14.2f}" if "median_s" in row["cpu"] else f"{'skipped':>14s}"
         ratio = f"{row['speedup']:8.2f}" if "speedup" in row else f"{'-':>8s}"
-        print(f"{n:3d} {row['synthesis']:8s} {gpu_ms} {cpu_ms} {ratio} {str(row.get('same_indices', '-')):>5s}",
-              flush=True)
+        same = str(row.get("same_indices", "-"))
+        print(f"{n:3d} {row.get('gpu_synthesis', '-'):8s} {gpu_ms} {cpu_ms} {ratio} {same:>5s}", flush=True)
     path.write_text(json.dumps(payload, indent=1))
     print(f"wrote {path}")
 

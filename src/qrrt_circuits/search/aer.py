@@ -58,6 +58,16 @@ SERIAL_BELOW_QUBITS = 14
 #: form slower at n = 13 (1.19 times: its X-strings one ``apply_x`` per qubit where the controller
 #: runs one ``pauli``)
 STATE_CHOSEN_BELOW_QUBITS = 13
+#: On the GPU, Aer sizes its matrix buffer for a dense matrix on the widest instruction's qubits
+#: (4^b complex128 entries for b qubits: ``DeviceChunkContainer::calculate_matrix_buffer_size`` in
+#: qiskit-aer 0.18), so a diagonal oracle on n qubits takes 16 * 4^n bytes of GPU memory: on an H200
+#: (141 GiB) the diagonal form ran at n = 14 (4 GiB, 8.6 ms for k = 1, 8 shots) and n = 16 (64 GiB,
+#: 77 ms, against 3.4 ms at n = 12) and ran out of GPU memory at n = 18 (``benchmarks/bench_gpu.py``'s
+#: ``diagonal_probe``, ``benchmarks/results/bench_gpu_h200.json``). ``synthesis="auto"`` on the GPU
+#: therefore takes the diagonal form only up to this width (4 GiB, which recent data-centre GPUs
+#: hold) and the ``mcz`` form above it, whatever the marks; ``synthesis="diagonal"`` is run as
+#: asked (Aer reports its out-of-memory error where the buffer does not fit).
+GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS = 14
 #: methods AerSimulator offers that these circuits cannot run, and why (refused at construction)
 UNSUPPORTED_METHODS = {
     "density_matrix": "its instruction set lacks the mcphase gate of aer_grover_circuit (and it "
@@ -186,15 +196,24 @@ class AerBackend(QuantumSearchBackend):
     #: diagonal form's bound whenever ``simulation_synthesis`` picks ``mcz`` (f < 2^n / 600)
     AER_BYTES_PER_MCZ_INSTRUCTION = 3072
 
+    def synthesis_for(self, num_qubits: int) -> str:
+        """The ``synthesis`` a circuit on ``num_qubits`` qubits is built with: the constructor's,
+        except ``"auto"`` on the GPU above ``GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS`` qubits, which is
+        ``"mcz"`` (Aer's GPU buffer for an n-qubit diagonal is 16 * 4^n bytes)."""
+        if self.synthesis == "auto" and self.device == "GPU" and num_qubits > GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS:
+            return "mcz"
+        return self.synthesis
+
     def oracle_form(self, num_qubits: int, marked: int) -> str:
-        """The oracle form a search of m = ``marked`` entries among 2^n runs with: the
-        constructor's ``synthesis``, or for ``"auto"`` without a noise model
+        """The oracle form a search of m = ``marked`` entries among 2^n runs with:
+        ``synthesis_for(n)`` where it names one, else (``"auto"``) without a noise model
         ``simulation_synthesis``'s choice (``"mcz"`` when 2^n > ENTRIES_PER_INSTRUCTION (2 min(m,
         2^n - m) + 1)); with a noise model ``"auto"`` counts as ``"diagonal"`` (its CX-based choice
-        transpiles an MCZ, more work than a memory estimate should do; the diagonal bound holds for
-        both forms)."""
-        if self.synthesis != "auto":
-            return self.synthesis
+        transpiles an MCZ, more work than a memory estimate should do; the diagonal form's bound
+        holds for both forms where ``"auto"`` may choose either)."""
+        synthesis = self.synthesis_for(num_qubits)
+        if synthesis != "auto":
+            return synthesis
         if getattr(self.simulator.options, "noise_model", None) is not None:
             return "diagonal"
         return simulation_synthesis_for(num_qubits, marked)
@@ -207,16 +226,20 @@ class AerBackend(QuantumSearchBackend):
             shots: Measurements of the search.
             iterations: k, the Grover iterations (Aer copies the diagonal oracle's phases once per
                 iteration).
-            marked: m, or None (default): the diagonal form's bound, the larger one for every m.
+            marked: m, or None (default) for a bound over every m: the diagonal form's estimate,
+                or where the ``mcz`` form is the only one (``synthesis="mcz"``, or ``"auto"`` on the
+                GPU above ``GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS``) its estimate for f = 2^(n-1).
 
         Returns:
-            The diagonal form (``marked`` None or ``oracle_form`` ``"diagonal"``):
+            The diagonal form (``oracle_form`` ``"diagonal"``):
             ``(AER_BYTES_PER_ENTRY + AER_BYTES_PER_ENTRY_PER_ITERATION * k) * 2^n +
             BYTES_PER_SHOT * shots`` bytes; the ``mcz`` form: ``AER_MCZ_BYTES_PER_ENTRY * 2^n +
             AER_BYTES_PER_MCZ_INSTRUCTION * 2 f (k + 1) + BYTES_PER_SHOT * shots``, f = min(m,
             2^n - m) (used by the memory guard, ``qrrt_circuits.memory``).
         """
         shot_bytes = self.BYTES_PER_SHOT * shots
+        if marked is None and self.synthesis_for(num_qubits) == "mcz":
+            marked = 1 << (num_qubits - 1)  # the most instructions the mcz form can have
         if marked is not None and self.oracle_form(num_qubits, marked) == "mcz":
             flipped = min(marked, (1 << num_qubits) - marked)
             instructions = 2 * flipped * (iterations + 1)
@@ -286,11 +309,12 @@ class AerBackend(QuantumSearchBackend):
         seed_simulator = self._first_integer(seed, 2**31 - 1)
         if self._on_state(num_qubits):  # Aer's state, instruction by instruction: the same words
             return aer_state.execute_grover(marks, iterations, self.synthesis, shots, seed_simulator)
+        synthesis = self.synthesis_for(num_qubits)
         if self._direct:  # the circuit's instructions straight to the controller
-            words = aer_direct.execute_grover(self.simulator, marks, iterations, self.synthesis, shots,
+            words = aer_direct.execute_grover(self.simulator, marks, iterations, synthesis, shots,
                                               seed_simulator, self.threads_for(num_qubits))
             return _indices(words)
-        circuit = self._build(marks, iterations, measure=True, synthesis=self.synthesis)
+        circuit = self._build(marks, iterations, measure=True, synthesis=synthesis)
         return self._run(circuit, num_qubits, shots, seed_simulator)
 
     def _sample(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
@@ -300,7 +324,7 @@ class AerBackend(QuantumSearchBackend):
     def _sample_sequence(self, marks: np.ndarray, num_qubits: int, sequence: IterateSequence, shots: int,
                          rng: np.random.Generator) -> np.ndarray:
         """Fixed-point amplification: the generalized iterates of ``sequence`` as one circuit."""
-        circuit = generalized_grover_circuit(marks, sequence, measure=True, synthesis=self.synthesis)
+        circuit = generalized_grover_circuit(marks, sequence, measure=True, synthesis=self.synthesis_for(num_qubits))
         return self._run(circuit, num_qubits, shots, int(rng.integers(0, 2**31 - 1)))
 
 
