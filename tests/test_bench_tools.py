@@ -111,3 +111,21 @@ def test_ab_planner_names_the_baseline_checkouts_commit(tmp_path):
     assert found["commit"] == head.stdout.strip()
     assert isinstance(found["dirty"], bool)
     assert ab_planner.checkout_commit(tmp_path) == {"commit": None, "dirty": None}
+
+
+def test_the_gpu_benchmark_without_a_gpu_says_why_and_is_recorded_as_skipped(tmp_path):
+    """``bench_gpu.py`` where Aer offers no GPU: exit 0 (``run.py`` must not call it a failure),
+    a JSON holding the reason, no figures."""
+    import subprocess
+
+    from qiskit_aer import AerSimulator
+
+    if "GPU" in AerSimulator().available_devices():
+        pytest.skip("this machine has Aer's GPU build: the benchmark would run")
+    out = tmp_path / "gpu.json"
+    done = subprocess.run([sys.executable, str(BENCHMARKS / "bench_gpu.py"), "--quick", "--out", str(out)],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert "device='GPU' needs qiskit-aer-gpu" in done.stdout
+    payload = json.loads(out.read_text())
+    assert payload["skipped"].startswith("skipped:") and _figures.flatten(payload) == {}
