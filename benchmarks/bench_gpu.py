@@ -6,10 +6,11 @@
 Needs qiskit-aer-gpu and an NVIDIA GPU (``benchmarks/gpu/on_device.sh`` installs the wheel on a
 machine without a package index). Without a GPU it measures nothing: it says why, writes a JSON
 holding only that reason (``skipped``) and exits 0, so ``benchmarks/run.py`` records it as skipped
-rather than failed; ``--cpu-only`` measures the CPU alone. ``--quick``: n = 12, 16, 20, 24 and a
+rather than failed; ``--cpu-only`` measures the CPU alone (its distribution check included,
+about 20 s on 2 cores). ``--quick``: n = 12, 16, 20, 24 (unless ``--qubits`` is given) and a
 30-second CPU budget.
 
-For each n: 12 marked entries (the ``mcz`` oracle from n = 12 on: ``simulation_synthesis``), k = 12
+For each n: 12 marked entries (the ``mcz`` oracle from n = 13 on: ``simulation_synthesis``), k = 12
 iterations, 8 shots (the searches of ``bench_search.py``'s floor table), ``AerBackend(seed=1,
 device=...)`` with ``max_parallel_threads=0`` (all cores; circuits under 14 qubits run on one thread,
 and under 13 on the CPU on Aer's state, ``aer_state``; the GPU runs every width on Aer's controller).
@@ -21,7 +22,7 @@ times 4 per 2 more qubits, times its repeats) fits what is left of ``--cpu-budge
 sizes it skips say so. A check of the sampled distribution on each device: n = 16, m = 2^n / 256
 (k = 12 is then optimal, sin^2(25 theta) = 0.99995; the mcz oracle), 256 shots: the fraction of
 marked indices and its binomial standard deviation; and a probe of the diagonal oracle on the GPU
-(k = 1, 8 shots, n = 10-20), where Aer's GPU build ran out of memory at n = 20 on an H200 (a failed
+(k = 1, 8 shots, n = 10-20), where Aer's GPU build ran out of memory from n = 18 on an H200 (a failed
 run is recorded with Aer's error and the benchmark goes on). ``--dense``: a q-RRT round's search
 instead (a fifth of the entries marked, k = 3, 1 shot), where the CPU takes the diagonal oracle and
 the GPU, above ``GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS``, the mcz form (``AerBackend.synthesis_for``).
@@ -44,12 +45,37 @@ import numpy as np
 from _common import RESULTS, machine
 
 import qrrt_circuits as qc
-from qrrt_circuits.search.aer_circuits import simulation_synthesis
 
 ITERATIONS = 12
 SHOTS = 8
 MARKED = 12
 DEFAULT_QUBITS = (8, 12, 16, 18, 20, 22, 24, 26, 28)
+QUICK_QUBITS = (12, 16, 20, 24)
+#: 12 marked entries need 2^n >= 12; 34 qubits are 256 GiB of state
+MIN_QUBITS, MAX_QUBITS = 4, 34
+
+
+def _qubit_list(text: str) -> list[int]:
+    """``--qubits``: comma-separated integers in [MIN_QUBITS, MAX_QUBITS]."""
+    try:
+        sizes = [int(part) for part in text.split(",")]
+    except ValueError:
+        sizes = []
+    if not sizes or any(not MIN_QUBITS <= n <= MAX_QUBITS for n in sizes):
+        raise argparse.ArgumentTypeError(f"must be comma-separated integers in [{MIN_QUBITS}, {MAX_QUBITS}], "
+                                         f"got {text!r}")
+    return sizes
+
+
+def _budget(text: str) -> float:
+    """``--cpu-budget``: a finite number of seconds >= 0."""
+    try:
+        seconds = float(text)
+    except ValueError:
+        seconds = math.nan
+    if not (math.isfinite(seconds) and seconds >= 0):
+        raise argparse.ArgumentTypeError(f"must be a finite number of seconds >= 0, got {text!r}")
+    return seconds
 DIAGONAL_PROBE_QUBITS = (10, 12, 14, 16, 18, 20)
 
 
@@ -57,7 +83,7 @@ def _attempt(measure) -> dict:
     """``measure()``, or the error Aer raised (a failed run is recorded, the benchmark goes on)."""
     try:
         return measure()
-    except RuntimeError as error:
+    except (RuntimeError, ValueError) as error:  # Aer's failure, or the memory guard's refusal
         return {"error": str(error)[:300]}
 
 
@@ -106,34 +132,33 @@ def distribution_check(device: str, n: int = 16, shots: int = 256) -> dict:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--qubits", default=",".join(map(str, DEFAULT_QUBITS)),
-                        help="comma-separated n (default %(default)s)")
-    parser.add_argument("--cpu-budget", type=float, default=150.0,
-                        help="seconds of CPU searches at most (default %(default)s)")
-    parser.add_argument("--cpu-only", action="store_true", help="measure the CPU alone (no GPU needed)")
-    parser.add_argument("--quick", action="store_true", help="n = 12, 16, 20, 24 and a 30 s CPU budget")
+    parser.add_argument("--qubits", type=_qubit_list, default=None,
+                        help=f"comma-separated n, each in [{MIN_QUBITS}, {MAX_QUBITS}] "
+                             f"(default {','.join(map(str, DEFAULT_QUBITS))})")
+    parser.add_argument("--cpu-budget", type=_budget, default=150.0,
+                        help="seconds of CPU searches at most, >= 0 (default %(default)s)")
+    parser.add_argument("--cpu-only", action="store_true",
+                        help="measure the CPU alone, its distribution check included (no GPU needed)")
+    parser.add_argument("--quick", action="store_true",
+                        help="n = 12, 16, 20, 24 (unless --qubits is given) and a CPU budget of at most 30 s")
     parser.add_argument("--dense", action="store_true",
                         help="a q-RRT round's search instead: a fifth of the entries marked, k = 3, 1 shot "
                              "(no distribution check or diagonal probe)")
     parser.add_argument("--out", default=None, help="JSON to write (default benchmarks/results/bench_gpu.json)")
     args = parser.parse_args()
+    sizes = args.qubits or (QUICK_QUBITS if args.quick else DEFAULT_QUBITS)
     if args.quick:
-        args.qubits, args.cpu_budget = "12,16,20,24", min(args.cpu_budget, 30.0)
-    sizes = [int(text) for text in args.qubits.split(",")]
-    if any(not 1 <= n <= 34 for n in sizes):
-        parser.error(f"--qubits must be integers in [1, 34], got {args.qubits!r}")
-    if args.cpu_budget < 0:
-        parser.error(f"--cpu-budget must be >= 0 seconds, got {args.cpu_budget}")
+        args.cpu_budget = min(args.cpu_budget, 30.0)
     from qiskit_aer import AerSimulator
 
     devices = list(AerSimulator().available_devices())
     path = Path(args.out) if args.out else RESULTS / ("bench_gpu_dense.json" if args.dense else "bench_gpu.json")
     path.parent.mkdir(parents=True, exist_ok=True)
     if "GPU" not in devices and not args.cpu_only:
-        reason = (f"skipped: this qiskit-aer offers the devices {devices}; device='GPU' needs qiskit-aer-gpu and an "
+        reason = (f"this qiskit-aer offers the devices {devices}; device='GPU' needs qiskit-aer-gpu and an "
                   "NVIDIA GPU (benchmarks/gpu/on_device.sh); --cpu-only measures the CPU alone")
         path.write_text(json.dumps({"machine": machine(), "skipped": reason}, indent=1))
-        print(reason)
+        print(f"skipped: {reason}")
         return
     iterations, shots = (3, 1) if args.dense else (ITERATIONS, SHOTS)
 
@@ -173,8 +198,7 @@ def main() -> None:
           flush=True)
     for n in sizes:
         marks = _marks(n, marked_for(n), rng)
-        row: dict = {"qubits": n, "marked": marked_for(n), "synthesis": simulation_synthesis(marks),
-                     "cpu_synthesis": cpu.oracle_form(n, marked_for(n))}
+        row: dict = {"qubits": n, "marked": marked_for(n), "cpu_synthesis": cpu.oracle_form(n, marked_for(n))}
         if gpu is not None:
             row["gpu_synthesis"] = gpu.oracle_form(n, marked_for(n))
         seeds = list(range(100, 105 if n <= 24 and not args.dense else 103))
@@ -184,14 +208,19 @@ def main() -> None:
                 _timed(gpu, marks, 99, shots, iterations)  # this width's first run (allocation)
                 gpu_runs = [_timed(gpu, marks, seed, shots, iterations) for seed in seeds]
                 row["gpu"] = _summary([t for t, _ in gpu_runs])
-            except RuntimeError as error:
+            except (RuntimeError, ValueError) as error:  # Aer's failure, or the memory guard's refusal
                 row["gpu_error"] = str(error)[:300]
         cpu_repeats = 3 if n <= 22 else 1
+        cpu_runs: list = []
         predicted = None if last_cpu is None else last_cpu[1] * 4.0 ** ((n - last_cpu[0]) / 2) * cpu_repeats
         if predicted is not None and predicted > cpu_left:
             row["cpu"] = {"skipped": f"predicted {predicted:.0f} s > the {cpu_left:.0f} s left of --cpu-budget"}
         else:
-            cpu_runs = [_timed(cpu, marks, seed, shots, iterations) for seed in seeds[:cpu_repeats]]
+            try:
+                cpu_runs = [_timed(cpu, marks, seed, shots, iterations) for seed in seeds[:cpu_repeats]]
+            except (RuntimeError, ValueError) as error:
+                row["cpu"] = {"error": str(error)[:300]}
+        if cpu_runs:
             cpu_left -= sum(t for t, _ in cpu_runs)
             row["cpu"] = _summary([t for t, _ in cpu_runs])
             last_cpu = (n, row["cpu"]["median_s"])
@@ -202,7 +231,8 @@ def main() -> None:
         payload["rows"].append(row)
         path.write_text(json.dumps(payload, indent=1))
         gpu_ms = f"{row['gpu']['median_s'] * 1e3:14.2f}" if "gpu" in row else f"{'-':>14s}"
-        cpu_ms = f"{row['cpu']['median_s'] * 1e3:14.2f}" if "median_s" in row["cpu"] else f"{'skipped':>14s}"
+        cpu_ms = (f"{row['cpu']['median_s'] * 1e3:14.2f}" if "median_s" in row["cpu"]
+                  else f"{'error' if 'error' in row['cpu'] else 'skipped':>14s}")
         ratio = f"{row['speedup']:8.2f}" if "speedup" in row else f"{'-':>8s}"
         same = str(row.get("same_indices", "-"))
         print(f"{n:3d} {row.get('gpu_synthesis', '-'):8s} {gpu_ms} {cpu_ms} {ratio} {same:>5s}", flush=True)

@@ -331,7 +331,9 @@ def largest_fitting(estimate_for: Callable[[int], MemoryEstimate], available: in
         below: Exclusive upper bound on n (n is never tried beyond 63).
 
     Returns:
-        The largest fitting n, trying n = 1, 2, ... until one does not fit; 0 if n = 1 does not.
+        The largest fitting n, every n < ``below`` tried (an estimate need not grow with n: an
+        Aer search of m marked entries changes its oracle's form with n; an n for which
+        ``estimate_for`` raises ``ValueError`` does not fit); 0 if none fits.
 
     Example:
         >>> from qrrt_circuits.memory import MemoryEstimate, database_bytes, largest_fitting
@@ -342,9 +344,11 @@ def largest_fitting(estimate_for: Callable[[int], MemoryEstimate], available: in
     """
     best = 0
     for n in range(1, min(below, _LARGEST_TRIED)):
-        if estimate_for(n).total_bytes > available:
-            break
-        best = n
+        try:
+            fits = estimate_for(n).total_bytes <= available
+        except ValueError:  # a run this n cannot hold (m marked entries among fewer than m)
+            fits = False
+        best = n if fits else best
     return best
 
 

@@ -39,7 +39,7 @@ from ..validation import check_int
 from . import aer_direct, aer_state
 from .aer_circuits import GroverProgram, simulation_synthesis_for
 from .backend import QuantumSearchBackend, seed_stream
-from .circuits import SYNTHESES, aer_grover_circuit, aer_literal_grover_circuit
+from .circuits import SYNTHESES, aer_grover_circuit, aer_literal_grover_circuit, oracle_cx_estimate
 from .fixed_point import generalized_grover_circuit
 
 if TYPE_CHECKING:
@@ -61,7 +61,7 @@ STATE_CHOSEN_BELOW_QUBITS = 13
 #: On the GPU, Aer sizes its matrix buffer for a dense matrix on the widest instruction's qubits
 #: (4^b complex128 entries for b qubits: ``DeviceChunkContainer::calculate_matrix_buffer_size`` in
 #: qiskit-aer 0.18), so a diagonal oracle on n qubits takes 16 * 4^n bytes of GPU memory: on an H200
-#: (141 GiB) the diagonal form ran at n = 14 (4 GiB, 8.6 ms for k = 1, 8 shots) and n = 16 (64 GiB,
+#: (about 140 GiB) the diagonal form ran at n = 14 (4 GiB, 8.6 ms for k = 1, 8 shots) and n = 16 (64 GiB,
 #: 77 ms, against 3.4 ms at n = 12) and ran out of GPU memory at n = 18 (``benchmarks/bench_gpu.py``'s
 #: ``diagonal_probe``, ``benchmarks/results/bench_gpu_h200.json``). ``synthesis="auto"`` on the GPU
 #: therefore takes the diagonal form only up to this width (4 GiB, which recent data-centre GPUs
@@ -187,8 +187,9 @@ class AerBackend(QuantumSearchBackend):
     BYTES_PER_SHOT = 200
 
     #: the ``mcz`` oracle's footprint, from ``benchmarks/bench_memory.py``'s ``mcz`` rows (peak RSS of
-    #: one search over the process before it, 12 marked entries, n = 20-24, k = 1 and 12: 33-36 bytes
-    #: per entry whatever k, i.e. Aer's complex128 state and one more 16-byte array); 48 leaves a margin
+    #: one search over the process before it, 12 marked entries, n = 20-24, k = 1 and 12: 32.0-32.3
+    #: bytes per entry, 40.3 at n = 20 and k = 12, where fixed costs weigh more; Aer's complex128 state
+    #: and about one more 16-byte array); 48 leaves a margin
     AER_MCZ_BYTES_PER_ENTRY = 48
     #: per ``mcphase`` / ``pauli`` instruction of the ``mcz`` form (2 per flipped entry per iteration):
     #: the program's step and Aer's operation, 2.4 KB measured (``bench_memory.py``'s ``mcz`` rows:
@@ -204,19 +205,26 @@ class AerBackend(QuantumSearchBackend):
             return "mcz"
         return self.synthesis
 
+    @property
+    def _literal(self) -> bool:
+        """Whether searches build the gate-by-gate circuit (a noise model at construction)."""
+        return self._build is aer_literal_grover_circuit
+
     def oracle_form(self, num_qubits: int, marked: int) -> str:
-        """The oracle form a search of m = ``marked`` entries among 2^n runs with:
-        ``synthesis_for(n)`` where it names one, else (``"auto"``) without a noise model
-        ``simulation_synthesis``'s choice (``"mcz"`` when 2^n > ENTRIES_PER_INSTRUCTION (2 min(m,
-        2^n - m) + 1)); with a noise model ``"auto"`` counts as ``"diagonal"`` (its CX-based choice
-        transpiles an MCZ, more work than a memory estimate should do; the diagonal form's bound
-        holds for both forms where ``"auto"`` may choose either)."""
+        """The oracle form a search of m = ``marked`` entries among 2^n is built with:
+        ``synthesis_for(n)`` where it names one; else (``"auto"``) ``simulation_synthesis``'s
+        choice (``"mcz"`` when 2^n > ENTRIES_PER_INSTRUCTION (2 min(m, 2^n - m) + 1)), or with a
+        noise model (the gate-by-gate circuit) the CX-based ``choose_synthesis``'s.
+
+        Args:
+            num_qubits: n.
+            marked: m, 0 .. 2^n.
+
+        Returns:
+            ``"diagonal"`` or ``"mcz"``.
+        """
         synthesis = self.synthesis_for(num_qubits)
-        if synthesis != "auto":
-            return synthesis
-        if getattr(self.simulator.options, "noise_model", None) is not None:
-            return "diagonal"
-        return simulation_synthesis_for(num_qubits, marked)
+        return synthesis if synthesis != "auto" else self._form(num_qubits, marked, self._literal)
 
     def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1, marked: int | None = None) -> int:
         """Upper bound of one search's peak memory.
@@ -226,27 +234,79 @@ class AerBackend(QuantumSearchBackend):
             shots: Measurements of the search.
             iterations: k, the Grover iterations (Aer copies the diagonal oracle's phases once per
                 iteration).
-            marked: m, or None (default) for a bound over every m: the diagonal form's estimate,
-                or where the ``mcz`` form is the only one (``synthesis="mcz"``, or ``"auto"`` on the
-                GPU above ``GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS``) its estimate for f = 2^(n-1).
+            marked: m (0 .. 2^n), or None (default) for a bound over every m.
 
         Returns:
-            The diagonal form (``oracle_form`` ``"diagonal"``):
-            ``(AER_BYTES_PER_ENTRY + AER_BYTES_PER_ENTRY_PER_ITERATION * k) * 2^n +
-            BYTES_PER_SHOT * shots`` bytes; the ``mcz`` form: ``AER_MCZ_BYTES_PER_ENTRY * 2^n +
-            AER_BYTES_PER_MCZ_INSTRUCTION * 2 f (k + 1) + BYTES_PER_SHOT * shots``, f = min(m,
-            2^n - m) (used by the memory guard, ``qrrt_circuits.memory``).
+            The diagonal form: ``(AER_BYTES_PER_ENTRY + AER_BYTES_PER_ENTRY_PER_ITERATION * k) *
+            2^n`` bytes; the ``mcz`` form: ``AER_MCZ_BYTES_PER_ENTRY * 2^n +
+            AER_BYTES_PER_MCZ_INSTRUCTION * i f (k + 1)``, with i = 2 instructions (``pauli``,
+            ``mcphase``) per flipped entry and f = min(m, 2^n - m) in the compact circuit, i = n + 1
+            (X gates, ``mcphase``) and f = m in the gate-by-gate one; plus ``BYTES_PER_SHOT * shots``.
+            The form is the one the search builds (``synthesis_for``; for ``"auto"``, the form
+            chosen for m: ``simulation_synthesis``'s in the compact circuit, which picks the mcz
+            form only where it is the smaller, the CX-based one in the gate-by-gate circuit). Without m,
+            the largest estimate over every m (for the gate-by-gate ``"auto"``, the larger of the
+            diagonal form's and the mcz form's with m < 2^n / (n - 1): an n-qubit MCZ needs at least
+            n - 1 CX, so the CX-based choice takes the mcz form for no larger m).
+
+        Raises:
+            ValueError: ``marked`` outside [0, 2^n].
         """
-        shot_bytes = self.BYTES_PER_SHOT * shots
-        if marked is None and self.synthesis_for(num_qubits) == "mcz":
-            marked = 1 << (num_qubits - 1)  # the most instructions the mcz form can have
-        if marked is not None and self.oracle_form(num_qubits, marked) == "mcz":
-            flipped = min(marked, (1 << num_qubits) - marked)
-            instructions = 2 * flipped * (iterations + 1)
-            return ((self.AER_MCZ_BYTES_PER_ENTRY << num_qubits)
-                    + self.AER_BYTES_PER_MCZ_INSTRUCTION * instructions + shot_bytes)
-        per_entry = self.AER_BYTES_PER_ENTRY + self.AER_BYTES_PER_ENTRY_PER_ITERATION * iterations
-        return (per_entry << num_qubits) + shot_bytes
+        return self._peak(num_qubits, shots, iterations, marked, self._literal)
+
+    def sequence_peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1,
+                            marked: int | None = None) -> int:
+        """``peak_bytes`` of a ``search_sequence``: its circuit (``generalized_grover_circuit``) is
+        built gate by gate, whatever the noise model.
+
+        Args:
+            num_qubits: n.
+            shots: Measurements.
+            iterations: The sequence's length.
+            marked: m (0 .. 2^n), or None (default) for a bound over every m.
+
+        Returns:
+            Bytes (see ``peak_bytes``).
+        """
+        return self._peak(num_qubits, shots, iterations, marked, True)
+
+    def _peak(self, num_qubits: int, shots: int, iterations: int, marked: int | None, literal: bool) -> int:
+        """``peak_bytes`` of the compact (``literal`` False) or the gate-by-gate circuit."""
+        entries = 1 << num_qubits
+        if marked is not None:
+            check_int(marked, "marked", 0, entries)
+        diagonal = (self.AER_BYTES_PER_ENTRY + self.AER_BYTES_PER_ENTRY_PER_ITERATION * iterations) << num_qubits
+        synthesis = self.synthesis_for(num_qubits)
+        if synthesis == "auto" and marked is not None:
+            synthesis = self._form(num_qubits, marked, literal)
+        if synthesis == "diagonal":
+            body = diagonal
+        elif synthesis == "mcz":
+            worst = marked if marked is not None else (entries if literal else entries // 2)
+            body = self._mcz_bytes(num_qubits, iterations, worst, literal)
+        elif literal:  # "auto" over every m: the CX-based choice takes the mcz form only while m c_n < 2^n - 2,
+            # and an n-qubit MCZ needs at least n - 1 CX (its qubits must all interact), so m < 2^n / (n - 1)
+            most = max(0, min(entries, (entries - 3) // max(1, num_qubits - 1)))
+            body = max(diagonal, self._mcz_bytes(num_qubits, iterations, most, literal))
+        else:
+            body = diagonal  # simulation_synthesis picks the mcz form only where it is the smaller
+        return body + self.BYTES_PER_SHOT * shots
+
+    def _form(self, num_qubits: int, marked: int, literal: bool) -> str:
+        """``"auto"``'s choice for m marked entries: CX-based in the gate-by-gate circuit (an MCZ's CX
+        count is transpiled once per n and cached), else ``simulation_synthesis``'s."""
+        if literal:
+            estimate = oracle_cx_estimate(num_qubits, marked)
+            return "mcz" if estimate["mcz"] < estimate["diagonal"] else "diagonal"
+        return simulation_synthesis_for(num_qubits, marked)
+
+    def _mcz_bytes(self, num_qubits: int, iterations: int, marked: int, literal: bool) -> int:
+        """The mcz form's estimate without the shots (see ``peak_bytes``)."""
+        if literal:
+            instructions = (num_qubits + 1) * marked * (iterations + 1)
+        else:
+            instructions = 2 * min(marked, (1 << num_qubits) - marked) * (iterations + 1)
+        return (self.AER_MCZ_BYTES_PER_ENTRY << num_qubits) + self.AER_BYTES_PER_MCZ_INSTRUCTION * instructions
 
     def threads_for(self, num_qubits: int) -> int:
         """The ``max_parallel_threads`` a circuit on ``num_qubits`` qubits runs with.

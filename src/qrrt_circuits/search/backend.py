@@ -17,7 +17,7 @@ each iterate queries the oracle once, so ``oracle_calls = len(sequence) * shots`
 from __future__ import annotations
 
 import abc
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, TypeAlias
 
@@ -32,6 +32,8 @@ if TYPE_CHECKING:
 
 #: a validated request: (marks, num_qubits, iterations, shots, rng)
 _Prepared: TypeAlias = tuple[np.ndarray, int, int, int, "int | np.random.Generator | None"]
+#: a peak-memory estimate: (num_qubits, shots, iterations, marked or None) -> bytes
+_Peak: TypeAlias = Callable[[int, int, int, "int | None"], int]
 
 
 @dataclass(frozen=True)
@@ -345,16 +347,30 @@ class QuantumSearchBackend(abc.ABC):
         Raises:
             ValueError: The estimate does not fit in the available memory.
         """
-        marks_text = "" if marked is None else f", {marked} marked"
-        check_fits(lambda n: self.memory_estimate(n, shots, iterations, marked), num_qubits,
-                   f"this {self.name} search ({shots} shots, {iterations} iterations{marks_text})")
+        self._check_peak(self.peak_bytes, num_qubits, shots, iterations, marked)
+
+    def sequence_peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1,
+                            marked: int | None = None) -> int:
+        """``peak_bytes`` of a ``search_sequence`` of ``iterations`` generalized iterates (by
+        default the same as a search's; ``AerBackend`` builds those circuits gate by gate).
+
+        Args:
+            num_qubits: n.
+            shots: Preparations (default 1).
+            iterations: The sequence's length.
+            marked: m, or None (default) for a bound over every m.
+
+        Returns:
+            Bytes.
+        """
+        return self.peak_bytes(num_qubits, shots, iterations, marked)
 
     def check_search_memory(self, marks: np.ndarray, shots: int = 1, iterations: int = 1) -> None:
         """Refuse the search of these marks if its estimated peak exceeds the available memory.
 
         First ``check_memory`` of their width with the bound over every m (no pass over the
-        marks); only where that bound does not fit, again with their count m (a backend whose
-        footprint depends on m, ``AerBackend`` with its ``mcz`` oracle, may still fit).
+        marks); only where that bound does not fit and the estimate for their count m is smaller
+        (``AerBackend`` with its ``mcz`` oracle), again with m.
 
         Args:
             marks: The validated boolean array of length 2^n.
@@ -364,11 +380,29 @@ class QuantumSearchBackend(abc.ABC):
         Raises:
             ValueError: The estimate does not fit in the available memory.
         """
+        self._check_marks_fit(self.peak_bytes, marks, shots, iterations)
+
+    def _check_marks_fit(self, peak: _Peak, marks: np.ndarray, shots: int, iterations: int) -> None:
+        """``_check_peak`` of ``peak`` for these marks: the bound first, then (only where it does
+        not fit and m's own estimate is smaller) with their count m."""
         num_qubits = int(marks.shape[0]).bit_length() - 1
         try:
-            self.check_memory(num_qubits, shots, iterations)
+            self._check_peak(peak, num_qubits, shots, iterations, None)
         except ValueError:
-            self.check_memory(num_qubits, shots, iterations, int(np.count_nonzero(marks)))
+            marked = int(np.count_nonzero(marks))
+            if peak(num_qubits, shots, iterations, marked) >= peak(num_qubits, shots, iterations, None):
+                raise
+            self._check_peak(peak, num_qubits, shots, iterations, marked)
+
+    def _check_peak(self, peak: _Peak, num_qubits: int, shots: int, iterations: int, marked: int | None) -> None:
+        """``check_fits`` of ``peak(n, shots, iterations, marked)`` bytes."""
+        marks_text = "" if marked is None else f", {marked} marked"
+
+        def estimate(width: int) -> MemoryEstimate:
+            return MemoryEstimate(width, search_bytes=peak(width, shots, iterations, marked), scratch_bytes=0)
+
+        what = f"this {self.name} search ({shots} shots, {iterations} iterations{marks_text})"
+        check_fits(estimate, num_qubits, what)
 
     def search_sequence(self, marks: np.ndarray, sequence: IterateSequence, shots: int = 1,
                         seed: int | None = None) -> SearchResult:
@@ -400,7 +434,7 @@ class QuantumSearchBackend(abc.ABC):
             raise TypeError(f"sequence must be an IterateSequence, got {type(sequence).__name__}")
         shots = validate_shots(shots)
         self.check_qubits(num_qubits)
-        self.check_memory(num_qubits, shots, len(sequence))
+        self._check_marks_fit(self.sequence_peak_bytes, marks, shots, len(sequence))
         rng = self._rng if seed is None else seed_stream(seed)
         indices = self._sample_sequence(marks, num_qubits, sequence, shots, rng)
         check_measured(indices, shots, marks.shape[0], self.name)
