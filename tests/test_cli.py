@@ -19,6 +19,23 @@ def test_search_command(capsys, backend):
     assert "classical lookup" in out
 
 
+def test_search_table_columns_line_up_for_wide_indices(capsys):
+    """Indices of 6 digits (n = 18) and of 1 digit share one layout: every row of the table has its
+    fields at the header's columns."""
+    assert main(["search", "--qubits", "18", "--marked", "3", "--iterations", "0", "--shots", "40",
+                 "--backend", "statevector", "--top", "40"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    header = next(i for i, line in enumerate(lines) if "bitstring" in line)
+    rows = [line for line in lines[header + 1:] if line.startswith("  ")]
+    assert len(rows) >= 30
+    count_end = lines[header].index("count") + len("count")
+    for row in rows:
+        index, bits, count, marked = row.split()
+        assert len(bits) == 18 and int(bits, 2) == int(index) and marked in ("yes", "no")
+        assert row.index(count, lines[header].index("bitstring") + 18) + len(count) == count_end
+        assert row.index(index) + len(index) == lines[header].index("index") + len("index")
+
+
 def test_search_command_rejects_bad_input(capsys):
     with pytest.raises(SystemExit) as exc:
         main(["search", "--qubits", "4", "--marked", "17"])

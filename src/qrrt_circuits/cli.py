@@ -110,10 +110,12 @@ def _print_search(args: argparse.Namespace, marks: np.ndarray, iterations: int, 
     values, counts = np.unique(result.indices, return_counts=True)
     order = np.argsort(-counts, kind="stable")[: args.top]
     print(f"top {len(order)} measured indices:")
-    print("  index   bitstring        count  marked")
+    width = max(5, len(str(num_items - 1)))  # the widest index
+    bits = max(args.qubits, len("bitstring"))
+    print(f"  {'index':>{width}}   {'bitstring':<{bits}}  count  marked")
     for j in order:
         index = int(values[j])
-        print(f"  {index:5d}   {index:0{args.qubits}b}{'':>{max(16 - args.qubits, 1)}} "
+        print(f"  {index:{width}d}   {index:0{args.qubits}b}{'':<{bits - args.qubits}}  "
               f"{counts[j]:5d}  {'yes' if marks[index] else 'no'}")
     print("note: the phase oracle is built from a classical lookup of the marks "
           "(a simulation shortcut); m is known here")
@@ -298,15 +300,18 @@ _Formatter: TypeAlias = "type[argparse.HelpFormatter]"
 
 def _add_search_parser(sub: _Subparsers, formatter: _Formatter) -> None:
     search = sub.add_parser("search", help="Grover-search a random marked database", formatter_class=formatter)
-    search.add_argument("--qubits", type=_positive_int, default=8)
-    search.add_argument("--marked", type=_nonnegative_int, default=12)
-    search.add_argument("--shots", type=_positive_int, default=2000)
+    search.add_argument("--qubits", type=_positive_int, default=8, help="n: the database has 2^n entries")
+    search.add_argument("--marked", type=_nonnegative_int, default=12,
+                        help="m: marked entries, drawn at random (0 .. 2^n)")
+    search.add_argument("--shots", type=_positive_int, default=2000, help="measurements")
+    # (a help text with %(default)s keeps argparse from appending "(default: None)" after it)
     search.add_argument("--iterations", type=_nonnegative_int, default=None,
-                        help="Grover iterations (default: optimal for the known m)")
+                        help="Grover iterations k (default %(default)s: the optimal k for the known m, about "
+                             "(pi/4) sqrt(2^n / m), so gate-level searches of large n with few marks take long)")
     search.add_argument("--backend", type=_registered(BACKENDS), choices=BACKENDS.names(), default="aer",
                         help=BACKENDS.help_text())
-    search.add_argument("--seed", type=_nonnegative_int, default=0)
-    search.add_argument("--top", type=_positive_int, default=10)
+    search.add_argument("--seed", type=_nonnegative_int, default=0, help="seed of the marks and the search")
+    search.add_argument("--top", type=_positive_int, default=10, help="most frequent indices to list")
     search.set_defaults(func=cmd_search)
 
 
