@@ -417,11 +417,12 @@ def test_on_the_gpu_auto_takes_the_mcz_form_above_14_qubits_and_the_bound_covers
     """Aer's GPU buffer for an n-qubit diagonal is 16 * 4^n bytes (out of GPU memory at n = 18 on
     an H200), so ``"auto"`` on the GPU builds the mcz form above ``GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS``
     whatever the marks; the bound over every m then covers the mcz form's most instructions. (The
-    rule alone, on a CPU backend told it is on the GPU: this machine has no GPU.)"""
+    rule alone, on a CPU backend whose simulator is told it is on the GPU after construction, as a
+    user may: this machine has no GPU, and nothing runs.)"""
     from qrrt_circuits.search.aer import GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS as widest
 
     backend = qc.AerBackend(0)
-    backend.device = "GPU"
+    backend.simulator.set_options(device="GPU")
     assert backend.synthesis_for(widest) == "auto" and backend.synthesis_for(widest + 1) == "mcz"
     half = 1 << widest  # half the entries of n = widest + 1: the diagonal form on the CPU
     assert qc.AerBackend(0).oracle_form(widest + 1, half) == "diagonal"
@@ -431,7 +432,7 @@ def test_on_the_gpu_auto_takes_the_mcz_form_above_14_qubits_and_the_bound_covers
         assert bound == backend.peak_bytes(widest + 1, 8, iterations, half)
         assert all(backend.peak_bytes(widest + 1, 8, iterations, m) <= bound for m in (0, 1, 12, half - 1, 2 * half))
     explicit = qc.AerBackend(0, synthesis="diagonal")
-    explicit.device = "GPU"
+    explicit.simulator.set_options(device="GPU")
     assert explicit.synthesis_for(widest + 10) == "diagonal"  # run as asked
 
 

@@ -200,8 +200,10 @@ class AerBackend(QuantumSearchBackend):
     def synthesis_for(self, num_qubits: int) -> str:
         """The ``synthesis`` a circuit on ``num_qubits`` qubits is built with: the constructor's,
         except ``"auto"`` on the GPU above ``GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS`` qubits, which is
-        ``"mcz"`` (Aer's GPU buffer for an n-qubit diagonal is 16 * 4^n bytes)."""
-        if self.synthesis == "auto" and self.device == "GPU" and num_qubits > GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS:
+        ``"mcz"`` (Aer's GPU buffer for an n-qubit diagonal is 16 * 4^n bytes). The device is read
+        from the simulator's options, so one set there after construction counts too."""
+        on_gpu = getattr(self.simulator.options, "device", self.device) == "GPU"
+        if self.synthesis == "auto" and on_gpu and num_qubits > GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS:
             return "mcz"
         return self.synthesis
 
