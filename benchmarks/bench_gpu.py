@@ -26,6 +26,7 @@ marked indices and its binomial standard deviation; and a probe of the diagonal 
 run is recorded with Aer's error and the benchmark goes on). ``--dense``: a q-RRT round's search
 instead (a fifth of the entries marked, k = 3, 1 shot), where the CPU takes the diagonal oracle and
 the GPU, above ``GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS``, the mcz form (``AerBackend.synthesis_for``).
+``--blocking``: only a probe of Aer's cache blocking for that dense search (``blocking_probe``).
 
 Writes the JSON after every size (a run cut short keeps what it measured), with the machine (CPU
 count, ``nvidia-smi``'s GPU name, memory and driver, Aer's devices and version).
@@ -114,6 +115,45 @@ def _summary(times: list[float]) -> dict:
     return {"median_s": float(np.median(times)), "min_s": float(np.min(times)), "repeats": len(times)}
 
 
+BLOCKING_QUBITS = (12, 14)
+
+
+def blocking_probe(sizes: list[int], cpu: qc.AerBackend, gpu: qc.AerBackend | None, path: Path,
+                   payload: dict) -> list[dict]:
+    """A q-RRT round's search (a fifth of the entries marked, k = 3, 1 shot) with the diagonal
+    oracle: on the CPU as ``AerBackend`` runs it, and on the GPU with Aer's cache blocking
+    (``blocking_enable``, ``blocking_qubits`` b), where Aer applies a wide diagonal chunk by chunk
+    on b qubits (``Chunk::block_diagonal_matrix``), so its matrix buffer might be sized for b, not
+    n. Median ms of 3 seeded searches each (after one unmeasured), and whether the GPU's indices
+    equal the CPU's; a failed run is recorded with Aer's error."""
+    rows = payload.setdefault("blocking_probe", [])
+    diagonal_cpu = qc.AerBackend(seed=1, device="CPU", synthesis="diagonal")
+    for n in sizes:
+        marks = _marks(n, (1 << n) // 5, np.random.default_rng(n))
+        row: dict = {"qubits": n, "marked": int(marks.sum()), "iterations": 3, "shots": 1}
+        runs: dict[str, list] = {}
+        backends = {"cpu_diagonal": diagonal_cpu}
+        for bits in BLOCKING_QUBITS if gpu is not None and n > min(BLOCKING_QUBITS) else ():
+            blocked = qc.AerBackend(seed=1, device="GPU", synthesis="diagonal")
+            blocked.simulator.set_options(blocking_enable=True, blocking_qubits=bits)
+            backends[f"gpu_diagonal_blocking{bits}"] = blocked
+        for name, backend in backends.items():
+            try:
+                _timed(backend, marks, 99, 1, 3)
+                runs[name] = [_timed(backend, marks, seed, 1, 3) for seed in (100, 101, 102)]
+                row[f"{name}_ms"] = float(np.median([t for t, _ in runs[name]])) * 1e3
+            except (RuntimeError, ValueError) as error:
+                row[f"{name}_error"] = str(error)[:300]
+        for name in runs:
+            if name != "cpu_diagonal" and "cpu_diagonal" in runs:
+                row[f"{name}_same_indices"] = all(np.array_equal(c, g) for (_, c), (_, g)
+                                                  in zip(runs["cpu_diagonal"], runs[name], strict=True))
+        rows.append(row)
+        path.write_text(json.dumps(payload, indent=1))
+        print(f"blocking probe n = {n}: {row}", flush=True)
+    return rows
+
+
 def distribution_check(device: str, n: int = 16, shots: int = 256) -> dict:
     """The fraction of marked indices among ``shots`` of k = 12 with m = 2^n / 256 (sin^2(25
     theta) = 0.99995), the ``mcz`` oracle (2 m instructions per iteration), and how many binomial
@@ -141,6 +181,9 @@ def main() -> None:
                         help="measure the CPU alone, its distribution check included (no GPU needed)")
     parser.add_argument("--quick", action="store_true",
                         help="n = 12, 16, 20, 24 (unless --qubits is given) and a CPU budget of at most 30 s")
+    parser.add_argument("--blocking", action="store_true",
+                        help="only the cache-blocking probe: the dense diagonal oracle on the GPU with Aer's "
+                             "blocking_enable (blocking_qubits 12 and 14) against the CPU's diagonal")
     parser.add_argument("--dense", action="store_true",
                         help="a q-RRT round's search instead: a fifth of the entries marked, k = 3, 1 shot "
                              "(no distribution check or diagonal probe)")
@@ -180,10 +223,10 @@ def main() -> None:
         print(f"GPU first search (CUDA context, kernels): {payload['gpu_first_search_s']:.2f} s", flush=True)
     cpu.search(_marks(8, MARKED, np.random.default_rng(9)), ITERATIONS, shots=SHOTS, seed=0)  # warm-up
     for name, backend in (("GPU", gpu), ("CPU", cpu)):
-        if backend is not None and not args.dense:
+        if backend is not None and not args.dense and not args.blocking:
             payload["checks"].append({"device": name, **_attempt(lambda d=name: distribution_check(d))})
             print(f"distribution check on {name}: {payload['checks'][-1]}", flush=True)
-    if gpu is not None and not args.dense:  # where the diagonal oracle runs on the GPU (k = 1, 8 shots)
+    if gpu is not None and not args.dense and not args.blocking:  # where the GPU runs the diagonal (k = 1, 8 shots)
         for n in DIAGONAL_PROBE_QUBITS:
             probe = qc.AerBackend(seed=1, device="GPU", synthesis="diagonal")
             marks = _marks(n, MARKED, np.random.default_rng(n))
@@ -191,6 +234,10 @@ def main() -> None:
             payload["diagonal_probe"].append({"qubits": n, **outcome})
             print(f"diagonal oracle on the GPU, n = {n}: {outcome}", flush=True)
     path.write_text(json.dumps(payload, indent=1))
+    if args.blocking:
+        payload["blocking_probe"] = blocking_probe(sizes, cpu, gpu, path, payload)
+        print(f"wrote {path}")
+        return
     cpu_left = args.cpu_budget
     last_cpu: tuple[int, float] | None = None
     rng = np.random.default_rng(0)
