@@ -118,15 +118,15 @@ def _summary(times: list[float]) -> dict:
 BLOCKING_QUBITS = (12, 14)
 
 
-def blocking_probe(sizes: list[int], cpu: qc.AerBackend, gpu: qc.AerBackend | None, path: Path,
-                   payload: dict) -> list[dict]:
+def blocking_probe(sizes: list[int], gpu: qc.AerBackend | None, path: Path, payload: dict) -> None:
     """A q-RRT round's search (a fifth of the entries marked, k = 3, 1 shot) with the diagonal
     oracle: on the CPU as ``AerBackend`` runs it, and on the GPU with Aer's cache blocking
     (``blocking_enable``, ``blocking_qubits`` b), where Aer applies a wide diagonal chunk by chunk
     on b qubits (``Chunk::block_diagonal_matrix``), so its matrix buffer might be sized for b, not
     n. Median ms of 3 seeded searches each (after one unmeasured), and whether the GPU's indices
-    equal the CPU's; a failed run is recorded with Aer's error."""
-    rows = payload.setdefault("blocking_probe", [])
+    equal the CPU's; a failed run is recorded with Aer's error. Rows go to
+    ``payload["blocking_probe"]``, written to ``path`` after each size."""
+    rows = payload["blocking_probe"] = []
     diagonal_cpu = qc.AerBackend(seed=1, device="CPU", synthesis="diagonal")
     for n in sizes:
         marks = _marks(n, (1 << n) // 5, np.random.default_rng(n))
@@ -151,13 +151,12 @@ def blocking_probe(sizes: list[int], cpu: qc.AerBackend, gpu: qc.AerBackend | No
         rows.append(row)
         path.write_text(json.dumps(payload, indent=1))
         print(f"blocking probe n = {n}: {row}", flush=True)
-    return rows
 
 
 def distribution_check(device: str, n: int = 16, shots: int = 256) -> dict:
     """The fraction of marked indices among ``shots`` of k = 12 with m = 2^n / 256 (sin^2(25
-    theta) = 0.99995), the ``mcz`` oracle (2 m instructions per iteration), and how many binomial
-    standard deviations it lies from that."""
+    theta) = 0.99995), the ``mcz`` oracle (2 m instructions per iteration), its binomial standard
+    deviation, and whether it lies within 5 of them (or one shot) of the expected fraction."""
     backend = qc.AerBackend(seed=1, device=device, synthesis="mcz")
     marks = _marks(n, (1 << n) // 256, np.random.default_rng(5))
     seconds, indices = _timed(backend, marks, 11, shots=shots)
@@ -195,7 +194,8 @@ def main() -> None:
     from qiskit_aer import AerSimulator
 
     devices = list(AerSimulator().available_devices())
-    path = Path(args.out) if args.out else RESULTS / ("bench_gpu_dense.json" if args.dense else "bench_gpu.json")
+    kind = "_blocking" if args.blocking else "_dense" if args.dense else ""
+    path = Path(args.out) if args.out else RESULTS / f"bench_gpu{kind}.json"
     path.parent.mkdir(parents=True, exist_ok=True)
     if "GPU" not in devices and not args.cpu_only:
         reason = (f"this qiskit-aer offers the devices {devices}; device='GPU' needs qiskit-aer-gpu and an "
@@ -235,7 +235,7 @@ def main() -> None:
             print(f"diagonal oracle on the GPU, n = {n}: {outcome}", flush=True)
     path.write_text(json.dumps(payload, indent=1))
     if args.blocking:
-        payload["blocking_probe"] = blocking_probe(sizes, cpu, gpu, path, payload)
+        blocking_probe(sizes, gpu, path, payload)
         print(f"wrote {path}")
         return
     cpu_left = args.cpu_budget

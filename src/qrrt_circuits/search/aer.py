@@ -225,8 +225,7 @@ class AerBackend(QuantumSearchBackend):
         Returns:
             ``"diagonal"`` or ``"mcz"``.
         """
-        synthesis = self.synthesis_for(num_qubits)
-        return synthesis if synthesis != "auto" else self._form(num_qubits, marked, self._literal)
+        return self._form(num_qubits, marked, self._literal)
 
     def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1, marked: int | None = None) -> int:
         """Upper bound of one search's peak memory.
@@ -278,9 +277,7 @@ class AerBackend(QuantumSearchBackend):
         if marked is not None:
             check_int(marked, "marked", 0, entries)
         diagonal = (self.AER_BYTES_PER_ENTRY + self.AER_BYTES_PER_ENTRY_PER_ITERATION * iterations) << num_qubits
-        synthesis = self.synthesis_for(num_qubits)
-        if synthesis == "auto" and marked is not None:
-            synthesis = self._form(num_qubits, marked, literal)
+        synthesis = self.synthesis_for(num_qubits) if marked is None else self._form(num_qubits, marked, literal)
         if synthesis == "diagonal":
             body = diagonal
         elif synthesis == "mcz":
@@ -295,8 +292,12 @@ class AerBackend(QuantumSearchBackend):
         return body + self.BYTES_PER_SHOT * shots
 
     def _form(self, num_qubits: int, marked: int, literal: bool) -> str:
-        """``"auto"``'s choice for m marked entries: CX-based in the gate-by-gate circuit (an MCZ's CX
-        count is transpiled once per n and cached), else ``simulation_synthesis``'s."""
+        """The form built for m marked entries: ``synthesis_for(n)`` where it names one; for
+        ``"auto"`` the CX-based choice in the gate-by-gate circuit (an MCZ's CX count is transpiled
+        once per n and cached), else ``simulation_synthesis``'s."""
+        synthesis = self.synthesis_for(num_qubits)
+        if synthesis != "auto":
+            return synthesis
         if literal:
             estimate = oracle_cx_estimate(num_qubits, marked)
             return "mcz" if estimate["mcz"] < estimate["diagonal"] else "diagonal"
