@@ -46,6 +46,23 @@ def test_degenerate_trees_line_and_repeated_points():
         assert tree_same(rng.random((10, 3))).tolist() == [0] * 10  # all equally near: the lowest index
 
 
+@pytest.mark.parametrize("width", [0.0, 0.7, 1.6])  # one, three and five columns of cells
+@pytest.mark.parametrize("vertical", [True, False])
+def test_strips_one_to_three_cells_wide_on_integer_points(width, vertical):
+    """The first visit's three column runs at the grid's edges (a column outside the grid is an empty
+    run): strips of integer points, so that many queries tie, searched along and across."""
+    rng = np.random.default_rng(int(width * 10) + vertical)
+    along = rng.integers(0, 60, size=500).astype(float)
+    across = np.round(rng.random(500) * width)
+    points = np.column_stack((across, along) if vertical else (along, across))
+    tree = Tree(points[0])
+    tree.add_many(points[1:], np.zeros(499, dtype=np.int64))
+    queries = np.round(rng.random((400, 2)) * np.array([8.0, 70.0] if vertical else [70.0, 8.0]) - 3.0) / 2.0
+    want = np.argmin(((queries[:, None, :] - tree.nodes[None]) ** 2).sum(-1), axis=1)  # ties: lowest index
+    assert np.array_equal(tree.grid_nearest(queries), want)
+    assert np.array_equal(tree.nearest(queries), want)
+
+
 def test_nearest_agrees_with_the_grid_on_both_sides_of_the_brute_force_switch():
     from qrrt_circuits import tree as tree_module
 
