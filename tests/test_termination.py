@@ -1,6 +1,7 @@
 """Termination conditions alone and combined, on planners and on progress snapshots; the status
 names the condition that ended the plan."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -431,3 +432,76 @@ class _DescribesMaxNodes(_UserCondition):
 def test_a_limit_key_keeps_its_finite_number_whatever_a_user_part_describes(value):
     for parts in ((qc.MaxNodes(5), _DescribesMaxNodes(value)), (_DescribesMaxNodes(value), qc.MaxNodes(5))):
         assert qc.AnyOf(parts).describe()["max_nodes"] == 5
+
+
+@pytest.mark.parametrize("per_round", [1, 3, 8])
+@pytest.mark.parametrize("condition, field", [
+    (qc.MaxNodes(40), "nodes"),
+    (qc.MaxRounds(40), "rounds"),
+    (qc.Stall(40), "rounds_without_new_node"),
+])
+def test_rounds_before_end_are_exactly_the_rounds_that_cannot_end_the_plan(condition, field, per_round):
+    """After R = rounds_before_end more rounds, the counter at its fastest (one round, p nodes, one
+    round without a node each) is still below the limit; after R + 1 it can reach it."""
+    grows = per_round if field == "nodes" else 1
+    for value in (0, 1, 17, 38, 39):
+        start = progress(**{field: value})
+        rounds = condition.rounds_before_end(start, per_round)
+        assert rounds >= 0
+        assert condition.ended_by(progress(**{field: value + rounds * grows})) is None
+        assert condition.ended_by(progress(**{field: value + (rounds + 1) * grows})) is not None
+
+
+def test_conditions_on_oracle_calls_time_or_a_redefined_test_are_checked_every_round():
+    class EvenNodes(qc.MaxNodes):  # a user's subclass with its own test
+        def ended_by(self, progress):
+            return qc.PlanStatus.MAX_NODES if progress.nodes % 2 else None
+
+    class Faster(qc.MaxRounds):  # one that redefines the counted value
+        def _value(self, progress):
+            return 2 * progress.rounds
+
+    quiet = progress(nodes=1, rounds=1)
+    for condition in (qc.MaxOracleCalls(10**6), qc.MaxCriticalPathCalls(10**6), qc.MaxWallTime(1e6),
+                      EvenNodes(100), Faster(100), qc.MaxNodes(100) | qc.MaxOracleCalls(10**6)):
+        assert condition.rounds_before_end(quiet, 1) == 0
+    assert (qc.MaxNodes(100) | qc.MaxRounds(50) | qc.Stall(70)).rounds_before_end(quiet, 1) == 48
+
+
+class _EveryRound(qc.TerminationCondition):
+    """A user's condition that wraps another without ``rounds_before_end``: checked every round."""
+
+    def __init__(self, inner):
+        self.inner = inner
+
+    def ended_by(self, progress):
+        return self.inner.ended_by(progress)
+
+    def describe(self):
+        return self.inner.describe()
+
+    @property
+    def limits_rounds(self):
+        return self.inner.limits_rounds
+
+    @property
+    def node_limit(self):
+        return self.inner.node_limit
+
+
+@pytest.mark.parametrize("planner_name", ["rrt", "prrt", "qrrt", "pqrrt", "pqrrt-unshared"])
+def test_skipped_checks_end_a_plan_where_checking_every_round_does(planner_name, clutter):
+    from qrrt_circuits.experiments.planners import make_planner
+
+    statuses = set()
+    for seed, condition in enumerate((qc.MaxNodes(23), qc.MaxRounds(41), qc.Stall(2),
+                                      qc.MaxNodes(30) | qc.Stall(4) | qc.MaxRounds(90))):
+        results = [make_planner(planner_name, clutter, seed, "statevector").plan(termination=chosen, goal_radius=1e-9)
+                   for chosen in (condition, _EveryRound(condition))]
+        fast, every = results
+        assert fast.status == every.status
+        assert dataclasses.replace(fast.metrics, wall_time_s=0.0) == dataclasses.replace(every.metrics, wall_time_s=0.0)
+        assert np.array_equal(fast.nodes, every.nodes)
+        assert all(np.array_equal(fast.history[key], every.history[key]) for key in every.history)
+        statuses.add(str(fast.status))
+    assert statuses >= {"max_nodes", "max_rounds", "stalled"}

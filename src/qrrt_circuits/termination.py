@@ -6,7 +6,10 @@ itself; ``a | b`` ends the plan when either ends it, and the status says which o
 
 Conditions are checked *before* each round, so the last round may overshoot an oracle-call budget
 by less than one round's cost and a node budget by fewer than ``workers`` nodes (the paper's
-cut-offs behave the same way).
+cut-offs behave the same way). A condition on counters that grow by a known most per round (nodes,
+rounds, rounds without a new node) tells the planner how many rounds cannot end the plan
+(``rounds_before_end``); the planner skips those checks, and the plan ends where checking before
+every round would (tested against a condition checked every round).
 
 Every plan terminates: ``Planner.plan`` always adds ``MaxRounds(DEFAULT_MAX_ROUNDS)`` unless the
 condition it is given already limits rounds, and ``Stall(DEFAULT_STALL_ROUNDS)`` unless it already
@@ -18,6 +21,7 @@ outgrows memory (``memory.check_plan_fits`` checks the limits in force before th
 from __future__ import annotations
 
 import abc
+import functools
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -134,6 +138,22 @@ class TerminationCondition(abc.ABC):
             A dict from the condition's name (``"max_nodes"``, ``"stall_rounds"``, ...) to its limit.
         """
 
+    def rounds_before_end(self, progress: Progress, nodes_per_round: int) -> int:
+        """How many rounds may run, after a check on ``progress`` that did not end the plan, before
+        this condition must be checked again: R such that ``ended_by`` is None at the checks before
+        each of the next R rounds whatever they do (each adds one round, at most
+        ``nodes_per_round`` nodes and at most one round without a new node). A planner skips those
+        checks and ends exactly where checking before every round would (``Planner._run``).
+
+        Args:
+            progress: The counters of the check that did not end the plan.
+            nodes_per_round: The most nodes one round of the plan adds (p for p workers).
+
+        Returns:
+            R >= 0; 0 (the default, and for oracle calls and wall time): check before every round.
+        """
+        return 0
+
     @property
     def limits_rounds(self) -> bool:
         """Whether this condition alone guarantees the plan ends (bounds the number of rounds)."""
@@ -177,8 +197,27 @@ class _Limit(TerminationCondition):
     def ended_by(self, progress: Progress) -> PlanStatus | None:
         return self.status if self._value(progress) >= self.limit else None
 
+    def _headroom(self, progress: Progress, nodes_per_round: int) -> int:
+        """``rounds_before_end`` of a limit whose value may grow by any amount in a round: 0."""
+        return 0
+
+    def rounds_before_end(self, progress: Progress, nodes_per_round: int) -> int:
+        """``_headroom`` where this class's test is the one it was written for (0 for a subclass
+        that redefines ``ended_by`` or ``_value``)."""
+        return max(self._headroom(progress, nodes_per_round), 0) if _headroom_holds(type(self)) else 0
+
     def describe(self) -> dict:
         return {str(self.status): self.limit}
+
+
+@functools.cache
+def _headroom_holds(kind: type[_Limit]) -> bool:
+    """Whether ``kind``'s ``_headroom`` was written for its test: its ``ended_by`` is ``_Limit``'s
+    and its ``_value`` comes from the class that defines its ``_headroom``."""
+    def owner(name: str) -> type:
+        return next(cls for cls in kind.__mro__ if name in cls.__dict__)
+
+    return kind.ended_by is _Limit.ended_by and owner("_value") is owner("_headroom")
 
 
 @dataclass(frozen=True)
@@ -248,6 +287,11 @@ class MaxNodes(_Limit):
     def _value(self, progress: Progress) -> float:
         return progress.nodes
 
+    def _headroom(self, progress: Progress, nodes_per_round: int) -> int:
+        """After j more rounds the tree holds at most nodes + j p nodes, below ``limit`` for
+        j <= (limit - nodes - 1) // p."""
+        return (self.limit - progress.nodes - 1) // max(nodes_per_round, 1)
+
     @property
     def node_limit(self) -> int:
         """``limit``."""
@@ -273,6 +317,10 @@ class MaxRounds(_Limit):
 
     def _value(self, progress: Progress) -> float:
         return progress.rounds
+
+    def _headroom(self, progress: Progress, nodes_per_round: int) -> int:
+        """After j more rounds, rounds + j: below ``limit`` for j <= limit - rounds - 1."""
+        return self.limit - progress.rounds - 1
 
     @property
     def limits_rounds(self) -> bool:
@@ -310,6 +358,11 @@ class Stall(_Limit):
 
     def _value(self, progress: Progress) -> float:
         return progress.rounds_without_new_node
+
+    def _headroom(self, progress: Progress, nodes_per_round: int) -> int:
+        """After j more rounds at most rounds_without_new_node + j: below ``limit`` for
+        j <= limit - rounds_without_new_node - 1."""
+        return self.limit - progress.rounds_without_new_node - 1
 
     def describe(self) -> dict:
         return {"stall_rounds": self.limit}
@@ -386,6 +439,16 @@ class AnyOf(TerminationCondition):
             if status is not None:
                 return status
         return None
+
+    def rounds_before_end(self, progress: Progress, nodes_per_round: int) -> int:
+        """The fewest of the parts' (none may end the plan before its own)."""
+        fewest = None
+        for condition in self.conditions:
+            rounds = condition.rounds_before_end(progress, nodes_per_round)
+            if rounds <= 0:
+                return 0
+            fewest = rounds if fewest is None else min(fewest, rounds)
+        return fewest or 0
 
     def describe(self) -> dict:
         """The parts' settings merged; where two parts set the same limit of this module (the

@@ -216,12 +216,21 @@ class Planner:
 
     def _run(self, state: RunState, condition: TerminationCondition, began: float) -> PlanStatus:
         """The round loop: check the condition, run a round, record it; until the goal or the end.
+        After a check that did not end the plan, the next ``condition.rounds_before_end`` checks
+        are skipped (they cannot end it: the plan ends where checking before every round would).
         Subclasses may run several rounds' work at once if every round's outcome, counters and
         termination check stay exactly those of this loop."""
+        per_round = self._max_new_nodes_per_round()
+        unchecked = 0  # rounds that may still run before the next check
         while state.goal_node is None:
-            ended = condition.ended_by(state.progress(time.perf_counter() - began))
-            if ended is not None:
-                return ended
+            if unchecked:
+                unchecked -= 1
+            else:
+                progress = state.progress(time.perf_counter() - began)
+                ended = condition.ended_by(progress)
+                if ended is not None:
+                    return ended
+                unchecked = condition.rounds_before_end(progress, per_round)
             self._round(state)
             state.end_round()
         return PlanStatus.REACHED
@@ -267,7 +276,8 @@ class Planner:
         """Subclasses validate their own settings before any work."""
 
     def _max_new_nodes_per_round(self) -> int:
-        """The most nodes one round can add (1 here; p for p workers)."""
+        """The most nodes one round can add (1 here; p for p workers): a bound that the memory check
+        (``check_plan_fits``) and the skipped termination checks (``_run``) rely on."""
         return 1
 
     def _start_policy(self) -> PolicyState | None:

@@ -186,6 +186,7 @@ class ParallelRRT(Planner):
         workers = self.workers
         changed = recorded = 0
         most = batch_round_limit(workers, self.env.dim)
+        unchecked = 0  # rounds that may still run before the next check (as ``Planner._run``)
         while state.goal_node is None:
             ahead = min(batch_rounds(changed, recorded), most)
             first = state.rounds
@@ -198,10 +199,15 @@ class ParallelRRT(Planner):
             truth = check_answers(self.predicate.reachable(state.tree.nodes[parents], children), children.shape[0],
                                   f"the predicate {self.predicate.name!r}")
             for offset in range(ahead):
-                ended = condition.ended_by(state.progress(time.perf_counter() - began))
-                if ended is not None:
-                    state.wasted_checks += (ahead - offset) * workers
-                    return ended
+                if unchecked:
+                    unchecked -= 1
+                else:
+                    progress = state.progress(time.perf_counter() - began)
+                    ended = condition.ended_by(progress)
+                    if ended is not None:
+                        state.wasted_checks += (ahead - offset) * workers
+                        return ended
+                    unchecked = condition.rounds_before_end(progress, workers)
                 nodes_before = state.nodes
                 rows = slice(offset * workers, (offset + 1) * workers)
                 self._record(state, first + offset, children[rows], parents[rows], truth[rows])
