@@ -26,6 +26,7 @@ from __future__ import annotations
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
+from numba import njit
 
 REQUIRED_MEMBERS = ("reachable", "dim", "name", "describe")
 
@@ -142,9 +143,20 @@ def as_pairs(parents: np.ndarray, children: np.ndarray, dim: int) -> tuple[np.nd
     if parents.shape != children.shape:
         raise ValueError(f"parents and children must have the same shape, got {parents.shape} and "
                          f"{children.shape}")
-    if not (np.all(np.isfinite(parents)) and np.all(np.isfinite(children))):
+    if not (_all_finite(parents) and _all_finite(children)):
         raise ValueError("parents and children must be finite")
     return parents, children
+
+
+@njit(cache=True, nogil=True)
+def _all_finite(points: np.ndarray) -> bool:
+    """Whether every coordinate of the C-contiguous float (M, d) ``points`` is finite (compiled:
+    ``np.all(np.isfinite(...))`` cost about 2.5 us for 256 pairs, a few per cent of a round)."""
+    for row in range(points.shape[0]):
+        for axis in range(points.shape[1]):
+            if not np.isfinite(points[row, axis]):
+                return False
+    return True
 
 
 def check_answers(answers: Any, count: int, source: str) -> np.ndarray:
