@@ -409,13 +409,17 @@ def test_a_closed_form_tally_is_the_worker_by_worker_tally(seed):
     entropy = RandomStreams.from_seed(seed)._run_entropy
     workers, k = 40, int(rng.integers(0, 4))
     children, parents = rng.random((size, 2)), rng.integers(0, 50, size)
-    indices, verified, added, reachable, good, added_children, added_parents = fused_round._measure(
-        entropy, 3, 0, marks, truth, 0, workers, children, parents)  # k = 0: P(G) = m/N, many verify
+    indices, added, reachable, good = fused_round._measure(
+        entropy, 3, 0, marks, truth, 0, workers)  # k = 0: P(G) = m/N, many verify
+    verified = truth[indices]
     assert reachable == int(truth.sum()) and good == int(verified.sum())
-    assert np.array_equal(added_children, children[added]) and np.array_equal(added_parents, parents[added])
-    outcome = fused_round.ClosedFormOutcome(size, reachable, k, indices, verified, added, children, parents,
-                                            SearchOutcome(None, k, 1, ((k, False),)), good, added_children,
-                                            added_parents)
+    first_verified = list(dict.fromkeys(indices[verified].tolist()))  # in worker order, each entry once
+    assert added.tolist() == first_verified
+    outcome = fused_round.ClosedFormOutcome(size, reachable, k, indices, truth, added, children, parents,
+                                            SearchOutcome(None, k, 1, ((k, False),)), good)
+    assert np.array_equal(outcome.verified, verified)
+    assert np.array_equal(outcome.added_children, children[added])
+    assert np.array_equal(outcome.added_parents, parents[added])
     assert verified.any() and not verified.all() and len(set(indices[verified].tolist())) < verified.sum()
     generic = DatabaseOutcome(size, int(truth.sum()), outcome.outcomes, outcome.found)
     fast, slow = outcome.tally(), generic.tally()

@@ -101,8 +101,7 @@ def _candidates(run_entropy: np.ndarray, round_index: int, worker: int, size: in
 
 @njit(cache=True, nogil=True)
 def _measure(run_entropy: np.ndarray, round_index: int, worker: int, marks: np.ndarray, truth: np.ndarray,
-             iterations: int, shots: int, children: np.ndarray,
-             parents: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, int, int, np.ndarray, np.ndarray]:
+             iterations: int, shots: int) -> tuple[np.ndarray, np.ndarray, int, int]:
     """The measured indices of one closed-form search, their verification, and the entries a
     planner adds.
 
@@ -111,7 +110,10 @@ def _measure(run_entropy: np.ndarray, round_index: int, worker: int, marks: np.n
     ``RandomStreams.seed(round_index, worker, Stream.SEARCH)`` (``randomness._stream_seed``), the
     draw ``_draw_two_level_seeded`` with that seed's ``integer_seed_words``
     (``randomness._small_seed_words``, the seed being below 2^62): the same functions the generic
-    round calls; the indices are verified by ``_verify``.
+    round calls; the indices are verified by ``_verify``. Two arrays come back (each array a
+    compiled call returns costs about 0.35 us to hand to Python): the workers' verifications and the
+    added entries' positions are read from ``truth``, ``children`` and ``parents`` where needed
+    (``ClosedFormOutcome``).
 
     Returns:
         (indices (shots,), then what ``_verify`` returns for them).
@@ -123,31 +125,27 @@ def _measure(run_entropy: np.ndarray, round_index: int, worker: int, marks: np.n
     p_good = compiled_good_probability(size, marked, iterations)
     words = _small_seed_words(_stream_seed(run_entropy, _key(round_index, worker, _SEARCH)))
     indices = _draw_two_level_seeded(marks, p_good, shots, words)
-    verified, added, reachable, good, added_children, added_parents = _verify(indices, truth, children, parents)
-    return indices, verified, added, reachable, good, added_children, added_parents
+    added, reachable, good = _verify(indices, truth)
+    return indices, added, reachable, good
 
 
 @njit(cache=True, nogil=True)
-def _verify(indices: np.ndarray, truth: np.ndarray, children: np.ndarray,
-            parents: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, int, np.ndarray, np.ndarray]:
+def _verify(indices: np.ndarray, truth: np.ndarray) -> tuple[np.ndarray, int, int]:
     """Each worker's classical verification of its measured index (the finalizer, 1 oracle call
     per worker, against ``truth``) and the entries a planner adds.
 
     Returns:
-        (verified (shots,) bool, added: the verified indices in worker order, each entry once (its
-        first verification), the candidates Alg. 3 adds; the reachable entries of ``truth``; the
-        verified shots; the added entries' children and parents).
+        (added: the verified indices in worker order, each entry once (its first verification),
+        the candidates Alg. 3 adds; the reachable entries of ``truth``; the verified shots).
     """
     size = truth.shape[0]
     shots = indices.shape[0]
-    verified = np.empty(shots, dtype=np.bool_)
     seen = np.zeros(size, dtype=np.bool_)
     added = np.empty(shots, dtype=np.int64)
     count = good = 0
     for shot in range(shots):
         index = indices[shot]
-        verified[shot] = truth[index]
-        if verified[shot]:
+        if truth[index]:
             good += 1
             if not seen[index]:
                 seen[index] = True
@@ -156,12 +154,7 @@ def _verify(indices: np.ndarray, truth: np.ndarray, children: np.ndarray,
     reachable = 0
     for entry in range(size):
         reachable += truth[entry]
-    added_children = np.empty((count, children.shape[1]))
-    added_parents = np.empty(count, dtype=np.int64)
-    for slot in range(count):
-        added_children[slot] = children[added[slot]]
-        added_parents[slot] = parents[added[slot]]
-    return verified, added[:count].copy(), reachable, good, added_children, added_parents
+    return added[:count], reachable, good
 
 
 class ClosedFormOutcome(NamedTuple):
@@ -179,28 +172,39 @@ class ClosedFormOutcome(NamedTuple):
         reachable_entries: Its truly reachable entries.
         iterations: k.
         indices: The workers' measured indices, in worker order.
-        verified: Whether each verified.
+        truth: The database's true answers (N,) bool: a worker verifies if ``truth[index]``.
         added: The verified indices in worker order, each entry once (the entries added).
         children: The database's child positions (N, d).
         parents: Their parent node indices (N,).
         missed: The (shared) outcome of a worker whose measurement did not verify.
         verified_count: The workers whose measurement verified.
-        added_children: The added entries' child positions, ``children[added]``.
-        added_parents: Their parents, ``parents[added]``.
     """
 
     entries: int
     reachable_entries: int
     iterations: int
     indices: np.ndarray
-    verified: np.ndarray
+    truth: np.ndarray
     added: np.ndarray
     children: np.ndarray
     parents: np.ndarray
     missed: SearchOutcome
     verified_count: int
-    added_children: np.ndarray
-    added_parents: np.ndarray
+
+    @property
+    def verified(self) -> np.ndarray:
+        """Whether each worker's measurement verified, ``truth[indices]`` (shots,) bool."""
+        return self.truth[self.indices]
+
+    @property
+    def added_children(self) -> np.ndarray:
+        """The added entries' child positions, ``children[added]`` (count, d)."""
+        return self.children[self.added]
+
+    @property
+    def added_parents(self) -> np.ndarray:
+        """Their parents, ``parents[added]`` (count,)."""
+        return self.parents[self.added]
 
     @property
     def outcomes(self) -> tuple[SearchOutcome, ...]:
@@ -221,8 +225,12 @@ class ClosedFormOutcome(NamedTuple):
         worker order and the later ones counted as duplicates."""
         workers = self.indices.shape[0]
         good = self.verified_count
+        added = self.added
+        # (most rounds add nothing: empty slices then, cheaper than indexing by an empty array)
+        children, parents = ((self.children[added], self.parents[added]) if added.shape[0] else
+                             (self.children[:0], self.parents[:0]))
         return (self.iterations * workers, workers, workers - good, self.iterations + 1 if workers else 0,
-                good - self.added.shape[0], self.added_children, self.added_parents)
+                good - added.shape[0], children, parents)
 
 
 def _iterations(k: int) -> int:
@@ -257,6 +265,8 @@ class FusedRound:
         self._checked: set[tuple[int, int]] = set()
         self._answers_of = f"the predicate {predicate.name!r}"  # (check_answers' name of the predicate)
         self._missed_outcomes: dict[int, SearchOutcome] = {}
+        self._flags_of: PolicyState | None = None  # the policy state whose flags _flags holds
+        self._flags = (False, False)  # its (searches_by_default(), reads_problem())
 
     def search(self, tree: Tree, round_index: int, groups: list[tuple[int, int]], policy_state: PolicyState,
                tree_nodes: int) -> list[DatabaseResult]:
@@ -294,8 +304,11 @@ class FusedRound:
         if len(groups) > 1 and any(count != workers for _, count in groups):
             raise ValueError("FusedRound.search needs groups of one size")
         built = [self._database(tree, round_index, first) for first, _ in groups]
-        by_default = policy_state.searches_by_default()
-        if by_default and not policy_state.reads_problem():  # k from N and the tree: no DatabaseSearch needed
+        if policy_state is not self._flags_of:  # (constant for a state: its class's methods decide them)
+            self._flags = policy_state.searches_by_default(), policy_state.reads_problem()
+            self._flags_of = policy_state
+        by_default, reads_problem = self._flags
+        if by_default and not reads_problem:  # k from N and the tree: no DatabaseSearch needed
             iterations = [_iterations(policy_state.iterations_by_size(tree_nodes)) for _ in groups]
         else:
             problems = [DatabaseSearch(marks, truth, self.backend, self.streams, round_index, first)
@@ -322,7 +335,7 @@ class FusedRound:
         requests = [SearchRequest(marks, k, workers, self.streams.seed(round_index, first, Stream.SEARCH))
                     for (_, _, _, marks), (first, _), k in zip(built, groups, iterations, strict=True)]
         results = self.backend.search_many(requests)
-        return [self._outcome(children, parents, k, result.indices, *_verify(result.indices, truth, children, parents))
+        return [self._outcome(children, parents, truth, k, result.indices, *_verify(result.indices, truth))
                 for (children, parents, truth, _), k, result in zip(built, iterations, results, strict=True)]
 
     def _database(self, tree: Tree, round_index: int,
@@ -342,16 +355,15 @@ class FusedRound:
                   round_index: int, first: int, count: int, iterations: int) -> ClosedFormOutcome:
         """The outcome of the default ``PolicyState.run`` at k = ``iterations`` for ``count``
         workers (``policies._verified`` of the backend's ``search``), compiled."""
-        return self._outcome(children, parents, iterations, *_measure(
-            self._entropy, round_index, first, marks, truth, iterations, count, children, parents))
+        return self._outcome(children, parents, truth, iterations, *_measure(
+            self._entropy, round_index, first, marks, truth, iterations, count))
 
-    def _outcome(self, children: np.ndarray, parents: np.ndarray, iterations: int, indices: np.ndarray,
-                 verified: np.ndarray, added: np.ndarray, reachable: int, good: int, added_children: np.ndarray,
-                 added_parents: np.ndarray) -> ClosedFormOutcome:
+    def _outcome(self, children: np.ndarray, parents: np.ndarray, truth: np.ndarray, iterations: int,
+                 indices: np.ndarray, added: np.ndarray, reachable: int, good: int) -> ClosedFormOutcome:
         """The ``ClosedFormOutcome`` of a database's measured ``indices`` and what ``_verify`` made
         of them (``_measure`` returns the indices and those, in this order)."""
-        return ClosedFormOutcome(self.size, reachable, iterations, indices, verified, added, children, parents,
-                                 self._missed(iterations), good, added_children, added_parents)
+        return ClosedFormOutcome(self.size, reachable, iterations, indices, truth, added, children, parents,
+                                 self._missed(iterations), good)
 
     def _missed(self, iterations: int) -> SearchOutcome:
         """The (frozen, shareable) outcome of a worker whose measurement did not verify."""
