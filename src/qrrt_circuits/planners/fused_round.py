@@ -300,11 +300,18 @@ class FusedRound:
         workers = groups[0][1]
         if len(groups) > 1 and any(count != workers for _, count in groups):
             raise ValueError("FusedRound.search needs groups of one size")
-        built = [self._database(tree, round_index, first) for first, _ in groups]
         if policy_state is not self._flags_of:  # (constant for a state: its class's methods decide them)
             self._flags = policy_state.searches_by_default(), policy_state.reads_problem()
             self._flags_of = policy_state
         by_default, reads_problem = self._flags
+        if len(groups) == 1 and by_default and not reads_problem and self.closed_form:
+            # one database drawn in closed form (q-RRT, shared Pq-RRT): the steps below, without their lists
+            first = groups[0][0]
+            children, parents, truth, marks = self._database(tree, round_index, first)
+            k = _iterations(policy_state.iterations_by_size(tree_nodes))
+            self._check_memory(k, workers)
+            return [self._measured(children, parents, marks, truth, round_index, first, workers, k)]
+        built = [self._database(tree, round_index, first) for first, _ in groups]
         if by_default and not reads_problem:  # k from N and the tree: no DatabaseSearch needed
             iterations = [_iterations(policy_state.iterations_by_size(tree_nodes)) for _ in groups]
         else:
@@ -354,8 +361,9 @@ class FusedRound:
                   round_index: int, first: int, count: int, iterations: int) -> ClosedFormOutcome:
         """The outcome of the default ``PolicyState.run`` at k = ``iterations`` for ``count``
         workers (``policies._verified`` of the backend's ``search``), compiled."""
-        return self._outcome(children, parents, truth, iterations, *_measure(
-            self._entropy, round_index, first, marks, truth, iterations, count))
+        indices, added, reachable, good = _measure(self._entropy, round_index, first, marks, truth, iterations, count)
+        return ClosedFormOutcome(self.size, reachable, iterations, indices, truth, added, children, parents,
+                                 self._missed(iterations), good)
 
     def _outcome(self, children: np.ndarray, parents: np.ndarray, truth: np.ndarray, iterations: int,
                  indices: np.ndarray, added: np.ndarray, reachable: int, good: int) -> ClosedFormOutcome:
