@@ -283,10 +283,10 @@ class PQRRT(Planner):
 
     def _round(self, state: RunState) -> None:
         groups = self._worker_groups()
+        policy_state = state.search_policy_state
         results: Sequence[DatabaseResult]
         if state.fused_round is not None:  # compiled calls around the predicate, the same outcomes
-            results = state.fused_round.search(state.tree, state.rounds, groups, state.search_policy_state,
-                                               state.nodes)
+            results = state.fused_round.search(state.tree, state.rounds, groups, policy_state, state.tree.size - 1)
         else:
             view = self._view(state, self._temperature_index(state))
             if self.executor is None:  # the round's searches go to the backend together (same outcomes)
@@ -296,8 +296,8 @@ class PQRRT(Planner):
         longest = 0
         for result in results:
             longest = max(longest, self._integrate(state, result))
-        if state.search_policy_state.learns():  # (skips building the outcomes when nothing learns)
-            state.search_policy_state.learn(outcome for result in results for outcome in result.outcomes)
+        if policy_state.learns():  # (skips building the outcomes when nothing learns)
+            policy_state.learn(outcome for result in results for outcome in result.outcomes)
         state.critical_path += longest
 
     @staticmethod

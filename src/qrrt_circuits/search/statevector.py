@@ -202,6 +202,8 @@ def _draw_two_level_seeded(marks: np.ndarray, p_good: float, shots: int, words: 
     draws in the same order (``shots`` doubles, then the marked picks, then the unmarked ranks, each
     an ``integers(0, high)`` draw), so the same indices. Needs N <= 2^32 (32-bit bounded draws)."""
     size = marks.shape[0]
+    if shots <= _SCANNED_SHOTS:
+        return _draw_two_level_scanned(marks, p_good, shots, words)
     marked = np.flatnonzero(marks)
     num_marked = marked.shape[0]
     if num_marked == 0 or num_marked == size:
@@ -223,6 +225,42 @@ def _draw_two_level_seeded(marks: np.ndarray, p_good: float, shots: int, words: 
             if not good[shot]:
                 rank = _bounded_below(state, size - num_marked)
                 out[shot] = rank + np.searchsorted(shifted, rank, side="right")
+    return out
+
+
+#: at most this many shots, ``_draw_two_level_seeded`` finds each drawn entry by a scan of the marks
+#: instead of building the lists of marked and unmarked entries (a planner's round: 1 to 8 workers)
+_SCANNED_SHOTS = 8
+
+
+@njit(cache=True, nogil=True)
+def _draw_two_level_scanned(marks: np.ndarray, p_good: float, shots: int, words: np.ndarray) -> np.ndarray:
+    """``_draw_two_level_seeded`` for a few shots: the same draws in the same order, the j-th marked
+    (or unmarked) entry found by scanning ``marks`` (no index arrays allocated)."""
+    size = marks.shape[0]
+    num_marked = 0
+    for entry in range(size):
+        num_marked += marks[entry]
+    if num_marked == 0 or num_marked == size:
+        p_good = 1.0 if num_marked == size else 0.0
+    state = _pcg_state(words)
+    good = np.empty(shots, dtype=np.bool_)
+    for shot in range(shots):
+        good[shot] = _next_double(state) < p_good
+    out = np.empty(shots, dtype=np.int64)
+    for want_marked in (True, False):  # the marked picks first, then the unmarked ranks (as the lists do)
+        for shot in range(shots):
+            if good[shot] != want_marked:
+                continue
+            rank = _bounded_below(state, num_marked if want_marked else size - num_marked)
+            entry = 0
+            while True:  # the rank-th entry (0-based) whose mark is want_marked
+                if marks[entry] == want_marked:
+                    if rank == 0:
+                        break
+                    rank -= 1
+                entry += 1
+            out[shot] = entry
     return out
 
 
