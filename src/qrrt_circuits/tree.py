@@ -213,7 +213,7 @@ class Tree:
 
     def _build_grid(self) -> None:
         nodes = self.nodes
-        low, high = nodes.min(axis=0), nodes.max(axis=0)
+        low, high = _bounding_box(nodes)  # (nodes.min(axis=0) took 77 us for 3 000 planar nodes)
         extent = np.maximum(high - low, 1e-9)
         cells = min(max(1.0, _CELLS_PER_NODE * self.size), _MAX_CELLS)
         cell = float(np.prod(extent) / cells) ** (1.0 / self.dim)
@@ -229,11 +229,12 @@ class Tree:
             shape = np.minimum(np.floor(extent / cell).astype(np.int64) + 1, 1 << 20)
         start = np.zeros(math.prod(int(count) for count in shape) + 1, dtype=np.int64)
         order = np.empty(self.size, dtype=np.int64)
-        _file_by_cell(nodes, low, cell, shape, start, order)
+        ordered = np.empty_like(nodes)
+        _file_by_cell(nodes, low, cell, shape, start, order, ordered)
         self._origin, self._cell, self._shape = low.copy(), cell, shape
         self._several_cells = math.prod(int(count) for count in shape) > 1  # (read by search_arrays every round)
-        self._low, self._high = low.copy(), high.copy()
-        self._start, self._order, self._sorted = start, order, nodes[order]
+        self._low, self._high = low, high
+        self._start, self._order, self._sorted = start, order, ordered
         self._rebuild_at = self.size + _pending_limit(self.size)
         self._grid_built_at = self.size
 
@@ -257,10 +258,11 @@ def _cell_of(point: np.ndarray, origin: np.ndarray, cell: float, shape: np.ndarr
 
 @njit(cache=True, nogil=True)
 def _file_by_cell(nodes: np.ndarray, origin: np.ndarray, cell: float, shape: np.ndarray, start: np.ndarray,
-                  order: np.ndarray) -> None:
+                  order: np.ndarray, ordered: np.ndarray) -> None:
     """A counting sort of the nodes by cell: ``order`` the node indices by cell (ascending within a
-    cell), ``start[c]`` the position in ``order`` of cell c's first node (``start`` has one entry
-    per cell plus the end, zero on entry)."""
+    cell), ``ordered`` their positions in that order (``nodes[order]``), ``start[c]`` the position
+    in ``order`` of cell c's first node (``start`` has one entry per cell plus the end, zero on
+    entry)."""
     size = nodes.shape[0]
     coordinates = np.empty(shape.shape[0], dtype=np.int64)
     cells = np.empty(size, dtype=np.int64)
@@ -271,8 +273,27 @@ def _file_by_cell(nodes: np.ndarray, origin: np.ndarray, cell: float, shape: np.
         start[flat + 1] += start[flat]
     filled = start[:-1].copy()
     for index in range(size):
-        order[filled[cells[index]]] = index
+        slot = filled[cells[index]]
+        order[slot] = index
+        for axis in range(nodes.shape[1]):
+            ordered[slot, axis] = nodes[index, axis]
         filled[cells[index]] += 1
+
+
+@njit(cache=True, nogil=True)
+def _bounding_box(nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The smallest and largest coordinate of the (M >= 1, d) ``nodes`` along each axis (what
+    ``nodes.min(axis=0)`` and ``nodes.max(axis=0)`` give, for finite coordinates) in one pass."""
+    low = nodes[0].copy()
+    high = nodes[0].copy()
+    for axis in range(nodes.shape[1]):
+        smallest = largest = nodes[0, axis]
+        for index in range(1, nodes.shape[0]):
+            value = nodes[index, axis]
+            smallest = value if value < smallest else smallest
+            largest = value if value > largest else largest
+        low[axis], high[axis] = smallest, largest
+    return low, high
 
 
 @njit(cache=True, nogil=True)
