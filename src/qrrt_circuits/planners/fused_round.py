@@ -196,7 +196,7 @@ class ClosedFormOutcome(NamedTuple):
     @property
     def added_children(self) -> np.ndarray:
         """The added entries' child positions, ``children[added]`` (count, d)."""
-        return self.children[self.added]
+        return self.children.take(self.added, axis=0)
 
     @property
     def added_parents(self) -> np.ndarray:
@@ -223,8 +223,9 @@ class ClosedFormOutcome(NamedTuple):
         workers = self.indices.shape[0]
         good = self.verified_count
         added = self.added
-        # (most rounds add nothing: empty slices then, cheaper than indexing by an empty array)
-        children, parents = ((self.children[added], self.parents[added]) if added.shape[0] else
+        # (most q-RRT rounds add nothing: empty slices then, cheaper than indexing by an empty
+        # array; take: 0.28 us where children[added] took 0.93 for 3 of 256 rows)
+        children, parents = ((self.children.take(added, axis=0), self.parents[added]) if added.shape[0] else
                              (self.children[:0], self.parents[:0]))
         return (self.iterations * workers, workers, workers - good, self.iterations + 1 if workers else 0,
                 good - added.shape[0], children, parents)
