@@ -3,7 +3,7 @@ alternating processes (a developer's A/B tool; not run by ``run.py``, which runs
 
     python benchmarks/ab_planner.py --baseline-src OTHER_CHECKOUT/src [--planner qrrt]
                                     [--backend aer] [--pairs 4] [--worlds 6] [--nodes 100]
-                                    [--out FILE]
+                                    [--replay] [--unreachable-goal] [--out FILE]
 
 A machine whose speed drifts over minutes (seen on this project's: 1.5x) makes two benchmark runs
 taken one after the other a poor comparison of two versions of the code. Here each pair is two
@@ -16,6 +16,14 @@ the medians and their ratio (baseline / ours: above 1 means ours is faster) and 
 the pairs' own ratios (less sensitive to a drift between pairs); writes JSON, with the baseline
 checkout's git commit and whether its tree differs from it (``baseline_checkout``), and the same
 for this checkout (``ours_checkout``), and the load average when it started.
+
+``--replay`` times everything but the predicate: each interpreter first plans each world with the
+exact predicate, recording its answers, then plans it again (the same seed, so the same plan) with
+a predicate that hands back the recorded answers, checks that the replayed tree is the recorded
+one, and reports the replayed plans' microseconds per round (``us_per_round_replayed``: a round's
+work outside the oracle, plus one list lookup per predicate call) instead of milliseconds per
+node. ``--unreachable-goal`` plans toward a goal of radius 1e-9, so that the trees grow to
+``--nodes`` (as the "3000 nodes" rows of ``bench_planners.py``).
 """
 
 from __future__ import annotations
@@ -33,27 +41,66 @@ from _common import machine, write_json
 HERE = Path(__file__).resolve().parent
 OURS = HERE.parent / "src"
 
-#: what each interpreter runs (argv: planner, backend, worlds, nodes); prints one JSON line
+#: what each interpreter runs (argv: planner, backend, worlds, nodes, replay, unreachable goal);
+#: prints one JSON line
 CHILD = """
 import json, sys, time
+import numpy as np
 import qrrt_circuits as qc
 from qrrt_circuits.experiments.planners import make_planner
 planner, backend, worlds, nodes = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
+replay, unreachable = sys.argv[5] == "1", sys.argv[6] == "1"
+goal = {"goal_radius": 1e-9} if unreachable else {}
 envs = [qc.scenarios.paper_clutter(seed=seed) for seed in range(worlds)]
 make_planner(planner, envs[0], 0, backend).plan(max_rounds=5)  # compile and warm up
-began, total = time.perf_counter(), 0
-for seed, env in enumerate(envs):
-    total += make_planner(planner, env, seed, backend).plan(max_nodes=nodes).metrics.nodes
-elapsed = time.perf_counter() - began
-print(json.dumps({"ms_per_node": elapsed * 1e3 / max(total, 1), "nodes": total, "module": qc.__file__}))
+
+
+class Recorded:  # the exact predicate of a world, recording its answers (record) or handing them back
+    def __init__(self, env, answers, record):
+        self.exact, self.answers, self.record, self.calls = qc.ReachabilityOracle(env), answers, record, 0
+        self.dim, self.name = self.exact.dim, "recorded"
+
+    def describe(self):
+        return {"name": self.name}
+
+    def reachable(self, parents, children):
+        if self.record:
+            self.answers.append(self.exact.reachable(parents, children).copy())
+            return self.answers[-1]
+        self.calls += 1
+        return self.answers[self.calls - 1]
+
+
+if not replay:
+    began, total = time.perf_counter(), 0
+    for seed, env in enumerate(envs):
+        total += make_planner(planner, env, seed, backend).plan(max_nodes=nodes, **goal).metrics.nodes
+    elapsed = time.perf_counter() - began
+    print(json.dumps({"ms_per_node": elapsed * 1e3 / max(total, 1), "nodes": total, "module": qc.__file__}))
+else:
+    wall = rounds = total = 0
+    for seed, env in enumerate(envs):
+        answers = []
+        recorded = make_planner(planner, env, seed, backend, predicate=Recorded(env, answers, True)).plan(
+            max_nodes=nodes, **goal)
+        replayed = make_planner(planner, env, seed, backend, predicate=Recorded(env, answers, False)).plan(
+            max_nodes=nodes, **goal)
+        if not np.array_equal(replayed.nodes, recorded.nodes):
+            raise RuntimeError(f"world {seed}: the replayed plan is not the recorded one")
+        wall += replayed.metrics.wall_time_s
+        rounds += replayed.metrics.rounds
+        total += replayed.metrics.nodes
+    print(json.dumps({"us_per_round_replayed": wall * 1e6 / max(rounds, 1), "rounds": rounds, "nodes": total,
+                      "module": qc.__file__}))
 """
 
 
-def run_child(src: Path, planner: str, backend: str, worlds: int, nodes: int) -> dict:
+def run_child(src: Path, planner: str, backend: str, worlds: int, nodes: int, replay: bool = False,
+              unreachable_goal: bool = False) -> dict:
     """One interpreter importing ``qrrt_circuits`` from ``src``; its JSON line."""
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(src), os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep))
-    done = subprocess.run([sys.executable, "-c", CHILD, planner, backend, str(worlds), str(nodes)], env=env,
-                          capture_output=True, text=True, check=True)
+    done = subprocess.run([sys.executable, "-c", CHILD, planner, backend, str(worlds), str(nodes), str(int(replay)),
+                           str(int(unreachable_goal))], env=env, capture_output=True, text=True, check=True)
     result = json.loads(done.stdout.strip().splitlines()[-1])
     if not Path(result["module"]).resolve().is_relative_to(src.resolve()):
         raise RuntimeError(f"the child imported {result['module']}, not the code under {src}")
@@ -80,6 +127,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--pairs", type=int, default=4)
     parser.add_argument("--worlds", type=int, default=6)
     parser.add_argument("--nodes", type=int, default=100)
+    parser.add_argument("--replay", action="store_true",
+                        help="time the rounds outside the predicate (its recorded answers replayed)")
+    parser.add_argument("--unreachable-goal", action="store_true", help="goal radius 1e-9: trees grow to --nodes")
     parser.add_argument("--out", default=None)
     args = parser.parse_args(argv)
     baseline = Path(args.baseline_src)
@@ -89,27 +139,30 @@ def main(argv: list[str] | None = None) -> None:
     for name in ("pairs", "worlds", "nodes"):
         if getattr(args, name) < 1:
             parser.error(f"--{name} must be >= 1, got {getattr(args, name)}")
+    key, unit = ("us_per_round_replayed", "us per round outside the predicate") if args.replay else \
+        ("ms_per_node", "ms per node")
     pairs = []
     for pair in range(args.pairs):
         order = ("baseline", "ours") if pair % 2 == 0 else ("ours", "baseline")
         row = {"first": order[0]}
         for side in order:
             row[side] = run_child(baseline if side == "baseline" else OURS, args.planner, args.backend,
-                                  args.worlds, args.nodes)
+                                  args.worlds, args.nodes, args.replay, args.unreachable_goal)
         pairs.append(row)
-        print(f"pair {pair}: baseline {row['baseline']['ms_per_node']:.3f}  ours {row['ours']['ms_per_node']:.3f} "
-              f"ms per node ({order[0]} first)")
-    medians = {side: float(np.median([row[side]["ms_per_node"] for row in pairs])) for side in ("baseline", "ours")}
-    pair_ratio = float(np.median([row["baseline"]["ms_per_node"] / row["ours"]["ms_per_node"] for row in pairs]))
-    print(f"medians: baseline {medians['baseline']:.3f}, ours {medians['ours']:.3f} ms per node; "
+        print(f"pair {pair}: baseline {row['baseline'][key]:.3f}  ours {row['ours'][key]:.3f} {unit} "
+              f"({order[0]} first)")
+    medians = {side: float(np.median([row[side][key] for row in pairs])) for side in ("baseline", "ours")}
+    pair_ratio = float(np.median([row["baseline"][key] / row["ours"][key] for row in pairs]))
+    print(f"medians: baseline {medians['baseline']:.3f}, ours {medians['ours']:.3f} {unit}; "
           f"baseline / ours = {medians['baseline'] / medians['ours']:.2f}; median of the pairs' ratios "
           f"{pair_ratio:.2f}")
     path = write_json(f"ab_{args.planner}_{args.backend}",
                       {"machine": machine(), "load_average_at_start": load_at_start, "baseline_src": str(baseline),
                        "baseline_checkout": checkout_commit(baseline), "ours_src": str(OURS),
                        "ours_checkout": checkout_commit(OURS), "planner": args.planner,
-                       "backend": args.backend, "worlds": args.worlds, "nodes": args.nodes, "pairs": pairs,
-                       "median_ms_per_node": medians,
+                       "backend": args.backend, "worlds": args.worlds, "nodes": args.nodes, "replay": args.replay,
+                       "unreachable_goal": args.unreachable_goal, "figure": key, "pairs": pairs,
+                       f"median_{key}": medians,
                        "baseline_over_ours": medians["baseline"] / medians["ours"],
                        "median_pair_baseline_over_ours": pair_ratio}, args.out)
     print(f"wrote {path}")

@@ -84,7 +84,7 @@ def test_compiled_two_level_draws_equal_the_numpy_ones():
         size = 1 << int(rng.integers(1, 12))
         fraction = float(rng.choice([0.0, 1.0, rng.random(), 1.0 / size]))
         marks = rng.random(size) < fraction
-        shots = int(rng.choice([1, 2, 3, 8, 33]))  # up to 2: the scan of the marks; then the lists
+        shots = int(rng.choice([1, 2, 3, 8, 33]))  # 1: the scan of the marks; more: the lists
         seed = int(rng.integers(0, 2**62))
         p_good = good_probability(size, int(marks.sum()), int(rng.integers(0, 6)))
         expected = _draw_two_level(marks, p_good, shots, np.random.default_rng(seed))

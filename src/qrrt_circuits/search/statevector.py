@@ -231,9 +231,10 @@ def _draw_two_level_seeded(marks: np.ndarray, p_good: float, shots: int, words: 
 #: at most this many shots, ``_draw_two_level_seeded`` finds each drawn entry by a scan of the marks
 #: instead of building the lists of marked and unmarked entries (one pass to count and on average
 #: half a pass per shot, against about three passes for the lists): with a fifth of the entries
-#: marked, one shot took 0.91 against 1.07 us at N = 256 and 4.5 against 35 us at N = 65 536, eight
-#: shots 1.31 against 1.12 us at N = 256 and 103 against 35 us at N = 65 536 (q-RRT draws one shot)
-_SCANNED_SHOTS = 2
+#: marked, one shot took 0.91 against 1.06 us at N = 256 and 4.6 against 35 us at N = 65 536; two
+#: shots were faster up to N = 2 048 only (4.4 against 3.3 us at 4 096) and eight slower from N =
+#: 256 (103 against 35 us at 65 536). q-RRT draws one shot a round.
+_SCANNED_SHOTS = 1
 
 
 @njit(cache=True, nogil=True)
