@@ -19,11 +19,12 @@ for this checkout (``ours_checkout``), and the load average when it started.
 
 ``--replay`` times everything but the predicate: each interpreter first plans each world with the
 exact predicate, recording its answers, then plans it again (the same seed, so the same plan) with
-a predicate that hands back the recorded answers, checks that the replayed tree is the recorded
-one, and reports the replayed plans' microseconds per round (``us_per_round_replayed``: a round's
-work outside the oracle, plus one list lookup per predicate call) instead of milliseconds per
-node. ``--unreachable-goal`` plans toward a goal of radius 1e-9, so that the trees grow to
-``--nodes`` (as the "3000 nodes" rows of ``bench_planners.py``).
+a predicate that hands back the recorded answers, checks that the replayed plan is the recorded
+one (its nodes, parents and oracle calls, every answer used), and reports the replayed plans'
+microseconds per round (``us_per_round_replayed``: a round's work outside the oracle, plus one
+list lookup per predicate call) instead of milliseconds per node. ``--unreachable-goal`` plans
+toward a goal of radius 1e-9, so that a plan ends at ``--nodes`` or at the default round limit
+(as the "3000 nodes" rows of ``bench_planners.py``).
 """
 
 from __future__ import annotations
@@ -83,9 +84,11 @@ else:
         answers = []
         recorded = make_planner(planner, env, seed, backend, predicate=Recorded(env, answers, True)).plan(
             max_nodes=nodes, **goal)
-        replayed = make_planner(planner, env, seed, backend, predicate=Recorded(env, answers, False)).plan(
-            max_nodes=nodes, **goal)
-        if not np.array_equal(replayed.nodes, recorded.nodes):
+        replayer = Recorded(env, answers, False)
+        replayed = make_planner(planner, env, seed, backend, predicate=replayer).plan(max_nodes=nodes, **goal)
+        same = (np.array_equal(replayed.nodes, recorded.nodes) and np.array_equal(replayed.parents, recorded.parents)
+                and replayed.metrics.oracle_calls == recorded.metrics.oracle_calls)
+        if not same or replayer.calls != len(answers):
             raise RuntimeError(f"world {seed}: the replayed plan is not the recorded one")
         wall += replayed.metrics.wall_time_s
         rounds += replayed.metrics.rounds
@@ -129,7 +132,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--nodes", type=int, default=100)
     parser.add_argument("--replay", action="store_true",
                         help="time the rounds outside the predicate (its recorded answers replayed)")
-    parser.add_argument("--unreachable-goal", action="store_true", help="goal radius 1e-9: trees grow to --nodes")
+    parser.add_argument("--unreachable-goal", action="store_true",
+                        help="goal radius 1e-9: a plan ends at --nodes or the default round limit")
     parser.add_argument("--out", default=None)
     args = parser.parse_args(argv)
     baseline = Path(args.baseline_src)

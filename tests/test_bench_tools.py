@@ -134,7 +134,7 @@ def test_the_gpu_benchmark_without_a_gpu_says_why_and_is_recorded_as_skipped(tmp
 def test_ab_planner_replay_times_a_replayed_plan_equal_to_the_recorded_one():
     """``--replay``: the child plans with the exact predicate recording its answers, replays them
     (its tree checked equal to the recorded one, else it raises) and reports microseconds per round;
-    an unreachable goal grows the tree to the node limit."""
+    with an unreachable goal this short plan ends at its node limit."""
     source = Path(ab_planner.__file__).resolve().parent.parent / "src"
     result = ab_planner.run_child(source, "qrrt", "statevector", 1, 25, replay=True, unreachable_goal=True)
     assert result["nodes"] == 25 and result["rounds"] >= 25

@@ -89,3 +89,18 @@ def test_compiled_two_level_draws_equal_the_numpy_ones():
         p_good = good_probability(size, int(marks.sum()), int(rng.integers(0, 6)))
         expected = _draw_two_level(marks, p_good, shots, np.random.default_rng(seed))
         assert np.array_equal(_draw_two_level_seeded(marks, p_good, shots, integer_seed_words(seed)), expected)
+
+
+def test_the_scan_of_the_marks_draws_what_numpy_draws_at_any_shot_count():
+    """``_draw_two_level_scanned`` (what one shot takes) is written for any shot count: the same
+    indices as numpy's ``_draw_two_level`` at 1 to 9 shots, none marked and all marked included."""
+    from qrrt_circuits.randomness import integer_seed_words
+    from qrrt_circuits.search.statevector import _draw_two_level, _draw_two_level_scanned
+
+    rng = np.random.default_rng(12)
+    for case in range(300):
+        size = 1 << int(rng.integers(1, 11))
+        marks = rng.random(size) < float(rng.choice([0.0, 1.0, rng.random()]))
+        shots, seed, p_good = int(rng.integers(1, 10)), int(rng.integers(0, 2**62)), float(rng.random())
+        expected = _draw_two_level(marks, p_good, shots, np.random.default_rng(seed))
+        assert np.array_equal(_draw_two_level_scanned(marks, p_good, shots, integer_seed_words(seed)), expected), case

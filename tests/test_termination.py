@@ -505,3 +505,67 @@ def test_skipped_checks_end_a_plan_where_checking_every_round_does(planner_name,
         assert all(np.array_equal(fast.history[key], every.history[key]) for key in every.history)
         statuses.add(str(fast.status))
     assert statuses >= {"max_nodes", "max_rounds", "stalled"}
+
+
+@pytest.mark.parametrize("rounds", [0.5, 3.0, True, "2"])
+def test_a_users_rounds_before_end_that_is_not_a_count_is_refused(rounds, clutter):
+    """A float would never count down to the next check (a plan that never checks its limits
+    again): refused at the first check, before the first round, in words."""
+    class Odd(qc.MaxWallTime):
+        def rounds_before_end(self, progress, nodes_per_round):
+            return rounds
+
+    for planner in (qc.RRT(clutter, seed=0), qc.QRRT(clutter, backend=qc.StatevectorBackend(), seed=0)):
+        with pytest.raises(TypeError, match=r"Odd.rounds_before_end\(...\) must be an integer"):
+            planner.plan(termination=qc.MaxRounds(50) | Odd(1e6), goal_radius=1e-9)
+
+
+def test_a_negative_rounds_before_end_is_refused_alone_and_as_a_part():
+    from qrrt_circuits.termination import rounds_unchecked
+
+    class Negative(qc.MaxWallTime):
+        def rounds_before_end(self, progress, nodes_per_round):
+            return -1
+
+    for condition in (Negative(1e6), qc.MaxRounds(50) | Negative(1e6)):
+        with pytest.raises(ValueError, match=r"Negative.rounds_before_end\(...\) must be an integer >= 0, got -1"):
+            rounds_unchecked(condition, progress(), 1)
+    assert rounds_unchecked(qc.MaxRounds(50) | qc.MaxNodes(90), progress(nodes=9), 4) == 20
+    assert rounds_unchecked(qc.MaxRounds(50) | qc.MaxWallTime(9.0), progress(), 4) == 0
+
+
+def test_an_anyof_subclass_with_its_own_test_is_checked_every_round(clutter):
+    class Cancelled(qc.AnyOf):  # a user's composite that also ends the plan at round 7
+        def ended_by(self, progress):
+            return qc.PlanStatus.MAX_TIME if progress.rounds >= 7 else super().ended_by(progress)
+
+    condition = Cancelled((qc.MaxNodes(500), qc.MaxRounds(1000), qc.Stall(300)))
+    assert condition.rounds_before_end(progress(rounds=1), 1) == 0
+    result = qc.RRT(clutter, seed=0).plan(termination=condition, goal_radius=1e-9)
+    assert result.status == qc.PlanStatus.MAX_TIME and result.metrics.rounds == 7
+    nested = qc.RRT(clutter, seed=0).plan(termination=Cancelled((qc.MaxNodes(500),)), goal_radius=1e-9)
+    assert nested.status == qc.PlanStatus.MAX_TIME and nested.metrics.rounds == 7  # kept when the defaults are added
+
+
+def test_rounds_that_add_more_nodes_than_the_planners_bound_bring_the_next_check_forward(clutter):
+    """A user's policy state that hands back two verified outcomes per worker (against the
+    contract) adds two nodes a round: the node limit still ends the plan where checking every
+    round ends it."""
+    from qrrt_circuits.search.policies import FixedIterations, PolicyState
+    from qrrt_circuits.search.problem import SearchOutcome
+
+    class Greedy(FixedIterations):
+        def start(self, num_items):
+            return GreedyState(self, num_items)
+
+    class GreedyState(PolicyState):
+        def run(self, problem, workers, tree_nodes):
+            found = [index for index in range(256) if problem.verify(index)][:2 * workers]
+            return tuple(SearchOutcome(index, 0, 1, ((0, True),)) for index in found)
+
+    ends = []
+    for condition in (qc.MaxNodes(40), _EveryRound(qc.MaxNodes(40))):
+        planner = qc.QRRT(clutter, backend=qc.StatevectorBackend(), search_policy=Greedy(0), seed=1)
+        result = planner.plan(termination=condition, goal_radius=1e-9)
+        ends.append((str(result.status), result.metrics.rounds, result.metrics.nodes))
+    assert ends[0] == ends[1] and ends[0][0] == "max_nodes" and ends[0][2] == 40

@@ -21,8 +21,8 @@ outgrows memory (``memory.check_plan_fits`` checks the limits in force before th
 from __future__ import annotations
 
 import abc
-import functools
 import math
+import weakref
 from collections.abc import Iterable
 from dataclasses import dataclass
 from enum import StrEnum
@@ -210,14 +210,34 @@ class _Limit(TerminationCondition):
         return {str(self.status): self.limit}
 
 
-@functools.cache
+#: ``_headroom_holds`` per class, held weakly (a user's class may go away)
+_HEADROOM_HOLDS: weakref.WeakKeyDictionary[type, bool] = weakref.WeakKeyDictionary()
+
+
 def _headroom_holds(kind: type[_Limit]) -> bool:
     """Whether ``kind``'s ``_headroom`` was written for its test: its ``ended_by`` is ``_Limit``'s
-    and its ``_value`` comes from the class that defines its ``_headroom``."""
-    def owner(name: str) -> type:
-        return next(cls for cls in kind.__mro__ if name in cls.__dict__)
+    and its ``_value`` comes from the class that defines its ``_headroom`` (read once per class)."""
+    holds = _HEADROOM_HOLDS.get(kind)
+    if holds is None:
+        def owner(name: str) -> type:
+            return next(cls for cls in kind.__mro__ if name in cls.__dict__)
 
-    return kind.ended_by is _Limit.ended_by and owner("_value") is owner("_headroom")
+        holds = _HEADROOM_HOLDS[kind] = kind.ended_by is _Limit.ended_by and owner("_value") is owner("_headroom")
+    return holds
+
+
+def rounds_unchecked(condition: TerminationCondition, progress: Progress, nodes_per_round: int) -> int:
+    """``condition.rounds_before_end(progress, nodes_per_round)``, checked: the rounds a planner
+    may run before it checks ``condition`` again (``Planner._run``).
+
+    Raises:
+        TypeError: A value that is not an integer (a user's condition returned a float, say).
+        ValueError: A negative value.
+    """
+    rounds = condition.rounds_before_end(progress, nodes_per_round)
+    if type(rounds) is int and rounds >= 0:
+        return rounds
+    return check_int(rounds, f"{type(condition).__name__}.rounds_before_end(...)", 0)
 
 
 @dataclass(frozen=True)
@@ -405,8 +425,9 @@ class AnyOf(TerminationCondition):
     """Ends the plan when any of ``conditions`` does; the first one (in order) names the status.
 
     What ``a | b`` builds (OMPL's ``plannerOrTerminationCondition``). Nested ``AnyOf`` are
-    flattened; ``describe`` merges the parts' settings; ``limits_rounds`` and ``detects_stall`` hold
-    if they hold for any part.
+    flattened (a subclass of ``AnyOf`` stays one part: it may have a test of its own);
+    ``describe`` merges the parts' settings; ``limits_rounds`` and ``detects_stall`` hold if they
+    hold for any part.
 
     Args:
         conditions: The ``TerminationCondition`` objects, at least one.
@@ -428,7 +449,8 @@ class AnyOf(TerminationCondition):
         for condition in self.conditions:
             if not isinstance(condition, TerminationCondition):
                 raise TypeError(f"AnyOf takes TerminationCondition objects, got {type(condition).__name__}")
-            flat.extend(condition.conditions if isinstance(condition, AnyOf) else (condition,))
+            # (an AnyOf subclass stays a part: it may have a test of its own)
+            flat.extend(condition.conditions if type(condition) is AnyOf else (condition,))
         if not flat:
             raise ValueError("AnyOf needs at least one condition")
         object.__setattr__(self, "conditions", tuple(flat))
@@ -441,11 +463,14 @@ class AnyOf(TerminationCondition):
         return None
 
     def rounds_before_end(self, progress: Progress, nodes_per_round: int) -> int:
-        """The fewest of the parts' (none may end the plan before its own)."""
+        """The fewest of the parts' (none may end the plan before its own); 0 for a subclass that
+        redefines ``ended_by``."""
+        if type(self).ended_by is not AnyOf.ended_by:
+            return 0
         fewest = None
         for condition in self.conditions:
-            rounds = condition.rounds_before_end(progress, nodes_per_round)
-            if rounds <= 0:
+            rounds = rounds_unchecked(condition, progress, nodes_per_round)  # (a part's bad count named)
+            if rounds == 0:
                 return 0
             fewest = rounds if fewest is None else min(fewest, rounds)
         return fewest or 0

@@ -32,7 +32,14 @@ from ..oracle import ReachabilityOracle
 from ..oracle_errors import OracleErrorModel
 from ..predicate import ReachabilityPredicate, can_leave, check_predicate
 from ..randomness import RandomStreams, Stream
-from ..termination import PlanStatus, TerminationCondition, from_budgets, limits_in_force, with_defaults
+from ..termination import (
+    PlanStatus,
+    TerminationCondition,
+    from_budgets,
+    limits_in_force,
+    rounds_unchecked,
+    with_defaults,
+)
 from ..validation import check_float, check_instance, check_int, check_real_array, check_seed
 from .context import RoundView, WorkerContext
 from .result import Metrics, PlanResult
@@ -217,20 +224,25 @@ class Planner:
     def _run(self, state: RunState, condition: TerminationCondition, began: float) -> PlanStatus:
         """The round loop: check the condition, run a round, record it; until the goal or the end.
         After a check that did not end the plan, the next ``condition.rounds_before_end`` checks
-        are skipped (they cannot end it: the plan ends where checking before every round would).
+        are skipped (they cannot end it: the plan ends where checking before every round would),
+        as long as no round adds more than ``_max_new_nodes_per_round`` nodes (a round that did,
+        a user's policy or planner breaking the bound, brings the next check forward).
         Subclasses may run several rounds' work at once if every round's outcome, counters and
         termination check stay exactly those of this loop."""
         per_round = self._max_new_nodes_per_round()
         unchecked = 0  # rounds that may still run before the next check
+        size_cap = 0  # the most nodes the tree may hold before the next round while checks are skipped
         while state.goal_node is None:
-            if unchecked:
+            if unchecked and state.tree.size <= size_cap:
                 unchecked -= 1
             else:
                 progress = state.progress(time.perf_counter() - began)
                 ended = condition.ended_by(progress)
                 if ended is not None:
                     return ended
-                unchecked = condition.rounds_before_end(progress, per_round)
+                unchecked = rounds_unchecked(condition, progress, per_round)
+                size_cap = state.tree.size
+            size_cap += per_round
             self._round(state)
             state.end_round()
         return PlanStatus.REACHED

@@ -39,7 +39,7 @@ from ..environment import Environment
 from ..oracle_errors import OracleErrorModel
 from ..predicate import ReachabilityPredicate, check_answers
 from ..randomness import Stream, uniform_draws
-from ..termination import PlanStatus, TerminationCondition
+from ..termination import PlanStatus, TerminationCondition, rounds_unchecked
 from ..validation import check_int
 from .base import Planner
 from .context import map_tasks
@@ -186,7 +186,7 @@ class ParallelRRT(Planner):
         workers = self.workers
         changed = recorded = 0
         most = batch_round_limit(workers, self.env.dim)
-        unchecked = 0  # rounds that may still run before the next check (as ``Planner._run``)
+        unchecked = size_cap = 0  # rounds that may still run before the next check (as ``Planner._run``)
         while state.goal_node is None:
             ahead = min(batch_rounds(changed, recorded), most)
             first = state.rounds
@@ -199,7 +199,7 @@ class ParallelRRT(Planner):
             truth = check_answers(self.predicate.reachable(state.tree.nodes[parents], children), children.shape[0],
                                   f"the predicate {self.predicate.name!r}")
             for offset in range(ahead):
-                if unchecked:
+                if unchecked and state.tree.size <= size_cap:
                     unchecked -= 1
                 else:
                     progress = state.progress(time.perf_counter() - began)
@@ -207,7 +207,9 @@ class ParallelRRT(Planner):
                     if ended is not None:
                         state.wasted_checks += (ahead - offset) * workers
                         return ended
-                    unchecked = condition.rounds_before_end(progress, workers)
+                    unchecked = rounds_unchecked(condition, progress, workers)
+                    size_cap = state.tree.size
+                size_cap += workers
                 nodes_before = state.nodes
                 rows = slice(offset * workers, (offset + 1) * workers)
                 self._record(state, first + offset, children[rows], parents[rows], truth[rows])

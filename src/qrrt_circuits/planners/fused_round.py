@@ -81,8 +81,9 @@ def _candidates(run_entropy: np.ndarray, round_index: int, worker: int, size: in
     generator of (``round_index``, ``worker``, ``Stream.CANDIDATES``) (row-major, as
     ``uniform_draws(...).reshape(size, d)``), the parents their nearest nodes (``nearest_into``: the
     kernels of ``Tree.nearest``), the positions the parents'. The caller allocates the three
-    arrays: each array a compiled call returns costs about 0.35 us to hand to Python (numba
-    unpickles its dtype), an ``np.empty`` there about 0.13 us.
+    arrays: a compiled call that returns three arrays of these shapes took 1.36 us, the same call
+    writing into three made by ``np.empty`` 0.94 us (numba builds each array it hands to Python,
+    unpickling its dtype; ``benchmarks/bench_round_parts.py``).
     """
     state = _pcg_state(_seed_words(run_entropy, _key(round_index, worker, _CANDIDATES))[0])
     dim = low.shape[0]
@@ -107,10 +108,10 @@ def _measure(run_entropy: np.ndarray, round_index: int, worker: int, marks: np.n
     ``RandomStreams.seed(round_index, worker, Stream.SEARCH)`` (``randomness._stream_seed``), the
     draw ``_draw_two_level_seeded`` with that seed's ``integer_seed_words``
     (``randomness._small_seed_words``, the seed being below 2^62): the same functions the generic
-    round calls; the indices are verified by ``_verify``. Two arrays come back (each array a
-    compiled call returns costs about 0.35 us to hand to Python): the workers' verifications and the
-    added entries' positions are read from ``truth``, ``children`` and ``parents`` where needed
-    (``ClosedFormOutcome``).
+    round calls; the indices are verified by ``_verify``. Two arrays come back, not five (each array
+    a compiled call returns costs time to hand to Python, see ``_candidates``): the workers'
+    verifications and the added entries' positions are read from ``truth``, ``children`` and
+    ``parents`` where needed (``ClosedFormOutcome``).
 
     Returns:
         (indices (shots,), then what ``_verify`` returns for them).
@@ -224,7 +225,7 @@ class ClosedFormOutcome(NamedTuple):
         good = self.verified_count
         added = self.added
         # (most q-RRT rounds add nothing: empty slices then, cheaper than indexing by an empty
-        # array; take: 0.28 us where children[added] took 0.93 for 3 of 256 rows)
+        # array; take: 0.27 us where children[added] took 0.96 for 3 of 256 rows, bench_round_parts.py)
         children, parents = ((self.children.take(added, axis=0), self.parents[added]) if added.shape[0] else
                              (self.children[:0], self.parents[:0]))
         return (self.iterations * workers, workers, workers - good, self.iterations + 1 if workers else 0,

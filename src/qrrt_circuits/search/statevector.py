@@ -201,9 +201,16 @@ def _draw_two_level_seeded(marks: np.ndarray, p_good: float, shots: int, words: 
     """``_draw_two_level(marks, p_good, shots, Generator(PCG64(words)))``, compiled: the same
     draws in the same order (``shots`` doubles, then the marked picks, then the unmarked ranks, each
     an ``integers(0, high)`` draw), so the same indices. Needs N <= 2^32 (32-bit bounded draws)."""
-    size = marks.shape[0]
     if shots <= _SCANNED_SHOTS:
         return _draw_two_level_scanned(marks, p_good, shots, words)
+    return _draw_two_level_listed(marks, p_good, shots, words)
+
+
+@njit(cache=True, nogil=True)
+def _draw_two_level_listed(marks: np.ndarray, p_good: float, shots: int, words: np.ndarray) -> np.ndarray:
+    """``_draw_two_level_seeded`` through the lists of marked and unmarked entries (what more
+    than ``_SCANNED_SHOTS`` shots take)."""
+    size = marks.shape[0]
     marked = np.flatnonzero(marks)
     num_marked = marked.shape[0]
     if num_marked == 0 or num_marked == size:
@@ -229,11 +236,10 @@ def _draw_two_level_seeded(marks: np.ndarray, p_good: float, shots: int, words: 
 
 
 #: at most this many shots, ``_draw_two_level_seeded`` finds each drawn entry by a scan of the marks
-#: instead of building the lists of marked and unmarked entries (one pass to count and on average
-#: half a pass per shot, against about three passes for the lists): with a fifth of the entries
-#: marked, one shot took 0.91 against 1.06 us at N = 256 and 4.6 against 35 us at N = 65 536; two
-#: shots were faster up to N = 2 048 only (4.4 against 3.3 us at 4 096) and eight slower from N =
-#: 256 (103 against 35 us at 65 536). q-RRT draws one shot a round.
+#: (``_draw_two_level_scanned``: one pass to count and on average half a pass per shot) instead of
+#: building the lists of marked and unmarked entries (``_draw_two_level_listed``: about three
+#: passes). One shot, what q-RRT draws a round, is faster by the scan at every N measured (2^8 to
+#: 2^16), two about even, eight slower (``python benchmarks/bench_round_parts.py``).
 _SCANNED_SHOTS = 1
 
 
