@@ -37,13 +37,12 @@ from ..termination import (
     TerminationCondition,
     from_budgets,
     limits_in_force,
-    rounds_unchecked,
     with_defaults,
 )
 from ..validation import check_float, check_instance, check_int, check_real_array, check_seed
 from .context import RoundView, WorkerContext
 from .result import Metrics, PlanResult
-from .run_state import RunState, first_in_ball
+from .run_state import RunState, TerminationChecks, first_in_ball
 
 if TYPE_CHECKING:
     from ..search.policies import PolicyState
@@ -223,26 +222,15 @@ class Planner:
 
     def _run(self, state: RunState, condition: TerminationCondition, began: float) -> PlanStatus:
         """The round loop: check the condition, run a round, record it; until the goal or the end.
-        After a check that did not end the plan, the next ``condition.rounds_before_end`` checks
-        are skipped (they cannot end it: the plan ends where checking before every round would),
-        as long as no round adds more than ``_max_new_nodes_per_round`` nodes (a round that did,
-        a user's policy or planner breaking the bound, brings the next check forward).
+        The checks that cannot end the plan are skipped (``run_state.TerminationChecks``: the plan
+        ends where checking before every round would).
         Subclasses may run several rounds' work at once if every round's outcome, counters and
         termination check stay exactly those of this loop."""
-        per_round = self._max_new_nodes_per_round()
-        unchecked = 0  # rounds that may still run before the next check
-        size_cap = 0  # the most nodes the tree may hold before the next round while checks are skipped
+        checks = TerminationChecks(condition, self._max_new_nodes_per_round(), began)
         while state.goal_node is None:
-            if unchecked and state.tree.size <= size_cap:
-                unchecked -= 1
-            else:
-                progress = state.progress(time.perf_counter() - began)
-                ended = condition.ended_by(progress)
-                if ended is not None:
-                    return ended
-                unchecked = rounds_unchecked(condition, progress, per_round)
-                size_cap = state.tree.size
-            size_cap += per_round
+            ended = checks.ended_by(state)
+            if ended is not None:
+                return ended
             self._round(state)
             state.end_round()
         return PlanStatus.REACHED

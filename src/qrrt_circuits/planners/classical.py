@@ -28,7 +28,6 @@ planners keep one task per worker per round.
 from __future__ import annotations
 
 import math
-import time
 from concurrent.futures import Executor
 
 import numpy as np
@@ -39,11 +38,11 @@ from ..environment import Environment
 from ..oracle_errors import OracleErrorModel
 from ..predicate import ReachabilityPredicate, check_answers
 from ..randomness import Stream, uniform_draws
-from ..termination import PlanStatus, TerminationCondition, rounds_unchecked
+from ..termination import PlanStatus, TerminationCondition
 from ..validation import check_int
 from .base import Planner
 from .context import map_tasks
-from .run_state import RunState
+from .run_state import RunState, TerminationChecks
 from .workers import classical_extension
 
 MAX_WORKERS = 4096
@@ -186,7 +185,7 @@ class ParallelRRT(Planner):
         workers = self.workers
         changed = recorded = 0
         most = batch_round_limit(workers, self.env.dim)
-        unchecked = size_cap = 0  # rounds that may still run before the next check (as ``Planner._run``)
+        checks = TerminationChecks(condition, workers, began)  # (as ``Planner._run``)
         while state.goal_node is None:
             ahead = min(batch_rounds(changed, recorded), most)
             first = state.rounds
@@ -199,17 +198,10 @@ class ParallelRRT(Planner):
             truth = check_answers(self.predicate.reachable(state.tree.nodes[parents], children), children.shape[0],
                                   f"the predicate {self.predicate.name!r}")
             for offset in range(ahead):
-                if unchecked and state.tree.size <= size_cap:
-                    unchecked -= 1
-                else:
-                    progress = state.progress(time.perf_counter() - began)
-                    ended = condition.ended_by(progress)
-                    if ended is not None:
-                        state.wasted_checks += (ahead - offset) * workers
-                        return ended
-                    unchecked = rounds_unchecked(condition, progress, workers)
-                    size_cap = state.tree.size
-                size_cap += workers
+                ended = checks.ended_by(state)
+                if ended is not None:
+                    state.wasted_checks += (ahead - offset) * workers
+                    return ended
                 nodes_before = state.nodes
                 rows = slice(offset * workers, (offset + 1) * workers)
                 self._record(state, first + offset, children[rows], parents[rows], truth[rows])
