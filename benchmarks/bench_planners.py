@@ -13,13 +13,10 @@ The "3000 nodes" rows grow q-RRT trees to ``--big-nodes`` nodes on the first ``-
 with the goal made unreachable (goal radius 1e-9), so the per-round cost can be compared at 100
 and 3000 nodes. If ``ompl`` is importable (``pip install ".[ompl]"``), OMPL's RRT runs on the same
 worlds with our closed-loop motion check (a Python MotionValidator) right after our RRT, and the
-ratio of their median ms per node is printed. Rows ending in ", generic round" run the quantum
-planner with ``fused_round=False`` (every part of the round a call of its own, as before
-``planners/fused_round.py``), beside the default, in the same run; the round breakdown times the
-parts of both. The ratio targets (q-RRT on Aer over the statevector planner, with its fused
-and its generic round) are also measured interleaved: per world the two planners one right after
-the other (``interleaved``, the two in alternating order), so that a drift of the machine's speed between
-sections does not enter the ratio. Writes JSON.
+ratio of their median ms per node is printed. The round breakdown times the parts of a quantum
+round. The ratio of q-RRT on Aer over the statevector planner is also measured interleaved: per
+world the two planners one right after the other (``interleaved``, the two in alternating order),
+so that a drift of the machine's speed between sections does not enter the ratio. Writes JSON.
 """
 
 from __future__ import annotations
@@ -42,12 +39,9 @@ CONFIGURATIONS = (
     ("RRT", "rrt", None, None),
     ("ParallelRRT (8)", "prrt", None, None),
     ("QRRT statevector", "qrrt", "statevector", "paper"),
-    ("QRRT statevector, generic round", "qrrt", "statevector", "paper"),
     ("QRRT statevector 3000 nodes", "qrrt", "statevector", "paper"),
-    ("QRRT statevector 3000 nodes, generic round", "qrrt", "statevector", "paper"),
     ("QRRT aer", "qrrt", "aer", "paper"),
     ("PQRRT shared statevector", "pqrrt", "statevector", "paper"),
-    ("PQRRT shared statevector, generic round", "pqrrt", "statevector", "paper"),
     ("PQRRT shared aer", "pqrrt", "aer", "paper"),
     ("PQRRT unshared statevector", "pqrrt-unshared", "statevector", "paper"),
     ("QRRT adaptive statevector", "qrrt", "statevector", "adaptive"),
@@ -56,12 +50,9 @@ CONFIGURATIONS = (
 )
 
 
-#: planner options of some configurations: the quantum planners' generic round (``fused_round=False``:
-#: every part of the round a call of its own, as before the fused round) beside the default in one run
-OPTIONS = {label: {"fused_round": False} for label, *_ in CONFIGURATIONS if label.endswith(", generic round")}
 
 #: the configurations grown to --big-nodes nodes with an unreachable goal
-BIG = ("QRRT statevector 3000 nodes", "QRRT statevector 3000 nodes, generic round")
+BIG = ("QRRT statevector 3000 nodes",)
 
 
 class TimedPredicate:
@@ -93,17 +84,13 @@ class TimedPredicate:
 
 class PartTimer:
     """Times the main parts of a quantum planner's round by wrapping, for the duration of a
-    ``with`` block, the functions that do them. Generic rounds: the nearest-node query of the
-    candidates (``Tree.nearest``), the compiled candidate draws (``database.uniform_draws``) and the
-    backend's searches (``QuantumSearchBackend.search_many``, also ``search``). Fused rounds
-    (``planners.fused_round``): the compiled call that draws the candidates and finds their nearest
-    nodes (``fused_candidates``) and the one that draws and verifies the measured indices
-    (``fused_search``). The predicate is timed by ``TimedPredicate``; the rest of the round (the
+    ``with`` block, the functions that do them: the nearest-node query of the candidates
+    (``Tree.nearest``), the candidate draws (``Environment.sample_uniform``) and the backend's
+    searches (``QuantumSearchBackend.search``). The predicate is timed by ``TimedPredicate``; the rest of the round (the
     policy, verification, bookkeeping, the planner's loop) is the plan's wall time minus these."""
 
     def __init__(self) -> None:
-        self.seconds = {"nearest": 0.0, "candidate_draws": 0.0, "search": 0.0, "fused_candidates": 0.0,
-                        "fused_search": 0.0}
+        self.seconds = {"nearest": 0.0, "candidate_draws": 0.0, "search": 0.0}
         self._patched: list[tuple[object, str, object]] = []
 
     def _wrap(self, owner, attribute: str, part: str) -> None:
@@ -121,16 +108,13 @@ class PartTimer:
         setattr(owner, attribute, timed)
 
     def __enter__(self) -> PartTimer:
-        from qrrt_circuits import database
-        from qrrt_circuits.planners import fused_round
+        from qrrt_circuits.environment import Environment
         from qrrt_circuits.search.backend import QuantumSearchBackend
         from qrrt_circuits.tree import Tree
 
         self._wrap(Tree, "nearest", "nearest")
-        self._wrap(database, "uniform_draws", "candidate_draws")
-        self._wrap(QuantumSearchBackend, "search_many", "search")
-        self._wrap(fused_round, "_candidates", "fused_candidates")
-        self._wrap(fused_round, "_measure", "fused_search")
+        self._wrap(Environment, "sample_uniform", "candidate_draws")
+        self._wrap(QuantumSearchBackend, "search", "search")
         return self
 
     def __exit__(self, *exc_info) -> None:
@@ -158,12 +142,10 @@ def breakdown(make, env, seed: int, nodes: int, big: bool) -> dict:
             "share": {k: v / wall for k, v in per_round.items()}}
 
 
-#: configurations whose round is broken down into parts (label, configuration, big, planner options): each
-#: quantum configuration with its default (fused) round and with the generic round, in one run
-BREAKDOWN = tuple((label + suffix, label, big, options)
+#: configurations whose round is broken down into parts (label, configuration, big, planner options)
+BREAKDOWN = tuple((label, label, big, {})
                   for label, big in (("QRRT statevector", False), ("QRRT statevector 3000 nodes", True),
-                                     ("PQRRT shared statevector", False))
-                  for suffix, options in (("", {}), (", generic round", {"fused_round": False})))
+                                     ("PQRRT shared statevector", False)))
 
 
 def configurations(**options):
@@ -175,7 +157,7 @@ def configurations(**options):
         return lambda env, seed, predicate: make_planner(planner, env, seed, backend or "statevector",
                                                          search_policy=policy, predicate=predicate, **extra)
 
-    return {label: factory(planner, backend, policy, {**OPTIONS.get(label, {}), **(options if backend else {})})
+    return {label: factory(planner, backend, policy, options if backend else {})
             for label, planner, backend, policy in CONFIGURATIONS}
 
 
@@ -208,7 +190,7 @@ def run_one(make, env, seed: int, nodes: int, big: bool) -> dict:
 #: statevector planner), each measured world by world with the two planners run one right after
 #: the other (numerator, denominator): a machine whose speed drifts over minutes (seen: the same
 #: planner 1.5x slower from one section of a run to the next) moves both sides alike
-INTERLEAVED = (("QRRT aer", "QRRT statevector"), ("QRRT aer", "QRRT statevector, generic round"))
+INTERLEAVED = (("QRRT aer", "QRRT statevector"),)
 
 
 def interleaved_ratios(worlds: list[qc.Environment], nodes: int) -> dict:
@@ -305,7 +287,7 @@ def main() -> None:
         print("(ompl not importable: OMPL comparison skipped; pip install '.[ompl]')")
     parts = {}
     print(f"\n{'round breakdown, us per round':44s} " + " ".join(f"{k:>15s}" for k in
-          ("predicate", "nearest", "candidate_draws", "search", "fused_candidates", "fused_search", "rest")))
+          ("predicate", "nearest", "candidate_draws", "search", "rest")))
     for name, configuration, big, options in BREAKDOWN:
         make = configurations(**options)[configuration]
         runs = [breakdown(make, env, seed, big_nodes if big else nodes, big)

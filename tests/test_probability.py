@@ -123,17 +123,3 @@ def test_lemma_limits():
 def test_bad_arguments(call, message):
     with pytest.raises(ValueError, match=message):
         call()
-
-
-def test_compiled_good_probability_is_the_same_double():
-    """The fused round's compiled P(G) (Eq. 1) is ``good_probability``'s double for every m of
-    small databases and a spread of m for large ones, k = 0 .. 40: a difference would change which
-    entries a fused round measures. Both square the amplitude as s * s (the C library's pow(s, 2)
-    is not always correctly rounded)."""
-    from qrrt_circuits.probability import compiled_good_probability, good_probability
-
-    pairs = [(1 << n, m) for n in range(1, 11) for m in range((1 << n) + 1)]
-    pairs += [(1 << n, m) for n in (16, 20, 24) for m in range(0, (1 << n) + 1, (1 << n) // 997)]
-    for size, marked in pairs:
-        for k in range(41):
-            assert compiled_good_probability(size, marked, k) == good_probability(size, marked, k), (size, marked, k)

@@ -434,42 +434,8 @@ def test_a_limit_key_keeps_its_finite_number_whatever_a_user_part_describes(valu
         assert qc.AnyOf(parts).describe()["max_nodes"] == 5
 
 
-@pytest.mark.parametrize("per_round", [1, 3, 8])
-@pytest.mark.parametrize("condition, field", [
-    (qc.MaxNodes(40), "nodes"),
-    (qc.MaxRounds(40), "rounds"),
-    (qc.Stall(40), "rounds_without_new_node"),
-])
-def test_rounds_before_end_are_exactly_the_rounds_that_cannot_end_the_plan(condition, field, per_round):
-    """After R = rounds_before_end more rounds, the counter at its fastest (one round, p nodes, one
-    round without a node each) is still below the limit; after R + 1 it can reach it."""
-    grows = per_round if field == "nodes" else 1
-    for value in (0, 1, 17, 38, 39):
-        start = progress(**{field: value})
-        rounds = condition.rounds_before_end(start, per_round)
-        assert rounds >= 0
-        assert condition.ended_by(progress(**{field: value + rounds * grows})) is None
-        assert condition.ended_by(progress(**{field: value + (rounds + 1) * grows})) is not None
-
-
-def test_conditions_on_oracle_calls_time_or_a_redefined_test_are_checked_every_round():
-    class EvenNodes(qc.MaxNodes):  # a user's subclass with its own test
-        def ended_by(self, progress):
-            return qc.PlanStatus.MAX_NODES if progress.nodes % 2 else None
-
-    class Faster(qc.MaxRounds):  # one that redefines the counted value
-        def _value(self, progress):
-            return 2 * progress.rounds
-
-    quiet = progress(nodes=1, rounds=1)
-    for condition in (qc.MaxOracleCalls(10**6), qc.MaxCriticalPathCalls(10**6), qc.MaxWallTime(1e6),
-                      EvenNodes(100), Faster(100), qc.MaxNodes(100) | qc.MaxOracleCalls(10**6)):
-        assert condition.rounds_before_end(quiet, 1) == 0
-    assert (qc.MaxNodes(100) | qc.MaxRounds(50) | qc.Stall(70)).rounds_before_end(quiet, 1) == 48
-
-
 class _EveryRound(qc.TerminationCondition):
-    """A user's condition that wraps another without ``rounds_before_end``: checked every round."""
+    """A user's condition that wraps another."""
 
     def __init__(self, inner):
         self.inner = inner
@@ -490,7 +456,7 @@ class _EveryRound(qc.TerminationCondition):
 
 
 @pytest.mark.parametrize("planner_name", ["rrt", "prrt", "qrrt", "pqrrt", "pqrrt-unshared"])
-def test_skipped_checks_end_a_plan_where_checking_every_round_does(planner_name, clutter):
+def test_a_wrapped_condition_ends_a_plan_where_the_condition_does(planner_name, clutter):
     from qrrt_circuits.experiments.planners import make_planner
 
     statuses = set()
@@ -507,50 +473,21 @@ def test_skipped_checks_end_a_plan_where_checking_every_round_does(planner_name,
     assert statuses >= {"max_nodes", "max_rounds", "stalled"}
 
 
-@pytest.mark.parametrize("rounds", [0.5, 3.0, True, "2"])
-def test_a_users_rounds_before_end_that_is_not_a_count_is_refused(rounds, clutter):
-    """A float would never count down to the next check (a plan that never checks its limits
-    again): refused at the first check, before the first round, in words."""
-    class Odd(qc.MaxWallTime):
-        def rounds_before_end(self, progress, nodes_per_round):
-            return rounds
-
-    for planner in (qc.RRT(clutter, seed=0), qc.QRRT(clutter, backend=qc.StatevectorBackend(), seed=0)):
-        with pytest.raises(TypeError, match=r"Odd.rounds_before_end\(...\) must be an integer"):
-            planner.plan(termination=qc.MaxRounds(50) | Odd(1e6), goal_radius=1e-9)
-
-
-def test_a_negative_rounds_before_end_is_refused_alone_and_as_a_part():
-    from qrrt_circuits.termination import rounds_unchecked
-
-    class Negative(qc.MaxWallTime):
-        def rounds_before_end(self, progress, nodes_per_round):
-            return -1
-
-    for condition in (Negative(1e6), qc.MaxRounds(50) | Negative(1e6)):
-        with pytest.raises(ValueError, match=r"Negative.rounds_before_end\(...\) must be an integer >= 0, got -1"):
-            rounds_unchecked(condition, progress(), 1)
-    assert rounds_unchecked(qc.MaxRounds(50) | qc.MaxNodes(90), progress(nodes=9), 4) == 20
-    assert rounds_unchecked(qc.MaxRounds(50) | qc.MaxWallTime(9.0), progress(), 4) == 0
-
-
 def test_an_anyof_subclass_with_its_own_test_is_checked_every_round(clutter):
     class Cancelled(qc.AnyOf):  # a user's composite that also ends the plan at round 7
         def ended_by(self, progress):
             return qc.PlanStatus.MAX_TIME if progress.rounds >= 7 else super().ended_by(progress)
 
     condition = Cancelled((qc.MaxNodes(500), qc.MaxRounds(1000), qc.Stall(300)))
-    assert condition.rounds_before_end(progress(rounds=1), 1) == 0
     result = qc.RRT(clutter, seed=0).plan(termination=condition, goal_radius=1e-9)
     assert result.status == qc.PlanStatus.MAX_TIME and result.metrics.rounds == 7
     nested = qc.RRT(clutter, seed=0).plan(termination=Cancelled((qc.MaxNodes(500),)), goal_radius=1e-9)
     assert nested.status == qc.PlanStatus.MAX_TIME and nested.metrics.rounds == 7  # kept when the defaults are added
 
 
-def test_rounds_that_add_more_nodes_than_the_planners_bound_bring_the_next_check_forward(clutter):
+def test_rounds_that_add_more_nodes_than_the_planners_bound_end_at_the_node_limit(clutter):
     """A user's policy state that hands back two verified outcomes per worker (against the
-    contract) adds two nodes a round: the node limit still ends the plan where checking every
-    round ends it."""
+    contract) adds two nodes a round: the node limit ends the plan at the first check past it."""
     from qrrt_circuits.search.policies import FixedIterations, PolicyState
     from qrrt_circuits.search.problem import SearchOutcome
 

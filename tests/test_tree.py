@@ -299,7 +299,7 @@ def test_high_dimensional_trees_past_the_switch(dim):
     for point in rng.uniform(0, 20, (450, dim)):
         tree.add(point, 0)
     assert tree.size == 451 and tree._grid_built_at >= 400 and tree._shape.tolist() == [1] * dim
-    assert tree.search_arrays()[2] == 0  # one cell: searched by the (vectorized) brute-force block
+    assert not tree._several_cells  # one cell: searched by the (vectorized) brute-force block
     queries = rng.uniform(0, 20, (64, dim))
     brute = np.argmin(((queries[:, None, :] - tree.nodes[None, :, :]) ** 2).sum(axis=2), axis=1)
     assert np.array_equal(tree.nearest(queries), brute)
@@ -320,10 +320,9 @@ def test_a_six_dimensional_grid_has_cells_once_the_nodes_outnumber_a_query_block
 
 
 def test_a_planar_tree_past_the_switch_is_searched_through_its_grid():
-    """The grid is used (search_arrays reports the nodes it holds) wherever it has several cells:
+    """The grid is used wherever it has several cells:
     a planner's 2-D tree past BRUTE_FORCE_BELOW is not scanned by brute force."""
     rng = np.random.default_rng(2)
     tree = Tree(rng.uniform(0, 20, 2))
     tree.add_many(rng.uniform(0, 20, (999, 2)), np.zeros(999, dtype=np.int64))
-    built = tree.search_arrays()[2]
-    assert built == tree._grid_built_at >= 400 and int(np.prod(tree._shape)) > 1
+    assert tree._several_cells and tree._grid_built_at >= 400 and int(np.prod(tree._shape)) > 1

@@ -10,14 +10,13 @@ from its parent to the sample but is moved to a distance drawn uniformly in the 
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from .environment import Environment
-from .randomness import RandomStreams, Stream, uniform_draws
+from .randomness import RandomStreams, Stream
 from .tree import Tree
 from .validation import check_choice, check_float, check_int
 
@@ -180,9 +179,25 @@ def build_database(
         The ``Database`` of candidates and their nearest parents.
     """
     samples = env.sample_uniform(size, rng)
-    return _finish_database(samples, tree, size, lambda: rng, goal, goal_radius, goal_bias, annealing,
-                            temperature_index)
-
+    if goal_bias > 0 and goal is not None:
+        biased = rng.random(size) < goal_bias
+        count = int(biased.sum())
+        if count:
+            samples[biased] = sample_ball(goal, goal_radius, count, rng)
+    parents = tree.nearest(samples)
+    band = None
+    if annealing is not None:
+        band = annealing.band(temperature_index)
+        origin = tree.nodes[parents]
+        offset = samples - origin
+        norm = np.linalg.norm(offset, axis=1)
+        zero = norm == 0
+        if np.any(zero):  # a sample on its parent: any direction will do
+            offset[zero] = rng.normal(size=(int(zero.sum()), tree.dim))
+            norm[zero] = np.linalg.norm(offset[zero], axis=1)
+        distance = rng.uniform(band[0], band[1], size)
+        samples = origin + offset / norm[:, None] * distance[:, None]
+    return Database(samples, parents, band)
 
 def stream_database(
     tree: Tree,
@@ -197,10 +212,7 @@ def stream_database(
     annealing: AnnealingSchedule | None = None,
     temperature_index: int = 0,
 ) -> Database:
-    """``build_database`` with the generator of (round, worker, ``Stream.CANDIDATES``), without
-    building it unless needed: the uniform samples (``Environment.sample_uniform``: low + (high -
-    low) * u) come from the compiled PCG64 draws; only goal bias or annealing build the generator,
-    advanced past those draws (each double is one 64-bit output). Same database, bit for bit.
+    """``build_database`` with the generator of (round, worker, ``Stream.CANDIDATES``).
 
     Args:
         tree: The ``Tree`` whose nearest nodes become the parents.
@@ -216,49 +228,10 @@ def stream_database(
         temperature_index: Alg. 4's h.
 
     Returns:
-        The ``Database``, identical to ``build_database`` with that generator.
+        The ``Database``.
     """
-    dim = tree.dim
-    key = np.array([[round_index, worker, int(Stream.CANDIDATES)]], dtype=np.int64)
-    low, high = env.bounds[:, 0], env.bounds[:, 1]
-    samples = low + (high - low) * uniform_draws(streams, key, size * dim).reshape(size, dim)
-
-    def generator() -> np.random.Generator:
-        rng = streams.generator(round_index, worker, Stream.CANDIDATES)
-        rng.bit_generator.advance(size * dim)  # type: ignore[attr-defined]  # a PCG64
-        return rng
-
-    return _finish_database(samples, tree, size, generator, goal, goal_radius, goal_bias, annealing,
-                            temperature_index)
-
-
-def _finish_database(samples: np.ndarray, tree: Tree, size: int, generator: Callable[[], np.random.Generator],
-                     goal: np.ndarray | None, goal_radius: float, goal_bias: float,
-                     annealing: AnnealingSchedule | None, temperature_index: int) -> Database:
-    """The rest of Alg. 1 lines 4-8 / Alg. 4 line 7 after the uniform samples; ``generator()``
-    gives the candidates' generator positioned after them (called only if more draws are needed)."""
-    rng: np.random.Generator | None = None
-    if goal_bias > 0 and goal is not None:
-        rng = generator()
-        biased = rng.random(size) < goal_bias
-        count = int(biased.sum())
-        if count:
-            samples[biased] = sample_ball(goal, goal_radius, count, rng)
-    parents = tree.nearest(samples)
-    band = None
-    if annealing is not None:
-        rng = generator() if rng is None else rng
-        band = annealing.band(temperature_index)
-        origin = tree.nodes[parents]
-        offset = samples - origin
-        norm = np.linalg.norm(offset, axis=1)
-        zero = norm == 0
-        if np.any(zero):  # a sample on its parent: any direction will do
-            offset[zero] = rng.normal(size=(int(zero.sum()), tree.dim))
-            norm[zero] = np.linalg.norm(offset[zero], axis=1)
-        distance = rng.uniform(band[0], band[1], size)
-        samples = origin + offset / norm[:, None] * distance[:, None]
-    return Database(samples, parents, band)
+    return build_database(tree, size, env, streams.generator(round_index, worker, Stream.CANDIDATES), goal,
+                          goal_radius, goal_bias, annealing, temperature_index)
 
 
 def sample_ball(centre: np.ndarray, radius: float, count: int, rng: np.random.Generator) -> np.ndarray:

@@ -163,8 +163,8 @@ def _all_finite(points: np.ndarray) -> bool:
 def check_answers(answers: Any, count: int, source: str) -> np.ndarray:
     """A predicate's (or an error model's) answers for ``count`` pairs as a bool array (M,).
 
-    Both quantum rounds (``planners.workers.make_database`` and ``planners.fused_round``) pass
-    every batch of answers through this, so they accept and refuse the same answers.
+    Every planner passes every batch of answers through this, so all accept and refuse the same
+    answers.
 
     Args:
         answers: What ``reachable`` (or ``OracleErrorModel.apply``) returned: any array-like of M

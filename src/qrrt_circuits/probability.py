@@ -10,8 +10,6 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from numba import njit
-
 from .validation import check_int, check_probability
 
 
@@ -54,21 +52,7 @@ def harmonic(k: int) -> float:
 
 def good_probability(num_items: int, num_marked: int, iterations: int) -> float:
     """sin^2((2k+1) theta) with sin^2 theta = m/N, unvalidated (Boyer et al. 1998, Eq. 1 of the
-    paper): the probability that one measurement after k Grover iterations is marked.
-
-    The square is the product s * s (correctly rounded, as the C library's pow(s, 2) is not always),
-    so ``compiled_good_probability`` gives the same double (tested)."""
-    if num_marked == 0:
-        return 0.0
-    theta = math.asin(math.sqrt(num_marked / num_items))
-    amplitude = math.sin((2 * iterations + 1) * theta)
-    return amplitude * amplitude
-
-
-@njit(cache=True, nogil=True)
-def compiled_good_probability(num_items: int, num_marked: int, iterations: int) -> float:
-    """``good_probability`` compiled, for compiled callers (the planners' fused round): the same
-    operations on the same C library's ``asin`` and ``sin``, so the same double (tested)."""
+    paper): the probability that one measurement after k Grover iterations is marked."""
     if num_marked == 0:
         return 0.0
     theta = math.asin(math.sqrt(num_marked / num_items))

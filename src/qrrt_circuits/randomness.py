@@ -246,10 +246,8 @@ class RandomStreams:
                 for words in self.seed_words(keys)]
 
     def seed(self, round_index: int, worker: int, stream: Stream = Stream.SEARCH) -> int:
-        """One integer seed (for a backend call) drawn from that generator: its
-        ``integers(0, 2**62)``, which for this range is the first 64-bit output shifted right by
-        2 (Lemire's bounded method with a power-of-two range never rejects), computed without
-        building the generator (tested against numpy).
+        """One integer seed (for a backend call): ``generator(round_index, worker, stream)``'s
+        first ``integers(0, 2**62)``.
 
         Args:
             round_index: The round (>= 0).
@@ -262,109 +260,12 @@ class RandomStreams:
         Raises:
             ValueError: A negative key.
         """
-        key = (int(round_index), int(worker), int(stream))
-        if min(key) < 0:
-            raise ValueError(f"spawn keys must be non-negative, got {key}")
-        return int(_stream_seed(self._run_entropy, np.array([key], dtype=np.int64)))
-
-
-# PCG64 (numpy's default bit generator, O'Neill 2014: 128-bit LCG, XSL-RR output) for the first
-# few doubles of many generators at once: numpy's pcg64.h, seeded as PCG64(seed_sequence) seeds it
-_PCG_MULT_HIGH = 0x2360ED051FC65DA4
-_PCG_MULT_LOW = 0x4385DF649FCCF645
-
-
-@njit(cache=True, nogil=True)
-def _mul64(a: np.uint64, b: np.uint64) -> tuple[np.uint64, np.uint64]:
-    """The 128-bit product of two uint64 as (high, low)."""
-    mask = np.uint64(0xFFFFFFFF)
-    shift = np.uint64(32)
-    a_lo, a_hi = a & mask, a >> shift
-    b_lo, b_hi = b & mask, b >> shift
-    lo_lo = a_lo * b_lo
-    hi_lo = a_hi * b_lo
-    lo_hi = a_lo * b_hi
-    hi_hi = a_hi * b_hi
-    cross = (lo_lo >> shift) + (hi_lo & mask) + lo_hi
-    return hi_hi + (hi_lo >> shift) + (cross >> shift), (cross << shift) | (lo_lo & mask)
-
-
-@njit(cache=True, nogil=True)
-def _pcg_step(state_hi: np.uint64, state_lo: np.uint64, inc_hi: np.uint64,
-              inc_lo: np.uint64) -> tuple[np.uint64, np.uint64]:
-    """state * MULT + inc (mod 2^128)."""
-    mult_hi, mult_lo = np.uint64(_PCG_MULT_HIGH), np.uint64(_PCG_MULT_LOW)
-    high, low = _mul64(state_lo, mult_lo)
-    high = high + state_hi * mult_lo + state_lo * mult_hi
-    new_lo = low + inc_lo
-    carry = np.uint64(1) if new_lo < low else np.uint64(0)
-    return high + inc_hi + carry, new_lo
-
-
-# The state of one generator is a uint64 array [state_hi, state_lo, inc_hi, inc_lo, has_uint32,
-# uinteger] that mirrors numpy's pcg64_state (``pcg64.h``: the buffered upper half of a 64-bit
-# output serves the next 32-bit draw).
-@njit(cache=True, nogil=True)
-def _pcg_state(words: np.ndarray) -> np.ndarray:
-    """numpy's ``pcg64_set_seed`` from the four seed words: the generator state array."""
-    one = np.uint64(1)
-    state = np.zeros(6, dtype=np.uint64)
-    inc_hi = (words[2] << one) | (words[3] >> np.uint64(63))
-    inc_lo = (words[3] << one) | one
-    state_hi, state_lo = _pcg_step(np.uint64(0), np.uint64(0), inc_hi, inc_lo)
-    state_lo_sum = state_lo + words[1]
-    carry = one if state_lo_sum < state_lo else np.uint64(0)
-    state_hi, state_lo = _pcg_step(state_hi + words[0] + carry, state_lo_sum, inc_hi, inc_lo)
-    state[0], state[1], state[2], state[3] = state_hi, state_lo, inc_hi, inc_lo
-    return state
-
-
-@njit(cache=True, nogil=True)
-def _next64(state: np.ndarray) -> np.uint64:
-    """``pcg64_next64``: advance, then the XSL-RR output of the new state."""
-    state_hi, state_lo = _pcg_step(state[0], state[1], state[2], state[3])
-    state[0], state[1] = state_hi, state_lo
-    rotation = state_hi >> np.uint64(58)
-    value = state_hi ^ state_lo
-    return (value >> rotation) | (value << ((np.uint64(64) - rotation) & np.uint64(63)))
-
-
-@njit(cache=True, nogil=True)
-def _stream_seed(run_entropy: np.ndarray, key: np.ndarray) -> np.uint64:
-    """``RandomStreams.seed`` of one (1, 3) key: the first 64-bit output of its generator >> 2."""
-    return _next64(_pcg_state(_seed_words(run_entropy, key)[0])) >> np.uint64(2)
-
-
-@njit(cache=True, nogil=True)
-def _small_seed_words(seed: np.uint64) -> np.ndarray:
-    """``integer_seed_words`` of a seed below 2^64: its two 32-bit words (the high one 0 or not,
-    as numpy's zero padding to the pool of four makes them the same), mixed with no spawn key."""
-    entropy = np.zeros(_POOL_SIZE, dtype=np.uint64)
-    entropy[0] = seed & np.uint64(_MASK)
-    entropy[1] = seed >> np.uint64(32)
-    return _seed_words(entropy, np.empty((1, 0), dtype=np.int64))[0]
-
-
-@njit(cache=True, nogil=True)
-def _next_double(state: np.ndarray) -> float:
-    """``Generator.random()``: the top 53 bits of one 64-bit output."""
-    return np.float64(_next64(state) >> np.uint64(11)) * (1.0 / 9007199254740992.0)
-
-
-@njit(cache=True, nogil=True)
-def _uniform_draws(words: np.ndarray, count: int) -> np.ndarray:
-    """(K, count): the first ``count`` values of ``Generator(PCG64(seed words)).random()``."""
-    out = np.empty((words.shape[0], count))
-    for row in range(words.shape[0]):
-        state = _pcg_state(words[row])
-        for column in range(count):
-            out[row, column] = _next_double(state)
-    return out
+        return int(self.generator(round_index, worker, stream).integers(0, 2**62))
 
 
 def uniform_draws(streams: RandomStreams, keys: np.ndarray, count: int) -> np.ndarray:
-    """(K, count): the first ``count`` doubles ``generator(*key).random()`` would return, for each
-    key (round, worker, stream) of ``keys`` (K, 3), computed without building the generators.
+    """(K, count): the first ``count`` doubles ``generator(*key).random()`` returns, for each key
+    (round, worker, stream) of ``keys`` (K, 3).
 
     Args:
         streams: The plan's ``RandomStreams``.
@@ -377,63 +278,8 @@ def uniform_draws(streams: RandomStreams, keys: np.ndarray, count: int) -> np.nd
     Raises:
         ValueError: A negative key.
     """
-    return _uniform_draws(streams.seed_words(keys), int(count))
-
-
-# ``np.random.default_rng(seed)`` for one integer seed, compiled: the backends' per-search
-# generators. A search needs only a handful of draws, yet building the Generator costs more than
-# the draws (``bench_search.py``: "statevector-seeded" against "statevector"); the functions below
-# give the same numbers from the seed's words directly.
-_NO_KEYS = np.empty((1, 0), dtype=np.int64)
-
-
-def integer_seed_words(seed: int) -> np.ndarray:
-    """(4,) uint64: the words ``SeedSequence(seed).generate_state(4, np.uint64)`` returns, i.e.
-    the seed of ``np.random.default_rng(seed)``'s PCG64, for any non-negative int (an entropy of at
-    most four 32-bit words is mixed exactly as when it is zero-padded to the pool size)."""
-    seed = int(seed)
-    if 0 <= seed < 1 << 64:
-        return _small_seed_words(np.uint64(seed))
-    words = _uint32_words(seed)
-    words += [0] * max(0, _POOL_SIZE - len(words))  # longer entropy is mixed in after the pool
-    return _seed_words(np.asarray(words, dtype=np.uint64), _NO_KEYS)[0]
-
-
-@njit(cache=True, nogil=True)
-def _next32(state: np.ndarray) -> np.uint64:
-    """``pcg64_next32``: the buffered upper half of the last output, else the lower half of a new one."""
-    if state[4]:
-        state[4] = np.uint64(0)
-        return state[5]
-    value = _next64(state)
-    state[4] = np.uint64(1)
-    state[5] = value >> np.uint64(32)
-    return value & np.uint64(0xFFFFFFFF)
-
-
-@njit(cache=True, nogil=True)
-def _bounded_below(state: np.ndarray, high: int) -> np.int64:
-    """One ``Generator.integers(0, high)`` draw for 1 <= high <= 2**32 (numpy's
-    ``random_bounded_uint64_fill``: nothing drawn for high = 1, Lemire's method on 32-bit draws)."""
-    span = np.uint64(high - 1)  # numpy's inclusive range ``rng``
-    if span == 0:
-        return np.int64(0)
-    mask = np.uint64(0xFFFFFFFF)
-    if span == mask:
-        return np.int64(_next32(state))
-    span_excl = span + np.uint64(1)
-    product = _next32(state) * span_excl
-    leftover = product & mask
-    if leftover < span_excl:
-        threshold = (mask - span) % span_excl
-        while leftover < threshold:
-            product = _next32(state) * span_excl
-            leftover = product & mask
-    return np.int64(product >> np.uint64(32))
-
-
-def first_integer_below(seed: int, high: int) -> int:
-    """``int(np.random.default_rng(seed).integers(0, high))`` for 1 <= high <= 2**32, compiled."""
-    if not 1 <= high <= 1 << 32:
-        raise ValueError(f"high must be in [1, 2**32], got {high}")
-    return int(_bounded_below(_pcg_state(integer_seed_words(seed)), high))
+    keys = np.ascontiguousarray(keys, dtype=np.int64).reshape(-1, 3)
+    out = np.empty((keys.shape[0], int(count)))
+    for row, words in enumerate(streams.seed_words(keys)):
+        out[row] = np.random.Generator(np.random.PCG64(_SeedWords(words))).random(int(count))  # type: ignore[arg-type]
+    return out

@@ -6,10 +6,8 @@ itself; ``a | b`` ends the plan when either ends it, and the status says which o
 
 Conditions are checked *before* each round, so the last round may overshoot an oracle-call budget
 by less than one round's cost and a node budget by fewer than ``workers`` nodes (the paper's
-cut-offs behave the same way). A condition on counters that grow by a known most per round (nodes,
-rounds, rounds without a new node) tells the planner how many rounds cannot end the plan
-(``rounds_before_end``); the planner skips those checks, and the plan ends where checking before
-every round would (tested against a condition checked every round).
+cut-offs behave the same way). The planner checks its condition before every round, as OMPL does;
+a condition whose test is costly caches inside itself.
 
 Every plan terminates: ``Planner.plan`` always adds ``MaxRounds(DEFAULT_MAX_ROUNDS)`` unless the
 condition it is given already limits rounds, and ``Stall(DEFAULT_STALL_ROUNDS)`` unless it already
@@ -22,7 +20,6 @@ from __future__ import annotations
 
 import abc
 import math
-import weakref
 from collections.abc import Iterable
 from dataclasses import dataclass
 from enum import StrEnum
@@ -138,22 +135,6 @@ class TerminationCondition(abc.ABC):
             A dict from the condition's name (``"max_nodes"``, ``"stall_rounds"``, ...) to its limit.
         """
 
-    def rounds_before_end(self, progress: Progress, nodes_per_round: int) -> int:
-        """How many rounds may run, after a check on ``progress`` that did not end the plan, before
-        this condition must be checked again: R such that ``ended_by`` is None at the checks before
-        each of the next R rounds whatever they do (each adds one round, at most
-        ``nodes_per_round`` nodes and at most one round without a new node). A planner skips those
-        checks and ends exactly where checking before every round would (``Planner._run``).
-
-        Args:
-            progress: The counters of the check that did not end the plan.
-            nodes_per_round: The most nodes one round of the plan adds (p for p workers).
-
-        Returns:
-            R >= 0; 0 (the default, and for oracle calls and wall time): check before every round.
-        """
-        return 0
-
     @property
     def limits_rounds(self) -> bool:
         """Whether this condition alone guarantees the plan ends (bounds the number of rounds)."""
@@ -197,47 +178,8 @@ class _Limit(TerminationCondition):
     def ended_by(self, progress: Progress) -> PlanStatus | None:
         return self.status if self._value(progress) >= self.limit else None
 
-    def _headroom(self, progress: Progress, nodes_per_round: int) -> int:
-        """``rounds_before_end`` of a limit whose value may grow by any amount in a round: 0."""
-        return 0
-
-    def rounds_before_end(self, progress: Progress, nodes_per_round: int) -> int:
-        """``_headroom`` where this class's test is the one it was written for (0 for a subclass
-        that redefines ``ended_by`` or ``_value``)."""
-        return max(self._headroom(progress, nodes_per_round), 0) if _headroom_holds(type(self)) else 0
-
     def describe(self) -> dict:
         return {str(self.status): self.limit}
-
-
-#: ``_headroom_holds`` per class, held weakly (a user's class may go away)
-_HEADROOM_HOLDS: weakref.WeakKeyDictionary[type, bool] = weakref.WeakKeyDictionary()
-
-
-def _headroom_holds(kind: type[_Limit]) -> bool:
-    """Whether ``kind``'s ``_headroom`` was written for its test: its ``ended_by`` is ``_Limit``'s
-    and its ``_value`` comes from the class that defines its ``_headroom`` (read once per class)."""
-    holds = _HEADROOM_HOLDS.get(kind)
-    if holds is None:
-        def owner(name: str) -> type:
-            return next(cls for cls in kind.__mro__ if name in cls.__dict__)
-
-        holds = _HEADROOM_HOLDS[kind] = kind.ended_by is _Limit.ended_by and owner("_value") is owner("_headroom")
-    return holds
-
-
-def rounds_unchecked(condition: TerminationCondition, progress: Progress, nodes_per_round: int) -> int:
-    """``condition.rounds_before_end(progress, nodes_per_round)``, checked: the rounds a planner
-    may run before it checks ``condition`` again (``Planner._run``).
-
-    Raises:
-        TypeError: A value that is not an integer (a user's condition returned a float, say).
-        ValueError: A negative value.
-    """
-    rounds = condition.rounds_before_end(progress, nodes_per_round)
-    if type(rounds) is int and rounds >= 0:
-        return rounds
-    return check_int(rounds, f"{type(condition).__name__}.rounds_before_end(...)", 0)
 
 
 @dataclass(frozen=True)
@@ -307,11 +249,6 @@ class MaxNodes(_Limit):
     def _value(self, progress: Progress) -> float:
         return progress.nodes
 
-    def _headroom(self, progress: Progress, nodes_per_round: int) -> int:
-        """After j more rounds the tree holds at most nodes + j p nodes, below ``limit`` for
-        j <= (limit - nodes - 1) // p."""
-        return (self.limit - progress.nodes - 1) // max(nodes_per_round, 1)
-
     @property
     def node_limit(self) -> int:
         """``limit``."""
@@ -337,10 +274,6 @@ class MaxRounds(_Limit):
 
     def _value(self, progress: Progress) -> float:
         return progress.rounds
-
-    def _headroom(self, progress: Progress, nodes_per_round: int) -> int:
-        """After j more rounds, rounds + j: below ``limit`` for j <= limit - rounds - 1."""
-        return self.limit - progress.rounds - 1
 
     @property
     def limits_rounds(self) -> bool:
@@ -378,11 +311,6 @@ class Stall(_Limit):
 
     def _value(self, progress: Progress) -> float:
         return progress.rounds_without_new_node
-
-    def _headroom(self, progress: Progress, nodes_per_round: int) -> int:
-        """After j more rounds at most rounds_without_new_node + j: below ``limit`` for
-        j <= limit - rounds_without_new_node - 1."""
-        return self.limit - progress.rounds_without_new_node - 1
 
     def describe(self) -> dict:
         return {"stall_rounds": self.limit}
@@ -461,19 +389,6 @@ class AnyOf(TerminationCondition):
             if status is not None:
                 return status
         return None
-
-    def rounds_before_end(self, progress: Progress, nodes_per_round: int) -> int:
-        """The fewest of the parts' (none may end the plan before its own); 0 for a subclass that
-        redefines ``ended_by``."""
-        if type(self).ended_by is not AnyOf.ended_by:
-            return 0
-        fewest = None
-        for condition in self.conditions:
-            rounds = rounds_unchecked(condition, progress, nodes_per_round)  # (a part's bad count named)
-            if rounds == 0:
-                return 0
-            fewest = rounds if fewest is None else min(fewest, rounds)
-        return fewest or 0
 
     def describe(self) -> dict:
         """The parts' settings merged; where two parts set the same limit of this module (the

@@ -84,7 +84,7 @@ class Tree:
         self._origin, self._low, self._high = np.zeros(self.dim), np.zeros(self.dim), np.zeros(self.dim)
         self._cell = 1.0
         self._shape = np.ones(self.dim, dtype=np.int64)
-        self._several_cells = False  # whether the grid has more than one cell (see search_arrays)
+        self._several_cells = False  # whether the grid has more than one cell (read by nearest)
         self._start = np.zeros(2, dtype=np.int64)  # offset of each cell's first node in _order, and the end
         self._order = np.empty(0, dtype=np.int64)  # the grid's node indices sorted by cell
         self._sorted = np.empty((0, self.dim))  # their positions, in that order
@@ -173,20 +173,10 @@ class Tree:
         """
         points = self._queries(points)
         out = np.empty(points.shape[0], dtype=np.int64)
-        nearest_into(points, *self.search_arrays(), out)
-        return out
-
-    def search_arrays(self) -> tuple[np.ndarray, int, int, np.ndarray, np.ndarray, np.ndarray, np.ndarray, float,
-                                     np.ndarray, np.ndarray, np.ndarray]:
-        """The arguments of ``nearest_into`` after the points, for compiled callers (the planners'
-        fused round, ``planners.fused_round``): the node buffer, the size, the nodes the grid holds
-        (0: no grid, or a tree below ``BRUTE_FORCE_BELOW`` nodes, searched by brute force even if a
-        ``grid_nearest`` call built one), the grid's cell offsets, sorted node indices and sorted
-        positions, its origin, cell size and shape, and the bounding box of its nodes. The arrays
-        are the tree's own (not copies) and stay valid until the next ``add`` or ``add_many``."""
         # a one-cell grid (high d, see _build_grid) is searched by the brute-force block instead,
-        # which scans the same nodes faster (vectorized over the queries)
-        return self._search_arrays(self.size >= BRUTE_FORCE_BELOW and self._several_cells)
+        # which scans the same nodes (vectorized over the queries)
+        nearest_into(points, *self._search_arrays(self.size >= BRUTE_FORCE_BELOW and self._several_cells), out)
+        return out
 
     def _search_arrays(self, grid: bool) -> tuple[np.ndarray, int, int, np.ndarray, np.ndarray, np.ndarray,
                                                    np.ndarray, float, np.ndarray, np.ndarray, np.ndarray]:
@@ -232,7 +222,7 @@ class Tree:
         ordered = np.empty_like(nodes)
         _file_by_cell(nodes, low, cell, shape, start, order, ordered)
         self._origin, self._cell, self._shape = low.copy(), cell, shape
-        self._several_cells = math.prod(int(count) for count in shape) > 1  # (read by search_arrays every round)
+        self._several_cells = math.prod(int(count) for count in shape) > 1
         self._low, self._high = low, high
         self._start, self._order, self._sorted = start, order, ordered
         self._rebuild_at = self.size + _pending_limit(self.size)

@@ -42,11 +42,10 @@ from ..termination import (
 from ..validation import check_float, check_instance, check_int, check_real_array, check_seed
 from .context import RoundView, WorkerContext
 from .result import Metrics, PlanResult
-from .run_state import RunState, TerminationChecks, first_in_ball
+from .run_state import RunState, first_in_ball
 
 if TYPE_CHECKING:
     from ..search.policies import PolicyState
-    from .fused_round import FusedRound
 
 #: kept for 0.1 code that imports it from here; the value lives in ``qrrt_circuits.termination``
 DEFAULT_MAX_ROUNDS = _termination.DEFAULT_MAX_ROUNDS
@@ -214,21 +213,16 @@ class Planner:
         state = RunState(start, goal, goal_radius)
         state.policy_state = self._start_policy()
         state.context = self._context()
-        state.fused_round = self._fused_round()
         began = time.perf_counter()
         status = self._run(state, condition, began)
         elapsed = time.perf_counter() - began
         return self._result(state, status, elapsed, start, goal, goal_radius, condition)
 
     def _run(self, state: RunState, condition: TerminationCondition, began: float) -> PlanStatus:
-        """The round loop: check the condition, run a round, record it; until the goal or the end.
-        The checks that cannot end the plan are skipped (``run_state.TerminationChecks``: the plan
-        ends where checking before every round would).
-        Subclasses may run several rounds' work at once if every round's outcome, counters and
-        termination check stay exactly those of this loop."""
-        checks = TerminationChecks(condition, self._max_new_nodes_per_round(), began)
+        """The round loop: check the condition before every round, run the round, record it; until
+        the goal or the end."""
         while state.goal_node is None:
-            ended = checks.ended_by(state)
+            ended = condition.ended_by(state.progress(time.perf_counter() - began))
             if ended is not None:
                 return ended
             self._round(state)
@@ -285,10 +279,6 @@ class Planner:
 
     def _round(self, state: RunState) -> None:
         raise NotImplementedError
-
-    def _fused_round(self) -> FusedRound | None:
-        """The plan's ``FusedRound`` where the quantum planners can use one (None here)."""
-        return None
 
     def _context(self) -> WorkerContext:
         """What workers need for this plan (subclasses add their backend, schedule, sizes)."""

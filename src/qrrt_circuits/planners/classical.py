@@ -7,27 +7,24 @@ of one candidate); a round's critical path is 1 call. With an ``OracleErrorModel
 is noisy and a positive answer is verified with the true predicate (one more call) before the node
 is added, as the quantum planners' finalizer does.
 
-Batched rounds (issue 11). A round's candidates depend only on its random streams, and the tree
-cannot change until a round adds a node, so without an executor the planners draw the candidates of
-the next B rounds at once (``randomness.uniform_draws``: the same doubles the round's own generator
-gives), find their nearest nodes in one query and test all B x p pairs in one ``reachable`` call.
-Then the rounds are recorded one by one exactly as the one-round loop records them (termination
-checked before each, counters, history, error flips), up to and including the first round that adds
-a node; the candidates of the later rounds were drawn against a tree that no longer exists and are
-dropped: their tests are counted in ``Metrics.wasted_checks``, never as oracle calls, and those
-rounds are drawn again next time. Trees, counters and statuses are therefore exactly the
-sequential ones (tested bit for bit). B adapts to the observed rate at which rounds add a node:
-B = ceil(1 / rate) with rate = (rounds that added + 1) / (rounds recorded + 2), at most
-``MAX_BATCH_ROUNDS``, the expected number of rounds up to the next success, so about one batch per
-node and, on average, about as many wasted tests as useful ones at worst; and at most
-``batch_round_limit(workers, d)`` rounds, so that a batch's candidates take at most
-``MAX_BATCH_BYTES`` (or one round). With an ``executor`` the
-planners keep one task per worker per round.
+Rounds in batches. A round's candidates depend only on its random streams (keyed by round and
+worker), and the tree cannot change until a round adds a node, so the planners draw the candidates
+of the next B rounds at once (``randomness.uniform_draws``), find their nearest nodes in one query
+and test all B x p pairs together. The rounds are then recorded one by one (the termination
+condition checked before each, counters, history, error flips), up to and including the first round
+that adds a node; the later rounds' candidates were drawn against a tree that no longer exists, so
+their tests are counted in ``Metrics.wasted_checks``, never as oracle calls, and those rounds are
+drawn again. The tree, the counters and the status are those of one round at a time. B is the
+expected number of rounds up to the next success, ceil(1 / rate) with the Laplace estimate
+rate = (rounds that added + 1) / (rounds recorded + 2), at most ``MAX_BATCH_ROUNDS`` and at most
+``batch_round_limit(workers, d)`` (a batch's candidates take at most ``MAX_BATCH_BYTES``). On an
+``executor`` B = 1 and each worker's test is one task.
 """
 
 from __future__ import annotations
 
 import math
+import time
 from concurrent.futures import Executor
 
 import numpy as np
@@ -42,8 +39,8 @@ from ..termination import PlanStatus, TerminationCondition
 from ..validation import check_int
 from .base import Planner
 from .context import map_tasks
-from .run_state import RunState, TerminationChecks
-from .workers import classical_extension
+from .run_state import RunState
+from .workers import check_extensions
 
 MAX_WORKERS = 4096
 #: the most rounds one batch tests ahead
@@ -159,34 +156,18 @@ class ParallelRRT(Planner):
                          goal_bias=goal_bias, resolution=resolution, seed=seed, oracle=oracle,
                          executor=executor)
 
-    def _round(self, state: RunState) -> None:
-        outcomes = map_tasks(self.executor, classical_extension, state.worker_context, self._view(state),
-                             range(self.workers))
-        longest = 1
-        for outcome in outcomes:
-            state.verification_calls += 1
-            state.round_entries += 1
-            state.round_reachable += int(outcome.truth)
-            if not outcome.answer:
-                continue
-            if self.oracle_errors is not None:
-                state.verification_calls += 1
-                longest = 2
-                if not outcome.truth:
-                    state.rejected += 1
-                    continue
-            state.add_node(outcome.child, outcome.parent)
-        state.critical_path += longest
-
-    # ----------------------------------------------------------------- batched rounds
     def _run(self, state: RunState, condition: TerminationCondition, began: float) -> PlanStatus:
-        if self.executor is not None:
-            return super()._run(state, condition, began)
+        """Rounds in batches: the candidates of the next B rounds drawn and tested together, then
+        recorded round by round (the condition checked before each) up to the first round that adds
+        a node; the later rounds' tests are ``wasted_checks`` and those rounds are drawn again. B is
+        ``batch_rounds`` (at most ``batch_round_limit``) in-process, 1 on an executor."""
         workers = self.workers
         changed = recorded = 0
-        most = batch_round_limit(workers, self.env.dim)
-        checks = TerminationChecks(condition, workers, began)  # (as ``Planner._run``)
+        most = 1 if self.executor is not None else batch_round_limit(workers, self.env.dim)
         while state.goal_node is None:
+            ended = condition.ended_by(state.progress(time.perf_counter() - began))
+            if ended is not None:
+                return ended
             ahead = min(batch_rounds(changed, recorded), most)
             first = state.rounds
             keys = np.empty((ahead * workers, 3), dtype=np.int64)
@@ -195,13 +176,13 @@ class ParallelRRT(Planner):
             keys[:, 2] = int(Stream.CANDIDATES)
             children = self._candidates(state, keys)
             parents = state.tree.nearest(children)
-            truth = check_answers(self.predicate.reachable(state.tree.nodes[parents], children), children.shape[0],
-                                  f"the predicate {self.predicate.name!r}")
+            truth = self._test(state, state.tree.nodes[parents], children)
             for offset in range(ahead):
-                ended = checks.ended_by(state)
-                if ended is not None:
-                    state.wasted_checks += (ahead - offset) * workers
-                    return ended
+                if offset:  # (the first round's check came before the draws)
+                    ended = condition.ended_by(state.progress(time.perf_counter() - began))
+                    if ended is not None:
+                        state.wasted_checks += (ahead - offset) * workers
+                        return ended
                 nodes_before = state.nodes
                 rows = slice(offset * workers, (offset + 1) * workers)
                 self._record(state, first + offset, children[rows], parents[rows], truth[rows])
@@ -212,6 +193,16 @@ class ParallelRRT(Planner):
                     state.wasted_checks += (ahead - offset - 1) * workers
                     break
         return PlanStatus.REACHED
+
+    def _test(self, state: RunState, origins: np.ndarray, children: np.ndarray) -> np.ndarray:
+        """The predicate on every (parent position, child) pair: one call in-process, one task per
+        worker on an executor."""
+        name = f"the predicate {self.predicate.name!r}"
+        if self.executor is None or children.shape[0] <= 1:
+            return check_answers(self.predicate.reachable(origins, children), children.shape[0], name)
+        pairs = [(origins[row:row + 1], children[row:row + 1]) for row in range(children.shape[0])]
+        answers = map_tasks(self.executor, check_extensions, state.worker_context, self._view(state), pairs)
+        return np.concatenate([check_answers(answer, 1, name) for answer in answers])
 
     def _candidates(self, state: RunState, keys: np.ndarray) -> np.ndarray:
         """The samples ``build_database(tree, 1, ...)`` draws from each key's generator: uniform

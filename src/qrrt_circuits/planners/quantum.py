@@ -15,16 +15,13 @@ Pq-RRT, unshared: each of the p workers builds and searches its own database (op
 ``executor``); all verified candidates are added.
 
 Both are one function, ``workers.search_database``, applied to groups of workers: one group of p
-for a shared database, p groups of one for unshared ones. Without an executor, a round's databases
-are built in turn and their searches handed to the backend together
-(``search_databases_together``: ``PolicyState.run_many``, ``backend.search_many``), with the same
-outcomes. The critical path of a round is the
-largest number of oracle calls one worker made in it: the time of p parallel quantum devices.
+for a shared database, p groups of one for unshared ones, in turn or on an ``executor``. The
+critical path of a round is the largest number of oracle calls one worker made in it: the time of
+p parallel quantum devices.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from concurrent.futures import Executor
 
 from ..database import AnnealingSchedule
@@ -35,53 +32,17 @@ from ..oracle_errors import OracleErrorModel
 from ..predicate import ReachabilityPredicate
 from ..search.backend import QuantumSearchBackend
 from ..search.policies import IterationPolicy, PaperSchedule, PolicyState
-from ..search.problem import DatabaseSearch
 from ..validation import check_bool, check_instance, check_int
 from .base import Planner
 from .classical import MAX_WORKERS
-from .context import RoundView, WorkerContext, map_tasks
-from .fused_round import FusedRound
+from .context import WorkerContext, map_tasks
 from .run_state import RunState
-from .workers import DatabaseOutcome, DatabaseResult, database_outcome, make_database, search_database
+from .workers import DatabaseOutcome, search_database
 
 ORACLE_LOOKUP_LABEL = (
     "simulation: the phase oracle is built from a classical lookup of all 2^n database entries "
     "(reported as simulation_checks, not as oracle calls)"
 )
-
-
-def search_databases_together(context: WorkerContext, view: RoundView,
-                              groups: list[tuple[int, int]]) -> list[DatabaseOutcome]:
-    """``search_database`` for every group of one round, with the searches handed over together.
-
-    The databases' searches go to the search policy at once (``PolicyState.run_many``, hence
-    ``backend.search_many``): the same outcomes as searching them one by one, since every search
-    draws its seed from the streams keyed by (round, worker).
-
-    Args:
-        context: The plan's ``WorkerContext`` (environment, predicate, streams, backend, sizes).
-        view: The round's ``RoundView`` (tree snapshot, goal, round and temperature index, policy
-            state).
-        groups: (first worker, workers) per database, all with the same worker count: one group of
-            p for a shared database, p groups of one for unshared ones.
-
-    Returns:
-        One ``DatabaseOutcome`` per group, in order (an empty list for no groups).
-
-    Raises:
-        ValueError: Groups with different worker counts.
-    """
-    if not groups:
-        return []
-    built = [make_database(context, view, first) for first, _ in groups]
-    problems = [DatabaseSearch(marks, truth, context.search_backend, context.streams, view.round_index, first)
-                for (_, truth, marks), (first, _) in zip(built, groups, strict=True)]
-    workers = groups[0][1]
-    if any(count != workers for _, count in groups):
-        raise ValueError("search_databases_together needs groups of one size")
-    outcomes = view.search_policy_state.run_many(problems, workers, view.tree_nodes)
-    return [database_outcome(db.children, db.parents, truth, found_by)
-            for (db, truth, _), found_by in zip(built, outcomes, strict=True)]
 
 
 class PQRRT(Planner):
@@ -142,21 +103,14 @@ class PQRRT(Planner):
             error.
         iterations: Alias of ``search_policy`` kept from 0.1; giving both (as different objects) is
             an error.
-        fused_round: True (default): without an executor, annealing or goal bias, each database is
-            drawn and paired with its nearest nodes in one compiled call, and where the backend's
-            seeded search is the closed-form draw (the ``StatevectorBackend``) and the policy
-            searches by default (one search per database at its k: every policy but ``BBHT``,
-            fixed-point and estimated ones), its workers are drawn and verified in a second one
-            (``qrrt_circuits.planners.fused_round``); the same results bit for bit. False: every
-            round takes the generic path (for tests and benchmarks). Must be a ``bool``.
 
     Raises:
         TypeError: An argument of the wrong type: ``env`` not an ``Environment``, a non-integer
             ``num_qubits``, ``workers`` or ``seed``, a non-real ``goal_bias`` or ``resolution``,
             ``dynamics`` or ``oracle_errors`` of the wrong class, a ``backend`` that is not a
             ``QuantumSearchBackend``, a ``search_policy`` that is not an ``IterationPolicy``, an
-            ``annealing`` that is not an ``AnnealingSchedule``, a non-bool ``shared_database`` or
-            ``fused_round``, or a ``predicate`` that lacks the members of the ``ReachabilityPredicate`` protocol.
+            ``annealing`` that is not an ``AnnealingSchedule``, a non-bool ``shared_database``, or
+            a ``predicate`` that lacks the members of the ``ReachabilityPredicate`` protocol.
         ValueError: ``num_qubits`` < 1 or above the backend's ``max_qubits``, ``workers`` outside
             [1, 4096], ``goal_bias`` outside [0, 1), a non-positive or non-finite ``resolution``, a
             negative ``seed``, a dimension mismatch between ``env`` and ``predicate`` or
@@ -186,10 +140,8 @@ class PQRRT(Planner):
         seed: int | None = None,
         oracle: ReachabilityPredicate | None = None,
         iterations: IterationPolicy | None = None,
-        fused_round: bool = True,
     ) -> None:
         self.num_qubits = check_int(num_qubits, "num_qubits", 1)
-        self.fused_round = check_bool(fused_round, "fused_round")
         self.workers = check_int(workers, "workers", 1, MAX_WORKERS)
         if backend is None:
             from ..search.aer import AerBackend  # qiskit and Aer are imported only when used
@@ -263,12 +215,6 @@ class PQRRT(Planner):
         return WorkerContext(self.env, self.predicate, self.streams, self.goal_bias, self.oracle_errors,
                              self.backend, self.annealing, self.database_size)
 
-    def _fused_round(self) -> FusedRound | None:
-        """A ``FusedRound`` if this plan's rounds can be fused (see ``fused_round``), else None."""
-        if not self.fused_round or self.executor is not None or self.annealing is not None or self.goal_bias > 0:
-            return None
-        return FusedRound(self.env, self.predicate, self.streams, self.oracle_errors, self.backend, self.num_qubits)
-
     def _worker_groups(self) -> list[tuple[int, int]]:
         """(first worker, workers) per database: one group of p on a shared database, p of one."""
         if self.shared_database:
@@ -282,26 +228,16 @@ class PQRRT(Planner):
         return self.annealing.temperature_index(state.rounds, state.nodes)
 
     def _round(self, state: RunState) -> None:
-        groups = self._worker_groups()
-        policy_state = state.search_policy_state
-        results: Sequence[DatabaseResult]
-        if state.fused_round is not None:  # compiled calls around the predicate, the same outcomes
-            results = state.fused_round.search(state.tree, state.rounds, groups, policy_state, state.tree.size - 1)
-        else:
-            view = self._view(state, self._temperature_index(state))
-            if self.executor is None:  # the round's searches go to the backend together (same outcomes)
-                results = search_databases_together(state.worker_context, view, groups)
-            else:
-                results = map_tasks(self.executor, search_database, state.worker_context, view, groups)
+        view = self._view(state, self._temperature_index(state))
+        results = map_tasks(self.executor, search_database, state.worker_context, view, self._worker_groups())
         longest = 0
         for result in results:
             longest = max(longest, self._integrate(state, result))
-        if policy_state.learns():  # (skips building the outcomes when nothing learns)
-            policy_state.learn(outcome for result in results for outcome in result.outcomes)
+        state.search_policy_state.learn(outcome for result in results for outcome in result.outcomes)
         state.critical_path += longest
 
     @staticmethod
-    def _integrate(state: RunState, result: DatabaseResult) -> int:
+    def _integrate(state: RunState, result: DatabaseOutcome) -> int:
         """Count one database's work and add its verified candidates (``DatabaseResult.tally``);
         returns the largest oracle calls of one of its workers."""
         quantum, verifications, rejected, longest, duplicates, children, parents = result.tally()
@@ -394,16 +330,13 @@ class QRRT(PQRRT):
             error.
         iterations: Alias of ``search_policy`` kept from 0.1; giving both (as different objects) is
             an error.
-        fused_round: True (default) to run the rounds that allow it in compiled calls around the
-            predicate, with the same results; False for the generic round (see ``PQRRT``). Must be
-            a ``bool``.
 
     Raises:
         TypeError: An argument of the wrong type: ``env`` not an ``Environment``, a non-integer
             ``num_qubits`` or ``seed``, a non-real ``goal_bias`` or ``resolution``, ``dynamics`` or
             ``oracle_errors`` of the wrong class, a ``backend`` that is not a
             ``QuantumSearchBackend``, a ``search_policy`` that is not an ``IterationPolicy``, an
-            ``annealing`` that is not an ``AnnealingSchedule``, a non-bool ``fused_round``, or a
+            ``annealing`` that is not an ``AnnealingSchedule``, or a
             ``predicate`` that lacks the members of the ``ReachabilityPredicate`` protocol.
         ValueError: ``num_qubits`` < 1 or above the backend's ``max_qubits``, ``goal_bias`` outside
             [0, 1), a non-positive or non-finite ``resolution``, a negative ``seed``, a dimension
@@ -431,10 +364,8 @@ class QRRT(PQRRT):
         seed: int | None = None,
         oracle: ReachabilityPredicate | None = None,
         iterations: IterationPolicy | None = None,
-        fused_round: bool = True,
     ) -> None:
         super().__init__(env, backend=backend, num_qubits=num_qubits, workers=1, shared_database=True,
                          search_policy=search_policy, annealing=annealing, predicate=predicate,
                          dynamics=dynamics, oracle_errors=oracle_errors, goal_bias=goal_bias,
-                         resolution=resolution, seed=seed, oracle=oracle, iterations=iterations,
-                         fused_round=fused_round)
+                         resolution=resolution, seed=seed, oracle=oracle, iterations=iterations)

@@ -2,19 +2,17 @@
 
 from __future__ import annotations
 
-import time
 from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
 
-from ..termination import PlanStatus, Progress, TerminationCondition, rounds_unchecked
+from ..termination import Progress
 from ..tree import Tree
 
 if TYPE_CHECKING:  # annotations only (context imports the search modules)
     from ..search.policies import PolicyState
     from .context import WorkerContext
-    from .fused_round import FusedRound
 
 HISTORY_KEYS = ("oracle_calls", "critical_path", "nodes", "entries", "reachable")
 
@@ -63,7 +61,6 @@ class RunState:
         self._nodes_at_round_start = 0
         self.policy_state: PolicyState | None = None  # quantum planners only
         self.context: WorkerContext | None = None  # the plan's WorkerContext, built once
-        self.fused_round: FusedRound | None = None  # quantum planners whose rounds can be fused
 
     @property
     def worker_context(self) -> WorkerContext:
@@ -121,40 +118,3 @@ class RunState:
         history["entries"].append(self.round_entries)
         history["reachable"].append(self.round_reachable)
         self.round_entries = self.round_reachable = 0
-
-
-class TerminationChecks:
-    """When a plan checks its termination condition (``Planner._run``, the batched RRT loop):
-    before every round, except the ``condition.rounds_before_end`` rounds after a check that cannot
-    end the plan, as long as no round adds more than ``nodes_per_round`` nodes (a round that did, a
-    user's policy or planner breaking the bound, brings the next check forward). The plan ends
-    where checking before every round would.
-
-    Args:
-        condition: The plan's condition.
-        nodes_per_round: The most nodes one round adds (``Planner._max_new_nodes_per_round``).
-        began: The plan's ``time.perf_counter()`` at its start (for ``Progress.elapsed_s``).
-    """
-
-    __slots__ = ("condition", "nodes_per_round", "began", "_unchecked", "_size_cap")
-
-    def __init__(self, condition: TerminationCondition, nodes_per_round: int, began: float) -> None:
-        self.condition = condition
-        self.nodes_per_round = nodes_per_round
-        self.began = began
-        self._unchecked = 0  # rounds that may still run before the next check
-        self._size_cap = 0  # the most nodes the tree may hold before the next round while checks are skipped
-
-    def ended_by(self, state: RunState) -> PlanStatus | None:
-        """Before a round: the status that ends the plan, or None (checked, or skipped)."""
-        if self._unchecked and state.tree.size <= self._size_cap:
-            self._unchecked -= 1
-        else:
-            progress = state.progress(time.perf_counter() - self.began)
-            ended = self.condition.ended_by(progress)
-            if ended is not None:
-                return ended
-            self._unchecked = rounds_unchecked(self.condition, progress, self.nodes_per_round)
-            self._size_cap = state.tree.size
-        self._size_cap += self.nodes_per_round
-        return None

@@ -3,8 +3,7 @@ processes, Dask) can run them. Each takes ``(WorkerContext, RoundView, task)`` a
 randomness from the streams keyed by (round, worker), so results never depend on which executor
 ran it or in what order.
 
-- ``classical_extension``: one RRT step (Alg. 1 with a 1-entry database): sample, nearest node,
-  one reachability test.
+- ``check_extensions``: the reachability tests of classical RRT extensions (Alg. 1 line 7).
 - ``search_database``: build one database of 2^n candidates, evaluate the predicate on all of them
   to build the phase oracle (``simulation_checks``), and let the search policy run the workers that
   share it (Alg. 1 lines 4-12; Alg. 2 for p workers).
@@ -13,7 +12,6 @@ ran it or in what order.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Protocol
 
 import numpy as np
 
@@ -24,54 +22,17 @@ from ..search.problem import DatabaseSearch, SearchOutcome
 from .context import RoundView, WorkerContext
 
 
-@dataclass(frozen=True)
-class ExtensionOutcome:
-    """One classical RRT extension: the candidate, its parent, the test's answer and the truth."""
-
-    child: np.ndarray
-    parent: int
-    answer: bool
-    truth: bool
-
-
-def classical_extension(context: WorkerContext, view: RoundView, worker: int) -> ExtensionOutcome:
-    """Sample (with goal bias), nearest node, one reachability test."""
-    db = stream_database(view.tree, 1, context.env, context.streams, view.round_index, worker, view.goal,
-                         view.goal_radius, context.goal_bias)
-    child, parent = db.children[0], int(db.parents[0])
-    truth = bool(check_answers(context.predicate.reachable(view.tree.nodes[parent][None], child[None]), 1,
-                               f"the predicate {context.predicate.name!r}")[0])
-    answer = truth
-    if context.oracle_errors is not None:
-        flips = context.streams.generator(view.round_index, worker, Stream.ORACLE_ERRORS)
-        answer = bool(context.oracle_errors.apply(np.array([truth]), flips)[0])
-    return ExtensionOutcome(child, parent, answer, truth)
+def check_extensions(context: WorkerContext, view: RoundView, pairs: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+    """The plan's predicate on (parent positions (M, d), children (M, d)): the reachability tests
+    of classical extensions (Alg. 1 line 7) handed to a worker."""
+    origins, children = pairs
+    return context.predicate.reachable(origins, children)
 
 
 #: what ``DatabaseResult.tally`` returns: (quantum oracle calls, verification calls, rejected
 #: measurements, the largest oracle calls of one worker, duplicates, and the candidates to add, in
 #: worker order, each distinct entry once: their child positions (m, d) and parent indices (m,))
 Tally = tuple[int, int, int, int, int, np.ndarray, np.ndarray]
-
-
-class DatabaseResult(Protocol):
-    """What a quantum planner integrates of one searched database (``DatabaseOutcome``, or the
-    fused round's ``ClosedFormOutcome``): its size, its reachable entries, per worker its
-    ``SearchOutcome`` and found candidate, and the round's counts (``tally``)."""
-
-    @property
-    def entries(self) -> int: ...
-
-    @property
-    def reachable_entries(self) -> int: ...
-
-    @property
-    def outcomes(self) -> tuple[SearchOutcome, ...]: ...
-
-    @property
-    def found(self) -> tuple[tuple[np.ndarray, int] | None, ...]: ...
-
-    def tally(self) -> Tally: ...
 
 
 @dataclass(frozen=True)

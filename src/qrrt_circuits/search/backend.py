@@ -24,7 +24,6 @@ from typing import TYPE_CHECKING, TypeAlias
 import numpy as np
 
 from ..memory import MemoryEstimate, check_fits
-from ..randomness import first_integer_below
 from ..validation import check_int, check_seed
 
 if TYPE_CHECKING:
@@ -278,16 +277,12 @@ class QuantumSearchBackend(abc.ABC):
         return self._rng if seed is None else seed_stream(seed)
 
     def _first_integer(self, seed: int | np.random.Generator | None, high: int) -> int:
-        """``int(self._generator(seed).integers(0, high))`` (a search's simulator seed), without
-        building a Generator for an integer seed (``randomness.first_integer_below``, compiled)."""
-        if seed is None or isinstance(seed, np.random.Generator):
-            return int(self._generator(seed).integers(0, high))
-        return first_integer_below(seed, high)
+        """``int(self._generator(seed).integers(0, high))``: a search's simulator seed."""
+        return int(self._generator(seed).integers(0, high))
 
     def _sample_seeded(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
                        seed: int | np.random.Generator | None) -> np.ndarray:
-        """``_sample`` with the generator of ``seed``; a backend that can draw from an integer seed
-        without building a Generator overrides this (same indices)."""
+        """``_sample`` with the generator of ``seed``."""
         return self._sample(marks, num_qubits, iterations, shots, self._generator(seed))
 
     def _finish(self, prepared: _Prepared, indices: np.ndarray) -> SearchResult:
@@ -446,23 +441,6 @@ class QuantumSearchBackend(abc.ABC):
         generalized iterates override this."""
         raise NotImplementedError(f"backend {self.name!r} does not run generalized Grover iterates "
                                   "(search_sequence); use the aer, statevector or sampler backend")
-
-    def draws_closed_form(self, num_qubits: int) -> bool:
-        """Whether every seeded search of 2^n entries is the compiled two-level closed-form draw.
-
-        True means: ``search(marks, k, shots, seed)`` with an integer ``seed`` returns exactly the
-        indices of ``statevector._draw_two_level_seeded(marks, p, shots, integer_seed_words(seed))``
-        with p = sin^2((2k+1) theta), sin^2 theta = m / 2^n (Eq. 1, Lemma 1). The quantum planners'
-        fused round (``qrrt_circuits.planners.fused_round``) then draws and verifies the measured
-        indices in one compiled call instead of calling ``search``, with the same results.
-
-        Args:
-            num_qubits: n.
-
-        Returns:
-            False here; ``StatevectorBackend`` answers True for its closed form.
-        """
-        return False
 
     def labels(self) -> tuple[str, ...]:
         """Caveats every result that depends on this backend must carry (none by default)."""

@@ -48,7 +48,7 @@ import numpy as np
 from ..probability import optimal_iterations
 from ..validation import check_choice, check_float, check_int, check_optional_int
 from .backend import MAX_ITERATIONS, validate_iterations
-from .problem import DatabaseSearch, SearchOutcome, search_together
+from .problem import DatabaseSearch, SearchOutcome
 
 __all__ = [
     "BBHT",
@@ -203,54 +203,6 @@ class PolicyState:
         """
         return self.policy.iterations_for(problem, tree_nodes)
 
-    def reads_problem(self) -> bool:
-        """Whether ``iterations_for`` may read more of a database than its size N.
-
-        False where neither this state's class nor its policy's overrides ``iterations_for``: k is
-        then ``iterations_by_size(tree_nodes)`` for every database of ``num_items`` entries, and a
-        caller may skip building the ``DatabaseSearch`` (the planners' fused round does).
-
-        Returns:
-            True if ``iterations_for`` is overridden (``KnownOptimal`` reads the marked count).
-        """
-        return not (type(self).iterations_for is PolicyState.iterations_for
-                    and type(self.policy).iterations_for is IterationPolicy.iterations_for)
-
-    def iterations_by_size(self, tree_nodes: int) -> int:
-        """The default ``iterations_for`` of a database of ``num_items`` entries: the policy's k
-        from N and the tree alone (what ``iterations_for`` returns when ``reads_problem()`` is False).
-
-        Args:
-            tree_nodes: Nodes in the tree so far.
-
-        Returns:
-            k >= 0.
-        """
-        return self.policy._iterations(self.num_items, tree_nodes, None)
-
-    def learns(self) -> bool:
-        """Whether ``learn`` does anything (False where neither ``learn`` nor ``observe`` is
-        overridden: callers may skip building the outcomes it would be given).
-
-        Returns:
-            True for learning states (``Adaptive``'s).
-        """
-        return type(self).learn is not PolicyState.learn or type(self).observe is not PolicyState.observe
-
-    def searches_by_default(self) -> bool:
-        """Whether this state's ``run`` and ``run_many`` are the defaults.
-
-        Then a round's outcomes are fixed by ``iterations_for`` on each database (in order) and one
-        backend search per database with ``shots = workers``, each worker verifying its own
-        measurement; the quantum planners' fused round (``qrrt_circuits.planners.fused_round``)
-        then draws those searches itself when the backend's are the closed-form draw. False for
-        states with their own loop (``BBHT``, fixed-point and estimated policies).
-
-        Returns:
-            True if neither ``run`` nor ``run_many`` is overridden.
-        """
-        return type(self).run is PolicyState.run and type(self).run_many is PolicyState.run_many
-
     def run(self, problem: DatabaseSearch, workers: int, tree_nodes: int) -> tuple[SearchOutcome, ...]:
         """``workers`` workers search one database (Alg. 3 worker loop; Alg. 2 for one worker).
 
@@ -273,11 +225,8 @@ class PolicyState:
 
     def run_many(self, problems: Sequence[DatabaseSearch], workers: int,
                  tree_nodes: int) -> tuple[tuple[SearchOutcome, ...], ...]:
-        """``run`` on each of several independent databases of one round (unshared Pq-RRT).
-
-        All their searches are handed to the backend at once (``QuantumSearchBackend.search_many``);
-        the outcomes are those of calling ``run`` on each database in turn. A state class that
-        overrides ``run`` but not ``run_many`` gets its own ``run`` on each database.
+        """``run`` on each of several independent databases of one round, in order (unshared
+        Pq-RRT without an executor).
 
         Args:
             problems: The round's database searches.
@@ -287,14 +236,7 @@ class PolicyState:
         Returns:
             Per database, the outcomes ``run`` returns for it.
         """
-        if type(self).run is not PolicyState.run:
-            return tuple(self.run(problem, workers, tree_nodes) for problem in problems)
-        iterations = [validate_iterations(self.iterations_for(problem, tree_nodes)) for problem in problems]
-        requests = [problem.request(k, workers, problem.shared_seed())
-                    for problem, k in zip(problems, iterations, strict=True)]
-        results = search_together(problems, requests)
-        return tuple(_verified(problem, k, result.indices)
-                     for problem, k, result in zip(problems, iterations, results, strict=True))
+        return tuple(self.run(problem, workers, tree_nodes) for problem in problems)
 
     def observe(self, iterations: int, success: bool) -> None:
         """Record that a measurement after ``iterations`` iterations verified (or not).
@@ -310,11 +252,8 @@ class PolicyState:
         """Feed a round's outcomes back, in worker order.
 
         Args:
-            outcomes: The round's ``SearchOutcome`` objects; each observation goes to ``observe``
-                (not read at all when ``observe`` is this class's no-op).
+            outcomes: The round's ``SearchOutcome`` objects; each observation goes to ``observe``.
         """
-        if type(self).observe is PolicyState.observe:  # nothing to learn: skip the loop
-            return
         for outcome in outcomes:
             for iterations, success in outcome.observations:
                 self.observe(iterations, success)
@@ -565,11 +504,6 @@ class BBHTState(PolicyState):
             found = self.policy.run(search, problem.verify, problem.num_items, rng)
             outcomes.append(SearchOutcome(found.index, found.iterations, found.verifications, found.attempts))
         return tuple(outcomes)
-
-    def run_many(self, problems: Sequence[DatabaseSearch], workers: int,
-                 tree_nodes: int) -> tuple[tuple[SearchOutcome, ...], ...]:
-        """Each database in turn: a BBHT worker's next search depends on its previous outcome."""
-        return tuple(self.run(problem, workers, tree_nodes) for problem in problems)
 
 
 @dataclass(frozen=True)

@@ -16,14 +16,13 @@ observations ``(iterations, verified)`` for learning policies.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..randomness import RandomStreams, Stream
-from .backend import QuantumSearchBackend, SearchRequest, SearchResult
+from .backend import QuantumSearchBackend
 
 if TYPE_CHECKING:
     from .fixed_point import IterateSequence
@@ -145,19 +144,6 @@ class DatabaseSearch:
         """
         return self.backend.search_sequence(self.marks, sequence, shots, seed=seed).indices
 
-    def request(self, iterations: int, shots: int, seed: int) -> SearchRequest:
-        """``search``'s arguments as a request for ``search_together``.
-
-        Args:
-            iterations: k.
-            shots: Preparations.
-            seed: The sampling seed.
-
-        Returns:
-            A ``SearchRequest`` for this database's marks.
-        """
-        return SearchRequest(self.marks, iterations, shots, seed)
-
     def verify(self, index: int) -> bool:
         """The classical finalizer: is entry ``index`` truly reachable? (1 oracle call.)
 
@@ -191,24 +177,3 @@ class DatabaseSearch:
             The generator of stream (``round_index``, worker, ``Stream.POLICY``).
         """
         return self.streams.generator(self.round_index, self.first_worker + offset, Stream.POLICY)
-
-
-def search_together(problems: Sequence[DatabaseSearch], requests: Sequence[SearchRequest]) -> tuple[SearchResult, ...]:
-    """One request per database, all handed to their (common) backend's ``search_many``.
-
-    Args:
-        problems: The databases, all searched by one backend.
-        requests: One ``SearchRequest`` per database, in order.
-
-    Returns:
-        One ``SearchResult`` per request, in order (empty for no problems).
-
-    Raises:
-        ValueError: Databases with different backends.
-    """
-    if not problems:
-        return ()
-    backend = problems[0].backend
-    if any(problem.backend is not backend for problem in problems):
-        raise ValueError("search_together needs databases searched by one backend")
-    return backend.search_many(requests)

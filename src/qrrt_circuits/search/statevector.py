@@ -14,10 +14,8 @@ import os
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numba import njit
 
 from ..probability import good_probability
-from ..randomness import _bounded_below, _next_double, _pcg_state, integer_seed_words
 from ..validation import check_bool, check_int
 from .backend import QuantumSearchBackend, seed_stream, validate_iterations, validate_marks
 from .fixed_point import statevector_after
@@ -128,29 +126,6 @@ class StatevectorBackend(QuantumSearchBackend):
             state = 2.0 * state.mean() - state
         return state
 
-    def draws_closed_form(self, num_qubits: int) -> bool:
-        """True with ``closed_form`` for n <= 32 (the compiled draw's 32-bit bound), unless a subclass
-        changes how a search is validated or drawn (``QuantumSearchBackend.draws_closed_form``).
-
-        Args:
-            num_qubits: n.
-
-        Returns:
-            Whether a seeded search is ``_draw_two_level_seeded``.
-        """
-        own = all(getattr(type(self), name) is getattr(StatevectorBackend, name)
-                  for name in ("search", "search_many", "_prepare", "_sample_seeded", "_finish"))
-        return self.closed_form and num_qubits <= 32 and own
-
-    def _sample_seeded(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
-                       seed: int | np.random.Generator | None) -> np.ndarray:
-        """The closed form with an integer seed draws in one compiled call (``_draw_two_level_seeded``:
-        the same indices as ``_draw_two_level`` with ``np.random.default_rng(seed)``)."""
-        if not self.closed_form or seed is None or isinstance(seed, np.random.Generator) or num_qubits > 32:
-            return super()._sample_seeded(marks, num_qubits, iterations, shots, seed)
-        p_good = good_probability(marks.shape[0], int(np.count_nonzero(marks)), iterations)
-        return _draw_two_level_seeded(marks, p_good, shots, integer_seed_words(seed))
-
     def _sample(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
                 rng: np.random.Generator) -> np.ndarray:
         if not self.closed_form:
@@ -193,84 +168,6 @@ def _draw_two_level(marks: np.ndarray, p_good: float, shots: int, rng: np.random
         # k-th unmarked index without listing them all: rank among the complement
         ranks = rng.integers(0, unmarked_count, shots - num_good)
         out[~good] = _kth_unmarked(marked, ranks)
-    return out
-
-
-@njit(cache=True, nogil=True)
-def _draw_two_level_seeded(marks: np.ndarray, p_good: float, shots: int, words: np.ndarray) -> np.ndarray:
-    """``_draw_two_level(marks, p_good, shots, Generator(PCG64(words)))``, compiled: the same
-    draws in the same order (``shots`` doubles, then the marked picks, then the unmarked ranks, each
-    an ``integers(0, high)`` draw), so the same indices. Needs N <= 2^32 (32-bit bounded draws)."""
-    if shots <= _SCANNED_SHOTS:
-        return _draw_two_level_scanned(marks, p_good, shots, words)
-    return _draw_two_level_listed(marks, p_good, shots, words)
-
-
-@njit(cache=True, nogil=True)
-def _draw_two_level_listed(marks: np.ndarray, p_good: float, shots: int, words: np.ndarray) -> np.ndarray:
-    """``_draw_two_level_seeded`` through the lists of marked and unmarked entries (what more
-    than ``_SCANNED_SHOTS`` shots take)."""
-    size = marks.shape[0]
-    marked = np.flatnonzero(marks)
-    num_marked = marked.shape[0]
-    if num_marked == 0 or num_marked == size:
-        p_good = 1.0 if num_marked == size else 0.0
-    state = _pcg_state(words)
-    good = np.empty(shots, dtype=np.bool_)
-    num_good = 0
-    for shot in range(shots):
-        good[shot] = _next_double(state) < p_good
-        num_good += good[shot]
-    out = np.empty(shots, dtype=np.int64)
-    if num_good:
-        for shot in range(shots):
-            if good[shot]:
-                out[shot] = marked[_bounded_below(state, num_marked)]
-    if num_good < shots:
-        shifted = marked - np.arange(num_marked)
-        for shot in range(shots):
-            if not good[shot]:
-                rank = _bounded_below(state, size - num_marked)
-                out[shot] = rank + np.searchsorted(shifted, rank, side="right")
-    return out
-
-
-#: at most this many shots, ``_draw_two_level_seeded`` finds each drawn entry by a scan of the marks
-#: (``_draw_two_level_scanned``: one pass to count and on average half a pass per shot) instead of
-#: building the lists of marked and unmarked entries (``_draw_two_level_listed``: about three
-#: passes). One shot, what q-RRT draws a round, is faster by the scan at every N measured (2^8 to
-#: 2^16), two about even, eight slower (``python benchmarks/bench_round_parts.py``).
-_SCANNED_SHOTS = 1
-
-
-@njit(cache=True, nogil=True)
-def _draw_two_level_scanned(marks: np.ndarray, p_good: float, shots: int, words: np.ndarray) -> np.ndarray:
-    """``_draw_two_level_seeded`` for a few shots: the same draws in the same order, the j-th marked
-    (or unmarked) entry found by scanning ``marks`` (no index arrays allocated)."""
-    size = marks.shape[0]
-    num_marked = 0
-    for entry in range(size):
-        num_marked += marks[entry]
-    if num_marked == 0 or num_marked == size:
-        p_good = 1.0 if num_marked == size else 0.0
-    state = _pcg_state(words)
-    good = np.empty(shots, dtype=np.bool_)
-    for shot in range(shots):
-        good[shot] = _next_double(state) < p_good
-    out = np.empty(shots, dtype=np.int64)
-    for want_marked in (True, False):  # the marked picks first, then the unmarked ranks (as the lists do)
-        for shot in range(shots):
-            if good[shot] != want_marked:
-                continue
-            rank = _bounded_below(state, num_marked if want_marked else size - num_marked)
-            entry = 0
-            while True:  # the rank-th entry (0-based) whose mark is want_marked
-                if marks[entry] == want_marked:
-                    if rank == 0:
-                        break
-                    rank -= 1
-                entry += 1
-            out[shot] = entry
     return out
 
 
