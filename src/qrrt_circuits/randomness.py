@@ -278,8 +278,9 @@ def uniform_draws(streams: RandomStreams, keys: np.ndarray, count: int) -> np.nd
     Raises:
         ValueError: A negative key.
     """
-    keys = np.ascontiguousarray(keys, dtype=np.int64).reshape(-1, 3)
-    out = np.empty((keys.shape[0], int(count)))
-    for row, words in enumerate(streams.seed_words(keys)):
-        out[row] = np.random.Generator(np.random.PCG64(_SeedWords(words))).random(int(count))  # type: ignore[arg-type]
-    return out
+    count = int(count)
+    words = streams.seed_words(keys)
+    if not words.shape[0]:
+        return np.empty((0, count))
+    return np.array([np.random.Generator(np.random.PCG64(_SeedWords(row))).random(count)  # type: ignore[arg-type]
+                     for row in words])

@@ -23,6 +23,7 @@ import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 from enum import StrEnum
+from typing import ClassVar, NamedTuple
 
 from .validation import check_int, check_positive_float
 
@@ -73,9 +74,8 @@ class PlanStatus(StrEnum):
         return self is PlanStatus.REACHED
 
 
-@dataclass(frozen=True)
-class Progress:
-    """What the conditions may look at: the plan's counters before the next round.
+class Progress(NamedTuple):
+    """What the conditions may look at: the plan's counters before the next round (immutable).
 
     Args:
         oracle_calls: Oracle calls so far (quantum + verification, DESIGN §2).
@@ -172,11 +172,11 @@ class _Limit(TerminationCondition):
     def __post_init__(self) -> None:  # kept as a Python int (a numpy integer wrapped in limit arithmetic)
         object.__setattr__(self, "limit", check_int(self.limit, f"{type(self).__name__}.limit", 1))
 
-    def _value(self, progress: Progress) -> float:
-        raise NotImplementedError
+    #: the ``Progress`` field this limit counts
+    counter: ClassVar[str] = "rounds"
 
     def ended_by(self, progress: Progress) -> PlanStatus | None:
-        return self.status if self._value(progress) >= self.limit else None
+        return self.status if getattr(progress, self.counter) >= self.limit else None
 
     def describe(self) -> dict:
         return {str(self.status): self.limit}
@@ -204,8 +204,7 @@ class MaxOracleCalls(_Limit):
 
     status = PlanStatus.MAX_ORACLE_CALLS
 
-    def _value(self, progress: Progress) -> float:
-        return progress.oracle_calls
+    counter = "oracle_calls"
 
 
 @dataclass(frozen=True)
@@ -225,8 +224,7 @@ class MaxCriticalPathCalls(_Limit):
 
     status = PlanStatus.MAX_CRITICAL_PATH_CALLS
 
-    def _value(self, progress: Progress) -> float:
-        return progress.critical_path_oracle_calls
+    counter = "critical_path_oracle_calls"
 
 
 @dataclass(frozen=True)
@@ -246,8 +244,7 @@ class MaxNodes(_Limit):
 
     status = PlanStatus.MAX_NODES
 
-    def _value(self, progress: Progress) -> float:
-        return progress.nodes
+    counter = "nodes"
 
     @property
     def node_limit(self) -> int:
@@ -272,8 +269,7 @@ class MaxRounds(_Limit):
 
     status = PlanStatus.MAX_ROUNDS
 
-    def _value(self, progress: Progress) -> float:
-        return progress.rounds
+    counter = "rounds"
 
     @property
     def limits_rounds(self) -> bool:
@@ -309,8 +305,7 @@ class Stall(_Limit):
 
     status = PlanStatus.STALLED
 
-    def _value(self, progress: Progress) -> float:
-        return progress.rounds_without_new_node
+    counter = "rounds_without_new_node"
 
     def describe(self) -> dict:
         return {"stall_rounds": self.limit}
