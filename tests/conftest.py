@@ -37,7 +37,23 @@ def random_marks(rng: np.random.Generator, num_qubits: int, num_marked: int) -> 
 
 
 @pytest.fixture(scope="session", autouse=True)
-def no_leftovers():
+def private_temp(tmp_path_factory):
+    """Every temporary file of this test session (and of the processes it starts) goes to a folder
+    of its own, so the checks below see only what this session created, whatever other runs on the
+    machine leave in the shared temporary folder."""
+    folder = str(tmp_path_factory.mktemp("tmp"))
+    saved_env, saved = os.environ.get("TMPDIR"), tempfile.tempdir
+    os.environ["TMPDIR"], tempfile.tempdir = folder, folder
+    yield folder
+    tempfile.tempdir = saved
+    if saved_env is None:
+        os.environ.pop("TMPDIR", None)
+    else:
+        os.environ["TMPDIR"] = saved_env
+
+
+@pytest.fixture(scope="session", autouse=True)
+def no_leftovers(private_temp):
     """After the whole run: no child processes and no Dask scratch files left behind."""
     prefixes = ("dask-scratch", "qrrt-dask-")
     scratch = {name for name in os.listdir(tempfile.gettempdir()) if name.startswith(prefixes)}

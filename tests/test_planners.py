@@ -46,7 +46,7 @@ def test_rrt_oracle_calls_are_its_reachability_tests(clutter):
     result = planner.plan(max_rounds=300)
     assert result.metrics.oracle_calls == 300 == result.metrics.rounds
     # batched rounds: every evaluation is a round's test or a dropped test of a later round
-    assert planner.oracle.evaluations == 300 + result.metrics.wasted_checks
+    assert planner.predicate.evaluations == 300 + result.metrics.wasted_checks
     assert result.metrics.quantum_oracle_calls == 0 and result.metrics.simulation_checks == 0
 
 
@@ -59,7 +59,7 @@ def test_parallel_rrt_counts_per_worker_and_critical_path(clutter):
 def test_quantum_counting_with_fixed_iterations(clutter):
     k, p, rounds = 3, 4, 25
     result = qc.PQRRT(clutter, backend=qc.StatevectorBackend(seed=0), workers=p,
-                      iterations=qc.FixedIterations(k), seed=0).plan(max_rounds=rounds)
+                      search_policy=qc.FixedIterations(k), seed=0).plan(max_rounds=rounds)
     m = result.metrics
     assert m.quantum_oracle_calls == rounds * p * k
     assert m.verification_calls == rounds * p
@@ -67,7 +67,7 @@ def test_quantum_counting_with_fixed_iterations(clutter):
     assert m.simulation_checks == rounds * 256 and m.databases == rounds
     assert m.nodes + m.duplicates + m.rejected == rounds * p
     unshared = qc.PQRRT(clutter, backend=qc.StatevectorBackend(seed=0), workers=p,
-                        shared_database=False, iterations=qc.FixedIterations(k),
+                        shared_database=False, search_policy=qc.FixedIterations(k),
                         seed=0).plan(max_rounds=rounds)
     assert unshared.metrics.databases == rounds * p
     assert unshared.metrics.simulation_checks == rounds * p * 256
@@ -94,7 +94,7 @@ def test_qrrt_adds_nodes_at_the_grover_rate(backend_name, clutter):
 def test_shared_database_duplicates_are_dropped(clutter):
     # 32 workers on a 16-entry database: many measure the same solution
     result = qc.PQRRT(clutter, backend=qc.StatevectorBackend(seed=0), num_qubits=4, workers=32,
-                      iterations=qc.FixedIterations(1), seed=0).plan(max_rounds=20)
+                      search_policy=qc.FixedIterations(1), seed=0).plan(max_rounds=20)
     assert result.metrics.duplicates > 0
     rows = {tuple(row) for row in result.nodes}
     assert len(rows) == len(result.nodes)
@@ -132,7 +132,7 @@ def test_process_pool_executor_gives_the_serial_result(name, clutter):
     assert serial.metrics.oracle_calls == parallel.metrics.oracle_calls
 
 
-def test_unreachable_goal_ends_with_budget_exhausted():
+def test_unreachable_goal_ends_without_reaching():
     # the goal is walled in: no plan can reach it
     boxes = np.array([[[14, 14], [18, 14.5]], [[14, 17.5], [18, 18]], [[14, 14], [14.5, 18]],
                       [[17.5, 14], [18, 18]]], dtype=float)
@@ -140,7 +140,7 @@ def test_unreachable_goal_ends_with_budget_exhausted():
     for planner in (qc.RRT(env, seed=0), qc.QRRT(env, backend=qc.StatevectorBackend(0), seed=0)):
         result = planner.plan([2, 2], [16, 16], 0.5, max_oracle_calls=400)
         assert result.status == qc.PlanStatus.MAX_ORACLE_CALLS == "max_oracle_calls"
-        assert result.path is None and result.budget_exhausted and not result.reached
+        assert result.path is None and not result.reached
         assert 400 <= result.metrics.oracle_calls < 400 + 7
 
 
@@ -181,10 +181,10 @@ def test_bbht_terminates_with_no_solution_and_respects_its_bound():
 
 
 def test_known_optimal_is_labelled_and_adaptive_is_not(clutter):
-    known = qc.QRRT(clutter, backend=qc.StatevectorBackend(0), iterations=qc.KnownOptimal(),
+    known = qc.QRRT(clutter, backend=qc.StatevectorBackend(0), search_policy=qc.KnownOptimal(),
                     seed=0).plan(max_rounds=5)
     assert any("true marked count" in label for label in known.labels)
-    adaptive = qc.QRRT(clutter, backend=qc.StatevectorBackend(0), iterations=qc.Adaptive(),
+    adaptive = qc.QRRT(clutter, backend=qc.StatevectorBackend(0), search_policy=qc.Adaptive(),
                        seed=0).plan(max_rounds=5)
     assert not any("true marked count" in label for label in adaptive.labels)
     assert any("classical lookup" in label for label in adaptive.labels)
@@ -215,7 +215,7 @@ def test_adaptive_posterior_covers_the_hidden_fraction_and_picks_its_argmax(mark
 
 def test_annealing_first_band_distance(clutter):
     schedule = qc.AnnealingSchedule(bands=[(2.7, 4.2), (0.8, 2.0)], switch_at=[1000])
-    planner = qc.QRRT(clutter, backend=qc.StatevectorBackend(0), iterations=qc.FixedIterations(2),
+    planner = qc.QRRT(clutter, backend=qc.StatevectorBackend(0), search_policy=qc.FixedIterations(2),
                       annealing=schedule, seed=0)
     result = planner.plan(max_nodes=25)
     distances = np.linalg.norm(result.nodes[1:] - result.nodes[result.parents[1:]], axis=1)

@@ -25,7 +25,6 @@ from .search.policies import (
     IterationPolicy,
     KnownOptimal,
     PaperSchedule,
-    SearchPolicy,
 )
 from .search.problem import DatabaseSearch, SearchOutcome
 from .termination import (
@@ -57,7 +56,12 @@ _LAZY = ("AerBackend", "EstimatedOptimal", "FixedPointAmplification", "IterateSe
 
 
 def __getattr__(name: str) -> Any:
-    """``qrrt_circuits.search``'s lazily imported names, cached here on first use."""
+    """``qrrt_circuits.search``'s lazily imported names, cached here on first use; deprecated names."""
+    if name == "SearchPolicy":
+        from .deprecation import warn_deprecated
+
+        warn_deprecated("qrrt_circuits.SearchPolicy", "qrrt_circuits.IterationPolicy")
+        return IterationPolicy
     if name in _LAZY:
         from . import search
 
@@ -110,7 +114,6 @@ __all__ = [
     "ReachabilityPredicate",
     "SamplerBackend",
     "SearchOutcome",
-    "SearchPolicy",
     "SearchRequest",
     "SearchResult",
     "Stall",

@@ -168,7 +168,11 @@ class ReachabilityOracle:
                 resolution: float = 0.01, check: str = "exact", time_samples: int = 50) -> Any:
         # Any: a ReachabilityOracle, or for check="time_samples" a TimeSampledCheck (0.1's alias)
         if check == "time_samples":
+            from .deprecation import warn_deprecated
             from .time_sampled import TimeSampledCheck
+
+            warn_deprecated("ReachabilityOracle(check='time_samples', time_samples=K)",
+                            "TimeSampledCheck(env, dynamics, time_samples=K)")
 
             return TimeSampledCheck(env, dynamics, time_samples=time_samples)
         if check != "exact":

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .. import termination as _termination
+from ..deprecation import warn_deprecated
 from ..dynamics import LinearTrackingDynamics
 from ..environment import Environment
 from ..memory import check_plan_fits
@@ -39,7 +40,7 @@ from ..termination import (
     limits_in_force,
     with_defaults,
 )
-from ..validation import check_float, check_instance, check_int, check_real_array, check_seed
+from ..validation import check_float, check_instance, check_real_array, check_seed
 from .context import RoundView, WorkerContext
 from .result import Metrics, PlanResult
 from .run_state import RunState, first_in_ball
@@ -47,25 +48,28 @@ from .run_state import RunState, first_in_ball
 if TYPE_CHECKING:
     from ..search.policies import PolicyState
 
-#: kept for 0.1 code that imports it from here; the value lives in ``qrrt_circuits.termination``
-DEFAULT_MAX_ROUNDS = _termination.DEFAULT_MAX_ROUNDS
-
-__all__ = ["DEFAULT_MAX_ROUNDS", "Metrics", "PlanResult", "Planner", "RunState"]
+__all__ = ["Metrics", "PlanResult", "Planner", "RunState"]
 
 
-def _check_count(value: Any, name: str, minimum: int = 1) -> int:
-    """0.1's integer check, kept for callers outside the package."""
-    return check_int(value, name, minimum)
+def __getattr__(name: str) -> Any:
+    """Deprecated names of this module."""
+    if name == "DEFAULT_MAX_ROUNDS":
+        warn_deprecated("qrrt_circuits.planners.base.DEFAULT_MAX_ROUNDS",
+                        "qrrt_circuits.termination.DEFAULT_MAX_ROUNDS")
+        return _termination.DEFAULT_MAX_ROUNDS
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def resolve_predicate(env: Environment, predicate: ReachabilityPredicate | None,
                       oracle: ReachabilityPredicate | None, dynamics: LinearTrackingDynamics | None,
                       resolution: float) -> ReachabilityPredicate:
-    """The planner's predicate: ``predicate=`` (or its alias ``oracle=``), else the sound
+    """The planner's predicate: ``predicate=`` (or its deprecated alias ``oracle=``), else the sound
     ``ReachabilityOracle`` built with ``dynamics`` and ``resolution``."""
-    if predicate is not None and oracle is not None and predicate is not oracle:
-        raise ValueError("give predicate= or its alias oracle=, not both")
-    predicate = oracle if predicate is None else predicate
+    if oracle is not None:
+        warn_deprecated("the planners' oracle= argument", "predicate=")
+        if predicate is not None and predicate is not oracle:
+            raise ValueError("give predicate= or its deprecated alias oracle=, not both")
+        predicate = oracle
     if predicate is None:
         if dynamics is not None:
             check_instance(dynamics, "dynamics", LinearTrackingDynamics, "a LinearTrackingDynamics")
@@ -114,10 +118,10 @@ class Planner:
         self.streams = RandomStreams.from_seed(self.seed)
         self.executor = executor
 
-    # ----------------------------------------------------------------- aliases kept from 0.1
     @property
     def oracle(self) -> ReachabilityPredicate:
-        """Alias of ``predicate``."""
+        """Deprecated alias of ``predicate``."""
+        warn_deprecated("Planner.oracle", "Planner.predicate")
         return self.predicate
 
     def rng(self, round_index: int, worker: int = 0, stream: int = Stream.CANDIDATES) -> np.random.Generator:

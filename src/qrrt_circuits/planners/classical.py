@@ -121,8 +121,7 @@ class ParallelRRT(Planner):
         seed: Non-negative integer seed of the keyed random streams (one generator per (round,
             worker, stream), so results do not depend on the executor or the order of the calls), or
             None (default) for fresh entropy.
-        oracle: Alias of ``predicate`` kept from 0.1; giving both (as different objects) is an
-            error.
+        oracle: Deprecated alias of ``predicate``.
 
     Raises:
         TypeError: An argument of the wrong type: ``env`` not an ``Environment``, a non-integer
@@ -280,8 +279,7 @@ class RRT(ParallelRRT):
         seed: Non-negative integer seed of the keyed random streams (one generator per (round,
             worker, stream), so results do not depend on the executor or the order of the calls), or
             None (default) for fresh entropy.
-        oracle: Alias of ``predicate`` kept from 0.1; giving both (as different objects) is an
-            error.
+        oracle: Deprecated alias of ``predicate``.
 
     Raises:
         TypeError: An argument of the wrong type: ``env`` not an ``Environment``, a non-integer

@@ -25,6 +25,7 @@ from __future__ import annotations
 from concurrent.futures import Executor
 
 from ..database import AnnealingSchedule
+from ..deprecation import warn_deprecated
 from ..dynamics import LinearTrackingDynamics
 from ..environment import Environment
 from ..memory import MemoryEstimate, check_fits, database_bytes, database_resident_bytes
@@ -99,10 +100,8 @@ class PQRRT(Planner):
         seed: Non-negative integer seed of the keyed random streams (one generator per (round,
             worker, stream), so results do not depend on the executor or the order of the calls), or
             None (default) for fresh entropy.
-        oracle: Alias of ``predicate`` kept from 0.1; giving both (as different objects) is an
-            error.
-        iterations: Alias of ``search_policy`` kept from 0.1; giving both (as different objects) is
-            an error.
+        oracle: Deprecated alias of ``predicate``.
+        iterations: Deprecated alias of ``search_policy``.
 
     Raises:
         TypeError: An argument of the wrong type: ``env`` not an ``Environment``, a non-integer
@@ -149,9 +148,12 @@ class PQRRT(Planner):
             backend = AerBackend()
         check_instance(backend, "backend", QuantumSearchBackend, "a QuantumSearchBackend")
         backend.check_qubits(self.num_qubits)
-        if search_policy is not None and iterations is not None and search_policy is not iterations:
-            raise ValueError("give search_policy= or its alias iterations=, not both")
-        policy = search_policy if search_policy is not None else iterations
+        policy = search_policy
+        if iterations is not None:
+            warn_deprecated("the quantum planners' iterations= argument", "search_policy=")
+            if search_policy is not None and search_policy is not iterations:
+                raise ValueError("give search_policy= or its deprecated alias iterations=, not both")
+            policy = iterations
         policy = PaperSchedule() if policy is None else policy
         check_instance(policy, "search_policy", IterationPolicy,
                        "a search policy (PaperSchedule(), FixedIterations(k), KnownOptimal(), BBHT(), Adaptive())")
@@ -196,7 +198,8 @@ class PQRRT(Planner):
 
     @property
     def iterations_policy(self) -> IterationPolicy:
-        """Alias of ``search_policy`` (0.1's attribute name)."""
+        """Deprecated alias of ``search_policy``."""
+        warn_deprecated("PQRRT.iterations_policy", "PQRRT.search_policy")
         return self.search_policy
 
     @property
@@ -326,10 +329,8 @@ class QRRT(PQRRT):
         seed: Non-negative integer seed of the keyed random streams (one generator per (round,
             worker, stream), so results do not depend on the executor or the order of the calls), or
             None (default) for fresh entropy.
-        oracle: Alias of ``predicate`` kept from 0.1; giving both (as different objects) is an
-            error.
-        iterations: Alias of ``search_policy`` kept from 0.1; giving both (as different objects) is
-            an error.
+        oracle: Deprecated alias of ``predicate``.
+        iterations: Deprecated alias of ``search_policy``.
 
     Raises:
         TypeError: An argument of the wrong type: ``env`` not an ``Environment``, a non-integer

@@ -141,7 +141,10 @@ class PlanResult:
 
     @property
     def budget_exhausted(self) -> bool:
-        """0.1's status "budget_exhausted": a termination condition ended the plan."""
+        """Deprecated: ``not reached`` (a termination condition ended the plan)."""
+        from ..deprecation import warn_deprecated
+
+        warn_deprecated("PlanResult.budget_exhausted", "not PlanResult.reached")
         return not self.reached
 
     @property

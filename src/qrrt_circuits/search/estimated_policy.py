@@ -136,7 +136,6 @@ class EstimatedOptimalState(PolicyState):
     def choose_iterations(self, tree_nodes: int, num_marked: int | None = None) -> int:
         raise TypeError("EstimatedOptimal chooses k per database from its estimate (see run)")
 
-    iterations = choose_iterations
 
     def run(self, problem: DatabaseSearch, workers: int, tree_nodes: int) -> tuple[SearchOutcome, ...]:
         """Estimate the database's m, then ``workers`` workers search it with the optimal k.

@@ -45,6 +45,7 @@ from typing import Any
 
 import numpy as np
 
+from ..deprecation import warn_deprecated
 from ..probability import optimal_iterations
 from ..validation import check_choice, check_float, check_int, check_optional_int
 from .backend import MAX_ITERATIONS, validate_iterations
@@ -60,7 +61,6 @@ __all__ = [
     "KnownOptimal",
     "PaperSchedule",
     "PolicyState",
-    "SearchPolicy",
     "parse_policy",
 ]
 
@@ -152,8 +152,12 @@ class IterationPolicy:
         raise NotImplementedError
 
 
-#: the name the planners' ``search_policy=`` argument uses for these objects
-SearchPolicy = IterationPolicy
+def __getattr__(name: str) -> Any:
+    """Deprecated names of this module."""
+    if name == "SearchPolicy":
+        warn_deprecated("SearchPolicy", "IterationPolicy")
+        return IterationPolicy
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 class PolicyState:
@@ -188,8 +192,10 @@ class PolicyState:
         """
         return self.policy._iterations(self.num_items, tree_nodes, num_marked)
 
-    #: alias kept from 0.1 (``state.iterations(tree_nodes)``)
-    iterations = choose_iterations
+    def iterations(self, tree_nodes: int, num_marked: int | None = None) -> int:
+        """Deprecated alias of ``choose_iterations``."""
+        warn_deprecated("PolicyState.iterations(...)", "PolicyState.choose_iterations(...)")
+        return self.choose_iterations(tree_nodes, num_marked)
 
     def iterations_for(self, problem: DatabaseSearch, tree_nodes: int) -> int:
         """The policy's k for ``problem`` (``IterationPolicy.iterations_for``).
@@ -491,7 +497,6 @@ class BBHTState(PolicyState):
     def choose_iterations(self, tree_nodes: int, num_marked: int | None = None) -> int:
         raise TypeError("BBHT chooses its iterations inside its own loop (BBHT.run)")
 
-    iterations = choose_iterations
 
     def run(self, problem: DatabaseSearch, workers: int, tree_nodes: int) -> tuple[SearchOutcome, ...]:
         outcomes = []
@@ -604,7 +609,6 @@ class AdaptiveState(PolicyState):
         expected = self.success @ weights
         return int(self.candidates[np.argmax(expected / (self.candidates + 1))])
 
-    iterations = choose_iterations
 
     def iterations_for(self, problem: DatabaseSearch, tree_nodes: int) -> int:
         """The posterior's k (``choose_iterations``); the problem's true m is never read.
