@@ -92,7 +92,8 @@ def _seed_words(run_entropy: np.ndarray, keys: np.ndarray) -> np.ndarray:
     count = keys.shape[0]
     out = np.empty((count, 4), dtype=np.uint64)
     entropy = np.empty(run_entropy.shape[0] + 2 * keys.shape[1], dtype=np.uint64)
-    entropy[: run_entropy.shape[0]] = run_entropy
+    for i in range(run_entropy.shape[0]):  # (an element loop: a slice assignment compiles numba's shape-error text)
+        entropy[i] = run_entropy[i]
     hash_const = np.empty(1, dtype=np.uint64)
     mixer = np.empty(_POOL_SIZE, dtype=np.uint64)
     state = np.empty(8, dtype=np.uint64)

@@ -385,7 +385,7 @@ def _grid_search(points: np.ndarray, start: np.ndarray, order: np.ndarray, order
                         for axis in range(dim):
                             delta = point[axis] - ordered[slot, axis]
                             squared += delta * delta
-                        candidate = order[slot]  # the update without branches (see _grid_search_2d)
+                        candidate = order[slot]  # the update without branches
                         nearer = (squared < nearest) | ((squared == nearest) & (candidate < nearest_index))
                         nearest = squared if nearer else nearest
                         nearest_index = candidate if nearer else nearest_index
@@ -425,105 +425,10 @@ def _grid_search(points: np.ndarray, start: np.ndarray, order: np.ndarray, order
 
 
 @njit(cache=True, nogil=True)
-def _grid_search_2d(points: np.ndarray, start: np.ndarray, order: np.ndarray, ordered: np.ndarray,
-                    origin: np.ndarray, cell: float, shape: np.ndarray, low: np.ndarray, high: np.ndarray,
-                    best: np.ndarray, out: np.ndarray) -> None:
-    """``_grid_search`` in two dimensions (the planners' case), unrolled: the same cells visited in
-    the same rings and the same answers; the stopping bound is the same up to rounding (it adds the
-    other axis's squared distance to the box directly, where ``_grid_search`` subtracts from the
-    total), which its slack covers. The first visit, the block of 3 x 3 cells, scans its three column
-    runs as one loop (slot j of the runs put end to end found without a branch): one loop exit to
-    mispredict per query instead of three."""
-    columns, rows = shape[0], shape[1]
-    for row in range(points.shape[0]):
-        x, y = points[row, 0], points[row, 1]
-        u = (x - origin[0]) / cell  # the cell of the point, clamped to the grid (as ``_cell_of``)
-        v = (y - origin[1]) / cell
-        cx = 0 if u < 0.0 else (columns - 1 if u >= columns else min(int(u), columns - 1))
-        cy = 0 if v < 0.0 else (rows - 1 if v >= rows else min(int(v), rows - 1))
-        outside_x = max(low[0] - x, x - high[0], 0.0)
-        outside_y = max(low[1] - y, y - high[1], 0.0)
-        slack_x = _EDGE_SLACK * (abs(x) + abs(origin[0]) + columns * cell)
-        slack_y = _EDGE_SLACK * (abs(y) + abs(origin[1]) + rows * cell)
-        nearest = best[row]
-        nearest_index = out[row]
-        # the first visit: the block of 3 x 3 cells, as the runs of its columns c0, cx, c2 (each
-        # [first_y, last_y]; at the grid's edge a column outside is an empty run) in one loop
-        first_y, last_y = max(cy - 1, 0), min(cy + 1, rows - 1)
-        c0, c2 = max(cx - 1, 0), min(cx + 1, columns - 1)
-        f0, s0 = start[c0 * rows + first_y], start[c0 * rows + last_y + 1]
-        f1, s1 = (start[cx * rows + first_y], start[cx * rows + last_y + 1]) if c0 < cx else (s0, s0)
-        f2, s2 = (start[c2 * rows + first_y], start[c2 * rows + last_y + 1]) if c2 > cx else (s1, s1)
-        n0 = s0 - f0
-        n01 = n0 + s1 - f1
-        skip0, skip1 = f1 - s0, f2 - s1
-        # slot j of the three runs put end to end; the scan is written out here and in the rings below
-        # (an inlined helper for both was slower, in a scratch timing not kept)
-        for j in range(n01 + s2 - f2):
-            slot = f0 + j + (skip0 if j >= n0 else 0) + (skip1 if j >= n01 else 0)
-            dx = x - ordered[slot, 0]
-            dy = y - ordered[slot, 1]
-            squared = dx * dx + dy * dy
-            candidate = order[slot]  # the update as selects, without a branch to mispredict
-            nearer = (squared < nearest) | ((squared == nearest) & (candidate < nearest_index))
-            nearest = squared if nearer else nearest
-            nearest_index = candidate if nearer else nearest_index
-        ring = 1  # as ``_grid_search``: the block covers rings 0 and 1
-        while True:
-            bound = np.inf  # as ``_grid_search``
-            covers = True
-            if cx - ring - 1 >= 0:
-                covers = False
-                gap = max(x - (origin[0] + (cx - ring) * cell) - slack_x, 0.0)
-                bound = min(bound, gap * gap + outside_y * outside_y)
-            if cx + ring + 1 <= columns - 1:
-                covers = False
-                gap = max(origin[0] + (cx + ring + 1) * cell - x - slack_x, 0.0)
-                bound = min(bound, gap * gap + outside_y * outside_y)
-            if cy - ring - 1 >= 0:
-                covers = False
-                gap = max(y - (origin[1] + (cy - ring) * cell) - slack_y, 0.0)
-                bound = min(bound, gap * gap + outside_x * outside_x)
-            if cy + ring + 1 <= rows - 1:
-                covers = False
-                gap = max(origin[1] + (cy + ring + 1) * cell - y - slack_y, 0.0)
-                bound = min(bound, gap * gap + outside_x * outside_x)
-            if covers or bound > nearest * (1.0 + _EDGE_SLACK):
-                break
-            ring += 1
-            # visit the cells of ring ``ring`` (clipped to the grid): the whole run of its first and
-            # last columns, the two end cells of the others
-            first_y, last_y = max(cy - ring, 0), min(cy + ring, rows - 1)
-            for column in range(max(cx - ring, 0), min(cx + ring, columns - 1) + 1):
-                prefix = column * rows
-                whole = column == cx - ring or column == cx + ring  # the whole run is unvisited
-                for end in range(2):  # whole: the run [first_y, last_y], once; else its two end cells
-                    if whole:
-                        if end:
-                            break
-                        first, stop = start[prefix + first_y], start[prefix + last_y + 1]
-                    else:
-                        cell_y = cy - ring if end == 0 else cy + ring
-                        if cell_y < 0 or cell_y > rows - 1:
-                            continue
-                        first, stop = start[prefix + cell_y], start[prefix + cell_y + 1]
-                    for slot in range(first, stop):  # the scan written out (an inlined helper was slower)
-                        dx = x - ordered[slot, 0]
-                        dy = y - ordered[slot, 1]
-                        squared = dx * dx + dy * dy
-                        candidate = order[slot]  # the update as selects, without a branch to mispredict
-                        nearer = (squared < nearest) | ((squared == nearest) & (candidate < nearest_index))
-                        nearest = squared if nearer else nearest
-                        nearest_index = candidate if nearer else nearest_index
-        best[row] = nearest
-        out[row] = nearest_index
-
-
-@njit(cache=True, nogil=True)
 def nearest_into(points: np.ndarray, nodes: np.ndarray, size: int, built: int, start: np.ndarray, order: np.ndarray,
                  ordered: np.ndarray, origin: np.ndarray, cell: float, shape: np.ndarray, low: np.ndarray,
                  high: np.ndarray, out: np.ndarray) -> None:
-    """``Tree.nearest`` compiled (the arguments after ``points`` are ``Tree.search_arrays()``): the
+    """``Tree.nearest`` compiled (the arguments after ``points`` are ``Tree._search_arrays``): the
     brute force over the nodes the grid does not hold (all of them without a grid), then the
     grid's ring search from that best; writes the node indices into ``out``.
 
@@ -536,7 +441,5 @@ def nearest_into(points: np.ndarray, nodes: np.ndarray, size: int, built: int, s
                 raise ValueError(_NOT_FINITE)
     best = np.empty(points.shape[0])
     _brute_block(points, nodes, built, size, best, out)
-    if built and points.shape[1] == 2:
-        _grid_search_2d(points, start, order, ordered, origin, cell, shape, low, high, best, out)
-    elif built:
+    if built:
         _grid_search(points, start, order, ordered, origin, cell, shape, low, high, best, out)
