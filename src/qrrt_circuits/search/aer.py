@@ -7,19 +7,11 @@ circuit (``aer_literal_grover_circuit``: h, x, mcphase) is run instead, so per-g
 the paper's gates. Each shot is an independent preparation, k Grover iterations and a measurement
 (``memory=True`` keeps them per shot).
 
-Without a noise model the circuit's instructions (``aer_direct.assemble_grover``) go to the simulator's
-C++ controller directly (``aer_direct``): the same simulation, the same configuration and the same
-measured words as ``AerSimulator.run`` (tested seed by seed), without the job thread, Aer's generic
-assembler and the ``Result`` conversion, which cost more than simulating these small circuits.
-Circuits on fewer than 13 qubits (``STATE_CHOSEN_BELOW_QUBITS``; ``aer_state`` simulates what the
-controller does up to 13), on the statevector method and
-the CPU with the simulator's options as made here, run instead on Aer's own statevector state
-(``aer_state``: the circuit's instructions applied one by one to ``AerState``, the state behind
-``AerStatevector``, then Aer's sampler with the same seed): again the same measured words as
-``AerSimulator.run`` (tested seed by seed), at about half the controller's fixed cost per run
-(61 against 113 us at k = 0, n = 8: ``bench_aer_overhead.py`` in ``benchmarks/results/run_c22abd7.json``).
-Independent searches (``search_many``) run one after the other: in a multi-circuit run Aer seeds
-circuit i with ``seed_simulator + 2113 i``, so one run cannot give each database its own seed.
+Every circuit runs through ``AerSimulator.run`` (Aer's documented interface), built once per
+search in the compact form Aer executes without a transpile; the simulator seed is drawn from the
+search's generator (``seed_simulator``), so a seeded search is reproducible. Independent searches
+(``search_many``) run one after the other: in a multi-circuit run Aer seeds circuit i with
+``seed_simulator + 2113 i``, so one run cannot give each database its own seed.
 
 Threads: Aer parallelises a state update only from ``statevector_parallel_threshold`` (14) qubits
 on; below it, extra OpenMP threads only cost their start-up and synchronisation (on a loaded
@@ -36,8 +28,7 @@ import numpy as np
 from qiskit_aer import AerSimulator
 
 from ..validation import check_int
-from . import aer_direct, aer_state
-from .aer_circuits import GroverProgram, simulation_synthesis_for
+from .aer_circuits import simulation_synthesis_for
 from .backend import QuantumSearchBackend, seed_stream
 from .circuits import SYNTHESES, aer_grover_circuit, aer_literal_grover_circuit, oracle_cx_estimate
 from .fixed_point import generalized_grover_circuit
@@ -51,13 +42,6 @@ if TYPE_CHECKING:
 METHODS = ("statevector", "automatic")
 #: circuits on fewer qubits run single-threaded (Aer's default statevector_parallel_threshold)
 SERIAL_BELOW_QUBITS = 14
-#: circuits on fewer qubits run on Aer's state (``aer_state``, which simulates what the controller
-#: does below 14 qubits): ``python benchmarks/bench_search.py``'s ``state_paths`` (both oracle
-#: forms, n = 10-13, m = 1 and 12, k = 12, 8 shots; ``benchmarks/results/run_c22abd7.json``) found
-#: the state faster in every case up to n = 12 (0.68-0.91 times the controller's time) and the mcz
-#: form slower at n = 13 (1.19 times: its X-strings one ``apply_x`` per qubit where the controller
-#: runs one ``pauli``)
-STATE_CHOSEN_BELOW_QUBITS = 13
 #: On the GPU, Aer sizes its matrix buffer for a dense matrix on the widest instruction's qubits
 #: (4^b complex128 entries for b qubits: ``DeviceChunkContainer::calculate_matrix_buffer_size`` in
 #: qiskit-aer 0.18), so a diagonal oracle on n qubits takes 16 * 4^n bytes of GPU memory: on an H200
@@ -79,10 +63,9 @@ UNSUPPORTED_METHODS = {
 class AerBackend(QuantumSearchBackend):
     """Gate-level Grover search (paper Alg. 2, lines 4-8) on ``AerSimulator(method=...)``.
 
-    Each search runs the Grover circuit of the marks (``aer_grover_circuit``, applied to Aer's
-    state instruction by instruction below 13 qubits, ``aer_state``, or handed to Aer's
-    controller as its instructions, ``aer_direct``; with a noise model the gate-by-gate
-    ``aer_literal_grover_circuit`` through ``AerSimulator.run``) with ``shots`` shots; a
+    Each search runs the Grover circuit of the marks through ``AerSimulator.run``
+    (``aer_grover_circuit``; with a noise model the gate-by-gate ``aer_literal_grover_circuit``)
+    with ``shots`` shots; a
     marked index is measured with probability sin^2((2k+1) theta), sin^2 theta = m / 2^n (paper
     Eq. 1, Lemma 1). Every call draws a ``seed_simulator`` from its stream, so a plan depends on
     the planner's seed only. Oracle calls: ``iterations * shots`` (DESIGN §2).
@@ -154,12 +137,6 @@ class AerBackend(QuantumSearchBackend):
         self.device = device
         self.max_parallel_threads = int(max_parallel_threads)
         self._build = aer_grover_circuit if noise_model is None else aer_literal_grover_circuit
-        #: False sends every circuit through AerSimulator.run (the benchmarks' before/after figures)
-        self._use_controller = True
-        #: False keeps small circuits on the controller instead of Aer's state (``aer_state``)
-        self._use_state = True
-        #: the simulator's options as made here: the state path runs only while they are unchanged
-        self._made_options = dict(self.simulator.options.__dict__)
 
     @property
     def max_qubits(self) -> int:
@@ -311,6 +288,17 @@ class AerBackend(QuantumSearchBackend):
             instructions = 2 * min(marked, (1 << num_qubits) - marked) * (iterations + 1)
         return (self.AER_MCZ_BYTES_PER_ENTRY << num_qubits) + self.AER_BYTES_PER_MCZ_INSTRUCTION * instructions
 
+    def describe(self) -> str:
+        """The backend in words: Aer's method, device, oracle synthesis and whether a noise model
+        is set (recorded in ``PlanResult.settings``).
+
+        Returns:
+            For example ``"aer (method=statevector, device=CPU, synthesis=auto, noise_model=None)"``.
+        """
+        noise = getattr(self.simulator.options, "noise_model", None)
+        return (f"aer (method={self.method}, device={self.device}, synthesis={self.synthesis}, "
+                f"noise_model={'set' if noise is not None else 'None'})")
+
     def threads_for(self, num_qubits: int) -> int:
         """The ``max_parallel_threads`` a circuit on ``num_qubits`` qubits runs with.
 
@@ -322,62 +310,21 @@ class AerBackend(QuantumSearchBackend):
         """
         return 1 if num_qubits < SERIAL_BELOW_QUBITS else self.max_parallel_threads
 
-    @property
-    def _direct(self) -> bool:
-        """Whether circuits go to the controller directly: no noise model on the simulator (also one
-        set after construction) and a qiskit-aer with the internals (checked where the backend
-        runs, e.g. after unpickling on another machine)."""
-        return (self._use_controller and aer_direct.DIRECT_AVAILABLE
-                and getattr(self.simulator.options, "noise_model", None) is None)
-
-    def _on_state(self, num_qubits: int) -> bool:
-        """Whether a Grover circuit on ``num_qubits`` qubits runs on Aer's state (``aer_state``):
-        the same simulation as the controller's, there (the statevector method on the CPU, no
-        noise model, the simulator's options as made here, fewer than ``STATE_CHOSEN_BELOW_QUBITS``
-        qubits), and a qiskit-aer with the internals."""
-        return (num_qubits < STATE_CHOSEN_BELOW_QUBITS and self._use_state and self._direct
-                and aer_state.STATE_AVAILABLE and self.method == "statevector" and self.device == "CPU"
-                and self._options_unchanged())
-
-    def _options_unchanged(self) -> bool:
-        """Whether the simulator's options are those it was made with (False also where comparing
-        them fails, e.g. an option set to an array)."""
-        try:
-            return bool(self.simulator.options.__dict__ == self._made_options)
-        except (TypeError, ValueError):
-            return False
-
-    def _run(self, circuit: QuantumCircuit | GroverProgram, num_qubits: int, shots: int, seed: int) -> np.ndarray:
-        """The measured index of every shot of ``circuit`` with ``seed_simulator = seed``.
-
-        Without a noise model the circuit goes to the simulator's controller directly
-        (``aer_direct.execute``: the same simulation and the same measured words as
-        ``AerSimulator.run``, without its job and generic-assembler overhead); with one, through
-        ``AerSimulator.run``, whose compile step prepares the noise model."""
-        threads = self.threads_for(num_qubits)
-        if self._direct:
-            words = aer_direct.execute(self.simulator, circuit, shots, seed, threads)
-        else:
-            result = self.simulator.run(circuit, shots=shots, seed_simulator=seed, memory=True,
-                                        max_parallel_threads=threads).result()
-            if not result.success:
-                raise RuntimeError(f"AerSimulator failed: {result.status}")
-            words = result.results[0].data.memory
-        return _indices(words)
+    def _run(self, circuit: QuantumCircuit, num_qubits: int, shots: int, seed: int) -> np.ndarray:
+        """The measured index of every shot of ``circuit`` through ``AerSimulator.run`` with
+        ``seed_simulator = seed`` and ``memory=True``."""
+        result = self.simulator.run(circuit, shots=shots, seed_simulator=seed, memory=True,
+                                    max_parallel_threads=self.threads_for(num_qubits)).result()
+        if not result.success:
+            raise RuntimeError(f"AerSimulator failed: {result.status}")
+        return _indices(result.results[0].data.memory)
 
     def _sample_seeded(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
                        seed: int | np.random.Generator | None) -> np.ndarray:
         """Build the Grover circuit and run it; the simulator seed is the first
         ``integers(0, 2**31 - 1)`` of the search's generator."""
         seed_simulator = self._first_integer(seed, 2**31 - 1)
-        if self._on_state(num_qubits):  # Aer's state, instruction by instruction: the same words
-            return aer_state.execute_grover(marks, iterations, self.synthesis, shots, seed_simulator)
-        synthesis = self.synthesis_for(num_qubits)
-        if self._direct:  # the circuit's instructions straight to the controller
-            words = aer_direct.execute_grover(self.simulator, marks, iterations, synthesis, shots,
-                                              seed_simulator, self.threads_for(num_qubits))
-            return _indices(words)
-        circuit = self._build(marks, iterations, measure=True, synthesis=synthesis)
+        circuit = self._build(marks, iterations, measure=True, synthesis=self.synthesis_for(num_qubits))
         return self._run(circuit, num_qubits, shots, seed_simulator)
 
     def _sample(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
