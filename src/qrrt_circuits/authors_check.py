@@ -55,8 +55,6 @@ first colliding point or after the 50 outputs the test can use. Boxes come from 
 uniform grid (``qrrt_circuits.collision.GridIndex``); a segment's ``rast_num`` points are tested only
 against the boxes the segment meets when padded by 1e-9 of its coordinates' magnitude (far above
 the points' rounding, so the verdict is the same as testing every point against every box).
-On one core it checks ~0.3-1.2 million pairs/s (``benchmarks/bench_authors_check.py``); the
-authors' code under Octave checks 1.7-12.6.
 """
 
 from __future__ import annotations
@@ -100,7 +98,7 @@ _BI = np.array([
     [0.0, -11 / 7, 11 / 3, -55 / 28],
     [0.0, 3 / 2, -4.0, 5 / 2],
 ])
-_MAX_ATTEMPTS = 1_000_000  # a guard; the linear, stable systems here take ~20-40 attempts
+_MAX_ATTEMPTS = 1_000_000  # a guard against a step size that never settles
 
 
 # The scalar state of a resumable integration, kept in a small float array

@@ -234,7 +234,7 @@ class LinearTrackingDynamics:
         the integral over [0, T] of 1 / h(t), h(t) = min(``max_step``, sqrt(8 ``resolution`` /
         (``max_error`` ``||M^2 expm(M t)||``))), the interval that keeps the chord error within
         ``resolution`` (the grid's own intervals are up to 1 / 0.7 shorter, its steps being
-        ``max_step`` x 0.7^j; measured 1.2-1.4x this estimate).
+        ``max_step`` x 0.7^j, so it has up to 1 / 0.7 times this many).
 
         Args:
             max_error: The largest tracking error ``|e|`` to cover.

@@ -10,9 +10,8 @@
 
 **Warm workers.** Local workers (pool and ``LocalCluster``) are forked from one *fork server*
 (the ``forkserver`` start method) that has imported ``qrrt_circuits.worker_warmup`` once: every
-experiment, Qiskit, Aer, numba's compiled kernels and the default world. A worker then starts in
-milliseconds with all of that in memory, instead of each one being a fresh interpreter spending
-seconds of CPU on the same imports (which on 2 cores ate much of what 2 workers gain). The fork
+experiment, Qiskit, Aer, numba's compiled kernels and the default world. A worker then starts
+with all of that in memory instead of repeating the same imports in a fresh interpreter. The fork
 server is a fresh single-threaded interpreter that never runs a simulator, so nothing forked holds
 threads or OpenMP state. It is started with the single-thread environment below and stopped when
 the executor is shut down. Where the platform has no fork server, workers are spawned (cold).
@@ -49,7 +48,7 @@ SINGLE_THREAD_ENV = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_N
 
 #: Dask settings for a ``LocalCluster`` of a few single-threaded workers: no statistical profiler
 #: sampling each running task every 10 ms, and the event-loop watchdog and system monitor ticking
-#: less often; each was CPU taken from the trials on 2 cores (measured: ``bench_scaleout.py``)
+#: less often (each takes CPU from the trials, which use every core)
 LOCAL_DASK_CONFIG = {"distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "1s",
                      "distributed.admin.system-monitor.interval": "5s"}
 
@@ -186,7 +185,7 @@ def check_executor_args(kind: str, jobs: int | None, scheduler: str | None) -> i
         scheduler: A Dask scheduler address (only with ``kind="dask"``), or None.
 
     Returns:
-        The number of jobs: ``jobs``, or the machine's CPU count for None.
+        The number of jobs: ``jobs``, or ``os.cpu_count()`` for None.
 
     Raises:
         ValueError: An unknown ``kind``, ``jobs`` < 1 (or above ``max_local_jobs()`` for local
@@ -403,11 +402,11 @@ class WorkerPool:
             self._stop_prestarted_fork_server()
 
     def _prestart_fork_server(self) -> None:
-        """Local workers are forked from the fork server, whose preload (every import a trial needs,
-        seconds of CPU) would otherwise begin only when the first trial is submitted. Starting it
-        here lets it import while this process prepares the sweep (its own imports, the records
-        already done), on another core. The pool's executors find it running and use it; it is
-        stopped when the pool closes."""
+        """Local workers are forked from the fork server, whose preload (every import a trial needs)
+        would otherwise begin only when the first trial is submitted. Starting it here lets it
+        import while this process prepares the sweep (its own imports, the records already done),
+        on another core. The pool's executors find it running and use it; it is stopped when the
+        pool closes."""
         self._fork_server = None
         self._forked = False
         if self.kind == "serial" or (self.kind == "dask" and self.scheduler is not None):

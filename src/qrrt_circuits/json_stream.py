@@ -2,8 +2,7 @@
 
 ``json.dump`` streams, but always through the pure-Python encoder (CPython uses its C encoder only
 for ``json.dumps`` without ``indent``), and ``json.dump(result.to_dict(), handle, indent=1)`` first
-makes every node a Python list: about 176 bytes per node besides the tree
-(``python benchmarks/bench_memory.py --only-plan-limits``, ``output-dump``).
+makes every node a Python list, so its memory grows with the tree on top of the arrays.
 ``dump_streamed`` writes the same JSON value (equal after
 ``json.load``): the small values as ``json.dumps(value, indent=1)``, each array ``CHUNK_ROWS`` rows
 at a time through ``json.dumps`` without indent (the C encoder), one row of a 2-D array per line

@@ -36,11 +36,16 @@ def chord_grid(
 
     ``dynamics.curvature_bound_times(max_error, resolution)`` and ``dynamics.propagators`` of its
     times, a pure function of M = A - B K, T, ``max_error`` and ``resolution``: computed once per
-    process for each distinct set (an experiment builds one predicate per trial, and the grid, a few
-    hundred small ``expm``, cost more than most trials' checks). Fresh copies are returned, so the
-    caller owns them. With a ``limit``, a grid not yet computed is first estimated
-    (``chord_count_estimate``) and refused if it would have more than ``limit`` chords (and
-    ``curvature_bound_times`` stops at twice that).
+    process for each distinct set and shared by every predicate built on it (an experiment builds
+    one predicate per trial). Fresh copies are returned, so the caller owns them. With a
+    ``limit``, a grid not yet computed is first estimated (``chord_count_estimate``) and refused if
+    it would have more than ``limit`` chords (and ``curvature_bound_times`` stops at twice that).
+
+    Args:
+        dynamics: The ``LinearTrackingDynamics`` (its closed loop M and horizon T).
+        max_error: The largest tracking error ``|e|`` the grid covers.
+        resolution: The chord error the grid keeps below.
+        limit: The most chords accepted, or None for no limit.
 
     Returns:
         (times, bounds, propagators): shapes (K + 1,), (K,) and (K + 1, d, d), C-contiguous.
@@ -74,8 +79,8 @@ def chord_grid(
     return grid[0].copy(), grid[1].copy(), grid[2].copy()
 
 
-#: the most chords (time-grid intervals) one exact check's trajectories are cut into: building the
-#: grid costs about 40 us per chord (one ``expm`` each), so 100 000 take a few seconds
+#: the most chords (time-grid intervals) one exact check's trajectories are cut into; building the
+#: grid computes one ``expm`` per chord, so this bounds its build time
 MAX_CHORDS = 100_000
 
 
@@ -132,8 +137,8 @@ class ReachabilityOracle:
         env: The ``Environment``.
         dynamics: ``LinearTrackingDynamics`` of the same dimension d (default: the paper's).
         resolution: The collision resolution in length units, > 0 (default 0.01).
-        check: ``"exact"`` (this class) or ``"time_samples"``, kept as an alias that returns
-            ``TimeSampledCheck(env, dynamics, time_samples=time_samples)`` instead.
+        check: ``"exact"`` (this class) or ``"time_samples"``, an alias of
+            ``TimeSampledCheck(env, dynamics, time_samples=time_samples)``, which is returned instead.
         time_samples: K for ``check="time_samples"``; unused otherwise.
 
     Attributes:
@@ -166,7 +171,7 @@ class ReachabilityOracle:
 
     def __new__(cls, env: Environment, dynamics: LinearTrackingDynamics | None = None,
                 resolution: float = 0.01, check: str = "exact", time_samples: int = 50) -> Any:
-        # Any: a ReachabilityOracle, or for check="time_samples" a TimeSampledCheck (0.1's alias)
+        # Any: a ReachabilityOracle, or for check="time_samples" a TimeSampledCheck (the alias)
         if check == "time_samples":
             from .deprecation import warn_deprecated
             from .time_sampled import TimeSampledCheck

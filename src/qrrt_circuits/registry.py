@@ -1,12 +1,11 @@
 """One registry of everything that is chosen by name: planners, backends, search policies,
 scenarios and reachability predicates.
 
-The CLI's choices and help text, the experiments, the benchmarks and the tests all build objects
-through these registries, so a name means the same thing everywhere. An unknown name is refused
-with the list of choices. Planner names are lower case (``rrt``, ``prrt``, ``qrrt``, ``pqrrt``,
-``pqrrt-unshared``); the class names used in 0.1's records (``RRT``, ``ParallelRRT``, ``QRRT``,
-``PQRRT``, ``PQRRT-unshared``) are aliases. A parametric entry is written ``name:VALUE``
-(``fixed:2``, ``time-samples:50``).
+The CLI's choices and help text and the experiments build objects through these registries, so a
+name means the same thing everywhere. An unknown name is refused with the list of choices. Planner
+names are lower case (``rrt``, ``prrt``, ``qrrt``, ``pqrrt``, ``pqrrt-unshared``); the class-style
+names (``RRT``, ``ParallelRRT``, ``QRRT``, ``PQRRT``, ``PQRRT-unshared``) are aliases of them. A
+parametric entry is written ``name:VALUE`` (``fixed:2``, ``time-samples:50``).
 """
 
 from __future__ import annotations
@@ -41,7 +40,7 @@ class Entry:
         name: The canonical name (``"qrrt"``, ``"fixed"``, ...).
         factory: The callable that builds the object.
         help: One line for the CLI's help.
-        aliases: Other names that resolve to this entry (0.1's class names, ...).
+        aliases: Other names that resolve to this entry (the planners' class-style names, ...).
         parameter: The parameter's placeholder for a parametric entry (``"K"`` for ``fixed:K``), or
             None.
         tags: Free labels (``"classical"``, ``"quantum"``, ``"parallel"``).
@@ -105,9 +104,8 @@ class Registry:
     """Named factories of one kind (``kind`` is used in error messages: "planner", ...).
 
     The module's registries are ``PLANNERS``, ``BACKENDS``, ``POLICIES``, ``SCENARIOS`` and
-    ``PREDICATES``; the CLI, the experiments, the benchmarks and the tests build objects through
-    them, so a name means the same thing everywhere. An unknown name is refused with the list of
-    choices.
+    ``PREDICATES``; the CLI and the experiments build objects through them, so a name means the
+    same thing everywhere. An unknown name is refused with the list of choices.
 
     Args:
         kind: What the entries are, for error messages (``"planner"``, ``"search policy"``, ...).

@@ -5,9 +5,9 @@ start method) that imports this module first: every experiment (and with them Qi
 scipy), the default world ``paper_clutter`` (seed 0), whose construction loads the compiled
 numba kernels of the collision checks from their on-disk cache and is then cached per process
 (``experiments.worlds.world``), and its exact predicate, whose chord grid for the paper's dynamics
-is then cached per process too (``oracle.chord_grid``). A worker forked from the server starts with all of it in memory
-instead of spending seconds of CPU importing and loading it; the fork server itself is a fresh,
-single-threaded interpreter (it never runs a simulator), so forking it is safe.
+is then cached per process too (``oracle.chord_grid``). A worker forked from the server starts
+with all of it in memory instead of importing and loading it again; the fork server itself is a
+fresh, single-threaded interpreter (it never runs a simulator), so forking it is safe.
 
 Importing this module performs the warm-up (that is how a fork server's ``preload`` works).
 """

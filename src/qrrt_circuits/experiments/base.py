@@ -47,13 +47,13 @@ class TrialStream(IntEnum):
     TREE_SIZE_PLANNERS = 12
     HEATMAP_HYPOTHESES = 13
     CORRIDOR_SENSITIVITY = 14
-    # noise and resources (issue 12); numbered apart from the other streams added beside them
+    # noise and resources: numbered from 31, apart from the streams above
     NOISE_SWEEP = 31
     NOISE_WORLDS = 32
     NOISE_PLANNERS = 33
     RESOURCES_WORLDS = 34
     RESOURCES_PLANNERS = 35
-    # search-policies (issue 12)
+    # search-policies
     SEARCH_POLICIES_WORLDS = 36
     SEARCH_POLICIES_PLANNERS = 37
 
@@ -134,7 +134,7 @@ class Experiment:
         """The settings of a run (stored in ``settings.json``; a resumed run must match them).
 
         Args:
-            quick: Small settings (each experiment then takes under two minutes).
+            quick: Small settings, for a quick check of the whole pipeline.
             trials: Trials per variant, or None for the experiment's default.
             seed: The root seed of every trial's seed.
 

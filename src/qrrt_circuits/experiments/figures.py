@@ -44,8 +44,7 @@ def save(fig: Figure, path: Path, tight: bool = True) -> Path:
         fig: The figure.
         path: Where to write it (the format follows the suffix).
         tight: Whether to run ``tight_layout`` first (default True); False for a figure whose
-            axes were placed by hand (``tight_layout`` draws every tick label to measure it: about
-            half a second for a 3 x 3 grid).
+            axes were placed by hand (``tight_layout`` draws every tick label to measure it).
 
     Returns:
         ``path``.

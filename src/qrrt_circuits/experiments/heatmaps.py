@@ -110,7 +110,7 @@ class Heatmaps(Experiment):
     def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         """One panel per planner (rows) and cut (columns), all on one logarithmic colour scale (the
         largest count of any cell), so the panels can be compared; the axes are placed by hand
-        (``tight_layout`` on this grid cost more than the rest of the figure)."""
+        (``save(..., tight=False)``)."""
         from matplotlib.colors import LogNorm
 
         env = world(settings["scenario"], settings["world_seed"])

@@ -132,7 +132,7 @@ def binomial_interval(successes: int, trials: int, level: float = LEVEL) -> tupl
     """
     if trials <= 0:
         return float("nan"), float("nan")
-    from scipy.stats import binomtest  # about 1 s to import: only the summaries that need it pay
+    from scipy.stats import binomtest  # a slow import: only the summaries that need it import it
 
     interval = binomtest(int(successes), int(trials)).proportion_ci(confidence_level=level, method="exact")
     return float(interval.low), float(interval.high)

@@ -96,7 +96,7 @@ class Noise(Experiment):
             return {"trials": trials or 1, "seed": seed, "quick": True,
                     "sweep_qubits": [3, 4], "sweep_iterations": [1, 2], "p2": [0.0, 1e-2],
                     "p1_ratio": 0.1, "exact_max_qubits": 3, "shots": 100,
-                    # the fake device's noise model takes seconds to build: tests/test_noise.py runs it
+                    # no device circuits: the fake device's noise model is slow to build
                     "device": device, "device_qubits": [], "device_iterations": [1], "device_shots": 100,
                     "planning_p2": [0.0, 1e-2], "planning_qubits": 4, "nodes": 3,
                     "planning_configs": ["QRRT adaptive"]}

@@ -83,7 +83,7 @@ def make_planner(kind: str, env: Environment, seed: int, backend: str = "aer", w
 def planner_for(settings: dict[str, Any], kind: str, env: Environment, seed: int, backend: str = "aer",
                 workers: int = 8, num_qubits: int = 8, **options: Any) -> Planner:
     """``make_planner`` with the experiment's predicate (``settings["predicate"]``; the exact check
-    when the settings name none, as 0.1's did).
+    when the settings name none).
 
     Args:
         settings: The experiment's settings (its ``predicate``, if any).

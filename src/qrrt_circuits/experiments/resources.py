@@ -10,8 +10,9 @@ Three parts, one trial list (``qrrt_circuits.resources`` holds the counting and 
   ``ft`` extra is installed, else the published formulas.
 - ``plan``: RRT and q-RRT (n = 8, the paper's schedule, exact statevector) grow 30-node trees in
   the worlds of ``oracle-efficiency`` (same world seeds). RRT's wall time gives the classical time
-  of a plan and of one reachability test (busy-machine timings); q-RRT's quantum calls times the
-  time of one call gives its projected time. The break-even time per call is where the two meet.
+  of a plan and of one reachability test (measured where the trials run, other trials running
+  beside it); q-RRT's quantum calls times the time of one call gives its projected time. The
+  break-even time per call is where the two meet.
 """
 
 from __future__ import annotations

@@ -66,12 +66,12 @@ def _run_on(executor: Executor | Callable[[], Executor], name: str, trials: list
     result as it arrives.
 
     With ``client_helps`` (a local pool not started yet; ``executor`` is then the callable that
-    starts it), starting the workers takes seconds (the fork server's preload, a Dask cluster's
-    start) during which this process would sit idle. So a background thread starts the pool and
-    submits the trials from the front of the list, while this process runs trials itself from the
-    back until the first worker result arrives. A trial is taken from the list under a lock, either
-    submitted or run here, so each runs exactly once; its record does not depend on where it ran
-    (trials draw only from their own seeds)."""
+    starts it), this process would sit idle while the workers start (the fork server's preload, a
+    Dask cluster's start). So a background thread starts the pool and submits the trials from the
+    front of the list, while this process runs trials itself from the back until the first worker
+    result arrives. A trial is taken from the list under a lock, either submitted or run here, so
+    each runs exactly once; its record does not depend on where it ran (trials draw only from their
+    own seeds)."""
     if not client_helps:
         pool = executor() if callable(executor) else executor
         submitted = [pool.submit(execute_trial, name, trial, settings) for trial in trials]
@@ -191,7 +191,7 @@ def _claim_directory(directory: Path, settings: Settings) -> None:
         if not isinstance(stored, dict):
             raise ValueError(f"{settings_path} is corrupt (not a JSON object); use another --out or delete the folder")
         if "predicate" not in stored and settings.get("predicate") == "exact":
-            stored["predicate"] = "exact"  # written by 0.1, whose experiments always used the exact check
+            stored["predicate"] = "exact"  # settings without a predicate are runs with the exact check
             settings_path.write_text(json.dumps(stored, indent=1))
         if stored != settings:
             raise ValueError(
@@ -295,7 +295,7 @@ def run_experiment(
     Args:
         name: An ``EXPERIMENTS`` name.
         out: The results folder; the run writes ``out/name``.
-        quick: Small settings (each experiment under two minutes).
+        quick: Small settings, for a quick check of the whole pipeline.
         trials: Trials per variant (default: the experiment's).
         seed: The root seed (>= 0).
         executor: Where trials run (see above).

@@ -8,7 +8,7 @@ Here every planner grows one tree per world in ``paper_clutter`` toward a goal i
 (goal radius 1e-9), and the cumulative oracle calls are read at tree sizes 30, 100, 300, 1000 and
 3000. The marginal cost of a window (calls added / nodes added between two sizes) is compared with
 RRT's on the same worlds; the crossover is the first window where a quantum planner's marginal
-cost is no longer below RRT's.
+cost is not below RRT's.
 
 Pq-RRT is reported on its critical path (the time of 8 parallel devices) and in total calls.
 """

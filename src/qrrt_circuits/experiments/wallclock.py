@@ -3,8 +3,8 @@
 Same trees as oracle-efficiency (30 nodes, paper_clutter), timed for RRT, parallel RRT, and
 q-RRT / Pq-RRT on both backends. Slopes are least-squares fits through the origin of seconds
 against oracle calls (or nodes) over the trials. The paper's numbers come from MATLAB on an
-8-core M2; ours from this machine, with everything in one process (the shared Pq-RRT shortcut —
-one search with p shots — is the same one the paper's simulation used).
+8-core M2; ours from the machine that runs the trials, with everything in one process (the
+shared Pq-RRT shortcut — one search with p shots — is the same one the paper's simulation used).
 """
 
 from __future__ import annotations
@@ -43,8 +43,8 @@ class Wallclock(Experiment):
     A trial times one 30-node tree of a configuration of ``CONFIGS`` (the worlds and seeds of
     oracle-efficiency). The summary fits seconds against oracle calls and against nodes through
     the origin (``slope_through_origin``), a 95 % interval on the per-node slope, next to the
-    paper's MATLAB times;
-    the timings are of this machine and are labelled so.
+    paper's MATLAB times; the timings are those of the machine that runs the trials and are
+    labelled so.
     """
 
     name = "wallclock"
