@@ -137,7 +137,7 @@ class ReachabilityOracle:
         env: The ``Environment``.
         dynamics: ``LinearTrackingDynamics`` of the same dimension d (default: the paper's).
         resolution: The collision resolution in length units, > 0 (default 0.01).
-        check: ``"exact"`` (this class) or ``"time_samples"``, an alias of
+        check: ``"exact"`` (this class) or ``"time_samples"``, a deprecated alias of
             ``TimeSampledCheck(env, dynamics, time_samples=time_samples)``, which is returned instead.
         time_samples: K for ``check="time_samples"``; unused otherwise.
 
