@@ -39,12 +39,12 @@ n, guarded = int(sys.argv[1]), sys.argv[2] == "guarded"
 if not guarded:
     memory.cgroup_available_bytes = lambda: None
 env = qc.scenarios.paper_clutter(seed=0)
+planner = qc.QRRT(env, backend=qc.StatevectorBackend(0, max_qubits=24), num_qubits=n, seed=0)
 try:
-    planner = qc.QRRT(env, backend=qc.StatevectorBackend(0, max_qubits=24), num_qubits=n, seed=0)
+    planner.plan(max_rounds=1)
 except ValueError as error:
     print("refused:", error)
 else:
-    planner.plan(max_rounds=1)
     print("ran")
 """
 

@@ -1,6 +1,7 @@
-"""The memory guard (issue 10, defect 2): a run whose estimated peak exceeds the available memory is
-refused before anything large is allocated, naming num_qubits, the estimate, the available memory
-and the largest n that fits."""
+"""The memory guard: a plan or a direct search whose estimated peak exceeds the available memory is
+refused by one check before anything large is allocated, naming the size, the estimate, the
+available memory (the smallest of MemAvailable, the control groups' room and the address space
+left under RLIMIT_AS) and the largest size that fits; a MemoryError while one runs is one line."""
 
 import re
 import resource
@@ -25,8 +26,15 @@ def env():
 @pytest.fixture
 def small_memory(monkeypatch):
     """The machine reports 300 MiB available (machine-independent refusals)."""
-    monkeypatch.setattr(memory, "available_memory_bytes", lambda: 300 * MIB)
+    monkeypatch.setattr(memory, "available_memory", lambda: (300 * MIB, memory.MACHINE_SOURCE))
     return 300 * MIB
+
+
+def _plan_total(planner, num_qubits, max_rounds=1):
+    """The plan's estimate (its round and its tree and history) at ``max_rounds`` and n."""
+    return memory.PlanSize(10**6, planner._max_new_nodes_per_round(),
+                           max_rounds, planner.env.dim, planner.memory_estimate,
+                           num_qubits).estimate().total_bytes
 
 
 def _peak_rss() -> int:
@@ -39,17 +47,16 @@ def _largest(message: str) -> int:
 
 @pytest.mark.parametrize("make_backend", [lambda: qc.StatevectorBackend(0), lambda: qc.AerBackend(0)],
                          ids=["statevector", "aer"])
-def test_planner_refused_at_construction_with_the_largest_fitting_n(env, small_memory, make_backend):
+def test_plan_refused_before_its_first_allocation_with_the_largest_fitting_n(env, small_memory, make_backend):
     backend = make_backend()
+    planner = qc.PQRRT(env, backend=backend, num_qubits=28, seed=0)  # construction allocates nothing
     before = _peak_rss()
-    with pytest.raises(ValueError, match=r"num_qubits = 28: this plan needs about .* at its peak .*more "
-                                         r"than the 300 MiB of memory available") as info:
-        qc.PQRRT(env, backend=backend, num_qubits=28, seed=0)
+    with pytest.raises(ValueError, match=r"num_qubits = 28: this plan could need about .* at its peak .*more "
+                                         r"than the 300 MiB of memory available \(MemAvailable\)") as info:
+        planner.plan(max_rounds=1)
     assert _peak_rss() - before < 64 * MIB  # refused before the 2^28-entry database was built
     largest = _largest(str(info.value))
-    planner = qc.PQRRT(env, backend=backend, num_qubits=largest, seed=0)
-    assert planner.memory_estimate().total_bytes <= small_memory
-    assert planner.memory_estimate(largest + 1).total_bytes > small_memory
+    assert _plan_total(planner, largest) <= small_memory < _plan_total(planner, largest + 1)
 
 
 def test_the_estimate_grows_with_what_the_run_holds(env):
@@ -139,8 +146,9 @@ def test_unshared_databases_are_counted_once_per_worker_without_an_executor(env)
 
 def test_adaptive_with_a_huge_table_is_refused_before_allocating_it(env):
     policy = qc.Adaptive(grid_size=100_000, max_iterations=1_000_000)  # a 2.4 TB success table
-    with pytest.raises(ValueError, match=r"num_qubits = 8: this plan needs about .*search policy"):
-        qc.QRRT(env, backend=qc.StatevectorBackend(0), num_qubits=8, seed=0, search_policy=policy)
+    planner = qc.QRRT(env, backend=qc.StatevectorBackend(0), num_qubits=8, seed=0, search_policy=policy)
+    with pytest.raises(ValueError, match=r"num_qubits = 8: this plan could need about .*search policy"):
+        planner.plan(max_rounds=1)
 
 
 @pytest.mark.parametrize("make_backend", [lambda: qc.StatevectorBackend(0, max_qubits=24),
@@ -204,7 +212,7 @@ def test_cli_plan_reproductions_refused(small_memory, capsys):
             cli.main(argv)
         assert info.value.code == 2
         err = capsys.readouterr().err
-        assert "this plan needs about" in err and "300 MiB of memory available" in err
+        assert err.count("\n") == 1 and "this plan could need about" in err and "300 MiB of memory available" in err
 
 
 @pytest.mark.parametrize("argv_backend, qubits, planner", [("statevector", 28, qc.QRRT), ("aer", 24, qc.PQRRT)])
@@ -217,8 +225,8 @@ def test_issue_reproductions_on_this_machine(env, argv_backend, qubits, planner)
     if available is None or estimate.total_bytes <= available:
         pytest.skip(f"this machine has {available} bytes available, enough for the estimated "
                     f"{estimate.total_bytes}")
-    with pytest.raises(ValueError, match=f"num_qubits = {qubits}: this plan needs about"):
-        planner(env, backend=backend, num_qubits=qubits, seed=0)
+    with pytest.raises(ValueError, match=f"num_qubits = {qubits}: this plan could need about"):
+        planner(env, backend=backend, num_qubits=qubits, seed=0).plan(max_rounds=1)
 
 
 def test_available_memory_reads_meminfo():
@@ -344,8 +352,10 @@ def test_a_plan_in_a_small_control_group_is_refused(tmp_path, monkeypatch, env):
 
     _cgroup(tmp_path, monkeypatch, str(512 * MIB), 100 * MIB, "")
     monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 20 * 1024 * MIB)
-    with pytest.raises(ValueError, match=r"num_qubits = 24: .* more than the 412 MiB of memory available"):
-        qc.QRRT(env, backend=qc.StatevectorBackend(0, max_qubits=24), num_qubits=24, seed=0)
+    planner = qc.QRRT(env, backend=qc.StatevectorBackend(0, max_qubits=24), num_qubits=24, seed=0)
+    with pytest.raises(ValueError, match=r"num_qubits = 24: .* more than the 412 MiB of memory available "
+                                         r"\(the memory control group's room\)"):
+        planner.plan(max_rounds=1)
 
 
 @pytest.mark.parametrize("version", [2, 1])
@@ -492,3 +502,292 @@ def test_a_refusal_that_the_marked_count_cannot_change_names_no_count(small_memo
     marks[:12] = True
     with pytest.raises(ValueError, match=r"search \(1 shots, 1 iterations\) needs"):
         qc.StatevectorBackend(0, max_qubits=24).search(marks, 1)
+
+
+# ------------------------------------------------------------------ one check per plan, and per direct search
+@pytest.fixture
+def counted_reads(monkeypatch):
+    """Every size is checked (nothing is accepted unread), and each read of the available memory is
+    counted."""
+    reads = []
+    real = memory.available_memory
+
+    def counting():
+        reads.append(1)
+        return real()
+
+    monkeypatch.setattr(memory, "ALWAYS_FITS_BYTES", 0)
+    monkeypatch.setattr(memory, "available_memory", counting)
+    return reads
+
+
+@pytest.mark.parametrize("make_planner", [
+    lambda env: qc.QRRT(env, backend=qc.StatevectorBackend(0), num_qubits=8, seed=0),
+    lambda env: qc.PQRRT(env, backend=qc.AerBackend(0), num_qubits=6, workers=3, shared_database=False, seed=0),
+    lambda env: qc.PQRRT(env, backend=qc.StatevectorBackend(0), num_qubits=6, workers=2, seed=0,
+                         search_policy=qc.BBHT()),
+    lambda env: qc.QRRT(env, backend=qc.AerBackend(0), num_qubits=6, seed=0,
+                        search_policy=qc.FixedPointAmplification()),
+    lambda env: qc.RRT(env, seed=0),
+], ids=["qrrt", "pqrrt-unshared-aer", "bbht", "fixed-point-aer", "rrt"])
+def test_a_plan_reads_the_available_memory_once_whatever_its_rounds(env, counted_reads, make_planner):
+    result = make_planner(env).plan(max_rounds=12)
+    assert result.metrics.rounds >= 1 and len(counted_reads) == 1
+
+
+def test_a_direct_search_checks_once_per_call(counted_reads):
+    backend = qc.StatevectorBackend(0)
+    marks = np.zeros(1 << 10, dtype=bool)
+    marks[::7] = True
+    backend.search(marks, 2, shots=4)
+    assert len(counted_reads) == 1
+    backend.search_many([qc.SearchRequest(marks, k, 2, seed=k) for k in range(5)])
+    assert len(counted_reads) == 2
+    from qrrt_circuits.search.fixed_point import IterateSequence
+
+    backend.search_sequence(marks, IterateSequence.grover(2), shots=3)
+    assert len(counted_reads) == 3
+
+
+def test_the_plan_check_counts_the_round_the_tree_and_the_history_together(env):
+    """Each part alone fits where the sum does not: the plan's one check refuses the sum, naming the
+    larger part (here the tree's node limit)."""
+    planner = qc.PQRRT(env, backend=qc.StatevectorBackend(0), num_qubits=20, workers=8, seed=0)
+    size = memory.PlanSize(2_000_000, 8, 10**6, 2, planner.memory_estimate, 20)
+    estimate = size.estimate()
+    available = estimate.total_bytes - 1
+    assert estimate.round_bytes < available and estimate.limits_bytes < available
+    with pytest.raises(ValueError, match=r"max_nodes = 2000000: this plan could need about .*database build .*tree "
+                                         r".*round history .*; the largest max_nodes that fits is about \d+"):
+        size.check(available)
+    small_round = memory.PlanSize(1000, 8, 20000, 2, planner.memory_estimate, 26)
+    with pytest.raises(ValueError, match=r"num_qubits = 26: .*the largest num_qubits that fits is 2[0-5]"):
+        small_round.check(1 << 30)
+
+
+def test_the_fixed_point_policy_is_sized_by_its_sequence_circuit(env):
+    planner = qc.QRRT(env, backend=qc.AerBackend(0), num_qubits=16, seed=0,
+                      search_policy=qc.FixedPointAmplification())
+    policy = planner.search_policy
+    assert planner.memory_estimate().search_bytes == planner.backend.sequence_peak_bytes(16, 1, policy.iterates)
+
+
+# ------------------------------------------------------------------ what is available: RLIMIT_AS
+def test_the_address_space_left_under_rlimit_as_bounds_the_available_memory(tmp_path, monkeypatch):
+    """The room under ``ulimit -v`` is the limit less the virtual size (/proc/self/statm's first
+    field in pages); it is taken where it is the smallest figure, and named."""
+    import os
+
+    page = os.sysconf("SC_PAGE_SIZE")
+    statm = tmp_path / "statm"
+    statm.write_text(f"{(700 * MIB) // page} 1 2 3 4 5 6\n")
+    monkeypatch.setattr(memory, "PROC_STATM", str(statm))
+    monkeypatch.setattr(memory, "address_space_limit", lambda: 1024 * MIB)
+    monkeypatch.setattr(memory, "cgroup_available_bytes", lambda: None)
+    monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 20 * 1024 * MIB)
+    assert memory.virtual_memory_bytes() == (700 * MIB) // page * page
+    room = 1024 * MIB - memory.virtual_memory_bytes()
+    assert memory.address_space_available_bytes() == room
+    assert memory.available_memory() == (room, memory.ADDRESS_SPACE_SOURCE)
+    assert memory.always_fits_bytes() == min(memory.ALWAYS_FITS_BYTES, room)
+    monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 100 * MIB)
+    assert memory.available_memory() == (100 * MIB, memory.MACHINE_SOURCE)
+    monkeypatch.setattr(memory, "PROC_STATM", str(tmp_path / "absent"))
+    assert memory.address_space_available_bytes() is None  # no virtual size: the limit is not taken
+    monkeypatch.setattr(memory, "address_space_limit", lambda: None)
+    assert memory.address_space_available_bytes() is None
+
+
+def test_without_a_limit_the_address_space_is_not_a_figure():
+    import resource
+
+    if resource.getrlimit(resource.RLIMIT_AS)[0] != resource.RLIM_INFINITY:
+        pytest.skip("this process runs under a RLIMIT_AS")
+    assert memory.address_space_limit() is None and memory.address_space_available_bytes() is None
+
+
+# ------------------------------------------------------------------ the refusals on the command line: one line each
+def _error_lines(stderr: str) -> list[str]:
+    return [line for line in stderr.splitlines() if line.strip()]
+
+
+def test_cli_plan_refused_under_a_control_group_limit_in_one_line(tmp_path, monkeypatch, capsys):
+    """A 512 MiB group on a machine with 20 GiB free: ``qrrt plan`` at n = 24 is refused in one line
+    naming the group's room and the largest n that fits, and writes nothing."""
+    _cgroup(tmp_path, monkeypatch, str(512 * MIB), 100 * MIB, "")
+    monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 20 * 1024 * MIB)
+    out = tmp_path / "plan.json"
+    with pytest.raises(SystemExit) as info:
+        cli.main(["plan", "--planner", "qrrt", "--backend", "statevector", "--qubits", "24", "--max-rounds", "1",
+                  "--json", str(out)])
+    assert info.value.code == 2
+    lines = _error_lines(capsys.readouterr().err)
+    assert len(lines) == 1, lines
+    assert re.fullmatch(r"qrrt plan: error: num_qubits = 24: this plan could need about \S+ [MG]iB at its peak \(.*\), "
+                        r"more than the 412 MiB of memory available \(the memory control group's room\); "
+                        r"the largest num_qubits that fits is 2[0-2]", lines[0]), lines[0]
+    assert not out.exists()
+
+
+_LINUX_RLIMIT = pytest.mark.skipif(not Path("/proc/self/statm").exists(),
+                                   reason="needs Linux's /proc/self/statm for the virtual size")
+
+
+def _limited(limit_bytes: int):
+    """preexec_fn: the child runs under ``ulimit -v`` of ``limit_bytes``."""
+    def apply():
+        resource.setrlimit(resource.RLIMIT_AS, (limit_bytes, limit_bytes))
+    return apply
+
+
+@_LINUX_RLIMIT
+def test_cli_plan_refused_under_ulimit_v_in_one_line(tmp_path):
+    """``ulimit -v`` of 2 GiB on a machine with more free: q-RRT at n = 28 (about 14.6 GiB) is
+    refused in one line naming the address space left and the largest n that fits, exit status 2,
+    no traceback, no output file."""
+    available = memory.available_memory_bytes()
+    if available is not None and available < 3 << 30:
+        pytest.skip("the machine has less than 3 GiB available: RLIMIT_AS would not be the smallest figure")
+    out = tmp_path / "plan.json"
+    run = subprocess.run([sys.executable, "-m", "qrrt_circuits.cli", "plan", "--planner", "qrrt", "--backend",
+                          "statevector", "--qubits", "28", "--max-rounds", "1", "--json", str(out)],
+                         capture_output=True, text=True, timeout=300, preexec_fn=_limited(2 << 30))
+    assert run.returncode == 2 and "Traceback" not in run.stderr
+    lines = _error_lines(run.stderr)
+    assert len(lines) == 1, run.stderr
+    assert re.fullmatch(r"qrrt plan: error: num_qubits = 28: this plan could need about \S+ GiB at its peak \(.*\), "
+                        r"more than the \S+ [MG]iB of memory available \(the address space left under RLIMIT_AS, "
+                        r"ulimit -v\); the largest num_qubits that fits is 2[0-4]", lines[0]), lines[0]
+    assert not out.exists()
+
+
+@_LINUX_RLIMIT
+def test_cli_search_refused_under_ulimit_v_in_one_line():
+    available = memory.available_memory_bytes()
+    if available is not None and available < 3 << 30:
+        pytest.skip("the machine has less than 3 GiB available: RLIMIT_AS would not be the smallest figure")
+    run = subprocess.run([sys.executable, "-m", "qrrt_circuits.cli", "search", "--backend", "statevector",
+                          "--qubits", "28", "--marked", "1", "--iterations", "1"],
+                         capture_output=True, text=True, timeout=300, preexec_fn=_limited(2 << 30))
+    assert run.returncode == 2 and "Traceback" not in run.stderr
+    lines = _error_lines(run.stderr)
+    assert len(lines) == 1 and "num_qubits = 28: this statevector search" in lines[0], run.stderr
+    assert "(the address space left under RLIMIT_AS, ulimit -v); the largest num_qubits that fits is" in lines[0]
+
+
+# ------------------------------------------------------------------ a MemoryError while a run runs: one line
+def _unable_to_allocate(*args, **kwargs):
+    """What numpy raises for an array that cannot be had (``_ArrayMemoryError``), without allocating."""
+    return np.empty(1 << 62, dtype=np.uint8)
+
+
+def test_a_memory_error_in_a_plan_is_one_out_of_memory_line(env, monkeypatch):
+    from qrrt_circuits.planners import workers
+
+    monkeypatch.setattr(workers, "make_database", _unable_to_allocate)
+    planner = qc.QRRT(env, backend=qc.StatevectorBackend(0), num_qubits=10, seed=0)
+    with pytest.raises(memory.OutOfMemory) as info:
+        planner.plan(max_rounds=3)
+    message = str(info.value)
+    assert "\n" not in message and isinstance(info.value.__cause__, MemoryError)
+    assert re.fullmatch(r"num_qubits = 10: this plan ran out of memory \(Unable to allocate .*\) with an estimated "
+                        r"peak of about .*; the largest num_qubits below 10 whose estimate fits in the .* of memory "
+                        r"available now \(.*\) is 9", message), message
+    assert info.value.__cause__.__traceback__ is None  # the failed run's frames (and arrays) were let go
+
+
+def test_a_memory_error_growing_a_classical_tree_names_the_limit(env, monkeypatch):
+    from qrrt_circuits.planners.run_state import RunState
+
+    monkeypatch.setattr(RunState, "add_node", _unable_to_allocate)
+    monkeypatch.setattr(RunState, "add_nodes", _unable_to_allocate)
+    with pytest.raises(memory.OutOfMemory, match=r"^max_nodes = 1000000 \(the default: the plan was given none\): "
+                                                 r"this plan ran out of memory .*the largest max_nodes below 1000000 "
+                                                 r"whose estimate fits"):
+        qc.ParallelRRT(env, workers=64, seed=0).plan()  # the tree (a million nodes) outweighs the history
+
+
+def test_a_memory_error_in_a_direct_search_is_one_out_of_memory_line(monkeypatch):
+    backend = qc.StatevectorBackend(0)
+    monkeypatch.setattr(qc.StatevectorBackend, "_sample", _unable_to_allocate)
+    marks = np.zeros(1 << 12, dtype=bool)
+    marks[3] = True
+    with pytest.raises(memory.OutOfMemory, match=r"^num_qubits = 12: this statevector search \(5 shots, 2 iterations\) "
+                                                 r"ran out of memory \(Unable to allocate .*\).* is 11$"):
+        backend.search(marks, 2, shots=5)
+    with pytest.raises(memory.OutOfMemory, match=r"^num_qubits = 12: this statevector search \(1 shots, 4 "):
+        backend.search_many([qc.SearchRequest(marks, 4)])
+
+
+@pytest.mark.parametrize("argv", [
+    ["plan", "--planner", "qrrt", "--backend", "statevector", "--qubits", "10", "--max-rounds", "3"],
+    ["search", "--backend", "statevector", "--qubits", "10", "--marked", "3"],
+], ids=["plan", "search"])
+def test_cli_memory_errors_are_one_line_with_a_nonzero_status(argv, monkeypatch, capsys, tmp_path):
+    from qrrt_circuits.planners import workers
+
+    monkeypatch.setattr(workers, "make_database", _unable_to_allocate)
+    monkeypatch.setattr(qc.StatevectorBackend, "_sample", _unable_to_allocate)
+    out = tmp_path / "out.json"
+    with pytest.raises(SystemExit) as info:
+        cli.main(argv + (["--json", str(out)] if argv[0] == "plan" else []))
+    assert info.value.code == 1
+    captured = capsys.readouterr()
+    lines = _error_lines(captured.err)
+    assert len(lines) == 1 and lines[0].startswith(f"qrrt {argv[0]}: error: num_qubits = 10: this ") and \
+        "ran out of memory (Unable to allocate" in lines[0] and "is 9" in lines[0], lines
+    assert captured.out == "" and not out.exists()
+
+
+def test_a_memory_error_while_writing_leaves_no_partial_file(env, monkeypatch, capsys, tmp_path):
+    """The outputs are written after the plan, each into a temporary file renamed over the target:
+    a MemoryError halfway through a write leaves the target as it was (absent here) and no
+    temporary file, and the command says so in one line."""
+    from qrrt_circuits.planners.result import PlanResult
+
+    def half_then_fail(self, handle):
+        handle.write('{"half": ')
+        np.empty(1 << 62, dtype=np.uint8)
+
+    monkeypatch.setattr(PlanResult, "write_json", half_then_fail)
+    out = tmp_path / "plan.json"
+    with pytest.raises(SystemExit) as info:
+        cli.main(["plan", "--planner", "rrt", "--max-rounds", "3", "--json", str(out)])
+    assert info.value.code == 1
+    lines = _error_lines(capsys.readouterr().err)
+    assert len(lines) == 1 and "--json: writing" in lines[0] and "out of memory: Unable to allocate" in lines[0]
+    assert list(tmp_path.iterdir()) == []
+
+
+_SHORT_ESTIMATE = """
+import sys
+import qrrt_circuits as qc
+from qrrt_circuits import cli, memory
+
+def short(self, num_qubits=None):  # an estimate that falls short: 16 bytes an entry
+    n = self.num_qubits if num_qubits is None else num_qubits
+    return memory.MemoryEstimate(n, database_bytes=16 << n)
+
+qc.PQRRT.memory_estimate = short
+sys.exit(cli.main(sys.argv[1:]))
+"""
+
+
+@_LINUX_RLIMIT
+def test_a_real_memory_error_under_ulimit_v_is_one_line(tmp_path):
+    """An estimate that falls short passes the check under ``ulimit -v`` of 2.5 GiB and the round
+    really runs out of address space: one line naming n, what the allocator reported and the
+    largest smaller n whose estimate fits in what was available when the plan started; exit status
+    1, no traceback, no output file."""
+    out = tmp_path / "plan.json"
+    run = subprocess.run([sys.executable, "-c", _SHORT_ESTIMATE, "plan", "--planner", "qrrt", "--backend",
+                          "statevector", "--qubits", "26", "--max-rounds", "1", "--json", str(out)],
+                         capture_output=True, text=True, timeout=300, preexec_fn=_limited(5 << 29))
+    assert run.returncode == 1 and "Traceback" not in run.stderr, run.stderr
+    lines = _error_lines(run.stderr)
+    assert len(lines) == 1, run.stderr
+    assert re.fullmatch(r"qrrt plan: error: num_qubits = 26: this plan ran out of memory \(.+\) with an estimated "
+                        r"peak of about .*; the largest num_qubits below 26 whose estimate fits in the .* of memory "
+                        r"available when it started \(the address space left under RLIMIT_AS, ulimit -v\) is 2[0-5]",
+                        lines[0]), lines[0]
+    assert not out.exists()

@@ -205,7 +205,7 @@ def test_the_to_dict_output_can_be_counted_before_a_plan(monkeypatch):
     from qrrt_circuits import memory
     from qrrt_circuits.memory import JSON_BYTES_PER_COORDINATE, JSON_BYTES_PER_NODE, check_plan_fits
 
-    monkeypatch.setattr(memory, "available_memory_bytes", lambda: 300 << 20)
+    monkeypatch.setattr(memory, "available_memory", lambda: (300 << 20, memory.MACHINE_SOURCE))
     check_plan_fits(10**6, 4096, 20000, 2)  # the plan alone: about 188 MiB
     with pytest.raises(ValueError, match="its JSON output"):
         check_plan_fits(10**6, 4096, 20000, 2,
@@ -219,11 +219,11 @@ def test_a_plan_too_large_for_memory_is_refused_before_it_runs_and_json_adds_not
     from qrrt_circuits import memory
     from qrrt_circuits.cli import main
 
-    monkeypatch.setattr(memory, "available_memory_bytes", lambda: 300 << 20)
+    monkeypatch.setattr(memory, "available_memory", lambda: (300 << 20, memory.MACHINE_SOURCE))
     with pytest.raises(SystemExit) as exited:  # a tree of about 380 MiB (above always_fits_bytes)
         main(["plan", "--planner", "prrt", "--workers", "4096", "--max-nodes", "2000000",
               "--json", str(tmp_path / "out.json")])
     assert exited.value.code == 2
     err = capsys.readouterr().err
-    assert "max_nodes = 2000000: this plan's tree" in err and "JSON output" not in err
+    assert "max_nodes = 2000000: this plan could need about" in err and "JSON output" not in err
     assert not (tmp_path / "out.json").exists()

@@ -62,36 +62,47 @@ def cmd_search(args: argparse.Namespace) -> int:
         raise ValueError(f"--marked must be in [0, 2**qubits = {num_items}], got {args.marked}")
     iterations = (probability.optimal_iterations(num_items, args.marked)
                   if args.iterations is None else args.iterations)
+    from .memory import OutOfMemory, check_fits, out_of_memory
     from .search.backend import validate_iterations, validate_shots
 
-    _check_search_memory(backend, args.qubits, validate_shots(args.shots), validate_iterations(iterations),
-                         args.marked)
+    shots = validate_shots(args.shots)
+    estimate = _search_estimate(backend, shots, validate_iterations(iterations), args.marked)
+    what = f"this {backend.name} search ({shots} shots, {iterations} iterations, {args.marked} marked)"
+    check_fits(estimate, args.qubits, what)  # the command's one memory check, before the marks exist
+    try:
+        marks, result = _run_search(args, backend, num_items, iterations)
+    except OutOfMemory:
+        raise
+    except MemoryError as error:
+        raise out_of_memory(error, estimate, args.qubits, what) from error
+    _print_search(args, marks, iterations, result)
+    return 0
+
+
+def _run_search(args: argparse.Namespace, backend: QuantumSearchBackend, num_items: int,
+                iterations: int) -> tuple[np.ndarray, SearchResult]:
+    """The marks (``--marked`` entries drawn with ``--seed``) and their search, which the
+    command's own memory check covered."""
     rng = np.random.default_rng(args.seed)
     marks = np.zeros(num_items, dtype=bool)
     marks[rng.choice(num_items, args.marked, replace=False)] = True
-    result = backend.search(marks, iterations, shots=args.shots)
-    _print_search(args, marks, iterations, result)
-    return 0
+    return marks, backend._search_covered(marks, iterations, shots=args.shots)
 
 
 #: the marks (1 byte per entry) and numpy's draw of the marked entries (a permutation, 8 bytes)
 SEARCH_MARKS_BYTES_PER_ENTRY = 9
 
 
-def _check_search_memory(backend: QuantumSearchBackend, num_qubits: int, shots: int, iterations: int,
-                         marked: int) -> None:
-    """Refuse before allocating the marks when the marks and the search of ``marked`` entries would
-    not fit."""
+def _search_estimate(backend: QuantumSearchBackend, shots: int, iterations: int,
+                     marked: int) -> Callable[[int], MemoryEstimate]:
+    """``qrrt search``'s peak as a function of n: the marks and the search of ``marked`` entries."""
     from dataclasses import replace
-
-    from .memory import check_fits
 
     def estimate(n: int) -> MemoryEstimate:
         search = backend.memory_estimate(n, shots, iterations, marked)
         return replace(search, resident_bytes=SEARCH_MARKS_BYTES_PER_ENTRY << n)
 
-    check_fits(estimate, num_qubits,
-               f"this {backend.name} search ({shots} shots, {iterations} iterations, {marked} marked)")
+    return estimate
 
 
 def _print_search(args: argparse.Namespace, marks: np.ndarray, iterations: int, result: SearchResult) -> None:
@@ -210,8 +221,8 @@ def _write_plan_outputs(args: argparse.Namespace, result: PlanResult, env: Envir
         try:  # streamed chunk by chunk (PlanResult.write_json), not built as one string
             write_replacing(Path(args.json), result.write_json)
             print(f"wrote {args.json}")
-        except OSError as exc:
-            failures.append(f"--json: writing {args.json!r} failed ({exc.strerror or exc})")
+        except (OSError, MemoryError) as exc:
+            failures.append(f"--json: writing {args.json!r} failed ({_write_failure(exc)})")
     if args.plot:
         import matplotlib
 
@@ -227,13 +238,20 @@ def _write_plan_outputs(args: argparse.Namespace, result: PlanResult, env: Envir
             write_replacing(Path(args.plot), lambda handle: fig.savefig(handle, format=suffix, dpi=130,
                                                                          bbox_inches="tight"), binary=True)
             print(f"wrote {args.plot}")
-        except OSError as exc:
-            failures.append(f"--plot: writing {args.plot!r} failed ({exc.strerror or exc})")
+        except (OSError, MemoryError) as exc:
+            failures.append(f"--plot: writing {args.plot!r} failed ({_write_failure(exc)})")
         finally:
             plt.close(fig)
     if failures:
         raise OSError(f"{'; '.join(failures)}; the plan finished (its metrics are printed above) but "
                       f"{'these outputs were' if len(failures) > 1 else 'this output was'} not (completely) written")
+
+
+def _write_failure(exc: OSError | MemoryError) -> str:
+    """Why an output was not written, in a few words (a file replaced whole is left as it was)."""
+    if isinstance(exc, MemoryError):
+        return f"out of memory: {' '.join(str(exc).split()) or 'MemoryError'}"
+    return str(exc.strerror or exc)
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
@@ -243,8 +261,9 @@ def cmd_plan(args: argparse.Namespace) -> int:
         raise ValueError(f"--json and --plot name the same file {args.plot!r} (the plot would overwrite the JSON)")
     env = _load_environment(args)
     planner = build_planner(args, env)
-    # (the plan checks its tree and history against the available memory before its first round;
-    # --json adds no memory per node: PlanResult.write_json streams the arrays chunk by chunk)
+    # (the plan makes its one memory check before it allocates anything, and words a MemoryError as
+    # one OutOfMemory line; --json adds no memory per node: PlanResult.write_json streams the arrays
+    # chunk by chunk; the outputs are written only once the plan has finished)
     result = planner.plan(max_nodes=args.max_nodes, max_oracle_calls=args.max_oracle_calls,
                           max_rounds=args.max_rounds, max_critical_path_calls=args.max_critical_path_calls,
                           stall_rounds=args.stall_rounds)
@@ -427,6 +446,17 @@ def main(argv: list[str] | None = None) -> int:
         parser.exit(2, f"qrrt {args.command}: error: {exc}\n")
     except OSError as exc:  # unreadable files, an unreachable Dask scheduler, a full disk
         parser.exit(1, f"qrrt {args.command}: error: {type(exc).__name__}: {exc}\n")
+    except MemoryError as exc:  # a plan's or a search's is a one-line memory.OutOfMemory naming the size
+        parser.exit(1, f"qrrt {args.command}: error: {_memory_error_text(exc)}\n")
+
+
+def _memory_error_text(exc: MemoryError) -> str:
+    """One line for a ``MemoryError``: an ``OutOfMemory``'s own message (the size that did not fit
+    and the largest smaller one whose estimate fits), else what the allocator reported."""
+    from .memory import OutOfMemory
+
+    text = " ".join(str(exc).split())
+    return text if isinstance(exc, OutOfMemory) and text else f"out of memory ({text or 'MemoryError'})"
 
 
 if __name__ == "__main__":

@@ -1,35 +1,53 @@
-"""The memory guard: estimate a run's peak memory before anything large is allocated, and refuse a
-run that would not fit (issue 10, defect 2).
+"""The memory guard: a plan or a search is sized once, before anything large is allocated, and
+refused (``ValueError``) if it would not fit; one that runs out of memory all the same ends with one
+``OutOfMemory``.
 
-A quantum planner's round holds, at its peak, one database of N = 2^n candidates (samples,
-nearest parents, the predicate's answers, the oracle's marks and the scratch arrays that build
-them), plus what one Grover search of it costs on the backend (``QuantumSearchBackend.peak_bytes``:
-each backend reports its own footprint) and the search policy's own state
-(``IterationPolicy.state_bytes``). The estimate is the sum, in bytes *added* to the running
-process (the interpreter and the imported libraries are already resident, so they are already
-missing from the available memory).
+What is sized, in bytes *added* to the running process (the interpreter and the imported libraries
+are already resident, so they are already missing from the available memory):
 
-Available memory is ``MemAvailable`` from ``/proc/meminfo`` (Linux: free memory plus the page cache
-and slabs the kernel can reclaim, i.e. what can be allocated without swapping); elsewhere
-``os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")`` (free pages only, a lower figure); if
-neither exists, no check is made. Inside a container or any memory-limited control group, the
-machine's figure overstates what the process may use (the kernel kills it at the group's limit),
-so the group's room is taken where it is smaller (``cgroup_available_bytes``: the limit less the
-usage, the usage without the inactive page cache the kernel reclaims first; cgroup v2 and v1).
-``psutil`` is not a runtime dependency, so it is not used.
+- a plan (``check_plan_fits``, called by ``Planner.plan`` before the plan allocates anything): its
+  tree and round history up to the node and round limits in force (``plan_bytes``) and, for a
+  quantum planner, one round at its peak (``MemoryEstimate``): the databases of 2^n candidates
+  alive at once (samples, nearest parents, the predicate's answers, the oracle's marks and the
+  scratch arrays that build them), the backend's search of them at the policy's largest iteration
+  count (``IterationPolicy.search_peak_bytes``: each backend reports its own footprint,
+  ``QuantumSearchBackend.peak_bytes``) and the search policy's state
+  (``IterationPolicy.state_bytes``). The plan's searches make no check of their own.
+- a direct search (``QuantumSearchBackend.search``, ``search_many``, ``search_sequence``): the
+  backend's footprint, checked once per call (``check_fits``).
 
-The per-entry constants are calibrated, not derived: ``benchmarks/bench_memory.py`` measures the
-peak resident set of real runs (``resource.getrusage``, in a fresh subprocess per case) against
-this estimate for n = 16..22 on both backends; the constants below are the measured bytes per
-entry rounded up (d = 2, 4, 6 fitted linearly in d for the database).
+What is available (``available_memory``): the smallest of
+
+- ``MemAvailable`` from ``/proc/meminfo`` (Linux: free memory plus the page cache and slabs the
+  kernel can reclaim, i.e. what can be allocated without swapping); elsewhere
+  ``os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")`` (free pages only, a lower figure);
+- the room left in the process's memory control groups (``cgroup_available_bytes``: inside a
+  container the kernel kills the process at its group's limit, whatever the machine has free);
+- the address space left under ``RLIMIT_AS`` (``ulimit -v``; ``address_space_available_bytes``):
+  the soft limit less the process's virtual size, the first field of ``/proc/self/statm`` times
+  the page size (not taken where that file cannot be read).
+
+A figure that cannot be read is left out; where none can, no check refuses. The estimates count
+resident bytes: address space that a library reserves without touching it (thread stacks,
+allocator arenas) is not in them, so a run sized close to the ``RLIMIT_AS`` room can still fail.
+
+A ``MemoryError`` raised while a plan or a direct search runs (numpy's ``_ArrayMemoryError`` is
+one) is raised again as an ``OutOfMemory`` whose message is one line: the size that did not fit
+(``num_qubits``, or the node or round limit), what the allocator reported, the estimate, and the
+largest smaller size whose estimate fits in the memory available after the failure.
+
+``psutil`` is not a runtime dependency, so it is not used. The per-entry constants are calibrated,
+not derived: the measured peak resident set of real runs, rounded up (their comments give the
+measurements).
 """
 
 from __future__ import annotations
 
 import functools
+import gc
 import os
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 MIB = 1 << 20
@@ -47,16 +65,86 @@ ANNEALING_BYTES_PER_COORDINATE = 38
 SCRATCH_BYTES = 64 * MIB
 
 
-def available_memory_bytes() -> int | None:
-    """Memory that can still be allocated without swapping, in bytes (None if unknown).
+#: where each figure of ``available_memory`` comes from, as its messages name it
+MACHINE_SOURCE = "MemAvailable"
+CGROUP_SOURCE = "the memory control group's room"
+ADDRESS_SPACE_SOURCE = "the address space left under RLIMIT_AS, ulimit -v"
+
+
+def available_memory() -> tuple[int, str] | None:
+    """The memory a run can still take, in bytes, and which figure bounds it.
 
     Returns:
-        The smaller of the machine's figure (``MemAvailable`` of ``/proc/meminfo`` on Linux, else
-        free pages times the page size) and the room left in the process's memory control group
-        (``cgroup_available_bytes``), whichever are known; None if neither is.
+        ``(bytes, source)``: the smallest of the figures that can be read (the module docstring):
+        the machine's (``MemAvailable``, or free pages where there is no ``/proc/meminfo``;
+        ``MACHINE_SOURCE``), the room of the memory control groups (``cgroup_available_bytes``;
+        ``CGROUP_SOURCE``) and the address space left under ``RLIMIT_AS``
+        (``address_space_available_bytes``; ``ADDRESS_SPACE_SOURCE``); None if none can.
     """
-    figures = [figure for figure in (_machine_available_bytes(), cgroup_available_bytes()) if figure is not None]
-    return min(figures) if figures else None
+    figures = [(figure, source) for figure, source in ((_machine_available_bytes(), MACHINE_SOURCE),
+                                                       (cgroup_available_bytes(), CGROUP_SOURCE),
+                                                       (address_space_available_bytes(), ADDRESS_SPACE_SOURCE))
+               if figure is not None]
+    return min(figures, key=lambda figure: figure[0]) if figures else None
+
+
+def available_memory_bytes() -> int | None:
+    """The bytes of ``available_memory`` (None if no figure can be read).
+
+    Returns:
+        The smallest of ``MemAvailable`` (or free pages), the control groups' room and the address
+        space left under ``RLIMIT_AS``, whichever are known; None if none is.
+    """
+    found = available_memory()
+    return None if found is None else found[0]
+
+
+#: the process's sizes in pages: total virtual size first (Linux)
+PROC_STATM = "/proc/self/statm"
+
+
+def virtual_memory_bytes() -> int | None:
+    """The process's virtual size (what ``RLIMIT_AS`` limits), in bytes; None where it cannot be
+    read.
+
+    Returns:
+        The first field of ``/proc/self/statm`` times the page size, or None (no such file).
+    """
+    try:
+        with open(PROC_STATM, encoding="ascii") as statm:
+            pages = int(statm.read().split()[0])
+        return pages * int(os.sysconf("SC_PAGE_SIZE"))
+    except (OSError, ValueError, IndexError, AttributeError):
+        return None
+
+
+def address_space_limit() -> int | None:
+    """The soft ``RLIMIT_AS`` (``ulimit -v``) in bytes; None where there is none (unlimited, or no
+    ``resource`` module).
+
+    Returns:
+        The limit, or None.
+    """
+    try:
+        import resource
+    except ImportError:  # not POSIX
+        return None
+    soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+    return None if soft == resource.RLIM_INFINITY or soft < 0 else int(soft)
+
+
+def address_space_available_bytes() -> int | None:
+    """The address space the process can still map under ``RLIMIT_AS``: the soft limit less the
+    process's virtual size (``virtual_memory_bytes``), at least 0.
+
+    Returns:
+        The bytes; None without a limit, or where the virtual size cannot be read.
+    """
+    limit = address_space_limit()
+    if limit is None:
+        return None
+    size = virtual_memory_bytes()
+    return None if size is None else max(limit - size, 0)
 
 
 def _machine_available_bytes() -> int | None:
@@ -122,11 +210,14 @@ def _smallest_limit_cached() -> int | None:
 
 
 def always_fits_bytes() -> int:
-    """Estimates up to this are accepted without reading the available memory: ``ALWAYS_FITS_BYTES``,
-    or an eighth of the smallest control-group limit where that is less (in a 130 MB container a
-    180 MiB estimate went unchecked and the kernel killed the run)."""
+    """Estimates up to this are accepted without reading the machine's or the control groups'
+    figures: ``ALWAYS_FITS_BYTES``, or an eighth of the smallest control-group limit where that is
+    less, and never more than the address space left under ``RLIMIT_AS`` where there is such a
+    limit (read on every call: the limit is a system call, the virtual size one small file)."""
     limit = smallest_cgroup_limit()
-    return ALWAYS_FITS_BYTES if limit is None else min(ALWAYS_FITS_BYTES, limit // 8)
+    fits = ALWAYS_FITS_BYTES if limit is None else min(ALWAYS_FITS_BYTES, limit // 8)
+    room = address_space_available_bytes()
+    return fits if room is None else min(fits, room)
 
 
 def _memory_groups() -> list[tuple[Path, _GroupFiles]]:
@@ -207,8 +298,8 @@ def database_bytes(num_qubits: int, dim: int, annealing: bool = False) -> int:
     """Peak bytes of building one database of 2^n candidates in d dimensions and evaluating the
     predicate on it (Alg. 1 lines 4-8; Alg. 4 line 7 with ``annealing``).
 
-    (26 + 16 d) 2^n bytes, or (46 + 38 d) 2^n with annealing: per-entry constants calibrated by
-    ``benchmarks/bench_memory.py`` (see the module docstring).
+    (26 + 16 d) 2^n bytes, or (46 + 38 d) 2^n with annealing: calibrated per-entry constants
+    (``DATABASE_BYTES_PER_ENTRY`` and the others).
 
     Args:
         num_qubits: n (the database holds 2^n candidates).
@@ -255,17 +346,22 @@ def database_resident_bytes(num_qubits: int, dim: int) -> int:
 class MemoryEstimate:
     """A run's estimated peak memory, in bytes added to the running process, by part.
 
-    The database's build scratch is freed before the search starts, so the peak is the larger of
-    building the databases and searching them while they are kept:
-    ``max(database_bytes, resident_bytes + search_bytes) + policy_bytes + scratch_bytes``.
+    The database's build scratch is freed before the search starts, so a round's peak is the larger
+    of building the databases and searching them while they are kept; a plan's tree, its output and
+    its round history are held beside it:
+    ``max(database_bytes, resident_bytes + search_bytes) + policy_bytes + scratch_bytes +
+    tree_bytes + output_bytes + history_bytes``.
 
     Args:
-        num_qubits: n, the database's qubits.
+        num_qubits: n, the database's qubits (0 for a plan without databases).
         database_bytes: Peak of building one round's databases (``database_bytes``).
         resident_bytes: The databases kept while they are searched (``database_resident_bytes``).
         search_bytes: The backend's search (``QuantumSearchBackend.peak_bytes``).
         policy_bytes: The search policy's state (``IterationPolicy.state_bytes``).
         scratch_bytes: Fixed allowance (default ``SCRATCH_BYTES``, 64 MiB).
+        tree_bytes: A plan's tree at its node limit (``plan_bytes``; default 0).
+        output_bytes: What writing a plan's result adds at that limit (default 0).
+        history_bytes: A plan's round history at its round limit (default 0).
 
     Example:
         >>> from qrrt_circuits.memory import MemoryEstimate, database_bytes, database_resident_bytes
@@ -284,25 +380,40 @@ class MemoryEstimate:
     search_bytes: int = 0
     policy_bytes: int = 0
     scratch_bytes: int = SCRATCH_BYTES
+    tree_bytes: int = 0
+    output_bytes: int = 0
+    history_bytes: int = 0
+
+    @property
+    def round_bytes(self) -> int:
+        """One round's peak: ``max(database, resident + search) + policy + scratch`` bytes."""
+        searched = self.resident_bytes + self.search_bytes
+        return max(self.database_bytes, searched) + self.policy_bytes + self.scratch_bytes
+
+    @property
+    def limits_bytes(self) -> int:
+        """What a plan's limits bound: ``tree + output + history`` bytes."""
+        return self.tree_bytes + self.output_bytes + self.history_bytes
 
     @property
     def total_bytes(self) -> int:
-        """The estimated peak: ``max(database, resident + search) + policy + scratch`` bytes."""
-        return (max(self.database_bytes, self.resident_bytes + self.search_bytes) + self.policy_bytes
-                + self.scratch_bytes)
+        """The estimated peak: ``round_bytes + limits_bytes``."""
+        return self.round_bytes + self.limits_bytes
 
     def describe(self) -> dict:
         """The parts and ``total_bytes`` as a JSON-able dict."""
         return {"num_qubits": self.num_qubits, "database_bytes": self.database_bytes,
                 "resident_bytes": self.resident_bytes, "search_bytes": self.search_bytes,
                 "policy_bytes": self.policy_bytes, "scratch_bytes": self.scratch_bytes,
-                "total_bytes": self.total_bytes}
+                "tree_bytes": self.tree_bytes, "output_bytes": self.output_bytes,
+                "history_bytes": self.history_bytes, "total_bytes": self.total_bytes}
 
     def breakdown(self) -> str:
-        """The non-zero parts in words (MiB or GiB), for error messages."""
+        """The non-zero parts in words (bytes, KiB, MiB or GiB), for error messages."""
         parts = [("database build", self.database_bytes), ("database kept", self.resident_bytes),
                  ("search", self.search_bytes), ("search policy", self.policy_bytes),
-                 ("scratch", self.scratch_bytes)]
+                 ("scratch", self.scratch_bytes), ("tree", self.tree_bytes),
+                 ("its JSON output", self.output_bytes), ("round history", self.history_bytes)]
         return ", ".join(f"{name} {_size(value)}" for name, value in parts if value)
 
 
@@ -311,15 +422,27 @@ def _size(value: float) -> str:
         return f"about 10^{len(str(int(value))) - 1} bytes"
     if value >= 1 << 30:
         return f"{value / (1 << 30):.1f} GiB"
-    return f"{value / MIB:.0f} MiB"
+    if value >= MIB:
+        return f"{value / MIB:.0f} MiB"
+    if value >= 1024:
+        return f"{value / 1024:.0f} KiB"
+    return f"{int(value)} bytes"
 
 
-#: estimates up to this size are not checked (reading /proc/meminfo on every small search would
-#: cost as much as the search)
+#: estimates up to this size are not checked (reading /proc/meminfo and the control groups for
+#: every small search would cost as much as the search)
 ALWAYS_FITS_BYTES = 256 * MIB
 
 #: n is never tried beyond this when looking for the largest n that fits (2^64 entries)
 _LARGEST_TRIED = 64
+
+
+class OutOfMemory(MemoryError):
+    """A plan or a direct search ran out of memory: its message is one line naming the size that
+    did not fit (``num_qubits``, or the node or round limit), what the allocator reported, the
+    estimate, and the largest smaller size whose estimate fits in the memory available after the
+    failure. The ``MemoryError`` it replaces is its ``__cause__`` (without its traceback, whose
+    frames held the run's arrays)."""
 
 
 def largest_fitting(estimate_for: Callable[[int], MemoryEstimate], available: int, below: int) -> int:
@@ -352,20 +475,30 @@ def largest_fitting(estimate_for: Callable[[int], MemoryEstimate], available: in
     return best
 
 
-def check_fits(estimate_for: Callable[[int], MemoryEstimate], num_qubits: int, what: str,
-               available: int | None = None) -> MemoryEstimate:
-    """Refuse (``ValueError``) a run whose estimated peak exceeds the available memory, naming
-    ``num_qubits``, the estimate, the available memory and the largest n that fits. ``what`` names
-    the run ("this plan", "this search"). Returns the estimate when it fits.
+def _memory_text(measured: tuple[int, str], when: str = "") -> str:
+    """``"the 1.0 GiB of memory available (MemAvailable)"``: the figure and where it comes from."""
+    figure, source = measured
+    return f"the {_size(figure)} of memory available{when}{f' ({source})' if source else ''}"
 
-    Estimates up to ``always_fits_bytes()`` (256 MiB, less in a small container) are accepted
-    without reading the available memory; so is any estimate when the available memory is unknown.
+
+def check_fits(estimate_for: Callable[[int], MemoryEstimate], num_qubits: int, what: str,
+               available: int | None = None, source: str = "") -> MemoryEstimate:
+    """Refuse (``ValueError``) a run whose estimated peak exceeds the available memory, naming
+    ``num_qubits``, the estimate, the available memory (and which figure bounds it) and the largest
+    n that fits. ``what`` names the run ("this aer search (8 shots, 5 iterations)"). Returns the
+    estimate when it fits. The available memory is read at most once.
+
+    Estimates up to ``always_fits_bytes()`` (256 MiB, less in a small container or under a small
+    ``RLIMIT_AS``) are accepted without reading the available memory; so is any estimate when the
+    available memory is unknown.
 
     Args:
         estimate_for: The run's ``MemoryEstimate`` as a function of n.
         num_qubits: The n asked for.
         what: The run's name for the message.
-        available: The available bytes; None (default) for ``available_memory_bytes()``.
+        available: The available bytes; None (default) for ``available_memory()``.
+        source: Which figure ``available`` is, for the message (``available_memory``'s second
+            item; default none named).
 
     Returns:
         ``estimate_for(num_qubits)``.
@@ -388,16 +521,69 @@ def check_fits(estimate_for: Callable[[int], MemoryEstimate], num_qubits: int, w
     estimate = estimate_for(num_qubits)
     if estimate.total_bytes <= always_fits_bytes():
         return estimate
-    available = available_memory_bytes() if available is None else available
-    if available is None or estimate.total_bytes <= available:
+    measured = available_memory() if available is None else (available, source)
+    if measured is None or estimate.total_bytes <= measured[0]:
         return estimate
-    largest = largest_fitting(estimate_for, available, num_qubits)
+    largest = largest_fitting(estimate_for, measured[0], num_qubits)
     raise ValueError(
         f"num_qubits = {num_qubits}: {what} needs about {_size(estimate.total_bytes)} at its peak "
-        f"({estimate.breakdown()}), more than the {_size(available)} of memory available "
-        f"(MemAvailable, or the memory control group's room where smaller); the largest num_qubits "
-        f"that fits is {largest}"
-        f"{' (none does)' if largest == 0 else ''}")
+        f"({estimate.breakdown()}), more than {_memory_text(measured)}; the largest num_qubits that fits is "
+        f"{largest}{' (none does)' if largest == 0 else ''}")
+
+
+def _released(error: MemoryError) -> None:
+    """Drop the traceback of a failed run (its frames hold the run's arrays) and collect, so that
+    memory read afterwards is read without them."""
+    error.__traceback__ = None
+    gc.collect()
+
+
+def _out_of_memory(error: MemoryError, name: str, value: int, what: str, estimate: MemoryEstimate,
+                   largest_below: Callable[[int], int], measured: tuple[int, str] | None,
+                   given: str = "") -> OutOfMemory:
+    """The ``OutOfMemory`` of a run of ``name = value`` that raised ``error``: ``largest_below``
+    gives the largest value below ``value`` whose estimate fits in a number of bytes (0: none);
+    ``measured`` is the memory available when the run started, or None to read it now."""
+    _released(error)
+    reason = " ".join(str(error).split()) or type(error).__name__  # one line
+    head = (f"{name} = {value}{given}: {what} ran out of memory ({reason}) with an estimated peak of about "
+            f"{_size(estimate.total_bytes)} ({estimate.breakdown()})")
+    when = " when it started"
+    if measured is None:
+        measured, when = available_memory(), " now"
+    if measured is None:
+        return OutOfMemory(f"{head}; the memory available cannot be read: try a smaller {name}")
+    largest = largest_below(measured[0])
+    room = _memory_text(measured, when)
+    if largest:
+        return OutOfMemory(f"{head}; the largest {name} below {value} whose estimate fits in {room} is {largest}")
+    return OutOfMemory(f"{head}; no {name} below {value} has an estimate that fits in {room}")
+
+
+def out_of_memory(error: MemoryError, estimate_for: Callable[[int], MemoryEstimate], num_qubits: int,
+                  what: str, measured: tuple[int, str] | None = None) -> OutOfMemory:
+    """The one-line ``OutOfMemory`` that replaces a ``MemoryError`` raised by a run of
+    ``num_qubits`` sized by ``estimate_for`` (a direct search, ``qrrt search``).
+
+    Drops ``error``'s traceback (its frames hold the run's arrays) before any memory is read.
+
+    Args:
+        error: The ``MemoryError`` (numpy's ``_ArrayMemoryError`` is one).
+        estimate_for: The run's ``MemoryEstimate`` as a function of n.
+        num_qubits: The n that ran out of memory.
+        what: The run's name for the message.
+        measured: The memory available when the run started, as ``available_memory()`` gave it
+            (what a new run would find; memory that a failed run leaves behind, such as arrays
+            that compiled code keeps after an exception, is not in it), or None (default) to read
+            it now.
+
+    Returns:
+        The ``OutOfMemory`` to raise (``raise out_of_memory(...) from error``): it names n, what the
+        allocator reported, the estimate and the largest n below it whose estimate fits in that
+        memory (the estimate fell short at n, so a smaller n than that may be needed).
+    """
+    return _out_of_memory(error, "num_qubits", num_qubits, what, estimate_for(num_qubits),
+                          lambda available: largest_fitting(estimate_for, available, num_qubits), measured)
 
 
 #: a plan's tree, bytes per node besides its coordinates (parents in the tree and the result, the
@@ -453,17 +639,21 @@ def plan_bytes(max_nodes: int, nodes_per_round: int, max_rounds: int | None, dim
         >>> plan_bytes(1000, 8, 10, 2)  # 10 rounds of 8 workers: at most 80 nodes
         (15552, 2560)
     """
-    nodes = max_nodes + nodes_per_round
-    if max_rounds is not None:
-        nodes = min(nodes, max_rounds * nodes_per_round + 1)
+    nodes = _tree_nodes(max_nodes, nodes_per_round, max_rounds)
     tree = nodes * (TREE_BYTES_PER_NODE + TREE_BYTES_PER_COORDINATE * dim + output_bytes_per_node)
     history = 0 if max_rounds is None else max_rounds * HISTORY_BYTES_PER_ROUND
     return tree, history
 
 
+def _tree_nodes(max_nodes: int, nodes_per_round: int, max_rounds: int | None) -> int:
+    """The most nodes a plan's tree holds, the root included (``plan_bytes``)."""
+    nodes = max_nodes + nodes_per_round
+    return nodes if max_rounds is None else min(nodes, max_rounds * nodes_per_round + 1)
+
+
 def _largest(fits: Callable[[int], bool], upto: int) -> int:
     """The largest v in [1, upto] with ``fits(v)`` (``fits`` monotone: true up to some v), else 0."""
-    if not fits(1):
+    if upto < 1 or not fits(1):
         return 0
     low, high = 1, upto  # fits(low) holds
     while low < high:
@@ -475,14 +665,175 @@ def _largest(fits: Callable[[int], bool], upto: int) -> int:
     return low
 
 
+@dataclass
+class PlanSize:
+    """What one plan's memory check sizes: its tree and round history up to the limits in force
+    and, for a quantum planner, one round at its peak as a function of n.
+
+    ``check`` is the plan's one memory check (``Planner.plan`` makes it before the plan allocates
+    anything); ``out_of_memory`` words a ``MemoryError`` raised while the plan ran. Both name one
+    size to lower: ``num_qubits`` where the round needs at least as much as the tree and history or
+    lowering the limits alone cannot make the plan fit, else ``max_nodes`` (where the tree needs at
+    least as much as the history and a tree of one node would fit) or ``max_rounds``.
+
+    Args:
+        max_nodes: The node limit in force.
+        nodes_per_round: The most nodes one round adds.
+        max_rounds: The round limit in force (None: not counted, see ``plan_bytes``).
+        dim: The workspace dimension d.
+        round_estimate: One round's ``MemoryEstimate`` as a function of n, or None (default) for a
+            plan without databases (the classical planners).
+        num_qubits: The plan's n (default 0: none).
+        default_nodes: Whether ``max_nodes`` is the default limit (the caller gave none).
+        default_rounds: Whether ``max_rounds`` is the default limit.
+        output_bytes_per_node: What writing the result adds per node (``plan_bytes``).
+
+    Attributes:
+        measured: The memory available as the last ``check`` read it (``available_memory()``'s
+            ``(bytes, source)``), or None where it read none.
+
+    Example:
+        >>> from qrrt_circuits.memory import MemoryEstimate, PlanSize, database_bytes
+        >>> size = PlanSize(1000, 1, 100, 2,
+        ...                 round_estimate=lambda n: MemoryEstimate(n, database_bytes=database_bytes(n, 2)),
+        ...                 num_qubits=26)
+        >>> size.estimate().breakdown()
+        'database build 3.6 GiB, scratch 64 MiB, tree 19 KiB, round history 25 KiB'
+        >>> size.check(available=2**30)  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        ValueError: num_qubits = 26: this plan could need about 3.7 GiB ...; the largest num_qubits that fits is 24
+    """
+
+    max_nodes: int
+    nodes_per_round: int
+    max_rounds: int | None
+    dim: int
+    round_estimate: Callable[[int], MemoryEstimate] | None = None
+    num_qubits: int = 0
+    default_nodes: bool = False
+    default_rounds: bool = False
+    output_bytes_per_node: int = 0
+    measured: tuple[int, str] | None = field(default=None, init=False, repr=False, compare=False)
+
+    def estimate(self, num_qubits: int | None = None) -> MemoryEstimate:
+        """The plan's estimated peak (``MemoryEstimate``: the round's parts, the tree, its output
+        and the round history).
+
+        Args:
+            num_qubits: n (default the plan's own).
+
+        Returns:
+            The estimate at the plan's limits.
+        """
+        n = self.num_qubits if num_qubits is None else num_qubits
+        base = MemoryEstimate(n, scratch_bytes=0) if self.round_estimate is None else self.round_estimate(n)
+        return self._at(base, self.max_nodes, self.max_rounds)
+
+    def _at(self, base: MemoryEstimate, max_nodes: int, max_rounds: int | None) -> MemoryEstimate:
+        """``base`` (a round) with the tree, output and history of these limits."""
+        nodes = _tree_nodes(max_nodes, self.nodes_per_round, max_rounds)
+        tree, history = plan_bytes(max_nodes, self.nodes_per_round, max_rounds, self.dim)
+        return replace(base, tree_bytes=tree, output_bytes=nodes * self.output_bytes_per_node,
+                       history_bytes=history)
+
+    def check(self, available: int | None = None) -> MemoryEstimate:
+        """Refuse (``ValueError``) a plan whose estimated peak exceeds the available memory, naming
+        the size to lower (see the class), whether a limit is the default one, the estimate, the
+        available memory (and which figure bounds it) and the largest value of that size that
+        fits. The available memory is read at most once.
+
+        Estimates up to ``always_fits_bytes()`` are accepted without reading the available memory;
+        so is any estimate when the available memory is unknown.
+
+        Args:
+            available: The available bytes; None (default) for ``available_memory()``.
+
+        Returns:
+            The plan's ``estimate()`` when it fits.
+
+        Raises:
+            ValueError: The estimate exceeds the available memory.
+        """
+        self.measured = None
+        estimate = self.estimate()
+        if estimate.total_bytes <= always_fits_bytes():
+            return estimate
+        measured = self.measured = (available, "") if available is not None else available_memory()
+        if measured is None or estimate.total_bytes <= measured[0]:
+            return estimate
+        name, value, given = self._size_to_lower(estimate, measured[0])
+        largest = self._largest_below(name, estimate, measured[0], value + 1)
+        about = "" if name == "num_qubits" else "about "
+        if largest:
+            fits = f"the largest {name} that fits is {about}{largest}"
+        elif name == "num_qubits":
+            fits = "the largest num_qubits that fits is 0 (none does)"
+        else:
+            fits = f"no {name} fits ({_size(measured[0])} is less than one round needs)"
+        raise ValueError(
+            f"{name} = {value}{given}: this plan could need about {_size(estimate.total_bytes)} at its peak "
+            f"({estimate.breakdown()}), more than {_memory_text(measured)}; {fits}")
+
+    def out_of_memory(self, error: MemoryError) -> OutOfMemory:
+        """The one-line ``OutOfMemory`` that replaces a ``MemoryError`` raised while the plan ran.
+
+        Drops ``error``'s traceback (its frames hold the plan's arrays) before any memory is read.
+
+        Args:
+            error: The ``MemoryError`` (numpy's ``_ArrayMemoryError`` is one).
+
+        Returns:
+            The ``OutOfMemory`` to raise (``raise size.out_of_memory(error) from error``): it names
+            the size to lower (see the class), what the allocator reported, the estimate and the
+            largest value below the plan's whose estimate fits in the memory available when the
+            plan started (``measured``; read now where the check read none). The estimate fell
+            short at the plan's value, so a smaller one than that may be needed.
+        """
+        estimate = self.estimate()
+        _released(error)
+        figure = self.measured if self.measured is not None else available_memory()
+        name, value, given = self._size_to_lower(estimate, None if figure is None else figure[0])
+        return _out_of_memory(error, name, value, "this plan", estimate,
+                              lambda available: self._largest_below(name, estimate, available, value),
+                              self.measured, given)
+
+    def _size_to_lower(self, estimate: MemoryEstimate, available: int | None) -> tuple[str, int, str]:
+        """(name, value, "the default" note) of the size a message names (see the class)."""
+        if self.round_estimate is not None:
+            least = self._at(estimate, 1, None if self.max_rounds is None else 1).total_bytes
+            if estimate.round_bytes >= estimate.limits_bytes or (available is not None and least > available):
+                return "num_qubits", self.num_qubits, ""
+        one_node = self._at(estimate, 1, self.max_rounds).total_bytes
+        tree_first = estimate.tree_bytes + estimate.output_bytes >= estimate.history_bytes
+        if self.max_rounds is None or (tree_first and (available is None or one_node <= available)):
+            default = self.default_nodes
+            name, value = "max_nodes", self.max_nodes
+        else:  # the history's limit (a lower one also bounds the tree)
+            default = self.default_rounds
+            name, value = "max_rounds", self.max_rounds
+        return name, value, " (the default: the plan was given none)" if default else ""
+
+    def _largest_below(self, name: str, estimate: MemoryEstimate, available: int, below: int) -> int:
+        """The largest value below ``below`` of the size ``name`` whose estimate fits (0: none)."""
+        if name == "num_qubits":
+            return largest_fitting(self.estimate, available, below)
+        if name == "max_nodes":
+            return _largest(lambda nodes: self._at(estimate, nodes, self.max_rounds).total_bytes <= available,
+                            below - 1)
+        return _largest(lambda rounds: self._at(estimate, self.max_nodes, rounds).total_bytes <= available, below - 1)
+
+
 def check_plan_fits(max_nodes: int, nodes_per_round: int, max_rounds: int | None, dim: int,
                     available: int | None = None, *, default_nodes: bool = False,
-                    default_rounds: bool = False, output_bytes_per_node: int = 0) -> None:
-    """Refuse (``ValueError``) limits whose tree and round history could exceed the available
-    memory (``plan_bytes``), naming the limit to lower (``max_nodes`` where the tree needs at least
-    as much as the history and lowering it alone can make the plan fit, else ``max_rounds``),
-    whether that limit is the default one, the estimate, the available memory and the largest value
-    of that limit that fits.
+                    default_rounds: bool = False, output_bytes_per_node: int = 0,
+                    round_estimate: Callable[[int], MemoryEstimate] | None = None,
+                    num_qubits: int = 0) -> MemoryEstimate:
+    """A plan's one memory check (``PlanSize.check``): refuse (``ValueError``) limits and a round
+    whose tree, round history and round peak together could exceed the available memory, naming
+    the size to lower (``num_qubits``, ``max_nodes`` or ``max_rounds``, see ``PlanSize``), whether
+    that limit is the default one, the estimate, the available memory and the largest value of that
+    size that fits.
 
     Estimates up to ``always_fits_bytes()`` are accepted without reading the available memory; so is
     any estimate when the available memory is unknown.
@@ -492,44 +843,28 @@ def check_plan_fits(max_nodes: int, nodes_per_round: int, max_rounds: int | None
         nodes_per_round: The most nodes one round adds.
         max_rounds: The round limit in force (None: not counted, see ``plan_bytes``).
         dim: The workspace dimension d.
-        available: The available bytes; None (default) for ``available_memory_bytes()``.
+        available: The available bytes; None (default) for ``available_memory()``.
         default_nodes: Whether ``max_nodes`` is the default limit (the caller gave none).
         default_rounds: Whether ``max_rounds`` is the default limit.
         output_bytes_per_node: What writing the result adds per node (``plan_bytes``).
+        round_estimate: One round's ``MemoryEstimate`` as a function of n (a quantum planner's
+            ``memory_estimate``), or None (default) for a plan without databases.
+        num_qubits: The plan's n (with ``round_estimate``).
+
+    Returns:
+        The plan's ``MemoryEstimate`` when it fits.
 
     Raises:
         ValueError: The estimate exceeds the available memory.
 
     Example:
         >>> from qrrt_circuits.memory import check_plan_fits
-        >>> check_plan_fits(10**6, 1, 20000, 2, available=2**30)
+        >>> check_plan_fits(10**6, 1, 20000, 2, available=2**30).breakdown()  # 20 001 nodes at most
+        'tree 4 MiB, round history 5 MiB'
         >>> check_plan_fits(10**6, 1, 10**9, 2, available=2**30)  # doctest: +ELLIPSIS
         Traceback (most recent call last):
         ...
-        ValueError: max_rounds = 1000000000: this plan's tree and round history could need about 238.6 GiB ...
+        ValueError: max_rounds = 1000000000: this plan could need about 238.6 GiB ...
     """
-    tree, history = plan_bytes(max_nodes, nodes_per_round, max_rounds, dim, output_bytes_per_node)
-    if tree + history <= always_fits_bytes():
-        return
-    available = available_memory_bytes() if available is None else available
-    if available is None or tree + history <= available:
-        return
-
-    def total(nodes: int, rounds: int | None) -> int:
-        return sum(plan_bytes(nodes, nodes_per_round, rounds, dim, output_bytes_per_node))
-
-    if max_rounds is None or (tree >= history and total(1, max_rounds) <= available):  # the tree's limit
-        name, value, default = "max_nodes", max_nodes, default_nodes
-        largest = _largest(lambda nodes: total(nodes, max_rounds) <= available, max_nodes)
-    else:  # the history's limit (a lower one also bounds the tree)
-        name, value, default = "max_rounds", max_rounds, default_rounds
-        largest = _largest(lambda rounds: total(max_nodes, rounds) <= available, max_rounds)
-    given = " (the default: the plan was given none)" if default else ""
-    fits = (f"the largest {name} that fits is about {largest}" if largest else
-            f"no {name} fits ({_size(available)} is less than one round needs)")
-    output = " and its JSON output" if output_bytes_per_node else ""
-    raise ValueError(
-        f"{name} = {value}{given}: this plan's tree{output} and round history could need about "
-        f"{_size(tree + history)} (tree {_size(tree)}, history {_size(history)}), more than the "
-        f"{_size(available)} of memory available (MemAvailable, or the memory control group's room where "
-        f"smaller); {fits}")
+    return PlanSize(max_nodes, nodes_per_round, max_rounds, dim, round_estimate, num_qubits, default_nodes,
+                    default_rounds, output_bytes_per_node).check(available)

@@ -11,14 +11,18 @@ calls.
 A plan runs rounds until the goal is reached or its termination condition ends it
 (``qrrt_circuits.termination``); the condition is checked before each round, and a round limit
 (``DEFAULT_MAX_ROUNDS``), a stall limit (``DEFAULT_STALL_ROUNDS``) and a node limit
-(``DEFAULT_MAX_NODES``) are always in force unless the caller gives their own, so every plan ends;
-the node and round limits in force are checked against the available memory before the first round
-(``memory.check_plan_fits``).
+(``DEFAULT_MAX_NODES``) are always in force unless the caller gives their own, so every plan ends.
+
+Memory: a plan makes one check, before it allocates anything (``memory.PlanSize.check``): its tree
+and round history up to the node and round limits in force and, for a quantum planner, one round at
+its peak (``_round_memory``). Its searches make no check of their own. A ``MemoryError`` raised
+while it runs is raised again as a one-line ``memory.OutOfMemory``.
 """
 
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from concurrent.futures import Executor
 from typing import TYPE_CHECKING, Any
 
@@ -28,7 +32,7 @@ from .. import termination as _termination
 from ..deprecation import warn_deprecated
 from ..dynamics import LinearTrackingDynamics
 from ..environment import Environment
-from ..memory import check_plan_fits
+from ..memory import MemoryEstimate, OutOfMemory, PlanSize
 from ..oracle import ReachabilityOracle
 from ..oracle_errors import OracleErrorModel
 from ..predicate import ReachabilityPredicate, can_leave, check_predicate
@@ -169,8 +173,9 @@ class Planner:
         ``qrrt_circuits.termination``; they combine (any of them ends the plan) with
         ``termination``. A round limit (``DEFAULT_MAX_ROUNDS``), a stall limit
         (``DEFAULT_STALL_ROUNDS``) and a node limit (``DEFAULT_MAX_NODES``) are added unless the
-        condition has its own, so every plan ends; limits whose tree and round history could
-        exceed the available memory are refused (``memory.check_plan_fits``).
+        condition has its own, so every plan ends. Before anything is allocated, the plan's
+        estimated peak (its tree and round history up to the limits in force, and a quantum
+        planner's round) is checked once against the available memory (``memory.PlanSize``).
         Conditions are checked before each round, so a round may overshoot an oracle-call budget
         by less than one round's cost.
 
@@ -197,10 +202,14 @@ class Planner:
 
         Raises:
             ValueError: A point outside the workspace or inside an obstacle, a boundary start, a
-                non-positive radius or budget, a node or round limit whose tree or history could
-                exceed the available memory, or a dimension mismatch, before any work.
+                non-positive radius or budget, an estimated peak memory that exceeds the available
+                memory (naming ``num_qubits``, ``max_nodes`` or ``max_rounds`` and the largest
+                value that fits), or a dimension mismatch, before any work.
             TypeError: An argument of the wrong type (e.g. a ``termination`` that is not a
                 ``TerminationCondition``).
+            qrrt_circuits.memory.OutOfMemory: A ``MemoryError`` while the plan ran (one line: the
+                size to lower, what the allocator reported, the largest smaller value whose
+                estimate fits in the memory available when the plan started).
         """
         start, goal, goal_radius = self._check_problem(start, goal, goal_radius)
         condition = from_budgets(max_oracle_calls, max_nodes, max_rounds, max_time_s,
@@ -212,8 +221,21 @@ class Planner:
         condition = with_defaults(condition, _termination.DEFAULT_MAX_ROUNDS, _termination.DEFAULT_STALL_ROUNDS,
                                   _termination.DEFAULT_MAX_NODES)
         self._check_ready()
-        check_plan_fits(limits.node_limit, self._max_new_nodes_per_round(), limits.round_limit, self.env.dim,
-                        default_nodes=limits.default_nodes, default_rounds=limits.default_rounds)
+        round_estimate, num_qubits = self._round_memory()
+        size = PlanSize(limits.node_limit, self._max_new_nodes_per_round(), limits.round_limit, self.env.dim,
+                        round_estimate, num_qubits, default_nodes=limits.default_nodes,
+                        default_rounds=limits.default_rounds)
+        size.check()  # the plan's one memory check, before its first allocation
+        try:
+            return self._plan_checked(start, goal, goal_radius, condition)
+        except OutOfMemory:
+            raise
+        except MemoryError as error:  # (its frames, and the plan's arrays, are released before the message)
+            raise size.out_of_memory(error) from error
+
+    def _plan_checked(self, start: np.ndarray, goal: np.ndarray, goal_radius: float,
+                      condition: TerminationCondition) -> PlanResult:
+        """The plan after its checks: the run state, the rounds and the result."""
         state = RunState(start, goal, goal_radius)
         state.policy_state = self._start_policy()
         state.context = self._context()
@@ -275,8 +297,13 @@ class Planner:
 
     def _max_new_nodes_per_round(self) -> int:
         """The most nodes one round can add (1 here; p for p workers): a bound that the memory check
-        (``check_plan_fits``) and the skipped termination checks (``_run``) rely on."""
+        (``memory.PlanSize``) and the skipped termination checks (``_run``) rely on."""
         return 1
+
+    def _round_memory(self) -> tuple[Callable[[int], MemoryEstimate] | None, int]:
+        """What the plan's memory check adds for one round: (its ``MemoryEstimate`` as a function
+        of n, the plan's n); (None, 0) here, a plan without databases."""
+        return None, 0
 
     def _start_policy(self) -> PolicyState | None:
         return None

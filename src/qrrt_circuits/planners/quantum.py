@@ -22,13 +22,14 @@ p parallel quantum devices.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from concurrent.futures import Executor
 
 from ..database import AnnealingSchedule
 from ..deprecation import warn_deprecated
 from ..dynamics import LinearTrackingDynamics
 from ..environment import Environment
-from ..memory import MemoryEstimate, check_fits, database_bytes, database_resident_bytes
+from ..memory import MemoryEstimate, database_bytes, database_resident_bytes
 from ..oracle_errors import OracleErrorModel
 from ..predicate import ReachabilityPredicate
 from ..search.backend import QuantumSearchBackend
@@ -63,8 +64,8 @@ class PQRRT(Planner):
             must allow ``num_qubits``). Default: a new ``AerBackend()`` (qiskit-aer statevector
             sampling).
         num_qubits: Qubits n per database, so each database holds N = 2^n (sample, nearest parent)
-            entries; an integer >= 1 and at most the backend's ``max_qubits``, and the estimated
-            peak memory of one round must fit in the available memory. Default 8.
+            entries; an integer >= 1 and at most the backend's ``max_qubits``. ``plan`` refuses
+            an n whose round, with the tree, does not fit in the available memory. Default 8.
         workers: Number p of quantum workers per round, in [1, ``MAX_WORKERS``] (4096). Default 8.
         shared_database: True (default): the manager builds one database per round and its p workers
             all search it (Alg. 3 as printed; a solution measured by several workers is added once,
@@ -114,8 +115,7 @@ class PQRRT(Planner):
             [1, 4096], ``goal_bias`` outside [0, 1), a non-positive or non-finite ``resolution``, a
             negative ``seed``, a dimension mismatch between ``env`` and ``predicate`` or
             ``dynamics``, both ``predicate`` and ``oracle`` (or both ``predicate`` and ``dynamics``)
-            given, both ``search_policy`` and ``iterations`` given, or a plan whose estimated peak
-            memory (``memory_estimate``) exceeds the available memory.
+            given, or both ``search_policy`` and ``iterations`` given.
     """
 
     name = "PQRRT"
@@ -166,15 +166,15 @@ class PQRRT(Planner):
         self.shared_database = check_bool(shared_database, "shared_database")
         self.search_policy = policy
         self.annealing = annealing
-        check_fits(self.memory_estimate, self.num_qubits, "this plan")
 
     def memory_estimate(self, num_qubits: int | None = None) -> MemoryEstimate:
-        """Estimated peak memory of one round (``qrrt_circuits.memory``); checked at construction.
+        """Estimated peak memory of one round (``qrrt_circuits.memory``); ``plan`` checks it, with
+        the tree and the round history, once before the plan allocates anything.
 
         Counts the databases alive at once (one shared database, or one per worker when the
         databases are unshared: a round builds every worker's database before it searches them, on
         an executor or not), each with its backend search at the policy's largest iteration count
-        (``IterationPolicy.iterations_bound``), plus the policy's state.
+        (``IterationPolicy.search_peak_bytes``), plus the policy's state.
 
         Args:
             num_qubits: Qubits n to estimate for (databases of 2^n entries); default the planner's
@@ -187,7 +187,7 @@ class PQRRT(Planner):
         size = 1 << n
         concurrent = 1 if self.shared_database else self.workers
         shots = self.workers if self.shared_database else 1
-        search = self.backend.peak_bytes(n, shots, self.search_policy.iterations_bound(size))
+        search = self.search_policy.search_peak_bytes(self.backend, n, shots)
         return MemoryEstimate(
             n,
             database_bytes=concurrent * database_bytes(n, self.env.dim, self.annealing is not None),
@@ -213,6 +213,10 @@ class PQRRT(Planner):
     def _max_new_nodes_per_round(self) -> int:
         """p: each worker adds at most one node a round."""
         return self.workers
+
+    def _round_memory(self) -> tuple[Callable[[int], MemoryEstimate] | None, int]:
+        """One round's ``memory_estimate`` as a function of n, and the plan's n."""
+        return self.memory_estimate, self.num_qubits
 
     def _context(self) -> WorkerContext:
         return WorkerContext(self.env, self.predicate, self.streams, self.goal_bias, self.oracle_errors,
@@ -300,8 +304,8 @@ class QRRT(PQRRT):
             must allow ``num_qubits``). Default: a new ``AerBackend()`` (qiskit-aer statevector
             sampling).
         num_qubits: Qubits n per database, so each database holds N = 2^n (sample, nearest parent)
-            entries; an integer >= 1 and at most the backend's ``max_qubits``, and the estimated
-            peak memory of one round must fit in the available memory. Default 8.
+            entries; an integer >= 1 and at most the backend's ``max_qubits``. ``plan`` refuses
+            an n whose round, with the tree, does not fit in the available memory. Default 8.
         search_policy: The ``IterationPolicy`` that decides how each worker searches a database:
             ``PaperSchedule()`` (the default: 5 Grover iterations, 3 once the tree has more than 10
             nodes), ``FixedIterations(k)``, ``KnownOptimal()`` (Eq. 1 with the true m), ``BBHT()``,
@@ -342,9 +346,8 @@ class QRRT(PQRRT):
         ValueError: ``num_qubits`` < 1 or above the backend's ``max_qubits``, ``goal_bias`` outside
             [0, 1), a non-positive or non-finite ``resolution``, a negative ``seed``, a dimension
             mismatch between ``env`` and ``predicate`` or ``dynamics``, both ``predicate`` and
-            ``oracle`` (or both ``predicate`` and ``dynamics``) given, both ``search_policy`` and
-            ``iterations`` given, or a plan whose estimated peak memory (``memory_estimate``)
-            exceeds the available memory.
+            ``oracle`` (or both ``predicate`` and ``dynamics``) given, or both ``search_policy``
+            and ``iterations`` given.
     """
 
     name = "QRRT"

@@ -12,18 +12,25 @@ Oracle calls are counted as DESIGN §2 says: one per Grover iteration per prepar
 ``search_sequence(marks, sequence, shots, seed)`` runs generalized iterates G(alpha_j, beta_j)
 instead (an ``IterateSequence``, ``search/fixed_point.py``: fixed-point amplitude amplification);
 each iterate queries the oracle once, so ``oracle_calls = len(sequence) * shots`` as well.
+
+Memory: each call of ``search``, ``search_many`` and ``search_sequence`` checks its estimated peak
+against the available memory once, before the search allocates anything, and a ``MemoryError``
+raised while it runs becomes a one-line ``qrrt_circuits.memory.OutOfMemory``. A plan's searches
+(``DatabaseSearch`` with ``memory_checked``) make neither: the plan's own check covers them.
 """
 
 from __future__ import annotations
 
 import abc
+import functools
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, TypeAlias
+from typing import TYPE_CHECKING, TypeAlias, TypeVar
 
 import numpy as np
 
-from ..memory import MemoryEstimate, check_fits
+from .. import memory
+from ..memory import MemoryEstimate, OutOfMemory, check_fits, out_of_memory
 from ..validation import check_int, check_seed
 
 if TYPE_CHECKING:
@@ -33,6 +40,9 @@ if TYPE_CHECKING:
 _Prepared: TypeAlias = tuple[np.ndarray, int, int, int, "int | np.random.Generator | None"]
 #: a peak-memory estimate: (num_qubits, shots, iterations, marked or None) -> bytes
 _Peak: TypeAlias = Callable[[int, int, int, "int | None"], int]
+#: what one search is sized by: (marks, num_qubits, iterations, shots)
+_Sized: TypeAlias = tuple[np.ndarray, int, int, int]
+_T = TypeVar("_T")
 
 
 @dataclass(frozen=True)
@@ -231,12 +241,23 @@ class QuantumSearchBackend(abc.ABC):
 
         Raises:
             ValueError: ``marks`` not of length 2^n (n >= 1), n above ``max_qubits``, an estimated
-                peak memory that does not fit (``qrrt_circuits.memory``), or ``iterations`` /
-                ``shots`` out of range, before any work.
+                peak memory that does not fit (``qrrt_circuits.memory``; checked once per call), or
+                ``iterations`` / ``shots`` out of range, before any work.
             TypeError: Arguments of the wrong type.
+            qrrt_circuits.memory.OutOfMemory: A ``MemoryError`` while the search ran (one line:
+                n, what the allocator reported, the largest smaller n whose estimate fits).
         """
         prepared = self._prepare(SearchRequest(marks, iterations, shots, seed))
-        return self._finish(prepared, self._sample_seeded(*prepared))
+        measured = self._check_searches(self.peak_bytes, [prepared[:4]])
+        return self._guarded(self.peak_bytes, prepared[:4], functools.partial(self._run_prepared, prepared),
+                             measured)
+
+    def _search_covered(self, marks: np.ndarray, iterations: int, shots: int = 1,
+                        seed: int | None = None) -> SearchResult:
+        """``search`` without its memory check and without ``OutOfMemory``: for a caller whose own
+        check covered this search (a plan's ``PlanSize.check``, ``qrrt search``'s) and which words
+        a ``MemoryError`` itself."""
+        return self._run_prepared(self._prepare(SearchRequest(marks, iterations, shots, seed)))
 
     def search_many(self, requests: Sequence[SearchRequest]) -> tuple[SearchResult, ...]:
         """Independent searches (the p databases of one unshared Pq-RRT round): result i is exactly
@@ -252,10 +273,18 @@ class QuantumSearchBackend(abc.ABC):
 
         Raises:
             TypeError: An element that is not a ``SearchRequest``, or arguments of the wrong type.
-            ValueError: Any request that ``search`` would refuse (checked for all before any runs).
+            ValueError: Any request that ``search`` would refuse (checked for all before any runs;
+                the available memory is read once for the call).
+            qrrt_circuits.memory.OutOfMemory: A ``MemoryError`` while a search ran.
         """
         prepared = [self._prepare(request) for request in requests]
-        return tuple(self._finish(item, self._sample_seeded(*item)) for item in prepared)
+        measured = self._check_searches(self.peak_bytes, [item[:4] for item in prepared])
+        return tuple(self._guarded(self.peak_bytes, item[:4], functools.partial(self._run_prepared, item), measured)
+                     for item in prepared)
+
+    def _run_prepared(self, prepared: _Prepared) -> SearchResult:
+        """The ``SearchResult`` of one validated request."""
+        return self._finish(prepared, self._sample_seeded(*prepared))
 
     def _prepare(self, request: SearchRequest) -> _Prepared:
         """(marks, n, iterations, shots, seed) of one validated request; the seed is None (the
@@ -266,7 +295,6 @@ class QuantumSearchBackend(abc.ABC):
         iterations = validate_iterations(request.iterations)
         shots = validate_shots(request.shots)
         self.check_qubits(num_qubits)
-        self.check_search_memory(marks, shots, iterations)
         seed = request.seed
         if not isinstance(seed, np.random.Generator):
             seed = check_seed(seed)
@@ -361,11 +389,13 @@ class QuantumSearchBackend(abc.ABC):
         return self.peak_bytes(num_qubits, shots, iterations, marked)
 
     def check_search_memory(self, marks: np.ndarray, shots: int = 1, iterations: int = 1) -> None:
-        """Refuse the search of these marks if its estimated peak exceeds the available memory.
+        """Refuse the search of these marks if its estimated peak exceeds the available memory
+        (what ``search`` checks, once per call).
 
         First ``check_memory`` of their width with the bound over every m (no pass over the
         marks); only where that bound does not fit and the estimate for their count m is smaller
-        (``AerBackend`` with its ``mcz`` oracle), again with m.
+        (``AerBackend`` with its ``mcz`` oracle), again with m. The available memory is read at
+        most once.
 
         Args:
             marks: The validated boolean array of length 2^n.
@@ -375,29 +405,59 @@ class QuantumSearchBackend(abc.ABC):
         Raises:
             ValueError: The estimate does not fit in the available memory.
         """
-        self._check_marks_fit(self.peak_bytes, marks, shots, iterations)
+        self._check_searches(self.peak_bytes, [(marks, int(marks.shape[0]).bit_length() - 1, iterations, shots)])
 
-    def _check_marks_fit(self, peak: _Peak, marks: np.ndarray, shots: int, iterations: int) -> None:
-        """``_check_peak`` of ``peak`` for these marks: the bound first, then (only where it does
-        not fit and m's own estimate is smaller) with their count m."""
-        num_qubits = int(marks.shape[0]).bit_length() - 1
-        try:
-            self._check_peak(peak, num_qubits, shots, iterations, None)
-        except ValueError:
-            marked = int(np.count_nonzero(marks))
-            if peak(num_qubits, shots, iterations, marked) >= peak(num_qubits, shots, iterations, None):
-                raise
-            self._check_peak(peak, num_qubits, shots, iterations, marked)
+    def _check_searches(self, peak: _Peak, searches: Sequence[_Sized]) -> tuple[int, str] | None:
+        """One memory check of searches run one after the other: each held to ``peak``'s bound
+        over every m and, where that does not fit and the estimate for its marks' count m is
+        smaller, to that; the available memory read at most once (none of it where every bound is
+        at most ``always_fits_bytes()``). Returns what was read (``available_memory()``), or None."""
+        bounds = [peak(num_qubits, shots, iterations, None) for _, num_qubits, iterations, shots in searches]
+        if not bounds or max(bounds) <= memory.always_fits_bytes():
+            return None
+        measured = memory.available_memory()
+        if measured is None:
+            return None
+        for (marks, num_qubits, iterations, shots), bound in zip(searches, bounds, strict=True):
+            if bound <= measured[0]:
+                continue
+            marked: int | None = int(np.count_nonzero(marks))
+            if peak(num_qubits, shots, iterations, marked) >= bound:
+                marked = None  # the count cannot lower the estimate: the message names none
+            self._check_peak(peak, num_qubits, shots, iterations, marked, measured)
+        return measured
 
-    def _check_peak(self, peak: _Peak, num_qubits: int, shots: int, iterations: int, marked: int | None) -> None:
-        """``check_fits`` of ``peak(n, shots, iterations, marked)`` bytes."""
+    def _check_peak(self, peak: _Peak, num_qubits: int, shots: int, iterations: int, marked: int | None,
+                    measured: tuple[int, str] | None = None) -> None:
+        """``check_fits`` of ``peak(n, shots, iterations, marked)`` bytes (against ``measured``,
+        ``(bytes, source)``, where given)."""
         marks_text = "" if marked is None else f", {marked} marked"
 
         def estimate(width: int) -> MemoryEstimate:
             return MemoryEstimate(width, search_bytes=peak(width, shots, iterations, marked), scratch_bytes=0)
 
         what = f"this {self.name} search ({shots} shots, {iterations} iterations{marks_text})"
-        check_fits(estimate, num_qubits, what)
+        if measured is None:
+            check_fits(estimate, num_qubits, what)
+        else:
+            check_fits(estimate, num_qubits, what, available=measured[0], source=measured[1])
+
+    def _guarded(self, peak: _Peak, search: _Sized, run: Callable[[], _T], measured: tuple[int, str] | None) -> _T:
+        """``run()``, a ``MemoryError`` raised again as a one-line ``OutOfMemory`` naming the
+        search's n, what the allocator reported and the largest smaller n whose bound fits in
+        ``measured`` (what the check read; None: read then)."""
+        try:
+            return run()
+        except OutOfMemory:
+            raise
+        except MemoryError as error:
+            _, num_qubits, iterations, shots = search
+
+            def estimate(width: int) -> MemoryEstimate:
+                return MemoryEstimate(width, search_bytes=peak(width, shots, iterations, None), scratch_bytes=0)
+
+            what = f"this {self.name} search ({shots} shots, {iterations} iterations)"
+            raise out_of_memory(error, estimate, num_qubits, what, measured) from error
 
     def search_sequence(self, marks: np.ndarray, sequence: IterateSequence, shots: int = 1,
                         seed: int | None = None) -> SearchResult:
@@ -418,10 +478,27 @@ class QuantumSearchBackend(abc.ABC):
 
         Raises:
             ValueError: ``marks`` not of length 2^n, n above ``max_qubits``, ``shots`` out of
-                range, or an estimated peak memory that does not fit.
+                range, or an estimated peak memory that does not fit (checked once per call).
             TypeError: ``sequence`` not an ``IterateSequence``, or a non-integer ``shots``.
             NotImplementedError: A backend that does not run generalized iterates.
+            qrrt_circuits.memory.OutOfMemory: A ``MemoryError`` while the search ran.
         """
+        marks, num_qubits, shots = self._prepare_sequence(marks, sequence, shots)
+        sized = (marks, num_qubits, len(sequence), shots)
+        measured = self._check_searches(self.sequence_peak_bytes, [sized])
+        return self._guarded(self.sequence_peak_bytes, sized,
+                             lambda: self._run_sequence(marks, num_qubits, sequence, shots, seed), measured)
+
+    def _search_sequence_covered(self, marks: np.ndarray, sequence: IterateSequence, shots: int = 1,
+                                 seed: int | None = None) -> SearchResult:
+        """``search_sequence`` without its memory check and without ``OutOfMemory`` (see
+        ``_search_covered``)."""
+        marks, num_qubits, shots = self._prepare_sequence(marks, sequence, shots)
+        return self._run_sequence(marks, num_qubits, sequence, shots, seed)
+
+    def _prepare_sequence(self, marks: np.ndarray, sequence: IterateSequence,
+                          shots: int) -> tuple[np.ndarray, int, int]:
+        """(marks, n, shots) of a validated ``search_sequence`` call."""
         from .fixed_point import IterateSequence
 
         marks, num_qubits = validate_marks(marks)
@@ -429,7 +506,10 @@ class QuantumSearchBackend(abc.ABC):
             raise TypeError(f"sequence must be an IterateSequence, got {type(sequence).__name__}")
         shots = validate_shots(shots)
         self.check_qubits(num_qubits)
-        self._check_marks_fit(self.sequence_peak_bytes, marks, shots, len(sequence))
+        return marks, num_qubits, shots
+
+    def _run_sequence(self, marks: np.ndarray, num_qubits: int, sequence: IterateSequence, shots: int,
+                      seed: int | None) -> SearchResult:
         rng = self._rng if seed is None else seed_stream(seed)
         indices = self._sample_sequence(marks, num_qubits, sequence, shots, rng)
         check_measured(indices, shots, marks.shape[0], self.name)

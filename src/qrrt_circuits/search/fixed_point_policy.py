@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .backend import MAX_ITERATIONS
+from .backend import MAX_ITERATIONS, QuantumSearchBackend
 from .fixed_point import (
     LENGTH_RULES,
     IterateSequence,
@@ -107,6 +107,20 @@ class FixedPointAmplification(IterationPolicy):
 
     def _iterations(self, num_items: int, tree_nodes: int, num_marked: int | None) -> int:
         return self.iterates
+
+    def search_peak_bytes(self, backend: QuantumSearchBackend, num_qubits: int, shots: int) -> int:
+        """The backend's peak for one ``search_sequence`` of the l iterates
+        (``backend.sequence_peak_bytes``, a bound over every marked count).
+
+        Args:
+            backend: The plan's ``QuantumSearchBackend``.
+            num_qubits: n, the database's qubits.
+            shots: The shots of one search.
+
+        Returns:
+            Bytes.
+        """
+        return backend.sequence_peak_bytes(num_qubits, shots, self.iterates)
 
     def start(self, num_items: int) -> FixedPointState:
         return FixedPointState(self, num_items)

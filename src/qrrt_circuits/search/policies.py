@@ -48,7 +48,7 @@ import numpy as np
 from ..deprecation import warn_deprecated
 from ..probability import optimal_iterations
 from ..validation import check_choice, check_float, check_int, check_optional_int
-from .backend import MAX_ITERATIONS, validate_iterations
+from .backend import MAX_ITERATIONS, QuantumSearchBackend, validate_iterations
 from .problem import DatabaseSearch, SearchOutcome
 
 __all__ = [
@@ -147,6 +147,21 @@ class IterationPolicy:
             The bytes (0 by default).
         """
         return 0
+
+    def search_peak_bytes(self, backend: QuantumSearchBackend, num_qubits: int, shots: int) -> int:
+        """The backend's peak for the largest search of one database this policy runs (a plan's
+        memory check counts it; the plan's searches make no check of their own).
+
+        Args:
+            backend: The plan's ``QuantumSearchBackend``.
+            num_qubits: n, the database's qubits.
+            shots: The shots of one search (p workers on a shared database).
+
+        Returns:
+            By default ``backend.peak_bytes(n, shots, iterations_bound(2^n))``, a bound over every
+            marked count.
+        """
+        return backend.peak_bytes(num_qubits, shots, self.iterations_bound(1 << num_qubits))
 
     def _iterations(self, num_items: int, tree_nodes: int, num_marked: int | None) -> int:
         raise NotImplementedError

@@ -88,6 +88,10 @@ class DatabaseSearch:
         streams: The plan's ``RandomStreams`` (seeds keyed by round and worker).
         round_index: The planner's round.
         first_worker: The first worker searching this database (default 0).
+        memory_checked: True where a plan's memory check covered this database's searches
+            (``memory.PlanSize``): they then make no check of their own and leave a
+            ``MemoryError`` to the plan. False (default): each search checks itself, as a direct
+            ``backend.search`` does.
 
     Example:
         >>> import numpy as np
@@ -107,6 +111,7 @@ class DatabaseSearch:
     streams: RandomStreams
     round_index: int
     first_worker: int = 0
+    memory_checked: bool = False
 
     @property
     def num_items(self) -> int:
@@ -128,6 +133,8 @@ class DatabaseSearch:
             ValueError: k or ``shots`` out of the backend's range.
             TypeError: A non-integer k or ``shots``.
         """
+        if self.memory_checked:
+            return self.backend._search_covered(self.marks, iterations, shots, seed=seed).indices
         return self.backend.search(self.marks, iterations, shots, seed=seed).indices
 
     def search_sequence(self, sequence: IterateSequence, shots: int, seed: int) -> np.ndarray:
@@ -142,6 +149,8 @@ class DatabaseSearch:
         Returns:
             Int array of ``shots`` measured indices.
         """
+        if self.memory_checked:
+            return self.backend._search_sequence_covered(self.marks, sequence, shots, seed=seed).indices
         return self.backend.search_sequence(self.marks, sequence, shots, seed=seed).indices
 
     def verify(self, index: int) -> bool:
