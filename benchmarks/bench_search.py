@@ -1,29 +1,27 @@
 """Time per Grover search for each backend, against Aer's floor, and reachability pairs per second.
 
     python benchmarks/bench_search.py [--quick] [--out FILE]
+    python benchmarks/bench_search.py --floor-only [--repeats R] [--out FILE]
 
 Against Aer's floor (n = 4, 8, 12, 16; ``--quick``: 4, 8, 12), m = 12 marked entries (4 at n = 4),
-k = 12 iterations, 8 shots, Aer on one thread; in each repeat, one after the other:
-- ``floor``: Aer's own floor, a 1-qubit circuit (h, measure) run with 8 shots (and
-  ``floor_all_threads``: the same with Aer's default thread count, all cores);
-- ``floor_controller``: that 1-qubit circuit on Aer's controller directly (``aer_direct``), the
-  floor of the path ``AerBackend`` takes from 13 qubits on;
-- ``floor_state``: the floor of Aer's state (``aer_state``): a 1-qubit state reset, one h and 8
-  samples;
-- ``ours``: ``AerBackend.search`` (the compact circuit of ``aer_grover_circuit``, its instructions
-  applied to Aer's state below 13 qubits, ``aer_state``, else handed to Aer's controller),
-  ``ours_controller`` the same searches on the controller (``aer_direct``, the path before
-  ``aer_state``), ``build`` its construction per search (the ``GroverProgram``: its
-  share of the search), ``assemble`` the program's conversion into Aer's circuit object (which
-  Aer's own assembler did inside ``AerSimulator.run`` before), ``build_circuit`` the same circuit as
-  a ``QuantumCircuit``, and ``ours_via_run`` the same searches through ``AerSimulator.run`` (the
-  path before ``aer_direct``);
-- ``gate_by_gate``: the previous implementation (``aer_literal_grover_circuit`` with the CX-based
-  synthesis choice, bitstring memory parsing), for before/after figures from one run;
+k = 12 iterations, 8 shots, Aer on one thread; in each repeat, in a shuffled order:
+- ``floor``: Aer's own floor, a 1-qubit circuit (h, measure) through ``AerSimulator.run`` with 8
+  shots, ``memory=True`` and the simulator options ``AerBackend`` uses (and ``floor_all_threads``:
+  the same with Aer's default thread count, all cores);
+- ``ours``: ``AerBackend.search`` (the compact circuit of ``aer_grover_circuit``, built once per
+  search and run through ``AerSimulator.run``), ``build`` its instruction list (the
+  ``GroverProgram``), ``build_circuit`` the whole ``QuantumCircuit`` (``build_share``: its share of
+  the search), ``run_prebuilt`` ``AerSimulator.run`` of that circuit built beforehand (Aer's share:
+  its conversion of the circuit, the simulation and the result), and ``sampler_v2`` the same
+  pre-built circuit through qiskit-aer's ``SamplerV2`` (the other documented way to run it);
+- ``gate_by_gate``: the circuit gate by gate (``aer_literal_grover_circuit`` with the CX-based
+  synthesis choice, bitstring memory parsing), the circuit a noise model runs;
 - ``qiskit_algorithms``: qiskit-algorithms' ``Grover`` (12 iterations) with qiskit-aer's
   ``SamplerV2`` (8 shots, one thread) and a preset pass manager for AerSimulator (n <= 12);
 - ``ours_diagonal`` / ``ours_mcz``: both oracle forms at n = 8 and 12, to check
   ``simulation_synthesis``'s choice.
+``--floor-only`` measures just ``floor`` and ``ours`` with ``--repeats`` repeats per n (default
+200; a quarter of them at n = 16) and writes ``bench_search_floor.json``.
 Oracle forms (``synthesis``): both forms over n = 8..14 and m = 1..64 (``--quick``: n = 8, 10), the
 choice of ``simulation_synthesis`` and its time over the faster form's (the data its cost model's
 constants were fitted on).
@@ -32,19 +30,15 @@ to the floor of the same run.
 
 One job for a round's databases (``one_job``): the p = 8 databases of an unshared Pq-RRT round
 (n = 8, k = 3, one shot each, random marks) searched one after the other by
-``AerBackend.search_many`` against one controller call with the 8 circuits (what "one Aer job"
-would be), interleaved; and whether such a call can give each database its own seed (Aer sets
-circuit i's seed to seed_simulator + 2113 i, whatever the circuit carries).
+``AerBackend.search_many`` against one ``AerSimulator.run`` of the 8 circuits (what "one Aer job"
+would be), interleaved; and whether such a run can give each database its own seed (Aer sets
+circuit i's seed to seed_simulator + 2113 i).
 
 A q-RRT round's search (``round_search``): n = 8, k = 3, one shot, a fifth of the entries marked,
-the search a q-RRT round on Aer makes, taken apart, interleaved: ``AerBackend.search``,
-``aer_direct.execute_grover`` (assembly into the recycled circuit and the controller's run),
-``assemble_grover`` (assembly into a new circuit), the controller's call on an assembled circuit
-(``controller_call``) and, from its output, the controller's own C++ time for the circuit
-(``time_taken``, k = 3 and k = 0), a new ``AerCircuit()`` alone (its ``std::random_device`` seed),
-``aer_state.execute_grover`` (the circuit on Aer's state, ``AerBackend``'s path since ``aer_state``),
-``search_on_controller`` (``AerBackend.search`` kept on the controller) and
-``StatevectorBackend.search`` of the same marks.
+the search a q-RRT round on Aer makes, taken apart, interleaved: ``AerBackend.search``, its
+circuit's construction (``build_circuit``), ``AerSimulator.run`` of the pre-built circuit at k = 3
+and k = 0 (``run_prebuilt``, ``run_prebuilt_k0``) with Aer's own C++ time for the circuit from its
+result (``time_taken``), and ``StatevectorBackend.search`` of the same marks.
 
 Search table: Aer for n = 4..16, the exact statevector for n = 4..20. Reachability: one core,
 batches of pairs on paper_clutter and annealing_field, for two pair distributions (``uniform``: a
@@ -66,7 +60,7 @@ from _common import machine, median_time, write_json
 
 import qrrt_circuits as qc
 from qrrt_circuits.registry import BACKENDS
-from qrrt_circuits.search import aer_direct, aer_state, circuits
+from qrrt_circuits.search import circuits
 from qrrt_circuits.search.aer_circuits import aer_grover_program
 
 FLOOR_QUBITS = (4, 8, 12, 16)
@@ -78,8 +72,8 @@ def _marks(n: int, rng: np.random.Generator) -> np.ndarray:
     return marks
 
 
-def _contenders(n: int, marks: np.ndarray) -> dict:
-    """name -> function running one search (k = 12, 8 shots) of ``marks``."""
+def _floor_runs(marks: np.ndarray) -> dict:
+    """``floor`` and ``ours``: the two contenders of the figure against Aer's floor."""
     from qiskit import QuantumCircuit
     from qiskit_aer import AerSimulator
 
@@ -88,15 +82,25 @@ def _contenders(n: int, marks: np.ndarray) -> dict:
     floor.h(0)
     floor.measure(0, 0)
     ours = qc.AerBackend(seed=1, max_parallel_threads=1)
-    via_run = qc.AerBackend(seed=1, max_parallel_threads=1)
-    via_run._use_controller = False  # the same circuits through AerSimulator.run (the path before aer_direct)
-    on_controller = qc.AerBackend(seed=1, max_parallel_threads=1)
-    on_controller._use_state = False  # the same circuits on the controller (the path before aer_state)
-    state_floor = np.zeros(2, dtype=bool)  # k = 0: the state's reset, W (one h) and 8 samples
-    program = aer_grover_program(marks, 12)
+    return {"floor": lambda: simulator.run(floor, shots=8, seed_simulator=1, memory=True).result(),
+            "ours": lambda: ours.search(marks, 12, shots=8)}
+
+
+def _contenders(n: int, marks: np.ndarray) -> dict:
+    """name -> function running one search (k = 12, 8 shots) of ``marks``."""
+    from qiskit import QuantumCircuit
+    from qiskit_aer import AerSimulator
+    from qiskit_aer.primitives import SamplerV2
+
+    simulator = AerSimulator(method="statevector", max_parallel_threads=1)
+    floor = QuantumCircuit(1, 1)
+    floor.h(0)
+    floor.measure(0, 0)
+    prebuilt = circuits.aer_grover_circuit(marks, 12)
+    sampler = SamplerV2(seed=1, default_shots=8, options={"backend_options": {"max_parallel_threads": 1}})
     seeds = np.random.default_rng(2)
 
-    def gate_by_gate():  # the implementation before this benchmark's figures (same seeds per call)
+    def gate_by_gate():  # the circuit gate by gate, as a noise model runs it (same seeds per call)
         circuit = circuits.aer_literal_grover_circuit(marks, 12, synthesis="auto")
         result = simulator.run(circuit, shots=8, seed_simulator=int(seeds.integers(2**31 - 1)),
                                memory=True).result()
@@ -104,26 +108,15 @@ def _contenders(n: int, marks: np.ndarray) -> dict:
 
     all_threads = AerSimulator(method="statevector", max_parallel_threads=0)
     runs = {
-        "floor": lambda: simulator.run(floor, shots=8, seed_simulator=1, memory=True).result(),
-        # the same 1-qubit circuit with Aer's default thread count (all cores), as AerBackend ran
-        # every circuit before it kept circuits under 14 qubits on one thread
+        **_floor_runs(marks),
+        # the same 1-qubit circuit with Aer's default thread count (all cores)
         "floor_all_threads": lambda: all_threads.run(floor, shots=8, seed_simulator=1, memory=True).result(),
-        # the same 1-qubit circuit on Aer's controller directly (aer_direct): the floor of the
-        # path AerBackend takes without a noise model from 13 qubits on
-        "floor_controller": lambda: aer_direct.execute(simulator, floor, 8, 1, 1),
-        # a 1-qubit circuit (h, 8 samples) on Aer's state: the floor of the path AerBackend takes
-        # below 13 qubits
-        "floor_state": lambda: aer_state.execute_grover(state_floor, 0, "diagonal", 8, 1),
-        "ours": lambda: ours.search(marks, 12, shots=8),
-        "ours_controller": lambda: on_controller.search(marks, 12, shots=8),
-        # the circuit's construction (its GroverProgram: what AerBackend builds per search), and
-        # its conversion into Aer's circuit object (what Aer's own assembler did inside run)
+        # the circuit's instruction list (its GroverProgram), and the whole QuantumCircuit
         "build": lambda: aer_grover_program(marks, 12),
-        "assemble": lambda: aer_direct.assemble_program(program),
-        # both at once from cached call arguments (AerBackend's path for the diagonal form)
-        "assemble_grover": lambda: aer_direct.assemble_grover(marks, 12),
         "build_circuit": lambda: circuits.aer_grover_circuit(marks, 12),
-        "ours_via_run": lambda: via_run.search(marks, 12, shots=8),
+        # Aer's share of a search: the pre-built circuit through AerSimulator.run
+        "run_prebuilt": lambda: simulator.run(prebuilt, shots=8, seed_simulator=1, memory=True).result(),
+        "sampler_v2": lambda: sampler.run([prebuilt]).result(),
         "gate_by_gate": gate_by_gate,
     }
     if n in (8, 12):
@@ -177,45 +170,59 @@ def _interleaved_times(runs: dict, repeats: int) -> dict[str, list[float]]:
     return times
 
 
+def _floor_row(n: int, marks: np.ndarray, runs: dict, repeats: int) -> dict:
+    """Medians, minimums and ratios to the floor of ``runs`` measured interleaved."""
+    for run in runs.values():  # warm-up (imports, caches, the pass manager)
+        run()
+    times = _interleaved_times(runs, repeats)
+    medians = {name: float(np.median(values)) for name, values in times.items()}
+    minimums = {name: float(np.min(values)) for name, values in times.items()}
+    floor = medians["floor"]
+    row = {"qubits": n, "marked": int(marks.sum()), "iterations": 12, "shots": 8, "repeats": repeats,
+           "synthesis": circuits.simulation_synthesis(marks),
+           "instructions": len(circuits.aer_grover_circuit(marks, 12).data),
+           "median_ms": {name: value * 1e3 for name, value in medians.items()},
+           "ratio_to_floor": {name: value / floor for name, value in medians.items()},
+           # the fastest repeat of each: less sensitive to other processes on a busy machine
+           "min_ms": {name: value * 1e3 for name, value in minimums.items()},
+           "ratio_of_minimums_to_floor": {name: value / minimums["floor"] for name, value in minimums.items()}}
+    text = "  ".join(f"{name} {value * 1e3:8.3f} ms ({value / floor:6.1f}x)" for name, value in medians.items())
+    print(f"  n={n:2d} m={row['marked']:2d}  {text}")
+    text = "  ".join(f"{name} {value:6.1f}x" for name, value in row["ratio_of_minimums_to_floor"].items())
+    print(f"        fastest repeats over the fastest floor: {text}")
+    return row
+
+
 def bench_floor(quick: bool) -> list[dict]:
     """Each contender's median time and its ratio to Aer's floor, measured interleaved."""
     rows = []
     rng = np.random.default_rng(0)
     for n in FLOOR_QUBITS[:3] if quick else FLOOR_QUBITS:
         marks = _marks(n, rng)
-        runs = _contenders(n, marks)
-        for run in runs.values():  # warm-up (imports, caches, the pass manager)
-            run()
         repeats = (5 if quick else 30) if n <= 8 else (3 if quick else (12 if n == 12 else 8))
-        # shuffled order (the all-threads floor leaves OpenMP threads that can slow whatever runs
-        # right after it)
-        times = _interleaved_times(runs, repeats)
-        medians = {name: float(np.median(values)) for name, values in times.items()}
-        minimums = {name: float(np.min(values)) for name, values in times.items()}
-        floor = medians["floor"]
-        row = {"qubits": n, "marked": int(marks.sum()), "iterations": 12, "shots": 8, "repeats": repeats,
-               "synthesis": circuits.simulation_synthesis(marks),
-               "instructions": len(circuits.aer_grover_circuit(marks, 12).data),
-               "instructions_gate_by_gate": len(circuits.aer_literal_grover_circuit(marks, 12).data),
-               "median_ms": {name: value * 1e3 for name, value in medians.items()},
-               "ratio_to_floor": {name: value / floor for name, value in medians.items()},
-               # the fastest repeat of each: less sensitive to other processes on a busy machine
-               "min_ms": {name: value * 1e3 for name, value in minimums.items()},
-               "ratio_of_minimums_to_floor": {name: value / minimums["floor"] for name, value in minimums.items()},
-               "build_share": medians["build"] / medians["ours"],
-               "assemble_share": medians["assemble"] / medians["ours"]}
+        row = _floor_row(n, marks, _contenders(n, marks), repeats)
+        row["instructions_gate_by_gate"] = len(circuits.aer_literal_grover_circuit(marks, 12).data)
+        row["build_share"] = row["median_ms"]["build_circuit"] / row["median_ms"]["ours"]
+        row["run_share"] = row["median_ms"]["run_prebuilt"] / row["median_ms"]["ours"]
+        print(f"        circuit construction {row['build_share']:.1%} of the search, AerSimulator.run "
+              f"{row['run_share']:.1%}")
         rows.append(row)
-        text = "  ".join(f"{name} {value * 1e3:8.3f} ms ({value / floor:6.1f}x)" for name, value in medians.items())
-        print(f"  n={n:2d} m={row['marked']:2d}  {text}  build share {row['build_share']:.1%}, "
-              f"assembly share {row['assemble_share']:.1%}")
-        text = "  ".join(f"{name} {value:6.1f}x" for name, value in row["ratio_of_minimums_to_floor"].items())
-        print(f"        fastest repeats over the fastest floor: {text}")
+    return rows
+
+
+def bench_floor_only(repeats: int) -> list[dict]:
+    """``ours`` against ``floor`` alone, ``repeats`` interleaved repeats per n (a quarter at n = 16)."""
+    rows = []
+    rng = np.random.default_rng(0)
+    for n in FLOOR_QUBITS:
+        marks = _marks(n, rng)
+        rows.append(_floor_row(n, marks, _floor_runs(marks), max(3, repeats // 4) if n >= 16 else repeats))
     return rows
 
 
 def bench_one_job(quick: bool) -> dict:
-    """The p databases of one unshared Pq-RRT round in one Aer controller call against
-    ``AerBackend.search_many`` (one call each), and the seeds Aer gives the circuits of one call."""
+    """The p databases of one unshared Pq-RRT round in one ``AerSimulator.run`` against
+    ``AerBackend.search_many`` (one run each), and the seeds Aer gives the circuits of one run."""
     workers, n, k = 8, 8, 3
     rng = np.random.default_rng(3)
     marks = [rng.random(2**n) < 0.1 for _ in range(workers)]
@@ -224,32 +231,34 @@ def bench_one_job(quick: bool) -> dict:
     simulator = backend.simulator
     synthesis = backend.synthesis
 
-    def one_by_one() -> None:  # the simulator seeds as AerBackend draws them, one call per database
-        for mk, seed in zip(marks, seeds, strict=True):
-            aer_direct.execute(simulator, aer_grover_program(mk, k, synthesis), 1, seed, 1)
+    def words(circuits_: list, shots: int, seed: int) -> list[list[str]]:
+        result = simulator.run(circuits_, shots=shots, seed_simulator=seed, memory=True,
+                               max_parallel_threads=1).result()
+        return [list(experiment.data.memory) for experiment in result.results]
+
+    def one_run() -> None:  # the circuits of the round built and run in one AerSimulator.run
+        words([circuits.aer_grover_circuit(mk, k, synthesis=synthesis) for mk in marks], 1, seeds[0])
 
     requests = [qc.SearchRequest(mk, k, 1, seed) for mk, seed in zip(marks, seeds, strict=True)]
-    runs = {"search_many": lambda: backend.search_many(requests), "one_by_one_controller": one_by_one,
-            "one_controller_call": lambda: _one_call_words(simulator, marks, k, synthesis, seeds[0], 1)}
+    runs = {"search_many": lambda: backend.search_many(requests), "one_run": one_run}
     for run in runs.values():
         run()
     repeats = 10 if quick else 60
     times = _interleaved_times(runs, repeats)
     medians = {name: float(np.median(values)) * 1e3 for name, values in times.items()}
-    # the seeds of one call: circuit i ran with seeds[0] + 2113 i, not with its own seeds[i]
-    own = [aer_direct.execute(simulator, aer_grover_program(mk, k, synthesis), 64, seed, 1)
-           for mk, seed in zip(marks, seeds, strict=True)]
-    together64 = _one_call_words(simulator, marks, k, synthesis, seeds[0], 64, circuit_seeds=seeds)
-    shifted = [aer_direct.execute(simulator, aer_grover_program(mk, k, synthesis), 64,
-                                  seeds[0] + 2113 * index, 1) for index, mk in enumerate(marks)]
+    # the seeds of one run: circuit i ran with seeds[0] + 2113 i, not with its own seeds[i]
+    built = [circuits.aer_grover_circuit(mk, k, synthesis=synthesis) for mk in marks]
+    own = [words([circuit], 64, seed)[0] for circuit, seed in zip(built, seeds, strict=True)]
+    together64 = words(built, 64, seeds[0])
+    shifted = [words([circuit], 64, seeds[0] + 2113 * index)[0] for index, circuit in enumerate(built)]
     row = {"workers": workers, "qubits": n, "iterations": k, "shots_per_database": 1, "repeats": repeats,
            "median_ms": medians,
-           "one_call_over_search_many": medians["one_controller_call"] / medians["search_many"],
+           "one_run_over_search_many": medians["one_run"] / medians["search_many"],
            "circuit_seeds_are_first_plus_2113_i": together64 == shifted,
            "circuit_seeds_are_their_own": together64 == own}
     print(f"  {workers} databases (n={n}, k={k}, 1 shot): "
           + "  ".join(f"{name} {value:.3f} ms" for name, value in medians.items())
-          + f"  one call / search_many = {row['one_call_over_search_many']:.2f}; circuit i seeded "
+          + f"  one run / search_many = {row['one_run_over_search_many']:.2f}; circuit i seeded "
           f"first + 2113 i: {row['circuit_seeds_are_first_plus_2113_i']}, its own seed: "
           f"{row['circuit_seeds_are_their_own']}")
     return row
@@ -257,32 +266,23 @@ def bench_one_job(quick: bool) -> dict:
 
 def bench_round_search(quick: bool) -> dict:
     """The parts of one q-RRT round's search on Aer (n = 8, k = 3, one shot), median microseconds."""
-    from qiskit_aer.backends.controller_wrappers import AerCircuit
-
     n, k = 8, 3
     marks = np.random.default_rng(5).random(2**n) < 0.2
     backend = qc.AerBackend(seed=0, max_parallel_threads=1)
     statevector = qc.StatevectorBackend(seed=0)
-    on_controller = qc.AerBackend(seed=0, max_parallel_threads=1)
-    on_controller._use_state = False
     simulator = backend.simulator
-    assembled = {iterations: aer_direct.assemble_grover(marks, iterations, "diagonal") for iterations in (k, 0)}
-    width = aer_direct._Width(n, n)
+    prebuilt = {iterations: circuits.aer_grover_circuit(marks, iterations) for iterations in (k, 0)}
     cpp_us: dict[int, list[float]] = {k: [], 0: []}
 
-    def controller(iterations: int) -> None:
-        config = aer_direct._configuration(simulator, width, 1, 1, 1)
-        output = simulator._execute_circuits([assembled[iterations]], None, config)
-        cpp_us[iterations].append(output["results"][0]["time_taken"] * 1e6)
+    def run_prebuilt(iterations: int) -> None:
+        result = simulator.run(prebuilt[iterations], shots=1, seed_simulator=1, memory=True,
+                               max_parallel_threads=1).result()
+        cpp_us[iterations].append(result.results[0].time_taken * 1e6)
 
     runs = {"search": lambda: backend.search(marks, k, 1, seed=1),
-            "execute_grover": lambda: aer_direct.execute_grover(simulator, marks, k, "diagonal", 1, 1, 1),
-            "assemble_grover": lambda: aer_direct.assemble_grover(marks, k, "diagonal"),
-            "controller_call": lambda: controller(k),
-            "controller_call_k0": lambda: controller(0),
-            "new_aer_circuit": AerCircuit,
-            "state_execute_grover": lambda: aer_state.execute_grover(marks, k, "diagonal", 1, 1),
-            "search_on_controller": lambda: on_controller.search(marks, k, 1, seed=1),
+            "build_circuit": lambda: circuits.aer_grover_circuit(marks, k),
+            "run_prebuilt": lambda: run_prebuilt(k),
+            "run_prebuilt_k0": lambda: run_prebuilt(0),
             "statevector_search": lambda: statevector.search(marks, k, 1, seed=1)}
     for run in runs.values():
         run()
@@ -291,32 +291,11 @@ def bench_round_search(quick: bool) -> dict:
     repeats = 200 if quick else 2000
     times = _interleaved_times(runs, repeats)
     medians = {name: float(np.median(values)) * 1e6 for name, values in times.items()}
-    medians["controller_cpp"] = float(np.median(cpp_us[k]))
-    medians["controller_cpp_k0"] = float(np.median(cpp_us[0]))
+    medians["aer_cpp"] = float(np.median(cpp_us[k]))
+    medians["aer_cpp_k0"] = float(np.median(cpp_us[0]))
     print(f"  n={n}, k={k}, 1 shot: " + "  ".join(f"{name} {value:.1f} us" for name, value in medians.items()))
     return {"qubits": n, "iterations": k, "shots": 1, "marked": int(marks.sum()), "repeats": repeats,
             "median_us": medians}
-
-
-def _one_call_words(simulator, marks, k: int, synthesis: str, seed: int, shots: int,
-                    circuit_seeds: list[int] | None = None) -> list[list[str]]:
-    """The measured words of one controller call with one Grover circuit per marks array, with
-    ``seed_simulator = seed`` and, if given, circuit i's own ``seed`` attribute set to
-    ``circuit_seeds[i]`` (to show that Aer replaces it by seed + 2113 i)."""
-    from qiskit_aer.backends.aer_compiler import generate_aer_config
-
-    circuits_ = []
-    for index, mk in enumerate(marks):
-        aer = aer_direct.assemble_program(aer_grover_program(mk, k, synthesis))
-        aer.circ_id = index
-        if circuit_seeds is not None:
-            aer.seed = circuit_seeds[index]
-        circuits_.append(aer)
-    n = int(marks[0].shape[0]).bit_length() - 1
-    config = generate_aer_config([aer_direct._Width(n, n)] * len(marks), simulator.options, shots=shots,
-                                 seed_simulator=seed, memory=True, max_parallel_threads=1)
-    output = simulator._execute_circuits(circuits_, None, config)
-    return [list(result["data"]["memory"]) for result in output["results"]]
 
 
 def bench_search(quick: bool) -> list[dict]:
@@ -381,34 +360,6 @@ def bench_synthesis(quick: bool) -> dict:
             "mean_choice_over_faster": float(np.mean(regrets))}
 
 
-def bench_state_paths(quick: bool) -> dict:
-    """The two paths of ``AerBackend`` for the same search: ``aer_state.execute_grover`` (Aer's
-    state) against ``aer_direct.execute_grover`` (Aer's controller, one thread), both oracle forms,
-    n = 10..13, m = 1 and 12, k = 12, 8 shots, interleaved; per case the medians and state /
-    controller (the data that ``aer.STATE_CHOSEN_BELOW_QUBITS`` rests on)."""
-    rng = np.random.default_rng(4)
-    rows = []
-    repeats = 6 if quick else 20
-    simulator = qc.AerBackend(seed=1, max_parallel_threads=1).simulator
-    widths = (10, 11, 12, 13)
-    for n in widths:
-        for marked in (1, 12):
-            marks = np.zeros(2**n, dtype=bool)
-            marks[rng.choice(2**n, marked, replace=False)] = True
-            for form in ("diagonal", "mcz"):
-                runs = {"state": lambda mk=marks, f=form: aer_state.execute_grover(mk, 12, f, 8, 1),
-                        "controller": lambda mk=marks, f=form: aer_direct.execute_grover(simulator, mk, 12, f, 8, 1, 1)}
-                times = _interleaved_times(runs, repeats)
-                medians = {name: float(np.median(values)) * 1e3 for name, values in times.items()}
-                rows.append({"qubits": n, "marked": marked, "synthesis": form, "median_ms": medians,
-                             "state_over_controller": medians["state"] / medians["controller"]})
-                print(f"  n={n:2d} m={marked:2d} {form:8s} state {medians['state']:7.3f} ms  controller "
-                      f"{medians['controller']:7.3f} ms  ratio {rows[-1]['state_over_controller']:.2f}")
-    return {"rows": rows, "repeats": repeats,
-            "worst_state_over_controller_by_qubits": {
-                str(n): max(row["state_over_controller"] for row in rows if row["qubits"] == n) for n in widths}}
-
-
 def bench_reachability(quick: bool) -> list[dict]:
     rows = []
     count = 20000 if quick else 200000
@@ -435,11 +386,39 @@ def bench_reachability(quick: bool) -> list[dict]:
     return rows
 
 
+def _floor_summary(floor: list[dict]) -> dict:
+    summary: dict = {}
+    for row in floor:
+        n = row["qubits"]
+        summary[f"aer_floor_ms_n{n}"] = row["median_ms"]["floor"]
+        for name in ("ours", "run_prebuilt", "sampler_v2", "gate_by_gate", "qiskit_algorithms"):
+            if name in row["ratio_to_floor"]:
+                summary[f"{name}_over_floor_n{n}"] = row["ratio_to_floor"][name]
+                summary[f"{name}_min_over_floor_min_n{n}"] = row["ratio_of_minimums_to_floor"][name]
+        summary[f"ours_ms_n{n}"] = row["median_ms"]["ours"]
+        for share in ("build_share", "run_share"):
+            if share in row:
+                summary[f"{share}_n{n}"] = row[share]
+    return summary
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--floor-only", action="store_true",
+                        help="only AerBackend.search against Aer's floor, n = 4, 8, 12, 16")
+    parser.add_argument("--repeats", type=int, default=200, help="--floor-only: repeats per n (default %(default)s)")
     parser.add_argument("--out", default=None)
     args = parser.parse_args()
+    if args.floor_only:
+        print(f"AerBackend.search against Aer's floor (k = 12, 8 shots, {args.repeats} repeats, medians):")
+        floor = bench_floor_only(max(1, args.repeats))
+        summary = _floor_summary(floor)
+        print("summary:", {k: round(v, 3) for k, v in summary.items()})
+        path = write_json("bench_search_floor", {"machine": machine(), "against_floor": floor, "summary": summary},
+                          args.out)
+        print(f"wrote {path}")
+        return
     print("Grover search against Aer's floor (k = 12, 8 shots, medians, ratio to the floor):")
     floor = bench_floor(args.quick)
     print("A round's databases in one Aer job:")
@@ -450,8 +429,6 @@ def main() -> None:
     search = bench_search(args.quick)
     print("Oracle forms for Aer (k = 12, 8 shots) and simulation_synthesis's choice:")
     synthesis = bench_synthesis(args.quick)
-    print("AerBackend.search on Aer's state against the controller (k = 12, 8 shots, medians):")
-    state_paths = bench_state_paths(args.quick)
     print("Reachability (one core):")
     reach = bench_reachability(args.quick)
     aer12 = next((r["median_s"] for r in search if r["backend"] == "aer" and r["qubits"] == 12), None)
@@ -464,28 +441,17 @@ def main() -> None:
             summary[f"{name.replace('-', '_')}_n{n}_us"] = time_s and time_s * 1e6
     sv20 = next((r["median_s"] for r in search if r["backend"] == "statevector" and r["qubits"] == 20), None)
     summary["statevector_n20_ms"] = sv20 and sv20 * 1e3
-    for row in floor:
-        n = row["qubits"]
-        summary[f"aer_floor_ms_n{n}"] = row["median_ms"]["floor"]
-        for name in ("ours", "ours_controller", "floor_state", "gate_by_gate", "qiskit_algorithms"):
-            if name in row["ratio_to_floor"]:
-                summary[f"{name}_over_floor_n{n}"] = row["ratio_to_floor"][name]
-                summary[f"{name}_min_over_floor_min_n{n}"] = row["ratio_of_minimums_to_floor"][name]
-        summary[f"ours_ms_n{n}"] = row["median_ms"]["ours"]
-        summary[f"build_share_n{n}"] = row["build_share"]
-        summary[f"assemble_share_n{n}"] = row["assemble_share"]
+    summary.update(_floor_summary(floor))
     for name, value in round_search["median_us"].items():
         summary[f"round_search_{name}_us"] = value
-    summary["one_job_over_search_many"] = one_job["one_call_over_search_many"]
+    summary["one_job_over_search_many"] = one_job["one_run_over_search_many"]
     summary["one_job_circuit_seeds_own"] = one_job["circuit_seeds_are_their_own"]
-    for n, ratio in state_paths["worst_state_over_controller_by_qubits"].items():
-        summary[f"state_worst_over_controller_n{n}"] = ratio
     summary["synthesis_worst_choice_over_faster"] = synthesis["worst_choice_over_faster"]
     summary["synthesis_mean_choice_over_faster"] = synthesis["mean_choice_over_faster"]
     print("summary:", {k: (round(v, 3) if isinstance(v, float) else v) for k, v in summary.items()})
     path = write_json("bench_search" + ("_quick" if args.quick else ""),
                       {"machine": machine(), "quick": args.quick, "against_floor": floor, "one_job": one_job,
-                       "round_search": round_search, "search": search, "state_paths": state_paths,
+                       "round_search": round_search, "search": search,
                        "synthesis": synthesis, "reachability": reach, "summary": summary,
                        "note": "phase oracle built from a classical lookup of all 2^n marks; "
                                "one circuit with 8 shots stands for 8 workers"}, args.out)

@@ -127,7 +127,7 @@ def test_planner_specific_options_take_their_defaults_where_they_apply(capsys):
 
     assert main(["plan", "--planner", "pqrrt", "--max-nodes", "3"]) == 0
     settings = dict(line.split(None, 1) for line in capsys.readouterr().out.splitlines()[1:12] if line.strip())
-    assert settings["num_qubits"] == "8" and settings["workers"] == "8" and settings["backend"] == "aer"
+    assert settings["num_qubits"] == "8" and settings["workers"] == "8" and settings["backend"].startswith("aer (")
     assert settings["search_policy"].startswith("paper")
     assert main(["plan", "--planner", "prrt", "--max-nodes", "3"]) == 0
     assert "workers                  8" in capsys.readouterr().out

@@ -1,31 +1,20 @@
 """Gate-level Grover search: real Qiskit circuits executed by qiskit-aer's ``AerSimulator``.
 
-The circuit (``aer_grover_circuit``: Walsh-Hadamard blocks, the oracle as one ``diagonal`` or as
-``pauli`` + ``mcphase`` pairs, one ``mcphase`` per diffuser) uses only instructions Aer executes
-natively, so it is run without a per-call transpile; with a ``noise_model`` the gate-by-gate
-circuit (``aer_literal_grover_circuit``: h, x, mcphase) is run instead, so per-gate noise acts on
-the paper's gates. Each shot is an independent preparation, k Grover iterations and a measurement
-(``memory=True`` keeps them per shot).
+Each search builds its circuit once and hands it to ``AerSimulator.run`` with ``shots``,
+``seed_simulator``, ``memory=True`` (the measured word of every shot, in order) and
+``max_parallel_threads``; nothing else of qiskit-aer is used. The circuit
+(``aer_grover_circuit``: Walsh-Hadamard blocks, the oracle as one ``diagonal`` or as ``pauli`` +
+``mcphase`` pairs, one ``mcphase`` per diffuser) uses only instructions Aer executes natively, so
+it is run without a transpile; with a ``noise_model`` the gate-by-gate circuit
+(``aer_literal_grover_circuit``: h, x, mcphase) is run instead, so per-gate noise acts on the
+paper's gates. Each shot is an independent preparation, k Grover iterations and a measurement.
 
-Without a noise model the circuit's instructions (``aer_direct.assemble_grover``) go to the simulator's
-C++ controller directly (``aer_direct``): the same simulation, the same configuration and the same
-measured words as ``AerSimulator.run`` (tested seed by seed), without the job thread, Aer's generic
-assembler and the ``Result`` conversion, which cost more than simulating these small circuits.
-Circuits on fewer than 13 qubits (``STATE_CHOSEN_BELOW_QUBITS``; ``aer_state`` simulates what the
-controller does up to 13), on the statevector method and
-the CPU with the simulator's options as made here, run instead on Aer's own statevector state
-(``aer_state``: the circuit's instructions applied one by one to ``AerState``, the state behind
-``AerStatevector``, then Aer's sampler with the same seed): again the same measured words as
-``AerSimulator.run`` (tested seed by seed), at about half the controller's fixed cost per run
-(61 against 113 us at k = 0, n = 8: ``bench_aer_overhead.py`` in ``benchmarks/results/run_c22abd7.json``).
 Independent searches (``search_many``) run one after the other: in a multi-circuit run Aer seeds
 circuit i with ``seed_simulator + 2113 i``, so one run cannot give each database its own seed.
 
 Threads: Aer parallelises a state update only from ``statevector_parallel_threshold`` (14) qubits
-on; below it, extra OpenMP threads only cost their start-up and synchronisation (on a loaded
-2-core machine a 1-qubit circuit took many times longer with all cores than with one:
-``floor_all_threads`` in ``benchmarks/bench_search.py``), so circuits narrower than
-``SERIAL_BELOW_QUBITS`` run on one thread whatever ``max_parallel_threads`` says.
+on; below it, extra OpenMP threads only cost their start-up and synchronisation, so circuits
+narrower than ``SERIAL_BELOW_QUBITS`` run on one thread whatever ``max_parallel_threads`` says.
 """
 
 from __future__ import annotations
@@ -36,8 +25,7 @@ import numpy as np
 from qiskit_aer import AerSimulator
 
 from ..validation import check_int
-from . import aer_direct, aer_state
-from .aer_circuits import GroverProgram, simulation_synthesis_for
+from .aer_circuits import simulation_synthesis_for
 from .backend import QuantumSearchBackend, seed_stream
 from .circuits import SYNTHESES, aer_grover_circuit, aer_literal_grover_circuit, oracle_cx_estimate
 from .fixed_point import generalized_grover_circuit
@@ -51,22 +39,11 @@ if TYPE_CHECKING:
 METHODS = ("statevector", "automatic")
 #: circuits on fewer qubits run single-threaded (Aer's default statevector_parallel_threshold)
 SERIAL_BELOW_QUBITS = 14
-#: circuits on fewer qubits run on Aer's state (``aer_state``, which simulates what the controller
-#: does below 14 qubits): ``python benchmarks/bench_search.py``'s ``state_paths`` (both oracle
-#: forms, n = 10-13, m = 1 and 12, k = 12, 8 shots; ``benchmarks/results/run_c22abd7.json``) found
-#: the state faster in every case up to n = 12 (0.68-0.91 times the controller's time) and the mcz
-#: form slower at n = 13 (1.19 times: its X-strings one ``apply_x`` per qubit where the controller
-#: runs one ``pauli``)
-STATE_CHOSEN_BELOW_QUBITS = 13
 #: On the GPU, Aer sizes its matrix buffer for a dense matrix on the widest instruction's qubits
-#: (4^b complex128 entries for b qubits: ``DeviceChunkContainer::calculate_matrix_buffer_size`` in
-#: qiskit-aer 0.18), so a diagonal oracle on n qubits takes 16 * 4^n bytes of GPU memory: on an H200
-#: (about 140 GiB) the diagonal form ran at n = 14 (4 GiB, 8.6 ms for k = 1, 8 shots) and n = 16 (64 GiB,
-#: 77 ms, against 3.4 ms at n = 12) and ran out of GPU memory at n = 18 (``benchmarks/bench_gpu.py``'s
-#: ``diagonal_probe``, ``benchmarks/results/bench_gpu_h200.json``). ``synthesis="auto"`` on the GPU
-#: therefore takes the diagonal form only up to this width (4 GiB, which recent data-centre GPUs
-#: hold) and the ``mcz`` form above it, whatever the marks; ``synthesis="diagonal"`` is run as
-#: asked (Aer reports its out-of-memory error where the buffer does not fit).
+#: (4^b complex128 entries for b qubits), so a diagonal oracle on n qubits takes 16 * 4^n bytes of
+#: GPU memory. ``synthesis="auto"`` on the GPU therefore takes the diagonal form only up to this
+#: width (4 GiB) and the ``mcz`` form above it, whatever the marks; ``synthesis="diagonal"`` is
+#: run as asked (Aer reports its out-of-memory error where the buffer does not fit).
 GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS = 14
 #: methods AerSimulator offers that these circuits cannot run, and why (refused at construction)
 UNSUPPORTED_METHODS = {
@@ -79,13 +56,12 @@ UNSUPPORTED_METHODS = {
 class AerBackend(QuantumSearchBackend):
     """Gate-level Grover search (paper Alg. 2, lines 4-8) on ``AerSimulator(method=...)``.
 
-    Each search runs the Grover circuit of the marks (``aer_grover_circuit``, applied to Aer's
-    state instruction by instruction below 13 qubits, ``aer_state``, or handed to Aer's
-    controller as its instructions, ``aer_direct``; with a noise model the gate-by-gate
-    ``aer_literal_grover_circuit`` through ``AerSimulator.run``) with ``shots`` shots; a
-    marked index is measured with probability sin^2((2k+1) theta), sin^2 theta = m / 2^n (paper
-    Eq. 1, Lemma 1). Every call draws a ``seed_simulator`` from its stream, so a plan depends on
-    the planner's seed only. Oracle calls: ``iterations * shots`` (DESIGN §2).
+    Each search builds the Grover circuit of the marks once (``aer_grover_circuit``; with a
+    noise model given here, the gate-by-gate ``aer_literal_grover_circuit``) and runs it through
+    ``AerSimulator.run`` with ``shots`` shots and ``memory=True``; a marked index is measured with
+    probability sin^2((2k+1) theta), sin^2 theta = m / 2^n (paper Eq. 1, Lemma 1). Every call
+    draws a ``seed_simulator`` from its stream, so a plan depends on the planner's seed only.
+    Oracle calls: ``iterations * shots`` (DESIGN §2).
 
     Args:
         seed: The backend's own stream for ``search`` calls without a seed: a non-negative
@@ -154,48 +130,29 @@ class AerBackend(QuantumSearchBackend):
         self.device = device
         self.max_parallel_threads = int(max_parallel_threads)
         self._build = aer_grover_circuit if noise_model is None else aer_literal_grover_circuit
-        #: False sends every circuit through AerSimulator.run (the benchmarks' before/after figures)
-        self._use_controller = True
-        #: False keeps small circuits on the controller instead of Aer's state (``aer_state``)
-        self._use_state = True
-        #: the simulator's options as made here: the state path runs only while they are unchanged
-        self._made_options = dict(self.simulator.options.__dict__)
 
     @property
     def max_qubits(self) -> int:
-        """The largest n the simulator's configuration accepts (``n_qubits``, memory-limited).
+        """The largest n the simulator's configuration accepts (``configuration().n_qubits``,
+        memory-limited; read on every call, so ``set_max_qubits`` and option changes count)."""
+        return int(self.simulator.configuration().n_qubits)
 
-        Read on every call, as ``simulator.configuration().n_qubits`` gives it, but without that
-        method's copy of the whole configuration (tens of microseconds, and every search checks n):
-        Aer's configuration is its ``_configuration`` with the ``_options_configuration`` entries
-        (``set_options``, ``set_max_qubits``) set on it; an Aer without those attributes is asked
-        through ``configuration()``."""
-        simulator = self.simulator
-        overrides = getattr(simulator, "_options_configuration", None)
-        base_qubits = getattr(getattr(simulator, "_configuration", None), "n_qubits", None)
-        if isinstance(overrides, dict) and base_qubits is not None:
-            return int(overrides.get("n_qubits", base_qubits))
-        return int(simulator.configuration().n_qubits)
-
-    #: calibrated on ``benchmarks/bench_memory.py`` (peak RSS of a round with many marked entries,
-    #: so the oracle is one diagonal): the oracle's 2^n phases, Aer's complex128 state and its
-    #: converted copy of the phases, then per iteration Aer's own copy of the oracle's phases (the
-    #: circuit appends the same gate k times; Aer converts each instance).
+    #: upper bounds fitted to the measured peak memory of a search whose oracle is one diagonal: the
+    #: oracle's 2^n phases, Aer's complex128 state and its converted copy of the phases, then per
+    #: iteration the circuit's and Aer's copies of the oracle's phases (the circuit holds the same
+    #: gate k times; Aer converts each instance)
     AER_BYTES_PER_ENTRY = 240
     AER_BYTES_PER_ENTRY_PER_ITERATION = 80
     #: per shot: the measured word kept by ``memory=True`` and its conversion to an index
     BYTES_PER_SHOT = 200
 
-    #: the ``mcz`` oracle's footprint, from ``benchmarks/bench_memory.py``'s ``mcz`` rows (peak RSS of
-    #: one search over the process before it, 12 marked entries, n = 20-24, k = 1 and 12: 32.0-32.3
-    #: bytes per entry, 40.3 at n = 20 and k = 12, where fixed costs weigh more; Aer's complex128 state
-    #: and about one more 16-byte array); 48 leaves a margin
+    #: the ``mcz`` oracle's footprint per entry: Aer's complex128 state and about one more 16-byte
+    #: array, with a margin
     AER_MCZ_BYTES_PER_ENTRY = 48
-    #: per ``mcphase`` / ``pauli`` instruction of the ``mcz`` form (2 per flipped entry per iteration):
-    #: the program's step and Aer's operation, 2.4 KB measured (``bench_memory.py``'s ``mcz`` rows:
-    #: n = 16, 100 marked entries, k = 400, 80 200 instructions); 3 KB leaves a margin. Below the
-    #: diagonal form's bound whenever ``simulation_synthesis`` picks ``mcz`` (f < 2^n / 600)
-    AER_BYTES_PER_MCZ_INSTRUCTION = 3072
+    #: per ``mcphase`` / ``pauli`` instruction of the ``mcz`` form (2 per flipped entry per
+    #: iteration): the circuit's instruction and Aer's operation, with a margin. Below the diagonal
+    #: form's bound whenever ``simulation_synthesis`` picks ``mcz`` (f < 2^n / 600)
+    AER_BYTES_PER_MCZ_INSTRUCTION = 4096
 
     def synthesis_for(self, num_qubits: int) -> str:
         """The ``synthesis`` a circuit on ``num_qubits`` qubits is built with: the constructor's,
@@ -322,62 +279,37 @@ class AerBackend(QuantumSearchBackend):
         """
         return 1 if num_qubits < SERIAL_BELOW_QUBITS else self.max_parallel_threads
 
-    @property
-    def _direct(self) -> bool:
-        """Whether circuits go to the controller directly: no noise model on the simulator (also one
-        set after construction) and a qiskit-aer with the internals (checked where the backend
-        runs, e.g. after unpickling on another machine)."""
-        return (self._use_controller and aer_direct.DIRECT_AVAILABLE
-                and getattr(self.simulator.options, "noise_model", None) is None)
+    def describe(self) -> str:
+        """The backend's settings in words: ``"aer (method=..., device=..., synthesis=...)"``, the
+        method and device as the simulator's options give them, the oracle synthesis requested,
+        and ``", noise model"`` where the simulator has one (with one given to the constructor the
+        circuit is the gate-by-gate one, ``", noise model, gate-by-gate circuit"``)."""
+        options = self.simulator.options
+        text = (f"{self.name} (method={getattr(options, 'method', self.method)}, "
+                f"device={getattr(options, 'device', self.device)}, synthesis={self.synthesis}")
+        if getattr(options, "noise_model", None) is not None or self._literal:
+            text += ", noise model" + (", gate-by-gate circuit" if self._literal else "")
+        return text + ")"
 
-    def _on_state(self, num_qubits: int) -> bool:
-        """Whether a Grover circuit on ``num_qubits`` qubits runs on Aer's state (``aer_state``):
-        the same simulation as the controller's, there (the statevector method on the CPU, no
-        noise model, the simulator's options as made here, fewer than ``STATE_CHOSEN_BELOW_QUBITS``
-        qubits), and a qiskit-aer with the internals."""
-        return (num_qubits < STATE_CHOSEN_BELOW_QUBITS and self._use_state and self._direct
-                and aer_state.STATE_AVAILABLE and self.method == "statevector" and self.device == "CPU"
-                and self._options_unchanged())
+    def _run(self, circuit: QuantumCircuit, num_qubits: int, shots: int, seed: int) -> np.ndarray:
+        """The measured index of every shot of ``circuit``: ``AerSimulator.run`` with ``shots``,
+        ``seed_simulator = seed``, ``memory=True`` and ``max_parallel_threads = threads_for(n)``.
 
-    def _options_unchanged(self) -> bool:
-        """Whether the simulator's options are those it was made with (False also where comparing
-        them fails, e.g. an option set to an array)."""
-        try:
-            return bool(self.simulator.options.__dict__ == self._made_options)
-        except (TypeError, ValueError):
-            return False
-
-    def _run(self, circuit: QuantumCircuit | GroverProgram, num_qubits: int, shots: int, seed: int) -> np.ndarray:
-        """The measured index of every shot of ``circuit`` with ``seed_simulator = seed``.
-
-        Without a noise model the circuit goes to the simulator's controller directly
-        (``aer_direct.execute``: the same simulation and the same measured words as
-        ``AerSimulator.run``, without its job and generic-assembler overhead); with one, through
-        ``AerSimulator.run``, whose compile step prepares the noise model."""
-        threads = self.threads_for(num_qubits)
-        if self._direct:
-            words = aer_direct.execute(self.simulator, circuit, shots, seed, threads)
-        else:
-            result = self.simulator.run(circuit, shots=shots, seed_simulator=seed, memory=True,
-                                        max_parallel_threads=threads).result()
-            if not result.success:
-                raise RuntimeError(f"AerSimulator failed: {result.status}")
-            words = result.results[0].data.memory
-        return _indices(words)
+        Raises:
+            RuntimeError: Aer reports a failed simulation.
+        """
+        result = self.simulator.run(circuit, shots=shots, seed_simulator=seed, memory=True,
+                                    max_parallel_threads=self.threads_for(num_qubits)).result()
+        if not result.success:
+            raise RuntimeError(f"AerSimulator failed: {result.status}")
+        return _indices(result.results[0].data.memory)
 
     def _sample_seeded(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
                        seed: int | np.random.Generator | None) -> np.ndarray:
         """Build the Grover circuit and run it; the simulator seed is the first
         ``integers(0, 2**31 - 1)`` of the search's generator."""
         seed_simulator = self._first_integer(seed, 2**31 - 1)
-        if self._on_state(num_qubits):  # Aer's state, instruction by instruction: the same words
-            return aer_state.execute_grover(marks, iterations, self.synthesis, shots, seed_simulator)
-        synthesis = self.synthesis_for(num_qubits)
-        if self._direct:  # the circuit's instructions straight to the controller
-            words = aer_direct.execute_grover(self.simulator, marks, iterations, synthesis, shots,
-                                              seed_simulator, self.threads_for(num_qubits))
-            return _indices(words)
-        circuit = self._build(marks, iterations, measure=True, synthesis=synthesis)
+        circuit = self._build(marks, iterations, measure=True, synthesis=self.synthesis_for(num_qubits))
         return self._run(circuit, num_qubits, shots, seed_simulator)
 
     def _sample(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
