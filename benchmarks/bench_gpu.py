@@ -12,8 +12,8 @@ about 20 s on 2 cores). ``--quick``: n = 12, 16, 20, 24 (unless ``--qubits`` is 
 
 For each n: 12 marked entries (the ``mcz`` oracle from n = 13 on: ``simulation_synthesis``), k = 12
 iterations, 8 shots (the searches of ``bench_search.py``'s floor table), ``AerBackend(seed=1,
-device=...)`` with ``max_parallel_threads=0`` (all cores; circuits under 14 qubits run on one thread,
-and the same path on the CPU).
+device=...)`` with ``max_parallel_threads=0`` (all cores; circuits under 14 qubits run on one thread;
+both devices run every width through ``AerSimulator.run``).
 Each repeat searches with the same seed on both devices and records whether they measured the same
 indices. Medians and minimums of the repeats; ``speedup`` = the CPU's median over the GPU's. The
 GPU's first search (CUDA's context, Aer's kernels) is timed apart (``gpu_first_search_s``) and not

@@ -252,7 +252,7 @@ def run_mcz_search_case(n: int, marked: int, k: int) -> dict:
     marks[np.random.default_rng(0).choice(1 << n, marked, replace=False)] = True
     warm = np.zeros(1 << 14, dtype=bool)
     warm[:marked] = True
-    backend.search(warm, 1, shots=8)  # warm up (the controller path, n >= 13)
+    backend.search(warm, 1, shots=8)  # warm up (a 14-qubit run: Aer's fusion and threads)
     base = _rss()
     backend.search(marks, k, shots=8)
     estimate = backend.memory_estimate(n, 8, k, marked)

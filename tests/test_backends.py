@@ -191,3 +191,169 @@ def test_search_sizes_have_documented_limits():
         backend.search(marks, 10**6, shots=1)
     with pytest.raises(ValueError, match="device must be one of"):
         qc.AerBackend(device="TPU")
+
+
+def _aer_random_marks(num_qubits: int, seed: int, fraction: float = 0.2) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    marks = rng.random(1 << num_qubits) < fraction
+    marks[rng.integers(1 << num_qubits)] = True
+    return marks
+
+
+def _run_memory(simulator, circuit, shots: int, seed: int, threads: int = 1) -> list[int]:
+    """The indices ``AerSimulator.run`` measures on ``circuit``, shot by shot."""
+    result = simulator.run(circuit, shots=shots, seed_simulator=seed, memory=True,
+                           max_parallel_threads=threads).result()
+    return [int(word, 2) for word in result.get_memory(0)]
+
+
+@pytest.mark.parametrize("num_qubits", [1, 2, 3, 5, 8, 13, 14])
+@pytest.mark.parametrize("synthesis", ["diagonal", "mcz", "auto"])
+def test_aer_search_measures_what_aersimulator_run_measures_on_its_circuit(num_qubits, synthesis):
+    """``AerBackend.search`` is ``AerSimulator.run`` of ``aer_grover_circuit`` with the search's
+    simulator seed (the first ``integers(0, 2**31 - 1)`` of its seed), word for word: k = 0 .. 4,
+    shot counts 1 (Aer's single-shot measurement) to 64 (its sampler), both sides of Aer's
+    parallel threshold (14 qubits)."""
+    from qrrt_circuits.search.circuits import aer_grover_circuit
+
+    backend = qc.AerBackend(seed=3, synthesis=synthesis)
+    rng = np.random.default_rng(num_qubits)
+    fraction = 0.3 if synthesis != "mcz" or num_qubits < 6 else 4 / (1 << num_qubits)  # mcz: few marked
+    for case in range(4 if num_qubits < 10 else 2):
+        marks = _aer_random_marks(num_qubits, case, fraction)
+        iterations, shots = case % 5, (1, 2, 64)[case % 3]
+        seed = int(rng.integers(0, 2**31 - 1))
+        measured = backend.search(marks, iterations, shots=shots, seed=seed).indices
+        circuit = aer_grover_circuit(marks, iterations, synthesis=synthesis)
+        expected = _run_memory(backend.simulator, circuit, shots, backend._first_integer(seed, 2**31 - 1),
+                               backend.threads_for(num_qubits))
+        assert measured.dtype == np.int64 and measured.tolist() == expected
+
+
+def test_aer_mcz_form_global_phase_and_x_strings_measure_the_circuits_words():
+    """Most entries marked: the mcz form flips the unmarked ones, with a global phase of pi per
+    oracle call; a sparse oracle's X-strings and mcphase gates; both run as their circuit."""
+    from qrrt_circuits.search.circuits import aer_grover_circuit
+
+    backend = qc.AerBackend(seed=0, synthesis="mcz")
+    many = np.ones(8, dtype=bool)
+    many[[2, 5]] = False
+    for marks in (many, ~many):
+        for iterations in (1, 2, 3):
+            circuit = aer_grover_circuit(marks, iterations, synthesis="mcz")
+            assert {instruction.operation.name for instruction in circuit.data} >= {"pauli", "mcphase"}
+            for seed in range(3):
+                expected = _run_memory(backend.simulator, circuit, 32, backend._first_integer(seed, 2**31 - 1))
+                assert backend.search(marks, iterations, shots=32, seed=seed).indices.tolist() == expected
+    assert aer_grover_circuit(many, 1, synthesis="mcz").global_phase != 0
+
+
+def test_aer_backend_uses_only_documented_aer_names():
+    """The Aer backend reaches qiskit-aer through ``AerSimulator`` (its ``run``, options and
+    configuration) only: no private module or name of qiskit-aer appears in its source."""
+    import inspect
+    import re
+
+    from qrrt_circuits.search import aer, aer_circuits
+
+    for module in (aer, aer_circuits):
+        source = inspect.getsource(module)
+        assert not re.search(r"controller_wrappers|AerCircuit|CircuitHeader|AerStateWrapper|aer_compiler"
+                             r"|qiskit_aer\.backends|_execute_circuits", source), module.__name__
+        assert not re.search(r"simulator\._", source), module.__name__
+
+
+def test_a_noise_model_set_later_acts_on_the_compact_circuit():
+    """With a noise model given to the constructor the gate-by-gate circuit runs; one set on the
+    simulator later acts on the compact circuit, run through ``AerSimulator.run`` as it is."""
+    from qiskit_aer.noise import NoiseModel, depolarizing_error
+
+    from qrrt_circuits.search.circuits import aer_grover_circuit
+
+    noise = NoiseModel()
+    noise.add_all_qubit_quantum_error(depolarizing_error(0.9, 4), ["mcphase"])
+    later = qc.AerBackend(seed=2, synthesis="mcz")
+    later.simulator.set_options(noise_model=noise)
+    marks = np.zeros(16, dtype=bool)
+    marks[3] = True
+    measured = later.search(marks, 3, shots=64, seed=1).indices
+    expected = _run_memory(later.simulator, aer_grover_circuit(marks, 3, synthesis="mcz"), 64,
+                           later._first_integer(1, 2**31 - 1))
+    np.testing.assert_array_equal(measured, expected)
+    assert marks[measured].mean() < 0.9  # the noise acts (noiseless: sin^2(7 theta) = 0.96)
+
+
+def test_a_failed_aer_simulation_raises():
+    backend = qc.AerBackend(seed=0)
+    backend.simulator.set_options(max_memory_mb=1)
+    with pytest.raises(RuntimeError, match="AerSimulator failed"):
+        backend.search(np.ones(2**17, dtype=bool), 0, 1, seed=1)  # a 2 MiB state
+    assert backend.search(np.ones(2, dtype=bool), 1, 3, seed=1).indices.shape == (3,)
+
+
+def test_aer_max_qubits_follows_the_simulators_configuration():
+    """``AerBackend.max_qubits`` is ``configuration().n_qubits`` after every way of changing it,
+    and after a pickle round trip; a search above it is refused."""
+    import pickle
+
+    backend = qc.AerBackend()
+    assert backend.max_qubits == backend.simulator.configuration().n_qubits
+    backend.simulator.set_max_qubits(3)
+    assert backend.max_qubits == 3
+    marks = np.zeros(16, dtype=bool)
+    marks[3] = True
+    with pytest.raises(ValueError, match="1..3 qubits"):
+        backend.search(marks, 1, 2, seed=1)
+    again = pickle.loads(pickle.dumps(backend))
+    assert again.max_qubits == 3
+    backend.simulator.clear_options()
+    assert backend.max_qubits == backend.simulator.configuration().n_qubits
+
+
+def test_aer_threads_searching_at_once_measure_what_one_thread_does():
+    from concurrent.futures import ThreadPoolExecutor
+
+    backend = qc.AerBackend(seed=0)
+    cases = [(_aer_random_marks(3 + seed % 5, seed), seed % 4, seed) for seed in range(16)]
+
+    def one(case):
+        marks, iterations, seed = case
+        return backend.search(marks, iterations, shots=16, seed=seed).indices.tolist()
+
+    alone = [one(case) for case in cases]
+    with ThreadPoolExecutor(max_workers=4) as pool:
+        assert list(pool.map(one, cases)) == alone
+
+
+def test_aer_describe_records_method_device_and_synthesis():
+    from qiskit_aer.noise import NoiseModel, depolarizing_error
+
+    assert qc.AerBackend().describe() == "aer (method=statevector, device=CPU, synthesis=auto)"
+    assert (qc.AerBackend(method="automatic", synthesis="mcz").describe()
+            == "aer (method=automatic, device=CPU, synthesis=mcz)")
+    noise = NoiseModel()
+    noise.add_all_qubit_quantum_error(depolarizing_error(0.05, 1), ["h"])
+    assert qc.AerBackend(noise_model=noise).describe() == (
+        "aer (method=statevector, device=CPU, synthesis=auto, noise model, gate-by-gate circuit)")
+    later = qc.AerBackend(synthesis="diagonal")
+    later.simulator.set_options(noise_model=noise)
+    assert later.describe() == "aer (method=statevector, device=CPU, synthesis=diagonal, noise model)"
+
+
+def _aer_search_words(marks: np.ndarray, seed: int) -> list[int]:
+    return qc.AerBackend(seed=0).search(marks, 2, shots=8, seed=seed).indices.tolist()
+
+
+@pytest.mark.skipif("fork" not in __import__("multiprocessing").get_all_start_methods(), reason="no fork")
+@pytest.mark.filterwarnings("ignore:This process .* is multi-threaded:DeprecationWarning")
+def test_a_process_forked_after_aer_searches_searches_too():
+    """``AerSimulator.run`` hands its work to a job thread, which a forked child does not inherit:
+    a child forked after the parent's searches searches too, and measures what the parent does
+    (this needs a qiskit-aer whose job executor is fork-safe)."""
+    import multiprocessing
+
+    marks = _aer_random_marks(6, 2)
+    parent = _aer_search_words(marks, 11)
+    with multiprocessing.get_context("fork").Pool(2) as pool:
+        children = pool.starmap_async(_aer_search_words, [(marks, 11)] * 2).get(timeout=120)
+    assert children == [parent, parent]

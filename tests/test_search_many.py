@@ -53,8 +53,7 @@ def test_search_many_checks_every_request_before_searching():
 
 def test_one_aer_job_cannot_carry_independent_seeds():
     """Why ``AerBackend.search_many`` runs one simulation per request: in a multi-circuit run Aer
-    seeds circuit i with seed_simulator + 2113 i, so one
-    run cannot give each circuit its own seed."""
+    seeds circuit i with seed_simulator + 2113 i, so one run cannot give each circuit its own seed."""
     from qiskit import QuantumCircuit
     from qiskit_aer import AerSimulator
 

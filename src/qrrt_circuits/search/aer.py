@@ -1,23 +1,20 @@
 """Gate-level Grover search: real Qiskit circuits executed by qiskit-aer's ``AerSimulator``.
 
-The circuit (``aer_grover_circuit``: Walsh-Hadamard blocks, the oracle as one ``diagonal`` or as
-``pauli`` + ``mcphase`` pairs, one ``mcphase`` per diffuser) uses only instructions Aer executes
-natively, so it is run without a per-call transpile; with a ``noise_model`` the gate-by-gate
-circuit (``aer_literal_grover_circuit``: h, x, mcphase) is run instead, so per-gate noise acts on
-the paper's gates. Each shot is an independent preparation, k Grover iterations and a measurement
-(``memory=True`` keeps them per shot).
+Each search builds its circuit once and hands it to ``AerSimulator.run`` with ``shots``,
+``seed_simulator``, ``memory=True`` (the measured word of every shot, in order) and
+``max_parallel_threads``; nothing else of qiskit-aer is used. The circuit
+(``aer_grover_circuit``: Walsh-Hadamard blocks, the oracle as one ``diagonal`` or as ``pauli`` +
+``mcphase`` pairs, one ``mcphase`` per diffuser) uses only instructions Aer executes natively, so
+it is run without a transpile; with a ``noise_model`` the gate-by-gate circuit
+(``aer_literal_grover_circuit``: h, x, mcphase) is run instead, so per-gate noise acts on the
+paper's gates. Each shot is an independent preparation, k Grover iterations and a measurement.
 
-Every circuit runs through ``AerSimulator.run`` (Aer's documented interface), built once per
-search in the compact form Aer executes without a transpile; the simulator seed is drawn from the
-search's generator (``seed_simulator``), so a seeded search is reproducible. Independent searches
-(``search_many``) run one after the other: in a multi-circuit run Aer seeds circuit i with
-``seed_simulator + 2113 i``, so one run cannot give each database its own seed.
+Independent searches (``search_many``) run one after the other: in a multi-circuit run Aer seeds
+circuit i with ``seed_simulator + 2113 i``, so one run cannot give each database its own seed.
 
 Threads: Aer parallelises a state update only from ``statevector_parallel_threshold`` (14) qubits
-on; below it, extra OpenMP threads only cost their start-up and synchronisation (on a loaded
-2-core machine a 1-qubit circuit took many times longer with all cores than with one:
-``floor_all_threads`` in ``benchmarks/bench_search.py``), so circuits narrower than
-``SERIAL_BELOW_QUBITS`` run on one thread whatever ``max_parallel_threads`` says.
+on; below it, extra OpenMP threads only cost their start-up and synchronisation, so circuits
+narrower than ``SERIAL_BELOW_QUBITS`` run on one thread whatever ``max_parallel_threads`` says.
 """
 
 from __future__ import annotations
@@ -43,14 +40,10 @@ METHODS = ("statevector", "automatic")
 #: circuits on fewer qubits run single-threaded (Aer's default statevector_parallel_threshold)
 SERIAL_BELOW_QUBITS = 14
 #: On the GPU, Aer sizes its matrix buffer for a dense matrix on the widest instruction's qubits
-#: (4^b complex128 entries for b qubits: ``DeviceChunkContainer::calculate_matrix_buffer_size`` in
-#: qiskit-aer 0.18), so a diagonal oracle on n qubits takes 16 * 4^n bytes of GPU memory: on an H200
-#: (about 140 GiB) the diagonal form ran at n = 14 (4 GiB, 8.6 ms for k = 1, 8 shots) and n = 16 (64 GiB,
-#: 77 ms, against 3.4 ms at n = 12) and ran out of GPU memory at n = 18 (``benchmarks/bench_gpu.py``'s
-#: ``diagonal_probe``, ``benchmarks/results/bench_gpu_h200.json``). ``synthesis="auto"`` on the GPU
-#: therefore takes the diagonal form only up to this width (4 GiB, which recent data-centre GPUs
-#: hold) and the ``mcz`` form above it, whatever the marks; ``synthesis="diagonal"`` is run as
-#: asked (Aer reports its out-of-memory error where the buffer does not fit).
+#: (4^b complex128 entries for b qubits), so a diagonal oracle on n qubits takes 16 * 4^n bytes of
+#: GPU memory. ``synthesis="auto"`` on the GPU therefore takes the diagonal form only up to this
+#: width (4 GiB) and the ``mcz`` form above it, whatever the marks; ``synthesis="diagonal"`` is
+#: run as asked (Aer reports its out-of-memory error where the buffer does not fit).
 GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS = 14
 #: methods AerSimulator offers that these circuits cannot run, and why (refused at construction)
 UNSUPPORTED_METHODS = {
@@ -63,12 +56,12 @@ UNSUPPORTED_METHODS = {
 class AerBackend(QuantumSearchBackend):
     """Gate-level Grover search (paper Alg. 2, lines 4-8) on ``AerSimulator(method=...)``.
 
-    Each search runs the Grover circuit of the marks through ``AerSimulator.run``
-    (``aer_grover_circuit``; with a noise model the gate-by-gate ``aer_literal_grover_circuit``)
-    with ``shots`` shots; a
-    marked index is measured with probability sin^2((2k+1) theta), sin^2 theta = m / 2^n (paper
-    Eq. 1, Lemma 1). Every call draws a ``seed_simulator`` from its stream, so a plan depends on
-    the planner's seed only. Oracle calls: ``iterations * shots`` (DESIGN §2).
+    Each search builds the Grover circuit of the marks once (``aer_grover_circuit``; with a
+    noise model given here, the gate-by-gate ``aer_literal_grover_circuit``) and runs it through
+    ``AerSimulator.run`` with ``shots`` shots and ``memory=True``; a marked index is measured with
+    probability sin^2((2k+1) theta), sin^2 theta = m / 2^n (paper Eq. 1, Lemma 1). Every call
+    draws a ``seed_simulator`` from its stream, so a plan depends on the planner's seed only.
+    Oracle calls: ``iterations * shots`` (DESIGN §2).
 
     Args:
         seed: The backend's own stream for ``search`` calls without a seed: a non-negative
@@ -140,39 +133,26 @@ class AerBackend(QuantumSearchBackend):
 
     @property
     def max_qubits(self) -> int:
-        """The largest n the simulator's configuration accepts (``n_qubits``, memory-limited).
+        """The largest n the simulator's configuration accepts (``configuration().n_qubits``,
+        memory-limited; read on every call, so ``set_max_qubits`` and option changes count)."""
+        return int(self.simulator.configuration().n_qubits)
 
-        Read on every call, as ``simulator.configuration().n_qubits`` gives it, but without that
-        method's copy of the whole configuration (tens of microseconds, and every search checks n):
-        Aer's configuration is its ``_configuration`` with the ``_options_configuration`` entries
-        (``set_options``, ``set_max_qubits``) set on it; an Aer without those attributes is asked
-        through ``configuration()``."""
-        simulator = self.simulator
-        overrides = getattr(simulator, "_options_configuration", None)
-        base_qubits = getattr(getattr(simulator, "_configuration", None), "n_qubits", None)
-        if isinstance(overrides, dict) and base_qubits is not None:
-            return int(overrides.get("n_qubits", base_qubits))
-        return int(simulator.configuration().n_qubits)
-
-    #: calibrated on ``benchmarks/bench_memory.py`` (peak RSS of a round with many marked entries,
-    #: so the oracle is one diagonal): the oracle's 2^n phases, Aer's complex128 state and its
-    #: converted copy of the phases, then per iteration Aer's own copy of the oracle's phases (the
-    #: circuit appends the same gate k times; Aer converts each instance).
+    #: upper bounds fitted to the measured peak memory of a search whose oracle is one diagonal: the
+    #: oracle's 2^n phases, Aer's complex128 state and its converted copy of the phases, then per
+    #: iteration the circuit's and Aer's copies of the oracle's phases (the circuit holds the same
+    #: gate k times; Aer converts each instance)
     AER_BYTES_PER_ENTRY = 240
     AER_BYTES_PER_ENTRY_PER_ITERATION = 80
     #: per shot: the measured word kept by ``memory=True`` and its conversion to an index
     BYTES_PER_SHOT = 200
 
-    #: the ``mcz`` oracle's footprint, from ``benchmarks/bench_memory.py``'s ``mcz`` rows (peak RSS of
-    #: one search over the process before it, 12 marked entries, n = 20-24, k = 1 and 12: 32.0-32.3
-    #: bytes per entry, 40.3 at n = 20 and k = 12, where fixed costs weigh more; Aer's complex128 state
-    #: and about one more 16-byte array); 48 leaves a margin
+    #: the ``mcz`` oracle's footprint per entry: Aer's complex128 state and about one more 16-byte
+    #: array, with a margin
     AER_MCZ_BYTES_PER_ENTRY = 48
-    #: per ``mcphase`` / ``pauli`` instruction of the ``mcz`` form (2 per flipped entry per iteration):
-    #: the program's step and Aer's operation, 2.4 KB measured (``bench_memory.py``'s ``mcz`` rows:
-    #: n = 16, 100 marked entries, k = 400, 80 200 instructions); 3 KB leaves a margin. Below the
-    #: diagonal form's bound whenever ``simulation_synthesis`` picks ``mcz`` (f < 2^n / 600)
-    AER_BYTES_PER_MCZ_INSTRUCTION = 3072
+    #: per ``mcphase`` / ``pauli`` instruction of the ``mcz`` form (2 per flipped entry per
+    #: iteration): the circuit's instruction and Aer's operation, with a margin. Below the diagonal
+    #: form's bound whenever ``simulation_synthesis`` picks ``mcz`` (f < 2^n / 600)
+    AER_BYTES_PER_MCZ_INSTRUCTION = 4096
 
     def synthesis_for(self, num_qubits: int) -> str:
         """The ``synthesis`` a circuit on ``num_qubits`` qubits is built with: the constructor's,
@@ -288,17 +268,6 @@ class AerBackend(QuantumSearchBackend):
             instructions = 2 * min(marked, (1 << num_qubits) - marked) * (iterations + 1)
         return (self.AER_MCZ_BYTES_PER_ENTRY << num_qubits) + self.AER_BYTES_PER_MCZ_INSTRUCTION * instructions
 
-    def describe(self) -> str:
-        """The backend in words: Aer's method, device, oracle synthesis and whether a noise model
-        is set (recorded in ``PlanResult.settings``).
-
-        Returns:
-            For example ``"aer (method=statevector, device=CPU, synthesis=auto, noise_model=None)"``.
-        """
-        noise = getattr(self.simulator.options, "noise_model", None)
-        return (f"aer (method={self.method}, device={self.device}, synthesis={self.synthesis}, "
-                f"noise_model={'set' if noise is not None else 'None'})")
-
     def threads_for(self, num_qubits: int) -> int:
         """The ``max_parallel_threads`` a circuit on ``num_qubits`` qubits runs with.
 
@@ -310,9 +279,25 @@ class AerBackend(QuantumSearchBackend):
         """
         return 1 if num_qubits < SERIAL_BELOW_QUBITS else self.max_parallel_threads
 
+    def describe(self) -> str:
+        """The backend's settings in words: ``"aer (method=..., device=..., synthesis=...)"``, the
+        method and device as the simulator's options give them, the oracle synthesis requested,
+        and ``", noise model"`` where the simulator has one (with one given to the constructor the
+        circuit is the gate-by-gate one, ``", noise model, gate-by-gate circuit"``)."""
+        options = self.simulator.options
+        text = (f"{self.name} (method={getattr(options, 'method', self.method)}, "
+                f"device={getattr(options, 'device', self.device)}, synthesis={self.synthesis}")
+        if getattr(options, "noise_model", None) is not None or self._literal:
+            text += ", noise model" + (", gate-by-gate circuit" if self._literal else "")
+        return text + ")"
+
     def _run(self, circuit: QuantumCircuit, num_qubits: int, shots: int, seed: int) -> np.ndarray:
-        """The measured index of every shot of ``circuit`` through ``AerSimulator.run`` with
-        ``seed_simulator = seed`` and ``memory=True``."""
+        """The measured index of every shot of ``circuit``: ``AerSimulator.run`` with ``shots``,
+        ``seed_simulator = seed``, ``memory=True`` and ``max_parallel_threads = threads_for(n)``.
+
+        Raises:
+            RuntimeError: Aer reports a failed simulation.
+        """
         result = self.simulator.run(circuit, shots=shots, seed_simulator=seed, memory=True,
                                     max_parallel_threads=self.threads_for(num_qubits)).result()
         if not result.success:

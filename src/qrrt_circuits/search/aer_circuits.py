@@ -17,21 +17,19 @@ identities that leave the unitary unchanged up to a global phase:
   indices in alternating order so the strings at their ends cancel); when more than half of the
   entries are marked, the unmarked ones are flipped instead, times the global phase -1.
 
-Why these forms (profiled with cProfile on qiskit 2.6 / qiskit-aer 0.18; the resulting speed is
-measured by ``benchmarks/bench_search.py``): for small n, Aer's Python assembler and its
-per-instruction binding cost far more than the arithmetic on the state vector, so the circuit has
-as few instructions as possible; a ``diagonal`` instruction is cheap to call but costs per entry
-(its 2^n phases are converted into Aer's own form; through ``AerSimulator.run`` qiskit's circuit
-and Aer's assembler also handle each phase as a parameter), so
-``simulation_synthesis`` weighs 2^n entries against 2m + 1 instructions. That choice is separate
-from ``circuits.choose_synthesis``, which counts CX gates for hardware and is what
+Why these forms: for small n, the per-instruction work around the simulation (building the
+circuit, Aer's conversion of each instruction) costs far more than the arithmetic on the state
+vector, so the circuit has as few instructions as possible; a ``diagonal`` instruction costs per
+entry (its 2^n phases are copied into qiskit's circuit and converted by Aer for every instance),
+so ``simulation_synthesis`` weighs 2^n entries against 2m + 1 instructions. That choice is
+separate from ``circuits.choose_synthesis``, which counts CX gates for hardware and is what
 ``resource_estimate`` uses.
 
-The parts that depend only on n (the W blocks, the ``mcphase``, the ``pauli`` Z^n,
-the measurements) are built once per n and reused; per search only the oracle's instructions are
-new, built from numpy arrays without per-entry Python work. ``aer_grover_program`` gives the
-instructions as a ``GroverProgram`` of (operation, qubits) steps, which ``AerBackend`` hands to
-Aer's controller without building a ``QuantumCircuit`` (``aer_direct``).
+The parts that depend only on n (the W blocks, the ``mcphase``, the ``pauli`` Z^n, the
+measurements) are built once per n and reused; per search only the oracle's instructions are new,
+built from numpy arrays without per-entry Python work. ``aer_grover_program`` gives the
+instructions as a ``GroverProgram`` of (operation, qubits) steps; its ``circuit()`` is the
+``QuantumCircuit`` of ``aer_grover_circuit``.
 """
 
 from __future__ import annotations
@@ -39,7 +37,6 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
-from typing import Protocol
 
 import numpy as np
 from qiskit import QuantumCircuit
@@ -51,36 +48,30 @@ from .backend import validate_iterations, validate_marks
 
 AER_SYNTHESES = ("auto", "diagonal", "mcz")
 
-#: the largest group of qubits one Walsh-Hadamard block acts on: 3 was the fastest of 1..5 for
-#: n = 6..16 (wider blocks cost more arithmetic per amplitude, narrower more instructions)
+#: the largest group of qubits one Walsh-Hadamard block acts on (wider blocks cost more arithmetic
+#: per amplitude, narrower ones more instructions)
 WALSH_HADAMARD_BLOCK = 3
 
 #: cost model of ``simulation_synthesis``: one phase of a ``diagonal`` instruction costs about
-#: 1/ENTRIES_PER_INSTRUCTION of one extra instruction. Fitted on ``AerBackend``'s controller path
-#: (``aer_direct``; qiskit 2.6 / Aer 0.18, 2-core machine, ``benchmarks/bench_search.py``'s
-#: ``synthesis`` sweep: both forms for n = 8..14, m = 1..64, k = 12, 8 shots): the diagonal form
-#: was faster up to 2^n / (2m + 1) = 252 at every n, the mcz form from 341 on for n = 10-12, while
-#: at n = 14 the two crossed near 500 (the arithmetic of the X strings grows with 2^n); 300 lies
-#: between (through ``AerSimulator.run``, whose assembler handles each phase in Python, the
-#: crossover was 100-200 and this constant 128). Below 13 qubits ``AerBackend`` now runs on Aer's
-#: state (``aer_state``); with it the same sweep's choice took at most 1.048 times the faster form's
-#: time, 1.002 on average (``benchmarks/results/run_c22abd7.json``, ``search.synthesis``)
+#: 1/ENTRIES_PER_INSTRUCTION of one extra instruction
 ENTRIES_PER_INSTRUCTION = 300
 
 #: one instruction of a Grover program: an operation and the qubits it acts on (a
 #: ``CircuitInstruction`` is made of it only when a ``QuantumCircuit`` is built: making one copies
-#: a ``diagonal``'s 2^n phases into qiskit's own representation, ~1 us per phase)
+#: a ``diagonal``'s 2^n phases into qiskit's own representation)
 Step = tuple[Operation, tuple[Qubit, ...]]
 
 
 def _diagonal_gate(phases: np.ndarray) -> DiagonalGate:
-    """A ``DiagonalGate`` of ``phases`` (entries +-1) without its per-entry Python validation.
+    """A ``DiagonalGate`` of ``phases`` (entries +-1.0) without its per-entry Python validation.
 
-    ``DiagonalGate(list)`` checks every entry in Python; the entries here are +-1 by construction,
-    so the gate is made from the list directly (``Operator`` and Aer read the same list)."""
+    ``DiagonalGate(list)`` checks every entry in Python and stores it as a ``complex``; the
+    entries here are +-1 by construction, so the gate is made from the list of floats directly
+    (``Operator`` and Aer read the same values; a circuit copies float parameters faster than
+    complex ones)."""
     gate = DiagonalGate.__new__(DiagonalGate)
     Gate.__init__(gate, "diagonal", int(phases.shape[0]).bit_length() - 1, [])
-    gate._params = phases.astype(complex).tolist()
+    gate._params = phases.astype(float).tolist()
     return gate
 
 
@@ -133,16 +124,6 @@ class _Parts:
         self.measures = tuple(CircuitInstruction(Measure(), (qubit,), (clbit,))
                               for qubit, clbit in zip(qubits, self.clbits, strict=True))
         self.signs = parity_signs(n)
-        #: qubit tuple -> its indices, filled as instructions are assembled for Aer (aer_direct)
-        self.qubit_indices: dict[tuple, list[int]] = {}
-
-    def indices_of(self, qubits: tuple) -> list[int]:
-        """The indices of ``qubits`` in this register (cached per tuple)."""
-        indices = self.qubit_indices.get(qubits)
-        if indices is None:
-            position = {qubit: index for index, qubit in enumerate(self.qubits)}
-            indices = self.qubit_indices[qubits] = [position[qubit] for qubit in qubits]
-        return indices
 
 
 @functools.lru_cache(maxsize=32)
@@ -262,9 +243,7 @@ class GroverProgram:
     the Walsh-Hadamard blocks, then per Grover iteration the oracle's instructions, W, one
     ``mcphase`` and W, and the final Z^n, with the circuit's global phase.
 
-    ``circuit()`` makes the ``QuantumCircuit``; ``aer_direct.assemble_program`` hands the same
-    instructions, in the same order, to Aer's controller without building one (``AerBackend``'s
-    path; the measured words are the same, tested).
+    ``circuit()`` makes the ``QuantumCircuit``.
 
     Attributes:
         num_qubits: n.
@@ -344,96 +323,3 @@ def aer_grover_program(marks: np.ndarray, iterations: int, synthesis: str = "aut
             steps += parts.walsh
         steps.append(parts.parity)
     return GroverProgram(parts, tuple(steps), phase * iterations)
-
-
-def check_grover_arguments(marks: np.ndarray, iterations: int) -> None:
-    """The cheap checks the direct paths (``aer_direct.execute_grover``, ``aer_state.execute_grover``)
-    make themselves, behind ``AerBackend``'s full ones: a 1-D bool array of length 2^n >= 2 and an
-    int k >= 0 (no coercion).
-
-    Raises:
-        ValueError: Either argument is not of that form, naming it.
-    """
-    if not (isinstance(marks, np.ndarray) and marks.dtype == np.bool_ and marks.ndim == 1):
-        raise ValueError(f"marks must be a 1-D bool array (validate_marks), got {marks!r}")
-    size = marks.shape[0]
-    if size < 2 or size & (size - 1):
-        raise ValueError(f"marks must have length 2**n with n >= 1, got length {size}")
-    if type(iterations) is not int or iterations < 0:
-        raise ValueError(f"iterations must be an int >= 0 (validate_iterations), got {iterations!r}")
-
-
-class DiagonalFormTarget(Protocol):
-    """Where ``DiagonalForm.emit`` puts the instructions: Aer's circuit object (``aer_direct``) or
-    Aer's statevector state (``aer_state``); qubits as register indices."""
-
-    def unitary(self, qubits: list[int], matrix: np.ndarray, label: str) -> None:
-        """A ``unitary`` instruction (a Walsh-Hadamard block)."""
-
-    def diagonal(self, qubits: list[int], phases: list[complex]) -> None:
-        """A ``diagonal`` instruction of 2^n phases (the oracle)."""
-
-    def gate(self, name: str, qubits: list[int], params: list[float], label: str) -> None:
-        """The reflection: ``mcphase`` (``p`` for n = 1) with its angle."""
-
-    def pauli(self, qubits: list[int], label: str) -> None:
-        """A ``pauli`` instruction (the final Z^n; big-endian label)."""
-
-
-@dataclass(frozen=True, eq=False)
-class DiagonalForm:
-    """The instructions of ``aer_grover_program(marks, k, "diagonal", block)`` that no search
-    changes, as the arguments of Aer's calls (register indices, matrices, labels), made once per n
-    and block width (``diagonal_form``): the Walsh-Hadamard blocks, the reflection, the final Z^n
-    and the signs (-1)^popcount(i) folded into the first oracle call.
-
-    ``emit`` gives a target the program's instructions in order, with only the oracle's two phase
-    lists made per search, without building the program's operations."""
-
-    qubits: list[int]
-    walsh: tuple[tuple[list[int], np.ndarray, str], ...]
-    reflection: tuple[str, list[float], str]
-    parity: str
-    signs: np.ndarray
-
-    def emit(self, target: DiagonalFormTarget, marks: np.ndarray, iterations: int) -> None:
-        """W, then per iteration the oracle's ``diagonal`` (the first with Z^n folded in), W, the
-        reflection and W, then Z^n (none of these for k = 0 but W): the program's steps, in order.
-
-        Args:
-            target: Where the instructions go.
-            marks: Bool array of length 2^n (validated by the caller).
-            iterations: k >= 0 (validated by the caller).
-        """
-        qubits = self.qubits
-        walsh = self.walsh
-        for group, matrix, label in walsh:
-            target.unitary(group, matrix, label)
-        if not iterations:
-            return
-        signs = np.where(marks, -1.0, 1.0)
-        first = (signs * self.signs).astype(complex).tolist()
-        rest = signs.astype(complex).tolist() if iterations > 1 else first
-        name, params, reflection_label = self.reflection
-        for call in range(iterations):
-            target.diagonal(qubits, rest if call else first)
-            for group, matrix, label in walsh:
-                target.unitary(group, matrix, label)
-            target.gate(name, qubits, params, reflection_label)
-            for group, matrix, label in walsh:
-                target.unitary(group, matrix, label)
-        target.pauli(qubits, self.parity)
-
-
-@functools.lru_cache(maxsize=32)
-def diagonal_form(num_qubits: int, block: int) -> DiagonalForm:
-    """The ``DiagonalForm`` of n qubits and Walsh-Hadamard blocks of at most ``block`` qubits,
-    from the cached parts ``aer_grover_program`` uses (``_parts``)."""
-    parts = _parts(num_qubits, block)
-    reflection, _ = parts.reflection
-    parity, _ = parts.parity
-    return DiagonalForm(
-        list(range(num_qubits)),
-        tuple((parts.indices_of(group), gate.params[0], gate.label or "unitary") for gate, group in parts.walsh),
-        (reflection.name, [float(p) for p in reflection.params], reflection.label or reflection.name),
-        str(parity.params[0]), parts.signs)
