@@ -3,7 +3,7 @@
 Each case runs in a fresh subprocess: it imports the library, warms up (numba compilation, a tiny
 plan), reads its resident set (VmRSS), then runs the case and reads its peak resident set
 (``resource.getrusage(RUSAGE_SELF).ru_maxrss``). The measured figure is the peak minus that
-baseline: the bytes the run added, which is what ``qrrt_circuits.memory`` estimates.
+baseline: the bytes the run added, which is what ``qrrt_circuits._support.memory`` estimates.
 
 Cases:
 - ``plan``: one round of q-RRT (``QRRT``, paper_clutter, the paper's schedule: k = 5 on a new tree)
@@ -81,9 +81,9 @@ def run_database_case(n: int, d: int, annealing: bool) -> dict:
     import numpy as np
 
     import qrrt_circuits as qc
-    from qrrt_circuits.database import AnnealingSchedule, build_database
-    from qrrt_circuits.memory import database_bytes
-    from qrrt_circuits.tree import Tree
+    from qrrt_circuits.planners.database import AnnealingSchedule, build_database
+    from qrrt_circuits._support.memory import database_bytes
+    from qrrt_circuits.planners.tree import Tree
 
     env = qc.Environment(np.array([[0.0, 10.0]] * d), np.array([[[4.0] * d, [5.0] * d]]))
     dynamics = None if d == 2 else qc.LinearTrackingDynamics(-np.eye(d), np.eye(d), np.eye(d))
@@ -123,7 +123,7 @@ def run_plan_limits_case(kind: str, dim: int, limit: int) -> dict:
     import numpy as np
 
     import qrrt_circuits as qc
-    from qrrt_circuits.memory import plan_bytes
+    from qrrt_circuits._support.memory import plan_bytes
 
     env, walled_in, outside = _walled_world(dim, 18.0)
     dynamics = None if dim == 2 else qc.LinearTrackingDynamics(-np.eye(dim), np.eye(dim), np.eye(dim))

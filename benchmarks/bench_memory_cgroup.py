@@ -34,7 +34,7 @@ LIMIT = 600 << 20
 CHILD = """
 import sys
 import qrrt_circuits as qc
-from qrrt_circuits import memory
+from qrrt_circuits._support import memory
 n, guarded = int(sys.argv[1]), sys.argv[2] == "guarded"
 if not guarded:
     memory.cgroup_available_bytes = lambda: None
@@ -128,7 +128,7 @@ def main() -> None:
         print(f"n = {row['num_qubits']} {row['guard']:9s} {row['outcome']:8s} rc {row['returncode']}  "
               f"{row['message'][:110]}")
     RESULTS.mkdir(exist_ok=True)
-    from qrrt_circuits.memory import _machine_available_bytes  # the machine's figure, outside any group
+    from qrrt_circuits._support.memory import _machine_available_bytes  # the machine's figure, outside any group
 
     path.write_text(json.dumps({"machine": machine(), "machine_available_bytes": _machine_available_bytes(),
                                 "limit_bytes": LIMIT, "rows": rows,

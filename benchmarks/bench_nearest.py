@@ -25,7 +25,7 @@ import numpy as np
 from _common import machine, median_time, write_json
 
 import qrrt_circuits as qc
-from qrrt_circuits.tree import Tree, _brute_block
+from qrrt_circuits.planners.tree import Tree, _brute_block
 
 QUERIES = 256
 SIZES = (100, 200, 300, 400, 500, 1000, 3000)

@@ -108,9 +108,9 @@ class PartTimer:
         setattr(owner, attribute, timed)
 
     def __enter__(self) -> PartTimer:
-        from qrrt_circuits.environment import Environment
+        from qrrt_circuits.world.environment import Environment
         from qrrt_circuits.search.backend import QuantumSearchBackend
-        from qrrt_circuits.tree import Tree
+        from qrrt_circuits.planners.tree import Tree
 
         self._wrap(Tree, "nearest", "nearest")
         self._wrap(Environment, "sample_uniform", "candidate_draws")
@@ -214,7 +214,7 @@ def interleaved_ratios(worlds: list[qc.Environment], nodes: int) -> dict:
 def predicate_construction(env, repeats: int = 20) -> dict:
     """Milliseconds to build the exact predicate (every trial of an experiment builds one): its
     chord grid computed (the process-wide cache emptied first) and taken from the cache."""
-    from qrrt_circuits import oracle
+    from qrrt_circuits.reachability import exact
 
     def median_ms(clear: bool) -> float:
         times = []

@@ -103,7 +103,7 @@ NOTEBOOK_COPIES = DOCS / "tutorials" / "_notebooks"
 GALLERY = DOCS / "results" / "_gallery.md"
 
 #: modules documented beyond ``qrrt_circuits.__all__`` (public, used in the README's examples)
-EXTRA_MODULES = ("qrrt_circuits.plotting", "qrrt_circuits.execution")
+EXTRA_MODULES = ("qrrt_circuits.plotting", "qrrt_circuits._support.execution")
 
 
 def _write_if_changed(path: Path, text: str) -> None:

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import qrrt_circuits as qc
-from qrrt_circuits.predicate import check_predicate
+from qrrt_circuits.reachability.predicate import check_predicate
 from qrrt_circuits.registry import PREDICATES
 
 DATA = Path(__file__).resolve().parent / "data" / "authors_check"

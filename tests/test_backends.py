@@ -70,7 +70,7 @@ def test_statevector_closed_form_equals_iteration():
 
 
 def test_kth_unmarked_ranks():
-    from qrrt_circuits.search.statevector import _kth_unmarked
+    from qrrt_circuits.search.backends.statevector import _kth_unmarked
 
     marks = np.zeros(32, dtype=bool)
     marks[[0, 3, 4, 5, 20, 31]] = True
@@ -254,7 +254,8 @@ def test_aer_backend_uses_only_documented_aer_names():
     import inspect
     import re
 
-    from qrrt_circuits.search import aer, aer_circuits
+    from qrrt_circuits.search.backends import aer
+    from qrrt_circuits.search import aer_circuits
 
     for module in (aer, aer_circuits):
         source = inspect.getsource(module)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import qrrt_circuits as qc
-from qrrt_circuits.deprecation import DEPRECATED, REMOVED_IN
+from qrrt_circuits._support.deprecation import DEPRECATED, REMOVED_IN
 
 
 @pytest.fixture(scope="module")
@@ -87,3 +87,17 @@ def test_time_samples_check_and_budget_exhausted(env):
 def test_every_deprecated_name_is_tested():
     """The table the docs show lists exactly the names this file exercises."""
     assert len(DEPRECATED) == 10
+
+
+@pytest.mark.parametrize("old, new", [
+    ("qrrt_circuits.environment", "qrrt_circuits.world.environment"),
+    ("qrrt_circuits.oracle", "qrrt_circuits.reachability.exact"),
+    ("qrrt_circuits.termination", "qrrt_circuits.planners.termination"),
+    ("qrrt_circuits.memory", "qrrt_circuits._support.memory"),
+    ("qrrt_circuits.search.aer", "qrrt_circuits.search.backends.aer"),
+    ("qrrt_circuits.search.fixed_point_policy", "qrrt_circuits.search.policies.fixed_point"),
+])
+def test_an_old_module_path_imports_the_new_module_and_warns(old, new):
+    sys.modules.pop(old, None)
+    module = _one_warning(lambda: importlib.import_module(old), new)
+    assert module is importlib.import_module(new)

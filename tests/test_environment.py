@@ -6,7 +6,7 @@ import pytest
 from tolerances import z_bound
 
 import qrrt_circuits as qc
-from qrrt_circuits.environment import Environment
+from qrrt_circuits.world.environment import Environment
 
 
 def test_is_free_matches_brute_force(clutter):

@@ -6,7 +6,7 @@ import signal
 import psutil
 import pytest
 
-from qrrt_circuits.execution import get_executor
+from qrrt_circuits._support.execution import get_executor
 from qrrt_circuits.experiments import read_records, run_experiment
 from qrrt_circuits.experiments.base import TIMING_SUFFIX
 
@@ -21,7 +21,7 @@ def dask_client(tmp_path_factory):
     scratch = tmp_path_factory.mktemp("dask")
     import dask
 
-    from qrrt_circuits.execution import NO_DASHBOARD
+    from qrrt_circuits._support.execution import NO_DASHBOARD
 
     # the scheduler, too, keeps its scratch space (and lock files) under "temporary-directory"
     with dask.config.set({"temporary-directory": str(scratch)}), \
@@ -96,7 +96,7 @@ def test_killed_process_pool_worker_is_replaced(tmp_path):
                 killed.append(process.pid)
                 return
 
-    from qrrt_circuits.execution import WorkerPool
+    from qrrt_circuits._support.execution import WorkerPool
 
     with WorkerPool("process", jobs=2) as pool:
         assert pool.executor is not None  # started before the sweep: every trial goes to a worker
@@ -121,7 +121,7 @@ def _children():
 
 #: evaluated in a worker: it was forked from the warm fork server (the warm-up module is imported
 #: by nothing else) and holds the default world already built
-WARM_CHECK = ("'qrrt_circuits.worker_warmup' in __import__('sys').modules and __import__("
+WARM_CHECK = ("'qrrt_circuits._support.worker_warmup' in __import__('sys').modules and __import__("
               "'qrrt_circuits.experiments.worlds', fromlist=['w'])._cached_world.cache_info().currsize >= 1")
 
 
@@ -134,7 +134,7 @@ def _is_warm(executor) -> bool:
 
 
 def test_one_worker_pool_serves_several_sweeps_and_starts_only_when_needed(tmp_path):
-    from qrrt_circuits.execution import WorkerPool
+    from qrrt_circuits._support.execution import WorkerPool
 
     serial = run_experiment("oracle-efficiency", out=tmp_path / "serial", quick=True, trials=2, progress=False)
     with WorkerPool("process", jobs=1) as pool:
@@ -214,7 +214,7 @@ def test_client_runs_trials_while_a_new_pool_starts_and_each_trial_runs_once(tmp
     trial is recorded exactly once, with the records serial execution gives."""
     import functools
 
-    from qrrt_circuits.execution import WorkerPool
+    from qrrt_circuits._support.execution import WorkerPool
     from qrrt_circuits.experiments import runner
 
     ran_here = []
@@ -246,7 +246,7 @@ def test_reproducing_several_experiments_makes_each_summary_while_the_next_trial
     the background thread, not by the thread that runs the next experiment's trials."""
     import threading
 
-    from qrrt_circuits.execution import WorkerPool
+    from qrrt_circuits._support.execution import WorkerPool
     from qrrt_circuits.experiments import EXPERIMENTS
     from qrrt_circuits.experiments.runner import run_experiments
 
@@ -283,7 +283,7 @@ def test_reproducing_several_experiments_makes_each_summary_while_the_next_trial
 
 def test_local_workers_are_limited_per_core():
     """100 000 local workers were accepted (each a Python process with Qiskit, Aer and numba)."""
-    from qrrt_circuits.execution import JOBS_PER_CORE, check_executor_args, max_local_jobs
+    from qrrt_circuits._support.execution import JOBS_PER_CORE, check_executor_args, max_local_jobs
 
     limit = max_local_jobs()
     assert limit == JOBS_PER_CORE * (os.cpu_count() or 1)

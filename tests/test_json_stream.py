@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import qrrt_circuits as qc
-from qrrt_circuits import json_stream
+from qrrt_circuits._support import json_stream
 
 
 def streamed(data) -> str:

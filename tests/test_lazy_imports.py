@@ -37,8 +37,8 @@ def test_a_lazy_name_imports_what_it_needs_on_first_use(name, needs):
 def test_lazy_names_are_the_search_modules_objects_and_unknown_names_raise():
     import qrrt_circuits as qc
     import qrrt_circuits.search as search
-    from qrrt_circuits.search.aer import AerBackend
-    from qrrt_circuits.search.statevector import StatevectorBackend
+    from qrrt_circuits.search.backends.aer import AerBackend
+    from qrrt_circuits.search.backends.statevector import StatevectorBackend
 
     assert qc.AerBackend is search.AerBackend is AerBackend
     assert qc.StatevectorBackend is StatevectorBackend

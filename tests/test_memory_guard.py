@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 import qrrt_circuits as qc
-from qrrt_circuits import cli, memory
+from qrrt_circuits import cli
+from qrrt_circuits._support import memory
 
 MIB = 1 << 20
 
@@ -261,7 +262,7 @@ _TREE_PEAK = _PEAK_OF + """
 import sys
 import numpy as np
 import qrrt_circuits as qc
-from qrrt_circuits.memory import plan_bytes
+from qrrt_circuits._support.memory import plan_bytes
 
 dim, nodes = int(sys.argv[1]), int(sys.argv[2])
 boxes = []
@@ -300,7 +301,7 @@ def test_the_tree_estimate_covers_a_tree_grown_to_its_node_limit(dim):
 def _cgroup(tmp_path, monkeypatch, limit: str, usage: int, stat: str, version: int = 2, parent_limit=None):
     """Fake control-group files of ``version`` for a process in group ``/box`` (parent: the root),
     and point ``memory`` at them."""
-    from qrrt_circuits import memory
+    from qrrt_circuits._support import memory
 
     root = tmp_path / "cgroup"
     names = ("memory.max", "memory.current", "memory.stat") if version == 2 else (
@@ -322,7 +323,7 @@ def _cgroup(tmp_path, monkeypatch, limit: str, usage: int, stat: str, version: i
 def test_a_control_group_limit_bounds_the_available_memory(tmp_path, monkeypatch, version):
     """In a container the kernel kills the process at its group's limit, whatever the machine has
     free: the room is the limit less the usage, the inactive page cache not counted as used."""
-    from qrrt_circuits import memory
+    from qrrt_circuits._support import memory
 
     prefix = "" if version == 2 else "total_"
     stat = f"{prefix}active_file {50 * MIB}\n{prefix}inactive_file {100 * MIB}\nanon 7\n"
@@ -338,7 +339,7 @@ def test_a_control_group_limit_bounds_the_available_memory(tmp_path, monkeypatch
 
 @pytest.mark.parametrize("limit, version", [("max", 2), (str(9223372036854771712), 1), ("garbage", 2)])
 def test_no_control_group_limit_leaves_the_machine_figure(tmp_path, monkeypatch, limit, version):
-    from qrrt_circuits import memory
+    from qrrt_circuits._support import memory
 
     _cgroup(tmp_path, monkeypatch, limit, 400 * MIB, "", version)
     assert memory.cgroup_available_bytes() is None
@@ -348,7 +349,7 @@ def test_no_control_group_limit_leaves_the_machine_figure(tmp_path, monkeypatch,
 
 def test_a_plan_in_a_small_control_group_is_refused(tmp_path, monkeypatch, env):
     """q-RRT at n = 24 needs over a GiB: refused in a 512 MiB group on a machine with 20 GiB free."""
-    from qrrt_circuits import memory
+    from qrrt_circuits._support import memory
 
     _cgroup(tmp_path, monkeypatch, str(512 * MIB), 100 * MIB, "")
     monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 20 * 1024 * MIB)
@@ -361,7 +362,7 @@ def test_a_plan_in_a_small_control_group_is_refused(tmp_path, monkeypatch, env):
 @pytest.mark.parametrize("version", [2, 1])
 def test_an_ancestor_group_with_less_room_bounds_the_available_memory(tmp_path, monkeypatch, version):
     """A group without a limit inside a parent with one (or a tighter parent): the smallest room."""
-    from qrrt_circuits import memory
+    from qrrt_circuits._support import memory
 
     _cgroup(tmp_path, monkeypatch, str(1024 * MIB), 100 * MIB, "", version, parent_limit=str(300 * MIB))
     assert memory.cgroup_available_bytes() == 200 * MIB
@@ -371,7 +372,7 @@ def test_an_ancestor_group_with_less_room_bounds_the_available_memory(tmp_path, 
 
 
 def test_without_control_group_files_the_machine_figure_stands(tmp_path, monkeypatch):
-    from qrrt_circuits import memory
+    from qrrt_circuits._support import memory
 
     monkeypatch.setattr(memory, "PROC_CGROUP", str(tmp_path / "absent"))
     assert memory.cgroup_available_bytes() is None
@@ -382,7 +383,7 @@ def test_without_control_group_files_the_machine_figure_stands(tmp_path, monkeyp
 @pytest.fixture(autouse=True)
 def _fresh_group_limit():
     """The smallest group limit is read once per process: each test starts and ends without it."""
-    from qrrt_circuits import memory
+    from qrrt_circuits._support import memory
 
     memory._smallest_limit_cached.cache_clear()
     yield
@@ -392,7 +393,7 @@ def _fresh_group_limit():
 def test_v1_hidden_ancestor_and_swap_limits_bound_the_room(tmp_path, monkeypatch):
     """A container's v1 mount hides its parent's limit except as ``hierarchical_memory_limit``; with
     swap accounting the kernel kills at the memory + swap limit."""
-    from qrrt_circuits import memory
+    from qrrt_circuits._support import memory
 
     _cgroup(tmp_path, monkeypatch, "9223372036854771712", 100 * MIB, f"hierarchical_memory_limit {600 * MIB}\n", 1)
     assert memory.cgroup_available_bytes() == 500 * MIB
@@ -406,7 +407,7 @@ def test_v1_hidden_ancestor_and_swap_limits_bound_the_room(tmp_path, monkeypatch
 def test_a_small_group_lowers_the_size_accepted_unchecked(tmp_path, monkeypatch):
     """In a 130 MB group an estimate of 180 MiB was accepted without a look and the kernel killed
     the run: up to an eighth of the group's limit is accepted unchecked, not 256 MiB."""
-    from qrrt_circuits import memory
+    from qrrt_circuits._support import memory
 
     _cgroup(tmp_path, monkeypatch, str(130 * 10**6), 50 * MIB, "")
     assert memory.always_fits_bytes() == 130 * 10**6 // 8
@@ -416,7 +417,7 @@ def test_a_small_group_lowers_the_size_accepted_unchecked(tmp_path, monkeypatch)
 
 
 def test_a_group_name_that_is_not_utf8_is_read(tmp_path, monkeypatch):
-    from qrrt_circuits import memory
+    from qrrt_circuits._support import memory
 
     _cgroup(tmp_path, monkeypatch, str(1024 * MIB), 100 * MIB, "")
     proc = Path(memory.PROC_CGROUP)
@@ -430,7 +431,7 @@ def test_on_the_gpu_auto_takes_the_mcz_form_above_14_qubits_and_the_bound_covers
     whatever the marks; the bound over every m then covers the mcz form's most instructions. (The
     rule alone, on a CPU backend whose simulator is told it is on the GPU after construction, as a
     user may: this machine has no GPU, and nothing runs.)"""
-    from qrrt_circuits.search.aer import GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS as widest
+    from qrrt_circuits.search.backends.aer import GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS as widest
 
     backend = qc.AerBackend(0)
     backend.simulator.set_options(device="GPU")
@@ -762,7 +763,8 @@ def test_a_memory_error_while_writing_leaves_no_partial_file(env, monkeypatch, c
 _SHORT_ESTIMATE = """
 import sys
 import qrrt_circuits as qc
-from qrrt_circuits import cli, memory
+from qrrt_circuits import cli
+from qrrt_circuits._support import memory
 
 def short(self, num_qubits=None):  # an estimate that falls short: 16 bytes an entry
     n = self.num_qubits if num_qubits is None else num_qubits

@@ -9,10 +9,10 @@ from qiskit import QuantumCircuit
 from qiskit.quantum_info import Statevector
 from tolerances import binomial_counts, within_binomial
 
-from qrrt_circuits import noise
+from qrrt_circuits.hardware import noise
 from qrrt_circuits.probability import good_probability, prob_true_solution
 from qrrt_circuits.search.circuits import grover_circuit
-from qrrt_circuits.search.noisy import depolarizing_backend
+from qrrt_circuits.search.backends.noisy import depolarizing_backend
 
 
 def _marks(n, marked, seed=0):
@@ -124,7 +124,7 @@ def test_fake_device_is_heavy_hex():
 
 def test_fake_device_backend_searches_on_the_device():
     pytest.importorskip("qiskit_ibm_runtime")
-    from qrrt_circuits.search.noisy import fake_device_backend
+    from qrrt_circuits.search.backends.noisy import fake_device_backend
 
     backend = fake_device_backend()
     marks, shots = _marks(3, 1, seed=1), 200

@@ -13,7 +13,7 @@ ob = pytest.importorskip("ompl.base")
 
 import qrrt_circuits as qc  # noqa: E402
 from qrrt_circuits.adapters.ompl import OMPLMotionPredicate, from_environment  # noqa: E402
-from qrrt_circuits.predicate import check_predicate  # noqa: E402
+from qrrt_circuits.reachability.predicate import check_predicate  # noqa: E402
 
 
 def wall_world() -> qc.Environment:

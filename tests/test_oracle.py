@@ -3,7 +3,7 @@ import pytest
 from reference import dense_trajectory, penetration_and_clearance
 
 import qrrt_circuits as qc
-from qrrt_circuits.environment import Environment
+from qrrt_circuits.world.environment import Environment
 
 
 def _check_against_reference(env, dyn, parents, children, resolution):
@@ -119,7 +119,7 @@ def test_oracle_agrees_with_exact_diagonal_check(clutter):
 
 
 def test_chord_grid_is_computed_once_per_dynamics_and_equals_the_direct_computation(clutter):
-    from qrrt_circuits import oracle as oracle_module
+    from qrrt_circuits.reachability import exact as oracle_module
 
     oracle_module._CHORD_GRIDS.clear()
     dyn = qc.LinearTrackingDynamics.paper()
@@ -165,7 +165,7 @@ def test_chord_count_estimate_is_close_below_the_grid(dynamics, max_error, resol
 
 
 def test_a_resolution_too_fine_for_the_workspace_is_refused_before_the_grid_is_built(clutter, monkeypatch):
-    from qrrt_circuits import oracle
+    from qrrt_circuits.reachability import exact as oracle
 
     monkeypatch.setattr(oracle, "MAX_CHORDS", 500)
     monkeypatch.setattr(oracle, "_CHORD_GRIDS", {})
@@ -198,7 +198,7 @@ def test_the_chord_grid_refuses_more_intervals_than_asked():
 def test_a_dimension_too_large_for_any_grid_says_so(monkeypatch):
     """Below 16 / 0.7 chords no resolution fits (the grid's longest step is T / 16): the error names
     d instead of suggesting a resolution that would fail again."""
-    from qrrt_circuits import oracle
+    from qrrt_circuits.reachability import exact as oracle
 
     d = 1200
     with pytest.raises(ValueError, match=r"an exact check in d = 1200 needs at least 17 propagators"):

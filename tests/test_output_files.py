@@ -1,4 +1,4 @@
-"""The command line's output files (``qrrt_circuits.output_files``): checked before the work without
+"""The command line's output files (``qrrt_circuits._support.output_files``): checked before the work without
 changing anything, written whole after it, and written in place wherever a rename would lose
 something."""
 
@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from qrrt_circuits import output_files
-from qrrt_circuits.output_files import check_output_file, same_file, write_replacing
+from qrrt_circuits._support import output_files
+from qrrt_circuits._support.output_files import check_output_file, same_file, write_replacing
 
 
 def _names(folder: Path) -> list[str]:
@@ -122,7 +122,7 @@ def test_a_pipe_is_checked_without_opening_it(tmp_path):
     check only asks for write permission (run in a child, so a regression cannot hang the suite)."""
     pipe = tmp_path / "out.json"
     os.mkfifo(pipe)
-    code = f"from qrrt_circuits.output_files import check_output_file; check_output_file({str(pipe)!r}, '--json')"
+    code = f"from qrrt_circuits._support.output_files import check_output_file; check_output_file({str(pipe)!r}, '--json')"
     subprocess.run([sys.executable, "-c", code], check=True, timeout=60)
 
 
@@ -202,8 +202,8 @@ def test_a_file_of_another_group_in_a_set_group_id_folder_is_replaced_whole(tmp_
 def test_the_to_dict_output_can_be_counted_before_a_plan(monkeypatch):
     """``to_dict``'s lists take about as much memory as the tree: a caller that writes them can
     have them counted (``output_bytes_per_node``), and a plan that fits alone is then refused."""
-    from qrrt_circuits import memory
-    from qrrt_circuits.memory import JSON_BYTES_PER_COORDINATE, JSON_BYTES_PER_NODE, check_plan_fits
+    from qrrt_circuits._support import memory
+    from qrrt_circuits._support.memory import JSON_BYTES_PER_COORDINATE, JSON_BYTES_PER_NODE, check_plan_fits
 
     monkeypatch.setattr(memory, "available_memory", lambda: (300 << 20, memory.MACHINE_SOURCE))
     check_plan_fits(10**6, 4096, 20000, 2)  # the plan alone: about 188 MiB
@@ -216,7 +216,7 @@ def test_a_plan_too_large_for_memory_is_refused_before_it_runs_and_json_adds_not
     """``qrrt plan --json``: the plan's own check refuses limits whose tree could exceed the
     available memory, before the plan and before any output file exists; the streamed JSON is not
     charged per node (``PlanResult.write_json``)."""
-    from qrrt_circuits import memory
+    from qrrt_circuits._support import memory
     from qrrt_circuits.cli import main
 
     monkeypatch.setattr(memory, "available_memory", lambda: (300 << 20, memory.MACHINE_SOURCE))

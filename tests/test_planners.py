@@ -8,7 +8,7 @@ from planner_checks import assert_path_valid, assert_tree_edges_valid
 from tolerances import binomial_counts, z_bound
 
 import qrrt_circuits as qc
-from qrrt_circuits.environment import Environment
+from qrrt_circuits.world.environment import Environment
 from qrrt_circuits.registry import PLANNERS
 
 METRIC_KEYS = {"oracle_calls", "quantum_oracle_calls", "verification_calls",
@@ -147,7 +147,7 @@ def test_unreachable_goal_ends_without_reaching():
 def test_default_round_limit_ends_a_plan_with_no_budget(monkeypatch):
     """With no budget at all the plan still ends, after DEFAULT_MAX_ROUNDS rounds (the goal is
     walled in, so only the round limit can end it)."""
-    from qrrt_circuits import termination
+    from qrrt_circuits.planners import termination
 
     monkeypatch.setattr(termination, "DEFAULT_MAX_ROUNDS", 17)
     boxes = np.array([[[14, 14], [18, 14.5]], [[14, 17.5], [18, 18]], [[14, 14], [14.5, 18]],

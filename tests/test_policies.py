@@ -11,7 +11,7 @@ from tolerances import within_binomial
 
 import qrrt_circuits as qc
 from qrrt_circuits.probability import optimal_iterations, success_probability
-from qrrt_circuits.randomness import RandomStreams
+from qrrt_circuits._support.randomness import RandomStreams
 from qrrt_circuits.registry import POLICIES
 
 POLICY_NAMES = ["paper", "fixed:2", "optimal", "bbht", "adaptive"]

@@ -8,7 +8,7 @@ from reference import penetration_and_clearance
 
 import qrrt_circuits as qc
 from qrrt_circuits.plotting import edge_curves, plan_dynamics
-from qrrt_circuits.predicate import check_predicate
+from qrrt_circuits.reachability.predicate import check_predicate
 from qrrt_circuits.registry import PLANNERS
 
 
@@ -140,7 +140,7 @@ def test_bad_predicates_are_refused_with_the_reason(clutter):
 
 @pytest.mark.parametrize("time_samples", [7, 30])
 def test_time_sampled_check_in_chunks_answers_as_in_one_piece(clutter, time_samples, monkeypatch):
-    from qrrt_circuits import time_sampled
+    from qrrt_circuits.reachability import time_sampled
 
     rng = np.random.default_rng(3)
     parents, children = clutter.sample_free(301, rng), clutter.sample_uniform(301, rng)

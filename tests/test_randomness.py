@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from qrrt_circuits.randomness import RandomStreams, Stream
+from qrrt_circuits._support.randomness import RandomStreams, Stream
 
 
 @pytest.mark.parametrize("seed", [0, 1, 7, 2**32 + 5, 2**70 + 3, 12345678901234567890123, None])
@@ -51,7 +51,7 @@ def test_search_seeds_equal_numpy_integers(seed):
 
 
 def test_uniform_draws_equal_the_generators_doubles():
-    from qrrt_circuits.randomness import uniform_draws
+    from qrrt_circuits._support.randomness import uniform_draws
 
     streams = RandomStreams.from_seed(4)
     keys = np.array([[r, w, int(Stream.CANDIDATES)] for r in (0, 7, 3000) for w in (0, 5)])

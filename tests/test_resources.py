@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from qrrt_circuits import resources as res
+from qrrt_circuits.hardware import resources as res
 from qrrt_circuits.search.circuits import phase_oracle
 
 

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import qrrt_circuits as qc
-from qrrt_circuits.environment import Environment
-from qrrt_circuits.termination import (
+from qrrt_circuits.world.environment import Environment
+from qrrt_circuits.planners.termination import (
     DEFAULT_MAX_NODES,
     DEFAULT_STALL_ROUNDS,
     Progress,
@@ -138,7 +138,7 @@ def test_termination_argument_combines_with_the_shorthands(walled):
 
 
 def test_a_round_limit_is_always_in_force():
-    from qrrt_circuits import termination
+    from qrrt_circuits.planners import termination
 
     assert with_round_limit(None) == qc.MaxRounds(termination.DEFAULT_MAX_ROUNDS)
     nodes_only = with_round_limit(qc.MaxNodes(5))
@@ -172,7 +172,7 @@ def test_bad_limits_are_refused_before_any_work(kwargs, error, message, clutter)
 def test_default_stall_ends_a_plan_given_only_a_node_budget(monkeypatch, boxed_in):
     """A plan with only max_nodes that can add no node ends as "stalled" after the default stall
     limit (0.1 looped forever here)."""
-    from qrrt_circuits import termination
+    from qrrt_circuits.planners import termination
 
     monkeypatch.setattr(termination, "DEFAULT_STALL_ROUNDS", 25)
     result = qc.RRT(boxed_in, seed=0).plan([5, 5], [15, 15], 0.5, max_nodes=5)
@@ -266,7 +266,7 @@ def test_a_node_limit_is_always_in_force(walled, monkeypatch):
     """Without a node limit of the caller's, DEFAULT_MAX_NODES ends a plan that keeps growing (8
     workers fill the world outside the walled goal): the status says max_nodes and the tree
     overshoots by fewer than p nodes; a caller's own node limit replaces the default."""
-    from qrrt_circuits import termination
+    from qrrt_circuits.planners import termination
 
     monkeypatch.setattr(termination, "DEFAULT_MAX_NODES", 40)
     result = qc.ParallelRRT(walled, workers=8, seed=0).plan([1, 1], [16, 16], 0.5)
@@ -291,7 +291,7 @@ def test_limits_whose_tree_or_history_exceed_memory_are_refused_before_any_work(
     """A round limit of 10^9 would let a plan that cannot grow keep about 240 GiB of round history
     (RRT's rounds take microseconds, so it would get there); a node limit of 10^9 the same of tree.
     Both are refused before the first round, naming the limit and the largest value that fits."""
-    from qrrt_circuits import memory
+    from qrrt_circuits._support import memory
 
     monkeypatch.setattr(memory, "available_memory", lambda: (1 << 30, memory.MACHINE_SOURCE))
     planner = qc.RRT(walled, seed=0)
@@ -307,7 +307,7 @@ def test_check_plan_fits_names_the_largest_limit_that_fits(dim):
     """The largest value the message names fits, and one more than it does not."""
     import re
 
-    from qrrt_circuits.memory import check_plan_fits, plan_bytes
+    from qrrt_circuits._support.memory import check_plan_fits, plan_bytes
 
     available = 1 << 30
     for limit_name, call in (("max_nodes", lambda v: check_plan_fits(v, 4096, 20000, dim, available)),
@@ -326,7 +326,7 @@ def test_a_round_limit_bounds_the_tree_the_memory_check_counts():
     """At most max_rounds * p nodes: a plan of 10 rounds in d = 600 is not refused for the default
     node limit's million nodes (it was: 26.9 GiB), and the message says when the limit to lower is
     the default one, or that no value fits."""
-    from qrrt_circuits.memory import check_plan_fits, plan_bytes
+    from qrrt_circuits._support.memory import check_plan_fits, plan_bytes
 
     assert plan_bytes(10**6, 8, 10, 600) == (81 * (96 + 48 * 600), 10 * 256)
     check_plan_fits(10**6, 1, 10, 600, available=1 << 20)
@@ -380,7 +380,7 @@ def test_numpy_limits_are_python_ints_and_the_memory_check_sees_them(walled, mon
     settings could not be written as JSON."""
     import json
 
-    from qrrt_circuits import memory
+    from qrrt_circuits._support import memory
 
     limit = qc.MaxRounds(np.int64(2**56))
     assert type(limit.limit) is int
@@ -415,7 +415,7 @@ def test_describe_merges_user_settings_without_comparing_them(walled):
 
 
 def test_a_limit_too_large_for_a_float_is_refused_in_words():
-    from qrrt_circuits.memory import check_plan_fits
+    from qrrt_circuits._support.memory import check_plan_fits
 
     with pytest.raises(ValueError, match=r"max_rounds = 1000+: .* about 10\^40[0-9] bytes"):
         check_plan_fits(10**6, 1, 10**400, 2, available=1 << 30)

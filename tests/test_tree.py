@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from qrrt_circuits.tree import Tree
+from qrrt_circuits.planners.tree import Tree
 
 
 @pytest.mark.parametrize("dim", [1, 2, 3, 5])
@@ -64,7 +64,7 @@ def test_strips_one_to_three_cells_wide_on_integer_points(width, vertical):
 
 
 def test_nearest_agrees_with_the_grid_on_both_sides_of_the_brute_force_switch():
-    from qrrt_circuits import tree as tree_module
+    from qrrt_circuits.planners import tree as tree_module
 
     rng = np.random.default_rng(8)
     tree = Tree(rng.random(2) * 20)
@@ -81,7 +81,7 @@ def test_the_grid_built_when_the_tree_reaches_the_switch_answers_as_one_kept_fro
     """Small trees keep no grid (built at BRUTE_FORCE_BELOW nodes, or by a first grid query), and a
     grid is rebuilt once the nodes added since its build reach ``_pending_limit``: both histories
     answer every query as the brute force does, at every size, rebuilds on both sides."""
-    from qrrt_circuits import tree as tree_module
+    from qrrt_circuits.planners import tree as tree_module
 
     switch = tree_module.BRUTE_FORCE_BELOW
     rebuilds = [switch]  # the sizes at which the lazy tree (re)builds its grid
@@ -112,7 +112,7 @@ def test_the_grid_built_when_the_tree_reaches_the_switch_answers_as_one_kept_fro
 def test_nodes_added_since_the_grid_was_built_are_found_and_win_no_false_ties():
     """The nodes the grid does not hold yet are scanned first: the nearest may be one of them, and
     a grid node exactly as near (a lower index) still wins the tie."""
-    from qrrt_circuits import tree as tree_module
+    from qrrt_circuits.planners import tree as tree_module
 
     rng = np.random.default_rng(4)
     tree = Tree(np.array([10.0, 10.0]))
@@ -193,7 +193,7 @@ def test_queries_of_the_wrong_shape_or_not_finite_are_refused():
 def test_queries_whose_squared_distances_overflow_still_end():
     """Every squared distance inf: the lowest index, from the brute force, from the grid, and from
     the grid with nodes added since its build (whose inf ties the grid's lower indices must win)."""
-    from qrrt_circuits import tree as tree_module
+    from qrrt_circuits.planners import tree as tree_module
 
     rng = np.random.default_rng(1)
     tree = Tree(rng.random(2))
@@ -255,7 +255,7 @@ def test_first_grid_queries_from_several_threads_agree_with_the_brute_force():
 def test_add_many_builds_the_tree_add_builds_one_node_at_a_time():
     """``add_many`` appends as ``add`` does (indices, positions, parents, buffers grown), with
     the grid rebuilt once at most, and queries answer as the brute force does on both trees."""
-    from qrrt_circuits import tree as tree_module
+    from qrrt_circuits.planners import tree as tree_module
 
     rng = np.random.default_rng(9)
     points = rng.random((1500, 2)) * 20

@@ -8,26 +8,10 @@ Lathrop, Boardman and Martinez, "Parallel Quantum Rapidly-Exploring Random Trees
 from importlib import metadata as _metadata
 from typing import TYPE_CHECKING, Any
 
-from . import probability, registry, scenarios, termination
-from .authors_check import AuthorsCheck
-from .database import AnnealingSchedule
-from .dynamics import LinearTrackingDynamics
-from .environment import Environment
-from .oracle import ReachabilityOracle
-from .oracle_errors import OracleErrorModel
-from .planners import PQRRT, QRRT, RRT, Metrics, ParallelRRT, PlanResult
-from .predicate import ReachabilityPredicate
-from .search.backend import QuantumSearchBackend, SearchRequest, SearchResult
-from .search.policies import (
-    BBHT,
-    Adaptive,
-    FixedIterations,
-    IterationPolicy,
-    KnownOptimal,
-    PaperSchedule,
-)
-from .search.problem import DatabaseSearch, SearchOutcome
-from .termination import (
+from . import probability, registry
+from .planners import PQRRT, QRRT, RRT, Metrics, ParallelRRT, PlanResult, termination
+from .planners.database import AnnealingSchedule
+from .planners.termination import (
     AnyOf,
     MaxCriticalPathCalls,
     MaxNodes,
@@ -38,16 +22,33 @@ from .termination import (
     Stall,
     TerminationCondition,
 )
-from .time_sampled import TimeSampledCheck
+from .reachability.authors_check import AuthorsCheck
+from .reachability.dynamics import LinearTrackingDynamics
+from .reachability.exact import ReachabilityOracle
+from .reachability.oracle_errors import OracleErrorModel
+from .reachability.predicate import ReachabilityPredicate
+from .reachability.time_sampled import TimeSampledCheck
+from .search.backend import QuantumSearchBackend, SearchRequest, SearchResult
+from .search.policies.iteration import (
+    BBHT,
+    Adaptive,
+    FixedIterations,
+    IterationPolicy,
+    KnownOptimal,
+    PaperSchedule,
+)
+from .search.problem import DatabaseSearch, SearchOutcome
+from .world import scenarios
+from .world.environment import Environment
 
 if TYPE_CHECKING:
     from .search import circuits
-    from .search.aer import AerBackend
-    from .search.estimated_policy import EstimatedOptimal
+    from .search.backends.aer import AerBackend
+    from .search.backends.sampler import SamplerBackend
+    from .search.backends.statevector import StatevectorBackend
     from .search.fixed_point import IterateSequence
-    from .search.fixed_point_policy import FixedPointAmplification
-    from .search.sampler import SamplerBackend
-    from .search.statevector import StatevectorBackend
+    from .search.policies.estimated import EstimatedOptimal
+    from .search.policies.fixed_point import FixedPointAmplification
 
 #: the names imported on first use (PEP 562): their modules import Qiskit (the circuits, Aer, the
 #: sampler, amplitude estimation) or its circuit types, which a plan on the statevector never needs
@@ -58,7 +59,7 @@ _LAZY = ("AerBackend", "EstimatedOptimal", "FixedPointAmplification", "IterateSe
 def __getattr__(name: str) -> Any:
     """``qrrt_circuits.search``'s lazily imported names, cached here on first use; deprecated names."""
     if name == "SearchPolicy":
-        from .deprecation import warn_deprecated
+        from ._support.deprecation import warn_deprecated
 
         warn_deprecated("qrrt_circuits.SearchPolicy", "qrrt_circuits.IterationPolicy")
         return IterationPolicy

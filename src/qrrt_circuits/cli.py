@@ -16,16 +16,16 @@ from typing import TYPE_CHECKING, Any, TypeAlias
 import numpy as np
 
 from . import __version__, probability
-from .output_files import check_output_file, same_file, write_replacing
+from ._support.output_files import check_output_file, same_file, write_replacing
 from .registry import BACKENDS, PLANNERS, POLICIES, PREDICATES, SCENARIOS
 
 if TYPE_CHECKING:
-    from .environment import Environment
-    from .memory import MemoryEstimate
+    from ._support.memory import MemoryEstimate
     from .planners.base import Planner
     from .planners.result import PlanResult
     from .registry import Registry
     from .search.backend import QuantumSearchBackend, SearchResult
+    from .world.environment import Environment
 
 
 def _positive_int(text: str) -> int:
@@ -62,7 +62,7 @@ def cmd_search(args: argparse.Namespace) -> int:
         raise ValueError(f"--marked must be in [0, 2**qubits = {num_items}], got {args.marked}")
     iterations = (probability.optimal_iterations(num_items, args.marked)
                   if args.iterations is None else args.iterations)
-    from .memory import OutOfMemory, check_fits, out_of_memory
+    from ._support.memory import OutOfMemory, check_fits, out_of_memory
     from .search.backend import validate_iterations, validate_shots
 
     shots = validate_shots(args.shots)
@@ -138,7 +138,7 @@ PLOT_FORMATS = (".png", ".pdf", ".svg", ".jpg", ".jpeg")
 
 def _load_environment(args: argparse.Namespace) -> Environment:
     if args.scenario_file:
-        from .environment import Environment
+        from .world.environment import Environment
 
         if Path(args.scenario_file).is_dir():
             raise ValueError(f"--scenario-file: {args.scenario_file!r} is a folder, not a scenario file")
@@ -274,7 +274,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 # ----------------------------------------------------------------------------------------- reproduce
 def cmd_reproduce(args: argparse.Namespace) -> int:
-    from .execution import WorkerPool
+    from ._support.execution import WorkerPool
     from .experiments import EXPERIMENTS
     from .experiments.runner import check_experiment_arguments, run_experiments
 
@@ -453,7 +453,7 @@ def main(argv: list[str] | None = None) -> int:
 def _memory_error_text(exc: MemoryError) -> str:
     """One line for a ``MemoryError``: an ``OutOfMemory``'s own message (the size that did not fit
     and the largest smaller one whose estimate fits), else what the allocator reported."""
-    from .memory import OutOfMemory
+    from ._support.memory import OutOfMemory
 
     text = " ".join(str(exc).split())
     return text if isinstance(exc, OutOfMemory) and text else f"out of memory ({text or 'MemoryError'})"

@@ -10,8 +10,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .dynamics import LinearTrackingDynamics
-from .environment import Environment
+from .reachability.dynamics import LinearTrackingDynamics
+from .world.environment import Environment
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from .validation import check_int, check_probability
+from ._support.validation import check_int, check_probability
 
 
 def _count(value: Any, name: str, minimum: int = 0) -> int:

@@ -20,15 +20,15 @@ if TYPE_CHECKING:
     import numpy as np
     from qiskit_aer.noise import NoiseModel
 
-    from .authors_check import AuthorsCheck
-    from .dynamics import LinearTrackingDynamics
-    from .environment import Environment
-    from .oracle import ReachabilityOracle
+    from .reachability.authors_check import AuthorsCheck
+    from .reachability.dynamics import LinearTrackingDynamics
+    from .reachability.exact import ReachabilityOracle
+    from .reachability.time_sampled import TimeSampledCheck
     from .search import AerBackend, SamplerBackend, StatevectorBackend
-    from .search.estimated_policy import EstimatedOptimal
-    from .search.fixed_point_policy import FixedPointAmplification
-    from .search.policies import FixedIterations
-    from .time_sampled import TimeSampledCheck
+    from .search.policies.estimated import EstimatedOptimal
+    from .search.policies.fixed_point import FixedPointAmplification
+    from .search.policies.iteration import FixedIterations
+    from .world.environment import Environment
 
 
 @dataclass(frozen=True)
@@ -335,7 +335,7 @@ def _backends() -> Registry:
 
 # ----------------------------------------------------------------------------------------- policies
 def _fixed(value: str) -> FixedIterations:
-    from .search.policies import FixedIterations
+    from .search.policies.iteration import FixedIterations
 
     try:
         k = int(value)
@@ -345,7 +345,7 @@ def _fixed(value: str) -> FixedIterations:
 
 
 def _fixed_point(value: str | None) -> FixedPointAmplification:
-    from .search.fixed_point_policy import FixedPointAmplification
+    from .search.policies.fixed_point import FixedPointAmplification
 
     if value is None:
         return FixedPointAmplification()
@@ -358,13 +358,13 @@ def _fixed_point(value: str | None) -> FixedPointAmplification:
 
 
 def _estimated() -> EstimatedOptimal:
-    from .search.estimated_policy import EstimatedOptimal
+    from .search.policies.estimated import EstimatedOptimal
 
     return EstimatedOptimal()
 
 
 def _policies() -> Registry:
-    from .search.policies import BBHT, Adaptive, KnownOptimal, PaperSchedule
+    from .search.policies.iteration import BBHT, Adaptive, KnownOptimal, PaperSchedule
 
     registry = Registry("search policy")
     registry.register("paper", PaperSchedule, "5 iterations, 3 after 10 nodes (the authors' code)")
@@ -383,7 +383,7 @@ def _policies() -> Registry:
 
 # ----------------------------------------------------------------------------------------- scenarios
 def _scenarios() -> Registry:
-    from . import scenarios
+    from .world import scenarios
 
     registry = Registry("scenario")
     registry.register("paper_clutter", scenarios.paper_clutter, "20 x 20, 525 boxes (paper Fig. 9-12)")
@@ -396,13 +396,13 @@ def _scenarios() -> Registry:
 # ----------------------------------------------------------------------------------------- predicates
 def _exact(env: Environment, dynamics: LinearTrackingDynamics | None = None,
            resolution: float = 0.01) -> ReachabilityOracle:
-    from .oracle import ReachabilityOracle
+    from .reachability.exact import ReachabilityOracle
 
     return ReachabilityOracle(env, dynamics, resolution=resolution)
 
 
 def _time_samples(value: str, env: Environment, dynamics: LinearTrackingDynamics | None = None) -> TimeSampledCheck:
-    from .time_sampled import TimeSampledCheck
+    from .reachability.time_sampled import TimeSampledCheck
 
     try:
         count = int(value)
@@ -412,13 +412,13 @@ def _time_samples(value: str, env: Environment, dynamics: LinearTrackingDynamics
 
 
 def _authors(env: Environment, dynamics: LinearTrackingDynamics | None = None) -> AuthorsCheck:
-    from .authors_check import AuthorsCheck
+    from .reachability.authors_check import AuthorsCheck
 
     return AuthorsCheck(env, dynamics, refine=4)
 
 
 def _authors_octave(env: Environment, dynamics: LinearTrackingDynamics | None = None) -> AuthorsCheck:
-    from .authors_check import AuthorsCheck
+    from .reachability.authors_check import AuthorsCheck
 
     return AuthorsCheck(env, dynamics, refine=1)
 

@@ -1,33 +1,5 @@
-"""What a worker process needs before its first trial, loaded once by the fork server.
+"""Deprecated location of ``qrrt_circuits._support.worker_warmup`` (importing it warns)."""
 
-Pool and Dask workers are forked from one *fork server* (``multiprocessing``'s ``forkserver``
-start method) that imports this module first: every experiment (and with them Qiskit, Aer, numba,
-scipy), the default world ``paper_clutter`` (seed 0), whose construction loads the compiled
-numba kernels of the collision checks from their on-disk cache and is then cached per process
-(``experiments.worlds.world``), and its exact predicate, whose chord grid for the paper's dynamics
-is then cached per process too (``oracle.chord_grid``). A worker forked from the server starts
-with all of it in memory instead of importing and loading it again; the fork server itself is a
-fresh, single-threaded interpreter (it never runs a simulator), so forking it is safe.
+from qrrt_circuits._support.deprecation import moved_module
 
-Importing this module performs the warm-up (that is how a fork server's ``preload`` works).
-"""
-
-from __future__ import annotations
-
-from .experiments import EXPERIMENTS  # noqa: F401  (every experiment, planner and backend)
-from .experiments.worlds import world
-from .oracle import ReachabilityOracle
-
-#: the world built (and so cached) in every warm worker
-WARM_WORLD = ("paper_clutter", 0)
-
-
-def warm_up() -> None:
-    """Import everything a trial needs, build the default world (loading numba's kernels) and its
-    exact predicate (caching the paper dynamics' chord grid)."""
-    import qiskit_aer  # noqa: F401  (the Aer backend's import, named: it is the heavy one)
-
-    ReachabilityOracle(world(*WARM_WORLD))
-
-
-warm_up()
+moved_module(__name__, "qrrt_circuits._support.worker_warmup")

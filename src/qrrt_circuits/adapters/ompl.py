@@ -32,9 +32,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..environment import Environment
-from ..predicate import as_pairs
-from ..validation import check_float, check_instance
+from .._support.validation import check_float, check_instance
+from ..reachability.predicate import as_pairs
+from ..world.environment import Environment
 
 INSTALL_HINT = 'pip install "qrrt-circuits[ompl]"'
 

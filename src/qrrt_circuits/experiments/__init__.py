@@ -1,27 +1,7 @@
 """Reproductions of the paper's figures and tables, one module per experiment, and a runner that
 writes records.csv (one row per trial), summary.json and figures, and resumes interrupted runs."""
 
-from .annealing import Annealing
-from .corridor import Corridor
-from .corridor_sensitivity import CorridorSensitivity
-from .heatmap_hypotheses import HeatmapHypotheses
-from .heatmaps import Heatmaps
-from .lemmas import Lemmas
-from .noise import Noise
-from .oracle_check import OracleCheck
-from .oracle_efficiency import OracleEfficiency
-from .resources import Resources
+from .catalog import EXPERIMENTS
 from .runner import read_records, run_experiment
-from .scaling import Scaling
-from .search_policies import SearchPolicies
-from .tree_size import TreeSize
-from .wallclock import Wallclock
-
-EXPERIMENTS = {
-    experiment.name: experiment
-    for experiment in (OracleEfficiency(), Wallclock(), Heatmaps(), Corridor(), Annealing(), Lemmas(),
-                       Scaling(), OracleCheck(), TreeSize(), HeatmapHypotheses(),
-                       CorridorSensitivity(), SearchPolicies(), Noise(), Resources())
-}
 
 __all__ = ["EXPERIMENTS", "read_records", "run_experiment"]

@@ -14,10 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..database import AnnealingSchedule
-from ..dynamics import LinearTrackingDynamics
+from ..planners.database import AnnealingSchedule
 from ..plotting import plot_edges
-from ..search.policies import FixedIterations
+from ..reachability.dynamics import LinearTrackingDynamics
+from ..search.policies.iteration import FixedIterations
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, paired_trials
 from .figures import new_figure, save
 from .intervals import bootstrap_interval, differs, rounded_interval

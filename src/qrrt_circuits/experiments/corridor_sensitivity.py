@@ -25,7 +25,7 @@ from .planners import planner_for
 from .worlds import world
 
 if TYPE_CHECKING:
-    from ..environment import Environment
+    from ..world.environment import Environment
 
 #: factor -> value of the base cell (numbers and a policy name)
 BASE: dict[str, Any] = {"distance": 1.0, "mouth_clearance": 1.5, "policy": "paper", "num_qubits": 8}

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from ..search.policies import FixedIterations, PaperSchedule
+from ..search.policies.iteration import FixedIterations, PaperSchedule
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import bootstrap_ratio_interval, differs, rounded_interval

@@ -19,7 +19,7 @@ from typing import SupportsFloat
 import numpy as np
 
 from .. import probability as pr
-from ..oracle import OracleErrorModel
+from ..reachability.exact import OracleErrorModel
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import binomial_interval, rounded_interval

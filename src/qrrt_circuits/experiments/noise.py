@@ -7,7 +7,7 @@ Three parts, one trial list:
   and p1 = p2 / 10 on sx/x. n <= ``exact_max_qubits``: exact probabilities from Aer's density
   matrix; larger n: noise trajectories on Aer's statevector with ``shots`` shots (binomial
   interval). Recorded next to the white-noise approximation F P_ideal + (1 - F) m / N and Lemma 4's
-  effective false-positive rate (``qrrt_circuits.noise``).
+  effective false-positive rate (``qrrt_circuits.hardware.noise``).
 - ``device``: the same circuits transpiled to a fake IBM heavy-hex device (qiskit-ibm-runtime's
   fake provider, optional extra ``noise``) and sampled with its calibrated noise model.
 - ``planning``: RRT and q-RRT (n = ``planning_qubits``, Adaptive and KnownOptimal) grow trees in
@@ -26,11 +26,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .. import noise
+from ..hardware import noise
 from ..probability import good_probability
 from ..registry import PLANNERS, PREDICATES
-from ..search.noisy import depolarizing_backend, fake_device_backend
-from ..search.policies import Adaptive, KnownOptimal
+from ..search.backends.noisy import depolarizing_backend, fake_device_backend
+from ..search.policies.iteration import Adaptive, KnownOptimal
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import binomial_interval, bootstrap_interval, rounded_interval
@@ -41,7 +41,7 @@ if TYPE_CHECKING:
     from numpy.typing import ArrayLike
     from qiskit import QuantumCircuit
 
-    from ..search.policies import IterationPolicy
+    from ..search.policies.iteration import IterationPolicy
 
 #: label -> q-RRT's search policy (its class)
 QRRT_CONFIGS: dict[str, Callable[[], IterationPolicy]] = {"QRRT adaptive": Adaptive, "QRRT optimal": KnownOptimal}

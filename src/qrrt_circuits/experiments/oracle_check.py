@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..oracle import ReachabilityOracle
+from ..reachability.exact import ReachabilityOracle
 from ..registry import PREDICATES
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
@@ -26,8 +26,8 @@ from .planners import make_planner
 from .worlds import world
 
 if TYPE_CHECKING:
-    from ..environment import Environment
-    from ..predicate import ReachabilityPredicate
+    from ..reachability.predicate import ReachabilityPredicate
+    from ..world.environment import Environment
 
 PLANNERS = ("RRT", "QRRT")
 CHECKS = ("exact", "authors", "authors-octave", "samples-200", "samples-50", "samples-20")

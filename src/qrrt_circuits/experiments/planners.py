@@ -6,13 +6,13 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from ..registry import BACKENDS, PLANNERS, POLICIES, PREDICATES
-from ..search.policies import IterationPolicy
+from ..search.policies.iteration import IterationPolicy
 
 if TYPE_CHECKING:
-    from ..environment import Environment
     from ..planners.base import Planner
-    from ..predicate import ReachabilityPredicate
+    from ..reachability.predicate import ReachabilityPredicate
     from ..search.backend import QuantumSearchBackend
+    from ..world.environment import Environment
 
 #: how each backend is described in summaries
 BACKEND_LABEL = {

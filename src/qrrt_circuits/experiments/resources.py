@@ -1,6 +1,6 @@
 """Beyond the paper: what one oracle call and one plan would cost on a quantum computer.
 
-Three parts, one trial list (``qrrt_circuits.resources`` holds the counting and the assumptions):
+Three parts, one trial list (``qrrt_circuits.hardware.resources`` holds the counting and the assumptions):
 
 - ``near-term``: one Grover iteration (one oracle call) over N = 2^n entries with m = N / 16
   random marks, each phase-oracle synthesis ("diagonal", "mcz"), transpiled to [cx, rz, sx, x] on
@@ -24,16 +24,16 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .. import resources as res
+from ..hardware import resources as res
 from ..registry import PLANNERS, PREDICATES
-from ..search.policies import PaperSchedule
+from ..search.policies.iteration import PaperSchedule
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import bootstrap_interval, rounded_interval
 from .worlds import world
 
 if TYPE_CHECKING:
-    from ..search.statevector import StatevectorBackend
+    from ..search.backends.statevector import StatevectorBackend
 
 _NUMBERS = ("n", "m", "two_qubit_gates", "two_qubit_depth", "depth", "physical_qubits", "oracle_ands",
             "oracle_t", "diffuser_ands", "t_count", "toffoli_equivalents", "nodes", "oracle_calls",
@@ -273,6 +273,6 @@ def plan_backend() -> StatevectorBackend:
     Returns:
         A new exact statevector backend.
     """
-    from ..search.statevector import StatevectorBackend
+    from ..search.backends.statevector import StatevectorBackend
 
     return StatevectorBackend()

@@ -22,12 +22,12 @@ from typing import TYPE_CHECKING, Any, cast
 
 from tqdm.auto import tqdm
 
-from ..validation import check_int, check_optional_int
+from .._support.validation import check_int, check_optional_int
 from .base import Experiment, Record, Settings, Summary, Trial
 from .records import RecordWriter, read_records
 
 if TYPE_CHECKING:
-    from ..execution import WorkerPool
+    from .._support.execution import WorkerPool
 
 __all__ = ["check_experiment_arguments", "execute_trial", "read_records", "run_experiment", "run_experiments"]
 
@@ -52,7 +52,7 @@ def execute_trial(experiment_name: str, trial: Trial, settings: Settings) -> Rec
     Raises:
         KeyError: If ``experiment_name`` is not an experiment.
     """
-    from . import EXPERIMENTS
+    from .catalog import EXPERIMENTS
 
     experiment = EXPERIMENTS[experiment_name]
     record = {"trial_id": trial.id, "seed": trial.seed, **trial.params}
@@ -135,9 +135,9 @@ def _started_executor(pool: WorkerPool) -> Executor:
 def _check_arguments(name: str, trials: int | None, seed: int, executor: str | Executor | WorkerPool | None,
                      jobs: int | None, scheduler: str | None, predicate: str) -> str | None:
     """Refuse bad arguments before any work; returns the executor kind (None for an object)."""
-    from ..execution import check_executor_args
+    from .._support.execution import check_executor_args
     from ..registry import PREDICATES
-    from . import EXPERIMENTS
+    from .catalog import EXPERIMENTS
 
     if name not in EXPERIMENTS:
         raise ValueError(f"unknown experiment {name!r}; choose one of {sorted(EXPERIMENTS)} or 'all'")
@@ -206,7 +206,7 @@ def _execute(kind: str | None, executor: str | Executor | WorkerPool | None, nam
              scheduler: str | None, max_restarts: int, on_restart: Callable[[int], None] | None) -> None:
     """Run ``todo`` serially, on a given executor or ``WorkerPool``, or on a pool built here; a
     pool whose executor breaks is renewed and the unfinished trials resubmitted."""
-    from ..execution import WorkerPool
+    from .._support.execution import WorkerPool
 
     if not todo:
         return
@@ -284,7 +284,7 @@ def run_experiment(
     """Run (or resume) experiment ``name`` into ``out/name``; returns the summary.
 
     ``executor``: ``"serial"`` (default), ``"process"``, ``"dask"`` (built here with ``jobs`` and
-    ``scheduler``, see ``qrrt_circuits.execution``), an open ``qrrt_circuits.execution.WorkerPool``
+    ``scheduler``, see ``qrrt_circuits._support.execution``), an open ``qrrt_circuits._support.execution.WorkerPool``
     (kept across several experiments, renewed if it breaks) or any ``concurrent.futures.Executor``.
     Records are written as trials finish, in whatever order. If a local process pool breaks (a
     worker died), a new pool is started (a given ``WorkerPool`` is renewed) and the unfinished trials resubmitted, up to
@@ -321,7 +321,7 @@ def run_experiment(
         RuntimeError: If the experiment produced duplicate trial ids.
     """
     from ..registry import PREDICATES
-    from . import EXPERIMENTS
+    from .catalog import EXPERIMENTS
 
     kind = _check_arguments(name, trials, seed, executor, jobs, scheduler, predicate)
     experiment = EXPERIMENTS[name]

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..search.policies import BBHT, Adaptive, IterationPolicy, KnownOptimal
+from ..search.policies.iteration import BBHT, Adaptive, IterationPolicy, KnownOptimal
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .fitting import power_law_exponent

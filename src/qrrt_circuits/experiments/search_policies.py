@@ -25,8 +25,8 @@ from typing import Any
 import numpy as np
 
 from ..registry import POLICIES
-from ..search.estimated_policy import EstimatedOptimal, EstimatedOptimalState
-from ..search.policies import IterationPolicy
+from ..search.policies.estimated import EstimatedOptimal, EstimatedOptimalState
+from ..search.policies.iteration import IterationPolicy
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, paired_trials
 from .figures import new_figure, save
 from .intervals import rounded_interval

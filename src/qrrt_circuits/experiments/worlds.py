@@ -6,8 +6,8 @@ from __future__ import annotations
 import functools
 from typing import Any
 
-from ..environment import Environment
 from ..registry import SCENARIOS
+from ..world.environment import Environment
 
 
 @functools.lru_cache(maxsize=16)

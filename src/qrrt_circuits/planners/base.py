@@ -9,7 +9,7 @@ entries to build the phase oracle in simulation is reported as ``simulation_chec
 calls.
 
 A plan runs rounds until the goal is reached or its termination condition ends it
-(``qrrt_circuits.termination``); the condition is checked before each round, and a round limit
+(``qrrt_circuits.planners.termination``); the condition is checked before each round, and a round limit
 (``DEFAULT_MAX_ROUNDS``), a stall limit (``DEFAULT_STALL_ROUNDS``) and a node limit
 (``DEFAULT_MAX_NODES``) are always in force unless the caller gives their own, so every plan ends.
 
@@ -28,29 +28,29 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .. import termination as _termination
-from ..deprecation import warn_deprecated
-from ..dynamics import LinearTrackingDynamics
-from ..environment import Environment
-from ..memory import MemoryEstimate, OutOfMemory, PlanSize
-from ..oracle import ReachabilityOracle
-from ..oracle_errors import OracleErrorModel
-from ..predicate import ReachabilityPredicate, can_leave, check_predicate
-from ..randomness import RandomStreams, Stream
-from ..termination import (
+from .._support.deprecation import warn_deprecated
+from .._support.memory import MemoryEstimate, OutOfMemory, PlanSize
+from .._support.randomness import RandomStreams, Stream
+from .._support.validation import check_float, check_instance, check_real_array, check_seed
+from ..reachability.dynamics import LinearTrackingDynamics
+from ..reachability.exact import ReachabilityOracle
+from ..reachability.oracle_errors import OracleErrorModel
+from ..reachability.predicate import ReachabilityPredicate, can_leave, check_predicate
+from ..world.environment import Environment
+from . import termination as _termination
+from .context import RoundView, WorkerContext
+from .result import Metrics, PlanResult
+from .run_state import RunState, first_in_ball
+from .termination import (
     PlanStatus,
     TerminationCondition,
     from_budgets,
     limits_in_force,
     with_defaults,
 )
-from ..validation import check_float, check_instance, check_real_array, check_seed
-from .context import RoundView, WorkerContext
-from .result import Metrics, PlanResult
-from .run_state import RunState, first_in_ball
 
 if TYPE_CHECKING:
-    from ..search.policies import PolicyState
+    from ..search.policies.iteration import PolicyState
 
 __all__ = ["Metrics", "PlanResult", "Planner", "RunState"]
 
@@ -59,7 +59,7 @@ def __getattr__(name: str) -> Any:
     """Deprecated names of this module."""
     if name == "DEFAULT_MAX_ROUNDS":
         warn_deprecated("qrrt_circuits.planners.base.DEFAULT_MAX_ROUNDS",
-                        "qrrt_circuits.termination.DEFAULT_MAX_ROUNDS")
+                        "qrrt_circuits.planners.termination.DEFAULT_MAX_ROUNDS")
         return _termination.DEFAULT_MAX_ROUNDS
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
@@ -170,7 +170,7 @@ class Planner:
         Pq-RRT; Alg. 4 with an annealing schedule).
 
         The ``max_*`` and ``stall_rounds`` keywords are shorthands for the conditions of
-        ``qrrt_circuits.termination``; they combine (any of them ends the plan) with
+        ``qrrt_circuits.planners.termination``; they combine (any of them ends the plan) with
         ``termination``. A round limit (``DEFAULT_MAX_ROUNDS``), a stall limit
         (``DEFAULT_STALL_ROUNDS``) and a node limit (``DEFAULT_MAX_NODES``) are added unless the
         condition has its own, so every plan ends. Before anything is allocated, the plan's
@@ -207,7 +207,7 @@ class Planner:
                 value that fits), or a dimension mismatch, before any work.
             TypeError: An argument of the wrong type (e.g. a ``termination`` that is not a
                 ``TerminationCondition``).
-            qrrt_circuits.memory.OutOfMemory: A ``MemoryError`` while the plan ran (one line: the
+            qrrt_circuits._support.memory.OutOfMemory: A ``MemoryError`` while the plan ran (one line: the
                 size to lower, what the allocator reported, the largest smaller value whose
                 estimate fits in the memory available when the plan started).
         """

@@ -29,17 +29,17 @@ from concurrent.futures import Executor
 
 import numpy as np
 
-from ..database import sample_ball
-from ..dynamics import LinearTrackingDynamics
-from ..environment import Environment
-from ..oracle_errors import OracleErrorModel
-from ..predicate import ReachabilityPredicate, check_answers
-from ..randomness import Stream, uniform_draws
-from ..termination import PlanStatus, TerminationCondition
-from ..validation import check_int
+from .._support.randomness import Stream, uniform_draws
+from .._support.validation import check_int
+from ..reachability.dynamics import LinearTrackingDynamics
+from ..reachability.oracle_errors import OracleErrorModel
+from ..reachability.predicate import ReachabilityPredicate, check_answers
+from ..world.environment import Environment
 from .base import Planner
 from .context import map_tasks
+from .database import sample_ball
 from .run_state import RunState
+from .termination import PlanStatus, TerminationCondition
 from .workers import check_extensions
 
 MAX_WORKERS = 4096

@@ -23,14 +23,14 @@ from typing import TypeVar
 
 import numpy as np
 
-from ..database import AnnealingSchedule
-from ..environment import Environment
-from ..oracle_errors import OracleErrorModel
-from ..predicate import ReachabilityPredicate
-from ..randomness import RandomStreams
+from .._support.randomness import RandomStreams
+from ..reachability.oracle_errors import OracleErrorModel
+from ..reachability.predicate import ReachabilityPredicate
 from ..search.backend import QuantumSearchBackend
-from ..search.policies import PolicyState
-from ..tree import Tree
+from ..search.policies.iteration import PolicyState
+from ..world.environment import Environment
+from .database import AnnealingSchedule
+from .tree import Tree
 
 T = TypeVar("T")
 R = TypeVar("R")

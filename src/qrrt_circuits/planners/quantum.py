@@ -25,19 +25,19 @@ from __future__ import annotations
 from collections.abc import Callable
 from concurrent.futures import Executor
 
-from ..database import AnnealingSchedule
-from ..deprecation import warn_deprecated
-from ..dynamics import LinearTrackingDynamics
-from ..environment import Environment
-from ..memory import MemoryEstimate, database_bytes, database_resident_bytes
-from ..oracle_errors import OracleErrorModel
-from ..predicate import ReachabilityPredicate
+from .._support.deprecation import warn_deprecated
+from .._support.memory import MemoryEstimate, database_bytes, database_resident_bytes
+from .._support.validation import check_bool, check_instance, check_int
+from ..reachability.dynamics import LinearTrackingDynamics
+from ..reachability.oracle_errors import OracleErrorModel
+from ..reachability.predicate import ReachabilityPredicate
 from ..search.backend import QuantumSearchBackend
-from ..search.policies import IterationPolicy, PaperSchedule, PolicyState
-from ..validation import check_bool, check_instance, check_int
+from ..search.policies.iteration import IterationPolicy, PaperSchedule, PolicyState
+from ..world.environment import Environment
 from .base import Planner
 from .classical import MAX_WORKERS
 from .context import WorkerContext, map_tasks
+from .database import AnnealingSchedule
 from .run_state import RunState
 from .workers import DatabaseOutcome, search_database
 
@@ -143,7 +143,7 @@ class PQRRT(Planner):
         self.num_qubits = check_int(num_qubits, "num_qubits", 1)
         self.workers = check_int(workers, "workers", 1, MAX_WORKERS)
         if backend is None:
-            from ..search.aer import AerBackend  # qiskit and Aer are imported only when used
+            from ..search.backends.aer import AerBackend  # qiskit and Aer are imported only when used
 
             backend = AerBackend()
         check_instance(backend, "backend", QuantumSearchBackend, "a QuantumSearchBackend")
@@ -168,7 +168,7 @@ class PQRRT(Planner):
         self.annealing = annealing
 
     def memory_estimate(self, num_qubits: int | None = None) -> MemoryEstimate:
-        """Estimated peak memory of one round (``qrrt_circuits.memory``); ``plan`` checks it, with
+        """Estimated peak memory of one round (``qrrt_circuits._support.memory``); ``plan`` checks it, with
         the tree and the round history, once before the plan allocates anything.
 
         Counts the databases alive at once (one shared database, or one per worker when the

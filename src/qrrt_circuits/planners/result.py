@@ -8,7 +8,7 @@ from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..termination import PlanStatus
+from .termination import PlanStatus
 
 if TYPE_CHECKING:
     import networkx as nx
@@ -142,7 +142,7 @@ class PlanResult:
     @property
     def budget_exhausted(self) -> bool:
         """Deprecated: ``not reached`` (a termination condition ended the plan)."""
-        from ..deprecation import warn_deprecated
+        from .._support.deprecation import warn_deprecated
 
         warn_deprecated("PlanResult.budget_exhausted", "not PlanResult.reached")
         return not self.reached
@@ -179,7 +179,7 @@ class PlanResult:
         Args:
             handle: A text file open for writing.
         """
-        from ..json_stream import dump_streamed
+        from .._support.json_stream import dump_streamed
 
         # arrays streamed as they are; anything else with tolist() (a numpy scalar in the history)
         # converted as to_dict converts it

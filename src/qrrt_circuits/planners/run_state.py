@@ -7,11 +7,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
-from ..termination import Progress
-from ..tree import Tree
+from .termination import Progress
+from .tree import Tree
 
 if TYPE_CHECKING:  # annotations only (context imports the search modules)
-    from ..search.policies import PolicyState
+    from ..search.policies.iteration import PolicyState
     from .context import WorkerContext
 
 HISTORY_KEYS = ("oracle_calls", "critical_path", "nodes", "entries", "reachable")

@@ -15,11 +15,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..database import Database, stream_database
-from ..predicate import check_answers
-from ..randomness import Stream
+from .._support.randomness import Stream
+from ..reachability.predicate import check_answers
 from ..search.problem import DatabaseSearch, SearchOutcome
 from .context import RoundView, WorkerContext
+from .database import Database, stream_database
 
 
 def check_extensions(context: WorkerContext, view: RoundView, pairs: tuple[np.ndarray, np.ndarray]) -> np.ndarray:

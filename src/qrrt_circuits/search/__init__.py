@@ -11,28 +11,28 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from . import circuits
-    from .aer import AerBackend
     from .backend import QuantumSearchBackend, SearchRequest, SearchResult
-    from .estimated_policy import EstimatedOptimal
+    from .backends.aer import AerBackend
+    from .backends.sampler import SamplerBackend
+    from .backends.statevector import StatevectorBackend
     from .fixed_point import IterateSequence
-    from .fixed_point_policy import FixedPointAmplification
+    from .policies.estimated import EstimatedOptimal
+    from .policies.fixed_point import FixedPointAmplification
     from .problem import DatabaseSearch, SearchOutcome
-    from .sampler import SamplerBackend
-    from .statevector import StatevectorBackend
 
 #: public name -> the submodule that defines it ("" for a submodule itself)
 _WHERE = {
-    "AerBackend": ".aer",
+    "AerBackend": ".backends.aer",
     "DatabaseSearch": ".problem",
-    "EstimatedOptimal": ".estimated_policy",
-    "FixedPointAmplification": ".fixed_point_policy",
+    "EstimatedOptimal": ".policies.estimated",
+    "FixedPointAmplification": ".policies.fixed_point",
     "IterateSequence": ".fixed_point",
     "QuantumSearchBackend": ".backend",
-    "SamplerBackend": ".sampler",
+    "SamplerBackend": ".backends.sampler",
     "SearchOutcome": ".problem",
     "SearchRequest": ".backend",
     "SearchResult": ".backend",
-    "StatevectorBackend": ".statevector",
+    "StatevectorBackend": ".backends.statevector",
     "circuits": "",
 }
 

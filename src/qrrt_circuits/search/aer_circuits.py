@@ -43,8 +43,8 @@ from qiskit import QuantumCircuit
 from qiskit.circuit import CircuitInstruction, Gate, Measure, Operation, Qubit
 from qiskit.circuit.library import DiagonalGate, MCPhaseGate, PauliGate, PhaseGate, UnitaryGate
 
-from ..validation import check_int
-from .backend import validate_iterations, validate_marks
+from .._support.validation import check_int
+from .requests import validate_iterations, validate_marks
 
 AER_SYNTHESES = ("auto", "diagonal", "mcz")
 

@@ -15,7 +15,7 @@ each iterate queries the oracle once, so ``oracle_calls = len(sequence) * shots`
 
 Memory: each call of ``search``, ``search_many`` and ``search_sequence`` checks its estimated peak
 against the available memory once, before the search allocates anything, and a ``MemoryError``
-raised while it runs becomes a one-line ``qrrt_circuits.memory.OutOfMemory``. A plan's searches
+raised while it runs becomes a one-line ``qrrt_circuits._support.memory.OutOfMemory``. A plan's searches
 (``DatabaseSearch`` with ``memory_checked``) make neither: the plan's own check covers them.
 """
 
@@ -24,14 +24,24 @@ from __future__ import annotations
 import abc
 import functools
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, TypeAlias, TypeVar
 
 import numpy as np
 
-from .. import memory
-from ..memory import MemoryEstimate, OutOfMemory, check_fits, out_of_memory
-from ..validation import check_int, check_seed
+from .._support import memory
+from .._support.memory import MemoryEstimate, OutOfMemory, check_fits, out_of_memory
+from .._support.validation import check_seed
+from .requests import (
+    MAX_ITERATIONS,
+    MAX_SHOTS,
+    SearchRequest,
+    SearchResult,
+    check_measured,
+    seed_stream,
+    validate_iterations,
+    validate_marks,
+    validate_shots,
+)
 
 if TYPE_CHECKING:
     from .fixed_point import IterateSequence
@@ -44,146 +54,9 @@ _Peak: TypeAlias = Callable[[int, int, int, "int | None"], int]
 _Sized: TypeAlias = tuple[np.ndarray, int, int, int]
 _T = TypeVar("_T")
 
-
-@dataclass(frozen=True)
-class SearchResult:
-    """Measured database indices (one per shot) and the oracle calls they cost.
-
-    Args:
-        indices: The measured indices, one per shot (stored as a read-only int64 array).
-        iterations: k, the Grover iterations (or generalized iterates) of each preparation.
-        shots: The preparations measured.
-        oracle_calls: ``iterations * shots`` (DESIGN §2: one call per iteration per preparation).
-    """
-
-    indices: np.ndarray
-    iterations: int
-    shots: int
-    oracle_calls: int
-
-    def __post_init__(self) -> None:
-        indices = np.asarray(self.indices, dtype=np.int64)
-        indices.setflags(write=False)
-        object.__setattr__(self, "indices", indices)
-
-
-@dataclass(frozen=True, eq=False)
-class SearchRequest:
-    """One search of ``QuantumSearchBackend.search_many``: the arguments of one ``search`` call.
-
-    Args:
-        marks: Boolean array of length 2^n, the phase oracle's marks.
-        iterations: k, 0 .. ``MAX_ITERATIONS``.
-        shots: Preparations, 1 .. ``MAX_SHOTS`` (default 1).
-        seed: This search's seed, or None (default) for the backend's own stream.
-    """
-
-    marks: np.ndarray
-    iterations: int
-    shots: int = 1
-    seed: int | None = None
-
-
-def validate_marks(marks: np.ndarray) -> tuple[np.ndarray, int]:
-    """Return (marks as bool array, n) or raise a ValueError naming the problem.
-
-    Args:
-        marks: A 1-D array of length 2^n (n >= 1) of booleans or 0/1 values.
-
-    Returns:
-        (the marks as a bool array, n).
-
-    Raises:
-        ValueError: Not 1-D, a length that is not a power of two >= 2, or values other than 0/1.
-    """
-    array = np.asarray(marks)
-    if array.ndim != 1:
-        raise ValueError(f"marks must be a 1-D array of length 2**n, got shape {array.shape}")
-    size = array.shape[0]
-    if size < 2 or size & (size - 1):
-        raise ValueError(
-            f"marks must have length 2**n with n >= 1 (a power of two >= 2), got length {size}"
-        )
-    if array.dtype != np.bool_:
-        if not np.all(np.isin(array, (0, 1))):
-            raise ValueError("marks must be booleans (or 0/1)")
-        array = array.astype(bool)
-    return array, size.bit_length() - 1
-
-
-def check_measured(indices: np.ndarray, shots: int, size: int, backend: str) -> None:
-    """Refuse measured indices that are not ``shots`` integers in [0, ``size``).
-
-    Args:
-        indices: What a backend's sampling returned.
-        shots: The shots asked for.
-        size: N = 2^n, the database's entries.
-        backend: The backend's name (for the message).
-
-    Raises:
-        RuntimeError: A shape other than (shots,), a non-integer dtype, or an index out of range.
-    """
-    if not (isinstance(indices, np.ndarray) and indices.shape == (shots,) and indices.dtype.kind in "iu"):
-        raise RuntimeError(f"the {backend} backend returned {indices!r} for {shots} shots: expected an integer "
-                           f"array of shape ({shots},)")
-    if shots and (int(indices.min()) < 0 or int(indices.max()) >= size):
-        raise RuntimeError(f"the {backend} backend measured an index outside [0, {size}): {indices.tolist()}")
-
-
-#: generous upper limits: far beyond any useful search (the optimal k for N = 2^30 and m = 1 is
-#: 25 735), small enough that a circuit or a result never exhausts memory
-MAX_ITERATIONS = 100_000
-MAX_SHOTS = 10_000_000
-
-
-def validate_iterations(iterations: int) -> int:
-    """k as an int in [0, ``MAX_ITERATIONS``].
-
-    Args:
-        iterations: k.
-
-    Returns:
-        k as a Python ``int``.
-
-    Raises:
-        TypeError: A non-integer k.
-        ValueError: k out of range.
-    """
-    return check_int(iterations, "iterations", 0, MAX_ITERATIONS)
-
-
-def validate_shots(shots: int) -> int:
-    """``shots`` as an int in [1, ``MAX_SHOTS``].
-
-    Args:
-        shots: The preparations.
-
-    Returns:
-        ``shots`` as a Python ``int``.
-
-    Raises:
-        TypeError: A non-integer ``shots``.
-        ValueError: ``shots`` out of range.
-    """
-    return check_int(shots, "shots", 1, MAX_SHOTS)
-
-
-def seed_stream(seed: int | np.random.Generator | None) -> np.random.Generator:
-    """A numpy Generator from a seed, a Generator (used as is) or None (fresh entropy).
-
-    Args:
-        seed: A non-negative integer, a ``numpy.random.Generator`` or None.
-
-    Returns:
-        The generator.
-
-    Raises:
-        TypeError: A seed that is neither an integer, a Generator nor None.
-        ValueError: A negative seed.
-    """
-    if isinstance(seed, np.random.Generator):
-        return seed
-    return np.random.default_rng(check_seed(seed))
+#: the request types and checks, importable from here as from ``requests``
+__all__ = ["MAX_ITERATIONS", "MAX_SHOTS", "QuantumSearchBackend", "SearchRequest", "SearchResult", "check_measured",
+           "seed_stream", "validate_iterations", "validate_marks", "validate_shots"]
 
 
 class QuantumSearchBackend(abc.ABC):
@@ -241,10 +114,10 @@ class QuantumSearchBackend(abc.ABC):
 
         Raises:
             ValueError: ``marks`` not of length 2^n (n >= 1), n above ``max_qubits``, an estimated
-                peak memory that does not fit (``qrrt_circuits.memory``; checked once per call), or
+                peak memory that does not fit (``qrrt_circuits._support.memory``; checked once per call), or
                 ``iterations`` / ``shots`` out of range, before any work.
             TypeError: Arguments of the wrong type.
-            qrrt_circuits.memory.OutOfMemory: A ``MemoryError`` while the search ran (one line:
+            qrrt_circuits._support.memory.OutOfMemory: A ``MemoryError`` while the search ran (one line:
                 n, what the allocator reported, the largest smaller n whose estimate fits).
         """
         prepared = self._prepare(SearchRequest(marks, iterations, shots, seed))
@@ -275,7 +148,7 @@ class QuantumSearchBackend(abc.ABC):
             TypeError: An element that is not a ``SearchRequest``, or arguments of the wrong type.
             ValueError: Any request that ``search`` would refuse (checked for all before any runs;
                 the available memory is read once for the call).
-            qrrt_circuits.memory.OutOfMemory: A ``MemoryError`` while a search ran.
+            qrrt_circuits._support.memory.OutOfMemory: A ``MemoryError`` while a search ran.
         """
         prepared = [self._prepare(request) for request in requests]
         measured = self._check_searches(self.peak_bytes, [item[:4] for item in prepared])
@@ -328,7 +201,7 @@ class QuantumSearchBackend(abc.ABC):
 
     def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1, marked: int | None = None) -> int:
         """Peak bytes one ``search`` of a 2^n-entry database adds to the process, beyond the marks
-        the caller holds (used by the memory guard, ``qrrt_circuits.memory``).
+        the caller holds (used by the memory guard, ``qrrt_circuits._support.memory``).
 
         Args:
             num_qubits: n.
@@ -481,7 +354,7 @@ class QuantumSearchBackend(abc.ABC):
                 range, or an estimated peak memory that does not fit (checked once per call).
             TypeError: ``sequence`` not an ``IterateSequence``, or a non-integer ``shots``.
             NotImplementedError: A backend that does not run generalized iterates.
-            qrrt_circuits.memory.OutOfMemory: A ``MemoryError`` while the search ran.
+            qrrt_circuits._support.memory.OutOfMemory: A ``MemoryError`` while the search ran.
         """
         marks, num_qubits, shots = self._prepare_sequence(marks, sequence, shots)
         sized = (marks, num_qubits, len(sequence), shots)

@@ -27,7 +27,7 @@ from qiskit import QuantumCircuit, transpile
 from qiskit.circuit.library import DiagonalGate, grover_operator
 
 from .aer_circuits import aer_grover_circuit, simulation_synthesis
-from .backend import validate_iterations, validate_marks
+from .requests import validate_iterations, validate_marks
 
 __all__ = [
     "BASIS_GATES",

@@ -41,9 +41,9 @@ from qiskit import QuantumCircuit
 from qiskit.primitives import BaseSamplerV2
 from qiskit.primitives.containers.sampler_pub import SamplerPub
 
-from .backend import validate_marks
 from .circuits import phase_oracle
 from .fixed_point import append_state_reflection
+from .requests import validate_marks
 
 if TYPE_CHECKING:
     from qiskit.primitives import PrimitiveJob

@@ -38,8 +38,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..validation import check_float, check_int
-from .backend import MAX_ITERATIONS, validate_marks
+from .._support.validation import check_float, check_int
+from .requests import MAX_ITERATIONS, validate_marks
 
 if TYPE_CHECKING:
     from qiskit import QuantumCircuit

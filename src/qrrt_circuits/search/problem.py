@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..randomness import RandomStreams, Stream
+from .._support.randomness import RandomStreams, Stream
 from .backend import QuantumSearchBackend
 
 if TYPE_CHECKING:
@@ -96,7 +96,7 @@ class DatabaseSearch:
     Example:
         >>> import numpy as np
         >>> from qrrt_circuits import DatabaseSearch, StatevectorBackend
-        >>> from qrrt_circuits.randomness import RandomStreams
+        >>> from qrrt_circuits._support.randomness import RandomStreams
         >>> marks = np.zeros(8, dtype=bool)
         >>> marks[5] = True
         >>> problem = DatabaseSearch(marks, marks, StatevectorBackend(seed=0), RandomStreams(0),

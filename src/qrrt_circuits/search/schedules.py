@@ -1,6 +1,6 @@
 """Deprecated alias of ``qrrt_circuits.search.policies``."""
 
-from ..deprecation import warn_deprecated
+from .._support.deprecation import warn_deprecated
 from .policies import *  # noqa: F403
 from .policies import __all__  # noqa: F401
 

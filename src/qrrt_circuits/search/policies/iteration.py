@@ -45,11 +45,12 @@ from typing import Any
 
 import numpy as np
 
-from ..deprecation import warn_deprecated
-from ..probability import optimal_iterations
-from ..validation import check_choice, check_float, check_int, check_optional_int
-from .backend import MAX_ITERATIONS, QuantumSearchBackend, validate_iterations
-from .problem import DatabaseSearch, SearchOutcome
+from ..._support.deprecation import warn_deprecated
+from ..._support.validation import check_choice, check_float, check_int, check_optional_int
+from ...probability import optimal_iterations
+from ..backend import QuantumSearchBackend
+from ..problem import DatabaseSearch, SearchOutcome
+from ..requests import MAX_ITERATIONS, validate_iterations
 
 __all__ = [
     "BBHT",
@@ -61,7 +62,6 @@ __all__ = [
     "KnownOptimal",
     "PaperSchedule",
     "PolicyState",
-    "parse_policy",
 ]
 
 
@@ -80,7 +80,7 @@ class IterationPolicy:
     Example:
         >>> import numpy as np
         >>> from qrrt_circuits import DatabaseSearch, KnownOptimal, PaperSchedule, StatevectorBackend
-        >>> from qrrt_circuits.randomness import RandomStreams
+        >>> from qrrt_circuits._support.randomness import RandomStreams
         >>> marks = np.zeros(64, dtype=bool)
         >>> marks[:2] = True
         >>> problem = DatabaseSearch(marks, marks, StatevectorBackend(seed=0), RandomStreams(0), 0)
@@ -648,27 +648,3 @@ class AdaptiveState(PolicyState):
         log_posterior = self.log_posterior
         weights = np.exp(log_posterior - log_posterior.max())
         return float(np.sum(weights * self.fractions) / weights.sum())
-
-
-def parse_policy(text: str) -> IterationPolicy:
-    """A policy from its registry name: ``paper``, ``optimal``, ``bbht``, ``adaptive`` or ``fixed:K``
-    (see ``qrrt_circuits.registry.POLICIES``).
-
-    Args:
-        text: A name of ``POLICIES`` (``"fixed:3"``, ``"fixed-point:0.3"``, ``"estimated"``, ...).
-
-    Returns:
-        The ``IterationPolicy``.
-
-    Raises:
-        TypeError: ``text`` is not a string.
-        ValueError: An unknown name or a malformed parameter.
-
-    Example:
-        >>> from qrrt_circuits.search.policies import parse_policy
-        >>> parse_policy("fixed:3")
-        FixedIterations(k=3)
-    """
-    from ..registry import POLICIES
-
-    return POLICIES.create(text)

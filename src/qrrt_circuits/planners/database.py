@@ -1,0 +1,254 @@
+"""Candidate generation: the database of (sample, nearest parent) pairs (Alg. 1, lines 4-8) and
+Quantum Database Annealing (Alg. 4).
+
+``build_database`` draws 2^n samples,
+uniform over the workspace (a fraction ``goal_bias`` uniform in the goal ball instead), and pairs
+each with its nearest tree node. With an ``AnnealingSchedule`` each candidate keeps the direction
+from its parent to the sample but is moved to a distance drawn uniformly in the current band
+[r_min, r_max] (DESIGN §1).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .._support.randomness import RandomStreams, Stream
+from .._support.validation import check_choice, check_float, check_int
+from ..world.environment import Environment
+from .tree import Tree
+
+
+def _check_bands(bands: Any) -> tuple[tuple[float, float], ...]:
+    """(r_min, r_max) pairs of finite distances >= 0, as floats (strings are not coerced)."""
+    if not isinstance(bands, tuple | list) or not bands:
+        raise TypeError(f"bands must be a non-empty sequence of (r_min, r_max) pairs, got {bands!r}")
+    checked = []
+    for i, band in enumerate(bands):
+        if not isinstance(band, tuple | list | np.ndarray) or len(band) != 2:
+            raise TypeError(f"bands[{i}] must be an (r_min, r_max) pair, got {band!r}")
+        checked.append((check_float(band[0], f"bands[{i}] r_min", 0.0), check_float(band[1], f"bands[{i}] r_max", 0.0)))
+    return tuple(checked)
+
+
+@dataclass(frozen=True)
+class AnnealingSchedule:
+    """Quantum Database Annealing (Alg. 4): the temperature array H as distance bands.
+
+    Band i = (r_min, r_max) is in force while ``switch_at[i-1] <= h < switch_at[i]``; the last band
+    stays in force. The temperature index h (Alg. 4's ``h``) counts databases built
+    (``counter="databases"``, Alg. 4's h++ per loop) or nodes in the tree (``counter="nodes"``).
+    In Alg. 4 every database adds a node, so the two coincide; with the classical verification a
+    database can add none, and counting nodes keeps the hot phase for the tree's first ``switch_at[0]`` nodes.
+
+    Args:
+        bands: Non-empty sequence of (r_min, r_max) distance bands, finite, 0 <= r_min <= r_max and
+            r_max > 0; band i is the distance range of Alg. 4's temperature H[i].
+        switch_at: ``len(bands) - 1`` strictly increasing integers >= 1: the temperature indices at
+            which the next band takes over (default ``()`` for one band).
+        counter: What h counts: ``"databases"`` (default, Alg. 4) or ``"nodes"``.
+
+    Raises:
+        TypeError: ``bands`` not a sequence of pairs, a non-real distance, ``switch_at`` not a
+            tuple or list, or a non-integer entry of it.
+        ValueError: An empty ``bands``, a negative or non-finite distance, r_min > r_max, r_max = 0,
+            ``switch_at`` of the wrong length or not strictly increasing and >= 1, or an unknown
+            ``counter``.
+
+    Example:
+        >>> from qrrt_circuits import AnnealingSchedule
+        >>> schedule = AnnealingSchedule(bands=((2.7, 4.2), (0.8, 2.0)), switch_at=(8,))
+        >>> schedule.band(0), schedule.band(7), schedule.band(8)
+        ((2.7, 4.2), (2.7, 4.2), (0.8, 2.0))
+    """
+
+    bands: tuple[tuple[float, float], ...]
+    switch_at: tuple[int, ...] = ()
+    counter: str = "databases"
+
+    def __post_init__(self) -> None:
+        bands = _check_bands(self.bands)
+        for i, (lo, hi) in enumerate(bands):
+            if lo > hi:
+                raise ValueError(f"bands[{i}] = ({lo}, {hi}): r_min must be <= r_max")
+            if hi == 0:
+                raise ValueError(f"bands[{i}]: r_max must be > 0")
+        if not isinstance(self.switch_at, tuple | list):
+            raise TypeError(f"switch_at must be a tuple of increasing integers >= 1, got {self.switch_at!r}")
+        switch_at = tuple(check_int(s, f"switch_at[{i}]", 1) for i, s in enumerate(self.switch_at))
+        if len(switch_at) != len(bands) - 1:
+            raise ValueError(
+                f"switch_at must have len(bands) - 1 = {len(bands) - 1} entries, got {len(switch_at)}"
+            )
+        steps = np.diff(np.asarray(switch_at, dtype=np.int64))
+        if any(s <= 0 for s in switch_at) or np.any(steps <= 0):
+            raise ValueError(f"switch_at must be strictly increasing positive integers, got {switch_at}")
+        check_choice(self.counter, "counter", ("databases", "nodes"))
+        object.__setattr__(self, "bands", bands)
+        object.__setattr__(self, "switch_at", switch_at)
+
+    @classmethod
+    def paper(cls, switch_at: int = 8) -> AnnealingSchedule:
+        """The paper's §V.D bands: [2.7, 4.2], then [0.8, 2.0] (the switch point is ours).
+
+        Args:
+            switch_at: The temperature index (databases built) at which the second band takes over,
+                an integer >= 1 (default 8).
+
+        Returns:
+            ``AnnealingSchedule(bands=((2.7, 4.2), (0.8, 2.0)), switch_at=(switch_at,))``.
+
+        Raises:
+            TypeError: A non-integer ``switch_at``.
+            ValueError: ``switch_at`` < 1.
+        """
+        return cls(bands=((2.7, 4.2), (0.8, 2.0)), switch_at=(switch_at,))
+
+    def temperature_index(self, databases: int, nodes: int) -> int:
+        """Alg. 4's h: databases built so far or nodes in the tree, per ``counter``.
+
+        Args:
+            databases: Databases built so far.
+            nodes: Nodes in the tree so far.
+
+        Returns:
+            ``nodes`` if ``counter == "nodes"``, else ``databases``.
+        """
+        return nodes if self.counter == "nodes" else databases
+
+    def describe(self) -> dict:
+        """The schedule as JSON-able settings: ``bands``, ``switch_at`` and ``counter``."""
+        return {"bands": [list(band) for band in self.bands], "switch_at": list(self.switch_at),
+                "counter": self.counter}
+
+    def band(self, temperature_index: int) -> tuple[float, float]:
+        """The band in force at temperature index h (h = 0, 1, ...).
+
+        Args:
+            temperature_index: h, an integer >= 0.
+
+        Returns:
+            (r_min, r_max) of band i, where i is the number of ``switch_at`` entries <= h.
+        """
+        index = int(np.searchsorted(np.asarray(self.switch_at), temperature_index, side="right"))
+        return self.bands[index]
+
+
+@dataclass(frozen=True)
+class Database:
+    """2^n candidates: ``children`` (N, d) and their ``parents`` (N,) as tree indices.
+
+    Args:
+        children: Float (N, d), the candidate points (Alg. 1's x_new, one per database entry).
+        parents: Int (N,), the tree row of each candidate's nearest node.
+        band: The annealing band (r_min, r_max) the candidates were moved into, or None.
+    """
+
+    children: np.ndarray
+    parents: np.ndarray
+    band: tuple[float, float] | None = None
+
+
+def build_database(
+    tree: Tree,
+    size: int,
+    env: Environment,
+    rng: np.random.Generator,
+    goal: np.ndarray | None = None,
+    goal_radius: float = 0.0,
+    goal_bias: float = 0.0,
+    annealing: AnnealingSchedule | None = None,
+    temperature_index: int = 0,
+) -> Database:
+    """Alg. 1 lines 4-8 (and Alg. 4 line 7 with ``annealing``).
+
+    Args:
+        tree: The ``Tree`` whose nearest nodes become the parents.
+        size: Candidates N (2^n for a quantum database).
+        env: The ``Environment`` whose workspace is sampled.
+        rng: The generator of the samples.
+        goal: Goal point (d,) for goal-biased samples, or None.
+        goal_radius: Radius of the goal ball the biased samples are drawn in.
+        goal_bias: Fraction in [0, 1) of samples drawn uniformly in the goal ball.
+        annealing: An ``AnnealingSchedule`` (Alg. 4), or None.
+        temperature_index: Alg. 4's h, which picks the annealing band.
+
+    Returns:
+        The ``Database`` of candidates and their nearest parents.
+    """
+    samples = env.sample_uniform(size, rng)
+    if goal_bias > 0 and goal is not None:
+        biased = rng.random(size) < goal_bias
+        count = int(biased.sum())
+        if count:
+            samples[biased] = sample_ball(goal, goal_radius, count, rng)
+    parents = tree.nearest(samples)
+    band = None
+    if annealing is not None:
+        band = annealing.band(temperature_index)
+        origin = tree.nodes[parents]
+        offset = samples - origin
+        norm = np.linalg.norm(offset, axis=1)
+        zero = norm == 0
+        if np.any(zero):  # a sample on its parent: any direction will do
+            offset[zero] = rng.normal(size=(int(zero.sum()), tree.dim))
+            norm[zero] = np.linalg.norm(offset[zero], axis=1)
+        distance = rng.uniform(band[0], band[1], size)
+        samples = origin + offset / norm[:, None] * distance[:, None]
+    return Database(samples, parents, band)
+
+def stream_database(
+    tree: Tree,
+    size: int,
+    env: Environment,
+    streams: RandomStreams,
+    round_index: int,
+    worker: int,
+    goal: np.ndarray | None = None,
+    goal_radius: float = 0.0,
+    goal_bias: float = 0.0,
+    annealing: AnnealingSchedule | None = None,
+    temperature_index: int = 0,
+) -> Database:
+    """``build_database`` with the generator of (round, worker, ``Stream.CANDIDATES``).
+
+    Args:
+        tree: The ``Tree`` whose nearest nodes become the parents.
+        size: Candidates N.
+        env: The ``Environment`` whose workspace is sampled.
+        streams: The plan's ``RandomStreams``.
+        round_index: The round (the generator's key).
+        worker: The worker (the generator's key).
+        goal: Goal point (d,) for goal-biased samples, or None.
+        goal_radius: Radius of the goal ball.
+        goal_bias: Fraction in [0, 1) of samples drawn in the goal ball.
+        annealing: An ``AnnealingSchedule`` (Alg. 4), or None.
+        temperature_index: Alg. 4's h.
+
+    Returns:
+        The ``Database``.
+    """
+    return build_database(tree, size, env, streams.generator(round_index, worker, Stream.CANDIDATES), goal,
+                          goal_radius, goal_bias, annealing, temperature_index)
+
+
+def sample_ball(centre: np.ndarray, radius: float, count: int, rng: np.random.Generator) -> np.ndarray:
+    """``count`` points uniform in the d-ball of ``radius`` around ``centre``.
+
+    A Gaussian direction, normalised, scaled by ``radius * u^(1/d)`` with u uniform in [0, 1).
+
+    Args:
+        centre: Float (d,), the ball's centre.
+        radius: The ball's radius.
+        count: Number of points.
+        rng: The generator of the draws.
+
+    Returns:
+        Float array (count, d).
+    """
+    d = centre.shape[0]
+    direction = rng.normal(size=(count, d))
+    direction /= np.linalg.norm(direction, axis=1, keepdims=True)
+    return centre + direction * radius * rng.random(count)[:, None] ** (1.0 / d)

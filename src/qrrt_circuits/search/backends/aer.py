@@ -1,0 +1,328 @@
+"""Gate-level Grover search: real Qiskit circuits executed by qiskit-aer's ``AerSimulator``.
+
+Each search builds its circuit once and hands it to ``AerSimulator.run`` with ``shots``,
+``seed_simulator``, ``memory=True`` (the measured word of every shot, in order) and
+``max_parallel_threads``; nothing else of qiskit-aer is used. The circuit
+(``aer_grover_circuit``: Walsh-Hadamard blocks, the oracle as one ``diagonal`` or as ``pauli`` +
+``mcphase`` pairs, one ``mcphase`` per diffuser) uses only instructions Aer executes natively, so
+it is run without a transpile; with a ``noise_model`` the gate-by-gate circuit
+(``aer_literal_grover_circuit``: h, x, mcphase) is run instead, so per-gate noise acts on the
+paper's gates. Each shot is an independent preparation, k Grover iterations and a measurement.
+
+Independent searches (``search_many``) run one after the other: in a multi-circuit run Aer seeds
+circuit i with ``seed_simulator + 2113 i``, so one run cannot give each database its own seed.
+
+Threads: Aer parallelises a state update only from ``statevector_parallel_threshold`` (14) qubits
+on; below it, extra OpenMP threads only cost their start-up and synchronisation, so circuits
+narrower than ``SERIAL_BELOW_QUBITS`` run on one thread whatever ``max_parallel_threads`` says.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+from qiskit_aer import AerSimulator
+
+from ..._support.validation import check_int
+from ..aer_circuits import simulation_synthesis_for
+from ..backend import QuantumSearchBackend, seed_stream
+from ..circuits import SYNTHESES, aer_grover_circuit, aer_literal_grover_circuit, oracle_cx_estimate
+from ..fixed_point import generalized_grover_circuit
+
+if TYPE_CHECKING:
+    from qiskit import QuantumCircuit
+    from qiskit_aer.noise import NoiseModel
+
+    from ..fixed_point import IterateSequence
+
+METHODS = ("statevector", "automatic")
+#: circuits on fewer qubits run single-threaded (Aer's default statevector_parallel_threshold)
+SERIAL_BELOW_QUBITS = 14
+#: On the GPU, Aer sizes its matrix buffer for a dense matrix on the widest instruction's qubits
+#: (4^b complex128 entries for b qubits), so a diagonal oracle on n qubits takes 16 * 4^n bytes of
+#: GPU memory. ``synthesis="auto"`` on the GPU therefore takes the diagonal form only up to this
+#: width (4 GiB) and the ``mcz`` form above it, whatever the marks; ``synthesis="diagonal"`` is
+#: run as asked (Aer reports its out-of-memory error where the buffer does not fit).
+GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS = 14
+#: methods AerSimulator offers that these circuits cannot run, and why (refused at construction)
+UNSUPPORTED_METHODS = {
+    "density_matrix": "its instruction set lacks the mcphase gate of aer_grover_circuit (and it "
+                      "doubles the qubits); use method='statevector' with a noise_model",
+    "matrix_product_state": "its instruction set lacks the mcphase gate of aer_grover_circuit",
+}
+
+
+class AerBackend(QuantumSearchBackend):
+    """Gate-level Grover search (paper Alg. 2, lines 4-8) on ``AerSimulator(method=...)``.
+
+    Each search builds the Grover circuit of the marks once (``aer_grover_circuit``; with a
+    noise model given here, the gate-by-gate ``aer_literal_grover_circuit``) and runs it through
+    ``AerSimulator.run`` with ``shots`` shots and ``memory=True``; a marked index is measured with
+    probability sin^2((2k+1) theta), sin^2 theta = m / 2^n (paper Eq. 1, Lemma 1). Every call
+    draws a ``seed_simulator`` from its stream, so a plan depends on the planner's seed only.
+    Oracle calls: ``iterations * shots`` (DESIGN §2).
+
+    Args:
+        seed: The backend's own stream for ``search`` calls without a seed: a non-negative
+            integer, a ``numpy.random.Generator`` (used as is) or None (fresh entropy).
+        method: ``"statevector"`` (default) or ``"automatic"`` (``METHODS``). ``"density_matrix"``
+            and ``"matrix_product_state"`` are refused (``UNSUPPORTED_METHODS``: their
+            instruction sets lack the ``mcphase`` gate of the circuit).
+        synthesis: The oracle's form: ``"auto"`` (``simulation_synthesis``, or with a noise model
+            the CX-based ``choose_synthesis``), ``"diagonal"`` or ``"mcz"`` (``SYNTHESES``).
+        noise_model: A ``qiskit_aer.noise.NoiseModel`` passed to the simulator as is, or None.
+            With one, the gate-by-gate circuit runs, so per-gate noise acts on the paper's gates.
+        device: One of ``AerSimulator().available_devices()`` for this qiskit-aer build:
+            ``"CPU"`` (default) or ``"GPU"`` (needs qiskit-aer-gpu and an NVIDIA GPU).
+        max_parallel_threads: Aer's thread limit, 0 .. 4096; 0 lets Aer use all cores. Circuits
+            on fewer than ``SERIAL_BELOW_QUBITS`` (14) qubits always run on one thread.
+
+    Attributes:
+        method: The Aer simulation method.
+        synthesis: The oracle synthesis requested.
+        simulator: The ``AerSimulator`` the circuits run on.
+        device: ``"CPU"`` or ``"GPU"``.
+        max_parallel_threads: The thread limit for circuits of 14 or more qubits.
+
+    Raises:
+        TypeError: ``method``, ``synthesis`` or ``device`` is not a string, or
+            ``max_parallel_threads`` / ``seed`` is not an integer.
+        ValueError: An unsupported or unknown ``method``, a ``device`` this build does not offer,
+            an unknown ``synthesis``, ``max_parallel_threads`` outside [0, 4096] or a negative
+            ``seed``.
+    """
+
+    name = "aer"
+
+    def __init__(
+        self,
+        seed: int | np.random.Generator | None = None,
+        method: str = "statevector",
+        synthesis: str = "auto",
+        noise_model: NoiseModel | None = None,
+        device: str = "CPU",
+        max_parallel_threads: int = 0,
+    ) -> None:
+        for name, value in (("method", method), ("synthesis", synthesis), ("device", device)):
+            if not isinstance(value, str):
+                raise TypeError(f"{name} must be a string, got {value!r}")
+        if method in UNSUPPORTED_METHODS:
+            raise ValueError(f"method={method!r} is not supported: {UNSUPPORTED_METHODS[method]}")
+        if method not in METHODS:
+            raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+        available = AerSimulator().available_devices()
+        if device not in available:
+            raise ValueError(f"device must be one of {tuple(available)} for this qiskit-aer build, got {device!r} "
+                             "(device='GPU' needs qiskit-aer-gpu and an NVIDIA GPU)")
+        if synthesis not in SYNTHESES:
+            raise ValueError(f"synthesis must be one of {SYNTHESES}, got {synthesis!r}")
+        check_int(max_parallel_threads, "max_parallel_threads", 0, 4096)
+        self._rng = seed_stream(seed)
+        self.method = method
+        self.synthesis = synthesis
+        self.simulator = AerSimulator(
+            method=method,
+            device=device,
+            noise_model=noise_model,
+            max_parallel_threads=int(max_parallel_threads),
+        )
+        self.device = device
+        self.max_parallel_threads = int(max_parallel_threads)
+        self._build = aer_grover_circuit if noise_model is None else aer_literal_grover_circuit
+
+    @property
+    def max_qubits(self) -> int:
+        """The largest n the simulator's configuration accepts (``configuration().n_qubits``,
+        memory-limited; read on every call, so ``set_max_qubits`` and option changes count)."""
+        return int(self.simulator.configuration().n_qubits)
+
+    #: upper bounds fitted to the measured peak memory of a search whose oracle is one diagonal: the
+    #: oracle's 2^n phases, Aer's complex128 state and its converted copy of the phases, then per
+    #: iteration the circuit's and Aer's copies of the oracle's phases (the circuit holds the same
+    #: gate k times; Aer converts each instance)
+    AER_BYTES_PER_ENTRY = 240
+    AER_BYTES_PER_ENTRY_PER_ITERATION = 80
+    #: per shot: the measured word kept by ``memory=True`` and its conversion to an index
+    BYTES_PER_SHOT = 200
+
+    #: the ``mcz`` oracle's footprint per entry: Aer's complex128 state and about one more 16-byte
+    #: array, with a margin
+    AER_MCZ_BYTES_PER_ENTRY = 48
+    #: per ``mcphase`` / ``pauli`` instruction of the ``mcz`` form (2 per flipped entry per
+    #: iteration): the circuit's instruction and Aer's operation, with a margin. Below the diagonal
+    #: form's bound whenever ``simulation_synthesis`` picks ``mcz`` (f < 2^n / 600)
+    AER_BYTES_PER_MCZ_INSTRUCTION = 4096
+
+    def synthesis_for(self, num_qubits: int) -> str:
+        """The ``synthesis`` a circuit on ``num_qubits`` qubits is built with: the constructor's,
+        except ``"auto"`` on the GPU above ``GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS`` qubits, which is
+        ``"mcz"`` (Aer's GPU buffer for an n-qubit diagonal is 16 * 4^n bytes). The device is read
+        from the simulator's options, so one set there after construction counts too."""
+        on_gpu = getattr(self.simulator.options, "device", self.device) == "GPU"
+        if self.synthesis == "auto" and on_gpu and num_qubits > GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS:
+            return "mcz"
+        return self.synthesis
+
+    @property
+    def _literal(self) -> bool:
+        """Whether searches build the gate-by-gate circuit (a noise model at construction)."""
+        return self._build is aer_literal_grover_circuit
+
+    def oracle_form(self, num_qubits: int, marked: int) -> str:
+        """The oracle form a search of m = ``marked`` entries among 2^n is built with:
+        ``synthesis_for(n)`` where it names one; else (``"auto"``) ``simulation_synthesis``'s
+        choice (``"mcz"`` when 2^n > ENTRIES_PER_INSTRUCTION (2 min(m, 2^n - m) + 1)), or with a
+        noise model (the gate-by-gate circuit) the CX-based ``choose_synthesis``'s.
+
+        Args:
+            num_qubits: n.
+            marked: m, 0 .. 2^n.
+
+        Returns:
+            ``"diagonal"`` or ``"mcz"``.
+        """
+        return self._form(num_qubits, marked, self._literal)
+
+    def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1, marked: int | None = None) -> int:
+        """Upper bound of one search's peak memory.
+
+        Args:
+            num_qubits: n, the index register's width.
+            shots: Measurements of the search.
+            iterations: k, the Grover iterations (Aer copies the diagonal oracle's phases once per
+                iteration).
+            marked: m (0 .. 2^n), or None (default) for a bound over every m.
+
+        Returns:
+            The diagonal form: ``(AER_BYTES_PER_ENTRY + AER_BYTES_PER_ENTRY_PER_ITERATION * k) *
+            2^n`` bytes; the ``mcz`` form: ``AER_MCZ_BYTES_PER_ENTRY * 2^n +
+            AER_BYTES_PER_MCZ_INSTRUCTION * i f (k + 1)``, with i = 2 instructions (``pauli``,
+            ``mcphase``) per flipped entry and f = min(m, 2^n - m) in the compact circuit, i = n + 1
+            (X gates, ``mcphase``) and f = m in the gate-by-gate one; plus ``BYTES_PER_SHOT * shots``.
+            The form is the one the search builds (``synthesis_for``; for ``"auto"``, the form
+            chosen for m: ``simulation_synthesis``'s in the compact circuit, which picks the mcz
+            form only where it is the smaller, the CX-based one in the gate-by-gate circuit). Without m,
+            the largest estimate over every m (for the gate-by-gate ``"auto"``, the larger of the
+            diagonal form's and the mcz form's with m < 2^n / (n - 1): an n-qubit MCZ needs at least
+            n - 1 CX, so the CX-based choice takes the mcz form for no larger m).
+
+        Raises:
+            ValueError: ``marked`` outside [0, 2^n].
+        """
+        return self._peak(num_qubits, shots, iterations, marked, self._literal)
+
+    def sequence_peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1,
+                            marked: int | None = None) -> int:
+        """``peak_bytes`` of a ``search_sequence``: its circuit (``generalized_grover_circuit``) is
+        built gate by gate, whatever the noise model.
+
+        Args:
+            num_qubits: n.
+            shots: Measurements.
+            iterations: The sequence's length.
+            marked: m (0 .. 2^n), or None (default) for a bound over every m.
+
+        Returns:
+            Bytes (see ``peak_bytes``).
+        """
+        return self._peak(num_qubits, shots, iterations, marked, True)
+
+    def _peak(self, num_qubits: int, shots: int, iterations: int, marked: int | None, literal: bool) -> int:
+        """``peak_bytes`` of the compact (``literal`` False) or the gate-by-gate circuit."""
+        entries = 1 << num_qubits
+        if marked is not None:
+            check_int(marked, "marked", 0, entries)
+        diagonal = (self.AER_BYTES_PER_ENTRY + self.AER_BYTES_PER_ENTRY_PER_ITERATION * iterations) << num_qubits
+        synthesis = self.synthesis_for(num_qubits) if marked is None else self._form(num_qubits, marked, literal)
+        if synthesis == "diagonal":
+            body = diagonal
+        elif synthesis == "mcz":
+            worst = marked if marked is not None else (entries if literal else entries // 2)
+            body = self._mcz_bytes(num_qubits, iterations, worst, literal)
+        elif literal:  # "auto" over every m: the CX-based choice takes the mcz form only while m c_n < 2^n - 2,
+            # and an n-qubit MCZ needs at least n - 1 CX (its qubits must all interact), so m < 2^n / (n - 1)
+            most = max(0, min(entries, (entries - 3) // max(1, num_qubits - 1)))
+            body = max(diagonal, self._mcz_bytes(num_qubits, iterations, most, literal))
+        else:
+            body = diagonal  # simulation_synthesis picks the mcz form only where it is the smaller
+        return body + self.BYTES_PER_SHOT * shots
+
+    def _form(self, num_qubits: int, marked: int, literal: bool) -> str:
+        """The form built for m marked entries: ``synthesis_for(n)`` where it names one; for
+        ``"auto"`` the CX-based choice in the gate-by-gate circuit (an MCZ's CX count is transpiled
+        once per n and cached), else ``simulation_synthesis``'s."""
+        synthesis = self.synthesis_for(num_qubits)
+        if synthesis != "auto":
+            return synthesis
+        if literal:
+            estimate = oracle_cx_estimate(num_qubits, marked)
+            return "mcz" if estimate["mcz"] < estimate["diagonal"] else "diagonal"
+        return simulation_synthesis_for(num_qubits, marked)
+
+    def _mcz_bytes(self, num_qubits: int, iterations: int, marked: int, literal: bool) -> int:
+        """The mcz form's estimate without the shots (see ``peak_bytes``)."""
+        if literal:
+            instructions = (num_qubits + 1) * marked * (iterations + 1)
+        else:
+            instructions = 2 * min(marked, (1 << num_qubits) - marked) * (iterations + 1)
+        return (self.AER_MCZ_BYTES_PER_ENTRY << num_qubits) + self.AER_BYTES_PER_MCZ_INSTRUCTION * instructions
+
+    def threads_for(self, num_qubits: int) -> int:
+        """The ``max_parallel_threads`` a circuit on ``num_qubits`` qubits runs with.
+
+        Args:
+            num_qubits: n, the circuit's width.
+
+        Returns:
+            1 below ``SERIAL_BELOW_QUBITS`` qubits, else the constructor's ``max_parallel_threads``.
+        """
+        return 1 if num_qubits < SERIAL_BELOW_QUBITS else self.max_parallel_threads
+
+    def describe(self) -> str:
+        """The backend's settings in words: ``"aer (method=..., device=..., synthesis=...)"``, the
+        method and device as the simulator's options give them, the oracle synthesis requested,
+        and ``", noise model"`` where the simulator has one (with one given to the constructor the
+        circuit is the gate-by-gate one, ``", noise model, gate-by-gate circuit"``)."""
+        options = self.simulator.options
+        text = (f"{self.name} (method={getattr(options, 'method', self.method)}, "
+                f"device={getattr(options, 'device', self.device)}, synthesis={self.synthesis}")
+        if getattr(options, "noise_model", None) is not None or self._literal:
+            text += ", noise model" + (", gate-by-gate circuit" if self._literal else "")
+        return text + ")"
+
+    def _run(self, circuit: QuantumCircuit, num_qubits: int, shots: int, seed: int) -> np.ndarray:
+        """The measured index of every shot of ``circuit``: ``AerSimulator.run`` with ``shots``,
+        ``seed_simulator = seed``, ``memory=True`` and ``max_parallel_threads = threads_for(n)``.
+
+        Raises:
+            RuntimeError: Aer reports a failed simulation.
+        """
+        result = self.simulator.run(circuit, shots=shots, seed_simulator=seed, memory=True,
+                                    max_parallel_threads=self.threads_for(num_qubits)).result()
+        if not result.success:
+            raise RuntimeError(f"AerSimulator failed: {result.status}")
+        return _indices(result.results[0].data.memory)
+
+    def _sample_seeded(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
+                       seed: int | np.random.Generator | None) -> np.ndarray:
+        """Build the Grover circuit and run it; the simulator seed is the first
+        ``integers(0, 2**31 - 1)`` of the search's generator."""
+        seed_simulator = self._first_integer(seed, 2**31 - 1)
+        circuit = self._build(marks, iterations, measure=True, synthesis=self.synthesis_for(num_qubits))
+        return self._run(circuit, num_qubits, shots, seed_simulator)
+
+    def _sample(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
+                rng: np.random.Generator) -> np.ndarray:
+        return self._sample_seeded(marks, num_qubits, iterations, shots, rng)
+
+    def _sample_sequence(self, marks: np.ndarray, num_qubits: int, sequence: IterateSequence, shots: int,
+                         rng: np.random.Generator) -> np.ndarray:
+        """Fixed-point amplification: the generalized iterates of ``sequence`` as one circuit."""
+        circuit = generalized_grover_circuit(marks, sequence, measure=True, synthesis=self.synthesis_for(num_qubits))
+        return self._run(circuit, num_qubits, shots, int(rng.integers(0, 2**31 - 1)))
+
+
+def _indices(words: list[str]) -> np.ndarray:
+    """The measured indices of Aer's hexadecimal memory words."""
+    return np.fromiter((int(word, 16) for word in words), dtype=np.int64, count=len(words))

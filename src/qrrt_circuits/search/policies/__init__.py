@@ -1,0 +1,31 @@
+"""Search policies: how the workers of a round search one database (paper Alg. 2 and 3).
+
+``iteration`` holds the policies that choose a Grover iteration count (the paper's schedule, fixed
+k, the optimal k of Eq. 1 for a known m, BBHT, the adaptive policy) and the ``PolicyState`` every
+planner round runs through; ``fixed_point`` fixed-point amplitude amplification; ``estimated`` the
+iteration count from an amplitude estimate of m.
+"""
+
+from typing import Any
+
+from .iteration import (
+    BBHT,
+    Adaptive,
+    AdaptiveState,
+    BBHTOutcome,
+    FixedIterations,
+    IterationPolicy,
+    KnownOptimal,
+    PaperSchedule,
+    PolicyState,
+)
+
+__all__ = ["BBHT", "Adaptive", "AdaptiveState", "BBHTOutcome", "FixedIterations", "IterationPolicy", "KnownOptimal",
+           "PaperSchedule", "PolicyState"]
+
+
+def __getattr__(name: str) -> Any:
+    """Deprecated names of this package."""
+    from . import iteration
+
+    return iteration.__getattr__(name)
