@@ -30,7 +30,7 @@ def _marked(num_items: Any, num_marked: Any) -> tuple[int, int]:
 
 
 def harmonic(k: int) -> float:
-    """H_k = 1 + 1/2 + ... + 1/k (H_0 = 0): the harmonic number of Lemmas 3 and 6.
+    """H_k, the sum of 1/i for i = 1 to k (H_0 = 0): the harmonic number of Lemmas 3 and 6.
 
     Args:
         k: An integer >= 0.
@@ -51,8 +51,8 @@ def harmonic(k: int) -> float:
 
 
 def good_probability(num_items: int, num_marked: int, iterations: int) -> float:
-    """sin^2((2k+1) theta) with sin^2 theta = m/N, unvalidated (Boyer et al. 1998, Eq. 1 of the
-    paper): the probability that one measurement after k Grover iterations is marked."""
+    """sin^2((2k+1) theta) with sin^2 theta = m/N, unvalidated (Boyer et al. 1998; the paper's
+    Equation 1): the probability that one measurement after k Grover iterations is marked."""
     if num_marked == 0:
         return 0.0
     theta = math.asin(math.sqrt(num_marked / num_items))
@@ -80,7 +80,7 @@ def success_probability(num_items: int, num_marked: int, iterations: int) -> flo
 
 
 def optimal_iterations(num_items: int, num_marked: int) -> int:
-    """floor(pi / (4 theta)) with sin^2 theta = m/N, and 0 for m = 0 (Eq. 1, DESIGN §2).
+    """floor(pi / (4 theta)) with sin^2 theta = m/N, and 0 for m = 0 (paper Equation 1, DESIGN §2).
 
     Args:
         num_items: N, the database size (>= 1).

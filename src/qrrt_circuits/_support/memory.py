@@ -37,8 +37,7 @@ one) is raised again as an ``OutOfMemory`` whose message is one line: the size t
 largest smaller size whose estimate fits in the memory available after the failure.
 
 ``psutil`` is not a runtime dependency, so it is not used. The per-entry constants are calibrated,
-not derived: the measured peak resident set of real runs, rounded up (their comments give the
-measurements).
+not derived: upper bounds of the measured peak resident set of real runs, rounded up.
 """
 
 from __future__ import annotations
@@ -52,13 +51,13 @@ from pathlib import Path
 
 MIB = 1 << 20
 
-#: database of one round, bytes per entry: samples and their scratch, nearest-parent indices, the
-#: (parent, child) pairs handed to the predicate, its answers and the marks. Measured 57 / 89 /
-#: 120 B per entry for d = 2 / 4 / 6 at n = 20 (``bench_memory.py --database``): 26 + 16 d.
+#: database of one round, bytes per entry, 26 + 16 d: samples and their scratch, nearest-parent
+#: indices, the (parent, child) pairs handed to the predicate, its answers and the marks (a
+#: calibrated upper bound of the measured peak)
 DATABASE_BYTES_PER_ENTRY = 26
 DATABASE_BYTES_PER_COORDINATE = 16
 #: with Quantum Database Annealing (Alg. 4) candidates are moved along their parent's direction:
-#: measured 122 / 193 / 273 B per entry for d = 2 / 4 / 6: 46 + 38 d.
+#: 46 + 38 d bytes per entry (calibrated in the same way)
 ANNEALING_BYTES_PER_ENTRY = 46
 ANNEALING_BYTES_PER_COORDINATE = 38
 #: fixed allowance: the nearest-node grid of the tree (``tree.Tree``) and allocator slack
@@ -296,7 +295,7 @@ def _room(folder: Path, files: _GroupFiles) -> int | None:
 
 def database_bytes(num_qubits: int, dim: int, annealing: bool = False) -> int:
     """Peak bytes of building one database of 2^n candidates in d dimensions and evaluating the
-    predicate on it (Alg. 1 lines 4-8; Alg. 4 line 7 with ``annealing``).
+    predicate on it (paper Algorithm 1, lines 4-8; Algorithm 4, line 7, with ``annealing``).
 
     (26 + 16 d) 2^n bytes, or (46 + 38 d) 2^n with annealing: calibrated per-entry constants
     (``DATABASE_BYTES_PER_ENTRY`` and the others).
@@ -587,26 +586,24 @@ def out_of_memory(error: MemoryError, estimate_for: Callable[[int], MemoryEstima
 
 
 #: a plan's tree, bytes per node besides its coordinates (parents in the tree and the result, the
-#: nearest-node grid's order, the history of nodes, allocator slack). Measured with
-#: ``python benchmarks/bench_memory.py --only-plan-limits`` (4 096 parallel-RRT workers filling a
-#: world whose goal is walled in, 200 000 and 600 000 nodes): 122-126 B per node at d = 2 and
-#: 200-211 at d = 4 in the committed run (182-216 at d = 4 in earlier ones); the estimate,
-#: 96 + 48 d, is 1.4-1.6 times that.
+#: nearest-node grid's order, the history of nodes, allocator slack): with the coordinates,
+#: 96 + 48 d, a calibrated upper bound, with a margin, of the measured peak of a parallel-RRT plan
+#: whose goal is walled in
 TREE_BYTES_PER_NODE = 96
 #: a plan's tree, bytes per node and coordinate (positions in the tree, the grid and the result)
 TREE_BYTES_PER_COORDINATE = 48
 #: a plan's round history (``RunState.end_round``: five Python integers a round in lists, and the
-#: result's copies), bytes per round: 180 measured over 10^6 RRT rounds from a start walled in a
-#: small cube (the same command; 3 % of the rounds added a node there), rounded up
+#: result's copies), bytes per round: a calibrated upper bound of the measured peak of long RRT
+#: plans from a walled-in start, rounded up
 HISTORY_BYTES_PER_ROUND = 256
 
 
 #: writing a plan's result as ``json.dump(result.to_dict(), ...)`` (the Python lists of ``to_dict``),
-#: bytes per node besides the tree's: 176 measured at d = 2 (``bench_memory.py --only-plan-limits``,
-#: ``output-dump``) and about 232 at d = 4 (a helper's tracemalloc); 128 + 48 d is 1.3-1.4 times that.
-#: For callers that write ``to_dict()`` themselves (``plan_bytes``' ``output_bytes_per_node``);
-#: ``qrrt plan --json`` writes with ``PlanResult.write_json``, which adds about 2 MiB whatever the
-#: node count (``output-stream``), so it charges nothing per node.
+#: bytes per node besides the tree's: 128 + 48 d, a calibrated upper bound of the measured peak, with
+#: a margin. For callers that write ``to_dict()`` themselves (``plan_bytes``'
+#: ``output_bytes_per_node``); ``qrrt plan --json`` writes with ``PlanResult.write_json``, which
+#: streams the arrays and adds a bounded amount whatever the node count, so it charges nothing per
+#: node.
 JSON_BYTES_PER_NODE = 128
 JSON_BYTES_PER_COORDINATE = 48
 

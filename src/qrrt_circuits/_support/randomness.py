@@ -5,14 +5,13 @@ A plan's randomness comes only from its ``seed``: ``SeedSequence(seed)`` is spaw
 workers ran or on the executor that ran them. The stream numbers are part of the reproducibility
 contract (changing one changes every published result), so they are named here once.
 
-Speed. Building ``SeedSequence(entropy, spawn_key=key)`` and seeding ``PCG64`` from it costs about
-60 us in Python, more than a round of RRT's other work. ``RandomStreams`` computes the same four
-64-bit seed words with a compiled copy of numpy's ``SeedSequence`` algorithm (``_seed_words``:
-entropy pool mixing, then ``generate_state(4, uint64)``, as numpy's ``bit_generator.pyx``), for
-many keys in one call, and hands them to ``PCG64`` through a fixed-words seed sequence
-(``_SeedWords``). The generators are therefore bit for bit the ones ``np.random.default_rng(
-SeedSequence(entropy, spawn_key=key))`` gives (tested against numpy on many keys), at about
-3 us each.
+Speed. Building ``SeedSequence(entropy, spawn_key=key)`` and seeding ``PCG64`` from it in Python
+costs more than the rest of an RRT round. ``RandomStreams`` computes the same four 64-bit seed
+words with a compiled copy of numpy's ``SeedSequence`` algorithm (``_seed_words``: entropy pool
+mixing, then ``generate_state(4, uint64)``, as numpy's ``bit_generator.pyx``), for many keys in
+one call, and hands them to ``PCG64`` through a fixed-words seed sequence (``_SeedWords``). The
+generators are therefore bit for bit the ones ``np.random.default_rng(SeedSequence(entropy,
+spawn_key=key))`` gives (tested against numpy on many keys).
 """
 
 from __future__ import annotations

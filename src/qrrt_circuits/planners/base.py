@@ -87,8 +87,55 @@ def resolve_predicate(env: Environment, predicate: ReachabilityPredicate | None,
 
 
 class Planner:
-    """Base planner: checks the problem, runs rounds until the goal or the termination condition,
-    and reports. Subclasses define ``_round`` (one round of Alg. 1 / Alg. 2) and their settings."""
+    """Base class of the planners: checks the problem, runs rounds until the goal or the
+    termination condition, and reports.
+
+    Subclasses define one round (``_round``: the paper's Alg. 1-3; ``ParallelRRT`` records its
+    rounds in batches, ``_run``) and their own settings. ``RRT``, ``ParallelRRT``, ``QRRT`` and
+    ``PQRRT`` document only their own arguments; the ones they share are documented here, once.
+
+    Arguments every planner takes (all keyword-only after ``env``):
+
+    Args:
+        env: The ``Environment``: workspace bounds, obstacles and the default start, goal and goal
+            radius.
+        predicate: The ``ReachabilityPredicate`` that decides whether a child is reachable from its
+            parent (its ``dim`` must equal ``env.dim``). Default: the sound ``ReachabilityOracle``
+            of ``env`` built with ``dynamics`` and ``resolution``.
+        dynamics: A ``LinearTrackingDynamics`` (same ``dim`` as ``env``) for the default predicate;
+            give it only without ``predicate`` (a predicate carries its own motion model). Default:
+            ``LinearTrackingDynamics.paper()``.
+        oracle_errors: An ``OracleErrorModel`` that corrupts the answers the algorithm sees (false
+            positives and negatives): the reachability tests of the classical planners, the marks
+            of the phase oracle of the quantum planners; or None (default) for exact answers. No
+            wrong answer adds a node: a classical planner verifies a positive answer with the true
+            predicate (one more verification call) before it adds the node, and a quantum
+            planner's finalizer verifies every measured entry, so an error costs oracle calls only.
+        goal_bias: Probability in [0, 1) that a sample is drawn in the goal ball instead of
+            uniformly in the workspace. Default 0 (the paper's uniform sampling).
+        resolution: Clearance of the default ``ReachabilityOracle`` in length units (> 0, finite;
+            default 0.01): a free trajectory is accepted if it passes farther than (1 + sqrt(d)) *
+            resolution from every obstacle and 2 * resolution from the workspace boundary. Unused
+            when ``predicate`` is given.
+        seed: Non-negative integer seed of the keyed random streams (one generator per (round,
+            worker, stream), so results do not depend on the executor or the order of the calls), or
+            None (default) for fresh entropy.
+        executor: ``ParallelRRT`` and ``PQRRT`` only: a ``concurrent.futures.Executor`` that runs
+            the workers' tasks (a ``ParallelRRT`` worker's reachability test, a ``PQRRT``
+            database's search), or None (default) to run them in-process, with the same results.
+            Not pickled with the planner.
+        oracle: Deprecated alias of ``predicate``.
+
+    Raises:
+        TypeError: ``env`` not an ``Environment``, a non-integer ``seed``, a non-real
+            ``goal_bias`` or ``resolution``, ``dynamics`` or ``oracle_errors`` of the wrong class,
+            or a ``predicate`` that lacks the members of the ``ReachabilityPredicate`` protocol.
+        ValueError: ``goal_bias`` outside [0, 1), a negative ``seed``, a dimension mismatch
+            between ``env`` and ``predicate`` or ``dynamics``, both ``predicate`` and ``oracle``
+            (or both ``predicate`` and ``dynamics``) given, or, for the default predicate, a
+            ``resolution`` that is not finite and > 0 or one too fine for the workspace
+            (``ReachabilityOracle``).
+    """
 
     name = "planner"
 
@@ -166,8 +213,10 @@ class Planner:
         termination: TerminationCondition | None = None,
     ) -> PlanResult:
         """Grow a tree from ``start`` until a node lands within ``goal_radius`` of ``goal`` or the
-        termination condition ends the plan (paper Alg. 1 for RRT, Alg. 2 for q-RRT, Alg. 3 for
-        Pq-RRT; Alg. 4 with an annealing schedule).
+        termination condition ends the plan.
+
+        The paper's Alg. 1 for RRT, Alg. 2 for q-RRT, Alg. 3 for Pq-RRT; Alg. 4 with an annealing
+        schedule.
 
         The ``max_*`` and ``stall_rounds`` keywords are shorthands for the conditions of
         ``qrrt_circuits.planners.termination``; they combine (any of them ends the plan) with
@@ -296,8 +345,8 @@ class Planner:
         """Subclasses validate their own settings before any work."""
 
     def _max_new_nodes_per_round(self) -> int:
-        """The most nodes one round can add (1 here; p for p workers): a bound that the memory check
-        (``memory.PlanSize``) and the skipped termination checks (``_run``) rely on."""
+        """The most nodes one round can add (1 here; p for p workers): the bound the memory check
+        (``memory.PlanSize``) sizes the tree by."""
         return 1
 
     def _round_memory(self) -> tuple[Callable[[int], MemoryEstimate] | None, int]:

@@ -12,10 +12,11 @@ worker), and the tree cannot change until a round adds a node, so the planners d
 of the next B rounds at once (``randomness.uniform_draws``), find their nearest nodes in one query
 and test all B x p pairs together. The rounds are then recorded one by one (the termination
 condition checked before each, counters, history, error flips), up to and including the first round
-that adds a node; the later rounds' candidates were drawn against a tree that no longer exists, so
-their tests are counted in ``Metrics.wasted_checks``, never as oracle calls, and those rounds are
-drawn again. The tree, the counters and the status are those of one round at a time. B is the
-expected number of rounds up to the next success, ceil(1 / rate) with the Laplace estimate
+that adds a node. The later rounds' tests were made against the tree without that node, so they
+are counted in ``Metrics.wasted_checks``, never as oracle calls, and those rounds are tested again
+in the next batch (the same candidates, from the same keys, with their nearest nodes in the new
+tree). The tree, the counters and the status are those of one round at a time. B is the expected
+number of rounds up to the next success, ceil(1 / rate) with the Laplace estimate
 rate = (rounds that added + 1) / (rounds recorded + 2), at most ``MAX_BATCH_ROUNDS`` and at most
 ``batch_round_limit(workers, d)`` (a batch's candidates take at most ``MAX_BATCH_BYTES``). On an
 ``executor`` B = 1 and each worker's test is one task.
@@ -46,14 +47,12 @@ MAX_WORKERS = 4096
 #: the most rounds one batch tests ahead
 MAX_BATCH_ROUNDS = 256
 #: the most memory one batch's candidates may take (at least one round is tested whatever its size):
-#: with 4 096 workers, 256 rounds ahead are a million candidates: about 272 MiB at d = 6 and 2.6 GiB
-#: at d = 64 at the bytes per candidate measured below, more than the plan's own limits allow for
+#: with 4 096 workers, 256 rounds ahead are a million candidates, about 350 MiB at d = 6 and 3 GiB
+#: at d = 64 at the bytes per candidate below, more than the plan's own limits allow for
 MAX_BATCH_BYTES = 64 << 20
-#: a batch's bytes per candidate: its keys, the candidate and its parent's position, the parent
-#: index, the answers and the predicate's scratch. ``python benchmarks/bench_memory.py
-#: --only-plan-limits`` (``plan-batch`` cases, a predicate that rejects everything) measured 123,
-#: 272 and 2 630 B per candidate at d = 2, 6 and 64 (about 30 + 40 d); the constants, 64 + 48 d,
-#: are 1.2-1.3 times that
+#: a batch's bytes per candidate, 64 + 48 d: its keys, the candidate and its parent's position, the
+#: parent index, the answers and the predicate's scratch (a calibrated upper bound of the measured
+#: peak of a batch whose predicate rejects everything)
 BATCH_BYTES_PER_CANDIDATE = 64
 BATCH_BYTES_PER_COORDINATE = 48
 
@@ -95,43 +94,18 @@ class ParallelRRT(Planner):
     call, counted as a ``verification_call`` (DESIGN §2); a round's critical path is 1 call (2 with
     ``oracle_errors``). ``RRT`` is the case p = 1.
 
+    The arguments every planner takes (``env``, ``predicate``, ``dynamics``, ``oracle_errors``,
+    ``goal_bias``, ``resolution``, ``seed``, ``executor`` and the deprecated ``oracle``) are
+    documented on ``Planner``. Without an ``executor`` the rounds are tested in batches (module
+    docstring); with one, each worker's test is one task.
+
     Args:
-        env: The ``Environment``: workspace bounds, obstacles and the default start, goal and goal
-            radius.
         workers: Number p of workers, i.e. extensions per round, in [1, ``MAX_WORKERS``] (4096).
             Default 8.
-        predicate: The ``ReachabilityPredicate`` that decides whether a child is reachable from its
-            parent (its ``dim`` must equal ``env.dim``). Default: the sound ``ReachabilityOracle``
-            of ``env`` built with ``dynamics`` and ``resolution``.
-        dynamics: A ``LinearTrackingDynamics`` (same ``dim`` as ``env``) for the default predicate;
-            give it only without ``predicate`` (a predicate carries its own motion model). Default:
-            ``LinearTrackingDynamics.paper()``.
-        oracle_errors: An ``OracleErrorModel`` that corrupts the reachability answers (false
-            positives and negatives), or None (default) for exact answers. A positive answer is
-            verified with the true predicate (one more verification call) before the node is added.
-        goal_bias: Probability in [0, 1) that a sample is drawn in the goal ball instead of
-            uniformly in the workspace. Default 0 (the paper's uniform sampling).
-        resolution: Clearance of the default ``ReachabilityOracle`` in length units (> 0, finite;
-            default 0.01): a free trajectory is accepted if it passes farther than (1 + sqrt(d)) *
-            resolution from every obstacle and 2 * resolution from the workspace boundary. Unused
-            when ``predicate`` is given.
-        executor: A ``concurrent.futures.Executor`` that runs the workers' extensions (one task per
-            worker per round), or None (default) to run them in-process in batches of rounds, with
-            the same results. Not pickled with the planner.
-        seed: Non-negative integer seed of the keyed random streams (one generator per (round,
-            worker, stream), so results do not depend on the executor or the order of the calls), or
-            None (default) for fresh entropy.
-        oracle: Deprecated alias of ``predicate``.
 
     Raises:
-        TypeError: An argument of the wrong type: ``env`` not an ``Environment``, a non-integer
-            ``workers`` or ``seed``, a non-real ``goal_bias`` or ``resolution``, ``dynamics`` or
-            ``oracle_errors`` of the wrong class, or a ``predicate`` that lacks the members of the
-            ``ReachabilityPredicate`` protocol.
-        ValueError: ``workers`` outside [1, 4096], ``goal_bias`` outside [0, 1), a non-positive or
-            non-finite ``resolution``, a negative ``seed``, a dimension mismatch between ``env`` and
-            ``predicate`` or ``dynamics``, both ``predicate`` and ``oracle`` (or both ``predicate``
-            and ``dynamics``) given.
+        TypeError: A non-integer ``workers``, or an argument ``Planner`` refuses.
+        ValueError: ``workers`` outside [1, 4096], or an argument ``Planner`` refuses.
     """
 
     name = "ParallelRRT"
@@ -158,7 +132,7 @@ class ParallelRRT(Planner):
     def _run(self, state: RunState, condition: TerminationCondition, began: float) -> PlanStatus:
         """Rounds in batches: the candidates of the next B rounds drawn and tested together, then
         recorded round by round (the condition checked before each) up to the first round that adds
-        a node; the later rounds' tests are ``wasted_checks`` and those rounds are drawn again. B is
+        a node; the later rounds' tests are ``wasted_checks`` and those rounds are tested again. B is
         ``batch_rounds`` (at most ``batch_round_limit``) in-process, 1 on an executor."""
         workers = self.workers
         changed = recorded = 0
@@ -253,43 +227,14 @@ class ParallelRRT(Planner):
 
 
 class RRT(ParallelRRT):
-    """Classical RRT (paper Alg. 1): one sample, nearest node and reachability test per round.
+    """Classical RRT (paper Algorithm 1): one sample, nearest node and reachability test per round.
 
     ``ParallelRRT`` with one worker and no executor. Each reachability test is one oracle call,
     counted as a ``verification_call`` (DESIGN §2).
 
-    Args:
-        env: The ``Environment``: workspace bounds, obstacles and the default start, goal and goal
-            radius.
-        predicate: The ``ReachabilityPredicate`` that decides whether a child is reachable from its
-            parent (its ``dim`` must equal ``env.dim``). Default: the sound ``ReachabilityOracle``
-            of ``env`` built with ``dynamics`` and ``resolution``.
-        dynamics: A ``LinearTrackingDynamics`` (same ``dim`` as ``env``) for the default predicate;
-            give it only without ``predicate`` (a predicate carries its own motion model). Default:
-            ``LinearTrackingDynamics.paper()``.
-        oracle_errors: An ``OracleErrorModel`` that corrupts the reachability answers (false
-            positives and negatives), or None (default) for exact answers. A positive answer is
-            verified with the true predicate (one more verification call) before the node is added.
-        goal_bias: Probability in [0, 1) that a sample is drawn in the goal ball instead of
-            uniformly in the workspace. Default 0 (the paper's uniform sampling).
-        resolution: Clearance of the default ``ReachabilityOracle`` in length units (> 0, finite;
-            default 0.01): a free trajectory is accepted if it passes farther than (1 + sqrt(d)) *
-            resolution from every obstacle and 2 * resolution from the workspace boundary. Unused
-            when ``predicate`` is given.
-        seed: Non-negative integer seed of the keyed random streams (one generator per (round,
-            worker, stream), so results do not depend on the executor or the order of the calls), or
-            None (default) for fresh entropy.
-        oracle: Deprecated alias of ``predicate``.
-
-    Raises:
-        TypeError: An argument of the wrong type: ``env`` not an ``Environment``, a non-integer
-            ``seed``, a non-real ``goal_bias`` or ``resolution``, ``dynamics`` or ``oracle_errors``
-            of the wrong class, or a ``predicate`` that lacks the members of the
-            ``ReachabilityPredicate`` protocol.
-        ValueError: ``goal_bias`` outside [0, 1), a non-positive or non-finite ``resolution``, a
-            negative ``seed``, a dimension mismatch between ``env`` and ``predicate`` or
-            ``dynamics``, both ``predicate`` and ``oracle`` (or both ``predicate`` and ``dynamics``)
-            given.
+    RRT has no arguments of its own: the arguments every planner takes (``env``, ``predicate``,
+    ``dynamics``, ``oracle_errors``, ``goal_bias``, ``resolution``, ``seed`` and the deprecated
+    ``oracle``; not ``executor``) are documented on ``Planner``, with what they raise.
     """
 
     name = "RRT"

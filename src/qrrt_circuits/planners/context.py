@@ -4,10 +4,11 @@
 model, the backend, the annealing schedule, the random streams). It is built once per plan and
 pickled once: every task carries the same bytes, and a worker process unpickles them only the
 first time it sees that plan (a small per-process cache keyed by a random token). ``RoundView``
-what one round adds (a snapshot of the tree, the goal, the round and temperature indices, the search policy's
-state). ``map_tasks`` runs one worker function over a round's tasks, serially or on any
-``concurrent.futures.Executor`` (threads, processes, Dask), in task order, so results never depend
-on the executor: every task draws its randomness from streams keyed by (round, worker).
+holds what one round adds (a snapshot of the tree, the goal, the round and temperature indices,
+the search policy's state). ``map_tasks`` runs one worker function over a round's tasks, serially
+or on any ``concurrent.futures.Executor`` (threads, processes, Dask), in task order, so results
+never depend on the executor: every task draws its randomness from streams keyed by (round,
+worker).
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
-"""Candidate generation: the database of (sample, nearest parent) pairs (Alg. 1, lines 4-8) and
-Quantum Database Annealing (Alg. 4).
+"""Candidate generation: the database of (sample, nearest parent) pairs (paper Algorithm 1, lines
+4-8) and Quantum Database Annealing (Algorithm 4).
 
 ``build_database`` draws 2^n samples,
 uniform over the workspace (a fraction ``goal_bias`` uniform in the goal ball instead), and pairs
@@ -35,7 +35,7 @@ def _check_bands(bands: Any) -> tuple[tuple[float, float], ...]:
 
 @dataclass(frozen=True)
 class AnnealingSchedule:
-    """Quantum Database Annealing (Alg. 4): the temperature array H as distance bands.
+    """Quantum Database Annealing (paper Algorithm 4): the temperature array H as distance bands.
 
     Band i = (r_min, r_max) is in force while ``switch_at[i-1] <= h < switch_at[i]``; the last band
     stays in force. The temperature index h (Alg. 4's ``h``) counts databases built
@@ -107,7 +107,7 @@ class AnnealingSchedule:
         return cls(bands=((2.7, 4.2), (0.8, 2.0)), switch_at=(switch_at,))
 
     def temperature_index(self, databases: int, nodes: int) -> int:
-        """Alg. 4's h: databases built so far or nodes in the tree, per ``counter``.
+        """The temperature index h of paper Algorithm 4 (databases built or tree nodes, per ``counter``).
 
         Args:
             databases: Databases built so far.
@@ -162,7 +162,9 @@ def build_database(
     annealing: AnnealingSchedule | None = None,
     temperature_index: int = 0,
 ) -> Database:
-    """Alg. 1 lines 4-8 (and Alg. 4 line 7 with ``annealing``).
+    """Build one database: ``size`` samples, each paired with its nearest tree node.
+
+    Paper Algorithm 1, lines 4-8 (and Algorithm 4, line 7, with ``annealing``).
 
     Args:
         tree: The ``Tree`` whose nearest nodes become the parents.

@@ -1,4 +1,4 @@
-"""q-RRT and Pq-RRT (paper Alg. 2 and 3; Quantum Database Annealing, Alg. 4).
+"""q-RRT and Pq-RRT (paper Algorithms 2 and 3), with Quantum Database Annealing (Algorithm 4).
 
 One round of q-RRT: build a database of 2^n (sample, nearest parent) pairs, evaluate the predicate
 on all of them to build the phase oracle (``simulation_checks``; with an ``OracleErrorModel`` the
@@ -48,7 +48,7 @@ ORACLE_LOOKUP_LABEL = (
 
 
 class PQRRT(Planner):
-    """Parallel q-RRT (paper Alg. 3) with ``workers`` quantum workers on a shared or unshared database.
+    """Parallel q-RRT (paper Algorithm 3) with ``workers`` quantum workers on a shared or unshared database.
 
     Each round builds 2^n (sample, nearest parent) databases, marks their reachable entries in a
     phase oracle, lets every worker run Grover search as ``search_policy`` decides, measure and
@@ -57,9 +57,12 @@ class PQRRT(Planner):
     phase oracle in simulation is reported as ``simulation_checks``. With ``annealing`` this is
     Quantum Database Annealing (Alg. 4). ``QRRT`` is the case p = 1 (Alg. 2).
 
+    The arguments every planner takes (``env``, ``predicate``, ``dynamics``, ``oracle_errors``,
+    ``goal_bias``, ``resolution``, ``seed``, ``executor`` and the deprecated ``oracle``) are
+    documented on ``Planner``. On an ``executor`` each database's search is one task; without one
+    the round's databases are searched in turn, with the same results.
+
     Args:
-        env: The ``Environment``: workspace bounds, obstacles and the default start, goal and goal
-            radius.
         backend: The ``QuantumSearchBackend`` that simulates each Grover search (its ``max_qubits``
             must allow ``num_qubits``). Default: a new ``AerBackend()`` (qiskit-aer statevector
             sampling).
@@ -79,43 +82,16 @@ class PQRRT(Planner):
         annealing: An ``AnnealingSchedule`` for Quantum Database Annealing (Alg. 4: samples are
             drawn in distance bands around the tree that shrink with the temperature index h), or
             None (default) for uniform databases.
-        predicate: The ``ReachabilityPredicate`` that decides whether a child is reachable from its
-            parent (its ``dim`` must equal ``env.dim``). Default: the sound ``ReachabilityOracle``
-            of ``env`` built with ``dynamics`` and ``resolution``.
-        dynamics: A ``LinearTrackingDynamics`` (same ``dim`` as ``env``) for the default predicate;
-            give it only without ``predicate`` (a predicate carries its own motion model). Default:
-            ``LinearTrackingDynamics.paper()``.
-        oracle_errors: An ``OracleErrorModel`` that corrupts the marks of the phase oracle (false
-            positives and negatives), or None (default) for exact marks. The finalizer verifies
-            every measured entry with the true predicate, so a wrong mark costs oracle calls, never
-            a bad node.
-        goal_bias: Probability in [0, 1) that a sample is drawn in the goal ball instead of
-            uniformly in the workspace. Default 0 (the paper's uniform sampling).
-        resolution: Clearance of the default ``ReachabilityOracle`` in length units (> 0, finite;
-            default 0.01): a free trajectory is accepted if it passes farther than (1 + sqrt(d)) *
-            resolution from every obstacle and 2 * resolution from the workspace boundary. Unused
-            when ``predicate`` is given.
-        executor: A ``concurrent.futures.Executor`` that runs the workers' database searches (one
-            task per database), or None (default) to hand a round's searches to the backend
-            together, with the same results. Not pickled with the planner.
-        seed: Non-negative integer seed of the keyed random streams (one generator per (round,
-            worker, stream), so results do not depend on the executor or the order of the calls), or
-            None (default) for fresh entropy.
-        oracle: Deprecated alias of ``predicate``.
         iterations: Deprecated alias of ``search_policy``.
 
     Raises:
-        TypeError: An argument of the wrong type: ``env`` not an ``Environment``, a non-integer
-            ``num_qubits``, ``workers`` or ``seed``, a non-real ``goal_bias`` or ``resolution``,
-            ``dynamics`` or ``oracle_errors`` of the wrong class, a ``backend`` that is not a
+        TypeError: A non-integer ``num_qubits`` or ``workers``, a ``backend`` that is not a
             ``QuantumSearchBackend``, a ``search_policy`` that is not an ``IterationPolicy``, an
             ``annealing`` that is not an ``AnnealingSchedule``, a non-bool ``shared_database``, or
-            a ``predicate`` that lacks the members of the ``ReachabilityPredicate`` protocol.
+            an argument ``Planner`` refuses.
         ValueError: ``num_qubits`` < 1 or above the backend's ``max_qubits``, ``workers`` outside
-            [1, 4096], ``goal_bias`` outside [0, 1), a non-positive or non-finite ``resolution``, a
-            negative ``seed``, a dimension mismatch between ``env`` and ``predicate`` or
-            ``dynamics``, both ``predicate`` and ``oracle`` (or both ``predicate`` and ``dynamics``)
-            given, or both ``search_policy`` and ``iterations`` given.
+            [1, 4096], both ``search_policy`` and ``iterations`` given, or an argument ``Planner``
+            refuses.
     """
 
     name = "PQRRT"
@@ -290,64 +266,28 @@ class PQRRT(Planner):
 
 
 class QRRT(PQRRT):
-    """q-RRT (paper Alg. 2): one database, one search and one measurement per round.
+    """q-RRT (paper Algorithm 2): one database, one search and one measurement per round.
 
     ``PQRRT`` with one worker on a shared database and no executor. Per round: build 2^n (sample,
     nearest parent) pairs, mark the reachable ones in the phase oracle, run Grover search as
     ``search_policy`` decides, measure, verify classically (1 oracle call) and add the entry if it
     verifies. With ``annealing`` this is Quantum Database Annealing (Alg. 4).
 
+    The arguments every planner takes (``env``, ``predicate``, ``dynamics``, ``oracle_errors``,
+    ``goal_bias``, ``resolution``, ``seed`` and the deprecated ``oracle``; not ``executor``) are
+    documented on ``Planner``; the others are ``PQRRT``'s, with the same meaning and defaults.
+
     Args:
-        env: The ``Environment``: workspace bounds, obstacles and the default start, goal and goal
-            radius.
-        backend: The ``QuantumSearchBackend`` that simulates each Grover search (its ``max_qubits``
-            must allow ``num_qubits``). Default: a new ``AerBackend()`` (qiskit-aer statevector
-            sampling).
-        num_qubits: Qubits n per database, so each database holds N = 2^n (sample, nearest parent)
-            entries; an integer >= 1 and at most the backend's ``max_qubits``. ``plan`` refuses
-            an n whose round, with the tree, does not fit in the available memory. Default 8.
-        search_policy: The ``IterationPolicy`` that decides how each worker searches a database:
-            ``PaperSchedule()`` (the default: 5 Grover iterations, 3 once the tree has more than 10
-            nodes), ``FixedIterations(k)``, ``KnownOptimal()`` (Eq. 1 with the true m), ``BBHT()``,
-            ``Adaptive()``, ``FixedPointAmplification()``, ``EstimatedOptimal()`` or any other
-            ``IterationPolicy``.
-        annealing: An ``AnnealingSchedule`` for Quantum Database Annealing (Alg. 4: samples are
-            drawn in distance bands around the tree that shrink with the temperature index h), or
-            None (default) for uniform databases.
-        predicate: The ``ReachabilityPredicate`` that decides whether a child is reachable from its
-            parent (its ``dim`` must equal ``env.dim``). Default: the sound ``ReachabilityOracle``
-            of ``env`` built with ``dynamics`` and ``resolution``.
-        dynamics: A ``LinearTrackingDynamics`` (same ``dim`` as ``env``) for the default predicate;
-            give it only without ``predicate`` (a predicate carries its own motion model). Default:
-            ``LinearTrackingDynamics.paper()``.
-        oracle_errors: An ``OracleErrorModel`` that corrupts the marks of the phase oracle (false
-            positives and negatives), or None (default) for exact marks. The finalizer verifies
-            every measured entry with the true predicate, so a wrong mark costs oracle calls, never
-            a bad node.
-        goal_bias: Probability in [0, 1) that a sample is drawn in the goal ball instead of
-            uniformly in the workspace. Default 0 (the paper's uniform sampling).
-        resolution: Clearance of the default ``ReachabilityOracle`` in length units (> 0, finite;
-            default 0.01): a free trajectory is accepted if it passes farther than (1 + sqrt(d)) *
-            resolution from every obstacle and 2 * resolution from the workspace boundary. Unused
-            when ``predicate`` is given.
-        seed: Non-negative integer seed of the keyed random streams (one generator per (round,
-            worker, stream), so results do not depend on the executor or the order of the calls), or
-            None (default) for fresh entropy.
-        oracle: Deprecated alias of ``predicate``.
+        backend: The ``QuantumSearchBackend`` of the searches. Default: a new ``AerBackend()``.
+        num_qubits: Qubits n per database (N = 2^n entries), 1 .. the backend's ``max_qubits``.
+            Default 8.
+        search_policy: The ``IterationPolicy`` of the searches. Default: ``PaperSchedule()``.
+        annealing: An ``AnnealingSchedule`` (Quantum Database Annealing), or None (default).
         iterations: Deprecated alias of ``search_policy``.
 
     Raises:
-        TypeError: An argument of the wrong type: ``env`` not an ``Environment``, a non-integer
-            ``num_qubits`` or ``seed``, a non-real ``goal_bias`` or ``resolution``, ``dynamics`` or
-            ``oracle_errors`` of the wrong class, a ``backend`` that is not a
-            ``QuantumSearchBackend``, a ``search_policy`` that is not an ``IterationPolicy``, an
-            ``annealing`` that is not an ``AnnealingSchedule``, or a
-            ``predicate`` that lacks the members of the ``ReachabilityPredicate`` protocol.
-        ValueError: ``num_qubits`` < 1 or above the backend's ``max_qubits``, ``goal_bias`` outside
-            [0, 1), a non-positive or non-finite ``resolution``, a negative ``seed``, a dimension
-            mismatch between ``env`` and ``predicate`` or ``dynamics``, both ``predicate`` and
-            ``oracle`` (or both ``predicate`` and ``dynamics``) given, or both ``search_policy``
-            and ``iterations`` given.
+        TypeError: An argument of the wrong type, as for ``PQRRT``.
+        ValueError: An argument out of range, as for ``PQRRT``.
     """
 
     name = "QRRT"

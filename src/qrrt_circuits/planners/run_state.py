@@ -19,14 +19,14 @@ HISTORY_KEYS = ("oracle_calls", "critical_path", "nodes", "entries", "reachable"
 
 @njit(cache=True, nogil=True)
 def first_in_ball(points: np.ndarray, centre: np.ndarray, radius: float) -> int:
-    """The first row of ``points`` within ``radius`` of ``centre``, or -1 (the goal test of every
-    planner, Alg. 1-4: a node reaches the goal if it lies in the closed goal ball).
+    """The first row of ``points`` within ``radius`` of ``centre``, or -1: the goal test of every
+    planner (paper Algorithms 1-4), a node reaching the goal if it lies in the closed goal ball.
 
     The distance is sqrt(sum over the axes, in order, of (x_i - c_i)^2), each operation rounded
-    once: the same on every machine, where ``np.linalg.norm(x - c)`` (0.1's test) takes its dot
-    product from the BLAS, whose kernels may fuse a multiply and an add (they do on this project's
-    machine), so a node within a rounding error of the goal radius could count as in or out
-    depending on the machine."""
+    once, so the answer is the same on every machine. ``np.linalg.norm(x - c)`` would take its dot
+    product from the BLAS, whose kernels may fuse a multiply and an add depending on the machine,
+    so a node within a rounding error of the goal radius could count as in on one machine and out
+    on another."""
     for row in range(points.shape[0]):
         squared = 0.0
         for axis in range(points.shape[1]):

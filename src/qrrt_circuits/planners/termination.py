@@ -13,7 +13,7 @@ Every plan terminates: ``Planner.plan`` always adds ``MaxRounds(DEFAULT_MAX_ROUN
 condition it is given already limits rounds, and ``Stall(DEFAULT_STALL_ROUNDS)`` unless it already
 has a stall condition, so a plan that can add no node (a start boxed in) ends as ``"stalled"``.
 It also adds ``MaxNodes(DEFAULT_MAX_NODES)`` unless the condition limits nodes, so no plan's tree
-outgrows memory (``memory.check_plan_fits`` checks the limits in force before the first round).
+outgrows memory (``memory.PlanSize.check`` checks the limits in force before the first round).
 """
 
 from __future__ import annotations
@@ -30,17 +30,15 @@ from .._support.validation import check_int, check_positive_float
 #: the round limit in force whenever the caller gives none
 DEFAULT_MAX_ROUNDS = 20000
 #: consecutive rounds without a new node that end a plan whenever the caller gives no stall limit.
-#: Large enough never to cut a plan that is still growing in our experiments: at the smallest
-#: per-round success rate measured there (RRT, about 0.7 % in 1000-box worlds) 5000 failures in a
-#: row have probability 0.993^5000 < 1e-15.
+#: Large enough not to cut a plan that is still growing: at a per-round success rate of 0.7 % (RRT
+#: in 1000-box worlds, the lowest of the library's experiments) 5000 failures in a row have
+#: probability 0.993^5000 < 1e-15.
 DEFAULT_STALL_ROUNDS = 5000
 #: the node limit in force whenever the caller gives none. Without it the round limit alone bounds
-#: the tree: 4 096 parallel-RRT workers filling a world whose goal is walled in add about 3 900
-#: nodes a round (``python benchmarks/bench_memory.py --only-plan-limits``), so 20 000 rounds would
-#: make about 80 million nodes (about 9-9.4 GiB at the 122-126 bytes per node measured there, and
-#: about 1.2 h at the rate measured there, 600 000 nodes in 33 s, if it stays linear).
-#: A million nodes is about 120 MiB there, and far beyond any tree of the paper's experiments
-#: (thousands of nodes).
+#: the tree: a round of 4 096 parallel-RRT workers adds up to 4 096 nodes, so 20 000 rounds of a
+#: plan whose goal is walled in could make about 80 million nodes (about 14 GiB at d = 2 by the
+#: memory guard's estimate, ``memory.plan_bytes``). A million nodes take about 180 MiB by that
+#: estimate, far beyond any tree of the paper's experiments (thousands of nodes).
 DEFAULT_MAX_NODES = 1_000_000
 
 
@@ -468,7 +466,7 @@ class LimitsInForce:
 
 def limits_in_force(given: TerminationCondition | None) -> LimitsInForce:
     """The ``LimitsInForce`` of a plan given ``given`` (None: no condition): what ``Planner.plan``
-    checks against the available memory (``memory.check_plan_fits``) before its first round.
+    checks against the available memory (``memory.PlanSize.check``) before its first round.
 
     Example:
         >>> from qrrt_circuits.planners.termination import MaxNodes, limits_in_force

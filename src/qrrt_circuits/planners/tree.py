@@ -16,8 +16,8 @@ Yao 1980). When the nodes added since the build reach that limit the grid is reb
 O(sqrt N) amortized per node). A query therefore costs about the nodes of a few cells plus the
 recent nodes, however large the tree. It answers what a brute-force search does, ties and
 rounding-level near-ties included: the stopping bound allows for the rounding of a node's cell
-(tested on adversarial cell-edge cases). ``benchmarks/bench_nearest.py`` times both searches and
-placed ``BRUTE_FORCE_BELOW``.
+(tested on adversarial cell-edge cases). ``BRUTE_FORCE_BELOW`` is calibrated: the tree size from
+which the grid search costs less than brute force.
 """
 
 from __future__ import annotations
@@ -184,8 +184,9 @@ class Tree:
                 self._origin, self._cell, self._shape, self._low, self._high)
 
     def grid_nearest(self, points: np.ndarray) -> np.ndarray:
-        """``nearest`` through the grid whatever the tree's size (for tests and benchmarks): the
-        same argument (float points, (M, d) or (d,)), result (int (M,) node indices) and errors."""
+        """``nearest`` through the grid whatever the tree's size (for tests, and for comparing the
+        two searches): the same argument (float points, (M, d) or (d,)), result (int (M,) node
+        indices) and errors."""
         points = self._queries(points)
         if not self._grid_built_at:  # a small tree's first grid query builds the grid, once
             with _FIRST_GRID:
@@ -203,7 +204,7 @@ class Tree:
 
     def _build_grid(self) -> None:
         nodes = self.nodes
-        low, high = _bounding_box(nodes)  # (numpy's min and max took 155 us at 3 000 nodes: bench_round_parts.py)
+        low, high = _bounding_box(nodes)  # (one compiled pass for both, not numpy's min and max)
         extent = np.maximum(high - low, 1e-9)
         cells = min(max(1.0, _CELLS_PER_NODE * self.size), _MAX_CELLS)
         cell = float(np.prod(extent) / cells) ** (1.0 / self.dim)
@@ -211,8 +212,8 @@ class Tree:
         shape = np.minimum(np.floor(extent / cell).astype(np.int64) + 1, 1 << 20)
         # the most cells: _MAX_CELLS; or one cell (a scan of every node, as brute force) where a
         # query's first visit, the block of 3^d cells around its own, would exceed the node count
-        # (high d: at d = 20 every axis got 2 cells and a query visited all 2^20). Products in
-        # Python integers: in int64, 2^64 wrapped to 0 and the grid was filed out of bounds.
+        # (high d: at d = 20, 2 cells per axis would make a query visit all 2^20). Products in
+        # Python integers: in int64, 2^64 wraps to 0 and the grid would be filed out of bounds.
         most = 1 if 3 ** self.dim > self.size else _MAX_CELLS
         while math.prod(int(count) for count in shape) > most:  # a very flat box, or high d: coarser cells
             cell *= 2.0
@@ -380,7 +381,7 @@ def _grid_search(points: np.ndarray, start: np.ndarray, order: np.ndarray, order
                         if cell_last < 0 or cell_last > shape[last] - 1:
                             continue
                         first, stop = start[prefix + cell_last], start[prefix + cell_last + 1]
-                    for slot in range(first, stop):  # the scan written out (an inlined helper was slower)
+                    for slot in range(first, stop):  # the scan written out (an inlined helper is slower)
                         squared = 0.0
                         for axis in range(dim):
                             delta = point[axis] - ordered[slot, axis]

@@ -24,7 +24,7 @@ from .database import Database, stream_database
 
 def check_extensions(context: WorkerContext, view: RoundView, pairs: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
     """The plan's predicate on (parent positions (M, d), children (M, d)): the reachability tests
-    of classical extensions (Alg. 1 line 7) handed to a worker."""
+    of classical extensions (paper Algorithm 1, line 7) handed to a worker."""
     origins, children = pairs
     return context.predicate.reachable(origins, children)
 
@@ -88,7 +88,8 @@ def database_outcome(children: np.ndarray, parents: np.ndarray, truth: np.ndarra
 
 
 def make_database(context: WorkerContext, view: RoundView, worker: int) -> tuple[Database, np.ndarray, np.ndarray]:
-    """Alg. 1 lines 4-8: the database, the true predicate on it, and the oracle's marks."""
+    """The database of paper Algorithm 1, lines 4-8, the true predicate on it, and the oracle's
+    marks."""
     db = stream_database(view.tree, context.database_size, context.env, context.streams, view.round_index,
                          worker, view.goal, view.goal_radius, context.goal_bias, context.annealing,
                          view.temperature_index)

@@ -151,8 +151,7 @@ def as_pairs(parents: np.ndarray, children: np.ndarray, dim: int) -> tuple[np.nd
 @njit(cache=True, nogil=True)
 def _all_finite(points: np.ndarray) -> bool:
     """Whether every coordinate of the C-contiguous float (M, d) ``points`` is finite (compiled:
-    ``np.all(np.isfinite(...))`` on both arrays took 4.9 us for 256 pairs, ``as_pairs`` now 1.5 in
-    all: ``benchmarks/bench_round_parts.py``)."""
+    one pass, no temporary array, unlike ``np.all(np.isfinite(points))``)."""
     for row in range(points.shape[0]):
         for axis in range(points.shape[1]):
             if not np.isfinite(points[row, axis]):

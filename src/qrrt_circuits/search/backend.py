@@ -133,10 +133,10 @@ class QuantumSearchBackend(abc.ABC):
         return self._run_prepared(self._prepare(SearchRequest(marks, iterations, shots, seed)))
 
     def search_many(self, requests: Sequence[SearchRequest]) -> tuple[SearchResult, ...]:
-        """Independent searches (the p databases of one unshared Pq-RRT round): result i is exactly
-        what ``search(marks, iterations, shots, seed)`` of request i returns when the requests are
-        searched one after the other (same seeds, same measured indices). Every request is
-        validated before any work. A backend may override this to run them together.
+        """Independent searches: result i is exactly what ``search(marks, iterations, shots,
+        seed)`` of request i returns when the requests are searched one after the other (same
+        seeds, same measured indices). Every request is validated before any work. A backend may
+        override this to run them together.
 
         Args:
             requests: The ``SearchRequest`` objects.

@@ -1,4 +1,4 @@
-"""Grover-search circuits over an n-qubit index register (paper Alg. 2, lines 4-8).
+"""Grover-search circuits over an n-qubit index register (paper Algorithm 2, lines 4-8).
 
 Index i of the database is the computational basis state ``|i>`` in Qiskit's little-endian order
 (qubit 0 is the least significant bit), so a measured bitstring b reads as i = int(b, 2).
@@ -50,7 +50,7 @@ BASIS_GATES = ("cx", "rz", "sx", "x")
 
 
 def phase_oracle(marks: np.ndarray, synthesis: str = "auto") -> QuantumCircuit:
-    """The phase oracle X of the paper (Alg. 2, line 7): a circuit on n qubits equal to diag((-1)^marks).
+    """The paper's phase oracle X (Algorithm 2, line 7): a circuit on n qubits equal to diag((-1)^marks).
 
     Args:
         marks: Boolean (or 0/1) array of length 2^n, n >= 1; entry i marks basis state i
@@ -145,7 +145,7 @@ def choose_synthesis(marks: np.ndarray) -> str:
 
 
 def uniform_preparation(num_qubits: int) -> QuantumCircuit:
-    """W = H^n, the paper's Walsh-Hadamard state preparation (Alg. 2 / 3, worker line 6).
+    """W = H^n, the paper's Walsh-Hadamard state preparation (Algorithms 2 and 3, worker line 6).
 
     Args:
         num_qubits: n, the index register's width.
@@ -166,7 +166,7 @@ def uniform_preparation(num_qubits: int) -> QuantumCircuit:
 def grover_circuit(
     marks: np.ndarray, iterations: int, measure: bool = True, synthesis: str = "auto"
 ) -> QuantumCircuit:
-    """The Grover search circuit of one worker (paper Alg. 2, lines 4-8).
+    """The Grover search circuit of one worker (paper Algorithm 2, lines 4-8).
 
     Prepares W applied to the all-zero state (W = H^n, line 6), applies ``iterations`` times
     Q = grover_operator(phase_oracle(marks), W) (lines 7-8) and measures. A marked index is then

@@ -1,7 +1,9 @@
-"""Amplitude estimation of a database's marked fraction with qiskit-algorithms: maximum-likelihood
-amplitude estimation (``"mlae"``, Suzuki et al., "Amplitude estimation without phase estimation",
-Quantum Inf. Process. 19, 75, 2020; the default) or iterative amplitude estimation (``"iae"``,
-Grinko, Gacon, Zoufal and Woerner, npj Quantum Inf. 7, 52, 2021).
+"""Amplitude estimation of a database's marked fraction with qiskit-algorithms.
+
+Two methods: maximum-likelihood amplitude estimation (``"mlae"``, the default; Suzuki et al.,
+"Amplitude estimation without phase estimation", Quantum Inf. Process. 19, 75, 2020) and
+iterative amplitude estimation (``"iae"``; Grinko, Gacon, Zoufal and Woerner, npj Quantum Inf. 7,
+52, 2021).
 
 The ``EstimationProblem`` is built from our circuits: the state preparation A = H^n (the paper's
 W), the Grover operator Q = one standard iterate (phase oracle diag((-1)^marks), then the
@@ -22,9 +24,9 @@ qubit by one query; in the planners it is the 1-call verification). So one estim
 qiskit-algorithms' ``num_oracle_queries`` reports ``sum_i shots_i k_i`` (checked on every estimate).
 
 Why MLAE is the default: qiskit-algorithms 0.4.0's ``IterativeAmplitudeEstimation`` can loop
-forever with few shots per round. We observed it (n = 5, 6 of 32 marked, 16 shots, alpha 0.2):
-once a round's Clopper-Pearson interval on the lower half-circle reaches a = 0, its theta_max is 1,
-the upper end of the theta interval grows by 1 / (4k + 2) every round and k never changes. The
+forever with few shots per round (for example n = 5, 6 of 32 marked, 16 shots, alpha 0.2): once a
+round's Clopper-Pearson interval on the lower half-circle reaches a = 0, its theta_max is 1, the
+upper end of the theta interval grows by 1 / (4k + 2) every round and k never changes. The
 sampler here therefore refuses to run more than ``MAX_IAE_ROUNDS`` circuits for one estimate
 (a ``RuntimeError`` instead of a hang). MLAE runs one fixed schedule of powers [0, 1, 2, 4, ...]
 (cost known in advance) and its likelihood-ratio interval is used.

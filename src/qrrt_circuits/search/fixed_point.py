@@ -21,9 +21,9 @@ and the probability of measuring a marked index, for a marked fraction f = m / N
 which is >= 1 - delta^2 for every f >= w whenever sqrt(1 - w) T_{1/L}(1/delta) <= 1, i.e.
 w >= 1 - gamma^2 (|T_L| <= 1 on [-1, 1]). The paper's sufficient length is
 L >= log(2 / delta) / sqrt(w) (``length_rule="paper"``); ``"tight"`` takes the smallest L with
-1 - gamma^2 <= w, which carries the same guarantee with fewer queries. The sign conventions were
-checked numerically (tests/test_fixed_point.py): flipping the sign of alpha or of beta alone
-breaks P_L.
+1 - gamma^2 <= w, which carries the same guarantee with fewer queries. The sign conventions
+matter: flipping the sign of alpha or of beta alone breaks P_L (the tests compare the exact
+evolution with P_L).
 
 Counting (DESIGN §2): each iterate queries the oracle once, so a sequence of l iterates costs l
 quantum oracle calls per preparation; the paper's L = 2l + 1 counts the applications of the state

@@ -54,7 +54,7 @@ UNSUPPORTED_METHODS = {
 
 
 class AerBackend(QuantumSearchBackend):
-    """Gate-level Grover search (paper Alg. 2, lines 4-8) on ``AerSimulator(method=...)``.
+    """Gate-level Grover search (paper Algorithm 2, lines 4-8) on ``AerSimulator(method=...)``.
 
     Each search builds the Grover circuit of the marks once (``aer_grover_circuit``; with a
     noise model given here, the gate-by-gate ``aer_literal_grover_circuit``) and runs it through

@@ -108,7 +108,7 @@ def depolarizing_backend(p1: float, p2: float, method: str = "statevector",
 
 @functools.lru_cache(maxsize=2)
 def _device_sampler(name: str | None, method: str) -> tuple[BackendV2, BaseSamplerV2]:
-    """Aer's SamplerV2 with a fake device's noise model (building it takes seconds: cached)."""
+    """Aer's SamplerV2 with a fake device's noise model (costly to build, so cached)."""
     from qiskit_aer.primitives import SamplerV2
 
     device = fake_device(name)

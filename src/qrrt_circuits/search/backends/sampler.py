@@ -33,7 +33,7 @@ if TYPE_CHECKING:
 
 
 class SamplerBackend(QuantumSearchBackend):
-    """Grover search (paper Alg. 2, lines 4-8) through any Qiskit ``BaseSamplerV2``.
+    """Grover search (paper Algorithm 2, lines 4-8) through any Qiskit ``BaseSamplerV2``.
 
     The logical circuit is ``grover_circuit(marks, k)``; it is transpiled once per shape (marks,
     iterations) by one preset pass manager and cached (least recently used first out).
@@ -82,9 +82,8 @@ class SamplerBackend(QuantumSearchBackend):
 
     name = "sampler"
     #: per shot: the sampler's result (its bit array and memory), the counts and the measured
-    #: indices; calibrated on qiskit-aer's ``SamplerV2`` (242 bytes per shot measured at 2 000 000
-    #: shots, n = 8; the generic 64 let ``qrrt search --backend sampler`` reach 2.5 GB where it
-    #: estimated 0.6 GiB)
+    #: indices; a calibrated upper bound of the measured peak per shot of qiskit-aer's ``SamplerV2``
+    #: (the generic ``QuantumSearchBackend.BYTES_PER_SHOT`` falls far short of it)
     BYTES_PER_SHOT = 400
 
     def __init__(self, sampler: BaseSamplerV2, backend: BackendV2 | None = None, optimization_level: int = 1,

@@ -35,7 +35,7 @@ def _memory_bytes() -> int:
 
 
 class StatevectorBackend(QuantumSearchBackend):
-    """Exact (noise-free) Grover search: the ideal machine of the paper (Alg. 2, lines 4-8).
+    """Exact (noise-free) Grover search: the ideal machine of the paper (Algorithm 2, lines 4-8).
 
     After k iterations every marked index has amplitude sin((2k+1) theta)/sqrt(m) and every
     unmarked one cos((2k+1) theta)/sqrt(N - m), sin^2 theta = m/N (paper Eq. 1, Lemma 1). The

@@ -31,7 +31,7 @@ __all__ = ["EstimatedOptimal", "EstimatedOptimalState"]
 
 @dataclass(frozen=True)
 class EstimatedOptimal(IterationPolicy):
-    """One amplitude estimation per database, then the optimal k of Eq. 1 for the estimate.
+    """One amplitude estimation per database, then the optimal k (paper Equation 1) for the estimate.
 
     Every worker of the database (Alg. 3; one for Alg. 2) runs k = floor(pi / (4 theta)),
     sin^2 theta = m_hat / N with m_hat = max(1, round(a_hat N)), measures once and verifies. The

@@ -10,9 +10,8 @@ given a database (its search, its verification and its size), run ``workers`` wo
 and return one frozen outcome per worker: the verified index or None, the quantum oracle calls and
 verifications spent, and observations for learning policies. After the round the planner hands
 all outcomes back with ``state.learn(outcomes)``. The planner never asks which policy it has.
-``state.run_many(problems, workers, tree_nodes)`` answers the same for the independent databases
-of one round (unshared Pq-RRT): by default their searches go to the backend together
-(``search_many``), with the outcomes ``run`` gives on each; ``BBHT`` runs them in turn.
+``state.run_many(problems, workers, tree_nodes)`` answers the same for several independent
+databases of one round: ``run`` on each, in order.
 
 Policies that pick one k before measuring (``PaperSchedule``, ``FixedIterations``,
 ``KnownOptimal``, ``Adaptive``) share the default ``run``: one backend search with ``shots =
@@ -225,7 +224,7 @@ class PolicyState:
         return self.policy.iterations_for(problem, tree_nodes)
 
     def run(self, problem: DatabaseSearch, workers: int, tree_nodes: int) -> tuple[SearchOutcome, ...]:
-        """``workers`` workers search one database (Alg. 3 worker loop; Alg. 2 for one worker).
+        """``workers`` workers search one database (paper Algorithm 3's worker loop; Algorithm 2 for one).
 
         The default: one backend search at the policy's k with ``shots = workers`` (each shot
         stands for one worker's independent preparation), then each worker verifies its own
@@ -246,8 +245,7 @@ class PolicyState:
 
     def run_many(self, problems: Sequence[DatabaseSearch], workers: int,
                  tree_nodes: int) -> tuple[tuple[SearchOutcome, ...], ...]:
-        """``run`` on each of several independent databases of one round, in order (unshared
-        Pq-RRT without an executor).
+        """``run`` on each of several independent databases of one round, in order.
 
         Args:
             problems: The round's database searches.
@@ -335,7 +333,7 @@ class PaperSchedule(IterationPolicy):
 
 @dataclass(frozen=True)
 class FixedIterations(IterationPolicy):
-    """Always ``k`` Grover iterations (Alg. 4, QDA, uses k = 2).
+    """Always ``k`` Grover iterations (paper Algorithm 4, QDA, uses k = 2).
 
     Args:
         k: The iteration count (default 2).
@@ -363,7 +361,7 @@ class FixedIterations(IterationPolicy):
 
 @dataclass(frozen=True)
 class KnownOptimal(IterationPolicy):
-    """The optimal k of Eq. 1 for each database's true marked count m.
+    """The optimal k (paper Equation 1) for each database's true marked count m.
 
     k = floor(pi / (4 theta)) with sin^2 theta = m/N, and 0 for m = 0. Reading m is simulation
     knowledge a quantum device does not have; every output planned with it is labelled so.
@@ -467,7 +465,7 @@ class BBHT(IterationPolicy):
 
     def run(self, search: Callable[[int], int], verify: Callable[[int], bool], num_items: int,
             rng: np.random.Generator) -> BBHTOutcome:
-        """One worker's BBHT search (BBHT 1998, Thm. 3, with an iteration cap).
+        """One worker's BBHT search (Theorem 3 of BBHT 1998, with an iteration cap).
 
         Args:
             search: ``search(j)`` prepares the database, runs j Grover iterations (j quantum oracle
@@ -533,8 +531,8 @@ class Adaptive(IterationPolicy):
     Each measurement after k iterations succeeds with probability sin^2((2k+1) asin(sqrt f)) for
     the marked fraction f = m/N (the success probability behind Eq. 1); a grid posterior over f
     picks the k with the largest expected success per oracle call, P(k) / (k + 1). It never reads
-    the true m. The defaults (uniform, 0.9) were chosen on 20 paper_clutter worlds plus sparse (100
-    boxes) and dense (1000 boxes) ones, against log-uniform and 0.97.
+    the true m. The defaults (a uniform prior, forgetting 0.9) are calibrated on cluttered, sparse
+    and dense worlds.
 
     Args:
         grid_size: Points of the geometric grid over f in [1/N, 1], in [10, 100000] (default 200).
