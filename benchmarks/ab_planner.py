@@ -58,7 +58,7 @@ make_planner(planner, envs[0], 0, backend).plan(max_rounds=5)  # compile and war
 
 class Recorded:  # the exact predicate of a world, recording its answers (record) or handing them back
     def __init__(self, env, answers, record):
-        self.exact, self.answers, self.record, self.calls = qc.ReachabilityOracle(env), answers, record, 0
+        self.exact, self.answers, self.record, self.calls = qc.ExactCheck(env), answers, record, 0
         self.dim, self.name = self.exact.dim, "recorded"
 
     def describe(self):

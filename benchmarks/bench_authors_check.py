@@ -1,5 +1,5 @@
 """Pairs per second of the authors' check (``qc.AuthorsCheck``, refine 1 = Octave, refine 4 = MATLAB)
-against our exact check (``qc.ReachabilityOracle``) on the 8 000 reference pairs.
+against our exact check (``qc.ExactCheck``) on the 8 000 reference pairs.
 
     python benchmarks/bench_authors_check.py [--quick] [--out FILE]
 
@@ -52,7 +52,7 @@ def main() -> None:
     for world in (0, 1):
         env, pairs = load(world)
         checks = {"authors-octave": qc.AuthorsCheck(env, refine=1), "authors": qc.AuthorsCheck(env, refine=4),
-                  "exact": qc.ReachabilityOracle(env)}
+                  "exact": qc.ExactCheck(env)}
         for family, (parents, children) in pairs.items():
             for name, check in checks.items():
                 check.reachable(parents[:10], children[:10])  # compile / load the cache
@@ -75,7 +75,7 @@ def main() -> None:
                       {"machine": machine(), "quick": args.quick, "rows": rows, "summary": summary,
                        "octave_reference_pairs_per_s": list(OCTAVE_PAIRS_PER_S),
                        "note": "one core, one batch of 2 000 pairs per world and family; the exact check is "
-                               "ReachabilityOracle at its default resolution 0.01"}, args.out)
+                               "ExactCheck at its default resolution 0.01"}, args.out)
     print(f"wrote {path}")
 
 

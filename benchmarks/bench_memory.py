@@ -66,7 +66,7 @@ def run_plan_case(backend_name: str, n: int, k: int | None) -> dict:
 
     env = qc.scenarios.paper_clutter(seed=0)
     backend = qc.AerBackend(seed=0) if backend_name == "aer" else qc.StatevectorBackend(seed=0)
-    policy = qc.PaperSchedule() if k is None else qc.FixedIterations(k)
+    policy = qc.PaperIterations() if k is None else qc.FixedIterations(k)
     qc.QRRT(env, backend=backend, num_qubits=4, seed=0, search_policy=policy).plan(max_rounds=2)  # warm up
     base = _rss()
     planner = qc.QRRT(env, backend=backend, num_qubits=n, seed=0, search_policy=policy)
@@ -81,13 +81,13 @@ def run_database_case(n: int, d: int, annealing: bool) -> dict:
     import numpy as np
 
     import qrrt_circuits as qc
-    from qrrt_circuits.planners.database import AnnealingSchedule, build_database
     from qrrt_circuits._support.memory import database_bytes
+    from qrrt_circuits.planners.database import AnnealingSchedule, build_database
     from qrrt_circuits.planners.tree import Tree
 
     env = qc.Environment(np.array([[0.0, 10.0]] * d), np.array([[[4.0] * d, [5.0] * d]]))
     dynamics = None if d == 2 else qc.LinearTrackingDynamics(-np.eye(d), np.eye(d), np.eye(d))
-    oracle = qc.ReachabilityOracle(env, dynamics)
+    oracle = qc.ExactCheck(env, dynamics)
     rng = np.random.default_rng(0)
     tree = Tree(np.full(d, 1.0))
     for point in env.sample_free(62, rng):  # a 63-node tree

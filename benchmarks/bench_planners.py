@@ -7,7 +7,7 @@ planner on paper_clutter.
 Each configuration plans on paper_clutter worlds seeds 0..S-1 (planner seed = world seed) until
 ``--nodes`` nodes or the goal. Per run: oracle calls / node, critical-path calls / node, wall
 ms / node, the oracle share (wall time inside the predicate's ``reachable`` calls / the plan's wall
-time; the predicate is the exact ``ReachabilityOracle`` wrapped in a timer) and the non-oracle
+time; the predicate is the exact ``ExactCheck`` wrapped in a timer) and the non-oracle
 microseconds per round; the table gives the median and the 10th-90th percentile spread over seeds.
 The "3000 nodes" rows grow q-RRT trees to ``--big-nodes`` nodes on the first ``--big-seeds`` worlds
 with the goal made unreachable (goal radius 1e-9), so the per-round cost can be compared at 100
@@ -108,9 +108,9 @@ class PartTimer:
         setattr(owner, attribute, timed)
 
     def __enter__(self) -> PartTimer:
-        from qrrt_circuits.world.environment import Environment
-        from qrrt_circuits.search.backend import QuantumSearchBackend
         from qrrt_circuits.planners.tree import Tree
+        from qrrt_circuits.search.backend import QuantumSearchBackend
+        from qrrt_circuits.world.environment import Environment
 
         self._wrap(Tree, "nearest", "nearest")
         self._wrap(Environment, "sample_uniform", "candidate_draws")
@@ -126,7 +126,7 @@ class PartTimer:
 def breakdown(make, env, seed: int, nodes: int, big: bool) -> dict:
     """Microseconds per round in the predicate, the nearest-node queries, the candidate draws, the
     backend search and the rest, for one plan (the wrappers add about a microsecond per call)."""
-    predicate = TimedPredicate(qc.ReachabilityOracle(env))
+    predicate = TimedPredicate(qc.ExactCheck(env))
     planner = make(env, seed, predicate)
     with PartTimer() as parts:
         result = planner.plan(max_nodes=nodes, goal_radius=1e-9) if big else planner.plan(max_nodes=nodes)
@@ -168,7 +168,7 @@ def summarize(values: list[float]) -> dict:
 
 
 def run_one(make, env, seed: int, nodes: int, big: bool) -> dict:
-    predicate = TimedPredicate(qc.ReachabilityOracle(env))
+    predicate = TimedPredicate(qc.ExactCheck(env))
     planner = make(env, seed, predicate)
     result = planner.plan(max_nodes=nodes, goal_radius=1e-9) if big else planner.plan(max_nodes=nodes)
     m = result.metrics
@@ -214,7 +214,7 @@ def interleaved_ratios(worlds: list[qc.Environment], nodes: int) -> dict:
 def predicate_construction(env, repeats: int = 20) -> dict:
     """Milliseconds to build the exact predicate (every trial of an experiment builds one): its
     chord grid computed (the process-wide cache emptied first) and taken from the cache."""
-    from qrrt_circuits.reachability import exact
+    from qrrt_circuits.reachability import exact as oracle
 
     def median_ms(clear: bool) -> float:
         times = []
@@ -222,7 +222,7 @@ def predicate_construction(env, repeats: int = 20) -> dict:
             if clear:
                 oracle._CHORD_GRIDS.clear()
             start = time.perf_counter()
-            qc.ReachabilityOracle(env)
+            qc.ExactCheck(env)
             times.append((time.perf_counter() - start) * 1e3)
         return float(np.median(times))
 

@@ -365,7 +365,7 @@ def bench_reachability(quick: bool) -> list[dict]:
     count = 20000 if quick else 200000
     for scenario in ("paper_clutter", "annealing_field"):
         env = qc.scenarios.by_name(scenario, seed=0)
-        oracle = qc.ReachabilityOracle(env)
+        oracle = qc.ExactCheck(env)
         rng = np.random.default_rng(1)
         parents = env.sample_free(count, rng)
         pairs = {

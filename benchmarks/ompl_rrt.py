@@ -3,7 +3,7 @@
     python benchmarks/ompl_rrt.py      (needs the ``ompl`` Python bindings, OMPL >= 2.0)
 
 ``run_ompl_rrt`` grows ``ompl.geometric.RRT`` on an ``Environment`` whose motion validator is our
-``ReachabilityOracle``: ``checkMotion(s1, s2)`` is ``oracle.reachable(s1, s2)`` for the directed
+``ExactCheck``: ``checkMotion(s1, s2)`` is ``oracle.reachable(s1, s2)`` for the directed
 closed-loop trajectory parent s1 -> child s2, and the state validity checker is ``env.is_free``. It
 stops when the tree has ``max_nodes`` nodes besides the root (counted as successful motion checks:
 RRT adds a node exactly when ``checkMotion`` succeeds) or a node lands within ``goal_radius`` of the
@@ -28,7 +28,7 @@ import time
 
 import numpy as np
 
-from qrrt_circuits import Environment, LinearTrackingDynamics, ReachabilityOracle
+from qrrt_circuits import Environment, ExactCheck, LinearTrackingDynamics
 
 
 def ompl_available() -> bool:
@@ -57,7 +57,7 @@ def run_ompl_rrt(env: Environment, start: np.ndarray, goal: np.ndarray, goal_rad
     if int(max_nodes) < 1 or int(seed) < 0:
         raise ValueError(f"need max_nodes >= 1 and seed >= 0, got {max_nodes} and {seed}")
     d = env.dim
-    oracle = ReachabilityOracle(env, dynamics)
+    oracle = ExactCheck(env, dynamics)
     start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
     oracle.reachable(start[None], start[None])  # load the compiled check before timing
 
@@ -138,7 +138,7 @@ if __name__ == "__main__":
         edges = out.pop("edges")
         again = run_ompl_rrt(*problem)
         same = all(out[k] == again[k] for k in ("reached", "nodes", "motion_checks"))
-        good = ReachabilityOracle(world).reachable(edges[:, 0], edges[:, 1])
+        good = ExactCheck(world).reachable(edges[:, 0], edges[:, 1])
         ok = bool(good.all()) and len(edges) == out["nodes"]
         print(f"{s:>4} {out['reached']!s:>7} {out['nodes']:>5} {out['motion_checks']:>6} "
               f"{out['ms_per_node']:>8.3f} {ok!s:>8} {same!s:>6}")

@@ -222,7 +222,7 @@ def test_refine_4_leaves_the_tail_untested():
     matlab = qc.AuthorsCheck(env, refine=4)
     times, _ = matlab.ode45_outputs(parent, child)
     assert len(times) > 50 and times[49] < 2.5
-    assert not qc.ReachabilityOracle(env).reachable(parent, child)[0]
+    assert not qc.ExactCheck(env).reachable(parent, child)[0]
     assert not qc.AuthorsCheck(env, refine=1).reachable(parent, child)[0]
     assert matlab.reachable(parent, child)[0]
 

@@ -254,8 +254,8 @@ def test_aer_backend_uses_only_documented_aer_names():
     import inspect
     import re
 
-    from qrrt_circuits.search.backends import aer
     from qrrt_circuits.search import aer_circuits
+    from qrrt_circuits.search.backends import aer
 
     for module in (aer, aer_circuits):
         source = inspect.getsource(module)

@@ -98,7 +98,7 @@ QUANTUM_ARGUMENTS = [
     ("workers", bad_int(1, 4096)),
     ("shared_database", st.one_of(st.integers(), st.text(max_size=3), st.none(), st.floats())),
     ("backend", st.one_of(st.integers(), st.text(max_size=3), st.just(qc.RRT))),
-    ("search_policy", st.one_of(st.integers(), st.text(max_size=5), st.just(qc.PaperSchedule))),
+    ("search_policy", st.one_of(st.integers(), st.text(max_size=5), st.just(qc.PaperIterations))),
     ("annealing", st.one_of(st.integers(), st.text(max_size=3), st.just(((1.0, 2.0),)))),
 ]
 
@@ -131,9 +131,9 @@ CALLS = {
                                       bad_int(1, 28, none_valid=True), "max_qubits"),
     "StatevectorBackend.closed_form": (lambda v: qc.StatevectorBackend(closed_form=v),
                                        st.one_of(st.integers(), st.text(max_size=3), st.none()), "closed_form"),
-    "PaperSchedule.early": (lambda v: qc.PaperSchedule(early=v), bad_int(0, 100_000), "early"),
-    "PaperSchedule.late": (lambda v: qc.PaperSchedule(late=v), bad_int(0, 100_000), "late"),
-    "PaperSchedule.switch_nodes": (lambda v: qc.PaperSchedule(switch_nodes=v), bad_int(0, 1_000_000),
+    "PaperIterations.early": (lambda v: qc.PaperIterations(early=v), bad_int(0, 100_000), "early"),
+    "PaperIterations.late": (lambda v: qc.PaperIterations(late=v), bad_int(0, 100_000), "late"),
+    "PaperIterations.switch_nodes": (lambda v: qc.PaperIterations(switch_nodes=v), bad_int(0, 1_000_000),
                                    "switch_nodes"),
     "FixedIterations.k": (lambda v: qc.FixedIterations(v), bad_int(0, 100_000), "k"),
     "BBHT.growth": (lambda v: qc.BBHT(growth=v), bad_float(1.0, 4 / 3 + 1e-12, open_minimum=True), "growth"),

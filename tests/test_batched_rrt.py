@@ -74,7 +74,7 @@ def test_wasted_checks_are_the_tests_of_rounds_that_never_ran():
     metrics = result.metrics
     assert metrics.oracle_calls == metrics.rounds == metrics.verification_calls
     assert metrics.wasted_checks > 0
-    predicate = qc.ReachabilityOracle(env)  # counts every pair it evaluates
+    predicate = qc.ExactCheck(env)  # counts every pair it evaluates
     again = qc.RRT(env, seed=3, predicate=predicate).plan(max_nodes=50)
     assert predicate.evaluations == again.metrics.oracle_calls + again.metrics.wasted_checks
     assert again.metrics.wasted_checks == metrics.wasted_checks

@@ -32,7 +32,7 @@ def _one_warning(action, replacement):
 
 
 def test_oracle_keyword_and_attribute(env):
-    predicate = qc.ReachabilityOracle(env)
+    predicate = qc.ExactCheck(env)
     for make in (lambda: qc.RRT(env, oracle=predicate, seed=0),
                  lambda: qc.ParallelRRT(env, workers=2, oracle=predicate, seed=0),
                  lambda: qc.QRRT(env, backend=qc.StatevectorBackend(), oracle=predicate, seed=0),
@@ -52,7 +52,7 @@ def test_iterations_keyword_and_attribute_give_the_same_plan(env):
 
 
 def test_policy_state_iterations():
-    state = qc.PaperSchedule().start(256)
+    state = qc.PaperIterations().start(256)
     assert _one_warning(lambda: state.iterations(20), "choose_iterations") == state.choose_iterations(20) == 3
 
 
@@ -67,7 +67,7 @@ def test_schedules_module():
     sys.modules.pop("qrrt_circuits.search.schedules", None)
     module = _one_warning(lambda: importlib.import_module("qrrt_circuits.search.schedules"),
                           "qrrt_circuits.search.policies")
-    assert module.PaperSchedule is qc.PaperSchedule
+    assert module.PaperIterations is qc.PaperIterations
 
 
 def test_default_max_rounds_of_the_planners_module():
@@ -78,7 +78,7 @@ def test_default_max_rounds_of_the_planners_module():
 
 
 def test_time_samples_check_and_budget_exhausted(env):
-    check = _one_warning(lambda: qc.ReachabilityOracle(env, check="time_samples", time_samples=9), "TimeSampledCheck")
+    check = _one_warning(lambda: qc.ExactCheck(env, check="time_samples", time_samples=9), "TimeSampledCheck")
     assert isinstance(check, qc.TimeSampledCheck) and check.time_samples == 9
     result = qc.RRT(env, seed=0).plan(max_rounds=3, goal_radius=1e-9)
     assert _one_warning(lambda: result.budget_exhausted, "not PlanResult.reached") is True
@@ -86,7 +86,7 @@ def test_time_samples_check_and_budget_exhausted(env):
 
 def test_every_deprecated_name_is_tested():
     """The table the docs show lists exactly the names this file exercises."""
-    assert len(DEPRECATED) == 10
+    assert len(DEPRECATED) == 12
 
 
 @pytest.mark.parametrize("old, new", [
@@ -101,3 +101,13 @@ def test_an_old_module_path_imports_the_new_module_and_warns(old, new):
     sys.modules.pop(old, None)
     module = _one_warning(lambda: importlib.import_module(old), new)
     assert module is importlib.import_module(new)
+
+
+def test_renamed_classes():
+    from qrrt_circuits.reachability import exact
+    from qrrt_circuits.search import policies
+
+    assert _one_warning(lambda: qc.ReachabilityOracle, "ExactCheck") is qc.ExactCheck
+    assert _one_warning(lambda: exact.ReachabilityOracle, "ExactCheck") is qc.ExactCheck
+    assert _one_warning(lambda: qc.PaperSchedule, "PaperIterations") is qc.PaperIterations
+    assert _one_warning(lambda: policies.PaperSchedule, "PaperIterations") is qc.PaperIterations

@@ -32,7 +32,7 @@ DESIGN = ROOT / "docs" / "DESIGN.md"
 DESIGN_VARIABLES = {
     "env": "Environment",
     "dyn": "LinearTrackingDynamics",
-    "oracle": "ReachabilityOracle",
+    "oracle": "ExactCheck",
     "backend": "QuantumSearchBackend",
     "res": "SearchResult",
     "planner": "PQRRT",

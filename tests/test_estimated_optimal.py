@@ -10,8 +10,8 @@ from scipy.stats import binom
 from tolerances import TAIL
 
 import qrrt_circuits as qc
-from qrrt_circuits.probability import optimal_iterations
 from qrrt_circuits._support.randomness import RandomStreams
+from qrrt_circuits.probability import optimal_iterations
 from qrrt_circuits.registry import POLICIES
 from qrrt_circuits.search.estimation import estimate_marked_fraction, estimation_problem, grover_iterate
 from qrrt_circuits.search.fixed_point import IterateSequence, generalized_grover_circuit

@@ -34,7 +34,7 @@ def reference_pairs(world: int) -> dict[str, np.ndarray]:
 def test_exact_check_is_sound_and_within_its_false_rejection_bound(world):
     env = reference_world(world)
     pairs = reference_pairs(world)
-    oracle = qc.ReachabilityOracle(env)
+    oracle = qc.ExactCheck(env)
     parents = np.stack([pairs["parent_x"], pairs["parent_y"]], axis=1)
     children = np.stack([pairs["child_x"], pairs["child_y"]], axis=1)
     accepted = oracle.reachable(parents, children)

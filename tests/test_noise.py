@@ -11,8 +11,8 @@ from tolerances import binomial_counts, within_binomial
 
 from qrrt_circuits.hardware import noise
 from qrrt_circuits.probability import good_probability, prob_true_solution
-from qrrt_circuits.search.circuits import grover_circuit
 from qrrt_circuits.search.backends.noisy import depolarizing_backend
+from qrrt_circuits.search.circuits import grover_circuit
 
 
 def _marks(n, marked, seed=0):

@@ -7,7 +7,7 @@ from qrrt_circuits.world.environment import Environment
 
 
 def _check_against_reference(env, dyn, parents, children, resolution):
-    oracle = qc.ReachabilityOracle(env, dyn, resolution=resolution)
+    oracle = qc.ExactCheck(env, dyn, resolution=resolution)
     verdict = oracle.reachable(parents, children)
     assert oracle.evaluations == len(parents)
     for p, c, ok in zip(parents, children, verdict, strict=True):
@@ -48,7 +48,7 @@ def test_oracle_in_three_dimensions_with_non_normal_closed_loop():
 
 def test_wall_crossing_is_rejected_and_free_motion_accepted():
     env = Environment(np.array([[0, 10], [0, 10]]), np.array([[[4.9, 0.0], [5.1, 10.0]]]))
-    oracle = qc.ReachabilityOracle(env)
+    oracle = qc.ExactCheck(env)
     verdict = oracle.reachable(np.array([[2.0, 5.0], [2.0, 5.0]]), np.array([[8.0, 5.0], [3.0, 3.0]]))
     assert verdict.tolist() == [False, True]
 
@@ -56,7 +56,7 @@ def test_wall_crossing_is_rejected_and_free_motion_accepted():
 def test_thin_obstacle_between_samples_is_caught():
     # an obstacle thinner than any fixed time step: evenly spaced samples would jump over it
     env = Environment(np.array([[0, 100], [0, 100]]), np.array([[[50.0, 0.0], [50.02, 100.0]]]))
-    oracle = qc.ReachabilityOracle(env)
+    oracle = qc.ExactCheck(env)
     assert not oracle.reachable(np.array([[1.0, 50.0]]), np.array([[99.0, 50.0]]))[0]
 
 
@@ -64,20 +64,20 @@ def test_endpoint_in_collision_is_rejected(clutter):
     box = clutter.boxes[0]
     centre = box.mean(axis=0)
     start = clutter.sample_free(1, np.random.default_rng(0))[0]
-    oracle = qc.ReachabilityOracle(clutter)
+    oracle = qc.ExactCheck(clutter)
     assert not oracle.reachable(start[None], centre[None])[0]
 
 
 def test_oracle_rejects_bad_shapes(clutter):
-    oracle = qc.ReachabilityOracle(clutter)
+    oracle = qc.ExactCheck(clutter)
     with pytest.raises(ValueError, match=r"shape \(M, 2\)"):
         oracle.reachable(np.zeros((3, 3)), np.zeros((3, 3)))
     with pytest.raises(ValueError, match="same shape"):
         oracle.reachable(np.zeros((3, 2)), np.zeros((4, 2)))
     with pytest.raises(ValueError, match="resolution"):
-        qc.ReachabilityOracle(clutter, resolution=0)
+        qc.ExactCheck(clutter, resolution=0)
     with pytest.raises(ValueError, match="dimension"):
-        qc.ReachabilityOracle(clutter, qc.LinearTrackingDynamics(-np.eye(3), np.eye(3), np.zeros((3, 3))))
+        qc.ExactCheck(clutter, qc.LinearTrackingDynamics(-np.eye(3), np.eye(3), np.zeros((3, 3))))
 
 
 def test_error_model_rates():
@@ -99,7 +99,7 @@ def test_oracle_agrees_with_exact_diagonal_check(clutter):
     from reference import diagonal_edge_hits
 
     dyn = qc.LinearTrackingDynamics.paper()
-    oracle = qc.ReachabilityOracle(clutter, dyn)
+    oracle = qc.ExactCheck(clutter, dyn)
     rng = np.random.default_rng(21)
     parents = clutter.sample_free(3000, rng)
     children = np.clip(parents + rng.normal(scale=2.5, size=parents.shape), 0.0, 20.0)
@@ -126,23 +126,23 @@ def test_chord_grid_is_computed_once_per_dynamics_and_equals_the_direct_computat
     max_error = float(np.linalg.norm(clutter.bounds[:, 1] - clutter.bounds[:, 0])) * 1.0001
     times, bounds = dyn.curvature_bound_times(max_error, 0.01)
     phis = dyn.propagators(times)
-    first = qc.ReachabilityOracle(clutter, dyn, resolution=0.01)
+    first = qc.ExactCheck(clutter, dyn, resolution=0.01)
     assert len(oracle_module._CHORD_GRIDS) == 1
     first._times[0] = 99.0  # each predicate owns its copy: corrupting it reaches no other
     # another dynamics object with the same closed loop and horizon reuses the grid...
-    second = qc.ReachabilityOracle(clutter, qc.LinearTrackingDynamics.paper(), resolution=0.01)
+    second = qc.ExactCheck(clutter, qc.LinearTrackingDynamics.paper(), resolution=0.01)
     assert len(oracle_module._CHORD_GRIDS) == 1
     for got, want in ((second._times, times), (second._curvature, bounds), (second._phis, phis)):
         np.testing.assert_array_equal(got, want)
         assert got.flags["C_CONTIGUOUS"] and got.flags["WRITEABLE"]
     # ...and a different resolution, horizon, workspace size (the largest tracking error the grid
     # must cover) or closed loop gets its own, equal to the direct computation
-    qc.ReachabilityOracle(clutter, dyn, resolution=0.02)
-    qc.ReachabilityOracle(clutter, qc.LinearTrackingDynamics.paper(horizon=4.0), resolution=0.01)
+    qc.ExactCheck(clutter, dyn, resolution=0.02)
+    qc.ExactCheck(clutter, qc.LinearTrackingDynamics.paper(horizon=4.0), resolution=0.01)
     wide = Environment(clutter.bounds * 3.0, clutter.boxes)
     faster = qc.LinearTrackingDynamics(dyn.A, dyn.B, dyn.K * 2.0)
     for env, dynamics in ((wide, dyn), (clutter, faster)):
-        predicate = qc.ReachabilityOracle(env, dynamics, resolution=0.01)
+        predicate = qc.ExactCheck(env, dynamics, resolution=0.01)
         extent = float(np.linalg.norm(env.bounds[:, 1] - env.bounds[:, 0])) * 1.0001
         direct_times, direct_bounds = dynamics.curvature_bound_times(extent, 0.01)
         np.testing.assert_array_equal(predicate._times, direct_times)
@@ -171,13 +171,13 @@ def test_a_resolution_too_fine_for_the_workspace_is_refused_before_the_grid_is_b
     monkeypatch.setattr(oracle, "_CHORD_GRIDS", {})
     with pytest.raises(ValueError, match=r"resolution = 0\.0001 on a workspace 28\.2843 across needs up to about "
                                          r".* chords per trajectory .*more than the 500 allowed.*at least ([0-9.e-]+)"):
-        qc.ReachabilityOracle(clutter, resolution=1e-4)
+        qc.ExactCheck(clutter, resolution=1e-4)
     assert oracle._CHORD_GRIDS == {}  # refused before any grid was built
     try:
-        qc.ReachabilityOracle(clutter, resolution=1e-4)
+        qc.ExactCheck(clutter, resolution=1e-4)
     except ValueError as error:
         finest = float(str(error).rsplit("at least ", 1)[1].split(",")[0])
-    fitting = qc.ReachabilityOracle(clutter, resolution=finest)  # the suggestion (as printed) is accepted
+    fitting = qc.ExactCheck(clutter, resolution=finest)  # the suggestion (as printed) is accepted
     assert len(fitting._times) - 1 <= 500
     assert oracle.max_chords(512) == 127 < oracle.max_chords(2) == 500  # d x d propagators limit large d
 
@@ -185,7 +185,7 @@ def test_a_resolution_too_fine_for_the_workspace_is_refused_before_the_grid_is_b
 def test_a_workspace_too_large_for_the_default_resolution_is_refused():
     huge = qc.Environment([[-1e12, 1e12], [-1e12, 1e12]], [])
     with pytest.raises(ValueError, match="resolution = 0.01 on a workspace 2.82843e\\+12 across needs up to about"):
-        qc.ReachabilityOracle(huge)
+        qc.ExactCheck(huge)
     with pytest.raises(ValueError, match="resolution = 0.01"):
         qc.RRT(huge)
 

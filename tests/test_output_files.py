@@ -122,7 +122,8 @@ def test_a_pipe_is_checked_without_opening_it(tmp_path):
     check only asks for write permission (run in a child, so a regression cannot hang the suite)."""
     pipe = tmp_path / "out.json"
     os.mkfifo(pipe)
-    code = f"from qrrt_circuits._support.output_files import check_output_file; check_output_file({str(pipe)!r}, '--json')"
+    code = ("from qrrt_circuits._support.output_files import check_output_file; "
+            f"check_output_file({str(pipe)!r}, '--json')")
     subprocess.run([sys.executable, "-c", code], check=True, timeout=60)
 
 

@@ -8,8 +8,8 @@ from planner_checks import assert_path_valid, assert_tree_edges_valid
 from tolerances import binomial_counts, z_bound
 
 import qrrt_circuits as qc
-from qrrt_circuits.world.environment import Environment
 from qrrt_circuits.registry import PLANNERS
+from qrrt_circuits.world.environment import Environment
 
 METRIC_KEYS = {"oracle_calls", "quantum_oracle_calls", "verification_calls",
                "critical_path_oracle_calls", "simulation_checks", "nodes", "rounds", "databases",

@@ -10,8 +10,8 @@ from conftest import BACKENDS, make_backend, random_marks
 from tolerances import within_binomial
 
 import qrrt_circuits as qc
-from qrrt_circuits.probability import optimal_iterations, success_probability
 from qrrt_circuits._support.randomness import RandomStreams
+from qrrt_circuits.probability import optimal_iterations, success_probability
 from qrrt_circuits.registry import POLICIES
 
 POLICY_NAMES = ["paper", "fixed:2", "optimal", "bbht", "adaptive"]
@@ -110,7 +110,7 @@ def test_adaptive_learns_from_outcomes_and_others_ignore_them():
     before = adaptive.choose_iterations(10)
     adaptive.learn([qc.SearchOutcome(None, before, 1, ((before, False),))] * 30)
     assert adaptive.choose_iterations(10) != before
-    paper = qc.PaperSchedule().start(256)
+    paper = qc.PaperIterations().start(256)
     paper.learn([qc.SearchOutcome(None, 5, 1, ((5, False),))] * 30)
     assert paper.choose_iterations(3) == 5
 
@@ -140,7 +140,7 @@ def test_every_policy_inside_the_planners(name, shared, clutter):
     (lambda: qc.Adaptive(grid_size=float("nan")), TypeError, "grid_size must be an integer"),
     (lambda: qc.BBHT(cap_factor=float("inf")), ValueError, "cap_factor must be a finite number"),
     (lambda: qc.FixedIterations(True), TypeError, "k must be an integer"),
-    (lambda: qc.PaperSchedule(early=2.5), TypeError, "early must be an integer"),
+    (lambda: qc.PaperIterations(early=2.5), TypeError, "early must be an integer"),
     (lambda: qc.AnnealingSchedule(bands=[(2.7, 4.2), (0.8, 2.0)], switch_at=[2.5]), TypeError,
      r"switch_at\[0\] must be an integer"),
 ])
@@ -149,10 +149,10 @@ def test_policy_settings_are_checked_at_construction(build, error, message):
         build()
 
 
-@pytest.mark.parametrize("make", [lambda: qc.FixedIterations(100_001), lambda: qc.PaperSchedule(early=100_001),
-                                  lambda: qc.PaperSchedule(late=100_001)])
+@pytest.mark.parametrize("make", [lambda: qc.FixedIterations(100_001), lambda: qc.PaperIterations(early=100_001),
+                                  lambda: qc.PaperIterations(late=100_001)])
 def test_iteration_counts_beyond_what_a_search_runs_are_refused_at_construction(make):
     """A plan with k = 200 000 was refused at its first search with that k, after the work before it."""
     with pytest.raises(ValueError, match=r"must be an integer in \[0, 100000\], got 100001"):
         make()
-    assert qc.PaperSchedule(switch_nodes=1_000_000).switch_nodes == 1_000_000  # a node count, not k
+    assert qc.PaperIterations(switch_nodes=1_000_000).switch_nodes == 1_000_000  # a node count, not k

@@ -13,7 +13,7 @@ from qrrt_circuits.registry import PLANNERS
 
 
 class StraightLine:
-    """A user's predicate (not a ReachabilityOracle): straight-line motion, sampled every
+    """A user's predicate (not a ExactCheck): straight-line motion, sampled every
     ``spacing`` along the segment, in any dimension."""
 
     name = "straight-line"
@@ -89,7 +89,7 @@ def test_a_user_predicate_in_three_dimensions():
 
 
 def test_builtin_predicates_describe_themselves(clutter):
-    exact = qc.ReachabilityOracle(clutter)
+    exact = qc.ExactCheck(clutter)
     assert check_predicate(exact, 2) is exact
     description = exact.describe()
     assert description["name"] == "exact" and description["resolution"] == 0.01 and description["sound"]
@@ -99,7 +99,7 @@ def test_builtin_predicates_describe_themselves(clutter):
     assert sampled.describe()["sound"] is False and sampled.describe()["time_samples"] == 30
     # the deprecated spelling returns the same kind of object
     with pytest.warns(DeprecationWarning, match="TimeSampledCheck"):
-        alias = qc.ReachabilityOracle(clutter, check="time_samples", time_samples=30)
+        alias = qc.ExactCheck(clutter, check="time_samples", time_samples=30)
     assert isinstance(alias, qc.TimeSampledCheck) and isinstance(alias, qc.ReachabilityPredicate)
     rng = np.random.default_rng(1)
     parents, children = clutter.sample_free(200, rng), clutter.sample_uniform(200, rng)
@@ -111,7 +111,7 @@ def test_planner_records_the_dynamics_its_predicate_follows(clutter):
     result = qc.RRT(clutter, dynamics=dynamics, seed=0).plan(max_nodes=3)
     assert plan_dynamics(result).describe() == dynamics.describe()
     # oracle= is a deprecated alias of predicate=
-    oracle = qc.ReachabilityOracle(clutter)
+    oracle = qc.ExactCheck(clutter)
     with pytest.warns(DeprecationWarning, match="use predicate="):
         planner = qc.RRT(clutter, oracle=oracle, seed=0)
     with pytest.warns(DeprecationWarning, match="Planner.predicate"):
@@ -135,7 +135,7 @@ def test_bad_predicates_are_refused_with_the_reason(clutter):
         qc.RRT(clutter, predicate=StraightLine(clutter), dynamics=qc.LinearTrackingDynamics.paper())
     with pytest.raises(ValueError, match="give predicate= or its deprecated alias oracle=, not both"), \
             pytest.warns(DeprecationWarning):
-        qc.RRT(clutter, predicate=StraightLine(clutter), oracle=qc.ReachabilityOracle(clutter))
+        qc.RRT(clutter, predicate=StraightLine(clutter), oracle=qc.ExactCheck(clutter))
 
 
 @pytest.mark.parametrize("time_samples", [7, 30])

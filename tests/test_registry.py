@@ -67,7 +67,7 @@ def test_every_backend_name_searches(name):
 
 
 def test_policies_including_parametric_ones():
-    assert POLICIES.create("paper") == qc.PaperSchedule()
+    assert POLICIES.create("paper") == qc.PaperIterations()
     assert POLICIES.create("fixed:3") == qc.FixedIterations(3)
     assert isinstance(POLICIES.create("bbht"), qc.BBHT)
     assert POLICIES.labels() == ("paper", "optimal", "bbht", "adaptive", "fixed:K", "fixed-point[:DELTA]", "estimated")
@@ -79,7 +79,7 @@ def test_policies_including_parametric_ones():
 
 def test_scenarios_and_predicates(clutter):
     assert SCENARIOS.create("paper_clutter", seed=0).boxes.tobytes() == clutter.boxes.tobytes()
-    assert isinstance(PREDICATES.create("exact", env=clutter), qc.ReachabilityOracle)
+    assert isinstance(PREDICATES.create("exact", env=clutter), qc.ExactCheck)
     sampled = PREDICATES.create("time-samples:20", env=clutter)
     assert isinstance(sampled, qc.TimeSampledCheck) and sampled.time_samples == 20
 

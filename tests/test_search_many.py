@@ -64,7 +64,7 @@ def test_one_aer_job_cannot_carry_independent_seeds():
     assert [experiment.seed_simulator for experiment in result.results] == [7, 7 + 2113, 7 + 2 * 2113]
 
 
-@pytest.mark.parametrize("policy", [qc.PaperSchedule(), qc.KnownOptimal(), qc.Adaptive(), qc.BBHT()],
+@pytest.mark.parametrize("policy", [qc.PaperIterations(), qc.KnownOptimal(), qc.Adaptive(), qc.BBHT()],
                          ids=lambda policy: policy.name)
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_unshared_pqrrt_round_searched_together_equals_one_by_one(policy, seed, clutter):

@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 import qrrt_circuits as qc
-from qrrt_circuits.world.environment import Environment
 from qrrt_circuits.planners.termination import (
     DEFAULT_MAX_NODES,
     DEFAULT_STALL_ROUNDS,
@@ -17,6 +16,7 @@ from qrrt_circuits.planners.termination import (
     with_defaults,
     with_round_limit,
 )
+from qrrt_circuits.world.environment import Environment
 
 WALLED_GOAL = np.array([[[14, 14], [18, 14.5]], [[14, 17.5], [18, 18]], [[14, 14], [14.5, 18]],
                         [[17.5, 14], [18, 18]]], dtype=float)

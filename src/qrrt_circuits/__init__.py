@@ -24,7 +24,7 @@ from .planners.termination import (
 )
 from .reachability.authors_check import AuthorsCheck
 from .reachability.dynamics import LinearTrackingDynamics
-from .reachability.exact import ReachabilityOracle
+from .reachability.exact import ExactCheck
 from .reachability.oracle_errors import OracleErrorModel
 from .reachability.predicate import ReachabilityPredicate
 from .reachability.time_sampled import TimeSampledCheck
@@ -35,7 +35,7 @@ from .search.policies.iteration import (
     FixedIterations,
     IterationPolicy,
     KnownOptimal,
-    PaperSchedule,
+    PaperIterations,
 )
 from .search.problem import DatabaseSearch, SearchOutcome
 from .world import scenarios
@@ -56,13 +56,22 @@ _LAZY = ("AerBackend", "EstimatedOptimal", "FixedPointAmplification", "IterateSe
          "StatevectorBackend", "circuits")
 
 
+#: deprecated name -> (its replacement, the object)
+_DEPRECATED: dict[str, tuple[str, Any]] = {
+    "SearchPolicy": ("IterationPolicy", IterationPolicy),
+    "PaperSchedule": ("PaperIterations", PaperIterations),
+    "ReachabilityOracle": ("ExactCheck", ExactCheck),
+}
+
+
 def __getattr__(name: str) -> Any:
     """``qrrt_circuits.search``'s lazily imported names, cached here on first use; deprecated names."""
-    if name == "SearchPolicy":
+    if name in _DEPRECATED:
         from ._support.deprecation import warn_deprecated
 
-        warn_deprecated("qrrt_circuits.SearchPolicy", "qrrt_circuits.IterationPolicy")
-        return IterationPolicy
+        new, value = _DEPRECATED[name]
+        warn_deprecated(f"qrrt_circuits.{name}", f"qrrt_circuits.{new}")
+        return value
     if name in _LAZY:
         from . import search
 
@@ -106,12 +115,12 @@ __all__ = [
     "MaxWallTime",
     "Metrics",
     "OracleErrorModel",
-    "PaperSchedule",
+    "PaperIterations",
     "ParallelRRT",
     "PlanResult",
     "PlanStatus",
     "QuantumSearchBackend",
-    "ReachabilityOracle",
+    "ExactCheck",
     "ReachabilityPredicate",
     "SamplerBackend",
     "SearchOutcome",

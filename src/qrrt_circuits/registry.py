@@ -22,7 +22,7 @@ if TYPE_CHECKING:
 
     from .reachability.authors_check import AuthorsCheck
     from .reachability.dynamics import LinearTrackingDynamics
-    from .reachability.exact import ReachabilityOracle
+    from .reachability.exact import ExactCheck
     from .reachability.time_sampled import TimeSampledCheck
     from .search import AerBackend, SamplerBackend, StatevectorBackend
     from .search.policies.estimated import EstimatedOptimal
@@ -364,10 +364,10 @@ def _estimated() -> EstimatedOptimal:
 
 
 def _policies() -> Registry:
-    from .search.policies.iteration import BBHT, Adaptive, KnownOptimal, PaperSchedule
+    from .search.policies.iteration import BBHT, Adaptive, KnownOptimal, PaperIterations
 
     registry = Registry("search policy")
-    registry.register("paper", PaperSchedule, "5 iterations, 3 after 10 nodes (the authors' code)")
+    registry.register("paper", PaperIterations, "5 iterations, 3 after 10 nodes (the authors' code)")
     registry.register("optimal", KnownOptimal, "optimal k for the true m (simulation knowledge)")
     registry.register("bbht", BBHT, "Boyer-Brassard-Hoyer-Tapp for unknown m")
     registry.register("adaptive", Adaptive, "k from a posterior over m/N learned from verified outcomes")
@@ -395,10 +395,10 @@ def _scenarios() -> Registry:
 
 # ----------------------------------------------------------------------------------------- predicates
 def _exact(env: Environment, dynamics: LinearTrackingDynamics | None = None,
-           resolution: float = 0.01) -> ReachabilityOracle:
-    from .reachability.exact import ReachabilityOracle
+           resolution: float = 0.01) -> ExactCheck:
+    from .reachability.exact import ExactCheck
 
-    return ReachabilityOracle(env, dynamics, resolution=resolution)
+    return ExactCheck(env, dynamics, resolution=resolution)
 
 
 def _time_samples(value: str, env: Environment, dynamics: LinearTrackingDynamics | None = None) -> TimeSampledCheck:

@@ -30,8 +30,10 @@ DEPRECATED: dict[str, str] = {
     "qrrt_circuits.SearchPolicy, qrrt_circuits.search.policies.iteration.SearchPolicy": "IterationPolicy",
     "qrrt_circuits.search.schedules": "qrrt_circuits.search.policies.iteration",
     "qrrt_circuits.planners.base.DEFAULT_MAX_ROUNDS": "qrrt_circuits.planners.termination.DEFAULT_MAX_ROUNDS",
-    "ReachabilityOracle(check='time_samples', time_samples=K)": "TimeSampledCheck(env, dynamics, time_samples=K)",
+    "ExactCheck(check='time_samples', time_samples=K)": "TimeSampledCheck(env, dynamics, time_samples=K)",
     "PlanResult.budget_exhausted": "not PlanResult.reached",
+    "ReachabilityOracle (the exact predicate)": "ExactCheck",
+    "PaperSchedule (the paper's iteration counts)": "PaperIterations",
 }
 
 

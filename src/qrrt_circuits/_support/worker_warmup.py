@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from ..experiments import EXPERIMENTS  # noqa: F401  (every experiment, planner and backend)
 from ..experiments.worlds import world
-from ..reachability.exact import ReachabilityOracle
+from ..reachability.exact import ExactCheck
 
 #: the world built (and so cached) in every warm worker
 WARM_WORLD = ("paper_clutter", 0)
@@ -27,7 +27,7 @@ def warm_up() -> None:
     exact predicate (caching the paper dynamics' chord grid)."""
     import qiskit_aer  # noqa: F401  (the Aer backend's import, named: it is the heavy one)
 
-    ReachabilityOracle(world(*WARM_WORLD))
+    ExactCheck(world(*WARM_WORLD))
 
 
 warm_up()

@@ -18,7 +18,7 @@ Notes:
 
 * ``reachable`` is a Python loop calling ``si.checkMotion`` once per pair, and the validity checker
   built by ``from_environment`` is a Python callback called once per interpolated state, so this
-  predicate is much slower than the library's vectorized, compiled checks (``ReachabilityOracle``,
+  predicate is much slower than the library's vectorized, compiled checks (``ExactCheck``,
   ``TimeSampledCheck``). It is for interoperability, not speed.
 * Soundness is OMPL's: the ``DiscreteMotionValidator`` tests states at most one longest valid
   segment length L apart, so an obstacle thinner than L can be stepped over (and the parent state

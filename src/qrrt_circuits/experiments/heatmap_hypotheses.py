@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from ..search.policies.iteration import FixedIterations, PaperSchedule
+from ..search.policies.iteration import FixedIterations, PaperIterations
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import bootstrap_ratio_interval, differs, rounded_interval
@@ -37,7 +37,7 @@ from .worlds import world
 BOX_COUNTS = (50, 100, 150, 200, 250, 300, 400, 525)
 CUTS = (10, 20, 40)
 #: label -> (registry planner, search policy)
-VARIANTS = {"RRT": ("rrt", None), "QRRT paper": ("qrrt", PaperSchedule()), "QRRT k=2": ("qrrt", FixedIterations(2))}
+VARIANTS = {"RRT": ("rrt", None), "QRRT paper": ("qrrt", PaperIterations()), "QRRT k=2": ("qrrt", FixedIterations(2))}
 #: planner -> cut -> {"nodes", "efficiency"}
 PAPER: dict[str, dict[str, dict[str, float]]] = {
     "RRT": {"10": {"nodes": 125, "efficiency": 0.125}, "20": {"nodes": 231, "efficiency": 0.116},

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..reachability.exact import ReachabilityOracle
+from ..reachability.exact import ExactCheck
 from ..registry import PREDICATES
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
@@ -94,7 +94,7 @@ class OracleCheck(Experiment):
                                num_qubits=settings["num_qubits"], predicate=predicate)
         result = planner.plan(max_oracle_calls=settings["budget"])
         nodes, calls = cut_at(result, settings["budget"])
-        exact = ReachabilityOracle(env)
+        exact = ExactCheck(env)
         children = np.arange(1, nodes + 1)
         valid: np.ndarray | list[bool] = (
             exact.reachable(result.nodes[result.parents[children]], result.nodes[children]) if nodes else [])

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..hardware import resources as res
 from ..registry import PLANNERS, PREDICATES
-from ..search.policies.iteration import PaperSchedule
+from ..search.policies.iteration import PaperIterations
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import bootstrap_interval, rounded_interval
@@ -136,7 +136,7 @@ class Resources(Experiment):
             planner = PLANNERS.create("RRT", **options)
         else:
             planner = PLANNERS.create("QRRT", backend=plan_backend(), num_qubits=settings["plan_qubits"],
-                                      search_policy=PaperSchedule(), **options)
+                                      search_policy=PaperIterations(), **options)
         result = planner.plan(max_nodes=settings["nodes"])
         m = result.metrics
         return {"status": str(result.status), "nodes": m.nodes, "oracle_calls": m.oracle_calls,

@@ -33,7 +33,7 @@ from .._support.memory import MemoryEstimate, OutOfMemory, PlanSize
 from .._support.randomness import RandomStreams, Stream
 from .._support.validation import check_float, check_instance, check_real_array, check_seed
 from ..reachability.dynamics import LinearTrackingDynamics
-from ..reachability.exact import ReachabilityOracle
+from ..reachability.exact import ExactCheck
 from ..reachability.oracle_errors import OracleErrorModel
 from ..reachability.predicate import ReachabilityPredicate, can_leave, check_predicate
 from ..world.environment import Environment
@@ -68,7 +68,7 @@ def resolve_predicate(env: Environment, predicate: ReachabilityPredicate | None,
                       oracle: ReachabilityPredicate | None, dynamics: LinearTrackingDynamics | None,
                       resolution: float) -> ReachabilityPredicate:
     """The planner's predicate: ``predicate=`` (or its deprecated alias ``oracle=``), else the sound
-    ``ReachabilityOracle`` built with ``dynamics`` and ``resolution``."""
+    ``ExactCheck`` built with ``dynamics`` and ``resolution``."""
     if oracle is not None:
         warn_deprecated("the planners' oracle= argument", "predicate=")
         if predicate is not None and predicate is not oracle:
@@ -80,7 +80,7 @@ def resolve_predicate(env: Environment, predicate: ReachabilityPredicate | None,
             if dynamics.dim != env.dim:
                 raise ValueError(f"dimension mismatch: the dynamics act in d = {dynamics.dim}, the environment "
                                  f"has d = {env.dim}")
-        return ReachabilityOracle(env, dynamics, resolution=resolution)
+        return ExactCheck(env, dynamics, resolution=resolution)
     if dynamics is not None:
         raise ValueError("give dynamics= or predicate=, not both (a predicate carries its own motion model)")
     return check_predicate(predicate, env.dim)
@@ -100,7 +100,7 @@ class Planner:
         env: The ``Environment``: workspace bounds, obstacles and the default start, goal and goal
             radius.
         predicate: The ``ReachabilityPredicate`` that decides whether a child is reachable from its
-            parent (its ``dim`` must equal ``env.dim``). Default: the sound ``ReachabilityOracle``
+            parent (its ``dim`` must equal ``env.dim``). Default: the sound ``ExactCheck``
             of ``env`` built with ``dynamics`` and ``resolution``.
         dynamics: A ``LinearTrackingDynamics`` (same ``dim`` as ``env``) for the default predicate;
             give it only without ``predicate`` (a predicate carries its own motion model). Default:
@@ -113,7 +113,7 @@ class Planner:
             planner's finalizer verifies every measured entry, so an error costs oracle calls only.
         goal_bias: Probability in [0, 1) that a sample is drawn in the goal ball instead of
             uniformly in the workspace. Default 0 (the paper's uniform sampling).
-        resolution: Clearance of the default ``ReachabilityOracle`` in length units (> 0, finite;
+        resolution: Clearance of the default ``ExactCheck`` in length units (> 0, finite;
             default 0.01): a free trajectory is accepted if it passes farther than (1 + sqrt(d)) *
             resolution from every obstacle and 2 * resolution from the workspace boundary. Unused
             when ``predicate`` is given.
@@ -134,7 +134,7 @@ class Planner:
             between ``env`` and ``predicate`` or ``dynamics``, both ``predicate`` and ``oracle``
             (or both ``predicate`` and ``dynamics``) given, or, for the default predicate, a
             ``resolution`` that is not finite and > 0 or one too fine for the workspace
-            (``ReachabilityOracle``).
+            (``ExactCheck``).
     """
 
     name = "planner"

@@ -32,7 +32,7 @@ from ..reachability.dynamics import LinearTrackingDynamics
 from ..reachability.oracle_errors import OracleErrorModel
 from ..reachability.predicate import ReachabilityPredicate
 from ..search.backend import QuantumSearchBackend
-from ..search.policies.iteration import IterationPolicy, PaperSchedule, PolicyState
+from ..search.policies.iteration import IterationPolicy, PaperIterations, PolicyState
 from ..world.environment import Environment
 from .base import Planner
 from .classical import MAX_WORKERS
@@ -75,7 +75,7 @@ class PQRRT(Planner):
             the extra copies counted as ``duplicates``). False: each worker builds and searches its
             own database. Must be a ``bool``.
         search_policy: The ``IterationPolicy`` that decides how each worker searches a database:
-            ``PaperSchedule()`` (the default: 5 Grover iterations, 3 once the tree has more than 10
+            ``PaperIterations()`` (the default: 5 Grover iterations, 3 once the tree has more than 10
             nodes), ``FixedIterations(k)``, ``KnownOptimal()`` (Eq. 1 with the true m), ``BBHT()``,
             ``Adaptive()``, ``FixedPointAmplification()``, ``EstimatedOptimal()`` or any other
             ``IterationPolicy``.
@@ -130,9 +130,9 @@ class PQRRT(Planner):
             if search_policy is not None and search_policy is not iterations:
                 raise ValueError("give search_policy= or its deprecated alias iterations=, not both")
             policy = iterations
-        policy = PaperSchedule() if policy is None else policy
+        policy = PaperIterations() if policy is None else policy
         check_instance(policy, "search_policy", IterationPolicy,
-                       "a search policy (PaperSchedule(), FixedIterations(k), KnownOptimal(), BBHT(), Adaptive())")
+                       "a search policy (PaperIterations(), FixedIterations(k), KnownOptimal(), BBHT(), Adaptive())")
         if annealing is not None:
             check_instance(annealing, "annealing", AnnealingSchedule, "an AnnealingSchedule or None")
         super().__init__(env, predicate=predicate, dynamics=dynamics, oracle_errors=oracle_errors,
@@ -281,7 +281,7 @@ class QRRT(PQRRT):
         backend: The ``QuantumSearchBackend`` of the searches. Default: a new ``AerBackend()``.
         num_qubits: Qubits n per database (N = 2^n entries), 1 .. the backend's ``max_qubits``.
             Default 8.
-        search_policy: The ``IterationPolicy`` of the searches. Default: ``PaperSchedule()``.
+        search_policy: The ``IterationPolicy`` of the searches. Default: ``PaperIterations()``.
         annealing: An ``AnnealingSchedule`` (Quantum Database Annealing), or None (default).
         iterations: Deprecated alias of ``search_policy``.
 

@@ -5,9 +5,9 @@ t in [0, T], stays in the workspace and outside every obstacle. The check is con
 documented ``resolution`` (default 0.01 length units): any trajectory that touches an obstacle is
 rejected, and a collision-free one is only rejected if it passes within
 (1 + sqrt(d)) * ``resolution`` of an obstacle or 2 * ``resolution`` of the workspace boundary
-(``ReachabilityOracle.false_rejection_bound``; the derivation is in ``qrrt_circuits.reachability.collision``).
+(``ExactCheck.false_rejection_bound``; the derivation is in ``qrrt_circuits.reachability.collision``).
 
-``ReachabilityOracle`` implements the ``ReachabilityPredicate`` protocol
+``ExactCheck`` implements the ``ReachabilityPredicate`` protocol
 (``qrrt_circuits.reachability.predicate``). ``OracleErrorModel`` lives in
 ``qrrt_circuits.reachability.oracle_errors`` and is re-exported here.
 """
@@ -26,7 +26,7 @@ from .dynamics import MAX_PROPAGATOR_BYTES, LinearTrackingDynamics
 from .oracle_errors import OracleErrorModel
 from .predicate import as_pairs
 
-__all__ = ["OracleErrorModel", "ReachabilityOracle"]
+__all__ = ["OracleErrorModel", "ExactCheck"]
 
 
 def chord_grid(
@@ -119,7 +119,7 @@ _CHORD_GRIDS: dict[_ChordGridKey, tuple[np.ndarray, np.ndarray, np.ndarray]] = {
 _CHORD_GRIDS_KEPT = 64
 
 
-class ReachabilityOracle:
+class ExactCheck:
     """The sound reachability predicate (DESIGN §2): the truth the quantum oracle marks by.
 
     A pair (p, c) is reachable iff x(t) = c + expm((A - BK) t)(p - c), t in [0, T], stays in the
@@ -157,9 +157,9 @@ class ReachabilityOracle:
 
     Example:
         >>> import numpy as np
-        >>> from qrrt_circuits import Environment, ReachabilityOracle
+        >>> from qrrt_circuits import Environment, ExactCheck
         >>> env = Environment([[0, 10], [0, 10]], [[[4, 0], [6, 6]]])  # one wall from below
-        >>> oracle = ReachabilityOracle(env)
+        >>> oracle = ExactCheck(env)
         >>> parents = np.array([[1.0, 8.0], [1.0, 1.0]])
         >>> children = np.array([[3.0, 8.0], [8.0, 1.0]])  # the second crosses the wall
         >>> oracle.reachable(parents, children).tolist(), oracle.evaluations
@@ -171,12 +171,12 @@ class ReachabilityOracle:
 
     def __new__(cls, env: Environment, dynamics: LinearTrackingDynamics | None = None,
                 resolution: float = 0.01, check: str = "exact", time_samples: int = 50) -> Any:
-        # Any: a ReachabilityOracle, or for check="time_samples" a TimeSampledCheck (the alias)
+        # Any: a ExactCheck, or for check="time_samples" a TimeSampledCheck (the alias)
         if check == "time_samples":
             from .._support.deprecation import warn_deprecated
             from .time_sampled import TimeSampledCheck
 
-            warn_deprecated("ReachabilityOracle(check='time_samples', time_samples=K)",
+            warn_deprecated("ExactCheck(check='time_samples', time_samples=K)",
                             "TimeSampledCheck(env, dynamics, time_samples=K)")
 
             return TimeSampledCheck(env, dynamics, time_samples=time_samples)
@@ -276,3 +276,13 @@ class ReachabilityOracle:
         )
         self.evaluations += int(parents.shape[0])
         return out
+
+
+def __getattr__(name: str) -> Any:
+    """Deprecated names of this module."""
+    if name == "ReachabilityOracle":
+        from .._support.deprecation import warn_deprecated
+
+        warn_deprecated("ReachabilityOracle", "ExactCheck")
+        return ExactCheck
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -15,7 +15,7 @@ A predicate may also offer ``can_leave(point) -> bool``: False where it is certa
 every motion from ``point`` (the planners then refuse such a start before any work). Without it,
 every start is assumed able to leave (the stall limit ends a plan that cannot grow).
 
-Implementations here: ``ReachabilityOracle`` (sound, exact up to a resolution), ``TimeSampledCheck``
+Implementations here: ``ExactCheck`` (sound, exact up to a resolution), ``TimeSampledCheck``
 (tests time samples only; unsound, for study) and, with the ``ompl`` extra,
 ``qrrt_circuits.adapters.ompl.OMPLMotionPredicate``. Any object with these four members works:
 planners, experiments and plotting never ask which class it is.

@@ -46,12 +46,12 @@ class TimeSampledCheck:
 
     Example:
         >>> import numpy as np
-        >>> from qrrt_circuits import Environment, ReachabilityOracle, TimeSampledCheck
+        >>> from qrrt_circuits import Environment, ExactCheck, TimeSampledCheck
         >>> env = Environment([[0, 10], [0, 10]], [[[5, 0], [5.01, 10]]])  # a thin wall
         >>> parent, child = np.array([[2.0, 5.0]]), np.array([[8.0, 5.0]])
         >>> TimeSampledCheck(env, time_samples=50).reachable(parent, child).tolist()  # stepped over
         [True]
-        >>> ReachabilityOracle(env).reachable(parent, child).tolist()
+        >>> ExactCheck(env).reachable(parent, child).tolist()
         [False]
     """
 

@@ -16,12 +16,12 @@ from .iteration import (
     FixedIterations,
     IterationPolicy,
     KnownOptimal,
-    PaperSchedule,
+    PaperIterations,
     PolicyState,
 )
 
 __all__ = ["BBHT", "Adaptive", "AdaptiveState", "BBHTOutcome", "FixedIterations", "IterationPolicy", "KnownOptimal",
-           "PaperSchedule", "PolicyState"]
+           "PaperIterations", "PolicyState"]
 
 
 def __getattr__(name: str) -> Any:

@@ -13,14 +13,14 @@ all outcomes back with ``state.learn(outcomes)``. The planner never asks which p
 ``state.run_many(problems, workers, tree_nodes)`` answers the same for several independent
 databases of one round: ``run`` on each, in order.
 
-Policies that pick one k before measuring (``PaperSchedule``, ``FixedIterations``,
+Policies that pick one k before measuring (``PaperIterations``, ``FixedIterations``,
 ``KnownOptimal``, ``Adaptive``) share the default ``run``: one backend search with ``shots =
 workers`` (each shot is one worker's independent preparation: the simulation shortcut of Pq-RRT),
 k quantum calls and 1 verification per worker. ``BBHT`` overrides ``run`` with its own loop per
 worker. A policy that needs several circuits per worker, or one estimate shared by all the workers
 of a shared database, overrides ``run`` the same way.
 
-- ``PaperSchedule()``: 5 iterations, 3 once the tree has more than 10 nodes (the authors' code).
+- ``PaperIterations()``: 5 iterations, 3 once the tree has more than 10 nodes (the authors' code).
 - ``FixedIterations(k)``: always k (Alg. 4 / QDA uses k = 2).
 - ``KnownOptimal()``: floor(pi / (4 theta)), sin^2 theta = m/N (Eq. 1), with the database's true
   marked count m. This is simulation knowledge a quantum device does not have: outputs say so.
@@ -59,7 +59,7 @@ __all__ = [
     "FixedIterations",
     "IterationPolicy",
     "KnownOptimal",
-    "PaperSchedule",
+    "PaperIterations",
     "PolicyState",
 ]
 
@@ -78,12 +78,12 @@ class IterationPolicy:
 
     Example:
         >>> import numpy as np
-        >>> from qrrt_circuits import DatabaseSearch, KnownOptimal, PaperSchedule, StatevectorBackend
+        >>> from qrrt_circuits import DatabaseSearch, KnownOptimal, PaperIterations, StatevectorBackend
         >>> from qrrt_circuits._support.randomness import RandomStreams
         >>> marks = np.zeros(64, dtype=bool)
         >>> marks[:2] = True
         >>> problem = DatabaseSearch(marks, marks, StatevectorBackend(seed=0), RandomStreams(0), 0)
-        >>> PaperSchedule().iterations_for(problem, 0), PaperSchedule().iterations_for(problem, 11)
+        >>> PaperIterations().iterations_for(problem, 0), PaperIterations().iterations_for(problem, 11)
         (5, 3)
         >>> KnownOptimal().iterations_for(problem, 0)  # floor(pi / (4 asin(sqrt(2/64))))
         4
@@ -171,6 +171,9 @@ def __getattr__(name: str) -> Any:
     if name == "SearchPolicy":
         warn_deprecated("SearchPolicy", "IterationPolicy")
         return IterationPolicy
+    if name == "PaperSchedule":
+        warn_deprecated("PaperSchedule", "PaperIterations")
+        return PaperIterations
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
@@ -294,7 +297,7 @@ def _check_iteration_count(value: Any, name: str) -> int:
 
 
 @dataclass(frozen=True)
-class PaperSchedule(IterationPolicy):
+class PaperIterations(IterationPolicy):
     """The authors' schedule: ``early`` iterations, then ``late`` once the tree is larger.
 
     The paper's q-RRT / Pq-RRT experiments (Alg. 2 / 3) use k = 5, then k = 3 once the tree has more
