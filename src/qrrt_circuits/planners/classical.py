@@ -14,7 +14,7 @@ and test all B x p pairs together. The rounds are then recorded one by one (the 
 condition checked before each, counters, history, error flips), up to and including the first round
 that adds a node. The later rounds' tests were made against the tree without that node, so they
 are counted in ``Metrics.wasted_checks``, never as oracle calls, and those rounds are tested again
-in the next batch (the same candidates, from the same keys, with their nearest nodes in the new
+in the next batch (the same candidates, kept from their draw, with their nearest nodes in the new
 tree). The tree, the counters and the status are those of one round at a time. B is the expected
 number of rounds up to the next success, ceil(1 / rate) with the Laplace estimate
 rate = (rounds that added + 1) / (rounds recorded + 2), at most ``MAX_BATCH_ROUNDS`` and at most
@@ -132,22 +132,27 @@ class ParallelRRT(Planner):
     def _run(self, state: RunState, condition: TerminationCondition, began: float) -> PlanStatus:
         """Rounds in batches: the candidates of the next B rounds drawn and tested together, then
         recorded round by round (the condition checked before each) up to the first round that adds
-        a node; the later rounds' tests are ``wasted_checks`` and those rounds are tested again. B is
-        ``batch_rounds`` (at most ``batch_round_limit``) in-process, 1 on an executor."""
+        a node; the later rounds' tests are ``wasted_checks`` and those rounds are tested again, with
+        the candidates already drawn (a round's candidates depend on its (round, worker) keys only).
+        B is ``batch_rounds`` (at most ``batch_round_limit``) in-process, 1 on an executor."""
         workers = self.workers
         changed = recorded = 0
         most = 1 if self.executor is not None else batch_round_limit(workers, self.env.dim)
+        drawn = np.empty((0, self.env.dim))  # candidates drawn for rounds first, first + 1, ... not yet recorded
         while state.goal_node is None:
             ended = condition.ended_by(state.progress(time.perf_counter() - began))
             if ended is not None:
                 return ended
             ahead = min(batch_rounds(changed, recorded), most)
             first = state.rounds
-            keys = np.empty((ahead * workers, 3), dtype=np.int64)
-            keys[:, 0] = np.repeat(np.arange(first, first + ahead), workers)
-            keys[:, 1] = np.tile(np.arange(workers), ahead)
-            keys[:, 2] = int(Stream.CANDIDATES)
-            children = self._candidates(state, keys)
+            kept = min(drawn.shape[0] // workers, ahead)  # a round's candidates depend on its key only
+            if kept < ahead:
+                keys = np.empty(((ahead - kept) * workers, 3), dtype=np.int64)
+                keys[:, 0] = np.repeat(np.arange(first + kept, first + ahead), workers)
+                keys[:, 1] = np.tile(np.arange(workers), ahead - kept)
+                keys[:, 2] = int(Stream.CANDIDATES)
+                drawn = np.concatenate((drawn[:kept * workers], self._candidates(state, keys)))
+            children = drawn[:ahead * workers]
             parents = state.tree.nearest(children)
             truth = self._test(state, state.tree.nodes[parents], children)
             for offset in range(ahead):
@@ -161,10 +166,11 @@ class ParallelRRT(Planner):
                 self._record(state, first + offset, children[rows], parents[rows], truth[rows])
                 state.end_round()
                 recorded += 1
-                if state.nodes != nodes_before:  # the tree changed: later candidates are stale
+                if state.nodes != nodes_before:  # the tree changed: later tests are stale, their candidates not
                     changed += 1
                     state.wasted_checks += (ahead - offset - 1) * workers
                     break
+            drawn = drawn[(offset + 1) * workers:]
         return PlanStatus.REACHED
 
     def _test(self, state: RunState, origins: np.ndarray, children: np.ndarray) -> np.ndarray:
