@@ -13,6 +13,7 @@ circuit is cached by its shape (marks, iterations), so a repeated search transpi
 
 from __future__ import annotations
 
+import threading
 from collections import OrderedDict
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
@@ -30,6 +31,10 @@ if TYPE_CHECKING:
     from qiskit.providers import BackendV2
 
     from ..fixed_point import IterateSequence
+
+
+#: held from setting a per-call seed on a sampler to its run's result (samplers may be shared)
+_SEEDED_RUN = threading.Lock()
 
 
 class SamplerBackend(QuantumSearchBackend):
@@ -180,8 +185,14 @@ class SamplerBackend(QuantumSearchBackend):
 
     def _execute(self, circuit: QuantumCircuit, shots: int, rng: np.random.Generator) -> np.ndarray:
         if self.per_call_seed:
-            self.sampler.options.run_options["seed_simulator"] = int(rng.integers(0, 2**31 - 1))
-        result = self.sampler.run([circuit], shots=shots).result()[0]
+            # the seed is a run option of the shared sampler, read when its job runs: one search at
+            # a time sets it and waits for its result, so threads never run with each other's seed
+            seed = int(rng.integers(0, 2**31 - 1))
+            with _SEEDED_RUN:
+                self.sampler.options.run_options["seed_simulator"] = seed
+                result = self.sampler.run([circuit], shots=shots).result()[0]
+        else:
+            result = self.sampler.run([circuit], shots=shots).result()[0]
         bitstrings = result.data.meas.get_bitstrings()
         return np.fromiter((int(bits, 2) for bits in bitstrings), dtype=np.int64,
                            count=len(bitstrings))
