@@ -5,7 +5,9 @@ finishes. Re-running with the same ``--out`` reads the file, skips finished tria
 rest; an interrupted run loses at most the trials in flight (a torn last line is dropped). The
 settings are stored in ``settings.json``; resuming with different settings is refused.
 ``summary.json`` = {"experiment", "settings", "ours", "paper", ...} and the figures are rewritten
-from all records at the end.
+from all records at the end. Both JSON files are strict JSON (a non-finite number is written as
+``null``) and written whole (``_support.json_files.write_json``: a temporary file renamed over the
+old one), and ``summary.json`` says ``"complete": true`` only once its figures are written.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from typing import TYPE_CHECKING, Any, cast
 
 from tqdm.auto import tqdm
 
+from .._support.json_files import dumps, write_json
 from .._support.validation import check_int, check_optional_int
 from .base import Experiment, Record, Settings, Summary, Trial
 from .records import RecordWriter, read_records
@@ -192,13 +195,13 @@ def _claim_directory(directory: Path, settings: Settings) -> None:
             raise ValueError(f"{settings_path} is corrupt (not a JSON object); use another --out or delete the folder")
         if "predicate" not in stored and settings.get("predicate") == "exact":
             stored["predicate"] = "exact"  # settings without a predicate are runs with the exact check
-            settings_path.write_text(json.dumps(stored, indent=1))
+            write_json(settings_path, stored)
         if stored != settings:
             raise ValueError(
                 f"{directory} holds results for other settings ({stored}); use another --out or "
                 "delete it")
     else:
-        settings_path.write_text(json.dumps(settings, indent=1))
+        write_json(settings_path, settings)
 
 
 def _execute(kind: str | None, executor: str | Executor | WorkerPool | None, name: str, todo: list[Trial],
@@ -257,10 +260,9 @@ def _summarize(experiment: Experiment, name: str, directory: Path, settings: Set
     summary = {"experiment": name, "title": experiment.title, "settings": settings,
                "ours": result.pop("ours"), "paper": result.pop("paper"), **result,
                "complete": True}
-    (directory / SUMMARY).write_text(json.dumps(summary, indent=1, default=float))
     figures = experiment.plot(records, settings, summary, directory)
     summary["figures"] = [str(path.name) for path in figures]
-    (directory / SUMMARY).write_text(json.dumps(summary, indent=1, default=float))
+    write_json(directory / SUMMARY, summary)  # complete only with its figures; non-finite numbers as null
     return summary
 
 
@@ -328,7 +330,7 @@ def run_experiment(
     settings = experiment.settings(quick, trials, int(seed))
     if experiment.uses_predicate:
         settings["predicate"] = PREDICATES.canonical(predicate)
-    settings = json.loads(json.dumps(settings))  # as stored
+    settings = json.loads(dumps(settings))  # as stored
     directory = Path(out) / name
     _claim_directory(directory, settings)
     all_trials = experiment.trials(settings)
