@@ -98,11 +98,14 @@ def check_float(value: Any, name: str, minimum: float | None = None, maximum: fl
     """
     if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
         raise TypeError(f"{name} must be a real number, got {value!r}")
-    value = float(value)
     low = "(" if open_minimum else "["
     text = (f"a finite number in {low}{minimum}, {maximum}]" if minimum is not None and maximum is not None
             else f"a finite number {'>' if open_minimum else '>='} {minimum}" if minimum is not None
             else f"a finite number <= {maximum}" if maximum is not None else "a finite number")
+    try:
+        value = float(value)
+    except OverflowError:  # an integer too large for a float
+        raise ValueError(f"{name} must be {text}, got an integer of {len(str(abs(int(value))))} digits") from None
     if not math.isfinite(value):
         raise ValueError(f"{name} must be {text}, got {value!r}")
     too_low = minimum is not None and (value <= minimum if open_minimum else value < minimum)
@@ -144,7 +147,11 @@ def check_probability(value: Any, name: str) -> float:
     """
     if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
         raise TypeError(f"{name} must be a probability in [0, 1], got {value!r}")
-    value = float(value)
+    try:
+        value = float(value)
+    except OverflowError:  # an integer too large for a float
+        raise ValueError(f"{name} must be a probability in [0, 1], got an integer of "
+                         f"{len(str(abs(int(value))))} digits") from None
     if not (0.0 <= value <= 1.0):
         raise ValueError(f"{name} must be a probability in [0, 1], got {value!r}")
     return value

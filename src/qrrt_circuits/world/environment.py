@@ -272,7 +272,10 @@ class Environment:
     def _check_points(self, points: np.ndarray) -> np.ndarray:
         """Points as a float array (..., d). Non-finite coordinates are allowed here and are never
         in bounds or free."""
-        points = np.asarray(points, dtype=float)
+        if isinstance(points, np.ndarray) and points.dtype.kind == "f":
+            points = np.asarray(points, dtype=float)
+        else:  # booleans and strings refused, not read as numbers
+            points = check_real_array(points, "points")
         if points.shape[-1:] != (self.dim,):
             raise ValueError(
                 f"points must have last dimension {self.dim} (the environment's d), "
