@@ -44,3 +44,13 @@ def test_a_failed_write_leaves_the_old_file_and_no_temporary(tmp_path, monkeypat
 @pytest.mark.parametrize("path", sorted(RESULTS.glob("*/summary.json")), ids=lambda p: p.parent.name)
 def test_every_committed_summary_is_strict_json(path):
     _strict_load(path.read_text())
+
+
+@pytest.mark.parametrize("predicate", ["time-samples:1", "time-samples:2000000", "time-samples:abc"])
+def test_a_refused_predicate_writes_nothing(tmp_path, predicate):
+    """The corrected command into the same folder must not find a settings.json of the refused one."""
+    from qrrt_circuits.experiments import run_experiment
+
+    with pytest.raises(ValueError, match="time.samples"):
+        run_experiment("heatmaps", out=tmp_path, quick=True, progress=False, predicate=predicate)
+    assert list(tmp_path.iterdir()) == []

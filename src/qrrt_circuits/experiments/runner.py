@@ -22,10 +22,12 @@ from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
 
+import numpy as np
 from tqdm.auto import tqdm
 
 from .._support.json_files import dumps, write_json
 from .._support.validation import check_int, check_optional_int
+from ..world.environment import Environment
 from .base import Experiment, Record, Settings, Summary, Trial
 from .records import RecordWriter, read_records
 
@@ -147,6 +149,8 @@ def _check_arguments(name: str, trials: int | None, seed: int, executor: str | E
     check_optional_int(trials, "trials", 1, MAX_TRIALS)
     check_int(seed, "seed", 0)
     PREDICATES.resolve(predicate)
+    # its parameter (time-samples:K, ...) checked by building it once, before any file is written
+    PREDICATES.create(predicate, env=Environment(np.array([[0.0, 1.0], [0.0, 1.0]]), np.zeros((0, 2, 2))))
     if not EXPERIMENTS[name].uses_predicate and PREDICATES.canonical(predicate) != "exact":
         raise ValueError(f"experiment {name!r} does not take a predicate (it plans nothing with one); "
                          "run it without --predicate")
