@@ -2,21 +2,21 @@
 
 ``strict(value)`` is ``value`` with every non-finite number (NaN, +-Infinity, which strict parsers
 such as a browser's ``JSON.parse`` refuse) replaced by ``null`` and numpy scalars and arrays turned
-into Python numbers and lists. ``write_json`` writes ``json.dumps(strict(value), indent=1)`` to a
-temporary file in the target's folder, flushes it to disk and renames it over the target, so a
-reader finds the old file or the new one, never a part of either.
+into Python numbers and lists. ``write_json`` writes ``json.dumps(strict(value), indent=1)``
+through ``output_files.write_replacing`` (a temporary file in the target's folder, flushed to disk
+and renamed over the target), so a reader finds the old file or the new one, never a part of either.
 """
 
 from __future__ import annotations
 
 import json
 import math
-import os
-import tempfile
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
+
+from .output_files import write_replacing
 
 
 def strict(value: Any) -> Any:
@@ -45,26 +45,19 @@ def dumps(value: Any) -> str:
 
 
 def write_json(path: Path, value: Any) -> None:
-    """Write ``dumps(value)`` to ``path`` atomically (temporary file, fsync, rename).
+    """Write ``dumps(value)`` to ``path`` whole (``output_files.write_replacing``: a temporary file,
+    fsync, rename).
 
     Raises:
-        OSError: The folder cannot be written (a full disk, say), naming ``path``; the target is
-            then left as it was and no temporary file remains.
+        OSError: The write failed (a full disk, say), naming ``path``; the target is then left as it
+            was and no temporary file remains.
     """
-    path = Path(path)
     text = dumps(value)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+
+    def write(handle: IO[Any]) -> None:
+        handle.write(text)
+
     try:
-        with os.fdopen(handle, "w") as stream:
-            stream.write(text)
-            stream.flush()
-            os.fsync(stream.fileno())
-        os.replace(temporary, path)
-    except BaseException as exc:
-        try:
-            os.unlink(temporary)
-        except OSError:
-            pass
-        if isinstance(exc, OSError):
-            raise OSError(exc.errno, f"could not write {path}: {exc.strerror or exc}") from exc
-        raise
+        write_replacing(Path(path), write)
+    except OSError as exc:
+        raise OSError(exc.errno, f"could not write {path}: {exc.strerror or exc}") from exc
