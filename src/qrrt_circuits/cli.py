@@ -289,9 +289,10 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     names = sorted(EXPERIMENTS) if args.experiment == "all" else [args.experiment]
     if args.predicate != "exact":  # 'all' with another check: the experiments that plan with one
         names = [name for name in names if EXPERIMENTS[name].uses_predicate or args.experiment != "all"]
-    for name in names:  # bad arguments are refused before any worker starts
+    for name in names:  # bad arguments and folders are refused before any experiment runs
         check_experiment_arguments(name, trials=args.trials, seed=args.seed, executor=args.executor,
-                                   jobs=args.jobs, scheduler=args.scheduler, predicate=args.predicate)
+                                   jobs=args.jobs, scheduler=args.scheduler, predicate=args.predicate,
+                                   out=args.out, quick=args.quick)
     # one pool or Dask cluster for every experiment, started when the first trial needs it; with
     # workers, an experiment's summary and figures are made while the next one's trials run
     with WorkerPool(args.executor, args.jobs, args.scheduler) as pool:

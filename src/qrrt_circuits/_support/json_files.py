@@ -3,7 +3,7 @@
 ``strict(value)`` is ``value`` with every non-finite number (NaN, +-Infinity, which strict parsers
 such as a browser's ``JSON.parse`` refuse) replaced by ``null`` and numpy scalars and arrays turned
 into Python numbers and lists. ``write_json`` writes ``json.dumps(strict(value), indent=1)``
-through ``output_files.write_replacing`` (a temporary file in the target's folder, flushed to disk
+through ``output_files.write_result_file`` (a temporary file in the target's folder, flushed to disk
 and renamed over the target), so a reader finds the old file or the new one, never a part of either.
 """
 
@@ -16,7 +16,7 @@ from typing import IO, Any
 
 import numpy as np
 
-from .output_files import write_replacing
+from .output_files import write_result_file
 
 
 def strict(value: Any) -> Any:
@@ -45,7 +45,7 @@ def dumps(value: Any) -> str:
 
 
 def write_json(path: Path, value: Any) -> None:
-    """Write ``dumps(value)`` to ``path`` whole (``output_files.write_replacing``: a temporary file,
+    """Write ``dumps(value)`` to ``path`` whole (``output_files.write_result_file``: a temporary file,
     fsync, rename).
 
     Raises:
@@ -57,7 +57,4 @@ def write_json(path: Path, value: Any) -> None:
     def write(handle: IO[Any]) -> None:
         handle.write(text)
 
-    try:
-        write_replacing(Path(path), write)
-    except OSError as exc:
-        raise OSError(exc.errno, f"could not write {path}: {exc.strerror or exc}") from exc
+    write_result_file(Path(path), write)

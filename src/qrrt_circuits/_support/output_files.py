@@ -157,6 +157,25 @@ def write_replacing(path: Path, write: Callable[[IO[Any]], None], binary: bool =
         raise
 
 
+def write_result_file(path: Path, write: Callable[[IO[Any]], None], binary: bool = False) -> None:
+    """``write_replacing`` for a file a run produces (a summary, a figure): a failed write's error
+    names the file.
+
+    Args:
+        path: The output path.
+        write: Writes the content to the file object it is given.
+        binary: Whether ``write`` writes bytes.
+
+    Raises:
+        OSError: The write failed (a full disk, say), naming ``path``; a replaced file is then left
+            as it was and no temporary file remains.
+    """
+    try:
+        write_replacing(Path(path), write, binary)
+    except OSError as exc:
+        raise OSError(exc.errno, f"could not write {path}: {exc.strerror or exc}") from exc
+
+
 #: /dev/fd/N and /proc/self/fd/N; /dev/stdout and /dev/stderr
 _DESCRIPTOR_PATH = re.compile(r"^/(?:dev/fd|proc/self/fd)/(\d+)$")
 _STANDARD_PATHS = {"/dev/stdout": 1, "/dev/stderr": 2}

@@ -8,6 +8,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._support.output_files import write_result_file
+
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.colors import Normalize
@@ -40,6 +42,9 @@ def new_figure(rows: int = 1, cols: int = 1, size: tuple[float, float] | None = 
 def save(fig: Figure, path: Path, tight: bool = True) -> Path:
     """Lay out ``fig`` (``tight_layout``), write it to ``path`` (110 dpi) and close it.
 
+    The file is replaced whole (``output_files.write_result_file``): a failed write (a full disk)
+    leaves the old figure, or none, never part of one.
+
     Args:
         fig: The figure.
         path: Where to write it (the format follows the suffix).
@@ -53,8 +58,11 @@ def save(fig: Figure, path: Path, tight: bool = True) -> Path:
 
     if tight:
         fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    try:
+        write_result_file(path, lambda handle: fig.savefig(handle, dpi=110, format=path.suffix.lstrip(".")),
+                        binary=True)
+    finally:
+        plt.close(fig)
     return path
 
 

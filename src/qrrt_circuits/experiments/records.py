@@ -1,18 +1,135 @@
-"""records.csv: one row per finished trial, appended and flushed as trials finish.
+"""records.csv: one row per finished trial, appended and flushed (fsync) as trials finish.
 
-A torn last line (the writer was killed mid-write) or a row of the wrong width is dropped and the
-file rewritten without it, so an interrupted run loses at most the trials in flight. Records are
-keyed by ``trial_id``: a second row with the same id (a file edited or concatenated by hand) is
-dropped with a warning, so no trial is ever counted twice.
+The file is only ever appended to. Reading it never changes it:
+
+- a line counts only once it ends with a line break, so a torn last line (the writer was killed
+  mid-write, or the disk filled) is not a record; a torn first line is a torn header: the file
+  holds no record yet;
+- with a ``RecordSchema`` (the runner always gives one), the header must name the experiment's
+  columns (``RecordsError`` naming the file and the column otherwise), and each row is checked
+  against its trial: ``seed`` and the trial's parameters must be the trial's own values, and each
+  measurement must be of its column's kind (``columns.ColumnKind``). A row that fails, has the
+  wrong number of cells or names no trial of the run is excluded, never counted, and reported
+  (file, line, column, value) in one ``RecordsWarning``; its trial runs again;
+- a second valid row of a trial (a file concatenated by hand) is reported and excluded: each trial
+  counts once, by its first valid row.
+
+Before appending, ``RecordWriter`` moves a torn last line out of the way: its bytes are appended to
+``records.csv.torn`` beside it, then the file is cut back to its last line break. Only bytes that
+were never a record are removed, so the count of valid records never decreases.
 """
 
 from __future__ import annotations
 
 import csv
+import io
 import os
 import warnings
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+from .base import Trial
+from .columns import ColumnKind, column_kind
+
+__all__ = ["RecordSchema", "RecordWriter", "RecordsError", "RecordsWarning", "check_records_header", "read_records"]
+
+#: the columns every record starts with
+_KEYS = ("trial_id", "seed")
+#: the most excluded rows a warning lists one by one
+_LISTED = 5
+
+
+class RecordsError(ValueError):
+    """A records.csv whose header cannot be used; the message names the file and the column."""
+
+
+class RecordsWarning(UserWarning):
+    """Rows of a records.csv were excluded (each named by file, line, column and value)."""
+
+
+def cell_text(value: Any) -> str:
+    """The text a value is written as in records.csv (None as an empty cell).
+
+    Args:
+        value: A JSON scalar.
+
+    Returns:
+        Its cell text.
+    """
+    return "" if value is None else str(value)
+
+
+@dataclass(frozen=True)
+class RecordSchema:
+    """What each row of one run's records.csv must hold: the run's trials, by id.
+
+    Attributes:
+        trials: Every trial of the run, by id.
+    """
+
+    trials: Mapping[str, Trial]
+
+    @classmethod
+    def of(cls, trials: Iterable[Trial]) -> RecordSchema:
+        """The schema of a run of ``trials``.
+
+        Args:
+            trials: The run's trials (unique ids).
+
+        Returns:
+            The schema.
+        """
+        return cls({trial.id: trial for trial in trials})
+
+    def header_problem(self, header: list[str]) -> str | None:
+        """Why ``header`` is not a header of this run's records, or None if it is one.
+
+        Args:
+            header: The column names of the file's first line.
+
+        Returns:
+            A reason naming the column, or None.
+        """
+        seen: set[str] = set()
+        for name in header:
+            if name in seen:
+                return f"column {name!r} appears twice"
+            seen.add(name)
+        parameters = {name for trial in self.trials.values() for name in trial.params}
+        for name in (*_KEYS, *sorted(parameters)):
+            if name not in seen:
+                return f"column {name!r} is missing"
+        for name in header:
+            if name not in parameters and name not in _KEYS and column_kind(name) is None:
+                return f"column {name!r} is not a column of any experiment's records"
+        return None
+
+    def row_problem(self, row: Mapping[str, str]) -> str | None:
+        """Why ``row`` (column name to cell text) is not a record of its trial, or None.
+
+        Args:
+            row: One row of a file whose header passed ``header_problem``.
+
+        Returns:
+            A reason naming the column and the value, or None.
+        """
+        trial = self.trials.get(row["trial_id"])
+        if trial is None:
+            return f"column 'trial_id': {row['trial_id']!r} is no trial of this run"
+        expected = {"seed": cell_text(trial.seed), **{name: cell_text(v) for name, v in trial.params.items()}}
+        for name, text in expected.items():
+            if row[name] != text:
+                return f"column {name!r}: {row[name]!r} is not this trial's value {text!r}"
+        for name, cell in row.items():
+            kind = column_kind(name)
+            if name in expected or name in _KEYS or kind is None:  # (another trial's parameter)
+                continue
+            problem = kind.problem(cell)
+            if problem is not None:
+                return f"column {name!r}: {problem}"
+        return None
 
 
 def _convert(value: str) -> int | float | bool | str | None:
@@ -28,68 +145,130 @@ def _convert(value: str) -> int | float | bool | str | None:
     return value
 
 
-def read_records(path: Path) -> list[dict[str, Any]]:
-    """Rows of a records.csv (numbers converted). A torn last line (no newline: the writer was
-    killed mid-write) or a row of the wrong width is dropped and the file rewritten without it.
+def _value(name: str, cell: str) -> int | float | bool | str | None:
+    """A cell read back: text columns stay text, other cells are converted (``_convert``)."""
+    if column_kind(name) is ColumnKind.TEXT:
+        return cell or None
+    return _convert(cell)
+
+
+def _lines(path: Path) -> list[str]:
+    """The file's complete lines (a last line without its line break is torn: left out)."""
+    text = path.read_bytes().decode("utf-8", errors="replace")
+    return text.split("\n")[:-1]
+
+
+def read_records(path: Path, schema: RecordSchema | None = None) -> list[dict[str, Any]]:
+    """The valid records of a records.csv (see the module docstring); the file is not changed.
 
     Args:
         path: The ``records.csv`` file (need not exist).
+        schema: The run's schema; None checks only each row's width and the trial ids' uniqueness.
 
     Returns:
-        One dict per kept row, column name to value (ints, floats and booleans converted back,
-        empty cells as None); ``[]`` for a missing or empty file.
+        One dict per valid row, in file order, column name to value (numbers and booleans converted
+        back, text columns kept as text, empty cells as None); ``[]`` for a missing file or one
+        without a complete header.
+
+    Raises:
+        RecordsError: The header does not fit ``schema``.
 
     Warns:
-        UserWarning: For each dropped second row of a ``trial_id``.
+        RecordsWarning: Once, listing the rows excluded.
     """
     if not path.exists():
         return []
-    text = path.read_text()
-    lines = text.split("\n")
-    torn = bool(lines and lines[-1])  # text does not end with a newline
-    lines = lines[:-1]
-    rows = list(csv.reader(lines))
-    if not rows:
+    lines = _lines(path)
+    if not lines:
         return []
-    header, body = rows[0], rows[1:]
-    good = [row for row in body if len(row) == len(header)]
-    if "trial_id" in header:
-        column, seen, unique = header.index("trial_id"), set(), []
-        for row in good:
-            if row[column] in seen:
-                warnings.warn(f"{path}: a second record of trial {row[column]!r} was dropped (each trial "
-                              "counts once)", stacklevel=2)
-                continue
-            seen.add(row[column])
-            unique.append(row)
-        good = unique
-    if torn or len(good) != len(body):
-        _rewrite(path, header, good)
-    return [{key: _convert(value) for key, value in zip(header, row, strict=True)} for row in good]
+    header = next(csv.reader([lines[0]]))
+    if schema is not None:
+        _check_header(path, header, schema)
+    excluded: list[str] = []
+    first_line: dict[str, int] = {}
+    records: list[dict[str, Any]] = []
+    for number, line in enumerate(lines[1:], start=2):
+        cells = next(csv.reader([line]), [])
+        if len(cells) != len(header):
+            excluded.append(f"line {number}: {len(cells)} cells, the header has {len(header)}")
+            continue
+        row = dict(zip(header, cells, strict=True))
+        problem = schema.row_problem(row) if schema is not None else None
+        if problem is None and "trial_id" in row and row["trial_id"] in first_line:
+            problem = f"a second record of trial {row['trial_id']!r} (line {first_line[row['trial_id']]} counts)"
+        if problem is not None:
+            excluded.append(f"line {number}: {problem}")
+            continue
+        if "trial_id" in row:
+            first_line[row["trial_id"]] = number
+        records.append({name: _value(name, cell) for name, cell in row.items()})
+    if excluded:
+        listed = "; ".join(excluded[:_LISTED]) + (f"; and {len(excluded) - _LISTED} more" if len(excluded) > _LISTED
+                                                  else "")
+        warnings.warn(f"{path}: {len(excluded)} row(s) excluded, never counted (their trials run again): {listed}",
+                      RecordsWarning, stacklevel=2)
+    return records
 
 
-def _rewrite(path: Path, header: list[str], rows: list[list[str]]) -> None:
-    temporary = path.with_suffix(".tmp")
-    with temporary.open("w", newline="") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(header)
-        writer.writerows(rows)
-    os.replace(temporary, path)
+def check_records_header(path: Path, schema: RecordSchema) -> None:
+    """Refuse a records.csv whose (complete) header does not fit ``schema``; reads only its first line.
+
+    Args:
+        path: The ``records.csv`` file (need not exist).
+        schema: The run's schema.
+
+    Raises:
+        RecordsError: The header does not fit, naming the file and the column.
+    """
+    if not path.exists():
+        return
+    with path.open("rb") as handle:
+        first = handle.readline()
+    if first.endswith(b"\n"):  # (a torn header is no header: the file holds no record yet)
+        _check_header(path, next(csv.reader([first.decode("utf-8", errors="replace")])), schema)
+
+
+def _check_header(path: Path, header: list[str], schema: RecordSchema) -> None:
+    problem = schema.header_problem(header)
+    if problem is not None:
+        raise RecordsError(f"{path} line 1: {problem}, so its records cannot be checked; move the file away "
+                           "(or use another --out) and run again")
+
+
+def _set_torn_tail_aside(path: Path) -> None:
+    """Append a torn last line's bytes to ``records.csv.torn`` and cut the file back to its last
+    line break (nothing else is removed)."""
+    with path.open("rb") as handle:
+        data = handle.read()
+    if not data or data.endswith(b"\n"):
+        return
+    keep = data.rfind(b"\n") + 1  # 0: the header itself is torn
+    aside = path.with_name(path.name + ".torn")
+    with aside.open("ab") as handle:
+        handle.write(data[keep:] + b"\n")
+        handle.flush()
+        os.fsync(handle.fileno())
+    os.truncate(path, keep)
 
 
 class RecordWriter:
     """Appends records to records.csv, one flushed line per trial.
 
     Args:
-        path: The ``records.csv`` file; an existing file's header fixes the columns.
+        path: The ``records.csv`` file; an existing file's header fixes the columns. A torn last
+            line is set aside first (see the module docstring).
+        schema: The run's schema: a record that does not fit it is refused before it is written.
     """
 
-    def __init__(self, path: Path) -> None:
+    def __init__(self, path: Path, schema: RecordSchema | None = None) -> None:
         self.path = path
+        self.schema = schema
         self.header: list[str] | None = None
-        if path.exists() and path.stat().st_size:
-            with path.open(newline="") as handle:
-                self.header = next(csv.reader(handle), None)
+        if path.exists():
+            _set_torn_tail_aside(path)
+            lines = _lines(path)
+            if lines:
+                self.header = next(csv.reader([lines[0]]))
 
     def write(self, record: dict[str, Any]) -> None:
         """Append ``record`` as one row and flush it to disk (fsync).
@@ -98,15 +277,32 @@ class RecordWriter:
             record: Column name to value; the first record written fixes the columns.
 
         Raises:
-            ValueError: If its columns differ from the file's header.
+            ValueError: Its columns differ from the file's header, or it does not fit the schema
+                (a bug in the experiment that made it).
+            OSError: The write failed (a full disk); the message names the file and says that a
+                re-run resumes.
         """
+        header = self.header or list(record)
+        if set(record) != set(header):
+            raise ValueError(f"record columns {sorted(record)} differ from the file's {sorted(header)}")
+        cells = [cell_text(record[name]) for name in header]
+        if self.schema is not None:
+            problem = self.schema.header_problem(header) or self.schema.row_problem(dict(zip(header, cells,
+                                                                                          strict=True)))
+            if problem is not None:
+                raise ValueError(f"trial {record.get('trial_id')!r} made a record that does not fit the "
+                                 f"records of its experiment: {problem}")
+        text = io.StringIO()
+        writer = csv.writer(text)
         if self.header is None:
-            self.header = list(record)
-            with self.path.open("w", newline="") as handle:
-                csv.writer(handle).writerow(self.header)
-        if set(record) != set(self.header):
-            raise ValueError(f"record columns {sorted(record)} differ from the file's {sorted(self.header)}")
-        with self.path.open("a", newline="") as handle:
-            csv.writer(handle).writerow(["" if record[key] is None else record[key] for key in self.header])
-            handle.flush()
-            os.fsync(handle.fileno())
+            writer.writerow(header)
+        writer.writerow(cells)
+        try:
+            with self.path.open("a", newline="") as handle:
+                handle.write(text.getvalue())
+                handle.flush()
+                os.fsync(handle.fileno())
+        except OSError as exc:
+            raise OSError(exc.errno, f"{self.path}: {exc.strerror or exc}; the records written before are kept "
+                                     "(run the same command again to resume)") from exc
+        self.header = header

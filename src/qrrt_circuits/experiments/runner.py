@@ -3,7 +3,9 @@
 ``DIR/EXPERIMENT/records.csv`` gets one row per trial, written and flushed as soon as the trial
 finishes. Re-running with the same ``--out`` reads the file, skips finished trials and runs the
 rest; an interrupted run loses at most the trials in flight (a torn last line is dropped). The
-settings are stored in ``settings.json``; resuming with different settings is refused.
+settings are stored in ``settings.json``; resuming with different settings is refused. Each row is
+checked against its trial on resume (``records.RecordSchema``): a row that fails is reported and
+excluded, never counted, and its trial runs again; the file is never rewritten.
 ``summary.json`` = {"experiment", "settings", "ours", "paper", ...} and the figures are rewritten
 from all records at the end. Both JSON files are strict JSON (a non-finite number is written as
 ``null``) and written whole (``_support.json_files.write_json``: a temporary file renamed over the
@@ -29,7 +31,7 @@ from .._support.json_files import dumps, write_json
 from .._support.validation import check_int, check_optional_int
 from ..world.environment import Environment
 from .base import Experiment, Record, Settings, Summary, Trial
-from .records import RecordWriter, read_records
+from .records import RecordSchema, RecordWriter, check_records_header, read_records
 
 if TYPE_CHECKING:
     from .._support.execution import WorkerPool
@@ -163,9 +165,10 @@ def _check_arguments(name: str, trials: int | None, seed: int, executor: str | E
 
 def check_experiment_arguments(name: str, trials: int | None = None, seed: int = 0,
                                executor: str | Executor | WorkerPool | None = None, jobs: int | None = None,
-                               scheduler: str | None = None, predicate: str = "exact") -> None:
-    """Refuse the arguments ``run_experiment`` would refuse, without doing anything (so a caller
-    running several experiments can check them all before starting workers).
+                               scheduler: str | None = None, predicate: str = "exact",
+                               out: str | Path | None = None, quick: bool = False) -> None:
+    """Refuse the arguments ``run_experiment`` would refuse, without writing anything (so a caller
+    running several experiments can check them all, their folders included, before any runs).
 
     Args:
         name: An ``EXPERIMENTS`` name.
@@ -175,42 +178,87 @@ def check_experiment_arguments(name: str, trials: int | None = None, seed: int =
         jobs: Worker processes for a pool built by the runner.
         scheduler: A Dask scheduler's address (``executor="dask"`` only).
         predicate: A ``PREDICATES`` name (only ``"exact"`` for experiments that take none).
+        out: The results folder: ``out/name`` is checked as ``run_experiment`` would check it
+            (results for other settings, a corrupt ``settings.json``, records without settings, a
+            records header that does not fit); None checks no folder.
+        quick: The ``quick`` of the run (it is part of the settings checked against ``out``).
 
     Raises:
-        ValueError: If an argument is out of range or names nothing known.
+        ValueError: If an argument is out of range or names nothing known, or ``out/name`` cannot
+            take this run.
         TypeError: If an argument has the wrong type.
     """
     _check_arguments(name, trials, seed, executor, jobs, scheduler, predicate)
+    if out is not None:
+        settings = _run_settings(name, quick, trials, seed, predicate)
+        _check_directory(Path(out) / name, settings, _schema(name, settings))
 
 
-def _claim_directory(directory: Path, settings: Settings) -> None:
-    """Create ``directory`` for ``settings``, or accept it if it holds results for the same settings."""
+def _run_settings(name: str, quick: bool, trials: int | None, seed: int, predicate: str) -> Settings:
+    """The settings of a run, as ``settings.json`` stores them."""
+    from ..registry import PREDICATES
+    from .catalog import EXPERIMENTS
+
+    experiment = EXPERIMENTS[name]
+    settings = experiment.settings(quick, trials, int(seed))
+    if experiment.uses_predicate:
+        settings["predicate"] = PREDICATES.canonical(predicate)
+    return cast(Settings, json.loads(dumps(settings)))
+
+
+def _schema(name: str, settings: Settings) -> RecordSchema:
+    """The schema of a run's records (refusing an experiment whose trial ids repeat)."""
+    from .catalog import EXPERIMENTS
+
+    all_trials = EXPERIMENTS[name].trials(settings)
+    if len({trial.id for trial in all_trials}) != len(all_trials):
+        raise RuntimeError(f"experiment {name} produced duplicate trial ids")
+    return RecordSchema.of(all_trials)
+
+
+def _stored_settings(settings_path: Path, settings: Settings) -> Settings | None:
+    """The settings a folder holds (None if it holds none); settings from before predicates
+    existed mean the exact check."""
+    if not settings_path.exists():
+        return None
+    try:
+        stored = json.loads(settings_path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{settings_path} is corrupt ({exc}); use another --out or delete the folder") from exc
+    if not isinstance(stored, dict):
+        raise ValueError(f"{settings_path} is corrupt (not a JSON object); use another --out or delete the folder")
+    if "predicate" not in stored and settings.get("predicate") == "exact":
+        stored = {**stored, "predicate": "exact"}  # (written back only when the run is accepted)
+    return stored
+
+
+def _check_directory(directory: Path, settings: Settings, schema: RecordSchema) -> None:
+    """Refuse, without writing anything, a folder that cannot take a run of ``settings``."""
+    settings_path, records_path = directory / SETTINGS, directory / RECORDS
+    stored = _stored_settings(settings_path, settings)
+    if stored is None and records_path.exists() and records_path.stat().st_size:
+        raise ValueError(f"{records_path} has records but {settings_path} is missing: their settings "
+                         "(seed, trials, predicate) cannot be checked; use another --out or delete the folder")
+    if stored is not None and stored != settings:
+        raise ValueError(f"{directory} holds results for other settings ({stored}); use another --out or "
+                         "delete it")
+    check_records_header(records_path, schema)
+
+
+def _claim_directory(directory: Path, settings: Settings, schema: RecordSchema) -> None:
+    """Create ``directory`` for ``settings``, or accept it if it holds results for the same
+    settings (``_check_directory``); ``settings.json`` is written only once the folder is accepted."""
+    _check_directory(directory, settings, schema)
     directory.mkdir(parents=True, exist_ok=True)
     settings_path = directory / SETTINGS
-    if not settings_path.exists() and (directory / RECORDS).exists() and (directory / RECORDS).stat().st_size:
-        raise ValueError(f"{directory / RECORDS} has records but {settings_path} is missing: their settings "
-                         "(seed, trials, predicate) cannot be checked; use another --out or delete the folder")
-    if settings_path.exists():
-        try:
-            stored = json.loads(settings_path.read_text())
-        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-            raise ValueError(f"{settings_path} is corrupt ({exc}); use another --out or delete the folder") from exc
-        if not isinstance(stored, dict):
-            raise ValueError(f"{settings_path} is corrupt (not a JSON object); use another --out or delete the folder")
-        if "predicate" not in stored and settings.get("predicate") == "exact":
-            stored["predicate"] = "exact"  # settings without a predicate are runs with the exact check
-            write_json(settings_path, stored)
-        if stored != settings:
-            raise ValueError(
-                f"{directory} holds results for other settings ({stored}); use another --out or "
-                "delete it")
-    else:
+    if not settings_path.exists() or json.loads(settings_path.read_text()) != settings:
         write_json(settings_path, settings)
 
 
 def _execute(kind: str | None, executor: str | Executor | WorkerPool | None, name: str, todo: list[Trial],
-             settings: Settings, record_one: Callable[[Record], None], records_path: Path, jobs: int | None,
-             scheduler: str | None, max_restarts: int, on_restart: Callable[[int], None] | None) -> None:
+             settings: Settings, record_one: Callable[[Record], None], records_path: Path, schema: RecordSchema,
+             jobs: int | None, scheduler: str | None, max_restarts: int,
+             on_restart: Callable[[int], None] | None) -> None:
     """Run ``todo`` serially, on a given executor or ``WorkerPool``, or on a pool built here; a
     pool whose executor breaks is renewed and the unfinished trials resubmitted."""
     from .._support.execution import WorkerPool
@@ -245,18 +293,16 @@ def _execute(kind: str | None, executor: str | Executor | WorkerPool | None, nam
                     raise
                 if on_restart:
                     on_restart(attempt + 1)
-            done_now = {r["trial_id"] for r in read_records(records_path)}
+            done_now = {r["trial_id"] for r in read_records(records_path, schema)}
             remaining = [t for t in remaining if t.id not in done_now]
             pool.renew()
 
 
 def _summarize(experiment: Experiment, name: str, directory: Path, settings: Settings,
-               all_trials: list[Trial]) -> Summary:
+               all_trials: list[Trial], schema: RecordSchema) -> Summary:
     """summary.json and the figures from all records (or a partial summary if trials are missing)."""
-    ids = [trial.id for trial in all_trials]
-    order = {trial_id: index for index, trial_id in enumerate(ids)}
-    records = read_records(directory / RECORDS)
-    records = sorted((r for r in records if r["trial_id"] in order), key=lambda r: order[r["trial_id"]])
+    order = {trial.id: index for index, trial in enumerate(all_trials)}
+    records = sorted(read_records(directory / RECORDS, schema), key=lambda r: order[r["trial_id"]])
     if len(records) < len(all_trials):
         return {"experiment": name, "settings": settings, "complete": False,
                 "finished_trials": len(records), "total_trials": len(all_trials)}
@@ -264,9 +310,13 @@ def _summarize(experiment: Experiment, name: str, directory: Path, settings: Set
     summary = {"experiment": name, "title": experiment.title, "settings": settings,
                "ours": result.pop("ours"), "paper": result.pop("paper"), **result,
                "complete": True}
-    figures = experiment.plot(records, settings, summary, directory)
-    summary["figures"] = [str(path.name) for path in figures]
-    write_json(directory / SUMMARY, summary)  # complete only with its figures; non-finite numbers as null
+    try:
+        figures = experiment.plot(records, settings, summary, directory)
+        summary["figures"] = [str(path.name) for path in figures]
+        write_json(directory / SUMMARY, summary)  # complete only with its figures; non-finite numbers as null
+    except OSError as exc:  # (a full disk): every record is kept, so the same command finishes the job
+        raise OSError(exc.errno, f"{exc.strerror or exc}; the finished trials are kept in {directory / RECORDS}: "
+                                 "run the same command again to write the summary") from exc
     return summary
 
 
@@ -326,26 +376,21 @@ def run_experiment(
         ValueError: If an argument is refused, or ``out/name`` holds results for other settings.
         RuntimeError: If the experiment produced duplicate trial ids.
     """
-    from ..registry import PREDICATES
     from .catalog import EXPERIMENTS
 
     kind = _check_arguments(name, trials, seed, executor, jobs, scheduler, predicate)
     experiment = EXPERIMENTS[name]
-    settings = experiment.settings(quick, trials, int(seed))
-    if experiment.uses_predicate:
-        settings["predicate"] = PREDICATES.canonical(predicate)
-    settings = json.loads(dumps(settings))  # as stored
+    settings = _run_settings(name, quick, trials, seed, predicate)
+    schema = _schema(name, settings)
+    all_trials = list(schema.trials.values())
     directory = Path(out) / name
-    _claim_directory(directory, settings)
-    all_trials = experiment.trials(settings)
-    if len({trial.id for trial in all_trials}) != len(all_trials):
-        raise RuntimeError(f"experiment {name} produced duplicate trial ids")
+    _claim_directory(directory, settings, schema)
     records_path = directory / RECORDS
-    done = {record["trial_id"] for record in read_records(records_path)}
+    done = {record["trial_id"] for record in read_records(records_path, schema)}
     todo = [trial for trial in all_trials if trial.id not in done]
     if stop_after is not None:
         todo = todo[:stop_after]
-    writer = RecordWriter(records_path)
+    writer = RecordWriter(records_path, schema)
     bar = tqdm(total=len(all_trials), initial=len(done), desc=name, disable=not progress, unit="trial")
 
     def record_one(record: Record) -> None:
@@ -355,14 +400,14 @@ def run_experiment(
         bar.update()
 
     try:
-        _execute(kind, executor, name, todo, settings, record_one, records_path, jobs, scheduler,
+        _execute(kind, executor, name, todo, settings, record_one, records_path, schema, jobs, scheduler,
                  max_restarts, on_restart)
     finally:
         bar.close()
     if defer_summary is not None:
-        defer_summary(partial(_summarize, experiment, name, directory, settings, all_trials))
+        defer_summary(partial(_summarize, experiment, name, directory, settings, all_trials, schema))
         return {"experiment": name, "deferred": True}
-    return _summarize(experiment, name, directory, settings, all_trials)
+    return _summarize(experiment, name, directory, settings, all_trials, schema)
 
 
 def run_experiments(names: list[str], pool: WorkerPool, on_summary: Callable[[str, Summary], None],
