@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import qrrt_circuits as qc
+from qrrt_circuits.reachability.dynamics import LinearTrackingDynamics
 
 ENV = qc.scenarios.paper_clutter(seed=0)
 
@@ -15,11 +16,12 @@ CASES = {
     "MaxWallTime": lambda v: qc.MaxWallTime(v),
     "false_positive": lambda v: qc.OracleErrorModel(false_positive=v),
     "cap_factor": lambda v: qc.BBHT(cap_factor=v),
+    "horizon": lambda v: LinearTrackingDynamics.paper(horizon=v),
 }
-BAD = [10**400, -(10**400), "0.5", True, np.array([0.5, 0.5]), complex(0.5, 0)]
+BAD = [10**400, -(10**400), "0.5", True, np.array([0.5, 0.5]), np.array(0.5), complex(0.5, 0)]
 
 
-@pytest.mark.parametrize("bad", BAD, ids=["huge", "-huge", "string", "bool", "array", "complex"])
+@pytest.mark.parametrize("bad", BAD, ids=["huge", "-huge", "string", "bool", "array", "0-d array", "complex"])
 @pytest.mark.parametrize("argument", sorted(CASES))
 def test_a_bad_float_is_refused_naming_the_argument(argument, bad):
     with pytest.raises((TypeError, ValueError)) as caught:
