@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import json
-import platform
 import time
 from pathlib import Path
 
 import numpy as np
+
+from qrrt_circuits._support.provenance import provenance
 
 RESULTS = Path(__file__).resolve().parent / "results"
 
@@ -25,17 +26,8 @@ def median_time(func, repeats: int, warmup: int = 1) -> tuple[float, float, floa
 
 
 def machine() -> dict:
-    import qiskit
-    import qiskit_aer
-
-    return {
-        "python": platform.python_version(),
-        "machine": platform.machine(),
-        "processor": platform.processor(),
-        "qiskit": qiskit.__version__,
-        "qiskit_aer": qiskit_aer.__version__,
-        "numpy": np.__version__,
-    }
+    """The run's provenance: commit, package versions, machine and date."""
+    return provenance()
 
 
 def write_json(name: str, payload: dict, out: str | None = None) -> Path:

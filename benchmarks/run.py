@@ -19,10 +19,8 @@ script joins in by accepting ``--quick`` and ``--out PATH`` (write its JSON ther
 from __future__ import annotations
 
 import argparse
-import datetime
 import json
 import os
-import platform
 import subprocess
 import sys
 import tempfile
@@ -35,9 +33,7 @@ sys.path.insert(0, str(HERE))
 
 from _figures import flatten  # noqa: E402
 
-#: packages whose versions describe the run
-PACKAGES = ("qrrt-circuits", "qiskit", "qiskit-aer", "qiskit-algorithms", "numpy", "numba", "scipy", "matplotlib",
-            "dask", "distributed", "ompl")
+from qrrt_circuits._support.provenance import provenance  # noqa: E402
 
 
 def discover(directory: Path = HERE) -> dict[str, Path]:
@@ -45,57 +41,9 @@ def discover(directory: Path = HERE) -> dict[str, Path]:
     return {path.stem.removeprefix("bench_"): path for path in sorted(directory.glob("bench_*.py"))}
 
 
-def _cpu_model() -> str:
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or platform.machine()
-
-
-def _memory_gib() -> float | None:
-    try:
-        for line in Path("/proc/meminfo").read_text().splitlines():
-            if line.startswith("MemTotal:"):
-                return round(int(line.split()[1]) / 2**20, 2)
-    except OSError:
-        pass
-    return None
-
-
-def _git(*args: str) -> str | None:
-    try:
-        return subprocess.run(["git", *args], cwd=HERE, capture_output=True, text=True, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return None
-
-
 def machine_description() -> dict:
-    """CPU, cores, memory, OS, Python, package versions, git commit and the date (UTC)."""
-    from importlib import metadata
-
-    versions = {}
-    for package in PACKAGES:
-        try:
-            versions[package] = metadata.version(package)
-        except metadata.PackageNotFoundError:
-            versions[package] = None
-    status = _git("status", "--porcelain", "--untracked-files=no")
-    return {
-        "cpu": _cpu_model(),
-        "cores": os.cpu_count(),
-        "cores_usable": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count(),
-        "memory_gib": _memory_gib(),
-        "os": platform.platform(),
-        "python": platform.python_version(),
-        "packages": versions,
-        "git_commit": _git("rev-parse", "HEAD"),
-        "git_dirty": bool(status) if status is not None else None,
-        "load_average": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
-        "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
-    }
+    """The run's provenance (``qrrt_circuits._support.provenance``) and the machine's load average."""
+    return {**provenance(), "load_average": list(os.getloadavg()) if hasattr(os, "getloadavg") else None}
 
 
 def run_one(script: Path, quick: bool, timeout: float | None) -> tuple[dict, dict | None]:

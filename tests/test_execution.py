@@ -5,6 +5,7 @@ import signal
 
 import psutil
 import pytest
+from summaries import results_of
 
 from qrrt_circuits._support.execution import get_executor
 from qrrt_circuits.experiments import read_records, run_experiment
@@ -275,8 +276,8 @@ def test_reproducing_several_experiments_makes_each_summary_while_the_next_trial
     for (name, ours), (_, reference) in zip(pooled, serial, strict=True):
         assert ours["complete"] and ours["ours"] == reference["ours"], name
         assert _records(tmp_path / "pool", name) == _records(tmp_path / "serial", name), name
-        written = (tmp_path / "pool" / name / "summary.json").read_text()
-        assert written == (tmp_path / "serial" / name / "summary.json").read_text(), name
+        written = results_of(tmp_path / "pool" / name / "summary.json")
+        assert written == results_of(tmp_path / "serial" / name / "summary.json"), name
         assert ours["figures"] and all((tmp_path / "pool" / name / figure).stat().st_size
                                        for figure in ours["figures"])
 

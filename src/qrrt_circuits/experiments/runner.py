@@ -2,14 +2,16 @@
 
 ``DIR/EXPERIMENT/records.csv`` gets one row per trial, written and flushed as soon as the trial
 finishes. Re-running with the same ``--out`` reads the file, skips finished trials and runs the
-rest; an interrupted run loses at most the trials in flight (a torn last line is dropped). The
+rest; an interrupted run loses at most the trials in flight (a torn last line is set aside). The
 settings are stored in ``settings.json``; resuming with different settings is refused. Each row is
 checked against its trial on resume (``records.RecordSchema``): a row that fails is reported and
 excluded, never counted, and its trial runs again; the file is never rewritten.
-``summary.json`` = {"experiment", "settings", "ours", "paper", ...} and the figures are rewritten
-from all records at the end. Both JSON files are strict JSON (a non-finite number is written as
-``null``) and written whole (``_support.json_files.write_json``: a temporary file renamed over the
-old one), and ``summary.json`` says ``"complete": true`` only once its figures are written.
+``summary.json`` = {"experiment", "settings", "ours", "paper", ..., "provenance"} and the figures
+are rewritten from all records at the end; ``provenance`` (commit, versions, machine, date) is the
+only part that differs between two runs with the same settings. Both JSON files are strict JSON
+(a non-finite number is written as ``null``) and written whole (``_support.json_files.write_json``:
+a temporary file renamed over the old one), and ``summary.json`` says ``"complete": true`` only once
+its figures are written.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from .._support.json_files import dumps, write_json
+from .._support.provenance import provenance
 from .._support.validation import check_int, check_optional_int
 from ..world.environment import Environment
 from .base import Experiment, Record, Settings, Summary, Trial
@@ -313,6 +316,7 @@ def _summarize(experiment: Experiment, name: str, directory: Path, settings: Set
     try:
         figures = experiment.plot(records, settings, summary, directory)
         summary["figures"] = [str(path.name) for path in figures]
+        summary["provenance"] = provenance()  # (the one part of a summary that differs between runs)
         write_json(directory / SUMMARY, summary)  # complete only with its figures; non-finite numbers as null
     except OSError as exc:  # (a full disk): every record is kept, so the same command finishes the job
         raise OSError(exc.errno, f"{exc.strerror or exc}; the finished trials are kept in {directory / RECORDS}: "
