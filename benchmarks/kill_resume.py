@@ -15,10 +15,9 @@ that each way of tearing is tried).
    into its own folder. The serial run's ``summary.json`` bytes, its records.csv header and its
    rows (keyed by ``trial_id``) are the reference; each executor's uninterrupted duration sets its
    kill times. The process and dask runs must give the same summary bytes and rows, else the
-   campaign stops (exit 2): comparing bytes would mean nothing. (For heatmaps they do: its
-   summary.json holds no timing and no executor name -- its keys are experiment, title, settings,
-   ours, paper, mean_reachable_fraction, interval_95, differs_from_paper, note, labels, complete,
-   figures -- so the bytes are compared whole, no field removed.)
+   campaign stops (exit 2): comparing bytes would mean nothing. A summary's bytes are compared
+   without its ``provenance`` (commit, machine, date: the one part that differs between two runs
+   with the same settings); for heatmaps the rest holds no timing and no executor name.
 2. Runs: run i uses executor serial, process, dask in turn (``--jobs`` workers for the latter two),
    in a fresh folder. The command is started in its own process group and killed at a moment drawn
    uniformly in [2 %, 90 %] of that executor's reference duration (tear runs: [40 %, 90 %], so
@@ -63,6 +62,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import json
 import os
 import shutil
 import signal
@@ -176,6 +176,14 @@ def run_phase(command: list[str], env: dict[str, str], logs: Path, name: str, ti
             "stderr_line": leaked[0] if leaked else (lines_seen[-1][:400] if lines_seen else None)}
 
 
+def results_bytes(path: Path) -> bytes:
+    """A summary.json's bytes without its ``provenance`` member (the rest as written: strict JSON,
+    indent 1, keys in the runner's order)."""
+    summary = json.loads(path.read_bytes())
+    summary.pop("provenance", None)
+    return json.dumps(summary, indent=1).encode()
+
+
 def reproduce_command(experiment: str, out: Path, seed: int, executor: str, jobs: int) -> list[str]:
     command = [sys.executable, "-m", "qrrt_circuits.cli", "reproduce", experiment, "--quick", "--seed", str(seed),
                "--no-progress", "--executor", executor, "--out", str(out)]
@@ -255,7 +263,7 @@ def make_references(args: argparse.Namespace, env: dict[str, str], work: Path) -
             raise SystemExit(f"the uninterrupted {executor} run failed (exit {phase['rc']}); see {folder}")
         header, rows, invalid = read_raw(directory / RECORDS)
         references[executor] = {"folder": str(folder), "wall_s": phase["wall_s"], "phase": phase,
-                                "summary": (directory / SUMMARY).read_bytes(), "header": header, "rows": rows,
+                                "summary": results_bytes(directory / SUMMARY), "header": header, "rows": rows,
                                 "invalid": invalid}
         first, last = phase["records_s"]
         print(f"  reference {executor:8s} {phase['wall_s']:6.2f} s, {len(rows)} records (written from "
@@ -327,7 +335,7 @@ def run_one(args: argparse.Namespace, env: dict[str, str], work: Path, entry: di
            "leaked_semaphore": any(p["leaked_semaphore"] for p in phases),
            "orphans": sum(len(p["orphans"]) for p in phases), "hung": any(p["hung"] for p in phases),
            # (by the resume that exited 0: a run that finished before its kill already wrote one)
-           "summary_identical": resumed and summary.exists() and summary.read_bytes() == reference["summary"],
+           "summary_identical": resumed and summary.exists() and results_bytes(summary) == reference["summary"],
            **check_records(records, reference["header"], reference["by_id"]), "phases": phases}
     why = []
     if not resumed:
@@ -453,7 +461,7 @@ def main() -> int:
                "seed": args.seed, "jobs": args.jobs, "tear_every": args.tear_every,
                "second_kill_every": args.second_kill_every, "attempts": args.attempts, "grace_s": args.grace,
                "strict": args.strict, "src": str(SRC), "work": str(work),
-               "compared": "summary.json bytes, whole (no field removed)",
+               "compared": "summary.json bytes without its provenance",
                "references": {executor: {"wall_s": ref["wall_s"], "records": len(ref["rows"]),
                                          "folder": ref["folder"] if kept_references else None}
                               for executor, ref in references.items()},
