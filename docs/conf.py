@@ -15,6 +15,8 @@ the tutorials or the results change (all three land in git-ignored folders under
   files under ``docs/``), executed by ``myst-nb`` at build time.
 * ``docs/results/_gallery.md`` -- every figure under ``docs/results`` (referenced in place, not
   copied).
+* ``docs/results/_generated/EXPERIMENT.md`` -- each results page's table of numbers, from the
+  committed ``summary.json`` files (``results_tables.py``).
 """
 
 from __future__ import annotations
@@ -30,6 +32,9 @@ from pathlib import Path
 DOCS = Path(__file__).resolve().parent
 ROOT = DOCS.parent
 sys.path.insert(0, str(ROOT / "src"))  # a source checkout builds without an install too
+sys.path.insert(0, str(DOCS))  # the page generators beside this file
+
+from results_tables import write_tables as write_results_tables  # noqa: E402
 
 import qrrt_circuits  # noqa: E402
 
@@ -59,6 +64,7 @@ exclude_patterns = [
     "_build",
     "**/.ipynb_checkpoints",
     "DESIGN.md",  # included by design.md
+    "results/_generated",  # included by the results pages
 ]
 include_patterns = ["**"]
 source_suffix = {".rst": "restructuredtext", ".md": "myst-nb", ".ipynb": "myst-nb"}
@@ -251,3 +257,4 @@ check_notebook_kernel()
 write_api_pages()
 copy_notebooks()
 write_gallery()
+write_results_tables(DOCS / "results", DOCS / "results" / "_generated")

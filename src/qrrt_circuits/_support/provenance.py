@@ -3,8 +3,8 @@
 Every results file (``summary.json``, a benchmark's JSON) carries ``provenance()`` inside, so that
 a number can be traced to what produced it without the file's name or the prose saying so. Two
 runs with the same seed give the same results and differ only in their provenance. A summary's
-provenance is that of the run that wrote it: a resumed run summarizes records that earlier runs of
-the same settings (``settings.json``) may have written.
+provenance is that of the run that wrote it: a resumed run summarizes records that runs before it,
+with the same settings (``settings.json``), may have written.
 """
 
 from __future__ import annotations

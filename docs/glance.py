@@ -1,0 +1,141 @@
+"""The README's *Results at a glance* table, generated from the committed ``summary.json`` files.
+
+``python docs/glance.py`` rewrites the table between the README's ``<!-- glance:start -->`` and
+``<!-- glance:end -->`` markers; ``python docs/glance.py --check`` exits 1 if the committed table
+differs from what the summaries give (``tests/test_readme.py`` runs the check), so the table cannot
+drift from the results.
+
+Each row reads one number from ``docs/results/EXPERIMENT/summary.json`` (our exact check) and, where
+the experiment was also run with the authors' check, from ``docs/results/authors/EXPERIMENT/``:
+``ours``, its ``interval_95`` and the paper's number from the same summary's ``paper``. "Paper
+inside?" is computed from the interval; "explained?" is the one column written by hand, naming
+where the results page discusses the difference.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parent.parent
+RESULTS = ROOT / "docs" / "results"
+README = ROOT / "README.md"
+START, END = "<!-- glance:start -->", "<!-- glance:end -->"
+
+
+@dataclass(frozen=True)
+class Row:
+    """One row: a quantity of one experiment, read at ``path`` in ``ours``, ``interval_95`` and
+    ``paper`` (``paper_path`` where the paper's number sits elsewhere)."""
+
+    figure: str
+    quantity: str
+    experiment: str
+    path: tuple[str, ...]
+    explained: str
+    paper_path: tuple[str, ...] | None = None
+    percent: bool = False
+
+
+ROWS = (
+    Row("Fig. 9", "RRT, oracle calls per node", "oracle-efficiency", ("RRT",),
+        "the check: the authors' check puts the paper inside"),
+    Row("Fig. 9", "parallel RRT (8 workers)", "oracle-efficiency", ("ParallelRRT",), "open"),
+    Row("Fig. 9", "q-RRT", "oracle-efficiency", ("QRRT",), "open; ordering reproduced"),
+    Row("Fig. 9", "Pq-RRT (8 workers, shared)", "oracle-efficiency", ("PQRRT",), "open; ordering reproduced"),
+    Row("Figs. 10-12", "RRT efficiency at 40 calls", "heatmaps", ("RRT", "40", "efficiency"),
+        "open (two hypotheses tested)", percent=True),
+    Row("Figs. 10-12", "q-RRT efficiency at 40 calls", "heatmaps", ("QRRT", "40", "efficiency"),
+        "open (two hypotheses tested)", percent=True),
+    Row("Figs. 13-14", "q-RRT nodes in the corridor (50 trials)", "corridor", ("QRRT",),
+        "open (sensitivity study)"),
+    Row("Figs. 13-14", "RRT nodes in the corridor (50 trials)", "corridor", ("RRT",), "open (sensitivity study)"),
+    Row("Figs. 15-17", "QDA mean parent distance, 16 nodes", "annealing", ("QDA", "16"),
+        "open; the 2x spread is reproduced", paper_path=("QDA",)),
+)
+
+
+def _at(value: Any, path: tuple[str, ...]) -> Any:
+    for key in path:
+        value = value[key]
+    return value
+
+
+def _number(value: float, percent: bool) -> str:
+    if percent:
+        return f"{100 * value:.1f} %"
+    return f"{value:.3g}" if abs(value) < 100 else f"{value:.0f}"
+
+
+def _cell(summary: dict[str, Any] | None, row: Row) -> tuple[str, tuple[float, float] | None]:
+    if summary is None:
+        return "not run", None
+    ours, interval = _at(summary["ours"], row.path), _at(summary["interval_95"], row.path)
+    low, high = interval
+    text = f"{_number(ours, row.percent)} [{_number(low, row.percent)}, {_number(high, row.percent)}]"
+    return text, (low, high)
+
+
+def _summary(folder: Path) -> dict[str, Any] | None:
+    path = folder / "summary.json"
+    return json.loads(path.read_text()) if path.exists() else None
+
+
+def table(results: Path = RESULTS) -> str:
+    """The Markdown table, from the summaries under ``results``.
+
+    Args:
+        results: The folder of the committed results (``docs/results``).
+
+    Returns:
+        The table's lines, with its header.
+    """
+    lines = ["| figure | quantity | paper | ours, 95 % interval | ours with the authors' check | paper inside ours? "
+             "| explained? |", "|---|---|---|---|---|---|---|"]
+    for row in ROWS:
+        exact = _summary(results / row.experiment)
+        if exact is None:
+            raise FileNotFoundError(f"{results / row.experiment / 'summary.json'} is missing: run "
+                                    f"qrrt reproduce {row.experiment} --out {results}")
+        paper = _at(exact["paper"], row.paper_path or row.path)
+        ours, bounds = _cell(exact, row)
+        authors, authors_bounds = _cell(_summary(results / "authors" / row.experiment), row)
+        inside = [bounds is not None and bounds[0] <= paper <= bounds[1],
+                  authors_bounds is not None and authors_bounds[0] <= paper <= authors_bounds[1]]
+        verdict = {(True, True): "yes", (False, False): "no"}.get(
+            (inside[0], inside[1]), "with the authors' check" if inside[1] else "with our check")
+        if authors_bounds is None:
+            verdict = "yes" if inside[0] else "no"
+        lines.append(f"| {row.figure} | {row.quantity} | {_number(paper, row.percent)} | {ours} | {authors} | "
+                     f"{verdict} | {row.explained} |")
+    return "\n".join(lines)
+
+
+def with_table(readme: str, rendered: str) -> str:
+    """``readme`` with the text between the glance markers replaced by ``rendered``."""
+    before, rest = readme.split(START, 1)
+    _, after = rest.split(END, 1)
+    return f"{before}{START}\n{rendered}\n{END}{after}"
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--check", action="store_true", help="exit 1 if README.md's table is not the generated one")
+    args = parser.parse_args(argv)
+    readme = README.read_text()
+    updated = with_table(readme, table())
+    if args.check:
+        if updated != readme:
+            print("README.md's results table differs from docs/results: run python docs/glance.py", file=sys.stderr)
+            return 1
+        return 0
+    README.write_text(updated)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,93 @@
+"""Each results page's table of numbers, generated from the committed ``summary.json`` at build time.
+
+``write_tables(results, target)`` writes ``target/EXPERIMENT.md`` for every
+``results/EXPERIMENT/summary.json`` (and ``results/authors/EXPERIMENT/summary.json``): every number
+of the summary's ``ours`` with the paper's number at the same place in ``paper``, its 95 %
+interval from ``interval_95`` and whether the paper's number lies outside it
+(``differs_from_paper``), then the run's settings and provenance. The pages' prose discusses these
+numbers; the tables are never typed by hand.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+
+def _leaves(value: Any, path: tuple[str, ...] = ()) -> list[tuple[tuple[str, ...], Any]]:
+    """(path, value) for every number, string or boolean in nested dicts (lists stay whole)."""
+    if isinstance(value, dict):
+        return [leaf for key, item in value.items() for leaf in _leaves(item, (*path, str(key)))]
+    return [(path, value)]
+
+
+def _at(value: Any, path: tuple[str, ...]) -> Any:
+    for key in path:
+        if not isinstance(value, dict) or key not in value:
+            return None
+        value = value[key]
+    return value
+
+
+def _shown(value: Any) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    if isinstance(value, list) and len(value) == 2 and all(isinstance(v, (int, float)) or v is None for v in value):
+        return "[" + ", ".join("" if v is None else f"{v:.4g}" for v in value) + "]"
+    text = json.dumps(value) if not isinstance(value, str) else value
+    return text.replace("|", "\\|")
+
+
+def table(summary: dict[str, Any], label: str) -> str:
+    """The Markdown of one summary: its numbers beside the paper's, its settings and provenance."""
+    rows = ["| quantity | ours | 95 % interval | paper | paper outside our interval |", "|---|---|---|---|---|"]
+    for path, value in _leaves(summary.get("ours", {})):
+        paper = _at(summary.get("paper", {}), path)
+        if paper is None and len(path) > 1:  # the paper gives one number where we give several
+            paper = _at(summary.get("paper", {}), path[:1])
+            paper = paper if not isinstance(paper, dict) else None
+        interval = _at(summary.get("interval_95") or {}, path)
+        differs = _at(summary.get("differs_from_paper") or {}, path)
+        rows.append(f"| {' / '.join(path)} | {_shown(value)} | {_shown(interval)} | {_shown(paper)} | "
+                    f"{_shown(differs)} |")
+    provenance = summary.get("provenance") or {}
+    packages = provenance.get("packages") or {}
+    made = (f"Summarized at commit `{(provenance.get('git_commit') or 'unknown')[:12]}` on "
+            f"{provenance.get('cpu', 'an unknown machine')} ({provenance.get('cores', '?')} cores), Python "
+            f"{provenance.get('python', '?')}, qiskit {packages.get('qiskit', '?')}, qiskit-aer "
+            f"{packages.get('qiskit-aer', '?')}, {provenance.get('date', 'date unknown')}."
+            if provenance else "This summary records no provenance.")
+    settings = ", ".join(f"`{key}`: `{json.dumps(value)}`" for key, value in summary.get("settings", {}).items())
+    complete = "" if summary.get("complete") else "\n\n**Incomplete:** this summary lacks some trials.\n"
+    return (f"### {label}\n\n" + "\n".join(rows) + f"{complete}\n\nSettings: {settings}.\n\n{made}\n")
+
+
+def write_tables(results: Path, target: Path) -> list[Path]:
+    """Write one page fragment per experiment (both checks in one file) under ``target``.
+
+    Args:
+        results: ``docs/results``.
+        target: The folder of the generated fragments.
+
+    Returns:
+        The fragments written (or left as they were).
+    """
+    target.mkdir(parents=True, exist_ok=True)
+    written = []
+    for summary_path in sorted(results.glob("*/summary.json")):
+        name = summary_path.parent.name
+        parts = [table(json.loads(summary_path.read_text()), f"`{name}`, our exact check")]
+        authors = results / "authors" / name / "summary.json"
+        if authors.exists():
+            parts.append(table(json.loads(authors.read_text()), f"`{name}`, the authors' check"))
+        path = target / f"{name}.md"
+        text = "\n".join(parts)
+        if not path.exists() or path.read_text() != text:
+            path.write_text(text)
+        written.append(path)
+    return written
