@@ -457,8 +457,13 @@ class _Lazy:
         return len(self.__getattr__("names")())
 
 
+#: the planners by name: ``rrt``, ``prrt``, ``qrrt``, ``pqrrt``, ``pqrrt-unshared`` (the class names are aliases)
 PLANNERS: Registry = _Lazy(_planners)  # type: ignore[assignment]
+#: the search backends by name: ``aer``, ``statevector``, ``sampler``
 BACKENDS: Registry = _Lazy(_backends)  # type: ignore[assignment]
+#: the iteration policies by name: ``paper``, ``optimal``, ``bbht``, ``adaptive``, ``fixed:K``, ...
 POLICIES: Registry = _Lazy(_policies)  # type: ignore[assignment]
+#: the scenarios by name: ``paper_clutter``, ``narrow_corridor``, ``annealing_field``, ``lattice``
 SCENARIOS: Registry = _Lazy(_scenarios)  # type: ignore[assignment]
+#: the reachability predicates by name: ``exact``, ``authors``, ``authors-octave``, ``time-samples:K``
 PREDICATES: Registry = _Lazy(_predicates)  # type: ignore[assignment]

@@ -11,9 +11,13 @@ import numpy as np
 from .._support.validation import check_int, check_seed
 from .environment import Environment
 
+#: the side of the paper's square cluttered workspace
 CLUTTER_SIZE = 20.0
+#: the paper's number of boxes in it
 CLUTTER_BOXES = 525
+#: the range of the boxes' side lengths
 SIDE_RANGE = (0.25, 0.85)
+#: the goal ball's radius in the paper's worlds
 GOAL_RADIUS = 0.75
 
 
@@ -249,6 +253,7 @@ def lattice(seed: int | None = 0, size: int = 72, blocked_fraction: float = 0.5)
                                  "component_cells": int(sizes[largest - 1])})
 
 
+#: every scenario's builder by name
 SCENARIOS: dict[str, Callable[..., Environment]] = {
     "paper_clutter": paper_clutter,
     "narrow_corridor": narrow_corridor,
