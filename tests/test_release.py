@@ -52,7 +52,7 @@ def test_citation_cites_the_software_and_the_paper():
     yaml = pytest.importorskip("yaml")
     citation = yaml.safe_load((ROOT / "CITATION.cff").read_text())
     assert citation["cff-version"] == "1.2.0" and citation["type"] == "software"
-    assert "version" not in citation, "the version has one source: pyproject.toml"
+    assert str(citation["version"]) == PYPROJECT_VERSION, "CITATION.cff repeats pyproject's version"
     paper = citation["preferred-citation"]
     assert paper["title"] == "Parallel Quantum Rapidly-Exploring Random Trees"
     assert [a["family-names"] for a in paper["authors"]] == ["Lathrop", "Boardman", "Martínez"]
