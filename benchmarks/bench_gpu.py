@@ -1,4 +1,4 @@
-"""``AerBackend(device="GPU")`` (Aer's GPU build) against the CPU, n = 16-28 (issue 11, item 6).
+"""``AerBackend(device="GPU")`` (Aer's GPU build) against the CPU, n = 16-28.
 
     python benchmarks/bench_gpu.py [--quick] [--dense] [--qubits 8,12,16,...] [--cpu-budget 150] [--out FILE]
     python benchmarks/bench_gpu.py --cpu-only      # a dry run where Aer offers no GPU

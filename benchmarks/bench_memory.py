@@ -1,4 +1,4 @@
-"""The memory guard's estimate against the measured peak memory (issue 10, defect 2).
+"""The memory guard's estimate against the measured peak memory.
 
 Each case runs in a fresh subprocess: it imports the library, warms up (numba compilation, a tiny
 plan), reads its resident set (VmRSS), then runs the case and reads its peak resident set

@@ -153,11 +153,10 @@ def _qiskit_algorithms_grover(n: int, marks: np.ndarray):
 
 def _interleaved_times(runs: dict, repeats: int) -> dict[str, list[float]]:
     """Seconds of each of ``runs`` (name -> function) over ``repeats`` rounds, each round in its
-    own shuffled order (seeded), so no contender always follows the same one. (A rotated order,
-    used before, keeps every contender behind the same neighbour: ``ours`` always ran a few calls
-    after ``floor_all_threads``, the one contender that starts OpenMP threads, and its n = 12
-    median was 11.00 and 10.65 ms in two runs, ``run_ed52c13.json`` and ``run_54c2b9a.json``,
-    against 7.05 with the order shuffled, ``run_c22abd7.json``.)"""
+    own shuffled order (seeded), so that no contender always follows the same one. A fixed or
+    rotated order keeps every contender behind the same neighbour, and a neighbour's after-effects
+    enter its times: ``floor_all_threads``, the one contender that starts OpenMP threads, slows
+    whichever contender runs right after it."""
     times: dict[str, list[float]] = {name: [] for name in runs}
     names = list(runs)
     order = np.random.default_rng(2026)

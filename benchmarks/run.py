@@ -12,8 +12,10 @@ others still run. Writes ``benchmarks/results/run.json`` (``run_quick.json`` wit
     {"machine": {...}, "quick": ..., "benchmarks": {name: {"returncode", "wall_s", "command"}},
      "figures": {"search.summary.aer_n12_ms": 45.0, ...}, "raw": {name: the script's JSON}}
 
-Compare two such files with ``python benchmarks/compare.py NEW.json [OLD.json]``. A benchmark
-script joins in by accepting ``--quick`` and ``--out PATH`` (write its JSON there).
+Compare two such files with ``python benchmarks/compare.py NEW [OLD]``, each a path or a
+``REV:PATH`` read from git (``HEAD~5:benchmarks/results/run.json``); ``benchmarks/results/baseline.json``
+is a pinned earlier run to compare with. A benchmark script joins in by accepting ``--quick`` and
+``--out PATH`` (write its JSON there).
 """
 
 from __future__ import annotations

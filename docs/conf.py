@@ -4,8 +4,8 @@ Build (from the repository root, after ``pip install ".[docs]"``)::
 
     python -m sphinx -W -b html docs docs/_build/html
 
-Three things are generated at build time, so nothing here has to be edited when the code,
-the tutorials or the results change (all three land in git-ignored folders under ``docs/``):
+Four things are generated at build time, so nothing here has to be edited when the code,
+the tutorials or the results change (all four land in git-ignored places under ``docs/``):
 
 * ``docs/api/_generated/reference.rst`` -- the API reference, written from
   ``qrrt_circuits.__all__`` (and each public submodule's own public names) by ``write_api_pages``;
@@ -17,6 +17,8 @@ the tutorials or the results change (all three land in git-ignored folders under
   copied).
 * ``docs/results/_generated/EXPERIMENT.md`` -- each results page's table of numbers, from the
   committed ``summary.json`` files (``results_tables.py``).
+* ``docs/_generated/performance.md`` -- the Performance page, written by ``performance_page.py``
+  from ``benchmarks/results/run.json`` and ``baseline.json``: every figure on it is read from them.
 """
 
 from __future__ import annotations
@@ -34,6 +36,7 @@ ROOT = DOCS.parent
 sys.path.insert(0, str(ROOT / "src"))  # a source checkout builds without an install too
 sys.path.insert(0, str(DOCS))  # the page generators beside this file
 
+from performance_page import write_performance_page  # noqa: E402
 from results_tables import write_tables as write_results_tables  # noqa: E402
 
 import qrrt_circuits  # noqa: E402
@@ -107,6 +110,7 @@ html_last_updated_fmt = None
 GENERATED_API = DOCS / "api" / "_generated"
 NOTEBOOK_COPIES = DOCS / "tutorials" / "_notebooks"
 GALLERY = DOCS / "results" / "_gallery.md"
+PERFORMANCE = DOCS / "_generated" / "performance.md"
 
 #: modules documented beyond ``qrrt_circuits.__all__`` (public, used in the README's examples)
 EXTRA_MODULES = ("qrrt_circuits.plotting", "qrrt_circuits._support.execution")
@@ -262,3 +266,4 @@ write_api_pages()
 copy_notebooks()
 write_gallery()
 write_results_tables(DOCS / "results", DOCS / "results" / "_generated")
+write_performance_page(ROOT, PERFORMANCE)

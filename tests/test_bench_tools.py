@@ -86,6 +86,38 @@ def test_compare_of_a_faster_run_reports_no_regression(tmp_path):
     assert compare.main([new, old]) == 0
 
 
+def test_compare_reads_runs_from_git_revisions_and_prints_ratios_per_benchmark(tmp_path, monkeypatch, capsys):
+    """``REV:PATH`` is read through ``git show``: two commits of the same file compare without a
+    checkout of either; one line per benchmark gives the geometric mean of ``worse``."""
+    import shutil
+    import subprocess
+
+    if shutil.which("git") is None:
+        pytest.skip("no git")
+    monkeypatch.chdir(tmp_path)
+    git = ["git", "-c", "user.name=t", "-c", "user.email=t@t", "-c", "commit.gpgsign=false"]
+    subprocess.run(["git", "init", "-q"], check=True)
+    _write(tmp_path / "run.json", {"search.n12.ms": 10.0, "search.n8.ms": 4.0, "planners.rrt.ms_per_node": 2.0})
+    subprocess.run(["git", "add", "run.json"], check=True)
+    subprocess.run([*git, "commit", "-q", "-m", "old"], check=True)
+    _write(tmp_path / "run.json", {"search.n12.ms": 5.0, "search.n8.ms": 1.0, "planners.rrt.ms_per_node": 3.0})
+    subprocess.run([*git, "commit", "-q", "-a", "-m", "new"], check=True)
+    assert compare.main(["HEAD:run.json", "HEAD~1:run.json", "--threshold", "0.2"]) == 1  # planners slower
+    printed = capsys.readouterr().out
+    assert "old: HEAD~1:run.json" in printed and "per benchmark" in printed
+    search = next(line for line in printed.splitlines() if line.strip().startswith("search "))
+    assert search.split()[1:3] == ["2", "0.354"]  # sqrt(0.5 * 0.25)
+    rows = compare.compare(compare.figures_of(compare.read_run("HEAD:run.json")[0]),
+                           compare.figures_of(compare.read_run("HEAD~1:run.json")[0]))
+    summary = compare.by_benchmark(rows)
+    assert summary["planners"]["regressions"] == 1 and summary["search"]["improvements"] == 2
+    assert summary["search"]["geomean_worse"] == pytest.approx((0.5 * 0.25) ** 0.5)
+    with pytest.raises(SystemExit, match="git show failed"):
+        compare.read_run("HEAD~9:run.json")
+    with pytest.raises(SystemExit, match="no such file"):
+        compare.read_run("missing.json")
+
+
 @pytest.mark.parametrize(("argv", "message"), [
     (["--baseline-src", "/no/such/checkout/src"], "must be a checkout's src directory"),
     (["--baseline-src", str(BENCHMARKS.parent / "src"), "--pairs", "0"], "--pairs must be >= 1"),

@@ -1,0 +1,468 @@
+"""The site's Performance page, written from ``benchmarks/results/run.json`` when the docs are built.
+
+``write_performance_page(root, target)`` reads the run that ``benchmarks/run.py`` wrote and the
+pinned ``benchmarks/results/baseline.json``, and writes a Markdown page: the run's provenance (the
+machine, the package versions, the commit), whether the measured commit is behind the code (asked
+of git), each planner's time per node and per oracle call, the ratios against the peers measured
+in the same run (OMPL's RRT, Aer's own floor, qiskit-algorithms' ``Grover``) and against the
+baseline, and the other results kept under ``benchmarks/results/`` with their provenance.
+
+Every number on the page is read from those files (or counted by git); the page's prose names no
+figure of its own. A missing or unreadable file gives a page that says so rather than a failed
+build.
+"""
+
+from __future__ import annotations
+
+import ast
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+RESULTS = Path("benchmarks") / "results"
+RUN = RESULTS / "run.json"
+BASELINE = RESULTS / "baseline.json"
+
+#: what a change to these paths can alter in the figures (the code measured, the measuring scripts)
+MEASURED_PATHS = ("src", "benchmarks/bench_*.py", "benchmarks/_common.py", "benchmarks/_figures.py",
+                  "benchmarks/ompl_rrt.py", "benchmarks/run.py")
+
+#: packages shown in the provenance table, in this order
+SHOWN_PACKAGES = ("qrrt-circuits", "qiskit", "qiskit-aer", "qiskit-algorithms", "numpy", "numba", "scipy",
+                  "ompl", "dask")
+
+#: contenders of ``bench_search.py``'s table against Aer's floor, in the page's column order
+CONTENDERS = {
+    "ours": "`AerBackend.search`",
+    "run_prebuilt": "`AerSimulator.run` of the circuit built beforehand",
+    "sampler_v2": "the same circuit through qiskit-aer's `SamplerV2`",
+    "gate_by_gate": "the circuit gate by gate",
+    "qiskit_algorithms": "qiskit-algorithms' `Grover` with `SamplerV2`",
+}
+
+PLANNER_SUMMARY = ("ms_per_node", "ms_per_call", "calls_per_node", "oracle_share")
+
+
+# ------------------------------------------------------------------------------------------ helpers
+def _number(value: Any) -> str:
+    """Three significant digits (whole numbers from 1 000 on), a dash for no value."""
+    if not isinstance(value, int | float) or isinstance(value, bool) or not math.isfinite(value):
+        return "—"
+    if abs(value) >= 1000:
+        return f"{value:,.0f}".replace(",", " ")
+    if value != 0 and abs(value) < 0.001:
+        return f"{value:.2e}"
+    return f"{value:.3g}"
+
+
+def _percent(value: Any) -> str:
+    return _number(100 * value) + " %" if isinstance(value, int | float) and not isinstance(value, bool) else "—"
+
+
+def _ratio(value: Any) -> str:
+    text = _number(value)
+    return text if text == "—" else f"{text}×"
+
+
+def _table(header: list[str], rows: list[list[str]], align: str | None = None) -> list[str]:
+    """A Markdown table; ``align``: one letter per column, ``l`` or ``r`` (default: first l, rest r)."""
+    align = align or "l" + "r" * (len(header) - 1)
+    rule = ["---:" if a == "r" else ":---" for a in align]
+    lines = ["| " + " | ".join(header) + " |", "| " + " | ".join(rule) + " |"]
+    lines += ["| " + " | ".join(cell.replace("|", "\\|") for cell in row) + " |" for row in rows]
+    return lines + [""]
+
+
+def _load(path: Path) -> tuple[dict | None, str | None]:
+    """(payload, None), or (None, why not)."""
+    try:
+        return json.loads(path.read_text()), None
+    except FileNotFoundError:
+        return None, "not found"
+    except (OSError, ValueError) as exc:
+        return None, f"unreadable ({type(exc).__name__})"
+
+
+def _git(root: Path, *args: str) -> str | None:
+    try:
+        return subprocess.run(["git", *args], cwd=root, capture_output=True, text=True, check=True,
+                              timeout=30).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return None
+
+
+def _median(summary: Any) -> Any:
+    return summary.get("median") if isinstance(summary, dict) else None
+
+
+def _spread(summary: Any) -> str:
+    """``median (p10–p90)`` of a ``{"median", "p10", "p90"}`` summary."""
+    if not isinstance(summary, dict):
+        return "—"
+    text = _number(summary.get("median"))
+    if "p10" in summary and "p90" in summary:
+        text += f" ({_number(summary['p10'])}–{_number(summary['p90'])})"
+    return text
+
+
+def _script_summary(root: Path, name: str) -> str:
+    """The first paragraph of ``benchmarks/bench_<name>.py``'s docstring, in Markdown."""
+    try:
+        doc = ast.get_docstring(ast.parse((root / "benchmarks" / f"bench_{name}.py").read_text()))
+    except (OSError, SyntaxError):
+        return ""
+    paragraph = " ".join((doc or "").strip().split("\n\n")[0].split())
+    return paragraph.replace("``", "`")
+
+
+def _compare_module(root: Path) -> Any:
+    """``benchmarks/compare.py``, imported (it holds the comparison the command line prints)."""
+    benchmarks = str(root / "benchmarks")
+    if benchmarks not in sys.path:
+        sys.path.insert(0, benchmarks)
+    import compare  # noqa: PLC0415
+
+    return compare
+
+
+# ------------------------------------------------------------------------------------------ sections
+def _provenance_rows(run: dict) -> list[list[str]]:
+    machine = run.get("machine") or {}
+    commit = machine.get("git_commit")
+    dirty = machine.get("git_dirty")
+    commit_text = f"`{commit}`" if commit else "not recorded"
+    if dirty is not None and commit:
+        commit_text += " (uncommitted changes to tracked files)" if dirty else " (no uncommitted changes)"
+    rows = [["commit", commit_text],
+            ["date (UTC)", str(machine.get("date", "not recorded"))],
+            ["kind", "quick run (`--quick`: fewer sizes and repeats)" if run.get("quick") else "full run"]]
+    cpu = machine.get("cpu") or machine.get("processor") or machine.get("machine") or "not recorded"
+    cores = machine.get("cores")
+    usable = machine.get("cores_usable")
+    if cores is not None:
+        cpu += f", {cores} cores" + (f" ({usable} usable)" if usable not in (None, cores) else "")
+    if machine.get("memory_gib") is not None:
+        cpu += f", {_number(machine['memory_gib'])} GiB of memory"
+    rows.append(["machine", cpu])
+    if machine.get("os"):
+        rows.append(["operating system", str(machine["os"])])
+    if machine.get("python"):
+        rows.append(["Python", str(machine["python"])])
+    packages = machine.get("packages") or {}
+    shown = [f"{name} {packages[name]}" for name in SHOWN_PACKAGES if packages.get(name)]
+    missing = [name for name in SHOWN_PACKAGES if name in packages and not packages.get(name)]
+    if shown:
+        rows.append(["packages", ", ".join(shown) + (f" (not installed: {', '.join(missing)})" if missing else "")])
+    load = machine.get("load_average")
+    if isinstance(load, list) and len(load) == 3:
+        rows.append(["load average at the start (1, 5, 15 min)", ", ".join(_number(x) for x in load)])
+    return rows
+
+
+def _staleness(root: Path, run: dict) -> list[str]:
+    """Whether commits after the measured one change the measured code, asked of git."""
+    machine = run.get("machine") or {}
+    commit = machine.get("git_commit")
+    lines: list[str] = []
+    if machine.get("git_dirty"):
+        lines += [":::{warning}", "The run was made from a working tree with uncommitted changes to tracked "
+                  "files: the code measured is not exactly that of its commit.", ":::", ""]
+    if not commit:
+        return lines + ["The run records no commit: whether the code has changed since cannot be checked.", ""]
+    if _git(root, "cat-file", "-e", f"{commit}^{{commit}}") is None:
+        return lines + [f"The measured commit `{commit}` is not in this checkout's history: whether the code "
+                        "has changed since cannot be checked.", ""]
+    count = _git(root, "rev-list", "--count", f"{commit}..HEAD", "--", *MEASURED_PATHS)
+    if count is None:
+        return lines + ["Whether the code has changed since the measured commit cannot be checked here.", ""]
+    paths = "`src/` or the benchmark scripts"
+    if int(count) == 0:
+        return lines + [f"No commit after the measured one (`{commit}`) changes {paths}: the figures describe "
+                        "the current code.", ""]
+    plural = "commits" if int(count) > 1 else "commit"
+    return lines + [":::{warning}",
+                    f"The figures are stale: {count} {plural} after the measured one (`{commit}`) change {paths}. "
+                    "They describe the code at the measured commit; `python benchmarks/run.py` measures the "
+                    "current code.", ":::", ""]
+
+
+def _benchmarks_table(root: Path, run: dict) -> list[str]:
+    rows = []
+    raw = run.get("raw") or {}
+    for name, entry in (run.get("benchmarks") or {}).items():
+        status = entry.get("returncode")
+        payload = raw.get(name)
+        if isinstance(payload, dict) and payload.get("skipped"):
+            outcome = "skipped: " + str(payload["skipped"]).split(";")[0]
+        else:
+            outcome = "ran" if status == 0 else f"failed (exit status {status})"
+        rows.append([f"`{name}`", _script_summary(root, name), outcome, _number(entry.get("wall_s"))])
+    if not rows:
+        return ["The run holds no benchmark.", ""]
+    return _table(["benchmark", "what it measures (its script's summary)", "outcome", "wall time (s)"], rows,
+                  "lllr")
+
+
+def _planners_section(run: dict) -> list[str]:
+    planners = (run.get("raw") or {}).get("planners")
+    if not isinstance(planners, dict) or not isinstance(planners.get("planners"), dict):
+        return ["This run holds no planner figures (`bench_planners.py`).", ""]
+    lines = [f"Each planner grows a tree on the benchmark's worlds ({planners.get('seeds', '—')} seeds, up to "
+             f"{planners.get('max_nodes', '—')} nodes; the rows at {planners.get('big_nodes', '—')} nodes: "
+             f"{planners.get('big_seeds', '—')} seeds, the goal made unreachable so that the tree reaches its size). "
+             "Medians over the worlds, with the 10th and 90th percentiles in brackets. An oracle call is one "
+             "question to the reachability oracle (classical planners) or one Grover search (quantum planners); "
+             "the oracle share is the fraction of the plan's wall time spent inside the predicate.", ""]
+    rows = []
+    for name, row in planners["planners"].items():
+        rows.append([name, _number(row.get("max_nodes")), str(len(row.get("runs") or [])),
+                     _spread(row.get("ms_per_node")), _spread(row.get("ms_per_call")),
+                     _number(_median(row.get("calls_per_node"))), _percent(_median(row.get("oracle_share")))])
+    lines += _table(["planner", "nodes", "worlds", "ms per node", "ms per oracle call", "oracle calls per node",
+                     "oracle share"], rows, "lrrrrrr")
+    if planners.get("note"):
+        lines += [f"Settings, as the benchmark records them: {planners['note']}.", ""]
+    return lines
+
+
+def _ompl_section(run: dict) -> list[str]:
+    planners = (run.get("raw") or {}).get("planners") or {}
+    ompl = planners.get("ompl_rrt")
+    lines = ["### OMPL's RRT", ""]
+    packages = ((run.get("machine") or {}).get("packages") or {})
+    if not isinstance(ompl, dict) or "ms_per_node" not in ompl:
+        return lines + ["OMPL's Python bindings were not importable in this run (`pip install \".[ompl]\"`): it "
+                        "holds no OMPL figures.", ""]
+    ours = ((planners.get("planners") or {}).get("RRT") or {}).get("ms_per_node")
+    version = f" {packages['ompl']}" if packages.get("ompl") else ""
+    lines += [f"OMPL{version}'s geometric RRT (`benchmarks/ompl_rrt.py`) on the same worlds and with the same "
+              "motion validator (this library's exact reachability check), beside this library's `RRT`. OMPL "
+              "samples, finds nearest nodes and keeps its tree in C++ with its own random numbers, so its trees "
+              "differ from ours: compare the rates, not the runs.", ""]
+    rows = [["`qrrt_circuits.RRT`", _spread(ours)], ["OMPL's `RRT`", _spread(ompl["ms_per_node"])]]
+    lines += _table(["planner", "ms per node"], rows)
+    lines += [f"Ratio of the medians, ours over OMPL's: **{_ratio(ompl.get('ours_over_ompl'))}** (below 1: ours "
+              "takes less time per node).", ""]
+    return lines
+
+
+def _floor_section(run: dict) -> list[str]:
+    search = (run.get("raw") or {}).get("search") or {}
+    rows_in = search.get("against_floor")
+    lines = ["### Aer's floor and qiskit-algorithms' Grover", ""]
+    if not isinstance(rows_in, list) or not rows_in:
+        return lines + ["This run holds no search figures against Aer's floor (`bench_search.py`).", ""]
+    present = [name for name in CONTENDERS if any(name in (row.get("median_ms") or {}) for row in rows_in)]
+    lines += ["One Grover search on n qubits (m marked entries, k iterations, the shots below), timed in each "
+              "repeat in a shuffled order, on one thread. "
+              "Aer's floor is a one-qubit circuit (a Hadamard and a measurement) through `AerSimulator.run` with "
+              "the same shots and options: what any search through Aer's documented API costs at least. Each "
+              "contender's median time, then its ratio to the floor measured in the same run:", ""]
+    lines += [f"* {CONTENDERS[name]} (`{name}`)" for name in present] + [""]
+    header = ["n", "m", "k", "shots", "repeats", "floor (ms)"]
+    for name in present:
+        header += [f"`{name}` (ms)", "× floor"]
+    rows = []
+    for row in rows_in:
+        times, ratios = row.get("median_ms") or {}, row.get("ratio_to_floor") or {}
+        cells = [str(row.get(key, "—")) for key in ("qubits", "marked", "iterations", "shots", "repeats")]
+        cells.append(_number(times.get("floor")))
+        for name in present:
+            cells += [_number(times.get(name)), _ratio(ratios.get(name))]
+        rows.append(cells)
+    lines += _table(header, rows, "r" * len(header))
+    both = [row for row in rows_in if "qiskit_algorithms" in (row.get("median_ms") or {})
+            and (row.get("median_ms") or {}).get("ours")]
+    if both:
+        pairs = ", ".join(f"{_ratio(row['median_ms']['qiskit_algorithms'] / row['median_ms']['ours'])} at n = "
+                          f"{row.get('qubits')}" for row in both)
+        lines += [f"qiskit-algorithms' `Grover` over `AerBackend.search`, ratio of the medians: {pairs} (above 1: "
+                  "`AerBackend.search` takes less time).", ""]
+    if search.get("note"):
+        lines += [f"Settings, as the benchmark records them: {search['note']}.", ""]
+    return lines
+
+
+def _interleaved_section(run: dict) -> list[str]:
+    interleaved = ((run.get("raw") or {}).get("planners") or {}).get("interleaved")
+    if not isinstance(interleaved, dict) or not interleaved:
+        return []
+    lines = ["### Aer against the exact statevector", "",
+             "The same planner on the two backends, world by world in alternation (so that the machine's drift "
+             "during the run enters both alike): the ratio of the medians of ms per node.", ""]
+    rows = [[name, _number(row.get("numerator_ms_per_node")), _number(row.get("denominator_ms_per_node")),
+             _ratio(row.get("ratio_of_medians"))] for name, row in interleaved.items() if isinstance(row, dict)]
+    return lines + _table(["ratio", "numerator (ms per node)", "denominator (ms per node)", "ratio of medians"],
+                          rows)
+
+
+def _baseline_section(root: Path, run: dict, baseline: dict | None, why: str | None) -> list[str]:
+    lines = ["## Against the baseline", ""]
+    if baseline is None:
+        return lines + [f"`{BASELINE.as_posix()}` is {why}: no comparison.", ""]
+    base_machine, run_machine = baseline.get("machine") or {}, run.get("machine") or {}
+    lines += [f"`{BASELINE.as_posix()}` is a pinned run of `benchmarks/run.py` kept to compare with; its "
+              "provenance, as recorded in it:", ""]
+    lines += _table(["", ""], _provenance_rows(baseline), "ll")
+    if (base_machine.get("cpu"), base_machine.get("cores")) != (run_machine.get("cpu"), run_machine.get("cores")):
+        lines += [":::{note}", "The two runs were measured on different machines (see the CPUs above): their "
+                  "timings differ for reasons of the machines as well as of the code.", ":::", ""]
+    if bool(baseline.get("quick")) != bool(run.get("quick")):
+        lines += [":::{note}", "One run is a quick run and the other a full one: their sizes and repeats differ.",
+                  ":::", ""]
+    lines += ["Ratios are this run over the baseline (below 1 for a time: this run takes less).", ""]
+    planners_new = ((run.get("raw") or {}).get("planners") or {}).get("planners") or {}
+    planners_old = ((baseline.get("raw") or {}).get("planners") or {}).get("planners") or {}
+    rows = []
+    for name in planners_new:
+        if name in planners_old:
+            new = _median(planners_new[name].get("ms_per_node"))
+            old = _median(planners_old[name].get("ms_per_node"))
+            rows.append([name, _number(old), _number(new), _ratio(new / old if new and old else None)])
+    if rows:
+        lines += ["Median ms per node:", ""] + _table(["planner", "baseline", "this run", "ratio"], rows)
+    floor_new = {row.get("qubits"): row for row in ((run.get("raw") or {}).get("search") or {}).get(
+        "against_floor") or []}
+    floor_old = {row.get("qubits"): row for row in ((baseline.get("raw") or {}).get("search") or {}).get(
+        "against_floor") or []}
+    rows = []
+    for n, row in floor_new.items():
+        old_row = floor_old.get(n)
+        if old_row is None:
+            continue
+        new, old = (row.get("ratio_to_floor") or {}).get("ours"), (old_row.get("ratio_to_floor") or {}).get("ours")
+        new_ms, old_ms = (row.get("median_ms") or {}).get("ours"), (old_row.get("median_ms") or {}).get("ours")
+        rows.append([str(n), _number(old_ms), _number(new_ms), _ratio(old), _ratio(new)])
+    if rows:
+        lines += ["`AerBackend.search` against Aer's floor, each run's own floor:", ""]
+        lines += _table(["n", "baseline (ms)", "this run (ms)", "baseline × floor", "this run × floor"], rows)
+    ompl_new = (((run.get("raw") or {}).get("planners") or {}).get("ompl_rrt") or {}).get("ours_over_ompl")
+    ompl_old = (((baseline.get("raw") or {}).get("planners") or {}).get("ompl_rrt") or {}).get("ours_over_ompl")
+    if ompl_new is not None and ompl_old is not None:
+        lines += [f"`RRT` over OMPL's RRT, ratio of the medians: {_ratio(ompl_old)} in the baseline, "
+                  f"{_ratio(ompl_new)} in this run.", ""]
+    try:
+        compare = _compare_module(root)
+        rows_all = compare.compare(compare.figures_of(run), compare.figures_of(baseline))
+        summary = compare.by_benchmark(rows_all)
+    except Exception as exc:  # noqa: BLE001 -- the page says what failed rather than failing the build
+        return lines + [f"The figure-by-figure comparison could not be made here ({type(exc).__name__}).", ""]
+    if summary:
+        lines += ["Every figure with a direction that both runs hold, per benchmark, as "
+                  "`python benchmarks/compare.py benchmarks/results/run.json benchmarks/results/baseline.json` "
+                  "prints it: `worse` is this run over the baseline for times and memory and the baseline over "
+                  "this run for throughputs (below 1: this run is better); a regression or an improvement is a "
+                  f"change beyond {_percent(compare.DEFAULT_THRESHOLD)}.", ""]
+        rows = [[f"`{name}`", str(row["figures"]), _number(row["geomean_worse"]), _number(row["median_worse"]),
+                 _number(row["min_worse"]), _number(row["max_worse"]), str(row["regressions"]),
+                 str(row["improvements"])] for name, row in summary.items()]
+        lines += _table(["benchmark", "figures", "geometric mean", "median", "lowest", "highest", "regressions",
+                         "improvements"], rows)
+    return lines
+
+
+def _script_of(root: Path, stem: str) -> str:
+    """The script under ``benchmarks/`` that writes a results file named ``stem``: the longest script
+    name that begins it (``bench_gpu_dense`` -> ``bench_gpu.py``), ``ab_planner.py`` for ``ab_*``."""
+    if stem.startswith("ab_"):
+        return "benchmarks/ab_planner.py"
+    scripts = sorted((p.stem for p in (root / "benchmarks").glob("*.py")), key=len, reverse=True)
+    for script in scripts:
+        if stem == script or stem.startswith(script + "_"):
+            return f"benchmarks/{script}.py"
+    return "—"
+
+
+def _recorded(payload: dict) -> str:
+    """What a results file records of its provenance: commit, date, machine, versions."""
+    machine = payload.get("machine") if isinstance(payload.get("machine"), dict) else {}
+    parts = []
+    if machine.get("git_commit"):
+        parts.append(f"commit `{machine['git_commit'][:12]}`" + (" (uncommitted changes)" if machine.get("git_dirty")
+                                                                  else ""))
+    for side in ("ours_checkout", "baseline_checkout"):  # ab_planner.py: the two checkouts compared
+        checkout = payload.get(side)
+        if isinstance(checkout, dict) and checkout.get("commit"):
+            parts.append(f"{side.split('_')[0]} `{checkout['commit'][:12]}`"
+                         + (" (uncommitted changes)" if checkout.get("dirty") else ""))
+    if machine.get("date"):
+        parts.append(str(machine["date"]))
+    if machine.get("cpu"):
+        parts.append(str(machine["cpu"]))
+    gpus = machine.get("gpus")
+    if isinstance(gpus, list) and gpus:
+        parts.append("; ".join(str(gpu).split(",")[0] for gpu in gpus))
+    packages = machine.get("packages") if isinstance(machine.get("packages"), dict) else {}
+    versions = [f"Python {machine['python']}"] if machine.get("python") else []
+    for name in ("qiskit", "qiskit-aer"):
+        version = packages.get(name) or machine.get(name.replace("-", "_"))  # older files: flat in machine
+        if isinstance(version, str):
+            versions.append(f"{name} {version}")
+    if versions:
+        parts.append(", ".join(versions))
+    missing = [what for what, present in (("commit", any("`" in part for part in parts)),
+                                          ("date", bool(machine.get("date")))) if not present]
+    if missing:
+        parts.append(f"no {' or '.join(missing)}")
+    return " · ".join(parts) if parts else "none"
+
+
+def _other_results(root: Path) -> list[str]:
+    lines = ["## Other results kept", "",
+             f"Besides the run and the baseline, `{RESULTS.as_posix()}/` keeps the latest result of measurements "
+             "that `benchmarks/run.py` does not make (other modes of a script, the GPU, comparisons of two "
+             "checkouts, a reliability campaign). Each file records its provenance inside, some more of it than "
+             "others; where a file lacks the commit or the date, git's history of the file gives them.", ""]
+    rows = []
+    for path in sorted((root / RESULTS).iterdir()):
+        if path.name in (RUN.name, BASELINE.name) or path.name.startswith("."):
+            continue
+        recorded = "—"
+        if path.suffix == ".json":
+            payload, _ = _load(path)
+            if isinstance(payload, dict):
+                recorded = _recorded(payload)
+        rows.append([f"`{path.name}`", f"`{_script_of(root, path.stem)}`", recorded])
+    return lines + _table(["file", "written by", "provenance recorded in it"], rows, "lll")
+
+
+# ------------------------------------------------------------------------------------------ the page
+def performance_page(root: Path) -> str:
+    """The page's Markdown, from the files under ``root / benchmarks/results``."""
+    lines = ["# Performance", "",
+             f"This page is written from `{RUN.as_posix()}` each time the site is built: every figure on it is "
+             f"read from that file (and, for the comparison, from `{BASELINE.as_posix()}`). "
+             "`python benchmarks/run.py` runs every `benchmarks/bench_*.py` script, each in its own process, and "
+             "writes that file: the figures and the provenance of the run (the code's commit, the package "
+             "versions, the machine). Timings depend on the machine and on its load: compare runs from one quiet "
+             "machine, with `python benchmarks/compare.py NEW OLD` (either file may be `REV:PATH`, a file as "
+             "committed at a git revision).", ""]
+    run, why = _load(root / RUN)
+    if run is None:
+        return "\n".join(lines + [f"`{RUN.as_posix()}` is {why}: no figures to show.", ""])
+    lines += ["## The run", ""]
+    lines += _table(["", ""], _provenance_rows(run), "ll")
+    lines += _staleness(root, run)
+    lines += ["## What is measured", ""]
+    lines += _benchmarks_table(root, run)
+    lines += ["## Time per node and per oracle call", ""]
+    lines += _planners_section(run)
+    lines += ["## Against peers measured in the same run", ""]
+    lines += _ompl_section(run)
+    lines += _floor_section(run)
+    lines += _interleaved_section(run)
+    baseline, why = _load(root / BASELINE)
+    lines += _baseline_section(root, run, baseline, why)
+    lines += _other_results(root)
+    return "\n".join(lines).rstrip() + "\n"
+
+
+def write_performance_page(root: Path, target: Path) -> None:
+    """Write the page to ``target`` (only when its text changes)."""
+    text = performance_page(root)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    if not target.exists() or target.read_text() != text:
+        target.write_text(text)
