@@ -158,7 +158,7 @@ def _provenance_rows(run: dict) -> list[list[str]]:
         rows.append(["packages", ", ".join(shown) + (f" (not installed: {', '.join(missing)})" if missing else "")])
     load = machine.get("load_average")
     if isinstance(load, list) and len(load) == 3:
-        rows.append(["load average at the start (1, 5, 15 min)", ", ".join(_number(x) for x in load)])
+        rows.append(["machine load at the start (1, 5, 15 min averages)", ", ".join(_number(x) for x in load)])
     return rows
 
 
