@@ -198,8 +198,12 @@ def api_reference() -> str:
 
 
 def write_api_pages() -> None:
+    """The reference page; autosummary's pages of an earlier build are removed first, so a name
+    that left the API leaves no page behind (autosummary writes the current ones again)."""
     title = "qrrt_circuits"
     text = "\n".join(_heading(title, "=")) + "\n" + api_reference()
+    for stale in GENERATED_API.glob("qrrt_circuits.*.rst"):
+        stale.unlink()
     _write_if_changed(GENERATED_API / "reference.rst", text)
 
 
