@@ -227,13 +227,16 @@ def write_gallery() -> None:
              "and their discussion are on the [results page](../results.md).", ""]
     for png in sorted((DOCS / "results").rglob("*.png")):
         rel = png.relative_to(DOCS / "results")
-        experiment = rel.parts[0] if len(rel.parts) == 2 else f"{rel.parts[1]} (authors' check)"
-        name = rel.parts[-2]
-        predicate = " --predicate authors" if rel.parts[0] == "authors" else ""
-        lines += [f"## `{rel.as_posix()}`", "",
-                  f"{experiment}: `qrrt reproduce {name}{predicate} --out docs/results"
-                  f"{'/authors' if predicate else ''}`", "",
-                  f"![{rel.as_posix()}]({rel.as_posix()})", ""]
+        if not (png.parent / "summary.json").exists():  # drawn from several folders' summaries
+            text = ("the paper's numbers beside both checks: `qrrt compare-checks docs/results "
+                    "docs/results/authors`")
+        else:
+            experiment = rel.parts[0] if len(rel.parts) == 2 else f"{rel.parts[1]} (authors' check)"
+            name = rel.parts[-2]
+            predicate = " --predicate authors" if rel.parts[0] == "authors" else ""
+            text = (f"{experiment}: `qrrt reproduce {name}{predicate} --out docs/results"
+                    f"{'/authors' if predicate else ''}`")
+        lines += [f"## `{rel.as_posix()}`", "", text, "", f"![{rel.as_posix()}]({rel.as_posix()})", ""]
     _write_if_changed(GALLERY, "\n".join(lines))
 
 

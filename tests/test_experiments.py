@@ -31,6 +31,11 @@ def test_quick_path_writes_summary_records_and_figure(name, tmp_path):
     assert sorted(r["trial_id"] for r in records) == sorted(t.id for t in trials)
     assert summary["figures"] and all(_is_png(directory / f) for f in summary["figures"])
     CHECKS[name](stored, records)
+    comparison = EXPERIMENTS[name].paper_comparison(stored)
+    if comparison is not None:  # numbers read from the summary, each with its interval
+        assert comparison.numbers and comparison.quantity
+        for number in comparison.numbers:
+            assert len(number.interval) == 2 and np.isfinite(number.paper)
 
 
 def _check_oracle_efficiency(summary, records):
@@ -143,6 +148,10 @@ def _check_search_policies(summary, records):
     for label, row in summary["whole_run"].items():
         if label.startswith("QRRT") or label == "RRT":  # one worker: the critical path is every call
             assert row["critical_path_per_node"] == row["calls_per_node"]
+    for label, by_window in summary["critical_path_per_node"].items():  # each value has its interval
+        assert set(summary["critical_path_interval_95"][label]) == set(by_window)
+        if label.startswith("QRRT") or label == "RRT":
+            assert summary["critical_path_interval_95"][label] == summary["interval_95"][label]
 
 
 def _check_noise(summary, records):
@@ -215,6 +224,30 @@ def test_bad_arguments(tmp_path):
         run_experiment("nope", out=tmp_path)
     with pytest.raises(ValueError, match="trials must be"):
         run_experiment("lemmas", out=tmp_path, trials=0)
+
+
+def test_compare_checks_sets_runs_beside_the_paper(tmp_path, capsys):
+    """``qrrt compare-checks`` draws one panel per experiment that every folder holds, with each
+    folder's numbers as its summary states them, and refuses folders with nothing to compare."""
+    from qrrt_circuits.experiments.compare import comparisons
+
+    exact, authors = tmp_path / "exact", tmp_path / "authors"
+    run_experiment("corridor", out=exact, quick=True, trials=2, progress=False)
+    run_experiment("corridor", out=authors, quick=True, trials=2, progress=False, predicate="authors")
+    run_experiment("lemmas", out=exact, quick=True, trials=20, progress=False)  # in one folder only
+    assert main(["compare-checks", str(exact), str(authors)]) == 0
+    figure = authors / "checks_vs_paper.png"
+    assert _is_png(figure) and str(figure) in capsys.readouterr().out
+    panel, = comparisons([exact, authors])
+    assert [label for label, _ in panel] == ["ours, exact check", "ours, authors' check"]
+    for (_, comparison), folder in zip(panel, (exact, authors), strict=True):
+        summary = json.loads((folder / "corridor" / "summary.json").read_text())
+        assert [(n.label, n.ours, list(n.interval), n.paper) for n in comparison.numbers] == [
+            (kind, summary["ours"][kind], summary["interval_95"][kind], summary["paper"][kind])
+            for kind in ("RRT", "QRRT")]
+    with pytest.raises(SystemExit) as exc:
+        main(["compare-checks", str(exact / "corridor")])
+    assert exc.value.code == 2 and "no experiment that compares with the paper" in capsys.readouterr().err
 
 
 def test_linear_fit_recovers_a_known_slope():

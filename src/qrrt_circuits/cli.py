@@ -302,6 +302,13 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_compare_checks(args: argparse.Namespace) -> int:
+    from .experiments.compare import compare_checks
+
+    print(f"wrote {compare_checks(args.folders, args.figure)}")
+    return 0
+
+
 def _print_summary(name: str, summary: dict, out: str) -> None:
     print(f"== {name}: {summary.get('title', '')}")
     print(f"   ours : {summary['ours']}")
@@ -399,6 +406,16 @@ def _add_reproduce_parser(sub: _Subparsers, formatter: _Formatter) -> None:
     reproduce.set_defaults(func=cmd_reproduce)
 
 
+def _add_compare_checks_parser(sub: _Subparsers, formatter: _Formatter) -> None:
+    compare = sub.add_parser("compare-checks", formatter_class=formatter,
+                             help="draw the paper's numbers beside runs of `reproduce` with different checks")
+    compare.add_argument("folders", nargs="+", metavar="FOLDER",
+                         help="--out folders of `qrrt reproduce`, one per check (docs/results docs/results/authors)")
+    compare.add_argument("--figure", default=None,
+                         help="the figure's path (default %(default)s: checks_vs_paper.png in the last FOLDER)")
+    compare.set_defaults(func=cmd_compare_checks)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="qrrt", description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
@@ -407,6 +424,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_search_parser(sub, formatter)
     _add_plan_parser(sub, formatter)
     _add_reproduce_parser(sub, formatter)
+    _add_compare_checks_parser(sub, formatter)
     return parser
 
 

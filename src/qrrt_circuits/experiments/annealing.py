@@ -11,15 +11,15 @@ from __future__ import annotations
 import functools
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from ..planners.database import AnnealingSchedule
-from ..plotting import plot_edges
 from ..reachability.dynamics import LinearTrackingDynamics
 from ..search.policies.iteration import FixedIterations
-from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, paired_trials
-from .figures import new_figure, save
+from .base import Experiment, PaperComparison, PaperNumber, Record, Settings, Summary, Trial, TrialStream, paired_trials
+from .figures import new_figure, save, tree_on_world
 from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import dumps, loads, rounded
 from .planners import planner_for
@@ -27,6 +27,8 @@ from .worlds import world
 
 METHODS = ("QDA", "QRRT")
 SIZES = (16, 48)
+#: each method's name in figures
+LABELS = {"QDA": "QDA", "QRRT": "uniform q-RRT"}
 
 
 def mean_parent_distance(rows: Sequence[Record], size: int) -> float:
@@ -108,30 +110,66 @@ class Annealing(Experiment):
                 "target_2x_reached": bool(ratio[str(min(settings["sizes"]))] >= 2.0),
                 "note": "mean distance from node to parent over the first 16 and all 48 nodes"}
 
+    def paper_comparison(self, summary: Summary) -> PaperComparison:
+        """The mean distance to the parent in the first 16 nodes (the trees the paper's numbers describe)."""
+        size = str(min(summary["settings"]["sizes"]))
+        numbers = tuple(PaperNumber(LABELS[method], summary["ours"][method][size],
+                                    tuple(summary["interval_95"][method][size]), summary["paper"][method])
+                        for method in METHODS)
+        return PaperComparison(self.title, f"mean distance to parent, first {size} nodes", numbers)
+
     def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
+        """Replicate 0's trees of each method over the whole world (one extent for every panel), and
+        per method the distances to the parent in every tree: the first 16 nodes (the summary's
+        16-node mean) and all 48."""
         first = {r["method"]: r for r in records if r["replicate"] == 0}
         env = world(settings["scenario"], first["QDA"]["world_seed"])
         sizes = settings["sizes"]
+        colors = {"QDA": "tab:red", "QRRT": "tab:blue"}
+        distances = {method: [parent_distances(r) for r in records if r["method"] == method] for method in METHODS}
+        top = max(float(np.max(d)) for tree in distances.values() for d in tree if d.size)
+        bins = np.linspace(0.0, top * 1.02, 34)
         fig, axes = new_figure(len(METHODS), len(sizes) + 1, (4.8 * (len(sizes) + 1), 4.6 * len(METHODS)))
         for row, method in enumerate(METHODS):
             nodes = np.array(loads(first[method]["positions_json"]))
             parents = np.array(loads(first[method]["parents_json"]))
             for col, size in enumerate(sizes):
-                ax = axes[row, col]
-                plot_edges(env, nodes[: size + 1], parents[: size + 1], LinearTrackingDynamics.paper(), ax=ax)
-                ax.set_title(f"{method}, {min(size, len(nodes) - 1)}-node tree", fontsize=10)
-                span = np.ptp(nodes[: size + 1], axis=0).max() + 8
-                centre = nodes[0]
-                low = np.clip(centre - span / 2, env.bounds[:, 0], env.bounds[:, 1] - span)
-                ax.set_xlim(low[0], low[0] + span)
-                ax.set_ylim(low[1], low[1] + span)
+                tree_on_world(axes[row, col], env, nodes[: size + 1], parents[: size + 1],
+                              LinearTrackingDynamics.paper(),
+                              f"{LABELS[method]}, replicate 0: {min(size, len(nodes) - 1)}-node tree",
+                              colors[method])
             ax = axes[row, len(sizes)]
-            distances = [np.linalg.norm(np.array(loads(r["positions_json"]))[1:] -
-                                        np.array(loads(r["positions_json"]))[np.array(loads(r["parents_json"]))[1:]],
-                                        axis=1) for r in records if r["method"] == method]
-            ax.hist(np.concatenate(distances), bins=30, color="tab:blue" if method == "QRRT" else "tab:red")
+            styles: list[dict[str, Any]] = [{"histtype": "step", "lw": 1.6}, {"alpha": 0.55}]
+            for size, style in zip(sorted(sizes, reverse=True), styles, strict=False):
+                pooled = np.concatenate([d[:size] for d in distances[method]])
+                low, high = summary["interval_95"][method][str(size)]
+                ax.hist(pooled, bins=bins, color=colors[method], **style,
+                        label=f"first {size} nodes: mean {summary['ours'][method][str(size)]} [{low}, {high}]")
+            small = str(min(sizes))
+            ax.axvline(summary["ours"][method][small], color=colors[method], lw=1.5)
+            ax.axvline(self.paper[method], color="black", ls="--", lw=1.5,
+                       label=f"paper (first {small} nodes): {self.paper[method]}")
             ax.set_xlabel("distance to parent")
-            low, high = summary["interval_95"][method][str(sizes[0])]
-            ax.set_title(f"{method}: mean {summary['ours'][method][str(sizes[0])]} [{low}, {high}] (16 nodes), "
-                         f"paper {self.paper[method]}", fontsize=9)
+            ax.set_ylabel(f"nodes ({sum(1 for r in records if r['method'] == method)} trees)")
+            ax.set_title(f"{LABELS[method]}: distance to parent (solid line: our {small}-node mean)", fontsize=9)
+            ax.legend(fontsize=7.5)
+            ax.grid(alpha=0.3, axis="y")
+        histograms = axes[:, len(sizes)]
+        top_count = max(ax.get_ylim()[1] for ax in histograms)
+        for ax in histograms:  # one count scale, as one distance scale (bins), for both methods
+            ax.set_ylim(0, top_count)
         return [save(fig, out_dir / "annealing.png")]
+
+
+def parent_distances(record: Record) -> np.ndarray:
+    """The distance from each node to its parent, in the order the nodes were added.
+
+    Args:
+        record: An annealing record (``positions_json``, ``parents_json``).
+
+    Returns:
+        (nodes,) distances (positions as stored: rounded to 1e-3).
+    """
+    nodes = np.array(loads(record["positions_json"]), dtype=float).reshape(-1, 2)
+    parents = np.array(loads(record["parents_json"]), dtype=int)
+    return np.linalg.norm(nodes[1:] - nodes[parents[1:]], axis=1)

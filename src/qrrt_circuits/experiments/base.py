@@ -113,6 +113,38 @@ def paired_trials(settings: Settings, variants: list[tuple[str, dict[str, Any]]]
     return trials
 
 
+@dataclass(frozen=True)
+class PaperNumber:
+    """One number an experiment compares with the paper.
+
+    Attributes:
+        label: What it is, short (a planner, a planner and a cut).
+        ours: Our value.
+        interval: Our 95 % interval, ``(low, high)``.
+        paper: The paper's value.
+    """
+
+    label: str
+    ours: float
+    interval: tuple[float, float]
+    paper: float
+
+
+@dataclass(frozen=True)
+class PaperComparison:
+    """The numbers of one summary that its experiment compares with the paper, all of one quantity.
+
+    Attributes:
+        title: The experiment's title (which figure of the paper).
+        quantity: What the numbers measure, with their unit (an axis label).
+        numbers: The numbers, in the order they are drawn.
+    """
+
+    title: str
+    quantity: str
+    numbers: tuple[PaperNumber, ...]
+
+
 class Experiment:
     """Base class; subclasses define the five methods below (and ``name``, ``title``).
 
@@ -191,3 +223,16 @@ class Experiment:
             The paths of the figures written.
         """
         raise NotImplementedError
+
+    def paper_comparison(self, summary: Summary) -> PaperComparison | None:
+        """The numbers of a summary that this experiment compares with the paper, for a figure
+        that sets several runs (one per reachability check, say) beside the paper's numbers
+        (``qrrt compare-checks``); read from the summary only, never from records.
+
+        Args:
+            summary: A complete ``summary.json`` of this experiment.
+
+        Returns:
+            The comparison, or None (the default) for an experiment that has none to draw.
+        """
+        return None

@@ -8,7 +8,17 @@ from pathlib import Path
 
 import numpy as np
 
-from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
+from .base import (
+    Experiment,
+    PaperComparison,
+    PaperNumber,
+    Record,
+    Settings,
+    Summary,
+    Trial,
+    TrialStream,
+    replicate_seed,
+)
 from .figures import new_figure, node_heatmap, save
 from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import cut_at, dumps, loads, reachable_fraction, rounded
@@ -83,6 +93,12 @@ class Corridor(Experiment):
                     for k in PLANNERS},
                 "note": "nodes inside the channel rectangle, summed over the trials; reachable_fraction is "
                         "the share of candidates (RRT tests, q-RRT database entries) that were reachable"}
+
+    def paper_comparison(self, summary: Summary) -> PaperComparison:
+        numbers = tuple(PaperNumber(kind, summary["ours"][kind], tuple(summary["interval_95"][kind]),
+                                    summary["paper"][kind]) for kind in PLANNERS)
+        return PaperComparison(self.title, f"nodes in the channel, summed over {summary['settings']['trials']} trials",
+                               numbers)
 
     def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         env = world(settings["scenario"], settings["world_seed"])

@@ -18,7 +18,17 @@ from typing import Any
 
 import numpy as np
 
-from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
+from .base import (
+    Experiment,
+    PaperComparison,
+    PaperNumber,
+    Record,
+    Settings,
+    Summary,
+    Trial,
+    TrialStream,
+    replicate_seed,
+)
 from .figures import heatmap_counts, new_figure, node_heatmap, save
 from .intervals import bootstrap_ratio_interval, differs, rounded_interval
 from .measures import cut_at, dumps, loads, reachable_fraction, rounded
@@ -106,6 +116,16 @@ class Heatmaps(Experiment):
                         "PQRRT is cut on critical-path calls (8 parallel devices); its 'calls' are those.",
                 "labels": ["phase oracle from a classical lookup of all 2^8 entries",
                            f"backend: {BACKEND_LABEL[settings['backend']]}"]}
+
+    def paper_comparison(self, summary: Summary) -> PaperComparison:
+        """Oracle efficiency at each cut, for the planners the paper reports (not Pq-RRT)."""
+        numbers = tuple(
+            PaperNumber(f"{kind}\n{cut} calls", summary["ours"][kind][str(cut)]["efficiency"],
+                        tuple(summary["interval_95"][kind][str(cut)]["efficiency"]),
+                        summary["paper"][kind][str(cut)]["efficiency"])
+            for kind in PLANNERS for cut in summary["settings"]["cuts"]
+            if str(cut) in summary["paper"].get(kind, {}))
+        return PaperComparison(self.title, "oracle efficiency at the cut (nodes / calls)", numbers)
 
     def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         """One panel per planner (rows) and cut (columns), all on one logarithmic colour scale (the

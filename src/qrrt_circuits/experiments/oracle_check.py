@@ -19,7 +19,7 @@ import numpy as np
 from ..reachability.exact import ExactCheck
 from ..registry import PREDICATES
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
-from .figures import new_figure, save
+from .figures import new_figure, save, wrapped
 from .intervals import bootstrap_interval, rounded_interval
 from .measures import cut_at, reachable_fraction
 from .planners import make_planner
@@ -49,6 +49,24 @@ def make_predicate(env: Environment, check: str) -> ReachabilityPredicate:
     name = f"time-samples:{check.split('-')[1]}" if check.startswith("samples-") else check
     predicate: ReachabilityPredicate = PREDICATES.create(name, env=env)
     return predicate
+
+
+def check_label(check: str) -> str:
+    """A check's tick label, over two lines: ``authors`` (MATLAB), ``authors-octave``, ``samples-K``.
+
+    Args:
+        check: A name of ``CHECKS`` (another name is broken at its hyphens).
+
+    Returns:
+        The label.
+    """
+    if check == "authors":
+        return "authors\n(MATLAB)"
+    if check == "authors-octave":
+        return "authors\n(Octave)"
+    if check.startswith("samples-"):
+        return f"{check.split('-', 1)[1]} time\nsamples"
+    return wrapped(check)
 
 
 def efficiency(rows: Sequence[Record]) -> float:
@@ -134,7 +152,7 @@ class OracleCheck(Experiment):
                            color=color, label=kind)
         for ax, label in ((axes[0, 0], "oracle efficiency (nodes / calls)"),
                           (axes[0, 1], "fraction of edges through an obstacle")):
-            ax.set_xticks(x, checks)
+            ax.set_xticks(x, [check_label(c) for c in checks], fontsize=8.5)
             ax.set_ylabel(label)
             ax.legend(fontsize=8)
             ax.grid(alpha=0.3, axis="y")

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, paired_trials
+from .base import Experiment, PaperComparison, PaperNumber, Record, Settings, Summary, Trial, TrialStream, paired_trials
 from .figures import new_figure, save
 from .fitting import linear_fit
 from .intervals import bootstrap_interval, differs, rounded_interval
@@ -89,6 +89,11 @@ class OracleEfficiency(Experiment):
                 "labels": ["phase oracle from a classical lookup of all 2^8 entries",
                            "Pq-RRT: one Aer search with 8 shots stands for 8 workers",
                            f"backend: {BACKEND_LABEL[settings['backend']]}"]}
+
+    def paper_comparison(self, summary: Summary) -> PaperComparison:
+        numbers = tuple(PaperNumber(kind, summary["ours"][kind], tuple(summary["interval_95"][kind]),
+                                    summary["paper"][kind]) for kind in PLANNERS)
+        return PaperComparison(self.title, "oracle calls per node (least-squares slope)", numbers)
 
     def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         fig, axes = new_figure(1, 2, (11, 4.4))

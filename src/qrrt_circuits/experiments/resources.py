@@ -28,11 +28,13 @@ from ..hardware import resources as res
 from ..registry import PLANNERS, PREDICATES
 from ..search.policies.iteration import PaperIterations
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
-from .figures import new_figure, save
+from .figures import new_figure, save, with_intervals
 from .intervals import bootstrap_interval, rounded_interval
 from .worlds import world
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
     from ..search.backends.statevector import StatevectorBackend
 
 _NUMBERS = ("n", "m", "two_qubit_gates", "two_qubit_depth", "depth", "physical_qubits", "oracle_ands",
@@ -218,7 +220,12 @@ class Resources(Experiment):
         return {"table": table, "interval_95": intervals}
 
     def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
-        fig, axes = new_figure(1, 3, (16, 4.8))
+        """Gate counts per call (near term, fault tolerant), the time per call against the plans'
+        break-even (its own panel: seconds, and classical tests on a second axis), and the time
+        per plan."""
+        fig, axes = new_figure(2, 2, (13, 9.6))
+        plan = summary["plan"]["table"]
+        spans = summary["plan"]["interval_95"]
         ax = axes[0, 0]
         for synthesis, marker in zip(settings["syntheses"], "os", strict=False):
             for connectivity in settings["connectivities"]:
@@ -229,42 +236,75 @@ class Resources(Experiment):
         ax.set_yscale("log")
         ax.set_xlabel("index qubits n (m = N/16)")
         ax.set_ylabel("CX per oracle call (one Grover iteration)")
-        ax.set_title("Near term: [cx, rz, sx, x] after routing", fontsize=9)
-        ax.legend(fontsize=7)
+        ax.set_title("Near term: [cx, rz, sx, x] after routing", fontsize=10)
+        ax.legend(fontsize=7.5)
         ax.grid(alpha=0.3, which="both")
 
         ax = axes[0, 1]
-        plan = summary["plan"]["table"]
         for lookup in settings["lookups"]:
             rows = sorted((r for r in records if r["part"] == "fault-tolerant" and r["lookup"] == lookup),
                           key=lambda r: r["n"])
             ax.plot([r["n"] for r in rows], [r["toffoli_equivalents"] for r in rows], "o-",
                     label=f"lookup oracle ({lookup}) + diffuser")
-        ax.axhline(plan["break_even_toffolis"], color="tab:red", ls="--",
-                   label=f"break-even on the n={plan['num_qubits']} plans: {plan['break_even_toffolis']:.0f}")
         ax.set_yscale("log")
         ax.set_xlabel("index qubits n")
         ax.set_ylabel("Toffoli equivalents per oracle call")
-        ax.set_title(f"Fault tolerant ({settings['ft_source']})", fontsize=9)
-        ax.legend(fontsize=7)
+        ax.set_title(f"Fault tolerant ({settings['ft_source']})", fontsize=10)
+        ax.legend(fontsize=7.5)
         ax.grid(alpha=0.3, which="both")
 
-        ax = axes[0, 2]
+        ax = axes[1, 0]
+        self._plot_time_per_call(ax, records, settings, plan, spans)
+
+        ax = axes[1, 1]
         labels = ["RRT (measured)", "q-RRT FT,\nquantum part", "q-RRT FT,\n+ lookup table",
                   "q-RRT near term\n(lower bound)"]
         keys = ["rrt_time_s", "qrrt_fault_tolerant_s", "qrrt_fault_tolerant_with_table_s",
                 "qrrt_near_term_lower_bound_s"]
         values = [plan[k] for k in keys]
-        errors = np.array([[plan[k] - summary["plan"]["interval_95"][k][0],
-                            summary["plan"]["interval_95"][k][1] - plan[k]] for k in keys]).T
+        errors = np.array([[plan[k] - spans[k][0], spans[k][1] - plan[k]] for k in keys]).T
         ax.bar(range(len(keys)), values, yerr=np.clip(errors, 0, None), capsize=4,
                color=["tab:gray", "tab:blue", "tab:purple", "tab:orange"])
-        ax.set_xticks(range(len(keys)), labels, fontsize=7)
+        ax.set_xticks(range(len(keys)), labels, fontsize=8)
         ax.set_yscale("log")
-        ax.set_ylabel(f"seconds per {settings['nodes']}-node plan")
-        ax.set_title(f"paper_clutter plans, n = {plan['num_qubits']}, paper schedule", fontsize=9)
+        ax.set_ylabel(f"seconds per {settings['nodes']}-node plan (95 % interval)")
+        ax.set_title(f"paper_clutter plans, n = {plan['num_qubits']}, paper schedule", fontsize=10)
         ax.grid(alpha=0.3, axis="y", which="both")
         return [save(fig, out_dir / "resources.png")]
+
+    @staticmethod
+    def _plot_time_per_call(ax: Axes, records: list[Record], settings: Settings, plan: dict[str, Any],
+                            spans: dict[str, list[float]]) -> None:
+        """Seconds per oracle call (fault tolerant at ``toffoli_s`` a Toffoli; near term at the
+        two-qubit depth, a lower bound) against n, and the break-even time per call of the n-qubit
+        plans with its 95 % interval; a second axis counts the seconds in classical reachability
+        tests of the measured time (the break-even's machine-independent unit)."""
+        for lookup in settings["lookups"]:
+            rows = sorted((r for r in records if r["part"] == "fault-tolerant" and r["lookup"] == lookup),
+                          key=lambda r: r["n"])
+            ax.plot([r["n"] for r in rows], [r["toffoli_equivalents"] * settings["toffoli_s"] for r in rows], "o-",
+                    label=f"fault tolerant, {lookup} (at {settings['toffoli_s'] * 1e6:g} µs a Toffoli)")
+        rows = sorted((r for r in records if r["part"] == "near-term" and r["synthesis"] == "diagonal"
+                       and r["connectivity"] == "heavy-hex"), key=lambda r: r["n"])
+        ax.plot([r["n"] for r in rows], [r["two_qubit_depth"] * settings["two_qubit_gate_s"] for r in rows], "s--",
+                color="tab:green", label=f"near term, diagonal on heavy-hex (two-qubit depth x "
+                                          f"{settings['two_qubit_gate_s'] * 1e9:g} ns; lower bound)")
+        n, test_s = plan["num_qubits"], plan["test_s"]
+        low, high = spans["break_even_call_s"]
+        tests_low, tests_high = spans["break_even_tests_per_call"]
+        with_intervals(ax, [n], [plan["break_even_call_s"]], [[low, high]], fmt="*", ms=14, color="tab:red",
+                       capsize=5, zorder=4,
+                       label=f"break-even of the n = {n} plans: {plan['break_even_call_s'] * 1e6:.3g} µs per call "
+                             f"[{low * 1e6:.3g}, {high * 1e6:.3g}]\n= {plan['break_even_tests_per_call']:.2g} "
+                             f"classical tests [{tests_low:.2g}, {tests_high:.2g}]")
+        ax.set_yscale("log")
+        ax.set_xlabel("index qubits n")
+        ax.set_ylabel("seconds per oracle call")
+        ax.set_title(f"Time per oracle call vs the break-even (n = {n} plans; q-RRT wins below it)", fontsize=10)
+        second = ax.secondary_yaxis("right", functions=(lambda s: s / test_s, lambda t: t * test_s))
+        second.set_ylabel(f"classical reachability tests per call ({test_s * 1e6:.2g} µs each, measured)")
+        ax.legend(fontsize=7.5, loc="upper left")
+        ax.grid(alpha=0.3, which="both")
 
 
 def plan_backend() -> StatevectorBackend:

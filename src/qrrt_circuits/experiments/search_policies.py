@@ -28,7 +28,7 @@ from ..registry import POLICIES
 from ..search.policies.estimated import EstimatedOptimal, EstimatedOptimalState
 from ..search.policies.iteration import IterationPolicy
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, paired_trials
-from .figures import new_figure, save
+from .figures import dodge, new_figure, save, with_intervals
 from .intervals import rounded_interval
 from .measures import dumps, loads
 from .planners import planner_for
@@ -122,12 +122,15 @@ class SearchPolicies(Experiment):
         ours: dict[str, dict[str, float]] = {}
         interval: dict[str, dict[str, list[float]]] = {}
         critical: dict[str, dict[str, float]] = {}
+        critical_interval: dict[str, dict[str, list[float]]] = {}
         whole: dict[str, dict[str, float]] = {}
         for label in settings["configs"]:
             rows = [r for r in records if r["config"] == label]
             ours[label] = {w: round(pooled_calls_per_node(rows, w), 3) for w in windows}
             interval[label] = {w: rounded_interval(pooled_interval(rows, w, settings["seed"]), 3) for w in windows}
             critical[label] = {w: round(pooled_calls_per_node(rows, w, 2), 3) for w in windows}
+            critical_interval[label] = {w: rounded_interval(pooled_interval(rows, w, settings["seed"], 2), 3)
+                                        for w in windows}
             nodes = sum(r["nodes"] for r in rows)
             whole[label] = {"calls_per_node": round(sum(r["oracle_calls"] for r in rows) / nodes, 3),
                             "critical_path_per_node": round(sum(r["critical_path_calls"] for r in rows) / nodes, 3)}
@@ -135,6 +138,7 @@ class SearchPolicies(Experiment):
                                              if w in loads(r["fractions_json"])] or [np.nan])), 4)
                      for w in windows}
         return {"ours": ours, "paper": self.paper, "interval_95": interval, "critical_path_per_node": critical,
+                "critical_path_interval_95": critical_interval,
                 "whole_run": whole, "mean_reachable_fraction": fractions,
                 "estimation": self._estimation_summary(records),
                 "note": "marginal oracle calls per node added in each window of tree sizes, pooled over worlds "
@@ -184,25 +188,36 @@ class SearchPolicies(Experiment):
         return out
 
     def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
-        fig, axes = new_figure(1, 2, (12, 5))
-        sizes = settings["sizes"]
+        """Marginal calls per node in each window with 95 % intervals (policies side by side in each
+        window): q-RRT; Pq-RRT's critical path (8 parallel devices); Pq-RRT's total calls."""
+        fig, axes = new_figure(1, 3, (17, 5.2))
         windows = list(summary["ours"]["RRT"])
-        centres = [np.sqrt(a * b) for a, b in zip(sizes[:-1], sizes[1:], strict=True)]
-        for ax, prefix, column in ((axes[0, 0], "QRRT", "ours"), (axes[0, 1], "PQRRT", "critical_path_per_node")):
-            ax.plot(centres, [summary["ours"]["RRT"][w] for w in windows], "o-", color="tab:gray", label="RRT")
-            for policy in POLICY_NAMES:
+        x = np.arange(len(windows), dtype=float)
+        offsets = dodge(len(POLICY_NAMES) + 1, 0.7)
+        panels = ((axes[0, 0], "QRRT", "ours", "interval_95", "q-RRT: oracle calls per node added"),
+                  (axes[0, 1], "PQRRT", "critical_path_per_node", "critical_path_interval_95",
+                   f"Pq-RRT, {settings['workers']} workers, shared database: critical path"),
+                  (axes[0, 2], "PQRRT", "ours", "interval_95", "Pq-RRT: total oracle calls per node added"))
+        for ax, prefix, column, spans, title in panels:
+            with_intervals(ax, x + offsets[0], [summary["ours"]["RRT"][w] for w in windows],
+                           [summary["interval_95"]["RRT"][w] for w in windows], fmt="o", ms=6, color="tab:gray",
+                           label="RRT")
+            for offset, policy in zip(offsets[1:], POLICY_NAMES, strict=True):
                 label = f"{prefix} {policy}"
-                values = [summary[column][label][w] for w in windows]
-                ax.plot(centres, values, "o-", color=COLORS[policy], ms=4, label=label)
-                if prefix == "PQRRT":
-                    ax.plot(centres, [summary["ours"][label][w] for w in windows], ":", color=COLORS[policy])
-            ax.set_xscale("log")
+                with_intervals(ax, x + offset, [summary[column][label][w] for w in windows],
+                               [summary[spans][label][w] for w in windows], fmt="o", ms=5,
+                               color=COLORS[policy], label=policy)
+            for boundary in x[:-1] + 0.5:
+                ax.axvline(boundary, color="0.85", lw=0.8)
+            ax.set_xticks(x, [f"{w} nodes" for w in windows])
+            ax.set_xlim(-0.5, len(windows) - 0.5)
             ax.set_yscale("log")
-            ax.set_xlabel("tree size (nodes, window centre)")
-            ax.grid(alpha=0.3, which="both")
-            ax.legend(fontsize=7)
-        axes[0, 0].set_ylabel("oracle calls per node added")
-        axes[0, 0].set_title(f"q-RRT: calls per node ({settings['trials']} worlds)", fontsize=10)
-        axes[0, 1].set_title("Pq-RRT, 8 workers, shared database: critical path (solid), total (dotted)",
-                             fontsize=10)
-        return [save(fig, out_dir / "search_policies.png")]
+            ax.set_xlabel("window of tree sizes")
+            ax.grid(alpha=0.3, axis="y", which="both")
+            ax.set_title(f"{title} ({settings['trials']} worlds)", fontsize=10)
+        axes[0, 0].set_ylabel("oracle calls per node added (95 % interval)")
+        handles, names = axes[0, 0].get_legend_handles_labels()
+        fig.legend(handles, [f"search policy: {n}" if n != "RRT" else n for n in names], loc="upper center",
+                   ncol=len(names), fontsize=8.5, frameon=False)
+        fig.tight_layout(rect=(0, 0, 1, 0.93))
+        return [save(fig, out_dir / "search_policies.png", tight=False)]

@@ -85,8 +85,8 @@ def pooled_calls_per_node(rows: Sequence[Record], window: str, column: int = 1) 
     return sum(calls) / sum(nodes) if sum(nodes) else float("nan")
 
 
-def pooled_interval(rows: Sequence[Record], window: str, seed: int) -> tuple[float, float]:
-    """The 95 % bootstrap interval of ``pooled_calls_per_node(rows, window)`` over the rows
+def pooled_interval(rows: Sequence[Record], window: str, seed: int, column: int = 1) -> tuple[float, float]:
+    """The 95 % bootstrap interval of ``pooled_calls_per_node(rows, window, column)`` over the rows
     (``bootstrap_ratio_interval`` on the per-row counts: the interval ``bootstrap_interval`` gives
     with that statistic, bit for bit, without re-reading every record in every resample).
 
@@ -94,11 +94,12 @@ def pooled_interval(rows: Sequence[Record], window: str, seed: int) -> tuple[flo
         rows: Records with a ``points_json`` column.
         window: ``"low-high"``.
         seed: Seed of the resampling generator.
+        column: 1 for oracle calls (default), 2 for critical-path calls.
 
     Returns:
         (low, high).
     """
-    calls, nodes = window_counts(rows, window)
+    calls, nodes = window_counts(rows, window, column)
     return bootstrap_ratio_interval(calls, nodes, seed)
 
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, paired_trials
-from .figures import new_figure, save
+from .figures import new_figure, save, with_intervals, wrapped
 from .fitting import slope_through_origin
 from .intervals import bootstrap_interval, rounded_interval
 from .planners import planner_for
@@ -94,36 +94,61 @@ class Wallclock(Experiment):
                 "speedup_over_paper_per_node": speedup,
                 "note": "the paper's times are MATLAB on an 8-core M2; ours one process on this machine"}
 
-    @staticmethod
-    def _interval(summary: Summary, key: str, name: str) -> str:
-        if key != "seconds_per_node":
-            return ""
-        low, high = summary["ms_per_node_interval_95"][name]
-        return f" [{low:.3g}, {high:.3g}]"
-
     def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
-        fig, axes = new_figure(1, 2, (11, 4.4))
+        """Left: each tree's seconds per node and the fitted slope (the fit through the origin of
+        seconds against nodes, which at about 30 nodes a tree is the level of the trees' ratios),
+        with its 95 % interval and the paper's value on the same logarithmic axis. Right: seconds
+        against oracle calls on log-log axes, where a line through the origin has unit slope and
+        its height is the seconds per call; each fit is drawn over its configuration's data."""
+        fig, axes = new_figure(1, 2, (13, 5.0))
         colors = dict(zip([label(*c) for c in CONFIGS],
                           ["tab:gray", "tab:brown", "tab:blue", "tab:cyan", "tab:orange", "gold"], strict=True))
-        for ax, key, xcol in ((axes[0, 0], "seconds_per_node", "nodes"),
-                              (axes[0, 1], "seconds_per_oracle_call", "oracle_calls")):
-            for planner, backend in CONFIGS:
-                name = label(planner, backend)
-                if name not in summary["ours"][key]:
-                    continue
-                rows = [r for r in records if r["planner"] == planner and r["backend"] == backend]
-                x = np.array([r[xcol] for r in rows])
-                y = np.array([r["wall_time_s"] for r in rows])
-                slope = summary["ours"][key][name]
-                paper = self.paper[key].get(planner)
-                ax.scatter(x, y, s=10, color=colors[name], alpha=0.6)
-                ax.plot([0, x.max()], [0, slope * x.max()], color=colors[name],
-                        label=f"{name}: {slope * 1e3:.3g} ms{self._interval(summary, key, name)} (paper {paper} s)")
-            ax.set_yscale("log")
-            ax.set_xlabel(xcol.replace("_", " "))
-            ax.set_ylabel("wall-clock seconds")
-            ax.legend(fontsize=7)
-            ax.grid(alpha=0.3)
-        axes[0, 0].set_title("Seconds vs nodes (Figs. 7-8)", fontsize=10)
-        axes[0, 1].set_title("Seconds vs oracle calls (Fig. 6)", fontsize=10)
+        ax = axes[0, 0]
+        names = [label(*c) for c in CONFIGS]
+        for index, (planner, backend) in enumerate(CONFIGS):
+            name = label(planner, backend)
+            rows = [r for r in records if r["planner"] == planner and r["backend"] == backend]
+            ratios = np.array([r["wall_time_s"] / r["nodes"] for r in rows])
+            jitter = np.linspace(-0.18, 0.18, len(rows)) if len(rows) > 1 else np.zeros(len(rows))
+            ax.scatter(index + jitter, ratios, s=12, color=colors[name], alpha=0.6, zorder=2,
+                       label="each tree: seconds / nodes" if index == 0 else None)
+            slope = summary["ours"]["seconds_per_node"][name]
+            low, high = summary["ms_per_node_interval_95"][name]
+            with_intervals(ax, [index + 0.3], [slope], [[low / 1e3, high / 1e3]], fmt="_", ms=14, mew=2,
+                           color="black", zorder=3,
+                           label="fit through the origin, 95 % interval" if index == 0 else None)
+            ax.annotate(f"{slope * 1e3:.2g} ms", (index + 0.45, slope), fontsize=7.5, va="center")
+            paper = self.paper["seconds_per_node"][planner]
+            ax.plot(index, paper, "D", color="black", mfc="white", ms=7,
+                    label="paper (MATLAB, 8-core M2)" if index == 0 else None)
+            ax.annotate(f"{paper} s", (index + 0.15, paper), fontsize=7.5, va="center")
+        ax.set_xticks(range(len(names)), [wrapped(n) for n in names], fontsize=8)
+        ax.set_xlim(-0.5, len(names) - 0.1)
+        ax.set_yscale("log")
+        ax.set_ylabel("wall-clock seconds per node")
+        ax.set_title(f"Seconds per node (Figs. 7-8), {settings['nodes']}-node trees", fontsize=10)
+        ax.legend(fontsize=7.5, loc="center left")
+        ax.grid(alpha=0.3, axis="y")
+
+        ax = axes[0, 1]
+        for planner, backend in CONFIGS:
+            name = label(planner, backend)
+            if name not in summary["ours"]["seconds_per_oracle_call"]:
+                continue
+            rows = [r for r in records if r["planner"] == planner and r["backend"] == backend]
+            x = np.array([r["oracle_calls"] for r in rows], dtype=float)
+            y = np.array([r["wall_time_s"] for r in rows])
+            slope = summary["ours"]["seconds_per_oracle_call"][name]
+            paper = self.paper["seconds_per_oracle_call"][planner]
+            ax.scatter(x, y, s=12, color=colors[name], alpha=0.6)
+            span = np.array([x.min(), x.max()])
+            ax.plot(span, slope * span, color=colors[name], lw=2.2,
+                    label=f"{name}: {slope * 1e3:.3g} ms per call (paper {paper} s)")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("oracle calls of the tree")
+        ax.set_ylabel("wall-clock seconds per tree")
+        ax.set_title("Seconds vs oracle calls (Fig. 6); lines: fits through the origin", fontsize=10)
+        ax.legend(fontsize=7.5)
+        ax.grid(alpha=0.3, which="both")
         return [save(fig, out_dir / "wallclock.png")]
