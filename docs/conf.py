@@ -198,7 +198,7 @@ def api_reference() -> str:
 
 
 def write_api_pages() -> None:
-    """The reference page; autosummary's pages of an earlier build are removed first, so a name
+    """The reference page; autosummary's pages of the last build are removed first, so a name
     that left the API leaves no page behind (autosummary writes the current ones again)."""
     title = "qrrt_circuits"
     text = "\n".join(_heading(title, "=")) + "\n" + api_reference()
