@@ -47,3 +47,14 @@ def test_lazy_names_are_the_search_modules_objects_and_unknown_names_raise():
         qc.Nope  # noqa: B018
     with pytest.raises(AttributeError, match="no attribute 'Nope'"):
         search.Nope  # noqa: B018
+
+
+def test_importing_the_package_and_the_command_line_imports_nothing_heavy():
+    """``qrrt``'s ``main`` installs its signal handlers before the heavy imports begin (so an
+    interrupt during them is reported in one line): importing the package and the command line
+    must not import them already."""
+    heavy = ("numpy", "numba", "scipy", "qiskit", "qiskit_aer", "matplotlib", "importlib.metadata")
+    script = (f"import json, sys\nimport qrrt_circuits, qrrt_circuits.cli\n"
+              f"print(json.dumps([m for m in {heavy!r} if m in sys.modules]))")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
+    assert json.loads(done.stdout.strip().splitlines()[-1]) == []

@@ -14,6 +14,9 @@ the docs just before the suite), the test checks the cached outputs instead of r
 notebook a second time; otherwise it executes the notebook itself.
 """
 
+import os
+import shutil
+import subprocess
 import sys
 from pathlib import Path
 
@@ -113,3 +116,58 @@ def check_outputs(name, nb):
         if "image/png" in out.get("data", {})
     ]
     assert images, f"{name} produced no image/png output"
+
+
+def _results_script() -> str:
+    """Notebook 06's imports and its section 3 (which reads the committed results), as a script."""
+    nb = nbformat.read(NOTEBOOKS_DIR / "06_would_it_pay_off.ipynb", as_version=4)
+    start = next(i for i, cell in enumerate(nb.cells) if cell.cell_type == "markdown" and "## 3." in cell.source)
+    end = next(i for i, cell in enumerate(nb.cells) if i > start and cell.cell_type == "markdown")
+    imports = next(cell for cell in nb.cells if cell.cell_type == "code")
+    cells = [imports, *(cell for cell in nb.cells[start:end] if cell.cell_type == "code")]
+    return "\n".join(line for cell in cells for line in cell.source.splitlines() if not line.startswith("%"))
+
+
+def _run_results_script(cwd, package_parent):
+    env = dict(os.environ, MPLBACKEND="Agg", PYTHONPATH=str(package_parent))
+    return subprocess.run([sys.executable, "-c", _results_script()], capture_output=True, text=True, cwd=cwd,
+                          env=env, timeout=300)
+
+
+RESULTS_READ = ["break-even p2, ", "break-even: one call must cost at most", "with the wall-clock experiment's"]
+RESULTS_USED = ["noise", "resources", "wallclock", "oracle-efficiency"]
+
+
+def test_notebook_06_finds_the_results_from_outside_the_repository(tmp_path):
+    """Run elsewhere (a copy of the notebook, say), it finds the repository's docs/results from the
+    checkout the package is imported from."""
+    import qrrt_circuits
+
+    package_parent = Path(qrrt_circuits.__file__).resolve().parent.parent
+    if not (package_parent.parent / "docs" / "results").is_dir():
+        pytest.skip("the package is not imported from a checkout of the repository")
+    run = _run_results_script(tmp_path, package_parent)
+    assert run.returncode == 0, run.stderr
+    assert all(text in run.stdout for text in RESULTS_READ), run.stdout
+
+
+def test_notebook_06_without_the_results_says_how_to_make_them_and_reads_results_here(tmp_path):
+    """Outside any checkout it prints, for each summary it lacks, one line naming the command that
+    makes it, and runs on; with those commands' output in ./results it reads that."""
+    import qrrt_circuits
+
+    package = tmp_path / "site" / "qrrt_circuits"
+    shutil.copytree(Path(qrrt_circuits.__file__).resolve().parent, package,
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    run = _run_results_script(elsewhere, package.parent)
+    assert run.returncode == 0, run.stderr
+    for experiment in RESULTS_USED[:2]:  # (the other two are read only with the resources)
+        assert f"`qrrt reproduce {experiment}` writes one to results/{experiment}; skipped" in run.stdout
+    assert not any(text in run.stdout for text in RESULTS_READ), run.stdout
+    for experiment in RESULTS_USED:
+        shutil.copytree(NOTEBOOKS_DIR.parent / "docs" / "results" / experiment, elsewhere / "results" / experiment)
+    run = _run_results_script(elsewhere, package.parent)
+    assert run.returncode == 0, run.stderr
+    assert all(text in run.stdout for text in RESULTS_READ) and "skipped" not in run.stdout, run.stdout

@@ -5,89 +5,126 @@ Lathrop, Boardman and Martinez, "Parallel Quantum Rapidly-Exploring Random Trees
 2024), with Grover search as real Qiskit circuits on Aer or on an exact statevector.
 """
 
-from importlib import metadata as _metadata
+import importlib as _importlib
 from typing import TYPE_CHECKING, Any
 
-from . import probability, registry
-from .planners import PQRRT, QRRT, RRT, Metrics, ParallelRRT, PlanResult, termination
-from .planners.database import AnnealingSchedule
-from .planners.termination import (
-    AnyOf,
-    MaxCriticalPathCalls,
-    MaxNodes,
-    MaxOracleCalls,
-    MaxRounds,
-    MaxWallTime,
-    PlanStatus,
-    Stall,
-    TerminationCondition,
-)
-from .reachability.authors_check import AuthorsCheck
-from .reachability.dynamics import LinearTrackingDynamics
-from .reachability.exact import ExactCheck
-from .reachability.oracle_errors import OracleErrorModel
-from .reachability.predicate import ReachabilityPredicate
-from .reachability.time_sampled import TimeSampledCheck
-from .search.backend import QuantumSearchBackend, SearchRequest, SearchResult
-from .search.policies.iteration import (
-    BBHT,
-    Adaptive,
-    FixedIterations,
-    IterationPolicy,
-    KnownOptimal,
-    PaperIterations,
-)
-from .search.problem import DatabaseSearch, SearchOutcome
-from .world import scenarios
-from .world.environment import Environment
-
 if TYPE_CHECKING:
+    from . import probability, registry
+    from .planners import PQRRT, QRRT, RRT, Metrics, ParallelRRT, PlanResult, termination
+    from .planners.database import AnnealingSchedule
+    from .planners.termination import (
+        AnyOf,
+        MaxCriticalPathCalls,
+        MaxNodes,
+        MaxOracleCalls,
+        MaxRounds,
+        MaxWallTime,
+        PlanStatus,
+        Stall,
+        TerminationCondition,
+    )
+    from .reachability.authors_check import AuthorsCheck
+    from .reachability.dynamics import LinearTrackingDynamics
+    from .reachability.exact import ExactCheck
+    from .reachability.oracle_errors import OracleErrorModel
+    from .reachability.predicate import ReachabilityPredicate
+    from .reachability.time_sampled import TimeSampledCheck
     from .search import circuits
+    from .search.backend import QuantumSearchBackend, SearchRequest, SearchResult
     from .search.backends.aer import AerBackend
     from .search.backends.sampler import SamplerBackend
     from .search.backends.statevector import StatevectorBackend
     from .search.fixed_point import IterateSequence
     from .search.policies.estimated import EstimatedOptimal
     from .search.policies.fixed_point import FixedPointAmplification
+    from .search.policies.iteration import (
+        BBHT,
+        Adaptive,
+        FixedIterations,
+        IterationPolicy,
+        KnownOptimal,
+        PaperIterations,
+    )
+    from .search.problem import DatabaseSearch, SearchOutcome
+    from .world import scenarios
+    from .world.environment import Environment
 
-#: the names imported on first use (PEP 562): their modules import Qiskit (the circuits, Aer, the
-#: sampler, amplitude estimation) or its circuit types, which a plan on the statevector never needs
-_LAZY = ("AerBackend", "EstimatedOptimal", "FixedPointAmplification", "IterateSequence", "SamplerBackend",
-         "StatevectorBackend", "circuits")
+    __version__: str
 
+#: every public name -> the module that defines it (or that is it, where the module's last part is the
+#: name). Each is imported on first use (PEP 562) and then cached here, so ``import qrrt_circuits``
+#: imports nothing heavy (no numpy, numba, scipy or Qiskit): a program such as the ``qrrt`` command
+#: line can set itself up (install its signal handlers) before the heavy imports begin, and what a
+#: program never uses it never imports (a plan on the statevector never imports Qiskit)
+_WHERE = {
+    "probability": ".probability",
+    "registry": ".registry",
+    **dict.fromkeys(["PQRRT", "QRRT", "RRT", "Metrics", "ParallelRRT", "PlanResult"], ".planners"),
+    "AnnealingSchedule": ".planners.database",
+    "termination": ".planners.termination",
+    **dict.fromkeys(["AnyOf", "MaxCriticalPathCalls", "MaxNodes", "MaxOracleCalls", "MaxRounds", "MaxWallTime",
+                     "PlanStatus", "Stall", "TerminationCondition"], ".planners.termination"),
+    "AuthorsCheck": ".reachability.authors_check",
+    "LinearTrackingDynamics": ".reachability.dynamics",
+    "ExactCheck": ".reachability.exact",
+    "OracleErrorModel": ".reachability.oracle_errors",
+    "ReachabilityPredicate": ".reachability.predicate",
+    "TimeSampledCheck": ".reachability.time_sampled",
+    **dict.fromkeys(["QuantumSearchBackend", "SearchRequest", "SearchResult"], ".search.backend"),
+    # (these import Qiskit: the circuits, Aer, the sampler, amplitude estimation, or its circuit types)
+    **dict.fromkeys(["AerBackend", "EstimatedOptimal", "FixedPointAmplification", "IterateSequence",
+                     "SamplerBackend", "StatevectorBackend"], ".search"),
+    "circuits": ".search.circuits",
+    **dict.fromkeys(["BBHT", "Adaptive", "FixedIterations", "IterationPolicy", "KnownOptimal", "PaperIterations"],
+                    ".search.policies.iteration"),
+    **dict.fromkeys(["DatabaseSearch", "SearchOutcome"], ".search.problem"),
+    "scenarios": ".world.scenarios",
+    "Environment": ".world.environment",
+}
 
-#: deprecated name -> (its replacement, the object)
-_DEPRECATED: dict[str, tuple[str, Any]] = {
-    "SearchPolicy": ("IterationPolicy", IterationPolicy),
-    "PaperSchedule": ("PaperIterations", PaperIterations),
-    "ReachabilityOracle": ("ExactCheck", ExactCheck),
+#: deprecated name -> its replacement (a name of ``_WHERE``)
+_DEPRECATED = {
+    "SearchPolicy": "IterationPolicy",
+    "PaperSchedule": "PaperIterations",
+    "ReachabilityOracle": "ExactCheck",
 }
 
 
 def __getattr__(name: str) -> Any:
-    """``qrrt_circuits.search``'s lazily imported names, cached here on first use; deprecated names."""
+    """A public name, imported on first use (``_WHERE``) and cached in this module; deprecated
+    names (they warn); ``__version__``."""
     if name in _DEPRECATED:
         from ._support.deprecation import warn_deprecated
 
-        new, value = _DEPRECATED[name]
+        new = _DEPRECATED[name]
         warn_deprecated(f"qrrt_circuits.{name}", f"qrrt_circuits.{new}")
-        return value
-    if name in _LAZY:
-        from . import search
-
-        value = getattr(search, name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+        return globals()[new] if new in globals() else __getattr__(new)
+    if name == "__version__":
+        value: Any = _version()
+    elif name in _WHERE:
+        where = _WHERE[name]
+        value = _importlib.import_module(where, __name__)
+        if where.rpartition(".")[2] != name:
+            value = getattr(value, name)
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value
+    return value
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+    return sorted(set(globals()) | set(__all__) | {"__version__"})
 
-try:  # one source of the version: ``version`` in pyproject.toml, read from the installed metadata
-    __version__ = _metadata.version("qrrt-circuits")
-except _metadata.PackageNotFoundError:  # a source tree on sys.path that was never installed
-    __version__ = "0+unknown"
+
+def _version() -> str:
+    """One source of the version: ``version`` in pyproject.toml, read from the installed metadata."""
+    from importlib import metadata
+
+    try:
+        return metadata.version("qrrt-circuits")
+    except metadata.PackageNotFoundError:  # a source tree on sys.path that was never installed
+        return "0+unknown"
+
 
 __all__ = [
     "BBHT",

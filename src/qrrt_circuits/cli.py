@@ -2,24 +2,32 @@
 
 Every choice (planners, backends, search policies, scenarios, predicates) and its help text comes
 from ``qrrt_circuits.registry``, so the command line and the library mean the same thing by a name.
+
+Every failure is one line on stderr, and the exit status says what happened (``EXIT_STATUSES``):
+0 done, 1 the environment failed (a file that cannot be read or written, an unreachable Dask
+scheduler, out of memory, an unreadable or corrupt numba cache), 2 bad input, 130 interrupted
+(Ctrl-C, SIGINT), 143 and 129 terminated (SIGTERM, SIGHUP): 128 + the signal's number.
+
+This module imports only the standard library; the package's heavy dependencies (numpy, numba,
+scipy, Qiskit) are imported inside ``main`` once its signal handlers are installed, so an
+interrupt during those imports is reported like any other.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
+import os
+import signal
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeAlias
 
-import numpy as np
-
-from . import __version__, probability
-from ._support.output_files import check_output_file, same_file, write_replacing
-from .registry import BACKENDS, PLANNERS, POLICIES, PREDICATES, SCENARIOS
-
 if TYPE_CHECKING:
+    import numpy as np
+
     from ._support.memory import MemoryEstimate
     from .planners.base import Planner
     from .planners.result import PlanResult
@@ -55,6 +63,9 @@ def _registered(registry: Registry) -> Callable[[str], str]:
 
 # ----------------------------------------------------------------------------------------- search
 def cmd_search(args: argparse.Namespace) -> int:
+    from . import probability
+    from .registry import BACKENDS
+
     backend = BACKENDS.create(args.backend, seed=args.seed)
     backend.check_qubits(args.qubits)  # before 2**qubits is computed (a huge --qubits is refused, not allocated)
     num_items = 1 << args.qubits
@@ -83,6 +94,8 @@ def _run_search(args: argparse.Namespace, backend: QuantumSearchBackend, num_ite
                 iterations: int) -> tuple[np.ndarray, SearchResult]:
     """The marks (``--marked`` entries drawn with ``--seed``) and their search, which the
     command's own memory check covered."""
+    import numpy as np
+
     rng = np.random.default_rng(args.seed)
     marks = np.zeros(num_items, dtype=bool)
     marks[rng.choice(num_items, args.marked, replace=False)] = True
@@ -106,6 +119,10 @@ def _search_estimate(backend: QuantumSearchBackend, shots: int, iterations: int,
 
 
 def _print_search(args: argparse.Namespace, marks: np.ndarray, iterations: int, result: SearchResult) -> None:
+    import numpy as np
+
+    from . import probability
+
     num_items = marks.shape[0]
     rate = float(marks[result.indices].mean())
     theory = probability.success_probability(num_items, args.marked, iterations)
@@ -145,6 +162,8 @@ def _load_environment(args: argparse.Namespace) -> Environment:
         if not Path(args.scenario_file).is_file():
             raise ValueError(f"--scenario-file: no such file {args.scenario_file!r}")
         return Environment.load(args.scenario_file)
+    from .registry import SCENARIOS
+
     return SCENARIOS.create(args.scenario, seed=args.scenario_seed)
 
 
@@ -162,6 +181,8 @@ def _planner_specific(args: argparse.Namespace) -> dict[str, Any]:
     """The planner-specific options of ``args`` (``PLANNER_SPECIFIC_OPTIONS``), defaults filled in
     for the ones the planner takes; one that was given but that the planner does not take is
     refused (``ValueError``) instead of being ignored."""
+    from .registry import PLANNERS
+
     accepted = PLANNERS.resolve(args.planner).options()
     given = vars(args)
     chosen: dict[str, Any] = {}
@@ -180,6 +201,8 @@ def _planner_specific(args: argparse.Namespace) -> dict[str, Any]:
 def build_planner(args: argparse.Namespace, env: Environment) -> Planner:
     """The planner the arguments name, with only the options that apply to it; a planner-specific
     option given to a planner that does not take it (``--qubits`` with ``rrt``) is refused."""
+    from .registry import BACKENDS, PLANNERS, POLICIES, PREDICATES
+
     specific = _planner_specific(args)
     options: dict[str, Any] = {"goal_bias": args.goal_bias, "seed": args.seed,
                                "predicate": PREDICATES.create(args.predicate, env=env)}
@@ -216,6 +239,8 @@ def _print_plan(result: PlanResult, env: Environment, seed: int) -> None:
 def _write_plan_outputs(args: argparse.Namespace, result: PlanResult, env: Environment) -> None:
     """Write ``--json`` and ``--plot``; if a write fails (a full disk), the other is still written
     and one ``OSError`` names every failed output and says the plan finished."""
+    from ._support.output_files import write_replacing
+
     failures = []
     if args.json:
         try:  # streamed chunk by chunk (PlanResult.write_json), not built as one string
@@ -255,6 +280,8 @@ def _write_failure(exc: OSError | MemoryError) -> str:
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
+    from ._support.output_files import check_output_file, same_file
+
     check_output_file(args.json, "--json")
     check_output_file(args.plot, "--plot", PLOT_FORMATS)
     if args.json and args.plot and same_file(args.json, args.plot):
@@ -326,6 +353,8 @@ _Formatter: TypeAlias = "type[argparse.HelpFormatter]"
 
 
 def _add_search_parser(sub: _Subparsers, formatter: _Formatter) -> None:
+    from .registry import BACKENDS
+
     search = sub.add_parser("search", help="Grover-search a random marked database", formatter_class=formatter)
     search.add_argument("--qubits", type=_positive_int, default=8, help="n: the database has 2^n entries")
     search.add_argument("--marked", type=_nonnegative_int, default=12,
@@ -343,6 +372,8 @@ def _add_search_parser(sub: _Subparsers, formatter: _Formatter) -> None:
 
 
 def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
+    from .registry import BACKENDS, PLANNERS, POLICIES, PREDICATES, SCENARIOS
+
     plan = sub.add_parser("plan", help="plan a path with one planner and print its metrics",
                           formatter_class=formatter)
     plan.add_argument("--scenario", type=_registered(SCENARIOS), choices=SCENARIOS.names(),
@@ -387,6 +418,8 @@ def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
 
 
 def _add_reproduce_parser(sub: _Subparsers, formatter: _Formatter) -> None:
+    from .registry import PREDICATES
+
     reproduce = sub.add_parser("reproduce", help="reproduce the paper's figures and tables",
                                formatter_class=formatter)
     reproduce.add_argument("experiment", help="an experiment name or 'all'")
@@ -417,6 +450,8 @@ def _add_compare_checks_parser(sub: _Subparsers, formatter: _Formatter) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from . import __version__
+
     parser = argparse.ArgumentParser(prog="qrrt", description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -428,45 +463,206 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _interrupted(command: str) -> int:
-    """Report an interrupted command in one line; the exit status 130 (128 + SIGINT)."""
-    kept = ("finished trials are kept in records.csv; run the same command again to resume"
-            if command == "reproduce" else "nothing was written")
-    print(f"qrrt {command}: interrupted; {kept}", file=sys.stderr)
-    return 130
+#: ``qrrt``'s exit statuses (every one but 0 comes with one line on stderr)
+EXIT_STATUSES = {
+    0: "done",
+    1: "the environment failed: a file that cannot be read or written, an unreachable Dask scheduler, "
+       "out of memory, or numba's compiled-function cache unreadable or corrupt",
+    2: "bad input (the line names the argument and what it accepts)",
+    128 + signal.SIGINT: "interrupted (Ctrl-C, SIGINT)",
+    128 + signal.SIGTERM: "terminated (SIGTERM)",
+    **({128 + signal.SIGHUP: "terminated (SIGHUP: the terminal closed)"} if hasattr(signal, "SIGHUP") else {}),
+}
+
+#: the signals that stop a command the way Ctrl-C does, besides SIGINT
+STOP_SIGNALS = tuple(getattr(signal, name) for name in ("SIGTERM", "SIGHUP") if hasattr(signal, name))
 
 
-def _caused_by_interrupt(exc: BaseException) -> bool:
-    """Whether a ``KeyboardInterrupt`` is in ``exc``'s chain of causes and contexts (numba wraps one
-    raised while a compiled function runs in ``SystemError: ... returned a result with an exception
-    set``)."""
+class Terminated(KeyboardInterrupt):
+    """Raised in the main thread by a signal of ``STOP_SIGNALS`` while ``main`` runs.
+
+    A ``KeyboardInterrupt``, so that it travels the way Ctrl-C's does: ``except Exception`` does not
+    catch it, and every ``with`` block and ``finally`` clause on the way out runs (worker pools and
+    Dask clusters are shut down, the progress bar is closed). ``signum`` is the signal's number.
+    """
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+@contextlib.contextmanager
+def _stop_signals() -> Iterator[None]:
+    """While the block runs, each signal of ``STOP_SIGNALS`` whose disposition is the default raises
+    ``Terminated`` (once: a repeat while the command shuts down is ignored, so the shut-down
+    finishes); a signal that is ignored (``nohup``) or has a handler of the caller's keeps it. The
+    previous dispositions are restored on exit. Outside the main thread (where Python cannot set
+    handlers) nothing changes."""
+    raised = False
+
+    def stop(signum: int, frame: object) -> None:
+        nonlocal raised
+        if not raised:
+            raised = True
+            raise Terminated(signum)
+
+    saved: dict[int, Any] = {}
+    try:
+        for signum in STOP_SIGNALS:
+            if signal.getsignal(signum) == signal.SIG_DFL:
+                signal.signal(signum, stop)
+                saved[signum] = signal.SIG_DFL
+    except ValueError:  # not the main thread
+        pass
+    try:
+        yield
+    finally:
+        for signum, previous in saved.items():
+            signal.signal(signum, previous)
+
+
+def _chain(exc: BaseException) -> Iterator[BaseException]:
+    """``exc`` and its causes and contexts, each once."""
     seen: set[int] = set()
     current: BaseException | None = exc
     while current is not None and id(current) not in seen:
-        if isinstance(current, KeyboardInterrupt):
-            return True
         seen.add(id(current))
+        yield current
         current = current.__cause__ or current.__context__
-    return False
+
+
+def _interrupt_in(exc: BaseException) -> KeyboardInterrupt | None:
+    """The ``KeyboardInterrupt`` (or ``Terminated``) in ``exc``'s chain of causes and contexts, if any:
+    numba wraps one raised while a compiled function runs in ``SystemError: ... returned a result
+    with an exception set``, and an error raised while an interrupt was being handled is its
+    consequence."""
+    return next((error for error in _chain(exc) if isinstance(error, KeyboardInterrupt)), None)
+
+
+def _command_in(words: list[str]) -> str | None:
+    """The command named in ``words`` (the first word that is not an option), if it is one."""
+    first = next((word for word in words if not word.startswith("-")), None)
+    return first if first in ("search", "plan", "reproduce") else None
+
+
+def _what_is_kept(command: str | None, args: argparse.Namespace | None) -> str:
+    """What an interrupted command leaves behind, and what to do about it."""
+    if command != "reproduce":
+        return "nothing was written"
+    if args is None:  # stopped before the arguments were read
+        where = "records.csv under the --out folder"
+    elif args.experiment == "all":
+        where = f"each experiment's records.csv under {args.out}"
+    else:
+        where = str(Path(args.out) / args.experiment / "records.csv")
+    return f"finished trials are kept in {where}; run the same command again to resume"
+
+
+def _stopped(stop: KeyboardInterrupt, command: str | None, args: argparse.Namespace | None) -> int:
+    """Report a command stopped by a signal in one line; the exit status 128 + the signal's number
+    (130 for Ctrl-C, 143 for SIGTERM, 129 for SIGHUP).
+
+    CPython (3.11 to 3.13 at least) marks a ``KeyboardInterrupt`` that escaped code run by ``exec``
+    of a string (``dataclasses`` and ``collections.namedtuple`` build their methods that way, so an
+    interrupt during the imports is often one), and a process started with ``python -m`` then dies
+    by SIGINT at exit instead of exiting with the status returned here, although the interrupt was
+    handled. An ``exec`` of a string that runs to its end clears the mark, hence the empty one."""
+    exec("")  # (see the docstring)
+    signum = stop.signum if isinstance(stop, Terminated) else signal.SIGINT
+    how = "interrupted" if signum == signal.SIGINT else f"terminated ({signal.Signals(signum).name})"
+    print(f"qrrt{f' {command}' if command else ''}: {how}; {_what_is_kept(command, args)}", file=sys.stderr)
+    return 128 + signum
+
+
+#: numba's module that reads and writes its on-disk cache of compiled functions
+_NUMBA_CACHING = os.path.join("numba", "core", "caching.py")
+
+
+def _numba_cache_failure(exc: BaseException) -> tuple[BaseException, str | None] | None:
+    """The error in ``exc``'s chain that numba raised while loading a compiled function from its
+    on-disk cache (an index ``*.nbi`` or data ``*.nbc`` file it could not read or unpickle), with the
+    folder of the file it was reading where the traceback shows it; None for any other error. An
+    error raised in a worker process is recognised by the text of its traceback (which
+    ``concurrent.futures`` attaches as its cause)."""
+    for error in _chain(exc):
+        loading, folder = False, None
+        tb = error.__traceback__
+        while tb is not None:
+            code, names = tb.tb_frame.f_code, tb.tb_frame.f_locals
+            if code.co_filename.endswith(_NUMBA_CACHING) and "load" in code.co_name:
+                loading = True
+                read = getattr(names.get("f"), "name", None) or names.get("path")  # the file being read
+                folder = os.path.dirname(read) if isinstance(read, str) else folder
+            tb = tb.tb_next
+        if loading:
+            return error, folder
+        remote = error.__cause__
+        text = str(remote) if type(remote).__name__ == "_RemoteTraceback" else ""
+        if _NUMBA_CACHING in text and any(f"in {name}\n" in text for name in
+                                          ("load_overload", "_load_overload", "_load_index", "_load_data")):
+            return error, None
+    return None
+
+
+def _numba_cache_text(error: BaseException, folder: str | None) -> str:
+    """One line for a failed load from numba's cache: where the cache is, and what to do."""
+    import numba
+
+    reason = f"{type(error).__name__}: {' '.join(str(error).split())}".rstrip(": ")
+    cache_dir = getattr(numba.config, "CACHE_DIR", "")  # NUMBA_CACHE_DIR: every cached function is under it
+    if cache_dir:
+        return (f"numba's compiled-function cache in {cache_dir} is unreadable or corrupt "
+                f"({reason}); delete that folder (or unset NUMBA_CACHE_DIR) and run again")
+    where = (folder if folder is not None else
+             f"the __pycache__ folders under {Path(__file__).resolve().parent}")
+    return (f"numba's compiled-function cache in {where} is unreadable or corrupt ({reason}); delete its "
+            f"*.nbi and *.nbc files (or set NUMBA_CACHE_DIR to an empty folder) and run again")
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    try:
-        return args.func(args)
-    except KeyboardInterrupt:
-        return _interrupted(args.command)
-    except SystemError as exc:  # Ctrl-C inside a compiled (numba) function reaches Python as a SystemError
-        if not _caused_by_interrupt(exc):
+    """Run ``qrrt`` with ``argv`` (default: ``sys.argv[1:]``) and return its exit status.
+
+    A failure prints one line on stderr and exits with its status (``EXIT_STATUSES``): bad input 2,
+    an environment error 1, through ``SystemExit``. While it runs, SIGTERM and SIGHUP stop the
+    command as Ctrl-C does (``Terminated``), from the first moment: the handlers are installed
+    before anything else is imported. A stopped command reports what was kept in one line and
+    returns 128 + the signal's number; the previous signal handlers are restored on return.
+    """
+    words = sys.argv[1:] if argv is None else list(argv)
+    args: argparse.Namespace | None = None
+    with _stop_signals():
+        try:
+            args = build_parser().parse_args(argv)
+            status: int = args.func(args)
+            return status
+        except KeyboardInterrupt as stop:
+            return _stopped(stop, args.command if args is not None else _command_in(words), args)
+        except Exception as exc:
+            command = args.command if args is not None else _command_in(words)
+            stop_in_chain = _interrupt_in(exc)
+            if stop_in_chain is not None:
+                return _stopped(stop_in_chain, command, args)
+            _exit(command, exc)
             raise
-        return _interrupted(args.command)
-    except (ValueError, TypeError) as exc:
-        parser.exit(2, f"qrrt {args.command}: error: {exc}\n")
-    except OSError as exc:  # unreadable files, an unreachable Dask scheduler, a full disk
-        parser.exit(1, f"qrrt {args.command}: error: {type(exc).__name__}: {exc}\n")
-    except MemoryError as exc:  # a plan's or a search's is a one-line memory.OutOfMemory naming the size
-        parser.exit(1, f"qrrt {args.command}: error: {_memory_error_text(exc)}\n")
+
+
+def _exit(command: str | None, exc: Exception) -> None:
+    """Exit with ``exc`` as one line on stderr and its status, if it is a failure ``qrrt`` reports
+    (``EXIT_STATUSES``); return for any other (a bug, which keeps its traceback)."""
+    prefix = f"qrrt{f' {command}' if command else ''}: error:"
+    cache = _numba_cache_failure(exc)
+    if cache is not None:
+        status, text = 1, _numba_cache_text(*cache)
+    elif isinstance(exc, ValueError | TypeError):
+        status, text = 2, str(exc)
+    elif isinstance(exc, OSError):  # unreadable files, an unreachable Dask scheduler, a full disk
+        status, text = 1, f"{type(exc).__name__}: {exc}"
+    elif isinstance(exc, MemoryError):  # a plan's or a search's is a one-line memory.OutOfMemory naming the size
+        status, text = 1, _memory_error_text(exc)
+    else:
+        return
+    print(f"{prefix} {text}", file=sys.stderr)
+    raise SystemExit(status)
 
 
 def _memory_error_text(exc: MemoryError) -> str:
