@@ -36,6 +36,7 @@ ROOT = DOCS.parent
 sys.path.insert(0, str(ROOT / "src"))  # a source checkout builds without an install too
 sys.path.insert(0, str(DOCS))  # the page generators beside this file
 
+from api_names import public_names as _public_names  # noqa: E402
 from performance_page import write_performance_page  # noqa: E402
 from results_tables import write_tables as write_results_tables  # noqa: E402
 
@@ -121,27 +122,6 @@ def _write_if_changed(path: Path, text: str) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     if not path.exists() or path.read_text() != text:
         path.write_text(text)
-
-
-def _public_names(module: types.ModuleType) -> list[str]:
-    """A module's public names: its ``__all__``, else the public classes and functions it defines
-    and its UPPER_CASE constants that carry a ``#:`` doc comment (``registry.PLANNERS``,
-    ``termination.DEFAULT_MAX_ROUNDS``; not ``TYPE_CHECKING`` or an undocumented constant)."""
-    from sphinx.pycode import ModuleAnalyzer
-
-    names = getattr(module, "__all__", None)
-    if names is not None:
-        return list(names)
-    documented = {name for (_, name) in ModuleAnalyzer.for_module(module.__name__).find_attr_docs()}
-
-    def public(name: str, obj: object) -> bool:
-        if name.startswith("_") or isinstance(obj, types.ModuleType):
-            return False
-        if inspect.isclass(obj) or inspect.isfunction(obj):
-            return getattr(obj, "__module__", None) == module.__name__
-        return name.isupper() and name in documented
-
-    return sorted(name for name, obj in vars(module).items() if public(name, obj))
 
 
 def _summary_line(module: types.ModuleType) -> str:

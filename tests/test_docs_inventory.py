@@ -25,6 +25,9 @@ import pytest
 import qrrt_circuits as qc
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "docs"))
+from api_names import public_names  # noqa: E402  (the reference's own rule, beside docs/conf.py)
+
 INVENTORY = ROOT / "docs" / "_build" / "html" / "objects.inv"
 DESIGN = ROOT / "docs" / "DESIGN.md"
 
@@ -122,12 +125,7 @@ def public_paths() -> list[str]:
     for name in qc.__all__:
         module = getattr(qc, name)
         if isinstance(module, types.ModuleType):
-            names = getattr(module, "__all__", None) or [
-                n for n, obj in vars(module).items()
-                if not n.startswith("_") and not isinstance(obj, types.ModuleType)
-                and (getattr(obj, "__module__", None) == module.__name__ if callable(obj) else n.isupper())
-            ]
-            paths += [f"{name}.{n}" for n in names]
+            paths += [f"{name}.{n}" for n in public_names(module)]
     return paths
 
 

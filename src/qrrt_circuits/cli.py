@@ -198,9 +198,10 @@ def _planner_specific(args: argparse.Namespace) -> dict[str, Any]:
     return chosen
 
 
-def build_planner(args: argparse.Namespace, env: Environment) -> Planner:
-    """The planner the arguments name, with only the options that apply to it; a planner-specific
-    option given to a planner that does not take it (``--qubits`` with ``rrt``) is refused."""
+def build_planner(args: argparse.Namespace, env: Environment, name: str | None = None) -> Planner:
+    """The planner the arguments name (or planner ``name`` with the same options, as far as it
+    takes them), with only the options that apply to it; a planner-specific option given to a
+    planner that does not take it (``--qubits`` with ``rrt``) is refused."""
     from .registry import BACKENDS, PLANNERS, POLICIES, PREDICATES
 
     specific = _planner_specific(args)
@@ -210,8 +211,47 @@ def build_planner(args: argparse.Namespace, env: Environment) -> Planner:
                                              "policy": POLICIES.create}
     for option, value in specific.items():  # each under the planner's keyword, backends and policies made
         options[PLANNER_SPECIFIC_OPTIONS[option][0]] = made[option](value) if option in made else value
-    planner: Planner = PLANNERS.create(args.planner, env=env, **PLANNERS.applicable(args.planner, options))
+    chosen = name or args.planner
+    planner: Planner = PLANNERS.create(chosen, env=env, **PLANNERS.applicable(chosen, options))
     return planner
+
+
+#: the classical planner each quantum planner is compared with: the same round structure without
+#: quantum search (one worker for q-RRT, p workers on one tree snapshot for Pq-RRT)
+CLASSICAL_PEERS = {"qrrt": "rrt", "pqrrt": "prrt", "pqrrt-unshared": "prrt"}
+#: the share of verified measurements above which the output says the iterations over-rotate
+OVER_ROTATION_SHARE = 0.5
+
+
+def _print_comparison(result: PlanResult, peer: PlanResult) -> None:
+    """The quantum plan beside its classical peer's, in the same world and with the same seed,
+    predicate and limits; the critical path named; a note where most measurements failed."""
+    rows: list[tuple[str, Callable[[PlanResult], str]]] = [
+        ("status", lambda r: str(r.status)),
+        ("nodes", lambda r: str(r.metrics.nodes)),
+        ("oracle calls", lambda r: str(r.metrics.oracle_calls)),
+        ("oracle calls per node", lambda r: _per_node(r.metrics.oracle_calls, r)),
+        ("critical-path calls", lambda r: str(r.metrics.critical_path_oracle_calls)),
+        ("critical-path calls per node", lambda r: _per_node(r.metrics.critical_path_oracle_calls, r)),
+        ("wall ms per node", lambda r: _per_node(r.metrics.wall_time_s * 1e3, r)),
+    ]
+    print(f"beside {peer.planner} (the same world, seed, predicate and limits; `--no-compare` skips it):")
+    print(f"  {'':30s} {result.planner:>14s} {peer.planner:>14s}")
+    for label, value in rows:
+        print(f"  {label:30s} {value(result):>14s} {value(peer):>14s}")
+    print("  (critical-path calls: per round, the most calls any one worker made: the time of parallel devices)")
+    metrics = result.metrics
+    if metrics.verification_calls and metrics.rejected / metrics.verification_calls > OVER_ROTATION_SHARE:
+        entries = int(result.history["entries"].sum())
+        share = int(result.history["reachable"].sum()) / entries if entries else 0.0
+        print(f"note: {metrics.rejected / metrics.verification_calls:.0%} of the measured candidates failed "
+              f"verification. {share:.0%} of the databases' entries were reachable on average; a fixed "
+              "iteration count tuned for a small share over-rotates past the peak of sin^2((2k+1)theta) "
+              "as the share grows. --policy adaptive learns the share from verified outcomes.")
+
+
+def _per_node(value: float, result: PlanResult) -> str:
+    return f"{value / result.metrics.nodes:.2f}" if result.metrics.nodes else "-"
 
 
 def _print_plan(result: PlanResult, env: Environment, seed: int) -> None:
@@ -281,6 +321,7 @@ def _write_failure(exc: OSError | MemoryError) -> str:
 
 def cmd_plan(args: argparse.Namespace) -> int:
     from ._support.output_files import check_output_file, same_file
+    from .registry import PLANNERS
 
     check_output_file(args.json, "--json")
     check_output_file(args.plot, "--plot", PLOT_FORMATS)
@@ -291,10 +332,13 @@ def cmd_plan(args: argparse.Namespace) -> int:
     # (the plan makes its one memory check before it allocates anything, and words a MemoryError as
     # one OutOfMemory line; --json adds no memory per node: PlanResult.write_json streams the arrays
     # chunk by chunk; the outputs are written only once the plan has finished)
-    result = planner.plan(max_nodes=args.max_nodes, max_oracle_calls=args.max_oracle_calls,
-                          max_rounds=args.max_rounds, max_critical_path_calls=args.max_critical_path_calls,
-                          stall_rounds=args.stall_rounds)
+    limits = {"max_nodes": args.max_nodes, "max_oracle_calls": args.max_oracle_calls, "max_rounds": args.max_rounds,
+              "max_critical_path_calls": args.max_critical_path_calls, "stall_rounds": args.stall_rounds}
+    result = planner.plan(**limits)
     _print_plan(result, env, args.seed)
+    peer = CLASSICAL_PEERS.get(PLANNERS.canonical(args.planner))
+    if peer is not None and not args.no_compare:
+        _print_comparison(result, build_planner(args, env, peer).plan(**limits))
     _write_plan_outputs(args, result, env)
     return 0
 
@@ -414,6 +458,9 @@ def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
     plan.add_argument("--plot", default=None,
                       help=f"write a figure of the tree ({', '.join(PLOT_FORMATS)}; default %(default)s: none)")
     plan.add_argument("--json", default=None, help="write the result as JSON (default %(default)s: none)")
+    plan.add_argument("--no-compare", action="store_true",
+                      help="do not plan with the quantum planner's classical peer (RRT for q-RRT, parallel RRT "
+                           "for Pq-RRT) in the same world to print the two side by side")
     plan.set_defaults(func=cmd_plan)
 
 
