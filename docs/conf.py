@@ -103,7 +103,8 @@ suppress_warnings = [
 # -- HTML ----------------------------------------------------------------------------------------
 html_theme = "qiskit-ecosystem"
 html_title = f"qrrt_circuits {release}"
-html_static_path: list[str] = []
+html_static_path = ["_static"]
+html_css_files = ["wide-figures.css"]  # figures of several panels read at their natural size
 html_last_updated_fmt = None
 
 

@@ -30,6 +30,16 @@ def _at(value: Any, path: tuple[str, ...]) -> Any:
     return value
 
 
+def _at_or_above(value: Any, path: tuple[str, ...]) -> Any:
+    """The value at ``path``, else at its first key where the paper gives one number (or one
+    verdict) for what we report per setting (``QDA`` for ``QDA / 16``)."""
+    found = _at(value, path)
+    if found is None and len(path) > 1:
+        found = _at(value, path[:1])
+        found = found if not isinstance(found, dict) else None
+    return found
+
+
 def _shown(value: Any) -> str:
     if value is None:
         return ""
@@ -47,12 +57,9 @@ def table(summary: dict[str, Any], label: str) -> str:
     """The Markdown of one summary: its numbers beside the paper's, its settings and provenance."""
     rows = ["| quantity | ours | 95 % interval | paper | paper outside our interval |", "|---|---|---|---|---|"]
     for path, value in _leaves(summary.get("ours", {})):
-        paper = _at(summary.get("paper", {}), path)
-        if paper is None and len(path) > 1:  # the paper gives one number where we give several
-            paper = _at(summary.get("paper", {}), path[:1])
-            paper = paper if not isinstance(paper, dict) else None
+        paper = _at_or_above(summary.get("paper", {}), path)
         interval = _at(summary.get("interval_95") or {}, path)
-        differs = _at(summary.get("differs_from_paper") or {}, path)
+        differs = _at_or_above(summary.get("differs_from_paper") or {}, path)
         rows.append(f"| {' / '.join(path)} | {_shown(value)} | {_shown(interval)} | {_shown(paper)} | "
                     f"{_shown(differs)} |")
     provenance = summary.get("provenance") or {}

@@ -1,0 +1,44 @@
+"""Every experiment has a results page, and its numbers are the committed summary's."""
+
+from __future__ import annotations
+
+import json
+import re
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+RESULTS = ROOT / "docs" / "results"
+sys.path.insert(0, str(ROOT / "docs"))
+from results_tables import table, write_tables  # noqa: E402
+
+SUMMARIES = sorted(RESULTS.glob("*/summary.json"))
+
+
+def test_every_experiment_has_a_page_that_includes_its_numbers():
+    pages = " ".join(path.read_text() for path in RESULTS.glob("*.md"))
+    for summary in SUMMARIES:
+        assert f"_generated/{summary.parent.name}.md" in pages, summary.parent.name
+
+
+@pytest.mark.parametrize("summary", SUMMARIES, ids=[s.parent.name for s in SUMMARIES])
+def test_the_table_shows_every_number_of_ours(summary):
+    data = json.loads(summary.read_text())
+    text = table(data, "x")
+    rows = [line for line in text.splitlines() if line.startswith("| ") and not line.startswith("| quantity")]
+
+    def leaves(value):
+        return sum(leaves(v) for v in value.values()) if isinstance(value, dict) else 1
+
+    assert len(rows) == leaves(data["ours"])
+    assert data["provenance"]["git_commit"][:12] in text
+
+
+def test_the_fragments_are_written_for_both_checks(tmp_path):
+    written = write_tables(RESULTS, tmp_path)
+    assert {path.stem for path in written} == {s.parent.name for s in SUMMARIES}
+    corridor = (tmp_path / "corridor.md").read_text()
+    assert "our exact check" in corridor and "the authors' check" in corridor
+    assert re.search(r"\| QRRT \| 3 \| \[0, 6\] \| 47 \| yes \|", corridor)
