@@ -115,7 +115,7 @@ GALLERY = DOCS / "results" / "_gallery.md"
 PERFORMANCE = DOCS / "_generated" / "performance.md"
 
 #: modules documented beyond ``qrrt_circuits.__all__`` (public, used in the README's examples)
-EXTRA_MODULES = ("qrrt_circuits.plotting", "qrrt_circuits._support.execution")
+EXTRA_MODULES = ("qrrt_circuits.plotting", "qrrt_circuits.execution")
 
 
 def _write_if_changed(path: Path, text: str) -> None:

@@ -292,3 +292,17 @@ def test_local_workers_are_limited_per_core():
     with pytest.raises(ValueError, match=rf"jobs must be an integer in \[1, {limit}\] for local workers"):
         check_executor_args("process", limit + 1, None)
     assert check_executor_args("serial", limit + 1, None) == limit + 1  # unused by the serial executor
+
+
+def test_the_public_module_gives_the_executors_without_a_warning():
+    import importlib
+    import sys
+    import warnings
+
+    from qrrt_circuits._support import execution as implementation
+
+    sys.modules.pop("qrrt_circuits.execution", None)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        public = importlib.import_module("qrrt_circuits.execution")
+    assert public.WorkerPool is implementation.WorkerPool and public.get_executor is implementation.get_executor

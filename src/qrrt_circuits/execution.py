@@ -1,5 +1,10 @@
-"""Deprecated location of ``qrrt_circuits._support.execution`` (importing it warns)."""
+"""Executors for sweeps and parallel planners: ``get_executor(kind, jobs, scheduler)`` gives a
+``concurrent.futures.Executor`` for ``"serial"``, ``"process"`` or ``"dask"``, and ``WorkerPool``
+keeps one for several sweeps (warm local workers forked from one preloaded server; a broken local
+pool renewed). Their contract is documented in ``qrrt_circuits._support.execution``, which
+implements them; this module is their public home.
+"""
 
-from qrrt_circuits._support.deprecation import moved_module
+from qrrt_circuits._support.execution import EXECUTORS, WorkerPool, check_executor_args, get_executor
 
-moved_module(__name__, "qrrt_circuits._support.execution")
+__all__ = ["EXECUTORS", "WorkerPool", "check_executor_args", "get_executor"]
