@@ -56,6 +56,8 @@ class TrialStream(IntEnum):
     # search-policies
     SEARCH_POLICIES_WORLDS = 36
     SEARCH_POLICIES_PLANNERS = 37
+    # summaries' own draws (no trial uses them)
+    PAPER_DESIGN = 41
 
 
 @dataclass(frozen=True)

@@ -10,6 +10,7 @@ paper does not.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -19,10 +20,13 @@ from .fitting import linear_fit
 from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import dumps, growth_curve, loads
 from .planners import BACKEND_LABEL, planner_for
+from .random_bound_fit import random_bound_slopes
 from .worlds import world
 
 PLANNERS = ("RRT", "ParallelRRT", "QRRT", "PQRRT")
 COLORS = {"RRT": "tab:gray", "ParallelRRT": "tab:brown", "QRRT": "tab:blue", "PQRRT": "tab:orange"}
+#: replicates of the paper's design drawn for its sampling distribution
+PAPER_DESIGN_RESAMPLES = 4000
 
 
 class OracleEfficiency(Experiment):
@@ -81,14 +85,34 @@ class OracleEfficiency(Experiment):
                          for r in records if r["planner"] == kind] for kind in PLANNERS}
         interval = {kind: rounded_interval(bootstrap_interval(curves[kind], slope, settings["seed"]), 3)
                     for kind in PLANNERS}
+        design = self._paper_design(curves, settings)
         return {"ours": slopes, "paper": dict(self.paper),
                 "interval_95": interval,
                 "differs_from_paper": {kind: differs(self.paper[kind], interval[kind]) for kind in PLANNERS},
+                "paper_design": design,
                 "critical_path_slope": critical, "pooled_calls_per_node": per_node,
                 "ordering_reproduced": bool(quantum_first and slopes["QRRT"] < slopes["PQRRT"]),
                 "labels": ["phase oracle from a classical lookup of all 2^8 entries",
                            "Pq-RRT: one Aer search with 8 shots stands for 8 workers",
                            f"backend: {BACKEND_LABEL[settings['backend']]}"]}
+
+    def _paper_design(self, curves: dict[str, list[np.ndarray]], settings: Settings) -> dict[str, Any]:
+        """The paper's estimator (``random_bound_fit``) resampled from our trees: its 95 % range,
+        and whether the paper's slope is plausible for one replicate of the paper's design."""
+        trees, resamples = settings["trials"], PAPER_DESIGN_RESAMPLES
+        ranges, plausible = {}, {}
+        for index, kind in enumerate(PLANNERS):
+            sequence = np.random.SeedSequence(settings["seed"], spawn_key=(TrialStream.PAPER_DESIGN, index))
+            slopes = random_bound_slopes(curves[kind], max(trees, 2), resamples, np.random.default_rng(sequence),
+                                         settings["nodes"])
+            low, high = np.nanpercentile(slopes, [2.5, 97.5])
+            ranges[kind] = [round(float(low), 3), round(float(high), 3)]
+            plausible[kind] = bool(low <= self.paper[kind] <= high)
+        return {"range_95": ranges, "paper_plausible": plausible, "trees": trees, "resamples": resamples,
+                "meaning": "the slope one replicate of the paper's design would give: each of `trees` trees "
+                           "(resampled from ours) stopped at a random bound ceil(30 u) and one least-squares "
+                           "line through one point per tree; the paper's tree count is not stated, so it is "
+                           "taken equal to ours"}
 
     def paper_comparison(self, summary: Summary) -> PaperComparison:
         numbers = tuple(PaperNumber(kind, summary["ours"][kind], tuple(summary["interval_95"][kind]),
