@@ -4,7 +4,8 @@
 ``results/EXPERIMENT/summary.json`` (and ``results/authors/EXPERIMENT/summary.json``): every number
 of the summary's ``ours`` with the paper's number at the same place in ``paper``, its 95 %
 interval from ``interval_95`` and whether the paper's number lies outside it
-(``differs_from_paper``), then the run's settings and provenance. The pages' prose discusses these
+(``differs_from_paper``); where the summary resamples the paper's own estimator (``paper_design``),
+its range and verdict; then the run's settings and provenance. The pages' prose discusses these
 numbers; the tables are never typed by hand.
 """
 
@@ -62,6 +63,14 @@ def table(summary: dict[str, Any], label: str) -> str:
         differs = _at_or_above(summary.get("differs_from_paper") or {}, path)
         rows.append(f"| {' / '.join(path)} | {_shown(value)} | {_shown(interval)} | {_shown(paper)} | "
                     f"{_shown(differs)} |")
+    design = summary.get("paper_design")
+    if design:  # the paper's own estimator, resampled from our trials
+        rows += ["", f"The paper's estimator ({design['trees']} trees, {design['resamples']} replicates; "
+                 f"{design['meaning']}):", "", "| quantity | paper | its 95 % range | paper plausible |",
+                 "|---|---|---|---|"]
+        for path, low_high in _leaves(design["range_95"]):
+            rows.append(f"| {' / '.join(path)} | {_shown(_at(summary.get('paper', {}), path))} | "
+                        f"{_shown(low_high)} | {_shown(_at(design['paper_plausible'], path))} |")
     provenance = summary.get("provenance") or {}
     packages = provenance.get("packages") or {}
     made = (f"Summarized at commit `{(provenance.get('git_commit') or 'unknown')[:12]}` on "

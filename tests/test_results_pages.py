@@ -27,13 +27,17 @@ def test_every_experiment_has_a_page_that_includes_its_numbers():
 def test_the_table_shows_every_number_of_ours(summary):
     data = json.loads(summary.read_text())
     text = table(data, "x")
-    rows = [line for line in text.splitlines() if line.startswith("| ") and not line.startswith("| quantity")]
+    first_table = text.split("| quantity", 1)[1].split("\n\n", 1)[0]  # up to the first blank line
+    rows = [line for line in first_table.splitlines() if line.startswith("| ")]
 
     def leaves(value):
         return sum(leaves(v) for v in value.values()) if isinstance(value, dict) else 1
 
     assert len(rows) == leaves(data["ours"])
     assert data["provenance"]["git_commit"][:12] in text
+    if "paper_design" in data:  # the paper's own estimator: one row per planner, its verdict
+        for kind, plausible in data["paper_design"]["paper_plausible"].items():
+            assert re.search(rf"\| {kind} \| [^|]+ \| [^|]+ \| {'yes' if plausible else 'no'} \|", text), kind
 
 
 def test_the_fragments_are_written_for_both_checks(tmp_path):
