@@ -104,7 +104,7 @@ suppress_warnings = [
 html_theme = "qiskit-ecosystem"
 html_title = f"qrrt_circuits {release}"
 html_static_path = ["_static"]
-html_css_files = ["wide-figures.css"]  # figures of several panels read at their natural size
+html_css_files = ["wide-figures.css"]  # pages with figures or wide tables use the whole width
 html_last_updated_fmt = None
 
 
