@@ -36,6 +36,7 @@ from .validation import check_optional_int
 
 __all__ = ["EXECUTORS", "WORKER_PRELOAD", "WorkerPool", "check_executor_args", "get_executor"]
 
+#: the executor kinds ``get_executor`` and ``WorkerPool`` build
 EXECUTORS = ("serial", "process", "dask")
 
 #: no Bokeh dashboard is served (bokeh is not a dependency); ``dashboard_address=None`` does not stop

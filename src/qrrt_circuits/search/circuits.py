@@ -45,7 +45,9 @@ __all__ = [
     "uniform_preparation",
 ]
 
+#: the phase-oracle constructions ``phase_oracle(marks, synthesis=...)`` accepts
 SYNTHESES = ("auto", "diagonal", "mcz")
+#: the gate set ``resource_estimate`` transpiles to (IBM's native basis)
 BASIS_GATES = ("cx", "rz", "sx", "x")
 
 
