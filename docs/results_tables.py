@@ -5,7 +5,8 @@
 of the summary's ``ours`` with the paper's number at the same place in ``paper``, its 95 %
 interval from ``interval_95`` and whether the paper's number lies outside it
 (``differs_from_paper``); where the summary resamples the paper's own estimator (``paper_design``),
-its range and verdict; then the run's settings and provenance. The pages' prose discusses these
+its range and verdict; where it holds the reported run of the authors' code (``authors_code``), that
+run beside ours under its design; then the run's settings and provenance. The pages' prose discusses these
 numbers; the tables are never typed by hand.
 """
 
@@ -71,6 +72,20 @@ def table(summary: dict[str, Any], label: str) -> str:
         for path, low_high in _leaves(design["range_95"]):
             rows.append(f"| {' / '.join(path)} | {_shown(_at(summary.get('paper', {}), path))} | "
                         f"{_shown(low_high)} | {_shown(_at(design['paper_plausible'], path))} |")
+    code = summary.get("authors_code")
+    if code:  # the reported Octave run of the authors' code, beside ours under its design
+        rows += ["", f"The authors' code under Octave, as reported, against ours under its design ({code['meaning']}; "
+                 f"the reported per-tree range covers the median tree with probability "
+                 f"{code['reported_range_covers_median_tree']:.3f}):", "",
+                 "| quantity | reported pooled | ours pooled, 95 % range | plausible | reported per-tree range "
+                 "| ours median tree, 95 % range | overlap |", "|---|---|---|---|---|---|---|"]
+        for path, pooled in _leaves(code["reported_pooled"]):
+            rows.append(f"| {' / '.join(path)} | {_shown(pooled)} | "
+                        f"{_shown(_at(code['ours_pooled_range_95'], path))} | "
+                        f"{_shown(_at(code['reported_pooled_plausible'], path))} | "
+                        f"{_shown(_at(code['reported_per_tree_range'], path))} | "
+                        f"{_shown(_at(code['ours_median_tree_range_95'], path))} | "
+                        f"{_shown(_at(code['median_tree_ranges_overlap'], path))} |")
     provenance = summary.get("provenance") or {}
     packages = provenance.get("packages") or {}
     made = (f"Summarized at commit `{(provenance.get('git_commit') or 'unknown')[:12]}` on "

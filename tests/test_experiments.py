@@ -46,6 +46,10 @@ def _check_oracle_efficiency(summary, records):
     for kind in summary["ours"]:  # a slope of calls against nodes: calls per node, at least 1
         assert summary["ours"][kind] >= 1.0 - 1e-9 or kind == "PQRRT"
         assert summary["critical_path_slope"][kind] <= summary["ours"][kind] + 1e-9
+        code = summary["authors_code"]  # the reported Octave run beside ours under its design
+        low, high = code["ours_pooled_range_95"][kind]
+        assert 1.0 - 1e-9 <= low <= high or kind == "PQRRT"
+        assert code["reported_pooled_plausible"][kind] == (low <= code["reported_pooled"][kind] <= high)
 
 
 def _check_wallclock(summary, records):

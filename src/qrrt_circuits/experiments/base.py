@@ -58,6 +58,7 @@ class TrialStream(IntEnum):
     SEARCH_POLICIES_PLANNERS = 37
     # summaries' own draws (no trial uses them)
     PAPER_DESIGN = 41
+    AUTHORS_CODE = 42
 
 
 @dataclass(frozen=True)
