@@ -72,3 +72,20 @@ def test_plan_command_rejects_bad_input(argv, message, capsys):
         main(argv)
     assert exc.value.code == 2
     assert message in capsys.readouterr().err
+
+
+def test_plan_says_in_words_whether_its_budget_or_a_safety_limit_ended_it(tmp_path, capsys):
+    import json
+
+    ring = [[[4, 4], [6, 4.99]], [[4, 5.01], [6, 6]], [[4, 4.99], [4.99, 5.01]], [[5.01, 4.99], [6, 5.01]]]
+    world = tmp_path / "walled.json"
+    world.write_text(json.dumps({"format": "qrrt-environment", "version": 1, "bounds": [[0, 10], [0, 10]],
+                                 "boxes": ring, "start": [5, 5], "goal": [9, 9], "goal_radius": 0.5}))
+    common = ["plan", "--planner", "rrt", "--scenario-file", str(world), "--no-compare"]
+    assert main([*common, "--max-oracle-calls", "6000"]) == 0
+    out = capsys.readouterr().out
+    assert "max_oracle_calls: ended by a limit you set: 6000 oracle calls were spent" in out
+    assert main([*common, "--max-nodes", "5", "--stall-rounds", "300"]) == 0
+    assert "stalled: ended by a limit you set: 300 rounds in a row added no node" in capsys.readouterr().out
+    assert main([*common, "--max-nodes", "5"]) == 0
+    assert "stalled: ended by a safety limit, not one you set: 5000 rounds" in capsys.readouterr().out

@@ -10,7 +10,6 @@ import pytest
 import qrrt_circuits as qc
 from qrrt_circuits.planners.termination import (
     DEFAULT_MAX_NODES,
-    DEFAULT_STALL_ROUNDS,
     Progress,
     from_budgets,
     with_defaults,
@@ -131,8 +130,8 @@ def test_termination_argument_combines_with_the_shorthands(walled):
                                          max_oracle_calls=12)
     assert result.status == "max_oracle_calls" and result.metrics.rounds == 12
     assert result.settings["termination"] == {"max_rounds": 30, "max_oracle_calls": 12,
-                                              "stall_rounds": DEFAULT_STALL_ROUNDS,
-                                              "max_nodes": DEFAULT_MAX_NODES}
+                                              "max_nodes": DEFAULT_MAX_NODES}  # budgets: no stall limit
+    assert not result.safety_limit and "ended by a limit you set" in result.status_text
     with pytest.raises(TypeError, match="termination must be a TerminationCondition"):
         qc.RRT(walled).plan([1, 1], [16, 16], 0.5, termination=30)
 
@@ -177,9 +176,12 @@ def test_default_stall_ends_a_plan_given_only_a_node_budget(monkeypatch, boxed_i
     monkeypatch.setattr(termination, "DEFAULT_STALL_ROUNDS", 25)
     result = qc.RRT(boxed_in, seed=0).plan([5, 5], [15, 15], 0.5, max_nodes=5)
     assert result.status == "stalled" and result.metrics.rounds == 25
+    assert result.to_dict()["safety_limit"] is True
     assert with_defaults(qc.Stall(3)) == (qc.Stall(3) | qc.MaxRounds(termination.DEFAULT_MAX_ROUNDS)
                                           | qc.MaxNodes(termination.DEFAULT_MAX_NODES))
-    assert with_defaults(qc.MaxRounds(3)) == qc.MaxRounds(3) | qc.Stall(25) | qc.MaxNodes(termination.DEFAULT_MAX_NODES)
+    assert result.safety_limit and "safety limit" in result.status_text and "stall_rounds=25" in result.status_text
+    # a budget ends the plan itself: no stall limit beside it
+    assert with_defaults(qc.MaxRounds(3)) == qc.MaxRounds(3) | qc.MaxNodes(termination.DEFAULT_MAX_NODES)
     complete = qc.MaxRounds(3) | qc.MaxNodes(4) | qc.Stall(2)
     assert with_defaults(complete) == complete
 
@@ -506,3 +508,32 @@ def test_rounds_that_add_more_nodes_than_the_planners_bound_end_at_the_node_limi
         result = planner.plan(termination=condition, goal_radius=1e-9)
         ends.append((str(result.status), result.metrics.rounds, result.metrics.nodes))
     assert ends[0] == ends[1] and ends[0][0] == "max_nodes" and ends[0][2] == 40
+
+
+@pytest.mark.parametrize("planner", ["RRT", "QRRT"])
+def test_a_budget_is_never_cut_by_a_safety_limit(monkeypatch, boxed_in, planner):
+    """With an oracle-call budget in force, neither the default round limit nor the default stall
+    limit ends the plan first: a start that can add no node spends the whole budget."""
+    from qrrt_circuits.planners import termination
+
+    monkeypatch.setattr(termination, "DEFAULT_STALL_ROUNDS", 25)
+    monkeypatch.setattr(termination, "DEFAULT_MAX_ROUNDS", 40)
+    make = {"RRT": lambda: qc.RRT(boxed_in, seed=0),
+            "QRRT": lambda: qc.QRRT(boxed_in, backend=qc.StatevectorBackend(seed=0), num_qubits=3, seed=0)}[planner]
+    result = make().plan([5, 5], [15, 15], 0.5, max_oracle_calls=300)
+    assert result.status == "max_oracle_calls" and not result.safety_limit
+    assert 300 <= result.metrics.oracle_calls and result.metrics.nodes == 0
+    assert result.settings["termination"]["max_rounds"] == 301 and "stall_rounds" not in result.settings["termination"]
+    timed = make().plan([5, 5], [15, 15], 0.5, max_critical_path_calls=100)
+    assert timed.status == "max_critical_path_calls" and timed.metrics.critical_path_oracle_calls >= 100
+    # without a budget the safety limits end it, and say so
+    unbounded = make().plan([5, 5], [15, 15], 0.5, max_nodes=3)
+    assert unbounded.status == "stalled" and unbounded.safety_limit and unbounded.metrics.rounds == 25
+
+
+def test_a_wall_clock_budget_alone_adds_no_round_or_stall_limit():
+    from qrrt_circuits.planners import termination
+
+    assert with_defaults(qc.MaxWallTime(1.0)) == qc.MaxWallTime(1.0) | qc.MaxNodes(termination.DEFAULT_MAX_NODES)
+    assert with_defaults(qc.MaxOracleCalls(10) | qc.MaxWallTime(1.0)).round_limit == termination.DEFAULT_MAX_ROUNDS
+    assert with_defaults(qc.MaxOracleCalls(10 ** 6)).round_limit == 10 ** 6 + 1

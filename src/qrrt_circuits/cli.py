@@ -227,7 +227,7 @@ def _print_comparison(result: PlanResult, peer: PlanResult) -> None:
     """The quantum plan beside its classical peer's, in the same world and with the same seed,
     predicate and limits; the critical path named; a note where most measurements failed."""
     rows: list[tuple[str, Callable[[PlanResult], str]]] = [
-        ("status", lambda r: str(r.status)),
+        ("status", lambda r: f"{r.status}{' (safety limit)' if r.safety_limit else ''}"),
         ("nodes", lambda r: str(r.metrics.nodes)),
         ("oracle calls", lambda r: str(r.metrics.oracle_calls)),
         ("oracle calls per node", lambda r: _per_node(r.metrics.oracle_calls, r)),
@@ -256,7 +256,7 @@ def _per_node(value: float, result: PlanResult) -> str:
 
 def _print_plan(result: PlanResult, env: Environment, seed: int) -> None:
     metrics = result.metrics
-    print(f"{result.planner} on {env.name} (seed {seed}): {result.status}")
+    print(f"{result.planner} on {env.name} (seed {seed}): {result.status}: {result.status_text}")
     for key, value in result.settings.items():
         if key in ("start", "goal", "termination", "oracle_errors", "dynamics"):
             continue

@@ -46,6 +46,7 @@ from .termination import (
     TerminationCondition,
     from_budgets,
     limits_in_force,
+    safety_limits,
     with_defaults,
 )
 
@@ -220,9 +221,11 @@ class Planner:
 
         The ``max_*`` and ``stall_rounds`` keywords are shorthands for the conditions of
         ``qrrt_circuits.planners.termination``; they combine (any of them ends the plan) with
-        ``termination``. A round limit (``DEFAULT_MAX_ROUNDS``), a stall limit
-        (``DEFAULT_STALL_ROUNDS``) and a node limit (``DEFAULT_MAX_NODES``) are added unless the
-        condition has its own, so every plan ends. Before anything is allocated, the plan's
+        ``termination``. Safety limits are added so that every plan ends (``termination.safety_limits``):
+        without a budget of the caller's, a round limit (``DEFAULT_MAX_ROUNDS``) and a stall limit
+        (``DEFAULT_STALL_ROUNDS``); with one, none that could end the plan before it; and a node
+        limit (``DEFAULT_MAX_NODES``) unless the condition has its own. A plan a safety limit ended
+        says so (``PlanResult.safety_limit``). Before anything is allocated, the plan's
         estimated peak (its tree and round history up to the limits in force, and a quantum
         planner's round) is checked once against the available memory (``memory.PlanSize``).
         Conditions are checked before each round, so a round may overshoot an oracle-call budget
@@ -267,8 +270,9 @@ class Planner:
             check_instance(termination, "termination", TerminationCondition, "a TerminationCondition")
             condition = termination if condition is None else termination | condition
         limits = limits_in_force(condition)
-        condition = with_defaults(condition, _termination.DEFAULT_MAX_ROUNDS, _termination.DEFAULT_STALL_ROUNDS,
-                                  _termination.DEFAULT_MAX_NODES)
+        defaults = (_termination.DEFAULT_MAX_ROUNDS, _termination.DEFAULT_STALL_ROUNDS, _termination.DEFAULT_MAX_NODES)
+        safety = frozenset(limit.status for limit in safety_limits(condition, *defaults))
+        condition = with_defaults(condition, *defaults)
         self._check_ready()
         round_estimate, num_qubits = self._round_memory()
         size = PlanSize(limits.node_limit, self._max_new_nodes_per_round(), limits.round_limit, self.env.dim,
@@ -276,22 +280,23 @@ class Planner:
                         default_rounds=limits.default_rounds)
         size.check()  # the plan's one memory check, before its first allocation
         try:
-            return self._plan_checked(start, goal, goal_radius, condition)
+            return self._plan_checked(start, goal, goal_radius, condition, safety)
         except OutOfMemory:
             raise
         except MemoryError as error:  # (its frames, and the plan's arrays, are released before the message)
             raise size.out_of_memory(error) from error
 
     def _plan_checked(self, start: np.ndarray, goal: np.ndarray, goal_radius: float,
-                      condition: TerminationCondition) -> PlanResult:
-        """The plan after its checks: the run state, the rounds and the result."""
+                      condition: TerminationCondition, safety: frozenset[PlanStatus]) -> PlanResult:
+        """The plan after its checks: the run state, the rounds and the result (``safety``: the
+        statuses of the safety limits added to the caller's condition)."""
         state = RunState(start, goal, goal_radius)
         state.policy_state = self._start_policy()
         state.context = self._context()
         began = time.perf_counter()
         status = self._run(state, condition, began)
         elapsed = time.perf_counter() - began
-        return self._result(state, status, elapsed, start, goal, goal_radius, condition)
+        return self._result(state, status, elapsed, start, goal, goal_radius, condition, status in safety)
 
     def _run(self, state: RunState, condition: TerminationCondition, began: float) -> PlanStatus:
         """The round loop: check the condition before every round, run the round, record it; until
@@ -385,7 +390,7 @@ class Planner:
         return ()
 
     def _result(self, state: RunState, status: PlanStatus, elapsed: float, start: np.ndarray, goal: np.ndarray,
-                goal_radius: float, condition: TerminationCondition) -> PlanResult:
+                goal_radius: float, condition: TerminationCondition, safety_limit: bool = False) -> PlanResult:
         tree = state.tree
         path = None
         if state.goal_node is not None:
@@ -422,5 +427,6 @@ class Planner:
             labels=self.labels(),
             history=history,
             goal_node=state.goal_node,
+            safety_limit=safety_limit,
         )
 

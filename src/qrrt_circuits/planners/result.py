@@ -109,6 +109,9 @@ class PlanResult:
         labels: Every simulation shortcut the numbers depend on, as sentences.
         history: Per-round arrays (name to array of one value per round).
         goal_node: The row of the node inside the goal ball, or None if not reached.
+        safety_limit: Whether the condition that ended the plan is a safety limit the library
+            added (``termination.safety_limits``: a round, stall or node limit the caller did not
+            set), not one of the caller's.
 
     Example:
         >>> from qrrt_circuits import QRRT, Environment, StatevectorBackend
@@ -133,11 +136,41 @@ class PlanResult:
     labels: tuple[str, ...]
     history: dict[str, np.ndarray] = field(repr=False)
     goal_node: int | None = None
+    safety_limit: bool = False
 
     @property
     def reached(self) -> bool:
         """Whether the goal was reached (``status is PlanStatus.REACHED``)."""
         return self.status is PlanStatus.REACHED
+
+    @property
+    def status_text(self) -> str:
+        """Why the plan ended, in words; a safety limit is named as one, with the keyword that
+        changes it.
+
+        Example:
+            >>> from qrrt_circuits import RRT, Environment
+            >>> ring = [[[4, 4], [6, 4.99]], [[4, 5.01], [6, 6]], [[4, 4.99], [4.99, 5.01]], [[5.01, 4.99], [6, 5.01]]]
+            >>> env = Environment([[0, 10], [0, 10]], ring, start=[5, 5], goal=[9, 9], goal_radius=0.5)
+            >>> result = RRT(env, seed=0).plan(max_nodes=5)  # the start is walled in
+            >>> result.safety_limit, result.status_text[:71]
+            (True, 'ended by a safety limit, not one you set: 5000 rounds in a row added no')
+        """
+        if self.reached:
+            return "reached the goal"
+        termination = self.settings.get("termination", {})
+        key = {PlanStatus.STALLED: "stall_rounds"}.get(self.status, str(self.status))
+        limit = termination.get(key)
+        what = {PlanStatus.STALLED: f"{limit} rounds in a row added no node",
+                PlanStatus.MAX_ROUNDS: f"{limit} rounds ran",
+                PlanStatus.MAX_NODES: f"the tree reached {limit} nodes",
+                PlanStatus.MAX_ORACLE_CALLS: f"{limit} oracle calls were spent",
+                PlanStatus.MAX_CRITICAL_PATH_CALLS: f"{limit} critical-path oracle calls were spent",
+                PlanStatus.MAX_TIME: f"{limit} s passed"}.get(self.status, str(self.status))
+        if not self.safety_limit:
+            return f"ended by a limit you set: {what} ({key}={limit})"
+        return (f"ended by a safety limit, not one you set: {what} ({key}={limit}; pass {key}, or a budget "
+                f"such as max_oracle_calls or max_time_s, to change it)")
 
     @property
     def budget_exhausted(self) -> bool:
@@ -165,7 +198,7 @@ class PlanResult:
 
         Returns:
             A dict with keys ``status``, ``planner``, ``settings``, ``labels``, ``metrics``,
-            ``nodes``, ``parents``, ``path``, ``goal_node`` and ``history``.
+            ``nodes``, ``parents``, ``path``, ``goal_node``, ``safety_limit`` and ``history``.
         """
         return self._data(lambda array: array.tolist())
 
@@ -197,5 +230,6 @@ class PlanResult:
             "parents": arrays(self.parents),
             "path": None if self.path is None else arrays(self.path),
             "goal_node": self.goal_node,
+            "safety_limit": self.safety_limit,
             "history": {key: arrays(value) for key, value in self.history.items()},
         }

@@ -9,11 +9,14 @@ by less than one round's cost and a node budget by fewer than ``workers`` nodes 
 cut-offs behave the same way). The planner checks its condition before every round, as OMPL does;
 a condition whose test is costly caches inside itself.
 
-Every plan terminates: ``Planner.plan`` always adds ``MaxRounds(DEFAULT_MAX_ROUNDS)`` unless the
-condition it is given already limits rounds, and ``Stall(DEFAULT_STALL_ROUNDS)`` unless it already
-has a stall condition, so a plan that can add no node (a start boxed in) ends as ``"stalled"``.
-It also adds ``MaxNodes(DEFAULT_MAX_NODES)`` unless the condition limits nodes, so no plan's tree
-outgrows memory (``memory.PlanSize.check`` checks the limits in force before the first round).
+Every plan terminates: ``Planner.plan`` adds the ``safety_limits`` the caller's condition lacks.
+Without a budget (oracle calls, critical-path calls, rounds or wall time: ``is_budget``) those are
+``MaxRounds(DEFAULT_MAX_ROUNDS)`` and ``Stall(DEFAULT_STALL_ROUNDS)``, so a plan that can add no
+node (a start boxed in) ends as ``"stalled"``. With a budget, the budget ends the plan: no stall
+limit is added, and the round limit, if any, lies beyond what the budget allows. ``MaxNodes
+(DEFAULT_MAX_NODES)`` is added unless the condition limits nodes, so no plan's tree outgrows memory
+(``memory.PlanSize.check`` checks the limits in force before the first round). A plan a safety
+limit ended says so (``PlanResult.safety_limit``, ``PlanResult.status_text``).
 """
 
 from __future__ import annotations
@@ -155,6 +158,19 @@ class TerminationCondition(abc.ABC):
         """The round count at which this condition ends the plan, if it sets one (else None)."""
         return None
 
+    @property
+    def is_budget(self) -> bool:
+        """Whether this condition is a budget that ends every plan by itself (oracle calls,
+        critical-path calls, rounds or wall time): the safety limits ``with_defaults`` adds then
+        never end the plan before it."""
+        return False
+
+    @property
+    def budget_rounds(self) -> int | None:
+        """For a budget on work (oracle calls, critical-path calls or rounds), the most rounds it
+        lets a plan run when every round makes at least one oracle call; else None."""
+        return None
+
     def __or__(self, other: TerminationCondition) -> AnyOf:
         """``AnyOf((self, other))``: ends the plan when either does (nested ``AnyOf`` flattened)."""
         if not isinstance(other, TerminationCondition):
@@ -204,6 +220,16 @@ class MaxOracleCalls(_Limit):
 
     counter = "oracle_calls"
 
+    @property
+    def is_budget(self) -> bool:
+        """True: a budget on work."""
+        return True
+
+    @property
+    def budget_rounds(self) -> int:
+        """``limit``: a round makes at least one oracle call."""
+        return self.limit
+
 
 @dataclass(frozen=True)
 class MaxCriticalPathCalls(_Limit):
@@ -223,6 +249,16 @@ class MaxCriticalPathCalls(_Limit):
     status = PlanStatus.MAX_CRITICAL_PATH_CALLS
 
     counter = "critical_path_oracle_calls"
+
+    @property
+    def is_budget(self) -> bool:
+        """True: a budget on work."""
+        return True
+
+    @property
+    def budget_rounds(self) -> int:
+        """``limit``: a round makes at least one critical-path oracle call."""
+        return self.limit
 
 
 @dataclass(frozen=True)
@@ -276,6 +312,16 @@ class MaxRounds(_Limit):
 
     @property
     def round_limit(self) -> int:
+        """``limit``."""
+        return self.limit
+
+    @property
+    def is_budget(self) -> bool:
+        """True: a budget on rounds."""
+        return True
+
+    @property
+    def budget_rounds(self) -> int:
         """``limit``."""
         return self.limit
 
@@ -339,6 +385,11 @@ class MaxWallTime(TerminationCondition):
 
     def describe(self) -> dict:
         return {"max_time_s": self.seconds}
+
+    @property
+    def is_budget(self) -> bool:
+        """True: a wall-clock budget ends every plan."""
+        return True
 
 
 @dataclass(frozen=True)
@@ -418,6 +469,16 @@ class AnyOf(TerminationCondition):
         """The smallest round limit of the parts (None if none sets one)."""
         return _smallest(checked_limit(part, "round_limit") for part in self.conditions)
 
+    @property
+    def is_budget(self) -> bool:
+        """Whether any part is a budget."""
+        return any(condition.is_budget for condition in self.conditions)
+
+    @property
+    def budget_rounds(self) -> int | None:
+        """The smallest ``budget_rounds`` of the parts (None if none sets one)."""
+        return _smallest(checked_limit(part, "budget_rounds") for part in self.conditions)
+
 
 #: the ``describe`` keys of this module's limits (a smaller value ends a plan sooner)
 _LIMIT_KEYS = frozenset({"max_oracle_calls", "max_critical_path_calls", "max_nodes", "max_rounds", "max_time_s",
@@ -435,12 +496,12 @@ def _smallest(limits: Iterable[int | None]) -> int | None:
 
 
 def checked_limit(condition: TerminationCondition, which: str) -> int | None:
-    """``condition.node_limit`` or ``condition.round_limit`` (``which``), checked: None or an
-    integer >= 1 (a user's own condition may return anything).
+    """``condition.node_limit``, ``condition.round_limit`` or ``condition.budget_rounds``
+    (``which``), checked: None or an integer >= 1 (a user's own condition may return anything).
 
     Args:
         condition: A ``TerminationCondition``.
-        which: ``"node_limit"`` or ``"round_limit"``.
+        which: ``"node_limit"``, ``"round_limit"`` or ``"budget_rounds"``.
 
     Returns:
         None, or the limit as a Python int.
@@ -528,13 +589,65 @@ def from_budgets(max_oracle_calls: int | None = None, max_nodes: int | None = No
     return parts[0] if len(parts) == 1 else AnyOf(tuple(parts))
 
 
+def safety_limits(condition: TerminationCondition | None, default_max_rounds: int | None = None,
+                  default_stall_rounds: int | None = None,
+                  default_max_nodes: int | None = None) -> tuple[MaxRounds | Stall | MaxNodes, ...]:
+    """The safety limits ``Planner.plan`` adds to the caller's ``condition`` so that every plan ends,
+    soon when it cannot grow, with a tree of bounded size; none of them ends a plan before a budget
+    of the caller's (``is_budget``).
+
+    - A round limit unless ``condition`` limits rounds: ``MaxRounds(default_max_rounds)`` without a
+      budget; with a budget on oracle or critical-path calls B, ``MaxRounds(max(default, B + 1))``,
+      which only a plan whose rounds make no oracle call can reach first; none with a wall-clock
+      budget alone (it ends the plan itself).
+    - ``Stall(default_stall_rounds)`` unless ``condition`` detects a stall or is a budget.
+    - ``MaxNodes(default_max_nodes)`` unless ``condition`` limits nodes: the memory bound, which a
+      plan with a budget can also reach (its status then says so, ``PlanResult.safety_limit``).
+
+    Args:
+        condition: The caller's condition, or None.
+        default_max_rounds: The round limit; None means ``DEFAULT_MAX_ROUNDS``.
+        default_stall_rounds: The stall limit; None means ``DEFAULT_STALL_ROUNDS``.
+        default_max_nodes: The node limit; None means ``DEFAULT_MAX_NODES``.
+
+    Returns:
+        The limits to add, in the order rounds, stall, nodes (possibly none).
+
+    Raises:
+        TypeError: A non-integer default that has to be added.
+        ValueError: A default < 1 that has to be added.
+
+    Example:
+        >>> from qrrt_circuits.planners.termination import MaxNodes, MaxOracleCalls, safety_limits
+        >>> safety_limits(MaxNodes(50))
+        (MaxRounds(limit=20000), Stall(limit=5000))
+        >>> safety_limits(MaxOracleCalls(100000))
+        (MaxRounds(limit=100001), MaxNodes(limit=1000000))
+    """
+    def default(value: int | None, fallback: int, name: str) -> int:
+        return fallback if value is None else check_int(value, name, 1)
+
+    budget = condition is not None and condition.is_budget
+    added: list[MaxRounds | Stall | MaxNodes] = []
+    if condition is None or not condition.limits_rounds:
+        rounds = default(default_max_rounds, DEFAULT_MAX_ROUNDS, "default_max_rounds")
+        bound = None if condition is None else checked_limit(condition, "budget_rounds")
+        if not budget:
+            added.append(MaxRounds(rounds))
+        elif bound is not None:
+            added.append(MaxRounds(max(rounds, bound + 1)))
+    if not budget and (condition is None or not condition.detects_stall):
+        added.append(Stall(default(default_stall_rounds, DEFAULT_STALL_ROUNDS, "default_stall_rounds")))
+    if condition is None or checked_limit(condition, "node_limit") is None:
+        added.append(MaxNodes(default(default_max_nodes, DEFAULT_MAX_NODES, "default_max_nodes")))
+    return tuple(added)
+
+
 def with_defaults(condition: TerminationCondition | None, default_max_rounds: int | None = None,
                   default_stall_rounds: int | None = None,
                   default_max_nodes: int | None = None) -> TerminationCondition:
-    """``condition`` with ``MaxRounds(DEFAULT_MAX_ROUNDS)`` added unless it already limits rounds,
-    ``Stall(DEFAULT_STALL_ROUNDS)`` unless it already has a stall condition, and
-    ``MaxNodes(DEFAULT_MAX_NODES)`` unless it already limits nodes: the guarantee that every plan
-    ends, soon when it cannot grow, and with a tree of bounded size.
+    """``condition`` with its ``safety_limits`` added: the guarantee that every plan ends, soon when
+    it cannot grow and with a tree of bounded size, never before a budget of the caller's.
 
     Args:
         condition: The caller's condition, or None.
@@ -543,8 +656,7 @@ def with_defaults(condition: TerminationCondition | None, default_max_rounds: in
         default_max_nodes: The node limit to add; None means ``DEFAULT_MAX_NODES``.
 
     Returns:
-        ``condition`` itself if it already limits rounds and nodes and detects a stall, else an
-        ``AnyOf`` with the missing defaults appended (rounds, stall, nodes).
+        ``condition`` itself if no limit is added, else an ``AnyOf`` with the limits appended.
 
     Raises:
         TypeError: A non-integer default that has to be added.
@@ -557,19 +669,8 @@ def with_defaults(condition: TerminationCondition | None, default_max_rounds: in
         >>> with_defaults(None).node_limit
         1000000
     """
-    def default(value: int | None, fallback: int, name: str) -> int:
-        return fallback if value is None else check_int(value, name, 1)
-
-    rounds = default(default_max_rounds, DEFAULT_MAX_ROUNDS, "default_max_rounds")
-    stall = default(default_stall_rounds, DEFAULT_STALL_ROUNDS, "default_stall_rounds")
-    nodes = default(default_max_nodes, DEFAULT_MAX_NODES, "default_max_nodes")
-    parts = [] if condition is None else [condition]
-    if condition is None or not condition.limits_rounds:
-        parts.append(MaxRounds(rounds))
-    if condition is None or not condition.detects_stall:
-        parts.append(Stall(stall))
-    if condition is None or checked_limit(condition, "node_limit") is None:
-        parts.append(MaxNodes(nodes))
+    parts: list[TerminationCondition] = [] if condition is None else [condition]
+    parts.extend(safety_limits(condition, default_max_rounds, default_stall_rounds, default_max_nodes))
     return parts[0] if len(parts) == 1 else AnyOf(tuple(parts))
 
 
