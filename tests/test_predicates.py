@@ -175,3 +175,41 @@ def test_time_sampled_check_refuses_propagators_that_do_not_fit():
     with pytest.raises(ValueError, match=message):
         qc.TimeSampledCheck(env, dynamics, time_samples=1_000_000)
     assert qc.TimeSampledCheck(env, dynamics, time_samples=8192).time_samples == 8192
+
+
+def test_a_user_predicates_own_validity_and_space_are_respected():
+    """Optional members: ``is_valid`` refuses a start or goal, ``bounds()`` an environment that
+    reaches outside the predicate's space; without them nothing changes."""
+    import qrrt_circuits as qc
+
+    class Disc:
+        dim, name = 2, "disc"
+
+        def reachable(self, parents, children):
+            return np.ones(len(np.atleast_2d(children)), dtype=bool)
+
+        def describe(self):
+            return {}
+
+        def is_valid(self, points):
+            return np.linalg.norm(points - np.array([3.0, 3.0]), axis=1) > 1.0
+
+        def bounds(self):
+            return np.array([[0.0, 10.0], [0.0, 10.0]])
+
+    env = qc.Environment(np.array([[0.0, 10.0], [0.0, 10.0]]), np.zeros((0, 2, 2)), start=[3, 3.5], goal=[9, 9],
+                         goal_radius=0.5)
+    with pytest.raises(ValueError, match=r"start \[3.0, 3.5\] is not a valid state: the disc check"):
+        qc.RRT(env, predicate=Disc(), seed=0).plan(max_nodes=2)
+    assert qc.RRT(env, predicate=Disc(), seed=0).plan(start=[6, 6], max_nodes=2).metrics.nodes == 2
+    wide = qc.Environment(np.array([[0.0, 12.0], [0.0, 10.0]]), np.zeros((0, 2, 2)), start=[6, 6], goal=[9, 9],
+                          goal_radius=0.5)
+    with pytest.raises(ValueError, match=r"reach outside the disc check's state space"):
+        qc.RRT(wide, predicate=Disc(), seed=0)
+
+    class Miscounting(Disc):
+        def is_valid(self, points):
+            return np.ones(1, dtype=bool)
+
+    with pytest.raises(ValueError, match="disc.is_valid must return 2 booleans for 2 points"):
+        qc.RRT(env, predicate=Miscounting(), seed=0).plan(start=[6, 6], max_nodes=2)

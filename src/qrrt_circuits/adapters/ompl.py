@@ -106,6 +106,27 @@ class OMPLMotionPredicate:
         bounds = self.space.getBounds()
         return np.column_stack([np.asarray(bounds.low, dtype=float), np.asarray(bounds.high, dtype=float)])
 
+    def is_valid(self, points: np.ndarray) -> np.ndarray:
+        """Bool (M,): ``si.isValid(state)`` for each point (the space's bounds and the state
+        validity checker, as OMPL tests a start or goal state).
+
+        Args:
+            points: Float (M, d) or (d,).
+
+        Returns:
+            Bool array (M,).
+        """
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        if points.ndim != 2 or points.shape[1] != self._dim:
+            raise ValueError(f"points must have shape (M, {self._dim}), got {points.shape}")
+        state = self.si.allocState()
+        out = np.empty(points.shape[0], dtype=np.bool_)
+        for m, point in enumerate(points.tolist()):
+            for axis in range(self._dim):
+                state[axis] = point[axis]
+            out[m] = self.si.isValid(state) and self.si.satisfiesBounds(state)
+        return out
+
     def motion_validator(self) -> str:
         """The class of the ``SpaceInformation``'s motion validator (a Python subclass by its name;
         OMPL's unbound C++ default by ``DEFAULT_VALIDATOR``)."""

@@ -35,7 +35,13 @@ from .._support.validation import check_float, check_instance, check_real_array,
 from ..reachability.dynamics import LinearTrackingDynamics
 from ..reachability.exact import ExactCheck
 from ..reachability.oracle_errors import OracleErrorModel
-from ..reachability.predicate import ReachabilityPredicate, can_leave, check_predicate
+from ..reachability.predicate import (
+    ReachabilityPredicate,
+    can_leave,
+    check_predicate,
+    check_within_space,
+    valid_states,
+)
 from ..world.environment import Environment
 from . import termination as _termination
 from .context import RoundView, WorkerContext
@@ -84,7 +90,9 @@ def resolve_predicate(env: Environment, predicate: ReachabilityPredicate | None,
         return ExactCheck(env, dynamics, resolution=resolution)
     if dynamics is not None:
         raise ValueError("give dynamics= or predicate=, not both (a predicate carries its own motion model)")
-    return check_predicate(predicate, env.dim)
+    check_predicate(predicate, env.dim)
+    check_within_space(predicate, env.bounds)
+    return predicate
 
 
 class Planner:
@@ -253,7 +261,8 @@ class Planner:
             simulation shortcut the numbers depend on).
 
         Raises:
-            ValueError: A point outside the workspace or inside an obstacle, a boundary start, a
+            ValueError: A point outside the workspace or inside an obstacle, a start or goal the
+                predicate's own validity check rejects (``is_valid``), a boundary start, a
                 non-positive radius or budget, an estimated peak memory that exceeds the available
                 memory (naming ``num_qubits``, ``max_nodes`` or ``max_rounds`` and the largest
                 value that fits), or a dimension mismatch, before any work.
@@ -337,6 +346,11 @@ class Planner:
             if not env.is_free(point):
                 raise ValueError(f"{name} {point.tolist()} is in collision with an obstacle")
             checked.append(point)
+        for name, point, valid in zip(("start", "goal"), checked, valid_states(self.predicate, np.stack(checked)),
+                                      strict=True):
+            if not valid:
+                raise ValueError(f"{name} {point.tolist()} is not a valid state: the {self.predicate.name} "
+                                 f"check's own validity check (is_valid) rejects it")
         goal_radius = check_float(goal_radius, "goal_radius", 0.0, open_minimum=True)
         reached = first_in_ball(checked[0][None], checked[1], goal_radius) == 0  # a start in the goal ball ends at once
         if not reached and not can_leave(self.predicate, checked[0]):

@@ -11,9 +11,16 @@ OMPL's motion validator (``ompl::base::MotionValidator::checkMotion``), batched:
   a predicate that follows closed-loop dynamics puts them under the key ``"dynamics"``
   (``LinearTrackingDynamics.describe()``), so figures draw edges along the motion actually used.
 
-A predicate may also offer ``can_leave(point) -> bool``: False where it is certain that it rejects
-every motion from ``point`` (the planners then refuse such a start before any work). Without it,
-every start is assumed able to leave (the stall limit ends a plan that cannot grow).
+A predicate may also offer, and the planners then use:
+
+- ``can_leave(point) -> bool``: False where it is certain that it rejects every motion from
+  ``point`` (the planners then refuse such a start before any work). Without it, every start is
+  assumed able to leave (the stall limit ends a plan that cannot grow).
+- ``is_valid(points (M, d)) -> bool (M,)``: its own state validity check (OMPL's
+  ``StateValidityChecker``, batched); the planners refuse a start or goal it calls invalid, as OMPL
+  refuses "no valid initial states" (``valid_states``).
+- ``bounds() -> (d, 2)``: the state space it checks; the planners refuse an environment whose
+  bounds reach outside it, where samples would fall outside the space (``check_within_space``).
 
 Implementations here: ``ExactCheck`` (sound, exact up to a resolution), ``TimeSampledCheck``
 (tests time samples only; unsound, for study) and, with the ``ompl`` extra,
@@ -200,3 +207,53 @@ def can_leave(predicate: ReachabilityPredicate, point: np.ndarray) -> bool:
     """
     method = getattr(predicate, "can_leave", None)
     return True if method is None else bool(method(point))
+
+
+def valid_states(predicate: ReachabilityPredicate, points: np.ndarray) -> np.ndarray:
+    """The predicate's own ``is_valid(points)`` if it has one, else every point valid.
+
+    Args:
+        predicate: Any ``ReachabilityPredicate``.
+        points: Float (M, d).
+
+    Returns:
+        Bool (M,).
+
+    Raises:
+        ValueError: An ``is_valid`` whose answer is not M booleans.
+    """
+    points = np.atleast_2d(np.asarray(points, dtype=float))
+    method = getattr(predicate, "is_valid", None)
+    if method is None:
+        return np.ones(points.shape[0], dtype=bool)
+    answers = np.asarray(method(points))
+    if answers.shape != (points.shape[0],):
+        raise ValueError(f"{predicate.name}.is_valid must return {points.shape[0]} booleans for "
+                         f"{points.shape[0]} points, got shape {answers.shape}")
+    return answers.astype(bool)
+
+
+def check_within_space(predicate: ReachabilityPredicate, bounds: np.ndarray) -> None:
+    """Refuse (``ValueError``) environment ``bounds`` that reach outside the predicate's own state
+    space (its ``bounds()``, if it has one): the planners sample inside the environment's bounds,
+    so such samples would be states the predicate does not model.
+
+    Args:
+        predicate: Any ``ReachabilityPredicate``.
+        bounds: Float (d, 2), the environment's [low, high] per axis.
+
+    Raises:
+        ValueError: Naming both boxes, when ``bounds`` is not inside the predicate's.
+    """
+    method = getattr(predicate, "bounds", None)
+    if method is None:
+        return
+    space = np.asarray(method() if callable(method) else method, dtype=float)
+    bounds = np.asarray(bounds, dtype=float)
+    if space.shape != bounds.shape:
+        raise ValueError(f"{predicate.name}.bounds() must be a (d, 2) array matching the environment's "
+                         f"{bounds.shape}, got shape {space.shape}")
+    if np.any(bounds[:, 0] < space[:, 0]) or np.any(bounds[:, 1] > space[:, 1]):
+        raise ValueError(f"the environment's bounds {bounds.tolist()} reach outside the {predicate.name} "
+                         f"check's state space {space.tolist()}: the planners would sample states it does "
+                         "not model (build the environment with bounds inside the space)")
