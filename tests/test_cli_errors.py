@@ -27,6 +27,8 @@ CASES = [
     (["plan", "--planner", "qrrt", "--backend", "statevector", "--qubits", "40"], "num_qubits = 40"),
     (["plan", "--goal-bias", "1.5"], "goal_bias must be a finite number in [0.0, 1.0), got 1.5"),
     (["plan", "--goal-bias", "1"], "goal_bias must be a finite number in [0.0, 1.0), got 1.0"),
+    (["plan", "--max-extension", "0"], "max_extension must be a finite number > 0.0, got 0.0"),
+    (["plan", "--max-extension", "nan"], "max_extension must be a finite number > 0.0"),
     (["plan", "--json", ""], "--json must name a file (for the standard output, /dev/stdout), got ''"),
     (["plan", "--json", "-"], "--json must name a file (for the standard output, /dev/stdout), got '-'"),
     (["plan", "--scenario-file", "."], "is a folder, not a scenario file"),

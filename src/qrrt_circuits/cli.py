@@ -205,7 +205,7 @@ def build_planner(args: argparse.Namespace, env: Environment, name: str | None =
     from .registry import BACKENDS, PLANNERS, POLICIES, PREDICATES
 
     specific = _planner_specific(args)
-    options: dict[str, Any] = {"goal_bias": args.goal_bias, "seed": args.seed,
+    options: dict[str, Any] = {"goal_bias": args.goal_bias, "max_extension": args.max_extension, "seed": args.seed,
                                "predicate": PREDICATES.create(args.predicate, env=env)}
     made: dict[str, Callable[[Any], Any]] = {"backend": lambda name: BACKENDS.create(name, seed=args.seed),
                                              "policy": POLICIES.create}
@@ -442,6 +442,8 @@ def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
     plan.add_argument("--predicate", type=_registered(PREDICATES), default="exact",
                       metavar="|".join(PREDICATES.labels()), help=f"reachability check: {PREDICATES.help_text()}")
     plan.add_argument("--goal-bias", type=float, default=0.0, help="probability of sampling the goal, in [0, 1)")
+    plan.add_argument("--max-extension", type=float, default=None,
+                      help="longest step from a parent (OMPL's RRT range), > 0 (default: none, the raw samples)")
     plan.add_argument("--seed", type=_nonnegative_int, default=0, help="the plan's seed")
     # (a help text with %(default)s keeps argparse from appending "(default: None)" after it)
     plan.add_argument("--max-nodes", type=_positive_int, default=None,

@@ -122,6 +122,10 @@ class Planner:
             planner's finalizer verifies every measured entry, so an error costs oracle calls only.
         goal_bias: Probability in [0, 1) that a sample is drawn in the goal ball instead of
             uniformly in the workspace. Default 0 (the paper's uniform sampling).
+        max_extension: The longest step from a parent (OMPL's RRT ``range``): a candidate farther
+            from its nearest node is moved toward it until the distance is ``max_extension``
+            (``database.steer``), for the classical tests and the quantum databases alike. A finite
+            number > 0, or None (default: the raw samples, as the paper's algorithms take them).
         resolution: Clearance of the default ``ExactCheck`` in length units (> 0, finite;
             default 0.01): a free trajectory is accepted if it passes farther than (1 + sqrt(d)) *
             resolution from every obstacle and 2 * resolution from the workspace boundary. Unused
@@ -139,7 +143,8 @@ class Planner:
         TypeError: ``env`` not an ``Environment``, a non-integer ``seed``, a non-real
             ``goal_bias`` or ``resolution``, ``dynamics`` or ``oracle_errors`` of the wrong class,
             or a ``predicate`` that lacks the members of the ``ReachabilityPredicate`` protocol.
-        ValueError: ``goal_bias`` outside [0, 1), a negative ``seed``, a dimension mismatch
+        ValueError: ``goal_bias`` outside [0, 1), a ``max_extension`` that is not finite and > 0, a
+            negative ``seed``, a dimension mismatch
             between ``env`` and ``predicate`` or ``dynamics``, both ``predicate`` and ``oracle``
             (or both ``predicate`` and ``dynamics``) given, or, for the default predicate, a
             ``resolution`` that is not finite and > 0 or one too fine for the workspace
@@ -156,6 +161,7 @@ class Planner:
         dynamics: LinearTrackingDynamics | None = None,
         oracle_errors: OracleErrorModel | None = None,
         goal_bias: float = 0.0,
+        max_extension: float | None = None,
         resolution: float = 0.01,
         seed: int | None = None,
         oracle: ReachabilityPredicate | None = None,
@@ -171,6 +177,8 @@ class Planner:
         if bias is None or bias >= 1.0:  # one message for 1, 1.5, -0.5 and NaN: the range is [0, 1)
             raise ValueError(f"goal_bias must be a finite number in [0.0, 1.0), got {goal_bias!r}")
         self.goal_bias = bias
+        self.max_extension = None if max_extension is None else check_float(
+            max_extension, "max_extension", 0.0, open_minimum=True)
         if oracle_errors is not None:
             check_instance(oracle_errors, "oracle_errors", OracleErrorModel, "an OracleErrorModel or None")
         self.oracle_errors = oracle_errors
@@ -381,7 +389,8 @@ class Planner:
 
     def _context(self) -> WorkerContext:
         """What workers need for this plan (subclasses add their backend, schedule, sizes)."""
-        return WorkerContext(self.env, self.predicate, self.streams, self.goal_bias, self.oracle_errors)
+        return WorkerContext(self.env, self.predicate, self.streams, self.goal_bias, self.oracle_errors,
+                             max_extension=self.max_extension)
 
     def _view(self, state: RunState, temperature_index: int = 0) -> RoundView:
         return RoundView(state.tree, state.goal, state.goal_radius, state.rounds, temperature_index,
@@ -392,7 +401,7 @@ class Planner:
         """Everything that fixes this planner's answers (JSON-able; recorded in the result)."""
         predicate = self.predicate.describe()
         return {"planner": self.name, "seed": self.seed, "goal_bias": self.goal_bias,
-                "predicate": predicate, "dynamics": predicate.get("dynamics"),
+                "max_extension": self.max_extension, "predicate": predicate, "dynamics": predicate.get("dynamics"),
                 "oracle_errors": None if self.oracle_errors is None else self.oracle_errors.describe()}
 
     def labels(self) -> tuple[str, ...]:

@@ -38,7 +38,7 @@ from ..reachability.predicate import ReachabilityPredicate, check_answers
 from ..world.environment import Environment
 from .base import Planner
 from .context import map_tasks
-from .database import sample_ball
+from .database import sample_ball, steer
 from .run_state import RunState
 from .termination import PlanStatus, TerminationCondition
 from .workers import check_extensions
@@ -95,7 +95,7 @@ class ParallelRRT(Planner):
     ``oracle_errors``). ``RRT`` is the case p = 1.
 
     The arguments every planner takes (``env``, ``predicate``, ``dynamics``, ``oracle_errors``,
-    ``goal_bias``, ``resolution``, ``seed``, ``executor`` and the deprecated ``oracle``) are
+    ``goal_bias``, ``max_extension``, ``resolution``, ``seed``, ``executor`` and the deprecated ``oracle``) are
     documented on ``Planner``. Without an ``executor`` the rounds are tested in batches (module
     docstring); with one, each worker's test is one task.
 
@@ -119,6 +119,7 @@ class ParallelRRT(Planner):
         dynamics: LinearTrackingDynamics | None = None,
         oracle_errors: OracleErrorModel | None = None,
         goal_bias: float = 0.0,
+        max_extension: float | None = None,
         resolution: float = 0.01,
         executor: Executor | None = None,
         seed: int | None = None,
@@ -126,8 +127,8 @@ class ParallelRRT(Planner):
     ) -> None:
         self.workers = check_int(workers, "workers", 1, MAX_WORKERS)
         super().__init__(env, predicate=predicate, dynamics=dynamics, oracle_errors=oracle_errors,
-                         goal_bias=goal_bias, resolution=resolution, seed=seed, oracle=oracle,
-                         executor=executor)
+                         goal_bias=goal_bias, max_extension=max_extension, resolution=resolution, seed=seed,
+                         oracle=oracle, executor=executor)
 
     def _run(self, state: RunState, condition: TerminationCondition, began: float) -> PlanStatus:
         """Rounds in batches: the candidates of the next B rounds drawn and tested together, then
@@ -152,8 +153,9 @@ class ParallelRRT(Planner):
                 keys[:, 1] = np.tile(np.arange(workers), ahead - kept)
                 keys[:, 2] = int(Stream.CANDIDATES)
                 drawn = np.concatenate((drawn[:kept * workers], self._candidates(state, keys)))
-            children = drawn[:ahead * workers]
-            parents = state.tree.nearest(children)
+            samples = drawn[:ahead * workers]  # kept raw: a round tested again is steered from its new parents
+            parents = state.tree.nearest(samples)
+            children = steer(state.tree.nodes[parents], samples, self.max_extension)
             truth = self._test(state, state.tree.nodes[parents], children)
             for offset in range(ahead):
                 if offset:  # (the first round's check came before the draws)
@@ -239,7 +241,7 @@ class RRT(ParallelRRT):
     counted as a ``verification_call`` (DESIGN §2).
 
     RRT has no arguments of its own: the arguments every planner takes (``env``, ``predicate``,
-    ``dynamics``, ``oracle_errors``, ``goal_bias``, ``resolution``, ``seed`` and the deprecated
+    ``dynamics``, ``oracle_errors``, ``goal_bias``, ``max_extension``, ``resolution``, ``seed`` and the deprecated
     ``oracle``; not ``executor``) are documented on ``Planner``, with what they raise.
     """
 
@@ -253,9 +255,11 @@ class RRT(ParallelRRT):
         dynamics: LinearTrackingDynamics | None = None,
         oracle_errors: OracleErrorModel | None = None,
         goal_bias: float = 0.0,
+        max_extension: float | None = None,
         resolution: float = 0.01,
         seed: int | None = None,
         oracle: ReachabilityPredicate | None = None,
     ) -> None:
         super().__init__(env, workers=1, predicate=predicate, dynamics=dynamics, oracle_errors=oracle_errors,
-                         goal_bias=goal_bias, resolution=resolution, seed=seed, oracle=oracle)
+                         goal_bias=goal_bias, max_extension=max_extension, resolution=resolution, seed=seed,
+                         oracle=oracle)

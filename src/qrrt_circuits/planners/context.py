@@ -49,6 +49,7 @@ class WorkerContext:
     backend: QuantumSearchBackend | None = None
     annealing: AnnealingSchedule | None = None
     database_size: int = 1
+    max_extension: float | None = None
 
     @property
     def search_backend(self) -> QuantumSearchBackend:

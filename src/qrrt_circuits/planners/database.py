@@ -161,6 +161,7 @@ def build_database(
     goal_bias: float = 0.0,
     annealing: AnnealingSchedule | None = None,
     temperature_index: int = 0,
+    max_extension: float | None = None,
 ) -> Database:
     """Build one database: ``size`` samples, each paired with its nearest tree node.
 
@@ -176,6 +177,8 @@ def build_database(
         goal_bias: Fraction in [0, 1) of samples drawn uniformly in the goal ball.
         annealing: An ``AnnealingSchedule`` (Alg. 4), or None.
         temperature_index: Alg. 4's h, which picks the annealing band.
+        max_extension: The longest step from a parent (``steer``), or None (default: the raw
+            samples, as the paper's Alg. 1 takes them).
 
     Returns:
         The ``Database`` of candidates and their nearest parents.
@@ -199,7 +202,27 @@ def build_database(
             norm[zero] = np.linalg.norm(offset[zero], axis=1)
         distance = rng.uniform(band[0], band[1], size)
         samples = origin + offset / norm[:, None] * distance[:, None]
-    return Database(samples, parents, band)
+    return Database(steer(tree.nodes[parents], samples, max_extension), parents, band)
+
+
+def steer(origins: np.ndarray, samples: np.ndarray, max_extension: float | None) -> np.ndarray:
+    """Each sample moved toward its origin until it lies at most ``max_extension`` from it (OMPL's
+    RRT ``range``; the step bound of the authors' ``drawrandin``): x = o + (s - o) min(1, r / |s - o|).
+
+    Args:
+        origins: Float (M, d), each candidate's parent position.
+        samples: Float (M, d), the raw samples.
+        max_extension: r > 0, or None for the samples unchanged.
+
+    Returns:
+        ``samples`` itself for None, else a new (M, d) array.
+    """
+    if max_extension is None:
+        return samples
+    offset = samples - origins
+    length = np.linalg.norm(offset, axis=1)
+    scale = np.minimum(1.0, max_extension / np.maximum(length, np.finfo(float).tiny))
+    return origins + offset * scale[:, None]
 
 def stream_database(
     tree: Tree,
@@ -213,6 +236,7 @@ def stream_database(
     goal_bias: float = 0.0,
     annealing: AnnealingSchedule | None = None,
     temperature_index: int = 0,
+    max_extension: float | None = None,
 ) -> Database:
     """``build_database`` with the generator of (round, worker, ``Stream.CANDIDATES``).
 
@@ -228,12 +252,13 @@ def stream_database(
         goal_bias: Fraction in [0, 1) of samples drawn in the goal ball.
         annealing: An ``AnnealingSchedule`` (Alg. 4), or None.
         temperature_index: Alg. 4's h.
+        max_extension: The longest step from a parent (``steer``), or None.
 
     Returns:
         The ``Database``.
     """
     return build_database(tree, size, env, streams.generator(round_index, worker, Stream.CANDIDATES), goal,
-                          goal_radius, goal_bias, annealing, temperature_index)
+                          goal_radius, goal_bias, annealing, temperature_index, max_extension)
 
 
 def sample_ball(centre: np.ndarray, radius: float, count: int, rng: np.random.Generator) -> np.ndarray:

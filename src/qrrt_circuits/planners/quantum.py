@@ -58,7 +58,7 @@ class PQRRT(Planner):
     Quantum Database Annealing (Alg. 4). ``QRRT`` is the case p = 1 (Alg. 2).
 
     The arguments every planner takes (``env``, ``predicate``, ``dynamics``, ``oracle_errors``,
-    ``goal_bias``, ``resolution``, ``seed``, ``executor`` and the deprecated ``oracle``) are
+    ``goal_bias``, ``max_extension``, ``resolution``, ``seed``, ``executor`` and the deprecated ``oracle``) are
     documented on ``Planner``. On an ``executor`` each database's search is one task; without one
     the round's databases are searched in turn, with the same results.
 
@@ -110,6 +110,7 @@ class PQRRT(Planner):
         dynamics: LinearTrackingDynamics | None = None,
         oracle_errors: OracleErrorModel | None = None,
         goal_bias: float = 0.0,
+        max_extension: float | None = None,
         resolution: float = 0.01,
         executor: Executor | None = None,
         seed: int | None = None,
@@ -136,8 +137,8 @@ class PQRRT(Planner):
         if annealing is not None:
             check_instance(annealing, "annealing", AnnealingSchedule, "an AnnealingSchedule or None")
         super().__init__(env, predicate=predicate, dynamics=dynamics, oracle_errors=oracle_errors,
-                         goal_bias=goal_bias, resolution=resolution, seed=seed, oracle=oracle,
-                         executor=executor)
+                         goal_bias=goal_bias, max_extension=max_extension, resolution=resolution, seed=seed,
+                         oracle=oracle, executor=executor)
         self.backend = backend
         self.shared_database = check_bool(shared_database, "shared_database")
         self.search_policy = policy
@@ -196,7 +197,7 @@ class PQRRT(Planner):
 
     def _context(self) -> WorkerContext:
         return WorkerContext(self.env, self.predicate, self.streams, self.goal_bias, self.oracle_errors,
-                             self.backend, self.annealing, self.database_size)
+                             self.backend, self.annealing, self.database_size, self.max_extension)
 
     def _worker_groups(self) -> list[tuple[int, int]]:
         """(first worker, workers) per database: one group of p on a shared database, p of one."""
@@ -274,7 +275,7 @@ class QRRT(PQRRT):
     verifies. With ``annealing`` this is Quantum Database Annealing (Alg. 4).
 
     The arguments every planner takes (``env``, ``predicate``, ``dynamics``, ``oracle_errors``,
-    ``goal_bias``, ``resolution``, ``seed`` and the deprecated ``oracle``; not ``executor``) are
+    ``goal_bias``, ``max_extension``, ``resolution``, ``seed`` and the deprecated ``oracle``; not ``executor``) are
     documented on ``Planner``; the others are ``PQRRT``'s, with the same meaning and defaults.
 
     Args:
@@ -304,6 +305,7 @@ class QRRT(PQRRT):
         dynamics: LinearTrackingDynamics | None = None,
         oracle_errors: OracleErrorModel | None = None,
         goal_bias: float = 0.0,
+        max_extension: float | None = None,
         resolution: float = 0.01,
         seed: int | None = None,
         oracle: ReachabilityPredicate | None = None,
@@ -312,4 +314,5 @@ class QRRT(PQRRT):
         super().__init__(env, backend=backend, num_qubits=num_qubits, workers=1, shared_database=True,
                          search_policy=search_policy, annealing=annealing, predicate=predicate,
                          dynamics=dynamics, oracle_errors=oracle_errors, goal_bias=goal_bias,
-                         resolution=resolution, seed=seed, oracle=oracle, iterations=iterations)
+                         max_extension=max_extension, resolution=resolution, seed=seed, oracle=oracle,
+                         iterations=iterations)
