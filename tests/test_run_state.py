@@ -6,7 +6,13 @@ import math
 
 import numpy as np
 
-from qrrt_circuits.planners.run_state import RunState, first_in_ball
+from qrrt_circuits.planners.goals import GoalBall, in_ball
+from qrrt_circuits.planners.run_state import RunState
+
+
+def first_in_ball(points, centre, radius):
+    hits = np.flatnonzero(in_ball(np.asarray(points, dtype=float).reshape(-1, len(centre)), centre, radius))
+    return int(hits[0]) if hits.size else -1
 
 
 def test_the_goal_ball_is_closed_and_the_first_row_inside_wins():
@@ -29,7 +35,8 @@ def test_add_nodes_in_a_batch_sets_the_goal_node_as_add_node_one_by_one():
     for _ in range(30):
         points = rng.uniform(0, 10, (12, 2))
         parents = rng.integers(0, 3, 12)
-        single, batch = RunState(np.array([1.0, 1.0]), goal, 2.5), RunState(np.array([1.0, 1.0]), goal, 2.5)
+        single = RunState(np.array([1.0, 1.0]), GoalBall(goal, 2.5))
+        batch = RunState(np.array([1.0, 1.0]), GoalBall(goal, 2.5))
         for point, parent in zip(points, parents, strict=True):
             single.add_node(point, int(parent))
         batch.add_nodes(points[:5], parents[:5])
@@ -39,4 +46,4 @@ def test_add_nodes_in_a_batch_sets_the_goal_node_as_add_node_one_by_one():
         inside = [i + 1 for i, p in enumerate(points) if np.hypot(*(p - goal)) <= 2.5]
         assert single.goal_node == (inside[0] if inside else None)
         assert np.array_equal(single.tree.nodes, batch.tree.nodes)
-    assert RunState(goal + [0.0, 2.5], goal, 2.5).goal_node == 0  # a root in the ball is the goal node
+    assert RunState(goal + [0.0, 2.5], GoalBall(goal, 2.5)).goal_node == 0  # a root in the ball is the goal node

@@ -12,6 +12,7 @@ if TYPE_CHECKING:
     from . import probability, registry
     from .planners import PQRRT, QRRT, RRT, Metrics, ParallelRRT, PlanResult, termination
     from .planners.database import AnnealingSchedule
+    from .planners.goals import Goal, GoalBall, GoalState
     from .planners.termination import (
         AnyOf,
         MaxCriticalPathCalls,
@@ -61,6 +62,7 @@ _WHERE = {
     "registry": ".registry",
     **dict.fromkeys(["PQRRT", "QRRT", "RRT", "Metrics", "ParallelRRT", "PlanResult"], ".planners"),
     "AnnealingSchedule": ".planners.database",
+    **dict.fromkeys(["Goal", "GoalBall", "GoalState"], ".planners.goals"),
     "termination": ".planners.termination",
     **dict.fromkeys(["AnyOf", "MaxCriticalPathCalls", "MaxNodes", "MaxOracleCalls", "MaxRounds", "MaxWallTime",
                      "PlanStatus", "Stall", "TerminationCondition"], ".planners.termination"),
@@ -141,6 +143,9 @@ __all__ = [
     "EstimatedOptimal",
     "FixedIterations",
     "FixedPointAmplification",
+    "Goal",
+    "GoalBall",
+    "GoalState",
     "IterationPolicy",
     "KnownOptimal",
     "IterateSequence",

@@ -45,8 +45,9 @@ from ..reachability.predicate import (
 from ..world.environment import Environment
 from . import termination as _termination
 from .context import RoundView, WorkerContext
+from .goals import Goal, GoalBall, ball_of, check_goal, first_satisfying
 from .result import Metrics, PlanResult
-from .run_state import RunState, first_in_ball
+from .run_state import RunState
 from .termination import (
     PlanStatus,
     TerminationCondition,
@@ -218,7 +219,7 @@ class Planner:
     def plan(
         self,
         start: np.ndarray | None = None,
-        goal: np.ndarray | None = None,
+        goal: Goal | np.ndarray | None = None,
         goal_radius: float | None = None,
         max_oracle_calls: int | None = None,
         max_nodes: int | None = None,
@@ -229,8 +230,8 @@ class Planner:
         stall_rounds: int | None = None,
         termination: TerminationCondition | None = None,
     ) -> PlanResult:
-        """Grow a tree from ``start`` until a node lands within ``goal_radius`` of ``goal`` or the
-        termination condition ends the plan.
+        """Grow a tree from ``start`` until a node satisfies the goal (a node in the goal ball, as
+        in the paper) or the termination condition ends the plan.
 
         The paper's Alg. 1 for RRT, Alg. 2 for q-RRT, Alg. 3 for Pq-RRT; Alg. 4 with an annealing
         schedule.
@@ -250,9 +251,13 @@ class Planner:
         Args:
             start: Root of the tree, shape (d,); default the environment's start. A start on the
                 workspace boundary, which the exact check can never leave, is refused.
-            goal: Goal point, shape (d,); default the environment's goal.
-            goal_radius: Radius of the goal ball (> 0); default the environment's. A start already
-                inside the ball is reached at once.
+            goal: A goal point, shape (d,) (default the environment's goal), the centre of a ball of
+                ``goal_radius``; or any ``Goal`` (``GoalBall``, ``GoalState``, a region of your own
+                with ``is_satisfied``): it needs ``sample`` where ``goal_bias > 0``, and a goal
+                without volume (``GoalState``) needs ``goal_bias > 0``. A start that already
+                satisfies the goal is reached at once.
+            goal_radius: Radius of the goal ball (> 0) with a goal point; default the environment's.
+                Not given with a ``Goal``.
             max_oracle_calls: End after this many oracle calls (DESIGN §2 counting).
             max_nodes: End once the tree has this many nodes besides the root.
             max_rounds: End after this many rounds.
@@ -280,7 +285,7 @@ class Planner:
                 size to lower, what the allocator reported, the largest smaller value whose
                 estimate fits in the memory available when the plan started).
         """
-        start, goal, goal_radius = self._check_problem(start, goal, goal_radius)
+        start, region = self._check_problem(start, goal, goal_radius)
         condition = from_budgets(max_oracle_calls, max_nodes, max_rounds, max_time_s,
                                  max_critical_path_calls, stall_rounds)
         if termination is not None:
@@ -297,23 +302,23 @@ class Planner:
                         default_rounds=limits.default_rounds)
         size.check()  # the plan's one memory check, before its first allocation
         try:
-            return self._plan_checked(start, goal, goal_radius, condition, safety)
+            return self._plan_checked(start, region, condition, safety)
         except OutOfMemory:
             raise
         except MemoryError as error:  # (its frames, and the plan's arrays, are released before the message)
             raise size.out_of_memory(error) from error
 
-    def _plan_checked(self, start: np.ndarray, goal: np.ndarray, goal_radius: float,
-                      condition: TerminationCondition, safety: frozenset[PlanStatus]) -> PlanResult:
+    def _plan_checked(self, start: np.ndarray, goal: Goal, condition: TerminationCondition,
+                      safety: frozenset[PlanStatus]) -> PlanResult:
         """The plan after its checks: the run state, the rounds and the result (``safety``: the
         statuses of the safety limits added to the caller's condition)."""
-        state = RunState(start, goal, goal_radius)
+        state = RunState(start, goal)
         state.policy_state = self._start_policy()
         state.context = self._context()
         began = time.perf_counter()
         status = self._run(state, condition, began)
         elapsed = time.perf_counter() - began
-        return self._result(state, status, elapsed, start, goal, goal_radius, condition, status in safety)
+        return self._result(state, status, elapsed, start, goal, condition, status in safety)
 
     def _run(self, state: RunState, condition: TerminationCondition, began: float) -> PlanStatus:
         """The round loop: check the condition before every round, run the round, record it; until
@@ -326,47 +331,63 @@ class Planner:
             state.end_round()
         return PlanStatus.REACHED
 
-    def _check_problem(self, start: np.ndarray | None, goal: np.ndarray | None,
-                       goal_radius: float | None) -> tuple[np.ndarray, np.ndarray, float]:
+    def _check_problem(self, start: np.ndarray | None, goal: Goal | np.ndarray | None,
+                       goal_radius: float | None) -> tuple[np.ndarray, Goal]:
+        """The start as a point and the goal as a ``Goal``, each checked against the environment
+        (bounds, obstacles) and the predicate's own validity check before any work."""
         env = self.env
         start = env.start if start is None else start
-        goal = env.goal if goal is None else goal
-        goal_radius = env.goal_radius if goal_radius is None else goal_radius
-        if start is None or goal is None or goal_radius is None:
-            raise ValueError("start, goal and goal_radius are required (the environment sets none)")
-        checked = []
-        for name, point in (("start", start), ("goal", goal)):
-            if point is None or isinstance(point, str | bytes):
-                raise ValueError(f"{name} must be {env.dim} numbers, got {point!r}")
-            try:
-                point = check_real_array(point, name).reshape(-1)  # booleans and strings refused
-            except ValueError as exc:
-                raise ValueError(f"{name} must be {env.dim} numbers, got {point!r}") from exc
-            if point.shape != (env.dim,):
-                raise ValueError(
-                    f"dimension mismatch: {name} has {point.shape[0]} coordinates, the environment "
-                    f"has d = {env.dim}"
-                )
-            if not np.all(np.isfinite(point)):
-                raise ValueError(f"{name} must be finite, got {point.tolist()}")
-            if not env.in_bounds(point):
-                raise ValueError(f"{name} {point.tolist()} is out of bounds {env.bounds.tolist()}")
-            if not env.is_free(point):
-                raise ValueError(f"{name} {point.tolist()} is in collision with an obstacle")
-            checked.append(point)
-        for name, point, valid in zip(("start", "goal"), checked, valid_states(self.predicate, np.stack(checked)),
-                                      strict=True):
-            if not valid:
-                raise ValueError(f"{name} {point.tolist()} is not a valid state: the {self.predicate.name} "
-                                 f"check's own validity check (is_valid) rejects it")
-        goal_radius = check_float(goal_radius, "goal_radius", 0.0, open_minimum=True)
-        reached = first_in_ball(checked[0][None], checked[1], goal_radius) == 0  # a start in the goal ball ends at once
-        if not reached and not can_leave(self.predicate, checked[0]):
+        if start is None:
+            raise ValueError("start is required (the environment sets none)")
+        start = self._checked_point("start", start)
+        if isinstance(goal, Goal):  # a goal object: the goal radius belongs to a goal point
+            if goal_radius is not None:
+                raise ValueError("goal_radius is given with a goal point, not with a Goal object "
+                                 f"({type(goal).__name__} carries its own extent)")
+            region = check_goal(goal, env.dim, self.goal_bias)
+            ball = ball_of(region)
+            if ball is not None:  # a ball's centre (a goal state) must be a valid point
+                self._checked_point("goal", ball[0])
+        else:
+            point = env.goal if goal is None else goal
+            radius = env.goal_radius if goal_radius is None else goal_radius
+            if point is None or radius is None:
+                raise ValueError("goal and goal_radius are required (the environment sets none)")
+            region = GoalBall(self._checked_point("goal", point), check_float(radius, "goal_radius", 0.0,
+                                                                               open_minimum=True))
+        reached = first_satisfying(region, start[None]) == 0  # a start in the goal ends at once
+        if not reached and not can_leave(self.predicate, start):
             raise ValueError(
-                f"start {checked[0].tolist()} lies on the workspace boundary {env.bounds.tolist()}: the "
+                f"start {start.tolist()} lies on the workspace boundary {env.bounds.tolist()}: the "
                 f"{self.predicate.name} check rejects every motion from it, so no node could ever be "
                 "added (move the start inside the workspace)")
-        return checked[0], checked[1], goal_radius
+        return start, region
+
+    def _checked_point(self, name: str, point: Any) -> np.ndarray:
+        """``point`` as d finite coordinates inside the bounds, free of the environment's obstacles
+        and valid under the predicate's own validity check (``is_valid``)."""
+        env = self.env
+        if point is None or isinstance(point, str | bytes):
+            raise ValueError(f"{name} must be {env.dim} numbers, got {point!r}")
+        try:
+            point = check_real_array(point, name).reshape(-1)  # booleans and strings refused
+        except ValueError as exc:
+            raise ValueError(f"{name} must be {env.dim} numbers, got {point!r}") from exc
+        if point.shape != (env.dim,):
+            raise ValueError(
+                f"dimension mismatch: {name} has {point.shape[0]} coordinates, the environment "
+                f"has d = {env.dim}"
+            )
+        if not np.all(np.isfinite(point)):
+            raise ValueError(f"{name} must be finite, got {point.tolist()}")
+        if not env.in_bounds(point):
+            raise ValueError(f"{name} {point.tolist()} is out of bounds {env.bounds.tolist()}")
+        if not env.is_free(point):
+            raise ValueError(f"{name} {point.tolist()} is in collision with an obstacle")
+        if not valid_states(self.predicate, point[None])[0]:
+            raise ValueError(f"{name} {point.tolist()} is not a valid state: the {self.predicate.name} "
+                             f"check's own validity check (is_valid) rejects it")
+        return np.array(point, dtype=float)
 
     def _check_ready(self) -> None:
         """Subclasses validate their own settings before any work."""
@@ -393,7 +414,7 @@ class Planner:
                              max_extension=self.max_extension)
 
     def _view(self, state: RunState, temperature_index: int = 0) -> RoundView:
-        return RoundView(state.tree, state.goal, state.goal_radius, state.rounds, temperature_index,
+        return RoundView(state.tree, state.goal, state.rounds, temperature_index,
                          state.policy_state)
 
     # ----------------------------------------------------------------- reporting
@@ -412,8 +433,8 @@ class Planner:
         """
         return ()
 
-    def _result(self, state: RunState, status: PlanStatus, elapsed: float, start: np.ndarray, goal: np.ndarray,
-                goal_radius: float, condition: TerminationCondition, safety_limit: bool = False) -> PlanResult:
+    def _result(self, state: RunState, status: PlanStatus, elapsed: float, start: np.ndarray, goal: Goal,
+                condition: TerminationCondition, safety_limit: bool = False) -> PlanResult:
         tree = state.tree
         path = None
         if state.goal_node is not None:
@@ -435,8 +456,10 @@ class Planner:
             wall_time_s=elapsed,
             wasted_checks=state.wasted_checks,
         )
-        settings = self.settings() | {"start": start.tolist(), "goal": goal.tolist(),
-                                      "goal_radius": goal_radius, "termination": condition.describe(),
+        ball = ball_of(goal)
+        settings = self.settings() | {"start": start.tolist(), "goal": None if ball is None else ball[0].tolist(),
+                                      "goal_radius": None if ball is None else ball[1],
+                                      "goal_region": goal.describe(), "termination": condition.describe(),
                                       "environment": self.env.name}
         history = {key: np.asarray(value, dtype=np.int64) for key, value in state.history.items()}
         return PlanResult(

@@ -38,7 +38,8 @@ from ..reachability.predicate import ReachabilityPredicate, check_answers
 from ..world.environment import Environment
 from .base import Planner
 from .context import map_tasks
-from .database import sample_ball, steer
+from .database import steer
+from .goals import sample_goal
 from .run_state import RunState
 from .termination import PlanStatus, TerminationCondition
 from .workers import check_extensions
@@ -198,7 +199,7 @@ class ParallelRRT(Planner):
             for row in np.flatnonzero(draws[:, dim] < self.goal_bias):
                 rng = self.streams.generator(*keys[row])
                 rng.random(dim + 1)  # the doubles used above
-                children[row] = sample_ball(state.goal, state.goal_radius, 1, rng)[0]
+                children[row] = sample_goal(state.goal, 1, rng)[0]
         return children
 
     def _record(self, state: RunState, round_index: int, children: np.ndarray, parents: np.ndarray,

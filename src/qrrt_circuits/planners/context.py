@@ -22,8 +22,6 @@ from dataclasses import dataclass, field
 from itertools import repeat
 from typing import TypeVar
 
-import numpy as np
-
 from .._support.randomness import RandomStreams
 from ..reachability.oracle_errors import OracleErrorModel
 from ..reachability.predicate import ReachabilityPredicate
@@ -31,6 +29,7 @@ from ..search.backend import QuantumSearchBackend
 from ..search.policies.iteration import PolicyState
 from ..world.environment import Environment
 from .database import AnnealingSchedule
+from .goals import Goal
 from .tree import Tree
 
 T = TypeVar("T")
@@ -88,8 +87,7 @@ class RoundView:
     """The round's part of a worker's task (the tree is a snapshot: workers never change it)."""
 
     tree: Tree
-    goal: np.ndarray
-    goal_radius: float
+    goal: Goal
     round_index: int
     temperature_index: int = 0
     policy_state: PolicyState | None = None

@@ -2,7 +2,7 @@
 4-8) and Quantum Database Annealing (Algorithm 4).
 
 ``build_database`` draws 2^n samples,
-uniform over the workspace (a fraction ``goal_bias`` uniform in the goal ball instead), and pairs
+uniform over the workspace (a fraction ``goal_bias`` drawn in the goal instead), and pairs
 each with its nearest tree node. With an ``AnnealingSchedule`` each candidate keeps the direction
 from its parent to the sample but is moved to a distance drawn uniformly in the current band
 [r_min, r_max] (DESIGN §1).
@@ -18,6 +18,7 @@ import numpy as np
 from .._support.randomness import RandomStreams, Stream
 from .._support.validation import check_choice, check_float, check_int
 from ..world.environment import Environment
+from .goals import Goal, sample_goal
 from .tree import Tree
 
 
@@ -156,8 +157,7 @@ def build_database(
     size: int,
     env: Environment,
     rng: np.random.Generator,
-    goal: np.ndarray | None = None,
-    goal_radius: float = 0.0,
+    goal: Goal | None = None,
     goal_bias: float = 0.0,
     annealing: AnnealingSchedule | None = None,
     temperature_index: int = 0,
@@ -172,9 +172,8 @@ def build_database(
         size: Candidates N (2^n for a quantum database).
         env: The ``Environment`` whose workspace is sampled.
         rng: The generator of the samples.
-        goal: Goal point (d,) for goal-biased samples, or None.
-        goal_radius: Radius of the goal ball the biased samples are drawn in.
-        goal_bias: Fraction in [0, 1) of samples drawn uniformly in the goal ball.
+        goal: The ``Goal`` whose ``sample`` draws the goal-biased samples, or None.
+        goal_bias: Fraction in [0, 1) of samples drawn in the goal (``goal.sample``).
         annealing: An ``AnnealingSchedule`` (Alg. 4), or None.
         temperature_index: Alg. 4's h, which picks the annealing band.
         max_extension: The longest step from a parent (``steer``), or None (default: the raw
@@ -188,7 +187,7 @@ def build_database(
         biased = rng.random(size) < goal_bias
         count = int(biased.sum())
         if count:
-            samples[biased] = sample_ball(goal, goal_radius, count, rng)
+            samples[biased] = sample_goal(goal, count, rng)
     parents = tree.nearest(samples)
     band = None
     if annealing is not None:
@@ -231,8 +230,7 @@ def stream_database(
     streams: RandomStreams,
     round_index: int,
     worker: int,
-    goal: np.ndarray | None = None,
-    goal_radius: float = 0.0,
+    goal: Goal | None = None,
     goal_bias: float = 0.0,
     annealing: AnnealingSchedule | None = None,
     temperature_index: int = 0,
@@ -247,9 +245,8 @@ def stream_database(
         streams: The plan's ``RandomStreams``.
         round_index: The round (the generator's key).
         worker: The worker (the generator's key).
-        goal: Goal point (d,) for goal-biased samples, or None.
-        goal_radius: Radius of the goal ball.
-        goal_bias: Fraction in [0, 1) of samples drawn in the goal ball.
+        goal: The ``Goal`` of the goal-biased samples, or None.
+        goal_bias: Fraction in [0, 1) of samples drawn in the goal.
         annealing: An ``AnnealingSchedule`` (Alg. 4), or None.
         temperature_index: Alg. 4's h.
         max_extension: The longest step from a parent (``steer``), or None.
@@ -258,24 +255,4 @@ def stream_database(
         The ``Database``.
     """
     return build_database(tree, size, env, streams.generator(round_index, worker, Stream.CANDIDATES), goal,
-                          goal_radius, goal_bias, annealing, temperature_index, max_extension)
-
-
-def sample_ball(centre: np.ndarray, radius: float, count: int, rng: np.random.Generator) -> np.ndarray:
-    """``count`` points uniform in the d-ball of ``radius`` around ``centre``.
-
-    A Gaussian direction, normalised, scaled by ``radius * u^(1/d)`` with u uniform in [0, 1).
-
-    Args:
-        centre: Float (d,), the ball's centre.
-        radius: The ball's radius.
-        count: Number of points.
-        rng: The generator of the draws.
-
-    Returns:
-        Float array (count, d).
-    """
-    d = centre.shape[0]
-    direction = rng.normal(size=(count, d))
-    direction /= np.linalg.norm(direction, axis=1, keepdims=True)
-    return centre + direction * radius * rng.random(count)[:, None] ** (1.0 / d)
+                          goal_bias, annealing, temperature_index, max_extension)

@@ -5,8 +5,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numba import njit
 
+from .goals import Goal, first_satisfying
 from .termination import Progress
 from .tree import Tree
 
@@ -17,34 +17,13 @@ if TYPE_CHECKING:  # annotations only (context imports the search modules)
 HISTORY_KEYS = ("oracle_calls", "critical_path", "nodes", "entries", "reachable")
 
 
-@njit(cache=True, nogil=True)
-def first_in_ball(points: np.ndarray, centre: np.ndarray, radius: float) -> int:
-    """The first row of ``points`` within ``radius`` of ``centre``, or -1: the goal test of every
-    planner (paper Algorithms 1-4), a node reaching the goal if it lies in the closed goal ball.
-
-    The distance is sqrt(sum over the axes, in order, of (x_i - c_i)^2), each operation rounded
-    once, so the answer is the same on every machine. ``np.linalg.norm(x - c)`` would take its dot
-    product from the BLAS, whose kernels may fuse a multiply and an add depending on the machine,
-    so a node within a rounding error of the goal radius could count as in on one machine and out
-    on another."""
-    for row in range(points.shape[0]):
-        squared = 0.0
-        for axis in range(points.shape[1]):
-            offset = points[row, axis] - centre[axis]
-            squared += offset * offset
-        if np.sqrt(squared) <= radius:
-            return row
-    return -1
-
-
 class RunState:
     """Counters of DESIGN §2 as a plan accumulates them; ``end_round`` appends the history."""
 
-    def __init__(self, root: np.ndarray, goal: np.ndarray, goal_radius: float) -> None:
+    def __init__(self, root: np.ndarray, goal: Goal) -> None:
         self.tree = Tree(root)
         self.goal = goal
-        self.goal_radius = goal_radius
-        self.goal_node: int | None = 0 if first_in_ball(root.reshape(1, -1), goal, goal_radius) == 0 else None
+        self.goal_node: int | None = 0 if first_satisfying(goal, root.reshape(1, -1)) == 0 else None
         self.rounds = 0
         self.quantum_calls = 0
         self.verification_calls = 0
@@ -86,9 +65,9 @@ class RunState:
         return self.tree.size - 1
 
     def add_node(self, position: np.ndarray, parent: int) -> int:
-        """Add one node (``Tree.add``); the first node inside the goal ball becomes ``goal_node``."""
+        """Add one node (``Tree.add``); the first node that satisfies the goal becomes ``goal_node``."""
         index = self.tree.add(position, parent)
-        if self.goal_node is None and first_in_ball(position.reshape(1, -1), self.goal, self.goal_radius) == 0:
+        if self.goal_node is None and first_satisfying(self.goal, position.reshape(1, -1)) == 0:
             self.goal_node = index
         return index
 
@@ -98,7 +77,7 @@ class RunState:
             return
         first = self.tree.add_many(positions, parents)
         if self.goal_node is None:
-            hit = first_in_ball(positions, self.goal, self.goal_radius)
+            hit = first_satisfying(self.goal, positions)
             if hit >= 0:
                 self.goal_node = first + hit
 

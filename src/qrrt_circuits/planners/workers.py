@@ -91,7 +91,7 @@ def make_database(context: WorkerContext, view: RoundView, worker: int) -> tuple
     """The database of paper Algorithm 1, lines 4-8, the true predicate on it, and the oracle's
     marks."""
     db = stream_database(view.tree, context.database_size, context.env, context.streams, view.round_index,
-                         worker, view.goal, view.goal_radius, context.goal_bias, context.annealing,
+                         worker, view.goal, context.goal_bias, context.annealing,
                          view.temperature_index, context.max_extension)
     size = db.parents.shape[0]
     truth = check_answers(context.predicate.reachable(view.tree.nodes[db.parents], db.children), size,
