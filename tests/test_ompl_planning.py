@@ -1,0 +1,121 @@
+"""OMPL both ways: a SimpleSetup planned by the library's planners, the library's planners as OMPL
+planners, and OMPL benchmark logs that OMPL's own statistics script reads."""
+
+from __future__ import annotations
+
+import sqlite3
+
+import numpy as np
+import pytest
+
+ob = pytest.importorskip("ompl.base")
+og = pytest.importorskip("ompl.geometric")
+
+import qrrt_circuits as qc  # noqa: E402
+from qrrt_circuits.adapters.ompl_planning import (  # noqa: E402
+    LibraryPlanner,
+    OMPLGoalRegion,
+    benchmark_log,
+    problem_from_setup,
+)
+
+
+def valid(state) -> bool:
+    """A wall x in [4, 6] with a gap y in [4, 6]."""
+    return not (4.0 <= state[0] <= 6.0 and not 4.0 <= state[1] <= 6.0)
+
+
+def gap_setup(goal_threshold: float = 0.5) -> og.SimpleSetup:
+    space = ob.RealVectorStateSpace(2)
+    bounds = ob.RealVectorBounds(2)
+    bounds.setLow(0.0)
+    bounds.setHigh(10.0)
+    space.setBounds(bounds)
+    setup = og.SimpleSetup(space)
+    setup.setStateValidityChecker(valid)
+    start, goal = space.allocState(), space.allocState()
+    start[0], start[1], goal[0], goal[1] = 1.0, 1.0, 9.0, 9.0
+    setup.setStartAndGoalStates(start, goal, goal_threshold)
+    return setup
+
+
+def test_a_setup_becomes_a_problem_the_planners_take():
+    problem = problem_from_setup(gap_setup())
+    assert problem.env.bounds.tolist() == [[0.0, 10.0], [0.0, 10.0]] and problem.env.start.tolist() == [1.0, 1.0]
+    assert isinstance(problem.goal, qc.GoalState) and problem.goal.threshold == 0.5
+    assert problem.predicate.is_valid(np.array([[5.0, 1.0], [5.0, 5.0]])).tolist() == [False, True]
+    for make in (lambda: qc.RRT(problem.env, predicate=problem.predicate, goal_bias=0.05, seed=0),
+                 lambda: qc.QRRT(problem.env, predicate=problem.predicate, backend=qc.StatevectorBackend(seed=0),
+                                 num_qubits=4, goal_bias=0.05, search_policy=qc.Adaptive(), seed=0)):
+        result = make().plan(goal=problem.goal, max_oracle_calls=20000)
+        assert result.reached and np.linalg.norm(result.path[-1] - [9, 9]) <= 0.5
+        for parent, child in zip(result.path[:-1], result.path[1:], strict=True):  # every path edge, by OMPL
+            assert problem.predicate.reachable(parent[None], child[None])[0]
+
+
+def test_a_goal_region_is_asked_through_ompl():
+    class RightStrip(ob.GoalRegion):
+        def __init__(self, si):
+            super().__init__(si)
+            self.setThreshold(1e-9)  # OMPL: satisfied where distanceGoal < threshold
+
+        def distanceGoal(self, state):
+            return max(0.0, 9.0 - state[0])
+
+    setup = gap_setup()
+    setup.setGoal(RightStrip(setup.getSpaceInformation()))
+    problem = problem_from_setup(setup)
+    assert isinstance(problem.goal, OMPLGoalRegion) and not hasattr(problem.goal, "sample")
+    assert problem.goal.is_satisfied(np.array([[9.5, 1.0], [8.0, 1.0]])).tolist() == [True, False]
+    result = qc.RRT(problem.env, predicate=problem.predicate, seed=1).plan(goal=problem.goal, max_oracle_calls=20000)
+    assert result.reached and result.path[-1][0] >= 9.0
+
+
+def test_library_planners_solve_through_simple_setup():
+    setup = gap_setup()
+    def make(env, predicate):
+        return qc.RRT(env, predicate=predicate, goal_bias=0.05, seed=2)
+
+    planner = LibraryPlanner(setup.getSpaceInformation(), make, "RRT-lib")
+    setup.setPlanner(planner)
+    assert setup.solve(30.0) and setup.haveExactSolutionPath()
+    path = setup.getSolutionPath()
+    assert path.check() and planner.last_result.reached
+    assert path.getStateCount() == len(planner.last_result.path)
+
+
+def test_benchmark_logs_carry_oracle_calls_that_ompls_statistics_read(tmp_path):
+    from ompl import _benchmark_statistics as statistics
+
+    setup = gap_setup()
+
+    def library(name, make):
+        return lambda si: LibraryPlanner(si, make, name)
+
+    planners = {
+        "RRT (OMPL)": og.RRT,
+        "q-RRT": library("q-RRT", lambda env, predicate: qc.QRRT(
+            env, predicate=predicate, backend=qc.StatevectorBackend(seed=0), num_qubits=4, goal_bias=0.05,
+            search_policy=qc.Adaptive(), seed=0)),
+    }
+    log = tmp_path / "run.log"
+    rows = benchmark_log(setup, planners, runs=2, max_time_s=20.0, path=log)
+    assert all(row["solved BOOLEAN"] == 1 for row in rows["q-RRT"])
+    assert all(row["oracle calls INTEGER"] >= 1 and row["motion checks INTEGER"] >= row["oracle calls INTEGER"]
+               for row in rows["q-RRT"])
+    database = tmp_path / "run.db"
+    statistics.readBenchmarkLog(str(database), [str(log)], False)
+    with sqlite3.connect(database) as connection:
+        names = [row[0] for row in connection.execute("SELECT name FROM plannerConfigs ORDER BY id")]
+        calls = connection.execute("SELECT oracle_calls FROM runs WHERE oracle_calls IS NOT NULL").fetchall()
+    assert names == ["RRT (OMPL)", "q-RRT"]
+    assert sorted(c for (c,) in calls) == sorted(row["oracle calls INTEGER"] for row in rows["q-RRT"])
+
+
+def test_bad_benchmark_arguments_are_refused(tmp_path):
+    with pytest.raises(ValueError, match="runs must be"):
+        benchmark_log(gap_setup(), {"RRT": og.RRT}, runs=0, max_time_s=1.0, path=tmp_path / "x.log")
+    with pytest.raises(ValueError, match="max_time_s must be a finite number > 0.0"):
+        benchmark_log(gap_setup(), {"RRT": og.RRT}, runs=1, max_time_s=0.0, path=tmp_path / "x.log")
+    with pytest.raises(ValueError, match="planners must name at least one"):
+        benchmark_log(gap_setup(), {}, runs=1, max_time_s=1.0, path=tmp_path / "x.log")
