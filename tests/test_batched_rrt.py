@@ -85,3 +85,30 @@ def test_batch_size_follows_the_success_rate():
     assert batch_rounds(9, 98) == 10
     assert batch_rounds(99, 98) == 1
     assert batch_rounds(0, 10**6) == MAX_BATCH_ROUNDS
+
+
+@pytest.mark.parametrize("workers", [1, 4])
+def test_without_look_ahead_the_predicate_is_asked_once_per_oracle_call(clutter, workers):
+    """look_ahead=False: the same plan, no wasted checks, and the predicate sees exactly the
+    counted oracle calls (for a user's expensive check)."""
+    class Counting:
+        dim, name = 2, "counting"
+
+        def __init__(self):
+            self.inner, self.pairs = qc.ExactCheck(clutter), 0
+
+        def reachable(self, parents, children):
+            self.pairs += len(np.atleast_2d(children))
+            return self.inner.reachable(parents, children)
+
+        def describe(self):
+            return self.inner.describe()
+
+    batched, single = Counting(), Counting()
+    ahead = qc.ParallelRRT(clutter, workers=workers, predicate=batched, seed=4).plan(max_nodes=20)
+    once = qc.ParallelRRT(clutter, workers=workers, predicate=single, seed=4, look_ahead=False).plan(max_nodes=20)
+    assert np.array_equal(ahead.nodes, once.nodes) and ahead.metrics.oracle_calls == once.metrics.oracle_calls
+    assert once.metrics.wasted_checks == 0 and single.pairs == once.metrics.oracle_calls
+    assert batched.pairs == ahead.metrics.oracle_calls + ahead.metrics.wasted_checks > single.pairs
+    with pytest.raises(TypeError, match="look_ahead"):
+        qc.RRT(clutter, look_ahead="no")

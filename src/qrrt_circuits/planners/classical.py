@@ -31,7 +31,7 @@ from concurrent.futures import Executor
 import numpy as np
 
 from .._support.randomness import Stream, uniform_draws
-from .._support.validation import check_int
+from .._support.validation import check_bool, check_int
 from ..reachability.dynamics import LinearTrackingDynamics
 from ..reachability.oracle_errors import OracleErrorModel
 from ..reachability.predicate import ReachabilityPredicate, check_answers
@@ -103,6 +103,11 @@ class ParallelRRT(Planner):
     Args:
         workers: Number p of workers, i.e. extensions per round, in [1, ``MAX_WORKERS``] (4096).
             Default 8.
+        look_ahead: Whether rounds are tested in batches ahead of the tree (default True). The
+            plan is the same either way; a batch tests rounds a node makes stale
+            (``Metrics.wasted_checks``), which costs little with the compiled checks and much with
+            an expensive user predicate: False tests one round at a time (B = 1), so the predicate
+            is asked exactly once per oracle call.
 
     Raises:
         TypeError: A non-integer ``workers``, or an argument ``Planner`` refuses.
@@ -125,8 +130,10 @@ class ParallelRRT(Planner):
         executor: Executor | None = None,
         seed: int | None = None,
         oracle: ReachabilityPredicate | None = None,
+        look_ahead: bool = True,
     ) -> None:
         self.workers = check_int(workers, "workers", 1, MAX_WORKERS)
+        self.look_ahead = check_bool(look_ahead, "look_ahead")
         super().__init__(env, predicate=predicate, dynamics=dynamics, oracle_errors=oracle_errors,
                          goal_bias=goal_bias, max_extension=max_extension, resolution=resolution, seed=seed,
                          oracle=oracle, executor=executor)
@@ -139,7 +146,7 @@ class ParallelRRT(Planner):
         B is ``batch_rounds`` (at most ``batch_round_limit``) in-process, 1 on an executor."""
         workers = self.workers
         changed = recorded = 0
-        most = 1 if self.executor is not None else batch_round_limit(workers, self.env.dim)
+        most = batch_round_limit(workers, self.env.dim) if self.executor is None and self.look_ahead else 1
         drawn = np.empty((0, self.env.dim))  # candidates drawn for rounds first, first + 1, ... not yet recorded
         while state.goal_node is None:
             ended = condition.ended_by(state.progress(time.perf_counter() - began))
@@ -241,9 +248,10 @@ class RRT(ParallelRRT):
     ``ParallelRRT`` with one worker and no executor. Each reachability test is one oracle call,
     counted as a ``verification_call`` (DESIGN §2).
 
-    RRT has no arguments of its own: the arguments every planner takes (``env``, ``predicate``,
-    ``dynamics``, ``oracle_errors``, ``goal_bias``, ``max_extension``, ``resolution``, ``seed`` and the deprecated
-    ``oracle``; not ``executor``) are documented on ``Planner``, with what they raise.
+    The arguments every planner takes (``env``, ``predicate``, ``dynamics``, ``oracle_errors``,
+    ``goal_bias``, ``max_extension``, ``resolution``, ``seed`` and the deprecated ``oracle``; not
+    ``executor``) are documented on ``Planner``, with what they raise; ``look_ahead`` on
+    ``ParallelRRT``.
     """
 
     name = "RRT"
@@ -260,7 +268,8 @@ class RRT(ParallelRRT):
         resolution: float = 0.01,
         seed: int | None = None,
         oracle: ReachabilityPredicate | None = None,
+        look_ahead: bool = True,
     ) -> None:
         super().__init__(env, workers=1, predicate=predicate, dynamics=dynamics, oracle_errors=oracle_errors,
                          goal_bias=goal_bias, max_extension=max_extension, resolution=resolution, seed=seed,
-                         oracle=oracle)
+                         oracle=oracle, look_ahead=look_ahead)
