@@ -17,9 +17,10 @@ from qrrt_circuits.planners.database import steer
 def test_steer_caps_the_step_and_keeps_the_direction():
     origins = np.zeros((3, 2))
     samples = np.array([[3.0, 4.0], [0.3, 0.4], [0.0, 0.0]])
-    steered = steer(origins, samples, 1.0)
+    space = qc.RealVectorSpace(2)
+    steered = steer(space, origins, samples, 1.0)
     assert np.allclose(steered, [[0.6, 0.8], [0.3, 0.4], [0.0, 0.0]])
-    assert steer(origins, samples, None) is samples
+    assert steer(space, origins, samples, None) is samples
 
 
 def _make(name, env, backend, **kwargs):

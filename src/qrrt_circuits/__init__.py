@@ -49,6 +49,7 @@ if TYPE_CHECKING:
     from .search.problem import DatabaseSearch, SearchOutcome
     from .world import scenarios
     from .world.environment import Environment
+    from .world.spaces import RealVectorSpace, SE2Space, StateSpace
 
     __version__: str
 
@@ -63,6 +64,7 @@ _WHERE = {
     **dict.fromkeys(["PQRRT", "QRRT", "RRT", "Metrics", "ParallelRRT", "PlanResult"], ".planners"),
     "AnnealingSchedule": ".planners.database",
     **dict.fromkeys(["Goal", "GoalBall", "GoalState"], ".planners.goals"),
+    **dict.fromkeys(["RealVectorSpace", "SE2Space", "StateSpace"], ".world.spaces"),
     "termination": ".planners.termination",
     **dict.fromkeys(["AnyOf", "MaxCriticalPathCalls", "MaxNodes", "MaxOracleCalls", "MaxRounds", "MaxWallTime",
                      "PlanStatus", "Stall", "TerminationCondition"], ".planners.termination"),
@@ -146,6 +148,9 @@ __all__ = [
     "Goal",
     "GoalBall",
     "GoalState",
+    "RealVectorSpace",
+    "SE2Space",
+    "StateSpace",
     "IterationPolicy",
     "KnownOptimal",
     "IterateSequence",

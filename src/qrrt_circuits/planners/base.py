@@ -43,6 +43,7 @@ from ..reachability.predicate import (
     valid_states,
 )
 from ..world.environment import Environment
+from ..world.spaces import RealVectorSpace, StateSpace
 from . import termination as _termination
 from .context import RoundView, WorkerContext
 from .goals import Goal, GoalBall, ball_of, check_goal, first_satisfying
@@ -70,6 +71,27 @@ def __getattr__(name: str) -> Any:
                         "qrrt_circuits.planners.termination.DEFAULT_MAX_ROUNDS")
         return _termination.DEFAULT_MAX_ROUNDS
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+#: the members a state space must have (``world.spaces.StateSpace``)
+SPACE_MEMBERS = ("dim", "distance", "interpolate", "nearest", "check_bounds", "describe")
+
+
+def check_space(space: Any, env: Environment) -> StateSpace:
+    """``space`` if it implements ``StateSpace`` in ``env``'s dimension and accepts its bounds.
+
+    Raises:
+        TypeError: A member of ``SPACE_MEMBERS`` missing.
+        ValueError: A dimension mismatch, or bounds the space refuses (``check_bounds``).
+    """
+    missing = [member for member in SPACE_MEMBERS if not hasattr(space, member)]
+    if missing:
+        raise TypeError(f"space must be a StateSpace (RealVectorSpace, SE2Space, ...); {type(space).__name__} lacks "
+                        f"{', '.join(missing)}")
+    if space.dim != env.dim:
+        raise ValueError(f"dimension mismatch: the space has d = {space.dim}, the environment has d = {env.dim}")
+    space.check_bounds(env.bounds)
+    return space
 
 
 def resolve_predicate(env: Environment, predicate: ReachabilityPredicate | None,
@@ -127,6 +149,10 @@ class Planner:
             from its nearest node is moved toward it until the distance is ``max_extension``
             (``database.steer``), for the classical tests and the quantum databases alike. A finite
             number > 0, or None (default: the raw samples, as the paper's algorithms take them).
+        space: The ``StateSpace`` whose metric picks nearest nodes and steers candidates
+            (``world.spaces``: ``RealVectorSpace``, ``SE2Space``, or your own); its ``dim`` must
+            be ``env.dim`` and it must accept ``env.bounds``. Default ``RealVectorSpace(env.dim)``
+            (Euclidean, the paper's).
         resolution: Clearance of the default ``ExactCheck`` in length units (> 0, finite;
             default 0.01): a free trajectory is accepted if it passes farther than (1 + sqrt(d)) *
             resolution from every obstacle and 2 * resolution from the workspace boundary. Unused
@@ -163,6 +189,7 @@ class Planner:
         oracle_errors: OracleErrorModel | None = None,
         goal_bias: float = 0.0,
         max_extension: float | None = None,
+        space: StateSpace | None = None,
         resolution: float = 0.01,
         seed: int | None = None,
         oracle: ReachabilityPredicate | None = None,
@@ -180,6 +207,7 @@ class Planner:
         self.goal_bias = bias
         self.max_extension = None if max_extension is None else check_float(
             max_extension, "max_extension", 0.0, open_minimum=True)
+        self.space = RealVectorSpace(env.dim) if space is None else check_space(space, env)
         if oracle_errors is not None:
             check_instance(oracle_errors, "oracle_errors", OracleErrorModel, "an OracleErrorModel or None")
         self.oracle_errors = oracle_errors
@@ -411,7 +439,7 @@ class Planner:
     def _context(self) -> WorkerContext:
         """What workers need for this plan (subclasses add their backend, schedule, sizes)."""
         return WorkerContext(self.env, self.predicate, self.streams, self.goal_bias, self.oracle_errors,
-                             max_extension=self.max_extension)
+                             max_extension=self.max_extension, space=self.space)
 
     def _view(self, state: RunState, temperature_index: int = 0) -> RoundView:
         return RoundView(state.tree, state.goal, state.rounds, temperature_index,
@@ -422,7 +450,8 @@ class Planner:
         """Everything that fixes this planner's answers (JSON-able; recorded in the result)."""
         predicate = self.predicate.describe()
         return {"planner": self.name, "seed": self.seed, "goal_bias": self.goal_bias,
-                "max_extension": self.max_extension, "predicate": predicate, "dynamics": predicate.get("dynamics"),
+                "max_extension": self.max_extension, "space": self.space.describe(), "predicate": predicate,
+                "dynamics": predicate.get("dynamics"),
                 "oracle_errors": None if self.oracle_errors is None else self.oracle_errors.describe()}
 
     def labels(self) -> tuple[str, ...]:

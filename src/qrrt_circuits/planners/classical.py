@@ -36,6 +36,7 @@ from ..reachability.dynamics import LinearTrackingDynamics
 from ..reachability.oracle_errors import OracleErrorModel
 from ..reachability.predicate import ReachabilityPredicate, check_answers
 from ..world.environment import Environment
+from ..world.spaces import StateSpace
 from .base import Planner
 from .context import map_tasks
 from .database import steer
@@ -126,6 +127,7 @@ class ParallelRRT(Planner):
         oracle_errors: OracleErrorModel | None = None,
         goal_bias: float = 0.0,
         max_extension: float | None = None,
+        space: StateSpace | None = None,
         resolution: float = 0.01,
         executor: Executor | None = None,
         seed: int | None = None,
@@ -135,8 +137,8 @@ class ParallelRRT(Planner):
         self.workers = check_int(workers, "workers", 1, MAX_WORKERS)
         self.look_ahead = check_bool(look_ahead, "look_ahead")
         super().__init__(env, predicate=predicate, dynamics=dynamics, oracle_errors=oracle_errors,
-                         goal_bias=goal_bias, max_extension=max_extension, resolution=resolution, seed=seed,
-                         oracle=oracle, executor=executor)
+                         goal_bias=goal_bias, max_extension=max_extension, space=space, resolution=resolution,
+                         seed=seed, oracle=oracle, executor=executor)
 
     def _run(self, state: RunState, condition: TerminationCondition, began: float) -> PlanStatus:
         """Rounds in batches: the candidates of the next B rounds drawn and tested together, then
@@ -162,8 +164,8 @@ class ParallelRRT(Planner):
                 keys[:, 2] = int(Stream.CANDIDATES)
                 drawn = np.concatenate((drawn[:kept * workers], self._candidates(state, keys)))
             samples = drawn[:ahead * workers]  # kept raw: a round tested again is steered from its new parents
-            parents = state.tree.nearest(samples)
-            children = steer(state.tree.nodes[parents], samples, self.max_extension)
+            parents = self.space.nearest(state.tree, samples)
+            children = steer(self.space, state.tree.nodes[parents], samples, self.max_extension)
             truth = self._test(state, state.tree.nodes[parents], children)
             for offset in range(ahead):
                 if offset:  # (the first round's check came before the draws)
@@ -265,11 +267,12 @@ class RRT(ParallelRRT):
         oracle_errors: OracleErrorModel | None = None,
         goal_bias: float = 0.0,
         max_extension: float | None = None,
+        space: StateSpace | None = None,
         resolution: float = 0.01,
         seed: int | None = None,
         oracle: ReachabilityPredicate | None = None,
         look_ahead: bool = True,
     ) -> None:
         super().__init__(env, workers=1, predicate=predicate, dynamics=dynamics, oracle_errors=oracle_errors,
-                         goal_bias=goal_bias, max_extension=max_extension, resolution=resolution, seed=seed,
-                         oracle=oracle, look_ahead=look_ahead)
+                         goal_bias=goal_bias, max_extension=max_extension, space=space, resolution=resolution,
+                         seed=seed, oracle=oracle, look_ahead=look_ahead)

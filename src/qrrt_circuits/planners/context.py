@@ -28,6 +28,7 @@ from ..reachability.predicate import ReachabilityPredicate
 from ..search.backend import QuantumSearchBackend
 from ..search.policies.iteration import PolicyState
 from ..world.environment import Environment
+from ..world.spaces import StateSpace
 from .database import AnnealingSchedule
 from .goals import Goal
 from .tree import Tree
@@ -49,6 +50,7 @@ class WorkerContext:
     annealing: AnnealingSchedule | None = None
     database_size: int = 1
     max_extension: float | None = None
+    space: StateSpace | None = None
 
     @property
     def search_backend(self) -> QuantumSearchBackend:

@@ -18,6 +18,7 @@ import numpy as np
 from .._support.randomness import RandomStreams, Stream
 from .._support.validation import check_choice, check_float, check_int
 from ..world.environment import Environment
+from ..world.spaces import RealVectorSpace, StateSpace
 from .goals import Goal, sample_goal
 from .tree import Tree
 
@@ -162,6 +163,7 @@ def build_database(
     annealing: AnnealingSchedule | None = None,
     temperature_index: int = 0,
     max_extension: float | None = None,
+    space: StateSpace | None = None,
 ) -> Database:
     """Build one database: ``size`` samples, each paired with its nearest tree node.
 
@@ -178,6 +180,8 @@ def build_database(
         temperature_index: Alg. 4's h, which picks the annealing band.
         max_extension: The longest step from a parent (``steer``), or None (default: the raw
             samples, as the paper's Alg. 1 takes them).
+        space: The ``StateSpace`` whose metric picks the nearest parents and steers; None for
+            ``RealVectorSpace`` (Euclidean, the paper's).
 
     Returns:
         The ``Database`` of candidates and their nearest parents.
@@ -188,7 +192,8 @@ def build_database(
         count = int(biased.sum())
         if count:
             samples[biased] = sample_goal(goal, count, rng)
-    parents = tree.nearest(samples)
+    space = RealVectorSpace(tree.dim) if space is None else space
+    parents = space.nearest(tree, samples)
     band = None
     if annealing is not None:
         band = annealing.band(temperature_index)
@@ -201,14 +206,16 @@ def build_database(
             norm[zero] = np.linalg.norm(offset[zero], axis=1)
         distance = rng.uniform(band[0], band[1], size)
         samples = origin + offset / norm[:, None] * distance[:, None]
-    return Database(steer(tree.nodes[parents], samples, max_extension), parents, band)
+    return Database(steer(space, tree.nodes[parents], samples, max_extension), parents, band)
 
 
-def steer(origins: np.ndarray, samples: np.ndarray, max_extension: float | None) -> np.ndarray:
-    """Each sample moved toward its origin until it lies at most ``max_extension`` from it (OMPL's
-    RRT ``range``; the step bound of the authors' ``drawrandin``): x = o + (s - o) min(1, r / |s - o|).
+def steer(space: StateSpace, origins: np.ndarray, samples: np.ndarray, max_extension: float | None) -> np.ndarray:
+    """Each sample moved toward its origin until it lies at most ``max_extension`` from it under
+    the space's metric (OMPL's RRT ``range``; the step bound of the authors' ``drawrandin``):
+    x = interpolate(o, s, min(1, r / distance(o, s))); in R^d, o + (s - o) min(1, r / |s - o|).
 
     Args:
+        space: The ``StateSpace``.
         origins: Float (M, d), each candidate's parent position.
         samples: Float (M, d), the raw samples.
         max_extension: r > 0, or None for the samples unchanged.
@@ -218,10 +225,9 @@ def steer(origins: np.ndarray, samples: np.ndarray, max_extension: float | None)
     """
     if max_extension is None:
         return samples
-    offset = samples - origins
-    length = np.linalg.norm(offset, axis=1)
-    scale = np.minimum(1.0, max_extension / np.maximum(length, np.finfo(float).tiny))
-    return origins + offset * scale[:, None]
+    length = space.distance(origins, samples)
+    fraction = np.minimum(1.0, max_extension / np.maximum(length, np.finfo(float).tiny))
+    return space.interpolate(origins, samples, fraction)
 
 def stream_database(
     tree: Tree,
@@ -235,6 +241,7 @@ def stream_database(
     annealing: AnnealingSchedule | None = None,
     temperature_index: int = 0,
     max_extension: float | None = None,
+    space: StateSpace | None = None,
 ) -> Database:
     """``build_database`` with the generator of (round, worker, ``Stream.CANDIDATES``).
 
@@ -250,9 +257,10 @@ def stream_database(
         annealing: An ``AnnealingSchedule`` (Alg. 4), or None.
         temperature_index: Alg. 4's h.
         max_extension: The longest step from a parent (``steer``), or None.
+        space: The ``StateSpace`` (None: ``RealVectorSpace``).
 
     Returns:
         The ``Database``.
     """
     return build_database(tree, size, env, streams.generator(round_index, worker, Stream.CANDIDATES), goal,
-                          goal_bias, annealing, temperature_index, max_extension)
+                          goal_bias, annealing, temperature_index, max_extension, space)

@@ -34,6 +34,7 @@ from ..reachability.predicate import ReachabilityPredicate
 from ..search.backend import QuantumSearchBackend
 from ..search.policies.iteration import IterationPolicy, PaperIterations, PolicyState
 from ..world.environment import Environment
+from ..world.spaces import StateSpace
 from .base import Planner
 from .classical import MAX_WORKERS
 from .context import WorkerContext, map_tasks
@@ -111,6 +112,7 @@ class PQRRT(Planner):
         oracle_errors: OracleErrorModel | None = None,
         goal_bias: float = 0.0,
         max_extension: float | None = None,
+        space: StateSpace | None = None,
         resolution: float = 0.01,
         executor: Executor | None = None,
         seed: int | None = None,
@@ -137,8 +139,8 @@ class PQRRT(Planner):
         if annealing is not None:
             check_instance(annealing, "annealing", AnnealingSchedule, "an AnnealingSchedule or None")
         super().__init__(env, predicate=predicate, dynamics=dynamics, oracle_errors=oracle_errors,
-                         goal_bias=goal_bias, max_extension=max_extension, resolution=resolution, seed=seed,
-                         oracle=oracle, executor=executor)
+                         goal_bias=goal_bias, max_extension=max_extension, space=space, resolution=resolution,
+                         seed=seed, oracle=oracle, executor=executor)
         self.backend = backend
         self.shared_database = check_bool(shared_database, "shared_database")
         self.search_policy = policy
@@ -197,7 +199,7 @@ class PQRRT(Planner):
 
     def _context(self) -> WorkerContext:
         return WorkerContext(self.env, self.predicate, self.streams, self.goal_bias, self.oracle_errors,
-                             self.backend, self.annealing, self.database_size, self.max_extension)
+                             self.backend, self.annealing, self.database_size, self.max_extension, self.space)
 
     def _worker_groups(self) -> list[tuple[int, int]]:
         """(first worker, workers) per database: one group of p on a shared database, p of one."""
@@ -306,6 +308,7 @@ class QRRT(PQRRT):
         oracle_errors: OracleErrorModel | None = None,
         goal_bias: float = 0.0,
         max_extension: float | None = None,
+        space: StateSpace | None = None,
         resolution: float = 0.01,
         seed: int | None = None,
         oracle: ReachabilityPredicate | None = None,
@@ -314,5 +317,5 @@ class QRRT(PQRRT):
         super().__init__(env, backend=backend, num_qubits=num_qubits, workers=1, shared_database=True,
                          search_policy=search_policy, annealing=annealing, predicate=predicate,
                          dynamics=dynamics, oracle_errors=oracle_errors, goal_bias=goal_bias,
-                         max_extension=max_extension, resolution=resolution, seed=seed, oracle=oracle,
-                         iterations=iterations)
+                         max_extension=max_extension, space=space, resolution=resolution, seed=seed,
+                         oracle=oracle, iterations=iterations)

@@ -92,7 +92,7 @@ def make_database(context: WorkerContext, view: RoundView, worker: int) -> tuple
     marks."""
     db = stream_database(view.tree, context.database_size, context.env, context.streams, view.round_index,
                          worker, view.goal, context.goal_bias, context.annealing,
-                         view.temperature_index, context.max_extension)
+                         view.temperature_index, context.max_extension, context.space)
     size = db.parents.shape[0]
     truth = check_answers(context.predicate.reachable(view.tree.nodes[db.parents], db.children), size,
                           f"the predicate {context.predicate.name!r}")
