@@ -221,7 +221,7 @@ class Lemmas(Experiment):
         """Per lemma, each grid point's measured value with its 95 % interval (``point_interval``)
         against the lemma's value, and the shares of points whose interval holds the lemma and that
         lie within 3 standard errors, with their intervals."""
-        fig, axes = new_figure(2, 3, (14, 8.5))
+        fig, axes = new_figure(2, 3, (14, 9.5))
         for ax, lemma in zip(axes.ravel(), LEMMAS, strict=True):
             points = [(r, summary["per_point"][r["trial_id"]][lemma]) for r in records
                       if lemma in summary["per_point"][r["trial_id"]]]
@@ -239,7 +239,7 @@ class Lemmas(Experiment):
             stats, spans_of = summary["ours"][lemma], summary["interval_95"][lemma]
             inside, within = spans_of["inside_interval_95"], spans_of["within_3_sigma"]
             ax.set_title(f"Lemma {lemma[-1]}: {self.paper[lemma]}\n"
-                         f"interval holds the lemma: {stats['inside_interval_95']} [{inside[0]}, {inside[1]}]; "
+                         f"interval holds the lemma: {stats['inside_interval_95']} [{inside[0]}, {inside[1]}]\n"
                          f"within 3 sigma: {stats['within_3_sigma']} [{within[0]}, {within[1]}]", fontsize=8.5)
             ax.set_xlabel("lemma")
             ax.set_ylabel("Aer shots")
