@@ -38,6 +38,30 @@ def test_quick_path_writes_summary_records_and_figure(name, tmp_path):
             assert len(number.interval) == 2 and np.isfinite(number.paper)
 
 
+def _leaves(value, path=()):
+    if isinstance(value, dict):
+        for key, item in value.items():
+            yield from _leaves(item, (*path, key))
+    else:
+        yield path, value
+
+
+def _assert_intervals_hold(ours, intervals):
+    """Every number of ``ours`` has a 95 % interval at the same place: low <= high (a null end is
+    unbounded), and the interval holds the number up to the rounding of either."""
+    for path, value in _leaves(ours):
+        span = intervals
+        for key in path:
+            span = span[key]
+        assert isinstance(span, list) and len(span) == 2, (path, span)
+        if value is None or not np.isfinite(value):  # (a break-even beyond the levels; an undefined fit)
+            continue
+        low = -np.inf if span[0] is None else span[0]
+        high = np.inf if span[1] is None else span[1]
+        slack = 5e-5 + 1e-3 * abs(value)
+        assert low <= high and low - slack <= value <= high + slack, (path, value, span)
+
+
 def _check_oracle_efficiency(summary, records):
     assert set(summary["ours"]) == {"RRT", "ParallelRRT", "QRRT", "PQRRT"}
     for r in records:
@@ -53,10 +77,18 @@ def _check_oracle_efficiency(summary, records):
 
 
 def _check_wallclock(summary, records):
+    _assert_intervals_hold(summary["ours"], summary["interval_95"])
     for name, per_node in summary["ours"]["seconds_per_node"].items():
         assert per_node > 0
         paper = summary["paper"]["seconds_per_node"][name.split(" ")[0]]
         assert summary["speedup_over_paper_per_node"][name] == round(paper / per_node, 1)
+        low, high = summary["speedup_over_paper_per_node_interval_95"][name]
+        assert low - 0.1 <= summary["speedup_over_paper_per_node"][name] <= high + 0.1
+    for backend, ratio in summary["ours"]["per_call_ratio_qrrt_over_pqrrt"].items():
+        # per call = (Pq-RRT's calls per critical-path call) x per critical-path call, when every
+        # Pq-RRT tree has the same calls per critical-path call (one tree here)
+        per_worker = summary["ours"]["per_critical_path_call_ratio_qrrt_over_pqrrt"][backend]
+        assert ratio == pytest.approx(summary["pqrrt_calls_per_critical_path_call"][backend] * per_worker, rel=1e-2)
 
 
 def _check_heatmaps(summary, records):
@@ -87,8 +119,19 @@ def _check_annealing(summary, records):
 
 
 def _check_lemmas(summary, records):
-    for stats in summary["ours"].values():  # points with a zero standard error are left out
-        assert 0 < stats["points"] <= len(records) and 0.0 <= stats["within_3_sigma"] <= 1.0
+    _assert_intervals_hold(summary["ours"], summary["interval_95"])
+    for lemma, stats in summary["z_scores"].items():  # points with a zero standard error are left out
+        assert 0 < stats["points"] <= len(records) and 0.0 <= summary["ours"][lemma]["within_3_sigma"] <= 1.0
+        low, high = stats["max_abs_z_range_if_exact_95"]
+        assert 0 < low < high
+        inside = [point[lemma]["inside"] for point in summary["per_point"].values() if lemma in point]
+        assert len(inside) == stats["points"]
+        assert summary["ours"][lemma]["inside_interval_95"] == round(sum(inside) / len(inside), 3)
+    for point in summary["per_point"].values():  # each measured value lies in its own interval
+        for value in point.values():
+            assert value["interval_95"][0] <= value["observed"] <= value["interval_95"][1]
+        assert all(value["inside"] == (value["interval_95"][0] <= value["lemma"] <= value["interval_95"][1])
+                   for value in point.values())
     for r in records:  # every lemma agrees with the Aer shots within 5.5 standard errors
         for lemma in ("lemma1", "lemma2", "lemma4", "lemma5"):
             assert abs(r[f"{lemma}_observed"] - r[f"{lemma}_theory"]) <= 5.5 * r[f"{lemma}_stderr"] + 1e-12
@@ -101,9 +144,11 @@ def _check_scaling(summary, records):
 
 
 def _check_oracle_check(summary, records):
-    # the exact check's trees never contain an edge through an obstacle
-    assert all(value == 0.0 for value in summary["invalid_edge_fraction"]["exact"].values())
+    _assert_intervals_hold(summary["ours"], summary["interval_95"])
+    # the exact check's trees never contain an edge it rejects; the finer check rejects a subset
+    assert all(value == 0.0 for value in summary["ours"]["invalid_edge_fraction"]["exact"].values())
     assert all(r["invalid_edges"] == 0 for r in records if r["check"] == "exact")
+    assert all(0 <= r["invalid_edges_fine"] <= r["invalid_edges"] <= r["nodes"] for r in records)
 
 
 def _check_tree_size(summary, records):
@@ -112,9 +157,9 @@ def _check_tree_size(summary, records):
         points = json.loads(r["points_json"])
         assert [p[0] for p in points] == sizes
         assert all(a[1] <= b[1] and a[2] <= b[2] <= b[1] for a, b in zip(points, points[1:], strict=False))
-    for label, windows in summary["ours"].items():
-        low, high = next(iter(summary["interval_95"][label].values()))
-        assert low <= next(iter(windows.values())) <= high or low == high
+    _assert_intervals_hold(summary["ours"], summary["interval_95"])
+    _assert_intervals_hold(summary["critical_path_per_node"], summary["critical_path_interval_95"])
+    _assert_intervals_hold(summary["mean_reachable_fraction"], summary["mean_reachable_fraction_interval_95"])
 
 
 def _check_heatmap_hypotheses(summary, records):
@@ -156,6 +201,12 @@ def _check_search_policies(summary, records):
         assert set(summary["critical_path_interval_95"][label]) == set(by_window)
         if label.startswith("QRRT") or label == "RRT":
             assert summary["critical_path_interval_95"][label] == summary["interval_95"][label]
+    _assert_intervals_hold(summary["ours"], summary["interval_95"])
+    _assert_intervals_hold(summary["critical_path_per_node"], summary["critical_path_interval_95"])
+    _assert_intervals_hold(summary["whole_run"], summary["whole_run_interval_95"])
+    _assert_intervals_hold(summary["mean_reachable_fraction"], summary["mean_reachable_fraction_interval_95"])
+    estimation = {key: value for key, value in summary["estimation"].items() if key != "break_even_note"}
+    _assert_intervals_hold(estimation, summary["estimation_interval_95"])
 
 
 def _check_noise(summary, records):
@@ -168,6 +219,7 @@ def _check_noise(summary, records):
             assert r["oracle_calls"] == r["quantum_oracle_calls"] + r["verification_calls"]
             assert r["config"] != "RRT" or r["quantum_oracle_calls"] == 0
     assert set(summary["ours"]["break_even_p2"]) == set(summary["settings"]["planning_configs"])
+    _assert_intervals_hold(summary["ours"], summary["interval_95"])
     assert summary["device"]["name"] or "pip install" in summary["device"]["missing"]
 
 

@@ -82,7 +82,10 @@ class Noise(Experiment):
     Three parts (see the module docstring): ``sweep`` (one search under depolarizing noise against
     the white-noise model), ``device`` (a fake IBM device, when the ``noise`` extra is installed)
     and ``planning`` (q-RRT's oracle calls per node as the two-qubit error grows, against RRT's,
-    and the break-even error rate with its 95 % interval).
+    and the break-even error rate with its 95 % interval). Every number of ``ours`` has its 95 %
+    interval at the same place in ``interval_95``: exact binomial for a sweep point sampled with
+    shots (the value itself for an exact density-matrix probability), a percentile bootstrap over
+    worlds for the planning numbers.
     """
 
     name = "noise"
@@ -208,9 +211,13 @@ class Noise(Experiment):
         sweep = [r for r in records if r["part"] == "sweep"]
         k_top = max(settings["sweep_iterations"])
         success: dict[str, dict[str, float]] = {}
+        success_interval: dict[str, dict[str, list[float]]] = {}
         for n in settings["sweep_qubits"]:
-            success[str(n)] = {f"{p2:g}": _mean([r["success"] for r in sweep if r["n"] == n and r["k"] == k_top
-                                                 and r["p2"] == p2]) for p2 in settings["p2"]}
+            success[str(n)], success_interval[str(n)] = {}, {}
+            for p2 in settings["p2"]:
+                rows = [r for r in sweep if r["n"] == n and r["k"] == k_top and r["p2"] == p2]
+                success[str(n)][f"{p2:g}"] = _mean([r["success"] for r in rows])
+                success_interval[str(n)][f"{p2:g}"] = sweep_interval(rows)
         exact = [r for r in sweep if r["shots"] == 0 and r["p2"] > 0]
         white_gap = max((abs(r["success"] - r["white_noise"]) for r in exact), default=math.nan)
         ratios = [r["collision"] / r["collision_uniform"] for r in exact if np.isfinite(r["collision"])]
@@ -218,9 +225,17 @@ class Noise(Experiment):
                      if np.isfinite(r["collision_false_positive_model"])]
         planning = self._planning_summary([r for r in records if r["part"] == "planning"], settings)
         device = [r for r in records if r["part"] == "device"]
-        ours = {f"success_at_k{k_top}": success, "break_even_p2": planning["break_even_p2"],
+        break_even = planning["break_even_p2"]
+        cells = planning["intervals"]
+        ours = {f"success_at_k{k_top}": success,
+                "break_even_p2": {config: value["p2"] for config, value in break_even.items()},
                 "calls_per_node": planning["calls_per_node"]}
-        return {"ours": ours, "paper": self.paper, "planning": planning,
+        interval = {f"success_at_k{k_top}": success_interval,
+                    "break_even_p2": {config: value["interval_95"] for config, value in break_even.items()},
+                    "calls_per_node": {config: (cell["interval_95"] if config == "RRT" else
+                                                {p2: x["interval_95"] for p2, x in cell.items()})
+                                       for config, cell in cells.items()}}
+        return {"ours": ours, "paper": self.paper, "interval_95": interval, "planning": planning,
                 "white_noise_max_abs_error": white_gap,
                 "wrong_answer_collision_over_uniform": {"measured_range": _range(ratios),
                                                         "false_positive_model_range": _range(fp_ratios)},
@@ -231,10 +246,13 @@ class Noise(Experiment):
                                                                 "ideal": r["ideal"],
                                                                 "two_qubit_gates": r["two_qubit_gates"]}
                                        for r in device}},
-                "labels": [f"sweep: n <= {settings['exact_max_qubits']} exact density matrix; larger n "
-                           f"noise trajectories with {settings['shots']} shots",
+                "labels": [f"sweep: n <= {settings['exact_max_qubits']} exact density matrix (its interval is the "
+                           f"value itself: no sampling); larger n noise trajectories with {settings['shots']} shots "
+                           "(exact binomial interval)",
                            "QRRT optimal uses the true m of each database (simulation knowledge)",
-                           f"p1 = {settings['p1_ratio']:g} x p2; rz is virtual and error-free"]}
+                           f"p1 = {settings['p1_ratio']:g} x p2; rz is virtual and error-free",
+                           "calls_per_node and break_even_p2: percentile bootstrap over worlds; a break-even "
+                           "interval's upper end null means beyond the largest p2"]}
 
     def _planning_summary(self, rows: list[Record], settings: Settings) -> dict[str, Any]:
         by_world: dict[int, list[Record]] = {}
@@ -364,6 +382,26 @@ class Noise(Experiment):
         ax.set_title("Where noise is not a false-positive oracle", fontsize=9)
         ax.legend(fontsize=7)
         ax.grid(alpha=0.3, which="both")
+
+
+def sweep_interval(rows: Sequence[Record]) -> list[float]:
+    """The 95 % interval of a sweep point's success probability: exact binomial over its shots for
+    noise trajectories, the value itself for an exact density-matrix probability (no sampling).
+
+    Args:
+        rows: The sweep records of one (n, k, p2) (one database each; several are pooled).
+
+    Returns:
+        ``[low, high]``; NaNs without rows.
+    """
+    if not rows:
+        return [math.nan, math.nan]
+    if all(r["shots"] == 0 for r in rows):  # exact probabilities
+        value = _mean([r["success"] for r in rows])
+        return [value, value]
+    successes = sum(int(r["successes"]) for r in rows)
+    shots = sum(int(r["shots"]) for r in rows)
+    return rounded_interval(binomial_interval(successes, shots))
 
 
 def crossing(levels: Sequence[float], values: ArrayLike, target: float) -> float:

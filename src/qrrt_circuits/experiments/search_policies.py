@@ -18,7 +18,9 @@ shared database are ignored in that formula (they only make sharing worse), so p
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -29,10 +31,17 @@ from ..search.policies.estimated import EstimatedOptimal, EstimatedOptimalState
 from ..search.policies.iteration import IterationPolicy
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, paired_trials
 from .figures import dodge, new_figure, save, with_intervals
-from .intervals import rounded_interval
-from .measures import dumps, loads
+from .intervals import bootstrap_interval, bootstrap_ratio_interval, rounded_interval
+from .measures import dumps
 from .planners import planner_for
-from .tree_size import calls_at_sizes, pooled_calls_per_node, pooled_interval, reachable_fraction_by_window
+from .tree_size import (
+    calls_at_sizes,
+    fraction_interval,
+    mean_fraction,
+    pooled_calls_per_node,
+    pooled_interval,
+    reachable_fraction_by_window,
+)
 from .worlds import world
 
 SIZES = (30, 100, 300, 1000)
@@ -60,6 +69,67 @@ class _LoggedEstimatedOptimal(EstimatedOptimal):
         return state
 
 
+#: a stand-in for "no number of workers pays" in a bootstrap resample (ranked above every finite p*)
+NEVER = 1e12
+
+
+def estimation_figures(records: Sequence[Record]) -> dict[str, Any]:
+    """Estimation vs search calls of EstimatedOptimal, and the workers p* at which one estimation
+    per database would match a rival's calls per node (from the q-RRT runs; module docstring).
+
+    Args:
+        records: The experiment's records (those of other configurations are ignored).
+
+    Returns:
+        ``{"QRRT" | "PQRRT": {"estimation_calls_per_database", "search_calls_per_worker",
+        "estimation_share_of_calls"}, "break_even_workers": {rival: p* or None}, "break_even_note"}``,
+        with the entries the records allow.
+    """
+    out: dict[str, Any] = {}
+    for prefix in ("QRRT", "PQRRT"):
+        rows = [r for r in records if r["config"] == f"{prefix} estimated"]
+        databases = sum(r["databases"] for r in rows)
+        searches = sum(r["verification_calls"] for r in rows)
+        if not databases or not searches:
+            continue
+        out[prefix] = {"estimation_calls_per_database": round(sum(r["estimation_calls"] for r in rows)
+                                                              / databases, 2),
+                       "search_calls_per_worker": round((sum(r["quantum_oracle_calls"] - r["estimation_calls"]
+                                                             for r in rows) + searches) / searches, 3),
+                       "estimation_share_of_calls": round(sum(r["estimation_calls"] for r in rows)
+                                                          / sum(r["oracle_calls"] for r in rows), 4)}
+    single = [r for r in records if r["config"] == "QRRT estimated"]
+    if single:
+        searches = sum(r["verification_calls"] for r in single)
+        estimation = sum(r["estimation_calls"] for r in single) / searches
+        search_cost = (sum(r["quantum_oracle_calls"] - r["estimation_calls"] for r in single) + searches) / searches
+        rate = sum(r["nodes"] for r in single) / searches
+        out["break_even_workers"] = {}
+        for rival in ("adaptive", "bbht", "paper"):
+            rows = [r for r in records if r["config"] == f"QRRT {rival}"]
+            if not rows:
+                continue
+            per_node = sum(r["oracle_calls"] for r in rows) / sum(r["nodes"] for r in rows)
+            margin = rate * per_node - search_cost
+            out["break_even_workers"][rival] = None if margin <= 0 else round(estimation / margin, 1)
+        out["break_even_note"] = ("p* = E / (r x rival's calls per node - s) from the q-RRT runs (E: estimation "
+                                  "calls per database, s: search calls per worker, r: nodes per worker search); "
+                                  "None: the searches after an estimate cost more per node than the rival's, so "
+                                  "no number of workers pays")
+    return out
+
+
+def _world_figure(by_world: dict[int, list[Record]], group: str, key: str, worlds: Sequence[int]) -> float:
+    """One ``estimation_figures`` number on the records of the given worlds (a bootstrap resample:
+    a world drawn twice counts twice); ``NEVER`` where no number of workers pays, NaN where the
+    resample cannot give it."""
+    figures = estimation_figures([r for w in worlds for r in by_world[w]])
+    value = figures.get(group, {}).get(key, math.nan) if group in figures else math.nan
+    if group == "break_even_workers" and key in figures.get(group, {}) and value is None:
+        return NEVER
+    return float(value)
+
+
 def _policy(name: str | None) -> IterationPolicy | None:
     if name == "estimated":
         return _LoggedEstimatedOptimal()
@@ -74,8 +144,10 @@ class SearchPolicies(Experiment):
 
     A trial grows one tree with RRT or q-RRT / Pq-RRT under one policy of ``POLICY_NAMES`` and
     records the calls at sizes 30, 100, 300 and 1000 (``calls_at_sizes``). The summary gives the
-    marginal calls per node in each window with 95 % intervals, and for ``EstimatedOptimal`` the
-    estimation's share of the calls and the break-even number of workers (module docstring).
+    marginal calls per node in each window (total and critical path), the whole run's calls per
+    node, the mean reachable fraction, and for ``EstimatedOptimal`` the estimation's share of the
+    calls and the break-even number of workers (module docstring), each with its 95 % bootstrap
+    interval over worlds.
     """
 
     name = "search-policies"
@@ -124,6 +196,7 @@ class SearchPolicies(Experiment):
         critical: dict[str, dict[str, float]] = {}
         critical_interval: dict[str, dict[str, list[float]]] = {}
         whole: dict[str, dict[str, float]] = {}
+        whole_interval: dict[str, dict[str, list[float]]] = {}
         for label in settings["configs"]:
             rows = [r for r in records if r["config"] == label]
             ours[label] = {w: round(pooled_calls_per_node(rows, w), 3) for w in windows}
@@ -131,19 +204,27 @@ class SearchPolicies(Experiment):
             critical[label] = {w: round(pooled_calls_per_node(rows, w, 2), 3) for w in windows}
             critical_interval[label] = {w: rounded_interval(pooled_interval(rows, w, settings["seed"], 2), 3)
                                         for w in windows}
-            nodes = sum(r["nodes"] for r in rows)
-            whole[label] = {"calls_per_node": round(sum(r["oracle_calls"] for r in rows) / nodes, 3),
-                            "critical_path_per_node": round(sum(r["critical_path_calls"] for r in rows) / nodes, 3)}
-        fractions = {w: round(float(np.mean([loads(r["fractions_json"])[w] for r in records
-                                             if w in loads(r["fractions_json"])] or [np.nan])), 4)
-                     for w in windows}
+            nodes = [int(r["nodes"]) for r in rows]
+            whole[label], whole_interval[label] = {}, {}
+            for key, column in (("calls_per_node", "oracle_calls"), ("critical_path_per_node", "critical_path_calls")):
+                calls = [int(r[column]) for r in rows]
+                whole[label][key] = round(sum(calls) / sum(nodes), 3)
+                whole_interval[label][key] = rounded_interval(bootstrap_ratio_interval(calls, nodes, settings["seed"]),
+                                                              3)
+        fractions = {w: round(mean_fraction(records, w), 4) for w in windows}
+        fractions_interval = {w: fraction_interval(records, w, settings["seed"]) for w in windows}
+        estimation, estimation_interval = self._estimation_summary(records, settings["seed"])
         return {"ours": ours, "paper": self.paper, "interval_95": interval, "critical_path_per_node": critical,
                 "critical_path_interval_95": critical_interval,
-                "whole_run": whole, "mean_reachable_fraction": fractions,
-                "estimation": self._estimation_summary(records),
+                "whole_run": whole, "whole_run_interval_95": whole_interval,
+                "mean_reachable_fraction": fractions, "mean_reachable_fraction_interval_95": fractions_interval,
+                "estimation": estimation, "estimation_interval_95": estimation_interval,
                 "note": "marginal oracle calls per node added in each window of tree sizes, pooled over worlds "
                         "(critical_path_per_node: the same for the critical path, the time of 8 parallel devices); "
-                        "whole_run: all calls / all nodes up to the largest size",
+                        "whole_run: all calls / all nodes up to the largest size; every interval is a percentile "
+                        "bootstrap over worlds (all configurations of a resampled world together for the "
+                        "estimation figures; a break-even resample where no number of workers pays ranks above "
+                        "every finite one, and an interval end there is null)",
                 "labels": ["QRRT/PQRRT optimal use the true m of each database (simulation knowledge)",
                            "estimated: amplitude-estimation shots are counted as quantum oracle calls (k + 1 per "
                            "shot of Q^k A|0>), run on qiskit-aer's SamplerV2; the searches on the exact statevector",
@@ -151,41 +232,30 @@ class SearchPolicies(Experiment):
                            "backend: exact statevector (ideal; same statistics as Aer)"]}
 
     @staticmethod
-    def _estimation_summary(records: Sequence[Record]) -> dict[str, Any]:
+    def _estimation_summary(records: Sequence[Record], seed: int) -> tuple[dict[str, Any], dict[str, Any]]:
         """Estimation vs search calls of EstimatedOptimal, and the workers p* at which one estimation
-        per database would match Adaptive's calls per node (from the q-RRT runs)."""
-        out: dict[str, Any] = {}
+        per database would match a rival's calls per node (``estimation_figures``), with their 95 %
+        bootstrap intervals over worlds (every configuration of a resampled world kept together)."""
+        out = estimation_figures(records)
+        by_world: dict[int, list[Record]] = {}
+        for r in records:
+            by_world.setdefault(int(r["replicate"]), []).append(r)
+        worlds = sorted(by_world)
+        intervals: dict[str, Any] = {}
         for prefix in ("QRRT", "PQRRT"):
-            rows = [r for r in records if r["config"] == f"{prefix} estimated"]
-            databases = sum(r["databases"] for r in rows)
-            searches = sum(r["verification_calls"] for r in rows)
-            if not databases or not searches:
+            if prefix not in out:
                 continue
-            out[prefix] = {"estimation_calls_per_database": round(sum(r["estimation_calls"] for r in rows)
-                                                                  / databases, 2),
-                           "search_calls_per_worker": round((sum(r["quantum_oracle_calls"] - r["estimation_calls"]
-                                                                 for r in rows) + searches) / searches, 3),
-                           "estimation_share_of_calls": round(sum(r["estimation_calls"] for r in rows)
-                                                              / sum(r["oracle_calls"] for r in rows), 4)}
-        single = [r for r in records if r["config"] == "QRRT estimated"]
-        if single:
-            searches = sum(r["verification_calls"] for r in single)
-            estimation = sum(r["estimation_calls"] for r in single) / searches
-            search_cost = (sum(r["quantum_oracle_calls"] - r["estimation_calls"] for r in single) + searches) / searches
-            rate = sum(r["nodes"] for r in single) / searches
-            out["break_even_workers"] = {}
-            for rival in ("adaptive", "bbht", "paper"):
-                rows = [r for r in records if r["config"] == f"QRRT {rival}"]
-                if not rows:
-                    continue
-                per_node = sum(r["oracle_calls"] for r in rows) / sum(r["nodes"] for r in rows)
-                margin = rate * per_node - search_cost
-                out["break_even_workers"][rival] = None if margin <= 0 else round(estimation / margin, 1)
-            out["break_even_note"] = ("p* = E / (r x rival's calls per node - s) from the q-RRT runs (E: estimation "
-                                      "calls per database, s: search calls per worker, r: nodes per worker search); "
-                                      "None: the searches after an estimate cost more per node than the rival's, so "
-                                      "no number of workers pays")
-        return out
+            intervals[prefix] = {}
+            for key in out[prefix]:
+                spans = bootstrap_interval(worlds, partial(_world_figure, by_world, prefix, key), seed)
+                intervals[prefix][key] = rounded_interval(spans, 4)
+        if "break_even_workers" in out:
+            intervals["break_even_workers"] = {}
+            for rival in out["break_even_workers"]:
+                low, high = bootstrap_interval(
+                    worlds, partial(_world_figure, by_world, "break_even_workers", rival), seed)
+                intervals["break_even_workers"][rival] = [None if v >= NEVER else round(v, 1) for v in (low, high)]
+        return out, intervals
 
     def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         """Marginal calls per node in each window with 95 % intervals (policies side by side in each
