@@ -15,7 +15,7 @@
   ``ompl_benchmark_statistics`` reads into the SQLite database Planner Arena shows. The library's
   runs carry ``oracle calls`` and ``critical path oracle calls``; every run carries ``motion checks``
   (the predicate's ``checkMotion`` calls for the library's planners; for OMPL's, the validity
-  checks it made). ``ompl.tools.Benchmark`` itself is not used: OMPL 2.0.1's wheel runs each
+  checks it made). ``ompl.tools.Benchmark`` itself is not used: the wheel of OMPL 2.0.1 runs each
   planner in a worker thread and crashes when that thread calls Python (a Python planner, or a
   Python validity checker beside OMPL's own planners).
 """
