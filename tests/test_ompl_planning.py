@@ -119,3 +119,34 @@ def test_bad_benchmark_arguments_are_refused(tmp_path):
         benchmark_log(gap_setup(), {"RRT": og.RRT}, runs=1, max_time_s=0.0, path=tmp_path / "x.log")
     with pytest.raises(ValueError, match="planners must name at least one"):
         benchmark_log(gap_setup(), {}, runs=1, max_time_s=1.0, path=tmp_path / "x.log")
+
+
+def test_ompls_planners_plan_a_library_problem_on_the_same_checks(clutter):
+    from qrrt_circuits.adapters.ompl_planning import setup_from_problem
+
+    check = qc.ExactCheck(clutter)
+    setup = setup_from_problem(clutter, check)
+    setup.setPlanner(og.RRTConnect(setup.getSpaceInformation()))
+    assert setup.solve(30.0) and setup.haveExactSolutionPath()
+    path = setup.getSolutionPath()
+    points = np.array([[path.getState(i)[axis] for axis in range(2)] for i in range(path.getStateCount())])
+    assert check.reachable(points[:-1], points[1:]).all()  # every edge OMPL kept, re-checked by ours
+    assert setup.getSpaceInformation().getMotionValidator().checks >= len(points) - 1
+
+
+def test_benchmark_logs_of_a_library_problem_count_every_planners_motion_checks(clutter, tmp_path):
+    from qrrt_circuits.adapters.ompl_planning import setup_from_problem
+
+    setup = setup_from_problem(clutter, qc.ExactCheck(clutter))
+
+    def rrt(env, predicate):
+        return qc.RRT(env, predicate=predicate, goal_bias=0.05, seed=0, look_ahead=False)
+
+    rows = benchmark_log(setup, {"RRTConnect (OMPL)": og.RRTConnect,
+                                 "RRT (library)": lambda si: LibraryPlanner(si, rrt, "RRT (library)")},
+                         runs=2, max_time_s=30.0, path=tmp_path / "clutter.log")
+    for name, runs in rows.items():
+        for row in runs:
+            assert row["solved BOOLEAN"] == 1 and row["motion checks INTEGER"] >= 1, name
+    for row in rows["RRT (library)"]:  # without look-ahead, one motion check per oracle call
+        assert row["motion checks INTEGER"] == row["oracle calls INTEGER"]

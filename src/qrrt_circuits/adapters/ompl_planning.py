@@ -13,9 +13,10 @@
 - **Benchmark logs**: ``benchmark_log`` runs OMPL's planners and the library's on one setup, one
   run after another in this thread, and writes OMPL's benchmark log format, which OMPL's
   ``ompl_benchmark_statistics`` reads into the SQLite database Planner Arena shows. The library's
-  runs carry ``oracle calls`` and ``critical path oracle calls``; every run carries ``motion checks``
-  (the predicate's ``checkMotion`` calls for the library's planners; for OMPL's, the validity
-  checks it made). ``ompl.tools.Benchmark`` itself is not used: the wheel of OMPL 2.0.1 runs each
+  runs carry ``oracle calls`` and ``critical path oracle calls``; runs carry ``motion checks`` where
+  they are counted (the library's planners; OMPL's on a ``PredicateMotionValidator``, which
+  ``setup_from_problem`` installs to plan the library's problems on the same checks) and every run
+  ``validity checks``. ``ompl.tools.Benchmark`` itself is not used: the wheel of OMPL 2.0.1 runs each
   planner in a worker thread and crashes when that thread calls Python (a Python planner, or a
   Python validity checker beside OMPL's own planners).
 """
@@ -48,8 +49,8 @@ except ImportError as exc:  # pragma: no cover - the same hint as adapters.ompl
     raise ImportError(f"qrrt_circuits.adapters.ompl_planning needs the OMPL Python bindings; install them with "
                       f"{INSTALL_HINT}") from exc
 
-__all__ = ["LibraryPlanner", "OMPLGoalRegion", "OMPLProblem", "OMPLTermination", "benchmark_log",
-           "problem_from_setup"]
+__all__ = ["LibraryPlanner", "OMPLGoalRegion", "OMPLProblem", "OMPLTermination", "PredicateMotionValidator",
+           "benchmark_log", "problem_from_setup", "setup_from_problem"]
 
 #: a factory of the library's planners for one problem: (environment, predicate) -> planner
 PlannerFactory = Callable[[Environment, ReachabilityPredicate], Planner]
@@ -226,6 +227,73 @@ class LibraryPlanner(ob.Planner):
         self.last_result = None
 
 
+class PredicateMotionValidator(ob.MotionValidator):
+    """A predicate of this library as OMPL's motion validator: ``checkMotion(s1, s2)`` asks
+    ``predicate.reachable`` for the one pair, so OMPL's planners check motions as the library's
+    planners do. ``checks`` counts the pairs asked.
+
+    Args:
+        si: The ``SpaceInformation`` (real-vector states of the predicate's dimension).
+        predicate: Any ``ReachabilityPredicate``.
+    """
+
+    def __init__(self, si: ob.SpaceInformation, predicate: ReachabilityPredicate) -> None:
+        super().__init__(si)
+        self.predicate, self.dim, self.checks = predicate, predicate.dim, 0
+
+    def checkMotion(self, first: Any, second: Any, *last_valid: Any) -> bool:  # noqa: N802 - OMPL's name
+        self.checks += 1
+        return bool(self.predicate.reachable(_coordinates(first, self.dim)[None],
+                                             _coordinates(second, self.dim)[None])[0])
+
+
+def setup_from_problem(env: Environment, predicate: ReachabilityPredicate, goal: np.ndarray | None = None,
+                       goal_radius: float | None = None) -> og.SimpleSetup:
+    """An ``ompl.geometric.SimpleSetup`` for a problem of this library, so that OMPL's planners plan
+    it on the same checks: a ``RealVectorStateSpace`` with ``env``'s bounds, a validity checker
+    (the predicate's ``is_valid`` where it has one, else ``env.is_free``), the predicate as the
+    motion validator (``PredicateMotionValidator``), ``env``'s start and the goal ball as OMPL's
+    goal state with ``goal_radius`` as its threshold.
+
+    Args:
+        env: The environment.
+        predicate: The motion check.
+        goal: The goal's centre (default ``env.goal``).
+        goal_radius: Its radius (default ``env.goal_radius``).
+
+    Returns:
+        The set-up ``SimpleSetup``; ``setup.getSpaceInformation().getMotionValidator().checks``
+        counts the motions OMPL's planners check.
+
+    Raises:
+        ValueError: No start, goal or radius.
+    """
+    goal = env.goal if goal is None else np.asarray(goal, dtype=float)
+    goal_radius = env.goal_radius if goal_radius is None else goal_radius
+    if env.start is None or goal is None or goal_radius is None:
+        raise ValueError("setup_from_problem needs a start, a goal and a goal radius")
+    dim = env.dim
+    space = ob.RealVectorStateSpace(dim)
+    bounds = ob.RealVectorBounds(dim)
+    for axis in range(dim):
+        bounds.setLow(axis, float(env.bounds[axis, 0]))
+        bounds.setHigh(axis, float(env.bounds[axis, 1]))
+    space.setBounds(bounds)
+    setup = og.SimpleSetup(space)
+    is_valid = getattr(predicate, "is_valid", None)
+
+    def valid(state: Any) -> bool:
+        point = _coordinates(state, dim)[None]
+        return bool(is_valid(point)[0]) if is_valid is not None else bool(env.is_free(point[0]))
+
+    setup.setStateValidityChecker(valid)
+    si = setup.getSpaceInformation()
+    si.setMotionValidator(PredicateMotionValidator(si, predicate))
+    setup.setStartAndGoalStates(_state(si, np.asarray(env.start, dtype=float)), _state(si, goal), float(goal_radius))
+    setup.setup()
+    return setup
+
+
 class _CountingValidity:
     """Counts the validity checks an OMPL planner makes through the setup's checker."""
 
@@ -248,8 +316,10 @@ def benchmark_log(setup: og.SimpleSetup, planners: Mapping[str, Callable[[ob.Spa
 
     Each run gets a fresh planner from its allocator (``planners[name](si)``; for the library's,
     a ``LibraryPlanner``) and ``setup.solve(max_time_s)``. Properties per run: ``time``, ``solved``,
-    ``status``, ``solution length``, ``solution segments``, ``motion checks``; the library's
-    planners add ``oracle calls``, ``critical path oracle calls`` and ``nodes``.
+    ``status``, ``solution length``, ``solution segments``, ``validity checks``; ``motion checks``
+    for the library's planners (the predicate's pairs, the simulated oracle's included) and for
+    OMPL's on a ``PredicateMotionValidator`` (``setup_from_problem``); the library's planners add
+    ``oracle calls``, ``critical path oracle calls`` and ``nodes``.
 
     Args:
         setup: The ``SimpleSetup`` (its validity checker is wrapped to count checks for the run).
@@ -279,6 +349,8 @@ def benchmark_log(setup: og.SimpleSetup, planners: Mapping[str, Callable[[ob.Spa
         for _ in range(runs):
             counting = _CountingValidity(checker)
             si.setStateValidityChecker(counting)
+            validator = si.getMotionValidator()
+            checked = getattr(validator, "checks", None)
             planner = allocate(si)
             setup.setPlanner(planner)
             setup.clear()
@@ -290,14 +362,15 @@ def benchmark_log(setup: og.SimpleSetup, planners: Mapping[str, Callable[[ob.Spa
             solution = setup.getSolutionPath() if solved else None
             row["solution length REAL"] = solution.length() if solution is not None else 0.0
             row["solution segments INTEGER"] = solution.getStateCount() - 1 if solution is not None else 0
+            row["validity checks INTEGER"] = counting.calls
             result = getattr(planner, "last_result", None)
             if result is not None:  # a LibraryPlanner: its own counters
                 row["motion checks INTEGER"] = planner.last_checks
                 row["oracle calls INTEGER"] = result.metrics.oracle_calls
                 row["critical path oracle calls INTEGER"] = result.metrics.critical_path_oracle_calls
                 row["nodes INTEGER"] = result.metrics.nodes
-            else:
-                row["motion checks INTEGER"] = counting.calls
+            elif checked is not None:  # OMPL's planner on a PredicateMotionValidator
+                row["motion checks INTEGER"] = validator.checks - checked
             rows.append(row)
         si.setStateValidityChecker(checker)
         results[name] = rows
