@@ -167,6 +167,53 @@ def test_narrow_corridor_channel():
     assert env.start[0] < x0 and env.goal[0] > x1
 
 
+
+@pytest.mark.parametrize(("width", "length"), [(0.4, 4.0), (1.0, 2.0), (2.0, 8.0)])
+def test_narrow_corridor_geometry_sets_the_channel(width, length):
+    env = qc.scenarios.narrow_corridor(seed=0, width=width, length=length, clutter=0)
+    (x0, y0), (x1, y1) = env.metadata["channel"]
+    assert (x1 - x0, y1 - y0) == (pytest.approx(length), pytest.approx(width))
+    assert (x0 + x1) / 2 == pytest.approx(10.0) and (y0 + y1) / 2 == pytest.approx(10.0)
+    # without clutter the free space is the square less the two blocks: 1 - length * (20 - width) / 400
+    free = 1 - length * (20 - width) / 400
+    assert abs(env.free_fraction() - free) <= z_bound() * math.sqrt(free * (1 - free) / 20000)
+    # the wall is closed except across the channel's width, over the channel's whole length
+    ys = np.linspace(0.0, 20.0, 4001)
+    for x in np.linspace(x0 + 1e-6, x1 - 1e-6, 5):
+        free = env.is_free(np.stack([np.full_like(ys, x), ys], axis=1))
+        assert np.all(free == ((ys > y0) & (ys < y1)))
+    outside = np.stack([np.full_like(ys, x0 - 0.2), ys], axis=1)  # beside the wall: open (no clutter)
+    assert env.is_free(outside[1:-1]).all()
+
+
+def test_narrow_corridor_clutter_count_and_defaults():
+    for clutter in (0, 60, 240):
+        env = qc.scenarios.narrow_corridor(seed=3, clutter=clutter)
+        assert env.num_boxes == 2 + clutter and env.metadata["clutter"] == clutter
+    default = qc.scenarios.narrow_corridor(seed=0)  # the corridor experiment's world
+    explicit = qc.scenarios.narrow_corridor(seed=0, width=0.4, length=4.0, clutter=120, mouth_clearance=1.5)
+    assert np.array_equal(default.boxes, explicit.boxes) and np.array_equal(default.start, explicit.start)
+    assert default.metadata["channel"] == [[8.0, 9.8], [12.0, 10.2]]
+
+
+@pytest.mark.parametrize(("options", "error", "match"), [
+    ({"width": 0.0}, ValueError, "width must be in"), ({"width": 10.0}, ValueError, "width must be in"),
+    ({"width": float("nan")}, ValueError, "width"), ({"width": "wide"}, TypeError, "width"),
+    ({"length": -1.0}, ValueError, "length must be in"), ({"length": 12.0}, ValueError, r"length must be in \(0, 12\)"),
+    ({"length": float("inf")}, ValueError, "length"), ({"length": True}, TypeError, "length"),
+    ({"clutter": -1}, ValueError, "clutter"), ({"clutter": 10_001}, ValueError, "clutter"),
+    ({"clutter": 1.5}, TypeError, "clutter"), ({"mouth_clearance": 5.5}, ValueError, "mouth_clearance"),
+])
+def test_narrow_corridor_refuses_bad_geometry(options, error, match):
+    with pytest.raises(error, match=match):
+        qc.scenarios.narrow_corridor(seed=0, **options)
+
+
+def test_narrow_corridor_says_when_clutter_has_no_room():
+    # a channel 9.9 wide with clearance 5 leaves no place for a box off the wall and the mouths
+    with pytest.raises(RuntimeError, match="could not place 1 clutter boxes"):
+        qc.scenarios.narrow_corridor(seed=0, width=9.9, length=11.0, clutter=1, mouth_clearance=5.0)
+
 def test_lattice_start_goal_connected():
     from scipy import ndimage
 

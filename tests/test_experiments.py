@@ -105,6 +105,8 @@ def _check_heatmaps(summary, records):
 def _check_corridor(summary, records):
     for kind, inside in summary["ours"].items():
         assert 0 <= inside <= summary["nodes"][kind]
+        low, high = summary["through_channel_interval_95"][kind]
+        assert low <= summary["through_channel"][kind] <= high
     assert all(r["oracle_calls"] >= summary["settings"]["budget"] for r in records)
 
 
@@ -176,13 +178,45 @@ def _check_heatmap_hypotheses(summary, records):
 
 
 def _check_corridor_sensitivity(summary, records):
-    from qrrt_circuits.experiments.corridor_sensitivity import BASE, cell_id, cells
+    from qrrt_circuits.experiments.corridor_sensitivity import (
+        FACTORS,
+        GAP,
+        PAPER,
+        PAPER_TRIALS,
+        cell_id,
+        cells,
+        single_block_range,
+    )
 
-    assert summary["base"] == cell_id(BASE) and set(summary["ours"]) == {cell_id(c) for c in
-                                                                         cells(summary["settings"]["factors"])}
+    settings = summary["settings"]
+    assert len(cells(FACTORS, "QRRT")) == 243 and len(cells(FACTORS, "RRT")) == 81  # the full design
+    for kind in ("RRT", "QRRT"):
+        keys = {cell_id(c, kind) for c in cells(settings["factors"], kind)}
+        assert set(summary["ours"][kind]) == set(summary["interval_95"][kind]) == keys
+        for key in keys:  # the per-50 mean of the cell's runs, inside its interval
+            counts = [n for r in records if r["planner"] == kind and cell_id(r, kind) == key
+                      for n in json.loads(r["in_channel_json"])]
+            assert len(counts) == settings["blocks"] * settings["block_size"]
+            assert summary["ours"][kind][key] == pytest.approx(PAPER_TRIALS * np.mean(counts), abs=0.01)
+            low, high = summary["interval_95"][kind][key]
+            assert low - 0.01 <= summary["ours"][kind][key] <= high + 0.01
+            assert summary["differs_from_paper"][kind][key] == (not low <= PAPER[kind] <= high)
+    for q in summary["paper_pair_inside"]:
+        assert not summary["differs_from_paper"]["QRRT"][q]
+    assert summary["intervals_wider_than_gap"] == [
+        f"{kind}/{key}" for kind in ("RRT", "QRRT") for key, (low, high) in summary["interval_95"][kind].items()
+        if high - low >= GAP]
+    assert summary["closest_to_paper"]["cell"] in summary["ours"]["QRRT"]
     for r in records:
-        assert 0 <= r["in_channel"] <= r["nodes"] and r["start_distance"] >= r["distance"]
-        assert r["oracle_calls"] >= summary["settings"]["budget"]
+        inside = json.loads(r["in_channel_json"])
+        assert len(inside) == settings["block_size"] and sum(inside) == r["in_channel"] <= r["nodes"]
+        assert r["start_distance"] >= r["distance"] and (r["iterations"] == "none") == (r["planner"] == "RRT")
+        # each run cut at the budget (a round overshoots it by less than its cost) or at the goal
+        assert 0 < r["oracle_calls"] < settings["block_size"] * (settings["budget"] + 10)
+    # one block's range: a constant count gives a point; counts of 0 or 1 give a binomial's range
+    assert single_block_range(np.full(20, 2), 50, 0) == (100.0, 100.0)
+    low, high = single_block_range(np.array([0, 1] * 200), 50, 0)
+    assert 25 - 2.2 * 3.54 <= low < 25 < high <= 25 + 2.2 * 3.54  # Binomial(50, 1/2): sd 3.54
 
 
 def _check_search_policies(summary, records):

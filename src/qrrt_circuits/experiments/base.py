@@ -46,7 +46,8 @@ class TrialStream(IntEnum):
     TREE_SIZE_WORLDS = 11
     TREE_SIZE_PLANNERS = 12
     HEATMAP_HYPOTHESES = 13
-    CORRIDOR_SENSITIVITY = 14
+    # corridor-sensitivity: the runs of its factorial design (a block of runs is one trial)
+    CORRIDOR_SENSITIVITY = 17
     # noise and resources: numbered from 31, apart from the streams above
     NOISE_SWEEP = 31
     NOISE_WORLDS = 32

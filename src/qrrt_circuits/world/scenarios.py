@@ -8,7 +8,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .._support.validation import check_int, check_seed
+from .._support.validation import check_float, check_int, check_seed
 from .environment import Environment
 
 #: the side of the paper's square cluttered workspace
@@ -19,6 +19,10 @@ CLUTTER_BOXES = 525
 SIDE_RANGE = (0.25, 0.85)
 #: the goal ball's radius in the paper's worlds
 GOAL_RADIUS = 0.75
+#: the most clutter boxes ``narrow_corridor`` accepts
+MAX_CORRIDOR_CLUTTER = 10_000
+#: random draws per box ``narrow_corridor`` tries before it gives up placing its clutter
+PLACEMENT_TRIES = 1_000
 
 
 def _random_boxes(rng: np.random.Generator, count: int, low: np.ndarray, high: np.ndarray,
@@ -102,16 +106,20 @@ def narrow_corridor(seed: int | None = 0, width: float = 0.4, length: float = 4.
                     clutter: int = 120, mouth_clearance: float = 1.5) -> Environment:
     """[0, 20]^2 split by two blocks leaving one horizontal channel through the middle (paper §V.C).
 
-    The channel is ``width`` wide and ``length`` long; ``clutter`` small random boxes lie on both
-    sides, off the wall's columns and kept ``mouth_clearance`` away from the channel's mouths.
-    Start in front of the left mouth (0.5 to 1.5 before it, on its axis), goal on the right;
-    goal radius 0.75. The channel's corners are in ``metadata["channel"]``.
+    The channel is ``width`` wide and ``length`` long, centred in the square: the blocks fill
+    x in [10 - length/2, 10 + length/2] except y in (10 - width/2, 10 + width/2), so the channel
+    covers ``width * length / 400`` of the workspace (0.4 % by default). ``clutter`` small random
+    boxes (sides U(0.25, 0.85)) lie on both sides, 0.3 off the wall's columns and kept
+    ``mouth_clearance`` away from the channel's mouths. Start in front of the left mouth (0.5 to
+    1.5 before it, on its axis), goal on the right; goal radius 0.75. The channel's corners are in
+    ``metadata["channel"]``. The defaults are the world of the ``corridor`` experiment; other
+    values draw from the same stream (same seed, same draws until the geometry differs).
 
     Args:
         seed: Non-negative integer (same seed, same world) or None (fresh entropy).
         width: Channel width, in (0, 10).
-        length: Channel length, in (0, 18).
-        clutter: Small boxes beside the wall.
+        length: Channel length, in (0, 12) (the goal lies at least 3 beyond the right mouth).
+        clutter: Small boxes beside the wall, an integer in [0, 10000].
         mouth_clearance: Box-free margin around the mouths, in [0, 5] (smaller: denser clutter
             beside the mouth).
 
@@ -119,15 +127,21 @@ def narrow_corridor(seed: int | None = 0, width: float = 0.4, length: float = 4.
         The ``Environment`` with ``start``, ``goal``, ``goal_radius`` and metadata set.
 
     Raises:
-        ValueError: A negative ``seed``, or ``width``, ``length`` or ``mouth_clearance`` out of
-            range.
-        TypeError: A non-integer ``seed``.
+        ValueError: A negative ``seed``, or ``width``, ``length``, ``clutter`` or
+            ``mouth_clearance`` out of range.
+        TypeError: A non-integer ``seed`` or ``clutter``, or a non-real ``width``, ``length`` or
+            ``mouth_clearance``.
+        RuntimeError: The clutter, start or goal could not be placed (a geometry leaving no room
+            for them).
     """
     _check_seed(seed)
+    width, length = check_float(width, "width"), check_float(length, "length")
+    mouth_clearance = check_float(mouth_clearance, "mouth_clearance")
     if not (0 < width < 10):
         raise ValueError(f"width must be in (0, 10), got {width}")
-    if not (0 < length < 18):
-        raise ValueError(f"length must be in (0, 18), got {length}")
+    if not (0 < length < 12):
+        raise ValueError(f"length must be in (0, 12), got {length}")
+    clutter = check_int(clutter, "clutter", 0, MAX_CORRIDOR_CLUTTER)
     if not (0 <= mouth_clearance <= 5):
         raise ValueError(f"mouth_clearance must be in [0, 5], got {mouth_clearance}")
     rng = _world_rng("narrow_corridor", seed)
@@ -137,7 +151,9 @@ def narrow_corridor(seed: int | None = 0, width: float = 0.4, length: float = 4.
     blocks = np.array([[[x0, 0.0], [x1, y0]], [[x0, y1], [x1, size]]])
     keep_out = 1.5  # free margin around the channel mouths
     small: list[np.ndarray] = []
-    while len(small) < clutter:
+    for _ in range(PLACEMENT_TRIES * (clutter + 1)):
+        if len(small) == clutter:
+            break
         box = _random_boxes(rng, 1, np.zeros(2), np.full(2, size))[0]
         if box[1, 0] > x0 - 0.3 and box[0, 0] < x1 + 0.3:
             continue  # overlaps the wall's columns: keep the wall's faces clean
@@ -146,6 +162,9 @@ def narrow_corridor(seed: int | None = 0, width: float = 0.4, length: float = 4.
         if near_mouth_y and near_mouth_x:
             continue
         small.append(box)
+    if len(small) < clutter:
+        raise RuntimeError(f"could not place {clutter} clutter boxes beside a channel {width} wide and {length} "
+                           f"long with mouth_clearance {mouth_clearance} (placed {len(small)})")
     boxes = np.concatenate([blocks, np.array(small).reshape(-1, 2, 2)])
     env = Environment(np.array([[0.0, size], [0.0, size]]), boxes, name="narrow_corridor")
     for _ in range(10000):
@@ -155,6 +174,8 @@ def narrow_corridor(seed: int | None = 0, width: float = 0.4, length: float = 4.
         if env.is_free(start) and env.is_free(goal) and _clearance_ok(env, goal, GOAL_RADIUS) \
                 and _clearance_ok(env, start, GOAL_RADIUS):
             break
+    else:
+        raise RuntimeError(f"could not place start and goal beside a channel {width} wide and {length} long")
     return Environment(env.bounds, boxes, name="narrow_corridor", start=start, goal=goal,
                        goal_radius=GOAL_RADIUS,
                        metadata={"seed": seed, "channel": [[x0, y0], [x1, y1]],
