@@ -11,7 +11,8 @@ from qrrt_circuits.experiments.fitting import linear_fit, power_law_exponent, sl
 TINY = {"oracle-efficiency": 1, "wallclock": 1, "heatmaps": 2, "corridor": 2, "annealing": 1,
         "lemmas": 60, "scaling": 1, "oracle-check": 1,
         "tree-size": 1, "heatmap-hypotheses": 3,
-        "corridor-sensitivity": 2, "search-policies": 1, "noise": 1, "resources": 1}
+        "corridor-sensitivity": 2, "search-policies": 1, "noise": 1, "resources": 1,
+        "heatmap-worlds": 5}
 
 
 def _is_png(path):
@@ -100,6 +101,29 @@ def _check_heatmaps(summary, records):
             # a run is cut after the first round that reaches the budget (or it reached the goal)
             assert all(r[f"calls_at_{cut}"] >= int(cut) or r["status"] == "reached" for r in rows)
         assert [by_cut[c]["nodes"] for c in cuts] == sorted(by_cut[c]["nodes"] for c in cuts)
+    pq = [r for r in records if r["planner"] == "PQRRT"]
+    for cut in cuts:  # Pq-RRT cut on total calls: the same runs, read earlier than on the critical path
+        total = summary["pqrrt_on_total_calls"][cut]
+        assert total["nodes"] == sum(r[f"nodes_at_{cut}_total"] for r in pq) <= summary["ours"]["PQRRT"][cut]["nodes"]
+        assert all(r[f"calls_at_{cut}_total"] >= int(cut) or r["status"] == "reached" for r in pq)
+        low, high = total["interval_95"]["efficiency"]
+        assert low <= total["efficiency"] <= high
+    for r in records:
+        if r["planner"] != "PQRRT":
+            assert all(r[f"nodes_at_{c}_total"] == r[f"nodes_at_{c}"] for c in cuts)
+
+
+def _check_heatmap_worlds(summary, records):
+    assert summary["round_costs"]["fitting"] == [3]  # the paper's totals fit only a 3-call round
+    worlds = summary["per_world"]
+    assert len(worlds) == summary["worlds_run"] == len(records) // 2
+    for key, entry in worlds.items():  # the rule, re-applied to the stored intervals
+        inside = all(entry["RRT"][c]["efficiency_interval_95"][0] <= summary["paper"]["RRT"][c]["efficiency"]
+                     <= entry["RRT"][c]["efficiency_interval_95"][1] for c in ("10", "20", "40"))
+        assert entry["passes"] == inside and (key in summary["passing_worlds"]) == inside
+    for label, by_planner in summary["efficiency_at_10_quantiles_over_worlds"].items():
+        for low, middle, high in by_planner.values():
+            assert low <= middle <= high, label
 
 
 def _check_corridor(summary, records):
@@ -274,7 +298,7 @@ CHECKS = {"oracle-efficiency": _check_oracle_efficiency, "wallclock": _check_wal
           "lemmas": _check_lemmas, "scaling": _check_scaling, "oracle-check": _check_oracle_check,
           "tree-size": _check_tree_size, "heatmap-hypotheses": _check_heatmap_hypotheses,
           "corridor-sensitivity": _check_corridor_sensitivity, "search-policies": _check_search_policies,
-          "noise": _check_noise, "resources": _check_resources}
+          "noise": _check_noise, "resources": _check_resources, "heatmap-worlds": _check_heatmap_worlds}
 
 
 def _comparable(records):

@@ -46,6 +46,7 @@ class TrialStream(IntEnum):
     TREE_SIZE_WORLDS = 11
     TREE_SIZE_PLANNERS = 12
     HEATMAP_HYPOTHESES = 13
+    HEATMAP_WORLDS = 15
     # corridor-sensitivity: the runs of its factorial design (a block of runs is one trial)
     CORRIDOR_SENSITIVITY = 17
     # noise and resources: numbered from 31, apart from the streams above

@@ -4,6 +4,7 @@ from .annealing import Annealing
 from .corridor import Corridor
 from .corridor_sensitivity import CorridorSensitivity
 from .heatmap_hypotheses import HeatmapHypotheses
+from .heatmap_worlds import HeatmapWorlds
 from .heatmaps import Heatmaps
 from .lemmas import Lemmas
 from .noise import Noise
@@ -18,7 +19,7 @@ from .wallclock import Wallclock
 EXPERIMENTS = {
     experiment.name: experiment
     for experiment in (OracleEfficiency(), Wallclock(), Heatmaps(), Corridor(), Annealing(), Lemmas(),
-                       Scaling(), OracleCheck(), TreeSize(), HeatmapHypotheses(),
+                       Scaling(), OracleCheck(), TreeSize(), HeatmapHypotheses(), HeatmapWorlds(),
                        CorridorSensitivity(), SearchPolicies(), Noise(), Resources())
 }
 

@@ -74,7 +74,7 @@ _NAMED: dict[str, ColumnKind] = {
 
 #: measurement columns by pattern (families whose names carry a setting)
 _PATTERNS: tuple[tuple[re.Pattern[str], ColumnKind], ...] = (
-    (re.compile(r"(nodes|calls)_at_\d+"), ColumnKind.NUMBER),  # a growth curve cut at a call budget
+    (re.compile(r"(nodes|calls)_at_\d+(_total)?"), ColumnKind.NUMBER),  # a growth curve cut at a call budget
     (re.compile(r"lemma\d+_(observed|theory|stderr)"), ColumnKind.NUMBER),
     (re.compile(r"mean_parent_distance_\d+"), ColumnKind.NUMBER),
     (re.compile(r"[a-z_]+_json"), ColumnKind.JSON),
