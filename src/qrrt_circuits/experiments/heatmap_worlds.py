@@ -38,6 +38,8 @@ from .planners import planner_for
 from .worlds import world
 
 BOX_COUNTS = (100, 150, 200, 250, 300, 400, 525)
+#: the most world seeds per obstacle count (a world's planner seeds are keyed by count and seed)
+WORLDS_PER_COUNT = 1000
 CUTS = (10, 20, 40)
 #: label -> (registry planner, search policy)
 VARIANTS = {"RRT": ("rrt", None), "QRRT": ("qrrt", FixedIterations(2))}
@@ -99,18 +101,18 @@ class HeatmapWorlds(Experiment):
     paper = PAPER
 
     def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
-        return {"runs": trials or (20 if quick else 100), "worlds": 2 if quick else 20, "cuts": list(CUTS),
+        return {"runs": trials or (20 if quick else 100), "worlds": 2 if quick else 40, "cuts": list(CUTS),
                 "box_counts": [150, 525] if quick else list(BOX_COUNTS), "num_qubits": 8,
                 "backend": "statevector", "scenario": "paper_clutter", "variants": list(VARIANTS),
                 "acceptance_rule": ACCEPTANCE_RULE, "seed": seed, "quick": quick}
 
     def trials(self, settings: Settings) -> list[Trial]:
-        blocks = [(variant, boxes, w) for boxes in settings["box_counts"] for w in range(settings["worlds"])
-                  for variant in settings["variants"]]
+        # one seed per world (obstacle count, world seed), shared by the variants; independent of the
+        # grid's other worlds (at most WORLDS_PER_COUNT world seeds per count)
         return [Trial(f"{variant}-{boxes}-{w}", {"variant": variant, "boxes": boxes, "world_seed": w},
-                      replicate_seed(settings["seed"], index // len(settings["variants"]),
-                                     TrialStream.HEATMAP_WORLDS))
-                for index, (variant, boxes, w) in enumerate(blocks)]
+                      replicate_seed(settings["seed"], boxes * WORLDS_PER_COUNT + w, TrialStream.HEATMAP_WORLDS))
+                for boxes in settings["box_counts"] for w in range(settings["worlds"])
+                for variant in settings["variants"]]
 
     def run_trial(self, trial: Trial, settings: Settings) -> Record:
         env = world(settings["scenario"], trial.params["world_seed"], num_boxes=trial.params["boxes"])
