@@ -41,6 +41,9 @@ class Row:
     explained: str
     paper_path: tuple[str, ...] | None = None
     percent: bool = False
+    #: the numbers ``explained`` quotes, read from the summaries: name -> (experiment, path); a
+    #: list is shown as its length, a pair of numbers as an interval
+    facts: tuple[tuple[str, str, tuple[str, ...]], ...] = ()
 
 
 #: "explained?" for a quantity whose summary resamples the paper's own estimator (``paper_design``)
@@ -51,13 +54,28 @@ ROWS = (
     Row("Fig. 9", "parallel RRT (8 workers)", "oracle-efficiency", ("ParallelRRT",), DESIGN),
     Row("Fig. 9", "q-RRT", "oracle-efficiency", ("QRRT",), DESIGN),
     Row("Fig. 9", "Pq-RRT (8 workers, shared)", "oracle-efficiency", ("PQRRT",), DESIGN),
-    Row("Figs. 10-12", "RRT efficiency at 40 calls", "heatmaps", ("RRT", "40", "efficiency"),
-        "open (two hypotheses tested)", percent=True),
-    Row("Figs. 10-12", "q-RRT efficiency at 40 calls", "heatmaps", ("QRRT", "40", "efficiency"),
-        "open (two hypotheses tested)", percent=True),
+    Row("Figs. 6-8", "q-RRT / Pq-RRT seconds per oracle call (Aer)", "wallclock",
+        ("per_call_ratio_qrrt_over_pqrrt", "aer"),
+        "open: ours is 8 workers sharing one search at {round}x q-RRT's cost a round; the paper's {paper}x a "
+        "round is not measured", paper_path=("per_call_ratio_qrrt_over_pqrrt",),
+        facts=(("round", "wallclock", ("ours", "per_critical_path_call_ratio_qrrt_over_pqrrt", "aer")),
+               ("paper", "wallclock", ("paper", "per_critical_path_call_ratio_qrrt_over_pqrrt")))),
+    Row("Figs. 10-12", "RRT efficiency at 40 calls, `paper_clutter`", "heatmaps", ("RRT", "40", "efficiency"),
+        "explained: the paper's RRT fits only sparser worlds ({passing} of {worlds} single worlds pass)",
+        percent=True, facts=(("passing", "heatmap-worlds", ("passing_worlds",)),
+                             ("worlds", "heatmap-worlds", ("worlds_run",)))),
+    Row("Figs. 10-12", "q-RRT nodes at 40 calls, single worlds with the paper's RRT", "heatmap-worlds",
+        ("QRRT", "40", "nodes"),
+        "open: with the 3-call round the paper's totals imply, {ours20} {span20} against {paper20} nodes at "
+        "20 calls", facts=(("ours20", "heatmap-worlds", ("ours", "QRRT", "20", "nodes")),
+                            ("span20", "heatmap-worlds", ("interval_95", "QRRT", "20", "nodes")),
+                            ("paper20", "heatmap-worlds", ("paper", "QRRT", "20", "nodes")))),
     Row("Figs. 13-14", "q-RRT nodes in the corridor (50 trials)", "corridor", ("QRRT",),
-        "open (sensitivity study)"),
-    Row("Figs. 13-14", "RRT nodes in the corridor (50 trials)", "corridor", ("RRT",), "open (sensitivity study)"),
+        "open in our corridor; inside ours in a 1 x 8 corridor with 1-2 iterations, never with the paper's"),
+    Row("Figs. 13-14", "RRT nodes in the corridor (50 trials)", "corridor", ("RRT",),
+        "open in our corridor; {rrt} {span} in that 1 x 8 corridor",
+        facts=(("rrt", "corridor-sensitivity", ("ours", "RRT", "w1.0-l8.0-c120-d3.0")),
+               ("span", "corridor-sensitivity", ("interval_95", "RRT", "w1.0-l8.0-c120-d3.0")))),
     Row("Figs. 15-17", "QDA mean parent distance, 16 nodes", "annealing", ("QDA", "16"),
         "open; the 2x spread is reproduced", paper_path=("QDA",)),
 )
@@ -88,7 +106,7 @@ def _explained(row: Row, summary: dict[str, Any]) -> str:
     """The row's "explained?" text; for ``DESIGN``, whether the paper's number is plausible for one
     replicate of the paper's own estimator, with that estimator's 95 % range."""
     if row.explained != DESIGN:
-        return row.explained
+        return row.explained.format(**{name: _fact(experiment, path) for name, experiment, path in row.facts})
     design = summary["paper_design"]
     low, high = _at(design["range_95"], row.path)
     verdict = "explained" if _at(design["paper_plausible"], row.path) else "open"
@@ -105,6 +123,20 @@ def _authors_code(row: Row, summary: dict[str, Any]) -> str:
     ours_low, ours_high = _at(code["ours_pooled_range_95"], row.path)
     return (f"{_number(_at(code['reported_pooled'], row.path), False)} (trees {_number(low, False)}-"
             f"{_number(high, False)}); ours so: [{_number(ours_low, False)}, {_number(ours_high, False)}]")
+
+
+def _fact(experiment: str, path: tuple[str, ...], results: Path = RESULTS) -> str:
+    """A number an "explained" text quotes: ``path`` in the experiment's summary (a list as its
+    length, a [low, high] pair as an interval)."""
+    summary = _summary(results / experiment)
+    if summary is None:
+        raise FileNotFoundError(f"{results / experiment / 'summary.json'} is missing")
+    value = _at(summary, path)
+    if isinstance(value, list) and len(value) == 2 and all(isinstance(v, int | float) for v in value):
+        return f"[{_number(value[0], False)}, {_number(value[1], False)}]"
+    if isinstance(value, list):
+        return str(len(value))
+    return _number(value, False)
 
 
 def _summary(folder: Path) -> dict[str, Any] | None:
