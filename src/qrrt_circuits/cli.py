@@ -34,6 +34,7 @@ if TYPE_CHECKING:
     from .registry import Registry
     from .search.backend import QuantumSearchBackend, SearchResult
     from .world.environment import Environment
+    from .world.problems import Problem
 
 
 def _positive_int(text: str) -> int:
@@ -167,6 +168,22 @@ def _load_environment(args: argparse.Namespace) -> Environment:
     return SCENARIOS.create(args.scenario, seed=args.scenario_seed)
 
 
+def _load_problem(args: argparse.Namespace) -> Problem | None:
+    """The ``--problem`` file's problem, or None; refused beside the options it replaces."""
+    if args.problem is None:
+        return None
+    given = [option for option, given in (("--scenario-file", args.scenario_file is not None),
+                                          ("--scenario", args.scenario != "paper_clutter"),
+                                          ("--predicate", args.predicate != "exact")) if given]
+    if given:
+        raise ValueError(f"--problem fixes the world and the motion check: leave out {', '.join(given)}")
+    if Path(args.problem).is_dir():
+        raise ValueError(f"--problem: {args.problem!r} is a folder, not a problem file")
+    from .world.problems import load_problem
+
+    return load_problem(args.problem)
+
+
 #: ``qrrt plan``'s options that only some planners take: option -> (the planner's keyword, the
 #: default used where the planner takes it and the option is not given)
 PLANNER_SPECIFIC_OPTIONS: dict[str, tuple[str, Any]] = {
@@ -198,15 +215,17 @@ def _planner_specific(args: argparse.Namespace) -> dict[str, Any]:
     return chosen
 
 
-def build_planner(args: argparse.Namespace, env: Environment, name: str | None = None) -> Planner:
+def build_planner(args: argparse.Namespace, env: Environment, name: str | None = None,
+                  problem: Problem | None = None) -> Planner:
     """The planner the arguments name (or planner ``name`` with the same options, as far as it
     takes them), with only the options that apply to it; a planner-specific option given to a
     planner that does not take it (``--qubits`` with ``rrt``) is refused."""
     from .registry import BACKENDS, PLANNERS, POLICIES, PREDICATES
 
     specific = _planner_specific(args)
-    options: dict[str, Any] = {"goal_bias": args.goal_bias, "max_extension": args.max_extension, "seed": args.seed,
-                               "predicate": PREDICATES.create(args.predicate, env=env)}
+    options: dict[str, Any] = {"goal_bias": args.goal_bias, "max_extension": args.max_extension, "seed": args.seed}
+    options |= problem.planner_options() if problem is not None else {
+        "predicate": PREDICATES.create(args.predicate, env=env)}
     made: dict[str, Callable[[Any], Any]] = {"backend": lambda name: BACKENDS.create(name, seed=args.seed),
                                              "policy": POLICIES.create}
     for option, value in specific.items():  # each under the planner's keyword, backends and policies made
@@ -327,18 +346,20 @@ def cmd_plan(args: argparse.Namespace) -> int:
     check_output_file(args.plot, "--plot", PLOT_FORMATS)
     if args.json and args.plot and same_file(args.json, args.plot):
         raise ValueError(f"--json and --plot name the same file {args.plot!r} (the plot would overwrite the JSON)")
-    env = _load_environment(args)
-    planner = build_planner(args, env)
+    problem = _load_problem(args)
+    env = _load_environment(args) if problem is None else problem.env
+    planner = build_planner(args, env, problem=problem)
     # (the plan makes its one memory check before it allocates anything, and words a MemoryError as
     # one OutOfMemory line; --json adds no memory per node: PlanResult.write_json streams the arrays
     # chunk by chunk; the outputs are written only once the plan has finished)
     limits = {"max_nodes": args.max_nodes, "max_oracle_calls": args.max_oracle_calls, "max_rounds": args.max_rounds,
               "max_critical_path_calls": args.max_critical_path_calls, "stall_rounds": args.stall_rounds}
-    result = planner.plan(**limits)
+    goal = None if problem is None else problem.goal
+    result = planner.plan(goal=goal, **limits)
     _print_plan(result, env, args.seed)
     peer = CLASSICAL_PEERS.get(PLANNERS.canonical(args.planner))
     if peer is not None and not args.no_compare:
-        _print_comparison(result, build_planner(args, env, peer).plan(**limits))
+        _print_comparison(result, build_planner(args, env, peer, problem).plan(goal=goal, **limits))
     _write_plan_outputs(args, result, env)
     return 0
 
@@ -423,6 +444,9 @@ def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
     plan.add_argument("--scenario", type=_registered(SCENARIOS), choices=SCENARIOS.names(),
                       default="paper_clutter", help=SCENARIOS.help_text())
     plan.add_argument("--scenario-file", default=None, help="an environment JSON file instead")
+    plan.add_argument("--problem", default=None,
+                      help="a problem JSON file instead (qrrt-problem: open-space, narrow-passage, se2-gap or "
+                           "boxes); it fixes the world, the motion check, the state space and the goal")
     plan.add_argument("--scenario-seed", type=_nonnegative_int, default=0,
                       help="seed of the scenario's random world")
     plan.add_argument("--planner", type=_registered(PLANNERS), choices=PLANNERS.names(), default="pqrrt",

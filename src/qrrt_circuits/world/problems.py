@@ -1,0 +1,215 @@
+"""Planning problems beyond the paper's box worlds, in OMPL's terms: an environment (bounds and
+start), a motion check, a state space and a goal; built by family or read from a JSON file.
+
+Families (each a function returning a ``Problem``):
+
+- ``open_space()``: [0, 10]^2 with one box in the middle; straight-line motions.
+- ``narrow_passage(dim, width)``: [0, 10]^d cut by a wall 1 thick at x_0 = 5 with one square hole
+  of side ``width`` at its centre; straight-line motions; d = 2 .. 6.
+- ``se2_gap(width)``: a 1.2 x 0.4 rectangle in SE(2) through a gap of ``width`` in a wall
+  (``reachability.rigid_body``).
+- ``box_world(path)``: a ``qrrt-environment`` scenario file (the paper's motion model).
+
+Straight-line motions are the exact check (``ExactCheck``) under the closed loop -4 I over 5 s,
+x(t) = c + exp(-4 t) (p - c): the segment from p toward c, stopping exp(-20) (about 2e-9) of the
+way short of c.
+
+``load_problem(path)`` reads ``{"format": "qrrt-problem", "version": 1, "family": NAME, ...}`` with
+the family's arguments, refusing a bad field by name before anything is built.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .._support.validation import check_float, check_int
+from ..planners.goals import Goal, GoalBall
+from ..reachability.dynamics import LinearTrackingDynamics
+from ..reachability.exact import ExactCheck
+from ..reachability.predicate import ReachabilityPredicate
+from ..reachability.rigid_body import se2_world
+from .environment import Environment
+from .spaces import RealVectorSpace, SE2Space, StateSpace
+
+__all__ = ["FAMILIES", "Problem", "box_world", "load_problem", "narrow_passage", "open_space", "se2_gap",
+           "straight_line_dynamics"]
+
+PROBLEM_FORMAT, PROBLEM_VERSION = "qrrt-problem", 1
+
+
+@dataclass(frozen=True, eq=False)
+class Problem:
+    """A planning problem: plan it with ``Planner(problem.env, **problem.planner_options())`` and
+    ``planner.plan(goal=problem.goal, ...)``.
+
+    Attributes:
+        name: The problem's name.
+        env: Bounds and start (and the boxes the default check sees, for box worlds).
+        predicate: The motion check.
+        space: The state space.
+        goal: The goal.
+    """
+
+    name: str
+    env: Environment
+    predicate: ReachabilityPredicate
+    space: StateSpace
+    goal: Goal
+
+    def planner_options(self) -> dict[str, Any]:
+        """The planner keywords this problem fixes: ``predicate`` and ``space``."""
+        return {"predicate": self.predicate, "space": self.space}
+
+
+def straight_line_dynamics(dim: int) -> LinearTrackingDynamics:
+    """Closed loop -4 I in d dimensions over 5 s: straight segments (see the module docstring).
+
+    Args:
+        dim: d >= 1.
+
+    Returns:
+        ``LinearTrackingDynamics(0, I, 4 I)``.
+    """
+    dim = check_int(dim, "dim", 1)
+    return LinearTrackingDynamics(np.zeros((dim, dim)), np.eye(dim), 4.0 * np.eye(dim))
+
+
+def _box_problem(name: str, bounds: np.ndarray, boxes: np.ndarray, start: np.ndarray, goal: np.ndarray,
+                 goal_radius: float) -> Problem:
+    env = Environment(bounds, boxes, start=start, goal=goal, goal_radius=goal_radius, name=name)
+    check = ExactCheck(env, straight_line_dynamics(env.dim))
+    return Problem(name, env, check, RealVectorSpace(env.dim), GoalBall(goal, goal_radius))
+
+
+def open_space() -> Problem:
+    """[0, 10]^2, one box [4, 6]^2, start (1, 1), goal ball (9, 9) of radius 0.5."""
+    return _box_problem("open-space", np.array([[0.0, 10.0], [0.0, 10.0]]), np.array([[[4.0, 4.0], [6.0, 6.0]]]),
+                        np.array([1.0, 1.0]), np.array([9.0, 9.0]), 0.5)
+
+
+def narrow_passage(dim: int = 2, width: float = 0.5) -> Problem:
+    """[0, 10]^d cut by the wall 4.5 <= x_0 <= 5.5 with a hole |x_i - 5| < width / 2 (i >= 1);
+    start (1, 5, ..., 5), goal ball (9, 5, ..., 5) of radius 0.5.
+
+    Args:
+        dim: d in [2, 6].
+        width: The hole's side, in (0, 8].
+
+    Returns:
+        The problem.
+
+    Raises:
+        TypeError: A non-integer ``dim`` or non-real ``width``.
+        ValueError: ``dim`` outside [2, 6] or ``width`` outside (0, 8].
+    """
+    dim = check_int(dim, "dim", 2, 6)
+    width = check_float(width, "width", 0.0, 8.0, open_minimum=True)
+    boxes = []
+    for axis in range(1, dim):  # the wall minus the hole: below and above the hole on each other axis
+        for low, high in ((0.0, 5.0 - width / 2), (5.0 + width / 2, 10.0)):
+            lower, upper = np.zeros(dim), np.full(dim, 10.0)
+            lower[0], upper[0] = 4.5, 5.5
+            lower[axis], upper[axis] = low, high
+            boxes.append([lower, upper])
+    centre = np.full(dim, 5.0)
+    start, goal = centre.copy(), centre.copy()
+    start[0], goal[0] = 1.0, 9.0
+    return _box_problem(f"narrow-passage-{dim}d", np.tile([0.0, 10.0], (dim, 1)), np.array(boxes), start, goal, 0.5)
+
+
+def se2_gap(width: float = 1.2) -> Problem:
+    """A 1.2 x 0.4 rectangle (half-lengths 0.6, 0.2) in SE(2) through a gap of ``width`` (centred
+    at y = 5) in the wall 4.8 <= x <= 5.2 of [0, 10]^2; start (2, 2, pi / 2), goal ball (8, 8, 0)
+    of radius 1 (Euclidean in (x, y, theta)).
+
+    Args:
+        width: The gap, in (0, 8].
+
+    Returns:
+        The problem (``space`` is ``SE2Space()``).
+
+    Raises:
+        TypeError: A non-real ``width``.
+        ValueError: ``width`` outside (0, 8].
+    """
+    width = check_float(width, "width", 0.0, 8.0, open_minimum=True)
+    wall = np.array([[[4.8, 0.0], [5.2, 5.0 - width / 2]], [[4.8, 5.0 + width / 2], [5.2, 10.0]]])
+    goal = np.array([8.0, 8.0, 0.0])
+    env, check = se2_world(np.array([[0.0, 10.0], [0.0, 10.0]]), wall, (0.6, 0.2),
+                           start=np.array([2.0, 2.0, math.pi / 2]), goal=goal, goal_radius=1.0, resolution=0.05,
+                           name="se2-gap")
+    return Problem("se2-gap", env, check, SE2Space(), GoalBall(goal, 1.0))
+
+
+def box_world(path: str | Path) -> Problem:
+    """A ``qrrt-environment`` scenario file with the library's default motion model (the paper's
+    dynamics, ``ExactCheck``).
+
+    Args:
+        path: The scenario file.
+
+    Returns:
+        The problem.
+    """
+    env = Environment.load(path)
+    if env.start is None or env.goal is None or env.goal_radius is None:
+        raise ValueError(f"{path}: a problem's scenario needs start, goal and goal_radius")
+    return Problem(env.name, env, ExactCheck(env), RealVectorSpace(env.dim), GoalBall(env.goal, env.goal_radius))
+
+
+#: family name -> (builder, its JSON arguments and their defaults)
+FAMILIES: dict[str, tuple[Any, dict[str, Any]]] = {
+    "open-space": (open_space, {}),
+    "narrow-passage": (narrow_passage, {"dim": 2, "width": 0.5}),
+    "se2-gap": (se2_gap, {"width": 1.2}),
+}
+
+
+def load_problem(path: str | Path) -> Problem:
+    """Read a problem file: ``{"format": "qrrt-problem", "version": 1, "family": NAME, ARGS...}``
+    for a family of ``FAMILIES``, or ``{"format": "qrrt-problem", "version": 1, "family": "boxes",
+    "scenario": FILE}`` for a scenario file (relative to the problem file).
+
+    Args:
+        path: The file.
+
+    Returns:
+        The problem.
+
+    Raises:
+        ValueError: A missing, unreadable or malformed file, naming the field and what is accepted.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"--problem: no such file {str(path)!r}")
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise ValueError(f"{path}: not a JSON problem file ({exc})") from exc
+    if not isinstance(data, dict) or data.get("format") != PROBLEM_FORMAT:
+        raise ValueError(f'{path}: "format" must be "{PROBLEM_FORMAT}"')
+    if data.get("version") != PROBLEM_VERSION:
+        raise ValueError(f'{path}: "version" must be {PROBLEM_VERSION}, got {data.get("version")!r}')
+    family = data.get("family")
+    arguments = {key: value for key, value in data.items() if key not in ("format", "version", "family")}
+    if family == "boxes":
+        if set(arguments) != {"scenario"} or not isinstance(arguments["scenario"], str):
+            raise ValueError(f'{path}: family "boxes" takes one field, "scenario" (a scenario file name)')
+        return box_world(path.parent / arguments["scenario"])
+    if family not in FAMILIES:
+        raise ValueError(f'{path}: "family" must be one of {sorted([*FAMILIES, "boxes"])}, got {family!r}')
+    builder, accepted = FAMILIES[family]
+    unknown = sorted(set(arguments) - set(accepted))
+    if unknown:
+        raise ValueError(f'{path}: family "{family}" takes {sorted(accepted) or "no fields"}, not {unknown}')
+    try:
+        problem: Problem = builder(**arguments)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{path}: {exc}") from exc
+    return problem

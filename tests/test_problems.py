@@ -1,0 +1,125 @@
+"""Problem families and problem files: each builds, plans, and refuses bad input by field."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import qrrt_circuits as qc
+from qrrt_circuits.world.problems import load_problem, narrow_passage, open_space, se2_gap, straight_line_dynamics
+
+
+def test_straight_line_motions_follow_the_segment():
+    dynamics = straight_line_dynamics(3)
+    parent, child = np.zeros(3), np.array([1.0, 2.0, 3.0])
+    points = dynamics.positions(parent, child, np.linspace(0, dynamics.horizon, 50))
+    offsets = points - parent
+    assert np.allclose(np.cross(offsets, child), 0.0, atol=1e-12)  # on the line
+    assert np.linalg.norm(points[-1] - child) < 1e-8
+
+
+@pytest.mark.parametrize("dim", [2, 3, 4, 6])
+def test_the_narrow_passage_is_open_only_through_its_hole(dim):
+    problem = narrow_passage(dim, width=0.5)
+    env, check = problem.env, problem.predicate
+    through = np.full(dim, 5.0)
+    beside = through.copy()
+    beside[1] = 5.3  # just outside the hole on axis 1
+    assert env.is_free(through) and not env.is_free(beside)
+    left, right = np.full(dim, 5.0), np.full(dim, 5.0)
+    left[0], right[0] = 3.0, 7.0
+    assert check.reachable(left[None], right[None])[0]
+    left[1] = right[1] = 5.3
+    assert not check.reachable(left[None], right[None])[0]
+
+
+@pytest.mark.parametrize("make", [open_space, lambda: narrow_passage(2, 1.0), lambda: narrow_passage(3, 1.5)])
+def test_families_are_solved_by_rrt_and_q_rrt(make):
+    problem = make()
+    for planner in (qc.RRT(problem.env, seed=0, goal_bias=0.05, max_extension=2.0, **problem.planner_options()),
+                    qc.QRRT(problem.env, backend=qc.StatevectorBackend(seed=0), num_qubits=6, seed=0, goal_bias=0.05,
+                            max_extension=2.0, search_policy=qc.Adaptive(), **problem.planner_options())):
+        result = planner.plan(goal=problem.goal, max_oracle_calls=30000)
+        assert result.reached, (problem.name, planner.name)
+        assert problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
+
+
+def test_the_se2_gap_problem_plans_in_se2():
+    problem = se2_gap()
+    assert problem.space.describe()["kind"] == "SE2" and problem.env.dim == 3
+    result = qc.RRT(problem.env, seed=1, max_extension=1.0, **problem.planner_options()).plan(
+        goal=problem.goal, max_oracle_calls=20000)
+    assert result.reached and problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
+
+
+def _write(tmp_path, **fields):
+    path = tmp_path / "problem.json"
+    path.write_text(json.dumps({"format": "qrrt-problem", "version": 1} | fields))
+    return path
+
+
+def test_problem_files_build_their_family(tmp_path):
+    problem = load_problem(_write(tmp_path, family="narrow-passage", dim=3, width=1.0))
+    assert problem.name == "narrow-passage-3d" and problem.env.dim == 3
+    scenario = tmp_path / "world.json"
+    scenario.write_text(json.dumps({"format": "qrrt-environment", "version": 1, "bounds": [[0, 20], [0, 20]],
+                                    "boxes": [], "start": [1, 1], "goal": [19, 19], "goal_radius": 0.75}))
+    boxes = load_problem(_write(tmp_path, family="boxes", scenario="world.json"))
+    assert boxes.env.bounds.tolist() == [[0.0, 20.0], [0.0, 20.0]]
+
+
+@pytest.mark.parametrize(("fields", "message"), [
+    ({"family": "maze"}, r'"family" must be one of \[\'boxes\', \'narrow-passage\', \'open-space\', \'se2-gap\'\]'),
+    ({"family": "narrow-passage", "dim": 9}, "dim must be an integer in"),
+    ({"family": "narrow-passage", "width": 0}, "width must be a finite number"),
+    ({"family": "narrow-passage", "depth": 1}, r"takes \['dim', 'width'\], not \['depth'\]"),
+    ({"family": "se2-gap", "width": "wide"}, "width"),
+    ({"family": "boxes"}, 'family "boxes" takes one field, "scenario"'),
+    ({"family": "open-space", "version": 2}, '"version" must be 1'),
+])
+def test_bad_problem_files_name_the_field(tmp_path, fields, message):
+    with pytest.raises(ValueError, match=message):
+        load_problem(_write(tmp_path, **fields))
+
+
+def test_unreadable_problem_files_are_refused(tmp_path):
+    with pytest.raises(ValueError, match="no such file"):
+        load_problem(tmp_path / "missing.json")
+    bad = tmp_path / "bad.json"
+    bad.write_text("{not json")
+    with pytest.raises(ValueError, match="not a JSON problem file"):
+        load_problem(bad)
+    other = tmp_path / "other.json"
+    other.write_text(json.dumps({"format": "qrrt-environment"}))
+    with pytest.raises(ValueError, match='"format" must be "qrrt-problem"'):
+        load_problem(other)
+
+
+def test_qrrt_plan_takes_a_problem_file(tmp_path, capsys):
+    from qrrt_circuits.cli import main
+
+    path = _write(tmp_path, family="narrow-passage", dim=2, width=1.0)
+    assert main(["plan", "--problem", str(path), "--planner", "qrrt", "--backend", "statevector", "--qubits", "5",
+                 "--policy", "adaptive", "--goal-bias", "0.05", "--max-extension", "2", "--max-oracle-calls",
+                 "20000"]) == 0
+    out = capsys.readouterr().out
+    assert "QRRT on narrow-passage-2d" in out and "reached: reached the goal" in out and "beside RRT" in out
+
+
+@pytest.mark.parametrize(("extra", "message"), [
+    (["--scenario-file", "world.json"], "--problem fixes the world and the motion check: leave out --scenario-file"),
+    (["--predicate", "authors"], "leave out --predicate"),
+    (["--scenario", "narrow_corridor"], "leave out --scenario"),
+])
+def test_qrrt_plan_refuses_a_problem_beside_what_it_fixes(tmp_path, capsys, extra, message):
+    from qrrt_circuits.cli import main
+
+    path = _write(tmp_path, family="open-space")
+    with pytest.raises(SystemExit) as exit_info:
+        main(["plan", "--problem", str(path), *extra])
+    assert exit_info.value.code == 2 and message in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["plan", "--problem", str(tmp_path)])
+    assert "is a folder, not a problem file" in capsys.readouterr().err
