@@ -8,8 +8,8 @@ with its nearest tree node under the space's distance (line 6), and moves a cand
 - ``RealVectorSpace(d)``: Euclidean distance, straight interpolation, and the tree's compiled
   exact grid search (``Tree.nearest``); the paper's space and the default.
 - ``SE2Space()``: a rigid body in the plane, states (x, y, theta) with theta in [-pi, pi);
-  OMPL's ``SE2StateSpace`` metric ||(dx, dy)|| + w |dtheta| (dtheta wrapped to the shorter way
-  round, w = 0.5 as in OMPL), interpolation along the shorter arc, and an exact brute-force
+  OMPL's ``SE2StateSpace`` metric ``||(dx, dy)|| + w * abs(dtheta)`` (dtheta wrapped to the shorter
+  way round, w = 0.5 as in OMPL), interpolation along the shorter arc, and an exact brute-force
   nearest search under that metric.
 
 Any object with ``dim``, ``distance``, ``interpolate``, ``nearest``, ``check_bounds`` and
@@ -116,7 +116,7 @@ class SE2Space:
     """A rigid body in the plane: states (x, y, theta), theta in [-pi, pi) (OMPL's
     ``SE2StateSpace``).
 
-    distance(a, b) = ||(x_b - x_a, y_b - y_a)|| + ``angle_weight`` |wrap(theta_b - theta_a)|;
+    The distance is ``||(x_b - x_a, y_b - y_a)|| + angle_weight * abs(wrap(theta_b - theta_a))``;
     interpolation moves (x, y) on the straight line and theta along the shorter arc.
 
     Args:
