@@ -209,7 +209,7 @@ def test_a_user_predicates_own_validity_and_space_are_respected():
 
     class Miscounting(Disc):
         def is_valid(self, points):
-            return np.ones(1, dtype=bool)
+            return np.ones(len(points) + 1, dtype=bool)
 
-    with pytest.raises(ValueError, match="disc.is_valid must return 2 booleans for 2 points"):
+    with pytest.raises(ValueError, match="disc.is_valid must return 1 booleans for 1 points"):
         qc.RRT(env, predicate=Miscounting(), seed=0).plan(start=[6, 6], max_nodes=2)
