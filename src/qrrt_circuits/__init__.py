@@ -27,6 +27,7 @@ if TYPE_CHECKING:
     from .reachability.authors_check import AuthorsCheck
     from .reachability.dynamics import LinearTrackingDynamics
     from .reachability.exact import ExactCheck
+    from .reachability.grid_check import GridCheck, image_world
     from .reachability.oracle_errors import OracleErrorModel
     from .reachability.predicate import ReachabilityPredicate
     from .reachability.time_sampled import TimeSampledCheck
@@ -49,6 +50,7 @@ if TYPE_CHECKING:
     from .search.problem import DatabaseSearch, SearchOutcome
     from .world import scenarios
     from .world.environment import Environment
+    from .world.image import OccupancyGrid
     from .world.spaces import RealVectorSpace, SE2Space, StateSpace
 
     __version__: str
@@ -71,6 +73,7 @@ _WHERE = {
     "AuthorsCheck": ".reachability.authors_check",
     "LinearTrackingDynamics": ".reachability.dynamics",
     "ExactCheck": ".reachability.exact",
+    **dict.fromkeys(["GridCheck", "image_world"], ".reachability.grid_check"),
     "OracleErrorModel": ".reachability.oracle_errors",
     "ReachabilityPredicate": ".reachability.predicate",
     "TimeSampledCheck": ".reachability.time_sampled",
@@ -84,6 +87,7 @@ _WHERE = {
     **dict.fromkeys(["DatabaseSearch", "SearchOutcome"], ".search.problem"),
     "scenarios": ".world.scenarios",
     "Environment": ".world.environment",
+    "OccupancyGrid": ".world.image",
 }
 
 #: deprecated name -> its replacement (a name of ``_WHERE``)
@@ -148,6 +152,7 @@ __all__ = [
     "Goal",
     "GoalBall",
     "GoalState",
+    "GridCheck",
     "RealVectorSpace",
     "SE2Space",
     "StateSpace",
@@ -161,6 +166,7 @@ __all__ = [
     "MaxRounds",
     "MaxWallTime",
     "Metrics",
+    "OccupancyGrid",
     "OracleErrorModel",
     "PaperIterations",
     "ParallelRRT",
@@ -178,6 +184,7 @@ __all__ = [
     "TerminationCondition",
     "TimeSampledCheck",
     "circuits",
+    "image_world",
     "probability",
     "registry",
     "scenarios",
