@@ -71,7 +71,7 @@ def test_problem_files_build_their_family(tmp_path):
 
 
 @pytest.mark.parametrize(("fields", "message"), [
-    ({"family": "maze"}, r'"family" must be one of \[\'boxes\', \'narrow-passage\', \'open-space\', \'se2-gap\'\]'),
+    ({"family": "maze"}, r"\"family\" must be one of \['boxes', 'image', 'narrow-passage', 'open-space', 'se2-gap'\]"),
     ({"family": "narrow-passage", "dim": 9}, "dim must be an integer in"),
     ({"family": "narrow-passage", "width": 0}, "width must be a finite number"),
     ({"family": "narrow-passage", "depth": 1}, r"takes \['dim', 'width'\], not \['depth'\]"),
@@ -123,3 +123,25 @@ def test_qrrt_plan_refuses_a_problem_beside_what_it_fixes(tmp_path, capsys, extr
     with pytest.raises(SystemExit):
         main(["plan", "--problem", str(tmp_path)])
     assert "is a folder, not a problem file" in capsys.readouterr().err
+
+
+def test_an_image_problem_file_plans_on_its_grid(tmp_path):
+    import matplotlib.pyplot as plt
+
+    pixels = np.ones((20, 20))
+    pixels[:, 9:11] = 0.0  # a black wall ...
+    pixels[8:12, 9:11] = 1.0  # ... with a door in the middle
+    plt.imsave(tmp_path / "door.png", pixels, cmap="gray", vmin=0, vmax=1)
+    path = _write(tmp_path, family="image", image="door.png", pixel_size=0.5, start=[1, 5], goal=[9, 5],
+                  goal_radius=0.5)
+    problem = load_problem(path)
+    assert problem.env.bounds.tolist() == [[0.0, 10.0], [0.0, 10.0]]
+    result = qc.RRT(problem.env, seed=0, goal_bias=0.05, **problem.planner_options()).plan(
+        goal=problem.goal, max_oracle_calls=20000)
+    assert result.reached and problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
+    with pytest.raises(ValueError, match='family "image" needs'):
+        load_problem(_write(tmp_path, family="image", image="door.png"))
+    walled = load_problem(_write(tmp_path, family="image", image="door.png", pixel_size=0.5, start=[5, 1],
+                                 goal=[9, 5], goal_radius=0.5))
+    with pytest.raises(ValueError, match=r"start \[5.0, 1.0\] is not a valid state: the grid check"):
+        qc.RRT(walled.env, seed=0, **walled.planner_options()).plan(goal=walled.goal, max_rounds=3)

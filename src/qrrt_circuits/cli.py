@@ -445,8 +445,8 @@ def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
                       default="paper_clutter", help=SCENARIOS.help_text())
     plan.add_argument("--scenario-file", default=None, help="an environment JSON file instead")
     plan.add_argument("--problem", default=None,
-                      help="a problem JSON file instead (qrrt-problem: open-space, narrow-passage, se2-gap or "
-                           "boxes); it fixes the world, the motion check, the state space and the goal")
+                      help="a problem JSON file instead (qrrt-problem: open-space, narrow-passage, se2-gap, boxes "
+                           "or image); it fixes the world, the motion check, the state space and the goal")
     plan.add_argument("--scenario-seed", type=_nonnegative_int, default=0,
                       help="seed of the scenario's random world")
     plan.add_argument("--planner", type=_registered(PLANNERS), choices=PLANNERS.names(), default="pqrrt",

@@ -9,6 +9,8 @@ Families (each a function returning a ``Problem``):
 - ``se2_gap(width)``: a 1.2 x 0.4 rectangle in SE(2) through a gap of ``width`` in a wall
   (``reachability.rigid_body``).
 - ``box_world(path)``: a ``qrrt-environment`` scenario file (the paper's motion model).
+- ``image_problem(path, pixel_size, start, goal, goal_radius)``: an occupancy image (PNG, PGM,
+  PPM) with the exact grid check of straight segments (``reachability.grid_check``).
 
 Straight-line motions are the exact check (``ExactCheck``) under the closed loop -4 I over 5 s,
 x(t) = c + exp(-4 t) (p - c): the segment from p toward c, stopping exp(-20) (about 2e-9) of the
@@ -37,8 +39,8 @@ from ..reachability.rigid_body import se2_world
 from .environment import Environment
 from .spaces import RealVectorSpace, SE2Space, StateSpace
 
-__all__ = ["FAMILIES", "Problem", "box_world", "load_problem", "narrow_passage", "open_space", "se2_gap",
-           "straight_line_dynamics"]
+__all__ = ["FAMILIES", "Problem", "box_world", "image_problem", "load_problem", "narrow_passage", "open_space",
+           "se2_gap", "straight_line_dynamics"]
 
 PROBLEM_FORMAT, PROBLEM_VERSION = "qrrt-problem", 1
 
@@ -163,11 +165,37 @@ def box_world(path: str | Path) -> Problem:
     return Problem(env.name, env, ExactCheck(env), RealVectorSpace(env.dim), GoalBall(env.goal, env.goal_radius))
 
 
+def image_problem(path: str | Path, pixel_size: float, start: Any, goal: Any, goal_radius: float,
+                  free_threshold: float = 0.5, negate: bool = False) -> Problem:
+    """An occupancy image as a problem: the grid's bounds, the ``GridCheck`` of straight segments,
+    R^2 and the goal ball.
+
+    Args:
+        path: A PNG, PGM or PPM file.
+        pixel_size: A pixel's side in world units (> 0).
+        start: (x, y).
+        goal: (x, y), the goal ball's centre.
+        goal_radius: Its radius (> 0).
+        free_threshold: A pixel is free where its grey value is >= this (in [0, 1]).
+        negate: Read 1 - grey instead (black free).
+
+    Returns:
+        The problem.
+    """
+    from ..reachability.grid_check import image_world
+
+    env, check = image_world(path, pixel_size, np.asarray(start, dtype=float), np.asarray(goal, dtype=float),
+                             goal_radius, free_threshold=free_threshold, negate=negate)
+    return Problem(env.name, env, check, RealVectorSpace(2), GoalBall(np.asarray(goal, dtype=float), goal_radius))
+
+
 #: family name -> (builder, its JSON arguments and their defaults)
 FAMILIES: dict[str, tuple[Any, dict[str, Any]]] = {
     "open-space": (open_space, {}),
     "narrow-passage": (narrow_passage, {"dim": 2, "width": 0.5}),
     "se2-gap": (se2_gap, {"width": 1.2}),
+    "image": (image_problem, {"path": None, "pixel_size": None, "start": None, "goal": None, "goal_radius": None,
+                              "free_threshold": 0.5, "negate": False}),
 }
 
 
@@ -202,6 +230,13 @@ def load_problem(path: str | Path) -> Problem:
         if set(arguments) != {"scenario"} or not isinstance(arguments["scenario"], str):
             raise ValueError(f'{path}: family "boxes" takes one field, "scenario" (a scenario file name)')
         return box_world(path.parent / arguments["scenario"])
+    if family == "image":  # the file's "image", relative to the problem file, is the builder's path
+        if not isinstance(arguments.get("image"), str) or "path" in arguments:
+            raise ValueError(f'{path}: family "image" needs "image", the file name of a PNG, PGM or PPM image')
+        missing = sorted({"pixel_size", "start", "goal", "goal_radius"} - set(arguments))
+        if missing:
+            raise ValueError(f'{path}: family "image" needs {missing}')
+        arguments["path"] = str(path.parent / arguments.pop("image"))
     if family not in FAMILIES:
         raise ValueError(f'{path}: "family" must be one of {sorted([*FAMILIES, "boxes"])}, got {family!r}')
     builder, accepted = FAMILIES[family]
