@@ -186,6 +186,25 @@ class OMPLMotionPredicate:
                 f"longest_valid_segment_length={self.space.getLongestValidSegmentLength():.4g})")
 
 
+def real_vector_space(bounds: np.ndarray) -> ob.RealVectorStateSpace:
+    """OMPL's ``RealVectorStateSpace`` with these bounds.
+
+    Args:
+        bounds: Float (d, 2), [low, high] per axis.
+
+    Returns:
+        The state space, its bounds set.
+    """
+    d = bounds.shape[0]
+    space = ob.RealVectorStateSpace(d)
+    limits = ob.RealVectorBounds(d)
+    for axis in range(d):
+        limits.setLow(axis, float(bounds[axis, 0]))
+        limits.setHigh(axis, float(bounds[axis, 1]))
+    space.setBounds(limits)
+    return space
+
+
 def environment_space_information(env: Environment) -> ob.SpaceInformation:
     """An OMPL ``SpaceInformation`` for ``env``: a ``RealVectorStateSpace`` with its bounds and a
     state validity checker that is ``env.is_free`` on one state (motion validation left to OMPL's
@@ -198,13 +217,7 @@ def environment_space_information(env: Environment) -> ob.SpaceInformation:
         The ``SpaceInformation`` (not yet set up).
     """
     d = env.dim
-    space = ob.RealVectorStateSpace(d)
-    bounds = ob.RealVectorBounds(d)
-    for axis in range(d):
-        bounds.setLow(axis, float(env.bounds[axis, 0]))
-        bounds.setHigh(axis, float(env.bounds[axis, 1]))
-    space.setBounds(bounds)
-    si = ob.SpaceInformation(space)
+    si = ob.SpaceInformation(real_vector_space(env.bounds))
 
     def is_valid(state: ob.State) -> bool:
         return bool(env.is_free(np.array(state[0:d])))

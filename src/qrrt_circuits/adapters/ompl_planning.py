@@ -39,7 +39,7 @@ from ..planners.result import PlanResult
 from ..planners.termination import PlanStatus, Progress, TerminationCondition
 from ..reachability.predicate import ReachabilityPredicate
 from ..world.environment import Environment
-from .ompl import INSTALL_HINT, OMPLMotionPredicate
+from .ompl import INSTALL_HINT, OMPLMotionPredicate, real_vector_space
 
 try:
     import ompl
@@ -273,13 +273,7 @@ def setup_from_problem(env: Environment, predicate: ReachabilityPredicate, goal:
     if env.start is None or goal is None or goal_radius is None:
         raise ValueError("setup_from_problem needs a start, a goal and a goal radius")
     dim = env.dim
-    space = ob.RealVectorStateSpace(dim)
-    bounds = ob.RealVectorBounds(dim)
-    for axis in range(dim):
-        bounds.setLow(axis, float(env.bounds[axis, 0]))
-        bounds.setHigh(axis, float(env.bounds[axis, 1]))
-    space.setBounds(bounds)
-    setup = og.SimpleSetup(space)
+    setup = og.SimpleSetup(real_vector_space(env.bounds))
     is_valid = getattr(predicate, "is_valid", None)
 
     def valid(state: Any) -> bool:

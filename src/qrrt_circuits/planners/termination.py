@@ -197,7 +197,23 @@ class _Limit(TerminationCondition):
 
 
 @dataclass(frozen=True)
-class MaxOracleCalls(_Limit):
+class _WorkBudget(_Limit):
+    """A budget on work (rounds, or oracle calls: every round makes at least one), so it ends a plan
+    within ``limit`` rounds (``budget_rounds``)."""
+
+    @property
+    def is_budget(self) -> bool:
+        """True: a budget on work."""
+        return True
+
+    @property
+    def budget_rounds(self) -> int:
+        """``limit``: a round is one round, and makes at least one (critical-path) oracle call."""
+        return self.limit
+
+
+@dataclass(frozen=True)
+class MaxOracleCalls(_WorkBudget):
     """Ends the plan once ``oracle_calls`` (quantum + verification) reach ``limit``.
 
     Status ``PlanStatus.MAX_ORACLE_CALLS``. Checked before each round, so the last round may
@@ -220,19 +236,9 @@ class MaxOracleCalls(_Limit):
 
     counter = "oracle_calls"
 
-    @property
-    def is_budget(self) -> bool:
-        """True: a budget on work."""
-        return True
-
-    @property
-    def budget_rounds(self) -> int:
-        """``limit``: a round makes at least one oracle call."""
-        return self.limit
-
 
 @dataclass(frozen=True)
-class MaxCriticalPathCalls(_Limit):
+class MaxCriticalPathCalls(_WorkBudget):
     """Ends the plan once the critical-path oracle calls (per round the largest count of one
     worker: the time of p parallel quantum devices) reach ``limit``.
 
@@ -249,16 +255,6 @@ class MaxCriticalPathCalls(_Limit):
     status = PlanStatus.MAX_CRITICAL_PATH_CALLS
 
     counter = "critical_path_oracle_calls"
-
-    @property
-    def is_budget(self) -> bool:
-        """True: a budget on work."""
-        return True
-
-    @property
-    def budget_rounds(self) -> int:
-        """``limit``: a round makes at least one critical-path oracle call."""
-        return self.limit
 
 
 @dataclass(frozen=True)
@@ -287,7 +283,7 @@ class MaxNodes(_Limit):
 
 
 @dataclass(frozen=True)
-class MaxRounds(_Limit):
+class MaxRounds(_WorkBudget):
     """Ends the plan after ``limit`` rounds.
 
     Status ``PlanStatus.MAX_ROUNDS``; it bounds the number of rounds (``limits_rounds`` is True), so
@@ -312,16 +308,6 @@ class MaxRounds(_Limit):
 
     @property
     def round_limit(self) -> int:
-        """``limit``."""
-        return self.limit
-
-    @property
-    def is_budget(self) -> bool:
-        """True: a budget on rounds."""
-        return True
-
-    @property
-    def budget_rounds(self) -> int:
         """``limit``."""
         return self.limit
 
