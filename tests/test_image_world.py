@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import pickle
+import zlib
 from fractions import Fraction
 
 import matplotlib
@@ -195,6 +196,39 @@ def test_pillow_greyscale_pngs_8_and_16_bit(tmp_path, picture):
         assert np.array_equal(qc.OccupancyGrid.from_image(tmp_path / name, 1.0).free, expected_free(grey, 255))
 
 
+def write_png(path, samples: np.ndarray, depth: int) -> None:
+    """A PNG written by hand (zlib, filter 0 on every row): ``samples`` (H, W) grey or (H, W, 3) RGB."""
+    height, width = samples.shape[:2]
+    colour = 2 if samples.ndim == 3 else 0
+    dtype = ">u2" if depth == 16 else np.uint8
+    raw = b"".join(b"\x00" + samples[row].astype(dtype).tobytes() for row in range(height))
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return len(data).to_bytes(4, "big") + kind + data + (zlib.crc32(kind + data) & 0xFFFFFFFF).to_bytes(4, "big")
+
+    header = width.to_bytes(4, "big") + height.to_bytes(4, "big") + bytes([depth, colour, 0, 0, 0])
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(raw))
+                     + chunk(b"IEND", b""))
+
+
+def test_sixteen_bit_pngs(tmp_path):
+    """A 16-bit greyscale PNG keeps its 16 bits (a threshold between two adjacent samples splits
+    them); a 16-bit colour PNG is read at 8 bits per channel (Pillow's reading), so its grey is
+    within 1 / 255 of the file's."""
+    write_png(tmp_path / "edge.png", np.array([[32767, 32768]]), 16)
+    grid = qc.OccupancyGrid.from_image(tmp_path / "edge.png", 1.0, free_threshold=32767.5 / 65535)
+    assert grid.free.tolist() == [[False, True]]
+    samples = np.random.default_rng(11).integers(0, 65536, (6, 8, 3))
+    write_png(tmp_path / "rgb16.png", samples, 16)
+    grey = samples.sum(axis=2) / (3 * 65535)
+    for threshold in np.linspace(0.05, 0.95, 19):
+        free = qc.OccupancyGrid.from_image(tmp_path / "rgb16.png", 1.0, free_threshold=threshold).free
+        assert np.all(free[grey >= threshold + 1 / 255]) and not np.any(free[grey < threshold - 1 / 255])
+    write_png(tmp_path / "grey8.png", samples[:, :, 0] >> 8, 8)
+    assert np.array_equal(qc.OccupancyGrid.from_image(tmp_path / "grey8.png", 1.0).free,
+                          expected_free(samples[:, :, 0] >> 8, 255))
+
+
 def test_threshold_is_inclusive_and_colour_is_the_mean_of_channels(tmp_path):
     write_pnm(tmp_path / "red.ppm", "P6", np.array([[[255, 0, 0], [128, 128, 128]]]))  # grey 1/3, 128/255
     assert qc.OccupancyGrid.from_image(tmp_path / "red.ppm", 1.0).free.tolist() == [[False, True]]
@@ -252,6 +286,19 @@ def test_grid_check_equals_the_exact_reference_on_random_segments(random_grid):
         assert disagreements.size == 0, [(parents[i].tolist(), children[i].tolist()) for i in disagreements]
         assert 0.2 < answers.mean() < 0.8, answers.mean()  # both verdicts exercised
         assert check.evaluations == count
+
+
+def test_grid_check_equals_the_exact_reference_on_lattice_segments():
+    """Endpoints on the half-integer lattice of unit cells: segments along cell edges, through cell
+    corners and ending on them, most of them ties; zero disagreements with the exact reference."""
+    rng = np.random.default_rng(8)
+    grid = qc.OccupancyGrid(rng.random((12, 15)) > 0.15, pixel_size=1.0)
+    parents = np.minimum(rng.integers(0, 31, (2000, 2)) / 2.0, [15.0, 12.0])
+    children = parents + rng.integers(-8, 9, (2000, 2)) / 2.0
+    answers = qc.GridCheck(grid).reachable(parents, children)
+    reference = np.array([exact_free(grid, p, c) for p, c in zip(parents, children, strict=True)])
+    assert np.array_equal(answers, reference), np.flatnonzero(answers != reference)
+    assert 0.15 < answers.mean() < 0.5, answers.mean()
 
 
 def test_grid_check_against_dense_sampling(random_grid):
@@ -315,6 +362,19 @@ def test_corner_cases(corner_grid, parent, child, expected, why):
     assert bool(check.reachable(p, c)[0]) is expected, why
     assert bool(check.reachable(c, p)[0]) is expected, why  # either direction
     assert exact_free(corner_grid, p, c) is expected, why  # the reference agrees
+
+
+def test_a_corner_clip_between_samples_is_what_sampling_misses(corner_grid):
+    """The disagreement the sampled reference is known to make, built on purpose: a diagonal that
+    cuts 1e-4 cells into the occupied cell's corner (3, 2), for a parameter length of 2.5e-5, between
+    two of the 2 001 samples. Sampling accepts it; the check and the exact reference reject it."""
+    s = corner_grid.pixel_size
+    p, c = np.array([1.9996, 0.9997]) * s, np.array([5.9996, 4.9997]) * s
+    touched = exact_touched(*cell_coordinates(corner_grid, p), *cell_coordinates(corner_grid, c), 6, 6)
+    t0, t1 = touched[(2, 2)]
+    assert 0 < t1 - t0 < Fraction(1, 2000) and math.floor(t0 * 2000) == math.floor(t1 * 2000)
+    assert sampled_free(corner_grid, p, c, 2000)
+    assert not exact_free(corner_grid, p, c) and not qc.GridCheck(corner_grid).reachable(p, c)[0]
 
 
 def test_epsilon_is_the_only_conservatism(corner_grid):
@@ -385,6 +445,50 @@ def test_rrt_and_q_rrt_plan_through_the_maze_and_every_edge_rechecks(maze_world)
         assert result.settings["predicate"]["motion"] == "straight-segment"
 
 
+def test_ompl_plans_the_same_maze_on_the_grid_check(maze_world):
+    """OMPL's RRT through ``setup_from_problem``: the check is its motion validator and ``is_valid``
+    its validity checker; every segment of its path rechecks with the exact reference."""
+    pytest.importorskip("ompl.base")
+    og = pytest.importorskip("ompl.geometric")
+    from ompl import util as ou
+
+    from qrrt_circuits.adapters.ompl_planning import setup_from_problem
+
+    env, check = maze_world
+    ou.RNG.setSeed(0)
+    ou.setLogLevel(ou.LOG_NONE)
+    setup = setup_from_problem(env, check)
+    planner = og.RRT(setup.getSpaceInformation())
+    planner.setRange(1.0)
+    setup.setPlanner(planner)
+    assert str(setup.solve(30.0)) == "Exact solution"
+    path = setup.getSolutionPath()
+    points = np.array([[path.getState(i)[0], path.getState(i)[1]] for i in range(path.getStateCount())])
+    assert np.linalg.norm(points[0] - env.start) == 0.0 and np.linalg.norm(points[-1] - env.goal) <= 0.5
+    for p, c in zip(points[:-1], points[1:], strict=True):
+        assert exact_free(check.grid, p, c), (p.tolist(), c.tolist())
+
+
+def test_image_world_refuses_a_start_or_goal_off_the_free_cells(maze_world, tmp_path):
+    """The maze's top-left pixel (row 0, col 0) is wall: a start there, on its edge, or outside the
+    map is refused naming the start, the pixel and what is accepted; so is such a goal."""
+    path = tmp_path / "maze.pgm"
+    write_pnm(path, "P5", maze(4, 3, seed=1).astype(int) * 255)
+    accepted = r"accepted: a point inside a free cell, within the bounds \[\[0.0, 8.5\], \[0.0, 8.5\]\]"
+    cases = [
+        ("start", [0.25, 8.25], r"it lies in or on the boundary of the occupied image pixel \(row 0, col 0\)"),
+        ("start", [0.5, 7.25], r"it lies in or on the boundary of the occupied image pixel \(row 2, col 0\)"),
+        ("goal", [9.0, 1.0], "it lies outside the bounds"),
+        ("goal", [8.3, 1.25], r"it lies in or on the boundary of the occupied image pixel \(row 14, col 16\)"),
+    ]
+    for key, point, why in cases:
+        arguments = {"start": [1.25, 7.25], "goal": [7.25, 1.25]} | {key: point}
+        with pytest.raises(ValueError, match=rf"{key} \[.*\] is not a free point of the map: {why}; {accepted}"):
+            qc.image_world(path, 0.5, goal_radius=0.5, **arguments)
+    env, _ = qc.image_world(path, 0.5, start=[0.75, 7.25], goal=[7.25, 1.25], goal_radius=0.5)  # beside the wall
+    assert env.start.tolist() == [0.75, 7.25]
+
+
 def test_planners_refuse_a_start_in_an_occupied_cell(maze_world):
     env, check = maze_world
     with pytest.raises(ValueError, match=r"start \[0.25, 0.25\] is not a valid state: the grid check"):
@@ -445,13 +549,19 @@ def test_images_beyond_the_cell_limit_are_refused_from_their_header(tmp_path):
     ({"free_threshold": -0.1}, r"free_threshold must be a finite number in \[0.0, 1.0\], got -0.1"),
     ({"free_threshold": 1.5}, r"free_threshold must be a finite number in \[0.0, 1.0\], got 1.5"),
     ({"origin": (0.0, math.nan)}, "origin must be two finite numbers"),
+    ({"origin": (1.0, 2.0, 3.0)}, "origin must be two finite numbers"),
+    ({"origin": "here"}, "origin must be two finite numbers"),
 ])
 def test_bad_arguments_are_refused_before_the_file_is_read(tmp_path, kwargs, message):
     arguments = {"path": tmp_path / "map.pgm", "pixel_size": 1.0} | kwargs  # no such file
-    if "origin" in kwargs:  # the origin is checked with the grid, after reading
-        write_pnm(tmp_path / "map.pgm", "P5", np.full((2, 2), 255))
     with pytest.raises(ValueError, match=message):
         qc.OccupancyGrid.from_image(**arguments)
+
+
+def test_bounds_beyond_the_largest_extent_are_refused_from_the_header(tmp_path):
+    (tmp_path / "wide.pgm").write_bytes(b"P5 4000 1 255\n")  # header only: refused before the pixels
+    with pytest.raises(ValueError, match=r"the map's bounds must lie within \[-1e\+12, 1e\+12\]"):
+        qc.OccupancyGrid.from_image(tmp_path / "wide.pgm", 1e9)
 
 
 def test_bad_grids_and_checks_are_refused():

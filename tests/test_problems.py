@@ -141,7 +141,8 @@ def test_an_image_problem_file_plans_on_its_grid(tmp_path):
     assert result.reached and problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
     with pytest.raises(ValueError, match='family "image" needs'):
         load_problem(_write(tmp_path, family="image", image="door.png"))
-    walled = load_problem(_write(tmp_path, family="image", image="door.png", pixel_size=0.5, start=[5, 1],
-                                 goal=[9, 5], goal_radius=0.5))
-    with pytest.raises(ValueError, match=r"start \[5.0, 1.0\] is not a valid state: the grid check"):
-        qc.RRT(walled.env, seed=0, **walled.planner_options()).plan(goal=walled.goal, max_rounds=3)
+    walled = _write(tmp_path, family="image", image="door.png", pixel_size=0.5, start=[5, 1], goal=[9, 5],
+                    goal_radius=0.5)
+    with pytest.raises(ValueError, match=r"start \[5.0, 1.0\] is not a free point of the map: it lies in or on "
+                                         r"the boundary of the occupied image pixel \(row 18, col 9\)"):
+        load_problem(walled)  # refused as it is read, before any planner is built

@@ -17,10 +17,13 @@ lies in an interval [v_lo, v_hi], and the cells touched there are the rows j wit
 j <= v_hi and j + 1 >= v_lo. Each interval is widened by ``EPSILON`` cell widths so that rounding
 never drops a touched cell: the check is conservative; it accepts no segment that touches an
 occupied cell, and rejects a free one only where it passes within ``EPSILON`` cell widths of an
-occupied cell. (Walking the major axis keeps |dv / du| <= 1, so the computed crossings are within
-a few units of rounding of the largest cell coordinate, under 1e-10 cells for the ``MAX_SIDE`` of
-``world.image``.) The loop is compiled with numba and batched over M pairs; its cost is the number
-of cells touched.
+occupied cell. (The cell coordinates are computed as (x - ox) / s of points in the bounds; the
+subtraction's result lies in [0, cols s], so it is rounded by at most 2^-53 cols s whatever the
+origin, and u is within 2^-52 cols cells of its exact value, under 1.5e-11 cells for the
+``MAX_SIDE`` of ``world.image``. Walking the major axis keeps |dv / du| <= 1, so the computed
+crossings are within a few units of rounding of the largest cell coordinate, under 1e-10 cells in
+all.) The loop is compiled with numba and batched over M pairs; its cost is the number of cells
+touched.
 """
 
 from __future__ import annotations
@@ -238,7 +241,9 @@ def image_world(path: str | Path, pixel_size: float, start: np.ndarray, goal: np
         (environment, check); the environment is named after the file's stem.
 
     Raises:
-        ValueError: Anything ``OccupancyGrid.from_image`` or ``Environment`` refuses.
+        ValueError: Anything ``OccupancyGrid.from_image`` or ``Environment`` refuses, or a
+            ``start`` or ``goal`` that is not a valid point of the map (``check.is_valid``: outside
+            the bounds, or in or on the boundary of an occupied cell), naming it and the pixel.
         TypeError: A non-numeric ``pixel_size``, ``free_threshold`` or ``goal_radius``.
 
     Example:
@@ -255,4 +260,24 @@ def image_world(path: str | Path, pixel_size: float, start: np.ndarray, goal: np
     check = GridCheck(grid)
     env = Environment(grid.bounds(), np.zeros((0, 2, 2)), name=f"image:{Path(path).stem}", start=start,
                       goal=goal, goal_radius=goal_radius, metadata={"occupancy": grid.describe()})
+    for key, point in (("start", env.start), ("goal", env.goal)):
+        if point is not None and not check.is_valid(point)[0]:
+            raise ValueError(f"{key} {point.tolist()} is not a free point of the map: {_why_invalid(grid, point)}; "
+                             f"accepted: a point inside a free cell, within the bounds {grid.bounds().tolist()}")
     return env, check
+
+
+def _why_invalid(grid: OccupancyGrid, point: np.ndarray) -> str:
+    """Why ``GridCheck(grid).is_valid`` rejects ``point``: out of bounds, or the occupied image
+    pixel (row, col) whose closed cell contains it."""
+    bounds = grid.bounds()
+    if not np.all((point >= bounds[:, 0]) & (point <= bounds[:, 1])):
+        return "it lies outside the bounds"
+    u = (point[0] - grid.origin[0]) / grid.pixel_size
+    v = (point[1] - grid.origin[1]) / grid.pixel_size
+    for col in sorted({min(int(math.floor(u)), grid.cols - 1), int(math.ceil(u)) - 1}):
+        for row_up in sorted({min(int(math.floor(v)), grid.rows - 1), int(math.ceil(v)) - 1}):
+            row = grid.rows - 1 - row_up
+            if 0 <= col < grid.cols and 0 <= row < grid.rows and not grid.free[row, col]:
+                return f"it lies in or on the boundary of the occupied image pixel (row {row}, col {col})"
+    return "it lies within rounding of an occupied cell"

@@ -6,8 +6,18 @@ convention, the usual way geometric planners such as OMPL's are given a 2-D map)
 ``P6`` or ASCII ``P2`` / ``P3``, read by the small reader of this module; the format is told by the
 file's first bytes, not by its name). Each pixel's grey value is the mean of its colour channels
 (an alpha channel is ignored), normalized to [0, 1] by the format's largest sample value
-(``maxval`` for PGM / PPM, 255 or 65535 for PNG). A pixel is **free where grey >=
-free_threshold** (white free, black occupied); ``negate=True`` reads 1 - grey instead (black free).
+(``maxval`` for PGM / PPM, 255 or 65535 for PNG; a 16-bit colour PNG is read at 8 bits per
+channel, as Pillow reads it, a 16-bit greyscale PNG at its 16 bits). A pixel is **free where grey
+>= free_threshold** (white free, black occupied); ``negate=True`` reads 1 - grey instead (black
+free). Every cell is free or occupied: there is no unknown cell.
+
+ROS ``map_server`` reads the same images with two thresholds on the occupancy p = 1 - grey (p =
+grey with its ``negate``): free where p < ``free_thresh`` (default 0.196), occupied where p >
+``occupied_thresh`` (default 0.65), unknown between. Here a cell is free iff p <= 1 -
+``free_threshold``, so ``free_threshold = 1 - free_thresh`` (0.804 for ROS's default) frees the
+cells ROS calls free (a pixel exactly at ROS's threshold aside) and makes the unknown ones
+occupied, as a check that must never accept a collision should; the default 0.5 splits the grey
+range in the middle instead.
 
 Geometry: pixel (row, col) of the image is the closed square
 [ox + col s, ox + (col + 1) s] x [oy + (rows - 1 - row) s, oy + (rows - row) s], with s the
@@ -90,19 +100,13 @@ class OccupancyGrid:
                              f"got dtype {free.dtype} and shape {free.shape}")
         _check_size(free.shape[1], free.shape[0], "free")
         pixel_size = check_positive_float(self.pixel_size, "pixel_size")
-        origin = check_real_array(self.origin, "origin").reshape(-1)
-        if origin.shape != (2,) or not np.all(np.isfinite(origin)):
-            raise ValueError(f"origin must be two finite numbers (x, y) of the map's bottom-left corner, "
-                             f"got {self.origin!r}")
-        top = origin + pixel_size * np.array([free.shape[1], free.shape[0]], dtype=float)
-        if np.any(np.abs(origin) > MAX_EXTENT) or np.any(np.abs(top) > MAX_EXTENT):
-            raise ValueError(f"the map's bounds must lie within [-{MAX_EXTENT:g}, {MAX_EXTENT:g}]: origin "
-                             f"{origin.tolist()} with pixel_size {pixel_size:g} reaches {top.tolist()}")
+        origin = _check_origin(self.origin)
+        _check_extent(origin, pixel_size, free.shape[1], free.shape[0])
         free = np.array(free, dtype=bool, order="C")
         free.setflags(write=False)
         object.__setattr__(self, "free", free)
         object.__setattr__(self, "pixel_size", pixel_size)
-        object.__setattr__(self, "origin", (float(origin[0]), float(origin[1])))
+        object.__setattr__(self, "origin", origin)
         if not isinstance(self.metadata, dict):
             raise ValueError(f"metadata must be a dict, got {self.metadata!r}")
         object.__setattr__(self, "metadata", dict(self.metadata))
@@ -128,11 +132,12 @@ class OccupancyGrid:
             and ``negate``.
 
         Raises:
-            ValueError: ``pixel_size`` not finite and > 0, ``free_threshold`` outside [0, 1], a
-                ``path`` that is missing or not a file, a file that is not one of the accepted
-                formats or is unreadable (truncated, bad header, samples above ``maxval``), or an
-                image with more than ``MAX_CELLS`` pixels or a side longer than ``MAX_SIDE``; each
-                message names the argument and what is accepted.
+            ValueError: ``pixel_size`` not finite and > 0, ``free_threshold`` outside [0, 1], an
+                ``origin`` that is not two finite numbers, a ``path`` that is missing or not a
+                file, a file that is not one of the accepted formats or is unreadable (truncated,
+                bad header, samples above ``maxval``), an image with more than ``MAX_CELLS`` pixels
+                or a side longer than ``MAX_SIDE``, or bounds beyond ``environment.MAX_EXTENT``;
+                each message names the argument and what is accepted.
             TypeError: A non-numeric ``pixel_size`` or ``free_threshold``, or ``negate`` not a bool.
 
         Example:
@@ -147,9 +152,11 @@ class OccupancyGrid:
         pixel_size = check_positive_float(pixel_size, "pixel_size")
         free_threshold = check_float(free_threshold, "free_threshold", 0.0, 1.0)
         negate = check_bool(negate, "negate")
+        origin = _check_origin(origin)
         path = _check_path(path)
         kind, width, height = _header(path)
         _check_size(width, height, "path")
+        _check_extent(origin, pixel_size, width, height)
         samples, maxval = _read_png(path) if kind == "PNG" else _read_pnm(path, kind)
         grey = _grey(samples, maxval)
         if negate:
@@ -214,6 +221,28 @@ def _check_size(width: int, height: int, name: str) -> None:
     if width * height > MAX_CELLS or max(width, height) > MAX_SIDE:
         raise ValueError(f"{name}: the image has {width} x {height} pixels; accepted are at most {MAX_CELLS} "
                          f"pixels (MAX_CELLS, 4096 x 4096) and at most {MAX_SIDE} along a side (MAX_SIDE)")
+
+
+def _check_origin(origin: Any) -> tuple[float, float]:
+    """``origin`` as two finite floats, else a ``ValueError`` naming it."""
+    try:
+        array = check_real_array(origin, "origin").reshape(-1)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"origin must be two finite numbers (x, y) of the map's bottom-left corner, "
+                         f"got {origin!r}") from exc
+    if array.shape != (2,) or not np.all(np.isfinite(array)):
+        raise ValueError(f"origin must be two finite numbers (x, y) of the map's bottom-left corner, "
+                         f"got {origin!r}")
+    return float(array[0]), float(array[1])
+
+
+def _check_extent(origin: tuple[float, float], pixel_size: float, width: int, height: int) -> None:
+    """Refuse a map whose bounds reach beyond ``environment.MAX_EXTENT``."""
+    top = (origin[0] + pixel_size * width, origin[1] + pixel_size * height)
+    if max(abs(origin[0]), abs(origin[1]), abs(top[0]), abs(top[1])) > MAX_EXTENT:
+        raise ValueError(f"the map's bounds must lie within [-{MAX_EXTENT:g}, {MAX_EXTENT:g}]: origin "
+                         f"{list(origin)} with pixel_size {pixel_size:g} and {width} x {height} pixels reaches "
+                         f"{list(top)}")
 
 
 def _check_path(path: Any) -> Path:
