@@ -70,7 +70,7 @@ def table(summary: dict[str, Any], label: str) -> str:
                  f"{design['meaning']}):", "", "| quantity | paper | its 95 % range | paper plausible |",
                  "|---|---|---|---|"]
         for path, low_high in _leaves(design["range_95"]):
-            rows.append(f"| {' / '.join(path)} | {_shown(_at(summary.get('paper', {}), path))} | "
+            rows.append(f"| {' / '.join(path)} | {_shown(_at_or_above(summary.get('paper', {}), path))} | "
                         f"{_shown(low_high)} | {_shown(_at(design['paper_plausible'], path))} |")
     code = summary.get("authors_code")
     if code:  # the reported Octave run of the authors' code, beside ours under its design
