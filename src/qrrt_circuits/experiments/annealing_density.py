@@ -107,7 +107,7 @@ class AnnealingDensity(Experiment):
     paper = {"QRRT": 1.70, "QDA": 3.68, READINGS_KEY: 3.68, RATIO_KEY: round(3.68 / 1.70, 2)}
 
     def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
-        return {"trials": trials or (2 if quick else 40),
+        return {"trials": trials or (2 if quick else 20),
                 "densities": [0.5, 1.0] if quick else list(DENSITIES),
                 "readings": [list(r) for r in (READINGS[:1] + READINGS[2:3] + READINGS[4:] if quick else READINGS)],
                 "num_boxes": BOXES, "num_qubits": 9, "iterations": 2, "bands": [[2.7, 4.2], [0.8, 2.0]],
