@@ -162,8 +162,12 @@ def _check_annealing_density(summary, records):
     for r in records:  # every QDA tree of 16 nodes is grown in the hot band, under every reading but
         # "band, databases", whose h may reach the cold band first
         assert r["nodes"] == settings["size"] or r["rounds"] == settings["max_rounds"] or r["status"] == "reached"
-        if r["method"] == "QDA" and r["counter"] == "nodes":
+        if r["method"] == "QDA" and r["counter"] == "nodes" and r["nodes"]:
             assert low - 1e-9 <= r["mean_parent_distance_16"] <= high + 1e-9
+    for head, by_key in summary["incomplete_trees"].items():  # trees short of 16 nodes, left out of the means
+        for key, count in by_key.items():
+            trials = settings["trials"]
+            assert 0 <= count <= trials and (count < trials) == (ours[head][key] is not None)
     densities = [str(float(d)) for d in settings["densities"]]
     assert list(ours["QRRT"]) == list(ours["QDA"]) == densities
     assert set(ours["QDA_readings"]) == {f"{p}, {c}" for p, c in settings["readings"]}

@@ -63,6 +63,8 @@ READINGS = (("band", "nodes"), ("band", "databases"), ("clamp", "nodes"), ("annu
 BOXES = 6025
 #: ``annealing_field``'s default side (``paper_clutter``'s box density)
 DEFAULT_SIDE = CLUTTER_SIZE * float(np.sqrt(BOXES / CLUTTER_BOXES))
+#: the trees' size (the paper's Figs. 15 and 17: 16-node trees)
+TREE_NODES = 16
 #: the summary's key of the readings
 READINGS_KEY = "QDA_readings"
 RATIO_KEY = "ratio_qda_over_uniform"
@@ -85,11 +87,17 @@ def reading_label(placement: str, counter: str) -> str:
     return f"{placement}, {counter}"
 
 
+def _complete(rows: Sequence[Record]) -> list[Record]:
+    """The rows whose tree reached ``TREE_NODES`` nodes (a tree stopped by ``max_rounds`` or at the
+    goal before that has no 16-node mean to compare)."""
+    return [r for r in rows if r["nodes"] >= TREE_NODES]
+
+
 def _mean(rows: Sequence[Record]) -> float:
-    """The mean over ``rows`` of their tree's mean distance to the parent (trees without one skipped)."""
-    values = [r["mean_parent_distance_16"] for r in rows if np.isfinite(r["mean_parent_distance_16"])]
+    """The mean over the complete trees of ``rows`` of their mean distance to the parent."""
+    values = [r["mean_parent_distance_16"] for r in _complete(rows)]
     if not values:
-        raise ValueError("no tree with a node")
+        raise ValueError("no complete tree")
     return float(np.mean(values))
 
 
@@ -111,8 +119,8 @@ class AnnealingDensity(Experiment):
                 "densities": [0.5, 1.0] if quick else list(DENSITIES),
                 "readings": [list(r) for r in (READINGS[:1] + READINGS[2:3] + READINGS[4:] if quick else READINGS)],
                 "num_boxes": BOXES, "num_qubits": 9, "iterations": 2, "bands": [[2.7, 4.2], [0.8, 2.0]],
-                "switch_at": 16, "size": 16, "max_rounds": 20000, "backend": "aer", "scenario": "annealing_field",
-                "seed": seed, "quick": quick}
+                "switch_at": 16, "size": TREE_NODES, "max_rounds": 20000, "backend": "aer",
+                "scenario": "annealing_field", "seed": seed, "quick": quick}
 
     def trials(self, settings: Settings) -> list[Trial]:
         """Per replicate: uniform q-RRT and QDA (``band, nodes``) at every density, then QDA's other
@@ -171,22 +179,31 @@ class AnnealingDensity(Experiment):
         ours: dict[str, dict[str, Any]] = {"QRRT": {}, "QDA": {}, READINGS_KEY: {}, RATIO_KEY: {}}
         interval: dict[str, dict[str, Any]] = {key: {} for key in ours}
         spread: dict[str, dict[str, Any]] = {key: {} for key in ours if key != RATIO_KEY}
+        incomplete: dict[str, dict[str, int]] = {}
         for (head, key), rows in groups.items():
+            trees = [r["mean_parent_distance_16"] for r in _complete(rows)]
+            incomplete.setdefault(head, {})[key] = len(rows) - len(trees)
+            if not trees:  # no tree reached 16 nodes: nothing to compare
+                ours[head][key], interval[head][key], spread[head][key] = None, [None, None], [None, None]
+                continue
             ours[head][key] = round(_mean(rows), 3)
             interval[head][key] = rounded_interval(bootstrap_interval(rows, _mean, seed), 3)
-            trees = [r["mean_parent_distance_16"] for r in rows if np.isfinite(r["mean_parent_distance_16"])]
             spread[head][key] = [round(float(v), 3) for v in np.percentile(trees, [2.5, 97.5])]
         for density in settings["densities"]:
             key = str(float(density))
-            pairs = list(zip(groups[("QDA", key)], groups[("QRRT", key)], strict=True))
+            uniform = {r["replicate"]: r for r in groups[("QRRT", key)]}
+            pairs = [(r, uniform[r["replicate"]]) for r in groups[("QDA", key)]]
+            if ours["QDA"][key] is None or ours["QRRT"][key] is None:
+                ours[RATIO_KEY][key], interval[RATIO_KEY][key] = None, [None, None]
+                continue
             ours[RATIO_KEY][key] = round(ours["QDA"][key] / ours["QRRT"][key], 2)
             interval[RATIO_KEY][key] = rounded_interval(bootstrap_interval(pairs, _ratio, seed), 2)
         if not ours[READINGS_KEY]:
             del ours[READINGS_KEY], interval[READINGS_KEY], spread[READINGS_KEY]
-        differs_from_paper = {head: {key: differs(self.paper[head], span) for key, span in spans.items()}
-                              for head, spans in interval.items()}
-        plausible = {head: {key: bool(span[0] <= self.paper[head] <= span[1]) for key, span in spans.items()}
-                     for head, spans in spread.items()}
+        differs_from_paper = {head: {key: None if span[0] is None else differs(self.paper[head], span)
+                                     for key, span in spans.items()} for head, spans in interval.items()}
+        plausible = {head: {key: None if span[0] is None else bool(span[0] <= self.paper[head] <= span[1])
+                            for key, span in spans.items()} for head, spans in spread.items()}
         free = {str(float(d)): round(float(np.mean([r["free_fraction"] for r in records if r["density"] == d])), 3)
                 for d in settings["densities"]}
         where = {method: {"inside_our_mean_at": [d for d, out in differs_from_paper[method].items() if out is False],
@@ -200,10 +217,12 @@ class AnnealingDensity(Experiment):
                 "meaning": "one 16-node tree's mean distance to the parent (each of Figs. 15-17 shows one tree): "
                            "the 2.5-97.5 % range of our single trees' means at each point"},
             "where_paper_falls": where,
+            "incomplete_trees": incomplete,
             "free_fraction": free,
             "side": {str(float(d)): round(side(d), 2) for d in settings["densities"]},
             "note": "density: 6025 boxes on a square of side 67.75 / sqrt(density) (1 is annealing_field's "
-                    "default); mean distance from node to parent over the first 16 nodes"}
+                    "default); mean distance from node to parent over the first 16 nodes, over the trees that "
+                    "reach 16 nodes in max_rounds databases (incomplete_trees: those that do not, left out)"}
         if READINGS_KEY in ours:
             summary["readings_reaching_paper"] = {
                 "inside_our_mean": [k for k, out in differs_from_paper[READINGS_KEY].items() if out is False],
@@ -235,7 +254,7 @@ class AnnealingDensity(Experiment):
         colors = {"QDA": "tab:red", "QRRT": "tab:blue"}
         labels = {"QDA": "QDA (band, nodes)", "QRRT": "uniform q-RRT"}
         for method in ("QRRT", "QDA"):
-            keys = list(ours[method])
+            keys = [k for k, v in ours[method].items() if v is not None]
             x = np.array([float(k) for k in keys])
             ranges = np.array([spread[method][k] for k in keys])
             ax.fill_between(x, ranges[:, 0], ranges[:, 1], color=colors[method], alpha=0.15,
@@ -248,11 +267,11 @@ class AnnealingDensity(Experiment):
         ax.set_xlabel("box density / annealing_field's default (6025 boxes, side 67.75 / sqrt(x))")
         ax.set_ylabel("mean distance to parent, first 16 nodes")
         ax.set_title("Parent distance against the world's density", fontsize=10)
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=7, loc="upper right")
         ax.grid(alpha=0.3)
         if readings:
             ax = axes[0, 1]
-            keys = list(readings)
+            keys = [k for k, v in readings.items() if v is not None]
             x = np.arange(len(keys))
             ranges = np.array([spread[READINGS_KEY][k] for k in keys])
             ax.vlines(x, ranges[:, 0], ranges[:, 1], color="tab:red", alpha=0.35, lw=6,
@@ -265,20 +284,21 @@ class AnnealingDensity(Experiment):
             ax.set_xticks(x, [k.replace(", ", "\n") for k in keys])
             ax.set_ylabel("QDA mean distance to parent, first 16 nodes")
             ax.set_title("QDA under the readings of Alg. 4, line 7 (default density)", fontsize=10)
-            ax.legend(fontsize=7)
+            ax.legend(fontsize=7, loc="lower right")
             ax.grid(alpha=0.3, axis="y")
         return [save(fig, out_dir / "annealing-density.png")]
 
 
 def _ratio(pairs: Sequence[tuple[Record, Record]]) -> float:
-    """mean(QDA) / mean(uniform q-RRT) over paired (QDA, uniform) trees of one density."""
+    """mean(QDA) / mean(uniform q-RRT) over paired (QDA, uniform) trees of one density (each mean
+    over its complete trees)."""
     return _mean([qda for qda, _ in pairs]) / _mean([uniform for _, uniform in pairs])
 
 
-def _crossing(means: dict[str, float], paper: float) -> list[float] | None:
+def _crossing(means: dict[str, float | None], paper: float) -> list[float] | None:
     """The first pair of neighbouring densities between which our means pass the paper's value
     (``[low, high]``), or None if they stay on one side over the grid."""
-    points = sorted((float(k), v) for k, v in means.items())
+    points = sorted((float(k), v) for k, v in means.items() if v is not None)
     for (d0, m0), (d1, m1) in zip(points, points[1:], strict=False):
         if (m0 - paper) * (m1 - paper) <= 0:
             return [d0, d1]
