@@ -172,6 +172,9 @@ def _check_annealing_density(summary, records):
     assert list(ours["QRRT"]) == list(ours["QDA"]) == densities
     assert set(ours["QDA_readings"]) == {f"{p}, {c}" for p, c in settings["readings"]}
     assert ours["QDA_readings"]["band, nodes"] == ours["QDA"]["1.0"]  # the same trees
+    for key, edges in summary["nodes_at_band_edges"].items():  # clamp piles nodes on the edges
+        assert key in ours["QDA_readings"]
+        assert all(value is None or 0.0 <= value <= 1.0 for value in edges.values())
     for d in densities:
         assert ours["ratio_qda_over_uniform"][d] == round(ours["QDA"][d] / ours["QRRT"][d], 2)
         assert summary["side"][d] == round(20 * (6025 / 525 / float(d)) ** 0.5, 2)  # 6025 boxes at density d

@@ -50,7 +50,7 @@ from .base import (
 )
 from .figures import new_figure, save, with_intervals
 from .intervals import bootstrap_interval, differs, rounded_interval
-from .measures import dumps, rounded
+from .measures import dumps, loads, rounded
 from .planners import planner_for
 from .worlds import world
 
@@ -65,6 +65,8 @@ BOXES = 6025
 DEFAULT_SIDE = CLUTTER_SIZE * float(np.sqrt(BOXES / CLUTTER_BOXES))
 #: the trees' size (the paper's Figs. 15 and 17: 16-node trees)
 TREE_NODES = 16
+#: a distance this close to a band edge counts as on it (the records round distances to 1e-3)
+EDGE_TOLERANCE = 2e-3
 #: the summary's key of the readings
 READINGS_KEY = "QDA_readings"
 RATIO_KEY = "ratio_qda_over_uniform"
@@ -227,6 +229,10 @@ class AnnealingDensity(Experiment):
             summary["readings_reaching_paper"] = {
                 "inside_our_mean": [k for k, out in differs_from_paper[READINGS_KEY].items() if out is False],
                 "plausible_for_one_tree": [k for k, ok in plausible[READINGS_KEY].items() if ok]}
+            low, high = settings["bands"][0]
+            summary["nodes_at_band_edges"] = {
+                key: _at_edges([r for r in _complete(groups[(READINGS_KEY, key)])], low, high)
+                for key in ours[READINGS_KEY]}
         return summary
 
     def paper_comparison(self, summary: Summary) -> PaperComparison:
@@ -293,6 +299,17 @@ def _ratio(pairs: Sequence[tuple[Record, Record]]) -> float:
     """mean(QDA) / mean(uniform q-RRT) over paired (QDA, uniform) trees of one density (each mean
     over its complete trees)."""
     return _mean([qda for qda, _ in pairs]) / _mean([uniform for _, uniform in pairs])
+
+
+def _at_edges(rows: Sequence[Record], low: float, high: float) -> dict[str, float | None]:
+    """The fractions of the trees' nodes whose distance to the parent is the band's r_min or r_max
+    (within the records' rounding to 1e-3), over all nodes of ``rows``."""
+    distances = np.concatenate([np.asarray(loads(r["parent_distances_json"]), dtype=float) for r in rows]
+                               or [np.zeros(0)])
+    if not distances.size:
+        return {"r_min": None, "r_max": None}
+    return {"r_min": round(float(np.mean(np.abs(distances - low) <= EDGE_TOLERANCE)), 3),
+            "r_max": round(float(np.mean(np.abs(distances - high) <= EDGE_TOLERANCE)), 3)}
 
 
 def _crossing(means: dict[str, float | None], paper: float) -> list[float] | None:
