@@ -66,7 +66,8 @@ def table(summary: dict[str, Any], label: str) -> str:
                     f"{_shown(differs)} |")
     design = summary.get("paper_design")
     if design:  # the paper's own estimator, resampled from our trials
-        rows += ["", f"The paper's estimator ({design['trees']} trees, {design['resamples']} replicates; "
+        trees = f"{design['trees']} tree{'' if design['trees'] == 1 else 's'}"
+        rows += ["", f"The paper's estimator ({trees}, {design['resamples']} replicates; "
                  f"{design['meaning']}):", "", "| quantity | paper | its 95 % range | paper plausible |",
                  "|---|---|---|---|"]
         for path, low_high in _leaves(design["range_95"]):

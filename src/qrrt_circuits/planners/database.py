@@ -57,7 +57,7 @@ class AnnealingSchedule:
     "constrained to be within a ball of radius H(h) ... while maintaining child-sample direction";
     §V.D: "databases of points at a distance between 2.7 and 4.2 units from current nodes", "only
     further away nodes are admitted to the database"). With t a uniform sample, P its nearest node,
-    r = |t - P| and the band [a, b]:
+    r the Euclidean distance from P to t and the band [a, b]:
 
     - ``"band"`` (default): t moved along P -> t to a distance drawn uniformly in [a, b];
     - ``"clamp"``: t projected onto the band along P -> t, to distance min(max(r, a), b) (the
