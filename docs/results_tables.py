@@ -66,11 +66,12 @@ def table(summary: dict[str, Any], label: str) -> str:
                     f"{_shown(differs)} |")
     design = summary.get("paper_design")
     if design:  # the paper's own estimator, resampled from our trials
-        rows += ["", f"The paper's estimator ({design['trees']} trees, {design['resamples']} replicates; "
+        trees = f"{design['trees']} tree{'' if design['trees'] == 1 else 's'}"
+        rows += ["", f"The paper's estimator ({trees}, {design['resamples']} replicates; "
                  f"{design['meaning']}):", "", "| quantity | paper | its 95 % range | paper plausible |",
                  "|---|---|---|---|"]
         for path, low_high in _leaves(design["range_95"]):
-            rows.append(f"| {' / '.join(path)} | {_shown(_at(summary.get('paper', {}), path))} | "
+            rows.append(f"| {' / '.join(path)} | {_shown(_at_or_above(summary.get('paper', {}), path))} | "
                         f"{_shown(low_high)} | {_shown(_at(design['paper_plausible'], path))} |")
     code = summary.get("authors_code")
     if code:  # the reported Octave run of the authors' code, beside ours under its design

@@ -155,6 +155,8 @@ CALLS = {
                                               st.just(5), st.text(min_size=1, max_size=2)), "switch_at"),
     "AnnealingSchedule.counter": (lambda v: qc.AnnealingSchedule(bands=((1.0, 2.0),), counter=v),
                                   bad_choice(("databases", "nodes")), "counter"),
+    "AnnealingSchedule.placement": (lambda v: qc.AnnealingSchedule(bands=((1.0, 2.0),), placement=v),
+                                    bad_choice(("band", "clamp", "annulus", "admit")), "placement"),
     "OracleErrorModel.false_positive": (lambda v: qc.OracleErrorModel(false_positive=v), bad_float(0.0, 1.0),
                                         "false_positive"),
     "OracleErrorModel.false_negative": (lambda v: qc.OracleErrorModel(false_negative=v), bad_float(0.0, 1.0),

@@ -154,6 +154,19 @@ def test_annealing_field_matches_clutter_density():
     assert abs(f1 - f2) <= z_bound() * math.sqrt(sum(sd**2 for sd in world_sd) + sum(sampling))
 
 
+def test_annealing_field_side_sets_the_density():
+    default = qc.scenarios.annealing_field(seed=2)
+    same = qc.scenarios.annealing_field(seed=2, side=float(default.bounds[0, 1]))
+    assert np.array_equal(default.boxes, same.boxes) and "side" not in default.metadata
+    dense = qc.scenarios.annealing_field(seed=2, side=40.0)
+    assert dense.num_boxes == 6025 and dense.bounds[0, 1] == 40.0 and dense.metadata["side"] == 40.0
+    assert dense.free_fraction() < default.free_fraction()
+    with pytest.raises(ValueError, match="side must be"):
+        qc.scenarios.annealing_field(seed=2, side=1.7)
+    with pytest.raises(TypeError, match="side must be a real number"):
+        qc.scenarios.annealing_field(seed=2, side="40")
+
+
 def test_narrow_corridor_channel():
     env = qc.scenarios.narrow_corridor(seed=1)
     (x0, y0), (x1, y1) = env.metadata["channel"]

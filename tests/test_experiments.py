@@ -12,7 +12,7 @@ TINY = {"oracle-efficiency": 1, "wallclock": 1, "heatmaps": 2, "corridor": 2, "a
         "lemmas": 60, "scaling": 1, "oracle-check": 1,
         "tree-size": 1, "heatmap-hypotheses": 3,
         "corridor-sensitivity": 2, "search-policies": 1, "noise": 1, "resources": 1,
-        "heatmap-worlds": 5}
+        "heatmap-worlds": 5, "annealing-density": 2}
 
 
 def _is_png(path):
@@ -142,6 +142,50 @@ def _check_annealing(summary, records):
             assert low <= r[f"mean_parent_distance_{hot}"] <= high
     ours = summary["ours"]
     assert summary["ratio_qda_over_uniform"]["16"] == round(ours["QDA"]["16"] / ours["QRRT"]["16"], 2)
+    assert ours["ratio_qda_over_uniform"] == summary["ratio_qda_over_uniform"]
+    _assert_intervals_hold({k: v for k, v in ours.items() if k != "ratio_qda_over_uniform"},
+                           summary["interval_95"])
+    for size, (low, high) in summary["interval_95"]["ratio_qda_over_uniform"].items():  # rounded to 0.01
+        assert low - 0.01 <= ours["ratio_qda_over_uniform"][size] <= high + 0.01
+    design = summary["paper_design"]
+    for method, by_size in design["range_95"].items():  # single trees spread at least as wide as their mean
+        trees = [r["mean_parent_distance_16"] for r in records if r["method"] == method]
+        low, high = by_size["16"]
+        assert min(trees) - 1e-3 <= low <= high <= max(trees) + 1e-3
+        assert design["paper_plausible"][method]["16"] == (low <= summary["paper"][method] <= high)
+
+
+def _check_annealing_density(summary, records):
+    settings, ours = summary["settings"], summary["ours"]
+    _assert_intervals_hold({k: v for k, v in ours.items() if k != "ratio_qda_over_uniform"}, summary["interval_95"])
+    low, high = settings["bands"][0]
+    for r in records:  # every QDA tree of 16 nodes is grown in the hot band, under every reading but
+        # "band, databases", whose h may reach the cold band first
+        assert r["nodes"] == settings["size"] or r["rounds"] == settings["max_rounds"] or r["status"] == "reached"
+        if r["method"] == "QDA" and r["counter"] == "nodes" and r["nodes"]:
+            assert low - 1e-9 <= r["mean_parent_distance_16"] <= high + 1e-9
+    for head, by_key in summary["incomplete_trees"].items():  # trees short of 16 nodes, left out of the means
+        for key, count in by_key.items():
+            trials = settings["trials"]
+            assert 0 <= count <= trials and (count < trials) == (ours[head][key] is not None)
+    densities = [str(float(d)) for d in settings["densities"]]
+    assert list(ours["QRRT"]) == list(ours["QDA"]) == densities
+    assert set(ours["QDA_readings"]) == {f"{p}, {c}" for p, c in settings["readings"]}
+    assert ours["QDA_readings"]["band, nodes"] == ours["QDA"]["1.0"]  # the same trees
+    for key, edges in summary["nodes_at_band_edges"].items():  # clamp piles nodes on the edges
+        assert key in ours["QDA_readings"]
+        assert all(value is None or 0.0 <= value <= 1.0 for value in edges.values())
+    for d in densities:
+        assert ours["ratio_qda_over_uniform"][d] == round(ours["QDA"][d] / ours["QRRT"][d], 2)
+        assert summary["side"][d] == round(20 * (6025 / 525 / float(d)) ** 0.5, 2)  # 6025 boxes at density d
+    assert summary["free_fraction"]["0.5"] > summary["free_fraction"]["1.0"]  # denser, less free
+    design = summary["paper_design"]
+    for method, where in summary["where_paper_falls"].items():
+        paper = summary["paper"][method]
+        assert where["inside_our_mean_at"] == [d for d in densities if not summary["differs_from_paper"][method][d]]
+        assert where["plausible_for_one_tree_at"] == [d for d in densities if design["paper_plausible"][method][d]]
+        assert all(design["range_95"][method][d][0] <= paper <= design["range_95"][method][d][1]
+                   for d in where["plausible_for_one_tree_at"])
 
 
 def _check_lemmas(summary, records):
@@ -298,7 +342,8 @@ CHECKS = {"oracle-efficiency": _check_oracle_efficiency, "wallclock": _check_wal
           "lemmas": _check_lemmas, "scaling": _check_scaling, "oracle-check": _check_oracle_check,
           "tree-size": _check_tree_size, "heatmap-hypotheses": _check_heatmap_hypotheses,
           "corridor-sensitivity": _check_corridor_sensitivity, "search-policies": _check_search_policies,
-          "noise": _check_noise, "resources": _check_resources, "heatmap-worlds": _check_heatmap_worlds}
+          "noise": _check_noise, "resources": _check_resources, "heatmap-worlds": _check_heatmap_worlds,
+          "annealing-density": _check_annealing_density}
 
 
 def _comparable(records):

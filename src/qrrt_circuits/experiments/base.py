@@ -49,6 +49,9 @@ class TrialStream(IntEnum):
     HEATMAP_WORLDS = 15
     # corridor-sensitivity: the runs of its factorial design (a block of runs is one trial)
     CORRIDOR_SENSITIVITY = 17
+    # annealing-density: its worlds (one per replicate and density) and planner seeds
+    ANNEALING_DENSITY_WORLDS = 19
+    ANNEALING_DENSITY_PLANNERS = 20
     # noise and resources: numbered from 31, apart from the streams above
     NOISE_SWEEP = 31
     NOISE_WORLDS = 32

@@ -1,6 +1,7 @@
 """Every experiment by name: the registry ``qrrt reproduce`` and ``run_experiment`` read."""
 
 from .annealing import Annealing
+from .annealing_density import AnnealingDensity
 from .corridor import Corridor
 from .corridor_sensitivity import CorridorSensitivity
 from .heatmap_hypotheses import HeatmapHypotheses
@@ -20,7 +21,7 @@ EXPERIMENTS = {
     experiment.name: experiment
     for experiment in (OracleEfficiency(), Wallclock(), Heatmaps(), Corridor(), Annealing(), Lemmas(),
                        Scaling(), OracleCheck(), TreeSize(), HeatmapHypotheses(), HeatmapWorlds(),
-                       CorridorSensitivity(), SearchPolicies(), Noise(), Resources())
+                       CorridorSensitivity(), SearchPolicies(), Noise(), Resources(), AnnealingDensity())
 }
 
 __all__ = ["EXPERIMENTS"]

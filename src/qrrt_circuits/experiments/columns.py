@@ -60,6 +60,7 @@ _NAMED: dict[str, ColumnKind] = {
         "critical_path_calls", "critical_path_oracle_calls", "simulation_checks", "duplicates", "rejected",
         "databases", "estimation_calls", "estimated_k_total", "calls_per_node", "reachable_fraction",
         "invalid_edges", "invalid_edges_fine", "in_channel", "through_channel", "start_distance", "wall_time_s",
+        "free_fraction",
         # searches and lemmas
         "iterations", "oracle_marked", "true_marked", "missed_good", "p_good", "repeats", "m",
         # noise

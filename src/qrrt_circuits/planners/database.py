@@ -5,7 +5,8 @@
 uniform over the workspace (a fraction ``goal_bias`` drawn in the goal instead), and pairs
 each with its nearest tree node. With an ``AnnealingSchedule`` each candidate keeps the direction
 from its parent to the sample but is moved to a distance drawn uniformly in the current band
-[r_min, r_max] (DESIGN §1).
+[r_min, r_max] (DESIGN §1); the schedule's ``placement`` names the other readings of Alg. 4, line 7
+that the paper's text allows.
 """
 
 from __future__ import annotations
@@ -35,6 +36,13 @@ def _check_bands(bands: Any) -> tuple[tuple[float, float], ...]:
     return tuple(checked)
 
 
+#: the readings of Alg. 4, line 7 ("Constrain t to disc of dist. H(h) from P") that
+#: ``AnnealingSchedule.placement`` names
+PLACEMENTS = ("band", "clamp", "annulus", "admit")
+#: ``placement="admit"``: the most samples drawn per database entry before the band is declared empty
+ADMIT_DRAWS_PER_ENTRY = 10_000
+
+
 @dataclass(frozen=True)
 class AnnealingSchedule:
     """Quantum Database Annealing (paper Algorithm 4): the temperature array H as distance bands.
@@ -45,19 +53,37 @@ class AnnealingSchedule:
     In Alg. 4 every database adds a node, so the two coincide; with the classical verification a
     database can add none, and counting nodes keeps the hot phase for the tree's first ``switch_at[0]`` nodes.
 
+    ``placement`` is the reading of Alg. 4, line 7 ("Constrain t to disc of dist. H(h) from P"; §IV.D:
+    "constrained to be within a ball of radius H(h) ... while maintaining child-sample direction";
+    §V.D: "databases of points at a distance between 2.7 and 4.2 units from current nodes", "only
+    further away nodes are admitted to the database"). With t a uniform sample, P its nearest node,
+    r the Euclidean distance from P to t and the band [a, b]:
+
+    - ``"band"`` (default): t moved along P -> t to a distance drawn uniformly in [a, b];
+    - ``"clamp"``: t projected onto the band along P -> t, to distance min(max(r, a), b) (the
+      constraint as a projection: only samples outside the band move);
+    - ``"annulus"``: t moved along P -> t to a distance sqrt(U(a^2, b^2)), the distance of a point
+      uniform over the annulus a <= r <= b around P (§IV.D's "sample initially over a disc");
+    - ``"admit"``: t kept where it is, and admitted to the database only if a <= r <= b (samples are
+      drawn until the database is full).
+
+    Distances are Euclidean (the paper's "disc").
+
     Args:
         bands: Non-empty sequence of (r_min, r_max) distance bands, finite, 0 <= r_min <= r_max and
             r_max > 0; band i is the distance range of Alg. 4's temperature H[i].
         switch_at: ``len(bands) - 1`` strictly increasing integers >= 1: the temperature indices at
             which the next band takes over (default ``()`` for one band).
         counter: What h counts: ``"databases"`` (default, Alg. 4) or ``"nodes"``.
+        placement: The reading of Alg. 4, line 7: ``"band"`` (default), ``"clamp"``, ``"annulus"``
+            or ``"admit"`` (above).
 
     Raises:
         TypeError: ``bands`` not a sequence of pairs, a non-real distance, ``switch_at`` not a
             tuple or list, or a non-integer entry of it.
         ValueError: An empty ``bands``, a negative or non-finite distance, r_min > r_max, r_max = 0,
             ``switch_at`` of the wrong length or not strictly increasing and >= 1, or an unknown
-            ``counter``.
+            ``counter`` or ``placement``.
 
     Example:
         >>> from qrrt_circuits import AnnealingSchedule
@@ -69,6 +95,7 @@ class AnnealingSchedule:
     bands: tuple[tuple[float, float], ...]
     switch_at: tuple[int, ...] = ()
     counter: str = "databases"
+    placement: str = "band"
 
     def __post_init__(self) -> None:
         bands = _check_bands(self.bands)
@@ -88,6 +115,7 @@ class AnnealingSchedule:
         if any(s <= 0 for s in switch_at) or np.any(steps <= 0):
             raise ValueError(f"switch_at must be strictly increasing positive integers, got {switch_at}")
         check_choice(self.counter, "counter", ("databases", "nodes"))
+        check_choice(self.placement, "placement", PLACEMENTS)
         object.__setattr__(self, "bands", bands)
         object.__setattr__(self, "switch_at", switch_at)
 
@@ -121,9 +149,9 @@ class AnnealingSchedule:
         return nodes if self.counter == "nodes" else databases
 
     def describe(self) -> dict:
-        """The schedule as JSON-able settings: ``bands``, ``switch_at`` and ``counter``."""
+        """The schedule as JSON-able settings: ``bands``, ``switch_at``, ``counter`` and ``placement``."""
         return {"bands": [list(band) for band in self.bands], "switch_at": list(self.switch_at),
-                "counter": self.counter}
+                "counter": self.counter, "placement": self.placement}
 
     def band(self, temperature_index: int) -> tuple[float, float]:
         """The band in force at temperature index h (h = 0, 1, ...).
@@ -186,28 +214,75 @@ def build_database(
     Returns:
         The ``Database`` of candidates and their nearest parents.
     """
+    space = RealVectorSpace(tree.dim) if space is None else space
+    band = None
+    if annealing is not None and annealing.placement == "admit":
+        band = annealing.band(temperature_index)
+        samples, parents = _admitted(tree, size, env, rng, goal, goal_bias, band, space)
+    else:
+        samples = _samples(size, env, rng, goal, goal_bias)
+        parents = space.nearest(tree, samples)
+        if annealing is not None:
+            band = annealing.band(temperature_index)
+            samples = _placed(tree.nodes[parents], samples, band, annealing.placement, rng)
+    return Database(steer(space, tree.nodes[parents], samples, max_extension), parents, band)
+
+
+def _samples(size: int, env: Environment, rng: np.random.Generator, goal: Goal | None,
+             goal_bias: float) -> np.ndarray:
+    """``size`` uniform samples of the workspace, a fraction ``goal_bias`` drawn in the goal instead."""
     samples = env.sample_uniform(size, rng)
     if goal_bias > 0 and goal is not None:
         biased = rng.random(size) < goal_bias
         count = int(biased.sum())
         if count:
             samples[biased] = sample_goal(goal, count, rng)
-    space = RealVectorSpace(tree.dim) if space is None else space
-    parents = space.nearest(tree, samples)
-    band = None
-    if annealing is not None:
-        band = annealing.band(temperature_index)
-        origin = tree.nodes[parents]
-        offset = samples - origin
-        norm = np.linalg.norm(offset, axis=1)
-        zero = norm == 0
-        if np.any(zero):  # a sample on its parent: any direction will do
-            offset[zero] = rng.normal(size=(int(zero.sum()), tree.dim))
-            norm[zero] = np.linalg.norm(offset[zero], axis=1)
-        distance = rng.uniform(band[0], band[1], size)
-        samples = origin + offset / norm[:, None] * distance[:, None]
-    return Database(steer(space, tree.nodes[parents], samples, max_extension), parents, band)
+    return samples
 
+
+def _placed(origin: np.ndarray, samples: np.ndarray, band: tuple[float, float], placement: str,
+            rng: np.random.Generator) -> np.ndarray:
+    """Each sample moved along origin -> sample to its ``placement`` distance in ``band``
+    (``AnnealingSchedule``: ``"band"``, ``"clamp"`` or ``"annulus"``)."""
+    offset = samples - origin
+    norm = np.linalg.norm(offset, axis=1)
+    zero = norm == 0
+    if np.any(zero):  # a sample on its parent: any direction will do
+        offset[zero] = rng.normal(size=(int(zero.sum()), origin.shape[1]))
+        norm[zero] = np.linalg.norm(offset[zero], axis=1)
+    low, high = band
+    if placement == "band":
+        distance = rng.uniform(low, high, len(samples))
+    elif placement == "clamp":
+        distance = np.clip(np.where(zero, 0.0, norm), low, high)
+    else:  # "annulus": uniform over the annulus' area, density proportional to the radius
+        distance = np.sqrt(rng.uniform(low * low, high * high, len(samples)))
+    return origin + offset / norm[:, None] * distance[:, None]
+
+
+def _admitted(tree: Tree, size: int, env: Environment, rng: np.random.Generator, goal: Goal | None,
+              goal_bias: float, band: tuple[float, float], space: StateSpace) -> tuple[np.ndarray, np.ndarray]:
+    """``size`` samples whose Euclidean distance to their nearest node lies in ``band``, and those
+    nodes (``placement="admit"``): batches of ``size`` samples, in order, until ``size`` are admitted.
+
+    Raises:
+        RuntimeError: Fewer than ``size`` admitted in ``ADMIT_DRAWS_PER_ENTRY * size`` samples.
+    """
+    kept_samples: list[np.ndarray] = []
+    kept_parents: list[np.ndarray] = []
+    admitted = 0
+    for _ in range(ADMIT_DRAWS_PER_ENTRY):
+        samples = _samples(size, env, rng, goal, goal_bias)
+        parents = space.nearest(tree, samples)
+        distance = np.linalg.norm(samples - tree.nodes[parents], axis=1)
+        inside = (distance >= band[0]) & (distance <= band[1])
+        kept_samples.append(samples[inside])
+        kept_parents.append(parents[inside])
+        admitted += int(inside.sum())
+        if admitted >= size:
+            return np.concatenate(kept_samples)[:size], np.concatenate(kept_parents)[:size]
+    raise RuntimeError(f"annealing placement 'admit': {admitted} of {size} samples admitted to the band "
+                       f"{band} in {ADMIT_DRAWS_PER_ENTRY * size} draws; the band is (nearly) empty of samples")
 
 def steer(space: StateSpace, origins: np.ndarray, samples: np.ndarray, max_extension: float | None) -> np.ndarray:
     """Each sample moved toward its origin until it lies at most ``max_extension`` from it under

@@ -183,34 +183,45 @@ def narrow_corridor(seed: int | None = 0, width: float = 0.4, length: float = 4.
                                  "mouth_clearance": mouth_clearance})
 
 
-def annealing_field(seed: int | None = 0, num_boxes: int = 6025) -> Environment:
+def annealing_field(seed: int | None = 0, num_boxes: int = 6025, side: float | None = None) -> Environment:
     """The Quantum Database Annealing world (paper §V.D, DESIGN §4).
 
     ``num_boxes`` boxes with ``paper_clutter``'s sides U(0.25, 0.85) on a square whose side keeps
     ``paper_clutter``'s box density (20 * sqrt(6025 / 525) ~ 67.75 by default), so the free
-    fraction matches. Start and goal as in ``paper_clutter``; goal radius 0.75.
+    fraction matches. Start and goal as in ``paper_clutter``; goal radius 0.75. The paper gives the
+    box count only; ``side`` sets the square (and so the density) instead: the box density relative
+    to the default is (default side / side)^2 at 6025 boxes.
 
     Args:
         seed: Non-negative integer (same seed, same world) or None (fresh entropy).
-        num_boxes: Boxes (the paper's 6025).
+        num_boxes: Boxes (the paper's 6025), >= 0.
+        side: Side of the square, finite and > 1.7 (twice the largest box side), or None (default:
+            ``paper_clutter``'s density).
 
     Returns:
         The ``Environment`` with ``start``, ``goal``, ``goal_radius`` and metadata set.
 
     Raises:
-        ValueError: A negative ``seed``.
-        TypeError: A non-integer ``seed``.
+        ValueError: A negative ``seed`` or ``num_boxes``, or ``side`` <= 1.7 or not finite.
+        TypeError: A non-integer ``seed``, or a non-real ``side``.
         RuntimeError: No start and goal could be placed.
     """
     _check_seed(seed)
-    size = CLUTTER_SIZE * math.sqrt(num_boxes / CLUTTER_BOXES)
+    if num_boxes < 0:
+        raise ValueError(f"num_boxes must be >= 0, got {num_boxes}")
+    if side is None:
+        size = CLUTTER_SIZE * math.sqrt(num_boxes / CLUTTER_BOXES)
+    else:
+        size = check_float(side, "side", 2 * SIDE_RANGE[1], open_minimum=True)
     rng = _world_rng("annealing_field", seed)
     bounds = np.array([[0.0, size], [0.0, size]])
     boxes = _random_boxes(rng, num_boxes, bounds[:, 0], bounds[:, 1])
     env = Environment(bounds, boxes, name="annealing_field")
     start, goal = _start_goal(env, rng, size / 2, GOAL_RADIUS)
+    metadata = {"seed": seed, "num_boxes": num_boxes} if side is None else {"seed": seed, "num_boxes": num_boxes,
+                                                                           "side": size}
     return Environment(bounds, boxes, name="annealing_field", start=start, goal=goal,
-                       goal_radius=GOAL_RADIUS, metadata={"seed": seed, "num_boxes": num_boxes})
+                       goal_radius=GOAL_RADIUS, metadata=metadata)
 
 
 def lattice(seed: int | None = 0, size: int = 72, blocked_fraction: float = 0.5) -> Environment:
