@@ -95,6 +95,8 @@ def _check_wallclock(summary, records):
 def _check_heatmaps(summary, records):
     cuts = [str(c) for c in summary["settings"]["cuts"]]
     for kind, by_cut in summary["ours"].items():
+        if kind == "PQRRT_total_calls":
+            continue
         rows = [r for r in records if r["planner"] == kind]
         for cut in cuts:
             assert by_cut[cut]["nodes"] == sum(r[f"nodes_at_{cut}"] for r in rows)
@@ -103,11 +105,14 @@ def _check_heatmaps(summary, records):
         assert [by_cut[c]["nodes"] for c in cuts] == sorted(by_cut[c]["nodes"] for c in cuts)
     pq = [r for r in records if r["planner"] == "PQRRT"]
     for cut in cuts:  # Pq-RRT cut on total calls: the same runs, read earlier than on the critical path
-        total = summary["pqrrt_on_total_calls"][cut]
+        total = summary["ours"]["PQRRT_total_calls"][cut]
         assert total["nodes"] == sum(r[f"nodes_at_{cut}_total"] for r in pq) <= summary["ours"]["PQRRT"][cut]["nodes"]
         assert all(r[f"calls_at_{cut}_total"] >= int(cut) or r["status"] == "reached" for r in pq)
-        low, high = total["interval_95"]["efficiency"]
+        low, high = summary["interval_95"]["PQRRT_total_calls"][cut]["efficiency"]
         assert low <= total["efficiency"] <= high
+        for cut_on, kind in (("critical_path", "PQRRT"), ("total_calls", "PQRRT_total_calls")):
+            assert summary["pqrrt_over_qrrt_nodes"][cut_on][cut] == pytest.approx(
+                summary["ours"][kind][cut]["nodes"] / summary["ours"]["QRRT"][cut]["nodes"], abs=0.005)
     for r in records:
         if r["planner"] != "PQRRT":
             assert all(r[f"nodes_at_{c}_total"] == r[f"nodes_at_{c}"] for c in cuts)
@@ -115,15 +120,35 @@ def _check_heatmaps(summary, records):
 
 def _check_heatmap_worlds(summary, records):
     assert summary["round_costs"]["fitting"] == [3]  # the paper's totals fit only a 3-call round
+    variants = summary["settings"]["variants"]
+    assert variants == ["RRT", "QRRT", "QRRT_PAPER"]
     worlds = summary["per_world"]
-    assert len(worlds) == summary["worlds_run"] == len(records) // 2
+    assert len(worlds) == summary["worlds_run"] == len(records) // len(variants)
     for key, entry in worlds.items():  # the rule, re-applied to the stored intervals
         inside = all(entry["RRT"][c]["efficiency_interval_95"][0] <= summary["paper"]["RRT"][c]["efficiency"]
                      <= entry["RRT"][c]["efficiency_interval_95"][1] for c in ("10", "20", "40"))
         assert entry["passes"] == inside and (key in summary["passing_worlds"]) == inside
+        for variant in variants:
+            for cut in ("10", "20", "40"):
+                assert 0.0 <= entry[variant][cut]["reachable_fraction"] <= 1.0
+                low, high = entry[variant][cut]["nodes_interval_95"]
+                assert low <= entry[variant][cut]["nodes"] <= high
+        # the paper's schedule spends 6 calls a round: at most ceil(b / 6) nodes a run
+        for cut, most in summary["round_costs"]["paper_schedule_most_nodes"].items():
+            assert entry["QRRT_PAPER"][cut]["nodes"] <= most
+    by_id = {(r["variant"], r["boxes"], r["world_seed"]): r for r in records}
+    for (_, boxes, w), record in by_id.items():  # the variants of one world share its planner seeds
+        assert record["seed"] == by_id[("RRT", boxes, w)]["seed"]
     for label, by_planner in summary["efficiency_at_10_quantiles_over_worlds"].items():
         for low, middle, high in by_planner.values():
             assert low <= middle <= high, label
+    for label, by_planner in summary["advantage_at_10_over_worlds"].items():
+        for advantage in by_planner.values():
+            low, middle, high = advantage["difference"]
+            assert low <= middle <= high and 0 <= advantage["worlds_quantum_below_rrt"] <= len(worlds), label
+    for variant, by_cut in summary["highest_nodes_over_worlds"].items():
+        for cut, best in by_cut.items():
+            assert best["nodes"] == max(entry[variant][cut]["nodes"] for entry in worlds.values())
 
 
 def _check_corridor(summary, records):

@@ -5,7 +5,10 @@ The paper ran its 100 trials in one world. Its q-RRT call totals (372 / 0.312 = 
 trial at the 10-, 20- and 40-call cuts) fit only a round of 3 calls (2 Grover iterations and one
 verification): a run cut at b calls stops after the first round that reaches b, so it makes
 c ceil(b / c) calls with rounds of c calls, and only c = 3 gives 12, 21 and 42 (``round_costs``).
-So q-RRT runs here with ``FixedIterations(2)``.
+So q-RRT runs here with ``FixedIterations(2)``. For contrast it also runs with the paper's schedule
+(``PaperIterations``: 5 iterations, so 6-call rounds, until the tree passes 10 nodes), which cannot
+give the paper's totals: with 6-call rounds a run cut at b calls adds at most ceil(b / 6) nodes,
+200, 400 and 700 per 100 trials at the three cuts, below the paper's 372, 650 and 1 091.
 
 Success after 2 iterations, sin^2(5 theta), is steeply non-linear in a world's reachable fraction,
 so efficiencies pooled over worlds are not those of any one world. The experiment therefore runs
@@ -14,11 +17,19 @@ applies an acceptance rule fixed before the run to RRT alone: **a world passes w
 three RRT efficiencies (12.5 %, 11.6 % and 13.2 % at 10, 20 and 40 calls) all lie inside that
 world's 95 % intervals from its 100 RRT runs.** q-RRT's nodes and efficiencies in exactly the
 passing worlds, with their intervals, are then set against the paper's. Over all worlds, the 5 %,
-50 % and 95 % quantiles of both planners' efficiency at 10 calls show how world-dependent the
+50 % and 95 % quantiles of each planner's efficiency at 10 calls, and of q-RRT's advantage over RRT
+(the difference and the ratio of their efficiencies in one world), show how world-dependent the
 advantage is.
 
-A trial is one block: 100 runs of one planner in one world, each cut at 40 oracle calls (the 10-
-and 20-call cuts read from its history, ``cut_at``).
+The runs also record the reachable share of the candidates they evaluated (q-RRT: its databases'
+entries) up to each cut. With k iterations a database whose reachable share is f = sin^2 theta is
+searched successfully with probability sin^2((2k + 1) theta), highest at f = sin^2(pi / (4k + 2)):
+9.5 % for k = 2, 2.0 % for k = 5. A share that grows past that peak as the tree grows lowers the
+efficiency at later cuts.
+
+A trial is one block: 100 runs of one planner variant in one world, each cut at 40 oracle calls (the
+10- and 20-call cuts read from its history, ``cut_at``). The variants of one world share its planner
+seeds.
 """
 
 from __future__ import annotations
@@ -29,11 +40,11 @@ from typing import Any
 
 import numpy as np
 
-from ..search.policies.iteration import FixedIterations
+from ..search.policies.iteration import FixedIterations, PaperIterations
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import bootstrap_ratio_interval, differs, rounded_interval
-from .measures import cut_at, dumps, loads
+from .measures import cut_at, dumps, loads, reachable_at
 from .planners import planner_for
 from .worlds import world
 
@@ -41,14 +52,20 @@ BOX_COUNTS = (100, 150, 200, 250, 300, 400, 525)
 #: the most world seeds per obstacle count (a world's planner seeds are keyed by count and seed)
 WORLDS_PER_COUNT = 1000
 CUTS = (10, 20, 40)
-#: label -> (registry planner, search policy)
-VARIANTS = {"RRT": ("rrt", None), "QRRT": ("qrrt", FixedIterations(2))}
+#: label -> (registry planner, search policy): RRT, q-RRT with the 3-call round the paper's totals
+#: imply, q-RRT with the paper's schedule (for contrast)
+VARIANTS = {"RRT": ("rrt", None), "QRRT": ("qrrt", FixedIterations(2)), "QRRT_PAPER": ("qrrt", PaperIterations())}
+#: the q-RRT variants, each compared with the paper's q-RRT
+QUANTUM = ("QRRT", "QRRT_PAPER")
+#: calls of one round of the paper's schedule while the tree is small (5 iterations + 1 verification)
+PAPER_SCHEDULE_ROUND = 6
 #: planner -> cut -> {"nodes" (per 100 trials), "efficiency"}
 PAPER: dict[str, dict[str, dict[str, float]]] = {
     "RRT": {"10": {"nodes": 125, "efficiency": 0.125}, "20": {"nodes": 231, "efficiency": 0.116},
             "40": {"nodes": 526, "efficiency": 0.132}},
     "QRRT": {"10": {"nodes": 372, "efficiency": 0.312}, "20": {"nodes": 650, "efficiency": 0.310},
              "40": {"nodes": 1091, "efficiency": 0.260}}}
+PAPER["QRRT_PAPER"] = PAPER["QRRT"]  # the paper's q-RRT, against either round
 ACCEPTANCE_RULE = ("a world passes when the paper's RRT efficiencies at 10, 20 and 40 calls (0.125, 0.116, 0.132) "
                    "all lie inside that world's 95 % intervals from its RRT runs; fixed before the run, applied "
                    "to RRT only")
@@ -76,7 +93,32 @@ def round_costs(paper: dict[str, dict[str, float]], costs: range = range(1, 13),
     implied = {cut: value["nodes"] / value["efficiency"] / 100.0 for cut, value in paper.items()}
     fitting = [c for c in costs if all(abs(calls_per_trial(c, int(cut)) - calls) <= tolerance
                                        for cut, calls in implied.items())]
-    return {"paper_calls_per_trial": {cut: round(calls, 3) for cut, calls in implied.items()}, "fitting": fitting}
+    return {"paper_calls_per_trial": {cut: round(calls, 3) for cut, calls in implied.items()}, "fitting": fitting,
+            "calls_per_trial_by_round": {str(c): {cut: calls_per_trial(c, int(cut)) for cut in paper}
+                                         for c in (3, PAPER_SCHEDULE_ROUND)},
+            "paper_schedule_most_nodes": {cut: most_nodes(PAPER_SCHEDULE_ROUND, int(cut)) for cut in paper}}
+
+
+def most_nodes(round_cost: int, cut: int, trials: int = 100) -> int:
+    """The most nodes ``trials`` runs cut at ``cut`` calls can add with rounds of ``round_cost``
+    calls: one node a round at best, ``trials * ceil(cut / round_cost)``.
+
+    With the paper's schedule a tree stays below its switch at 10 nodes up to 40 calls (at most 7
+    rounds), so every round costs 6 calls and the most is 200, 400 and 700 nodes per 100 trials
+    at 10, 20 and 40 calls.
+    """
+    return trials * math.ceil(cut / round_cost)
+
+
+def peak_fraction(iterations: int) -> float:
+    """The reachable share f at which k Grover iterations succeed for certain: sin^2((2k + 1) theta)
+    = 1 with f = sin^2 theta, so f = sin^2(pi / (4k + 2)) (9.5 % for k = 2)."""
+    return math.sin(math.pi / (4 * iterations + 2)) ** 2
+
+
+def quantiles(values: list[float]) -> list[float] | None:
+    """The 5 %, 50 % and 95 % quantiles, rounded to 4 digits (None for no values)."""
+    return [round(float(q), 4) for q in np.quantile(values, [0.05, 0.5, 0.95])] if values else None
 
 
 def passes(intervals: dict[str, list[float]], paper: dict[str, dict[str, float]]) -> bool:
@@ -120,6 +162,8 @@ class HeatmapWorlds(Experiment):
         options: dict[str, Any] = {} if policy is None else {"search_policy": policy}
         nodes: dict[str, list[int]] = {str(cut): [] for cut in settings["cuts"]}
         calls: dict[str, list[int]] = {str(cut): [] for cut in settings["cuts"]}
+        reachable: dict[str, list[int]] = {str(cut): [] for cut in settings["cuts"]}
+        entries: dict[str, list[int]] = {str(cut): [] for cut in settings["cuts"]}
         for run in range(settings["runs"]):  # the planners of one world share their seeds across variants
             planner = planner_for(settings, planner_name, env, replicate_seed(trial.seed, run),
                                   settings["backend"], num_qubits=settings["num_qubits"], **options)
@@ -128,97 +172,129 @@ class HeatmapWorlds(Experiment):
                 placed, spent = cut_at(result, cut)
                 nodes[str(cut)].append(placed)
                 calls[str(cut)].append(spent)
-        return {"nodes_json": dumps(nodes), "calls_json": dumps(calls)}
+                good, seen = reachable_at(result, cut)
+                reachable[str(cut)].append(good)
+                entries[str(cut)].append(seen)
+        return {"nodes_json": dumps(nodes), "calls_json": dumps(calls), "reachable_json": dumps(reachable),
+                "entries_json": dumps(entries)}
 
     def summarize(self, records: list[Record], settings: Settings) -> Summary:
-        seed, cuts = settings["seed"], [str(c) for c in settings["cuts"]]
-        blocks = {(r["variant"], r["boxes"], r["world_seed"]): (loads(r["nodes_json"]), loads(r["calls_json"]))
+        seed, cuts, variants = settings["seed"], [str(c) for c in settings["cuts"]], settings["variants"]
+        blocks = {(r["variant"], r["boxes"], r["world_seed"]): {key: loads(r[f"{key}_json"]) for key in
+                                                                ("nodes", "calls", "reachable", "entries")}
                   for r in records}
 
-        def measure(nodes: list[int], calls: list[int]) -> dict[str, Any]:
-            spent = sum(calls)
+        def measure(block: dict[str, list[int]]) -> dict[str, Any]:
+            nodes, calls, spent, seen = block["nodes"], block["calls"], sum(block["calls"]), sum(block["entries"])
             return {"nodes": round(100.0 * sum(nodes) / len(nodes), 1),
                     "efficiency": round(sum(nodes) / spent, 4) if spent else None,
                     "nodes_interval_95": rounded_interval(bootstrap_ratio_interval(nodes, None, seed,
                                                                                    per_trials=100.0), 1),
-                    "efficiency_interval_95": rounded_interval(bootstrap_ratio_interval(nodes, calls, seed))}
+                    "efficiency_interval_95": rounded_interval(bootstrap_ratio_interval(nodes, calls, seed)),
+                    "reachable_fraction": round(sum(block["reachable"]) / seen, 4) if seen else None}
+
+        def at_cut(variant: str, keys: list[str], cut: str) -> dict[str, list[int]]:
+            """The runs of ``variant`` in the worlds ``keys``, read at ``cut``, pooled."""
+            return {column: [value for key in keys for value in blocks[(variant, *_world(per_world[key]))][column][cut]]
+                    for column in ("nodes", "calls", "reachable", "entries")}
 
         per_world: dict[str, dict[str, Any]] = {}
         for boxes in settings["box_counts"]:
             for w in range(settings["worlds"]):
                 entry: dict[str, Any] = {"boxes": boxes, "world_seed": w}
-                for variant in settings["variants"]:
-                    nodes, calls = blocks[(variant, boxes, w)]
-                    entry[variant] = {cut: measure(nodes[cut], calls[cut]) for cut in cuts}
+                for variant in variants:
+                    block = blocks[(variant, boxes, w)]
+                    entry[variant] = {cut: measure({column: values[cut] for column, values in block.items()})
+                                      for cut in cuts}
                 entry["passes"] = passes({cut: entry["RRT"][cut]["efficiency_interval_95"] for cut in cuts},
                                          PAPER["RRT"])
-                entry["paper_qrrt_inside"] = all(
-                    not differs(PAPER["QRRT"][cut][key], entry["QRRT"][cut][f"{key}_interval_95"])
-                    for cut in cuts for key in ("nodes", "efficiency"))
+                entry["paper_inside"] = {variant: all(
+                    not differs(PAPER[variant][cut][key], entry[variant][cut][f"{key}_interval_95"])
+                    for cut in cuts for key in ("nodes", "efficiency")) for variant in variants if variant in QUANTUM}
                 per_world[f"{boxes}-{w}"] = entry
         passing = [key for key, entry in per_world.items() if entry["passes"]]
         ours: dict[str, dict[str, dict[str, float | None]]] = {}
         interval: dict[str, dict[str, dict[str, list[float]]]] = {}
         differs_from_paper: dict[str, dict[str, dict[str, bool | None]]] = {}
-        for variant in settings["variants"]:  # pooled over the passing worlds' runs
-            ours[variant], interval[variant], differs_from_paper[variant] = {}, {}, {}
+        reachable: dict[str, dict[str, float | None]] = {}
+        for variant in variants:  # pooled over the passing worlds' runs
+            ours[variant], interval[variant], differs_from_paper[variant], reachable[variant] = {}, {}, {}, {}
             for cut in cuts:
-                nodes = [n for key in passing for n in blocks[(variant, *_world(per_world[key]))][0][cut]]
-                calls = [c for key in passing for c in blocks[(variant, *_world(per_world[key]))][1][cut]]
-                if not nodes:
+                pooled_runs = at_cut(variant, passing, cut)
+                if not pooled_runs["nodes"]:
                     ours[variant][cut] = {"nodes": None, "efficiency": None}
+                    reachable[variant][cut] = None
                     continue
-                pooled = measure(nodes, calls)
+                pooled = measure(pooled_runs)
                 ours[variant][cut] = {"nodes": pooled["nodes"], "efficiency": pooled["efficiency"]}
                 interval[variant][cut] = {"nodes": pooled["nodes_interval_95"],
                                           "efficiency": pooled["efficiency_interval_95"]}
                 differs_from_paper[variant][cut] = {key: differs(PAPER[variant][cut][key], interval[variant][cut][key])
                                                     for key in ("nodes", "efficiency")}
-        spread: dict[str, dict[str, list[float]]] = {}
-        for label, keys in [(str(boxes), [k for k, e in per_world.items() if e["boxes"] == boxes])
-                            for boxes in settings["box_counts"]] + [("all", list(per_world))]:
-            spread[label] = {variant: [round(float(q), 4) for q in np.quantile(
-                [per_world[key][variant]["10"]["efficiency"] for key in keys], [0.05, 0.5, 0.95])]
-                for variant in settings["variants"]}
-        return {"ours": ours, "paper": PAPER, "interval_95": interval, "differs_from_paper": differs_from_paper,
+                reachable[variant][cut] = pooled["reachable_fraction"]
+        groups = [(str(boxes), [k for k, e in per_world.items() if e["boxes"] == boxes])
+                  for boxes in settings["box_counts"]] + [("all", list(per_world))]
+        spread = {label: {variant: quantiles([per_world[key][variant]["10"]["efficiency"] for key in keys])
+                          for variant in variants} for label, keys in groups}
+        advantage = {label: {variant: _advantage([per_world[key]["RRT"]["10"]["efficiency"] for key in keys],
+                                                 [per_world[key][variant]["10"]["efficiency"] for key in keys])
+                             for variant in variants if variant in QUANTUM} for label, keys in groups}
+        highest = {variant: {cut: _highest(per_world, variant, cut) for cut in cuts}
+                   for variant in variants if variant in QUANTUM}
+        return {"ours": ours, "paper": {variant: PAPER[variant] for variant in variants}, "interval_95": interval,
+                "differs_from_paper": differs_from_paper,
                 "acceptance_rule": ACCEPTANCE_RULE, "passing_worlds": passing,
-                "paper_qrrt_inside_in_passing_worlds": [key for key in passing
-                                                        if per_world[key]["paper_qrrt_inside"]],
+                "paper_inside_in_passing_worlds": {variant: [key for key in passing
+                                                             if per_world[key]["paper_inside"][variant]]
+                                                   for variant in variants if variant in QUANTUM},
                 "worlds_run": len(per_world), "per_world": per_world,
                 "efficiency_at_10_quantiles_over_worlds": spread,
+                "advantage_at_10_over_worlds": advantage,
+                "highest_nodes_over_worlds": highest,
+                "reachable_fraction_in_passing_worlds": reachable,
+                "peak_reachable_fraction": {"QRRT": round(peak_fraction(2), 4),
+                                            "QRRT_PAPER": round(peak_fraction(PaperIterations().early), 4)},
                 "round_costs": round_costs(PAPER["QRRT"]),
                 "note": "ours: pooled over the runs of the passing worlds (nodes per 100 runs); per_world gives each "
                         "world's own values; quantiles over worlds are the 5 %, 50 % and 95 % of the worlds' "
-                        "efficiencies at 10 calls. The paper's Fig. 12 caption says 60 calls where its text "
-                        "says 40; 40 is used.",
+                        "values at 10 calls (advantage: q-RRT's efficiency minus RRT's, and their ratio over the "
+                        "worlds where RRT added a node). QRRT_PAPER (the paper's schedule) is a contrast: its "
+                        "6-call rounds cannot reach the paper's totals (round_costs). The paper's Fig. 12 caption "
+                        "says 60 calls where its text says 40; 40 is used.",
                 "labels": ["phase oracle from a classical lookup of all 2^8 entries",
                            "backend: exact statevector (ideal; same statistics as Aer)",
-                           "q-RRT: 2 Grover iterations a round (the round the paper's call totals imply)"]}
+                           "QRRT: 2 Grover iterations a round (the round the paper's call totals imply)",
+                           "QRRT_PAPER: the paper's schedule (5 iterations, 3 after 10 nodes)"]}
 
     def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
-        fig, axes = new_figure(1, 2, (12, 4.6))
+        """Left and middle: one point per world (RRT against q-RRT with 2 iterations, at 10 and 40
+        calls), the passing worlds highlighted, the paper's pair as a star. Right: the quantiles over
+        worlds of each variant's efficiency at 10 calls, by obstacle count."""
+        fig, axes = new_figure(1, 3, (17, 4.8))
         worlds = summary["per_world"]
-        ax = axes[0, 0]
-        for entry in worlds.values():
-            x = entry["RRT"]["10"]["efficiency"]
-            y = entry["QRRT"]["10"]["efficiency"]
-            ax.scatter(x, y, s=14, color="tab:orange" if entry["passes"] else "tab:gray",
-                       alpha=0.9 if entry["passes"] else 0.4)
-        ax.scatter([], [], color="tab:orange", s=14, label="passes the RRT rule")
-        ax.scatter([], [], color="tab:gray", s=14, alpha=0.4, label="does not")
-        ax.scatter([PAPER["RRT"]["10"]["efficiency"]], [PAPER["QRRT"]["10"]["efficiency"]], marker="*", s=160,
-                   color="k", label="paper")
-        ax.set_xlabel("RRT efficiency at 10 calls (one world)")
-        ax.set_ylabel("q-RRT (k = 2) efficiency at 10 calls")
-        ax.set_title(f"{summary['worlds_run']} single worlds, {settings['runs']} runs each", fontsize=10)
-        ax.legend(fontsize=7)
-        ax.grid(alpha=0.3)
-        ax = axes[0, 1]
+        for ax, cut, key in ((axes[0, 0], "10", "efficiency"), (axes[0, 1], "40", "nodes")):
+            for entry in worlds.values():
+                ax.scatter(entry["RRT"][cut]["efficiency"], entry["QRRT"][cut][key], s=14,
+                           color="tab:orange" if entry["passes"] else "tab:gray",
+                           alpha=0.9 if entry["passes"] else 0.4)
+            ax.scatter([], [], color="tab:orange", s=14, label="passes the RRT rule")
+            ax.scatter([], [], color="tab:gray", s=14, alpha=0.4, label="does not")
+            ax.scatter([PAPER["RRT"][cut]["efficiency"]], [PAPER["QRRT"][cut][key]], marker="*", s=160,
+                       color="k", label="paper")
+            ax.set_xlabel(f"RRT efficiency at {cut} calls (one world)")
+            ax.set_ylabel(f"q-RRT (k = 2) {'efficiency' if key == 'efficiency' else 'nodes per 100 runs'} "
+                          f"at {cut} calls")
+            ax.set_title(f"{summary['worlds_run']} single worlds, {settings['runs']} runs each, {cut} calls",
+                         fontsize=10)
+            ax.legend(fontsize=7)
+            ax.grid(alpha=0.3)
+        ax = axes[0, 2]
         counts = settings["box_counts"]
-        for variant, color in (("RRT", "tab:gray"), ("QRRT", "tab:orange")):
-            quantiles = np.array([summary["efficiency_at_10_quantiles_over_worlds"][str(b)][variant] for b in counts])
-            ax.fill_between(counts, quantiles[:, 0], quantiles[:, 2], color=color, alpha=0.25)
-            ax.plot(counts, quantiles[:, 1], marker="o", ms=4, color=color, label=f"{variant}: median, 5-95 %")
+        colors = {"RRT": "tab:gray", "QRRT": "tab:orange", "QRRT_PAPER": "tab:blue"}
+        for variant in settings["variants"]:
+            bands = np.array([summary["efficiency_at_10_quantiles_over_worlds"][str(b)][variant] for b in counts])
+            ax.fill_between(counts, bands[:, 0], bands[:, 2], color=colors[variant], alpha=0.2)
+            ax.plot(counts, bands[:, 1], marker="o", ms=4, color=colors[variant], label=f"{variant}: median, 5-95 %")
         ax.axhline(PAPER["RRT"]["10"]["efficiency"], color="tab:gray", ls="--", lw=1, label="paper RRT")
         ax.axhline(PAPER["QRRT"]["10"]["efficiency"], color="tab:orange", ls="--", lw=1, label="paper q-RRT")
         ax.set_xlabel("obstacles in the 20 x 20 world")
@@ -231,3 +307,24 @@ class HeatmapWorlds(Experiment):
 
 def _world(entry: dict[str, Any]) -> tuple[int, int]:
     return entry["boxes"], entry["world_seed"]
+
+
+def _advantage(rrt: list[float | None], quantum: list[float | None]) -> dict[str, Any]:
+    """q-RRT's advantage over RRT across worlds: quantiles of the difference of their efficiencies
+    (every world), of their ratio (the worlds where RRT added a node), and the worlds where q-RRT's
+    efficiency is below RRT's."""
+    pairs = [(r or 0.0, q or 0.0) for r, q in zip(rrt, quantum, strict=True)]
+    return {"difference": quantiles([q - r for r, q in pairs]),
+            "ratio": quantiles([q / r for r, q in pairs if r > 0]),
+            "worlds_rrt_added_none": sum(1 for r, _ in pairs if r == 0),
+            "worlds_quantum_below_rrt": sum(1 for r, q in pairs if q < r)}
+
+
+def _highest(per_world: dict[str, dict[str, Any]], variant: str, cut: str) -> dict[str, Any]:
+    """The world where ``variant`` placed the most nodes at ``cut``, with its interval and RRT's
+    efficiency in the same world."""
+    key = max(per_world, key=lambda k: per_world[k][variant][cut]["nodes"])
+    found = per_world[key]
+    return {"world": key, "nodes": found[variant][cut]["nodes"],
+            "nodes_interval_95": found[variant][cut]["nodes_interval_95"],
+            "rrt_efficiency": found["RRT"][cut]["efficiency"], "passes": found["passes"]}

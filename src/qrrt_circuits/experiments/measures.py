@@ -55,6 +55,27 @@ def cut_at(result: PlanResult, budget: int, on: str = "oracle_calls") -> tuple[i
     return int(nodes[index]), int(calls[index])
 
 
+def reachable_at(result: PlanResult, budget: int, on: str = "oracle_calls") -> tuple[int, int]:
+    """(truly reachable candidates, all candidates) the run evaluated up to the cut of ``cut_at``:
+    summed over its rounds up to and including the first round whose ``on`` count reaches
+    ``budget`` (every round if none does).
+
+    Args:
+        result: A finished plan (its per-round ``history``).
+        budget: The call budget to cut at.
+        on: The ``history`` counter compared with ``budget``.
+
+    Returns:
+        ``(reachable, entries)``; ``(0, 0)`` for a plan without rounds.
+    """
+    calls = result.history[on]
+    if len(calls) == 0:
+        return 0, 0
+    reached = np.flatnonzero(calls >= budget)
+    stop = int(reached[0]) + 1 if reached.size else len(calls)
+    return int(result.history["reachable"][:stop].sum()), int(result.history["entries"][:stop].sum())
+
+
 def reachable_fraction(result: PlanResult) -> float:
     """Truly reachable candidates / all candidates the run evaluated (RRT: its tests; q-RRT: its
     database entries).
