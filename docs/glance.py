@@ -77,13 +77,19 @@ ROWS = (
         facts=(("rrt", "corridor-sensitivity", ("ours", "RRT", "w1.0-l8.0-c120-d3.0")),
                ("span", "corridor-sensitivity", ("interval_95", "RRT", "w1.0-l8.0-c120-d3.0")))),
     Row("Figs. 15-17", "QDA mean parent distance, 16 nodes", "annealing", ("QDA", "16"),
-        "open; the 2x spread is reproduced", paper_path=("QDA",)),
+        "open: outside one tree's range {single} at every density and every reading of Alg. 4 line 7 tried",
+        paper_path=("QDA",), facts=(("single", "annealing", ("paper_design", "range_95", "QDA", "16")),)),
+    Row("Figs. 15-17", "uniform q-RRT mean parent distance, 16 nodes", "annealing", ("QRRT", "16"),
+        "explained by the world's density (our assumption): our mean crosses it between {low}x and {high}x",
+        paper_path=("QRRT",),
+        facts=(("low", "annealing-density", ("where_paper_falls", "QRRT", "our_mean_crosses_paper_between", "0")),
+               ("high", "annealing-density", ("where_paper_falls", "QRRT", "our_mean_crosses_paper_between", "1")))),
 )
 
 
 def _at(value: Any, path: tuple[str, ...]) -> Any:
     for key in path:
-        value = value[key]
+        value = value[int(key)] if isinstance(value, list) else value[key]
     return value
 
 
