@@ -77,7 +77,8 @@ ROWS = (
         facts=(("rrt", "corridor-sensitivity", ("ours", "RRT", "w1.0-l8.0-c120-d3.0")),
                ("span", "corridor-sensitivity", ("interval_95", "RRT", "w1.0-l8.0-c120-d3.0")))),
     Row("Figs. 15-17", "QDA mean parent distance, 16 nodes", "annealing", ("QDA", "16"),
-        "open: outside one tree's range {single} at every density and every reading of Alg. 4 line 7 tried",
+        "open: outside one tree's range {single}; our reading stays below it at every density, the other "
+        "readings of Alg. 4 line 7 at our density (other densities not run)",
         paper_path=("QDA",), facts=(("single", "annealing", ("paper_design", "range_95", "QDA", "16")),)),
     Row("Figs. 15-17", "uniform q-RRT mean parent distance, 16 nodes", "annealing", ("QRRT", "16"),
         "explained by the world's density (our assumption): our mean crosses it between {low}x and {high}x",
