@@ -20,7 +20,8 @@ from .._support.randomness import RandomStreams, Stream
 from .._support.validation import check_choice, check_float, check_int
 from ..world.environment import Environment
 from ..world.spaces import RealVectorSpace, StateSpace
-from .goals import Goal, sample_goal
+from .goals import Goal
+from .placement import PLACEMENTS, uniform_samples
 from .tree import Tree
 
 
@@ -36,11 +37,6 @@ def _check_bands(bands: Any) -> tuple[tuple[float, float], ...]:
     return tuple(checked)
 
 
-#: the readings of Alg. 4, line 7 ("Constrain t to disc of dist. H(h) from P") that
-#: ``AnnealingSchedule.placement`` names
-PLACEMENTS = ("band", "clamp", "annulus", "admit")
-#: ``placement="admit"``: the most samples drawn per database entry before the band is declared empty
-ADMIT_DRAWS_PER_ENTRY = 10_000
 
 
 @dataclass(frozen=True)
@@ -115,7 +111,7 @@ class AnnealingSchedule:
         if any(s <= 0 for s in switch_at) or np.any(steps <= 0):
             raise ValueError(f"switch_at must be strictly increasing positive integers, got {switch_at}")
         check_choice(self.counter, "counter", ("databases", "nodes"))
-        check_choice(self.placement, "placement", PLACEMENTS)
+        check_choice(self.placement, "placement", tuple(PLACEMENTS))
         object.__setattr__(self, "bands", bands)
         object.__setattr__(self, "switch_at", switch_at)
 
@@ -216,73 +212,15 @@ def build_database(
     """
     space = RealVectorSpace(tree.dim) if space is None else space
     band = None
-    if annealing is not None and annealing.placement == "admit":
-        band = annealing.band(temperature_index)
-        samples, parents = _admitted(tree, size, env, rng, goal, goal_bias, band, space)
-    else:
-        samples = _samples(size, env, rng, goal, goal_bias)
+    if annealing is None:
+        samples = uniform_samples(size, env, rng, goal, goal_bias)
         parents = space.nearest(tree, samples)
-        if annealing is not None:
-            band = annealing.band(temperature_index)
-            samples = _placed(tree.nodes[parents], samples, band, annealing.placement, rng)
+    else:  # Alg. 4, line 7, under the schedule's reading (``placement.PLACEMENTS``)
+        band = annealing.band(temperature_index)
+        samples, parents = PLACEMENTS[annealing.placement].candidates(tree, size, env, rng, goal, goal_bias, band,
+                                                                      space)
     return Database(steer(space, tree.nodes[parents], samples, max_extension), parents, band)
 
-
-def _samples(size: int, env: Environment, rng: np.random.Generator, goal: Goal | None,
-             goal_bias: float) -> np.ndarray:
-    """``size`` uniform samples of the workspace, a fraction ``goal_bias`` drawn in the goal instead."""
-    samples = env.sample_uniform(size, rng)
-    if goal_bias > 0 and goal is not None:
-        biased = rng.random(size) < goal_bias
-        count = int(biased.sum())
-        if count:
-            samples[biased] = sample_goal(goal, count, rng)
-    return samples
-
-
-def _placed(origin: np.ndarray, samples: np.ndarray, band: tuple[float, float], placement: str,
-            rng: np.random.Generator) -> np.ndarray:
-    """Each sample moved along origin -> sample to its ``placement`` distance in ``band``
-    (``AnnealingSchedule``: ``"band"``, ``"clamp"`` or ``"annulus"``)."""
-    offset = samples - origin
-    norm = np.linalg.norm(offset, axis=1)
-    zero = norm == 0
-    if np.any(zero):  # a sample on its parent: any direction will do
-        offset[zero] = rng.normal(size=(int(zero.sum()), origin.shape[1]))
-        norm[zero] = np.linalg.norm(offset[zero], axis=1)
-    low, high = band
-    if placement == "band":
-        distance = rng.uniform(low, high, len(samples))
-    elif placement == "clamp":
-        distance = np.clip(np.where(zero, 0.0, norm), low, high)
-    else:  # "annulus": uniform over the annulus' area, density proportional to the radius
-        distance = np.sqrt(rng.uniform(low * low, high * high, len(samples)))
-    return origin + offset / norm[:, None] * distance[:, None]
-
-
-def _admitted(tree: Tree, size: int, env: Environment, rng: np.random.Generator, goal: Goal | None,
-              goal_bias: float, band: tuple[float, float], space: StateSpace) -> tuple[np.ndarray, np.ndarray]:
-    """``size`` samples whose Euclidean distance to their nearest node lies in ``band``, and those
-    nodes (``placement="admit"``): batches of ``size`` samples, in order, until ``size`` are admitted.
-
-    Raises:
-        RuntimeError: Fewer than ``size`` admitted in ``ADMIT_DRAWS_PER_ENTRY * size`` samples.
-    """
-    kept_samples: list[np.ndarray] = []
-    kept_parents: list[np.ndarray] = []
-    admitted = 0
-    for _ in range(ADMIT_DRAWS_PER_ENTRY):
-        samples = _samples(size, env, rng, goal, goal_bias)
-        parents = space.nearest(tree, samples)
-        distance = np.linalg.norm(samples - tree.nodes[parents], axis=1)
-        inside = (distance >= band[0]) & (distance <= band[1])
-        kept_samples.append(samples[inside])
-        kept_parents.append(parents[inside])
-        admitted += int(inside.sum())
-        if admitted >= size:
-            return np.concatenate(kept_samples)[:size], np.concatenate(kept_parents)[:size]
-    raise RuntimeError(f"annealing placement 'admit': {admitted} of {size} samples admitted to the band "
-                       f"{band} in {ADMIT_DRAWS_PER_ENTRY * size} draws; the band is (nearly) empty of samples")
 
 def steer(space: StateSpace, origins: np.ndarray, samples: np.ndarray, max_extension: float | None) -> np.ndarray:
     """Each sample moved toward its origin until it lies at most ``max_extension`` from it under
