@@ -564,20 +564,55 @@ class Terminated(KeyboardInterrupt):
         self.signum = signum
 
 
+class _Received:
+    """The first stop signal received while ``main`` runs (its number), or None; while
+    ``deferring`` is set, a signal is only recorded, and ``deferred`` raises it at the block's end."""
+
+    signum: int | None = None
+    deferring: bool = False
+
+    @contextlib.contextmanager
+    def deferred(self) -> Iterator[None]:
+        """Hold stop signals back while the block runs (an interrupt inside a C extension's import
+        is printed and turned into an ``ImportError`` by numba), then raise the one received."""
+        self.deferring = True
+        try:
+            yield
+        finally:
+            self.deferring = False
+        stop = self.stop()
+        if stop is not None:
+            raise stop
+
+    def stop(self) -> KeyboardInterrupt | None:
+        """The interrupt that signal stands for, or None."""
+        if self.signum is None:
+            return None
+        return KeyboardInterrupt() if self.signum == signal.SIGINT else Terminated(self.signum)
+
+
 @contextlib.contextmanager
-def _stop_signals() -> Iterator[None]:
+def _stop_signals() -> Iterator[_Received]:
     """While the block runs, each signal of ``STOP_SIGNALS`` whose disposition is the default raises
     ``Terminated`` (once: a repeat while the command shuts down is ignored, so the shut-down
-    finishes); a signal that is ignored (``nohup``) or has a handler of the caller's keeps it. The
-    previous dispositions are restored on exit. Outside the main thread (where Python cannot set
-    handlers) nothing changes."""
-    raised = False
+    finishes); a signal that is ignored (``nohup``) or has a handler of the caller's keeps it.
+    Ctrl-C keeps Python's ``KeyboardInterrupt``, recorded too. The block gets the record
+    (``_Received``): a library that turns an interrupt into an error of its own (numba's C import
+    does) cannot hide that the command was stopped. The previous dispositions are restored on exit.
+    Outside the main thread (where Python cannot set handlers) nothing changes."""
+    received = _Received()
 
     def stop(signum: int, frame: object) -> None:
-        nonlocal raised
-        if not raised:
-            raised = True
-            raise Terminated(signum)
+        if received.signum is None:
+            received.signum = signum
+            if not received.deferring:
+                raise Terminated(signum)
+
+    def interrupt(signum: int, frame: object) -> None:
+        if received.signum is None:
+            received.signum = signum
+        if not received.deferring:
+            raise KeyboardInterrupt
 
     saved: dict[int, Any] = {}
     try:
@@ -585,10 +620,13 @@ def _stop_signals() -> Iterator[None]:
             if signal.getsignal(signum) == signal.SIG_DFL:
                 signal.signal(signum, stop)
                 saved[signum] = signal.SIG_DFL
+        if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+            signal.signal(signal.SIGINT, interrupt)
+            saved[signal.SIGINT] = signal.default_int_handler
     except ValueError:  # not the main thread
         pass
     try:
-        yield
+        yield received
     finally:
         for signum, previous in saved.items():
             signal.signal(signum, previous)
@@ -703,16 +741,18 @@ def main(argv: list[str] | None = None) -> int:
     """
     words = sys.argv[1:] if argv is None else list(argv)
     args: argparse.Namespace | None = None
-    with _stop_signals():
+    with _stop_signals() as received:
         try:
-            args = build_parser().parse_args(argv)
+            with received.deferred():  # the parser's registries import numpy, numba and scipy
+                parser = build_parser()
+            args = parser.parse_args(argv)
             status: int = args.func(args)
             return status
         except KeyboardInterrupt as stop:
             return _stopped(stop, args.command if args is not None else _command_in(words), args)
         except Exception as exc:
             command = args.command if args is not None else _command_in(words)
-            stop_in_chain = _interrupt_in(exc)
+            stop_in_chain = _interrupt_in(exc) or received.stop()  # (an error a signal caused)
             if stop_in_chain is not None:
                 return _stopped(stop_in_chain, command, args)
             _exit(command, exc)
