@@ -12,7 +12,7 @@ TINY = {"oracle-efficiency": 1, "wallclock": 1, "heatmaps": 2, "corridor": 2, "a
         "lemmas": 60, "scaling": 1, "oracle-check": 1,
         "tree-size": 1, "heatmap-hypotheses": 3,
         "corridor-sensitivity": 2, "search-policies": 1, "noise": 1, "resources": 1,
-        "heatmap-worlds": 5, "annealing-density": 2}
+        "heatmap-worlds": 5, "annealing-density": 2, "problems": 2}
 
 
 def _is_png(path):
@@ -336,6 +336,32 @@ def _check_search_policies(summary, records):
     _assert_intervals_hold(estimation, summary["estimation_interval_95"])
 
 
+def _check_problems(summary, records):
+    from qrrt_circuits.experiments.problems import POLICY_CANDIDATES
+
+    settings = summary["settings"]
+    for r in records:
+        if r["reached"]:  # the shortcut never lengthens a path (straight segments, a metric)
+            assert r["path_length_simplified"] <= r["path_length"] + 1e-9
+        else:  # only the budget ends a run that did not reach the goal
+            assert r["status"] == "max_oracle_calls" and r["oracle_calls"] >= settings["budget"]
+        assert r["critical_path_calls"] <= r["oracle_calls"]
+        assert r["classical_checks"] >= r["simulation_checks"]
+        if r["config"].startswith("QRRT") or r["config"].startswith("PQRRT"):
+            assert r["simulation_checks"] > 0 and r["simulation_checks"] % (1 << settings["num_qubits"]) == 0
+        elif r["config"] == "RRT range" or r["config"].startswith("OMPL"):  # no check thrown away
+            assert r["classical_checks"] == r["oracle_calls"]
+    for family, planners in summary["ours"].items():
+        for config, row in planners.items():
+            runs = [r for r in records if r["family"] == family and r["config"] == config]
+            solved = sum(r["reached"] for r in runs)
+            assert row["success_rate"] == round(solved / len(runs), 4)
+            if solved:
+                assert row["calls_per_solution"] == round(sum(r["oracle_calls"] for r in runs) / solved, 4)
+        _assert_intervals_hold(planners, summary["interval_95"][family])
+    assert summary["default_policy"]["chosen"] in POLICY_CANDIDATES
+
+
 def _check_noise(summary, records):
     for r in records:
         if r["part"] == "sweep" and r["p2"] == 0 and r["shots"] == 0:  # zero noise: exactly the ideal
@@ -368,7 +394,7 @@ CHECKS = {"oracle-efficiency": _check_oracle_efficiency, "wallclock": _check_wal
           "tree-size": _check_tree_size, "heatmap-hypotheses": _check_heatmap_hypotheses,
           "corridor-sensitivity": _check_corridor_sensitivity, "search-policies": _check_search_policies,
           "noise": _check_noise, "resources": _check_resources, "heatmap-worlds": _check_heatmap_worlds,
-          "annealing-density": _check_annealing_density}
+          "annealing-density": _check_annealing_density, "problems": _check_problems}
 
 
 def _comparable(records):

@@ -71,7 +71,8 @@ def test_problem_files_build_their_family(tmp_path):
 
 
 @pytest.mark.parametrize(("fields", "message"), [
-    ({"family": "maze"}, r"\"family\" must be one of \['boxes', 'image', 'narrow-passage', 'open-space', 'se2-gap'\]"),
+    ({"family": "labyrinth"},
+     r"\"family\" must be one of \['boxes', 'image', 'maze', 'narrow-passage', 'open-space', 'se2-gap'\]"),
     ({"family": "narrow-passage", "dim": 9}, "dim must be an integer in"),
     ({"family": "narrow-passage", "width": 0}, "width must be a finite number"),
     ({"family": "narrow-passage", "depth": 1}, r"takes \['dim', 'width'\], not \['depth'\]"),
@@ -146,3 +147,81 @@ def test_an_image_problem_file_plans_on_its_grid(tmp_path):
     with pytest.raises(ValueError, match=r"start \[5.0, 1.0\] is not a free point of the map: it lies in or on "
                                          r"the boundary of the occupied image pixel \(row 18, col 9\)"):
         load_problem(walled)  # refused as it is read, before any planner is built
+
+
+@pytest.mark.parametrize("cells,seed", [(2, 0), (4, 3), (7, 11)])
+def test_mazes_are_perfect_and_seeded(cells, seed):
+    from qrrt_circuits.world.maze import maze_grid
+
+    grid = maze_grid(cells, seed)
+    free = grid.free
+    assert free.shape == (2 * cells + 1, 2 * cells + 1)
+    assert not free[0].any() and not free[-1].any() and not free[:, 0].any() and not free[:, -1].any()
+    # a perfect maze is a spanning tree of the rooms: rooms + openings = 2 rooms - 1 free pixels,
+    # and every free pixel is connected to room (0, 0)
+    assert int(free.sum()) == 2 * cells * cells - 1
+    seen, stack = {(2 * cells - 1, 1)}, [(2 * cells - 1, 1)]
+    while stack:
+        r, c = stack.pop()
+        for nr, nc in ((r + 1, c), (r - 1, c), (r, c + 1), (r, c - 1)):
+            if free[nr, nc] and (nr, nc) not in seen:
+                seen.add((nr, nc))
+                stack.append((nr, nc))
+    assert len(seen) == int(free.sum())
+    assert np.array_equal(maze_grid(cells, seed).free, free)
+    assert any(not np.array_equal(maze_grid(cells, other).free, free) for other in range(seed + 1, seed + 6))
+
+
+@pytest.mark.parametrize("arguments,message", [({"cells": 1}, "cells"), ({"cells": 300}, "cells"),
+                                               ({"seed": -1}, "seed"), ({"pixel_size": 0.0}, "pixel_size")])
+def test_bad_maze_arguments_are_refused_by_name(arguments, message):
+    from qrrt_circuits.world.maze import maze_grid
+
+    with pytest.raises(ValueError, match=message):
+        maze_grid(**({"cells": 3, "seed": 0} | arguments))
+
+
+def test_the_maze_problem_is_solved_through_its_corridors():
+    from qrrt_circuits.world.problems import maze
+
+    problem = maze(4, seed=2)
+    assert problem.env.bounds.tolist() == [[0.0, 10.0], [0.0, 10.0]]
+    for planner in (qc.RRT(problem.env, seed=0, goal_bias=0.05, **problem.planner_options()),
+                    qc.QRRT(problem.env, backend=qc.StatevectorBackend(seed=0), seed=0, goal_bias=0.05,
+                            search_policy=qc.Adaptive(), **problem.planner_options())):
+        result = planner.plan(goal=problem.goal, max_oracle_calls=20000)
+        assert result.reached
+        assert problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
+    assert load_problem(_write_maze(problem)).env.metadata == problem.env.metadata
+
+
+def _write_maze(problem):
+    import tempfile
+    from pathlib import Path
+
+    path = Path(tempfile.mkdtemp()) / "maze.json"
+    path.write_text(json.dumps({"format": "qrrt-problem", "version": 1, "family": "maze", "cells": 4, "seed": 2}))
+    return path
+
+
+def test_the_shortcut_keeps_checked_motions_and_never_lengthens():
+    from qrrt_circuits.planners.paths import path_length, shortcut
+
+    problem = narrow_passage(2, 0.5)
+    result = qc.RRT(problem.env, seed=3, goal_bias=0.05, max_extension=1.0, **problem.planner_options()).plan(
+        goal=problem.goal, max_oracle_calls=20000)
+    assert result.reached
+    short = shortcut(result.path, problem.predicate)
+    assert np.array_equal(short[0], result.path[0]) and np.array_equal(short[-1], result.path[-1])
+    assert problem.predicate.reachable(short[:-1], short[1:]).all()
+    assert path_length(short) <= path_length(result.path) + 1e-12
+    assert len(short) < len(result.path)  # 1-unit steps across 8 units of free space shorten
+    straight = np.array([[1.0, 1.0], [2.0, 1.0], [3.0, 1.0]])  # collinear in free space: one motion
+    assert shortcut(straight, open_space().predicate).tolist() == [[1.0, 1.0], [3.0, 1.0]]
+    assert path_length(straight) == pytest.approx(2.0)
+
+
+def test_rigid_body_checks_are_counted():
+    problem = se2_gap()
+    problem.predicate.reachable(np.array([[2.0, 2.0, 0.0]] * 3), np.array([[2.5, 2.0, 0.0]] * 3))
+    assert problem.predicate.evaluations == 3

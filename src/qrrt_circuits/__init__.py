@@ -27,7 +27,7 @@ if TYPE_CHECKING:
     from .reachability.authors_check import AuthorsCheck
     from .reachability.dynamics import LinearTrackingDynamics
     from .reachability.exact import ExactCheck
-    from .reachability.grid_check import GridCheck, image_world
+    from .reachability.grid_check import GridCheck, grid_world, image_world
     from .reachability.oracle_errors import OracleErrorModel
     from .reachability.predicate import ReachabilityPredicate
     from .reachability.time_sampled import TimeSampledCheck
@@ -73,7 +73,7 @@ _WHERE = {
     "AuthorsCheck": ".reachability.authors_check",
     "LinearTrackingDynamics": ".reachability.dynamics",
     "ExactCheck": ".reachability.exact",
-    **dict.fromkeys(["GridCheck", "image_world"], ".reachability.grid_check"),
+    **dict.fromkeys(["GridCheck", "grid_world", "image_world"], ".reachability.grid_check"),
     "OracleErrorModel": ".reachability.oracle_errors",
     "ReachabilityPredicate": ".reachability.predicate",
     "TimeSampledCheck": ".reachability.time_sampled",
@@ -184,6 +184,7 @@ __all__ = [
     "TerminationCondition",
     "TimeSampledCheck",
     "circuits",
+    "grid_world",
     "image_world",
     "probability",
     "registry",

@@ -52,6 +52,8 @@ class TrialStream(IntEnum):
     # annealing-density: its worlds (one per replicate and density) and planner seeds
     ANNEALING_DENSITY_WORLDS = 19
     ANNEALING_DENSITY_PLANNERS = 20
+    # problems: the planner seeds of its replicates (its worlds are fixed, or seeded by replicate)
+    PROBLEMS_PLANNERS = 21
     # noise and resources: numbered from 31, apart from the streams above
     NOISE_SWEEP = 31
     NOISE_WORLDS = 32

@@ -11,6 +11,7 @@ from .lemmas import Lemmas
 from .noise import Noise
 from .oracle_check import OracleCheck
 from .oracle_efficiency import OracleEfficiency
+from .problems import Problems
 from .resources import Resources
 from .scaling import Scaling
 from .search_policies import SearchPolicies
@@ -21,7 +22,7 @@ EXPERIMENTS = {
     experiment.name: experiment
     for experiment in (OracleEfficiency(), Wallclock(), Heatmaps(), Corridor(), Annealing(), Lemmas(),
                        Scaling(), OracleCheck(), TreeSize(), HeatmapHypotheses(), HeatmapWorlds(),
-                       CorridorSensitivity(), SearchPolicies(), Noise(), Resources(), AnnealingDensity())
+                       CorridorSensitivity(), SearchPolicies(), Noise(), Resources(), AnnealingDensity(), Problems())
 }
 
 __all__ = ["EXPERIMENTS"]

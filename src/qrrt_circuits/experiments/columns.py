@@ -61,6 +61,8 @@ _NAMED: dict[str, ColumnKind] = {
         "databases", "estimation_calls", "estimated_k_total", "calls_per_node", "reachable_fraction",
         "invalid_edges", "invalid_edges_fine", "in_channel", "through_channel", "start_distance", "wall_time_s",
         "free_fraction",
+        # problem families
+        "reached", "classical_checks", "path_length", "path_length_simplified",
         # searches and lemmas
         "iterations", "oracle_marked", "true_marked", "missed_good", "p_good", "repeats", "m",
         # noise

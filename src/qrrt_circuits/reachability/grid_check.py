@@ -257,8 +257,30 @@ def image_world(path: str | Path, pixel_size: float, start: np.ndarray, goal: np
         ([[0.0, 4.0], [0.0, 4.0]], [False, True])
     """
     grid = OccupancyGrid.from_image(path, pixel_size, free_threshold, negate, origin)
+    return grid_world(grid, start, goal, goal_radius, name=f"image:{Path(path).stem}")
+
+
+def grid_world(grid: OccupancyGrid, start: np.ndarray, goal: np.ndarray, goal_radius: float,
+               name: str = "grid") -> tuple[Environment, GridCheck]:
+    """The planning problem of an ``OccupancyGrid``: an ``Environment`` with the grid's bounds and
+    no boxes, and the grid's ``GridCheck`` (``image_world`` for a grid read from an image).
+
+    Args:
+        grid: The grid.
+        start: (x, y).
+        goal: (x, y), the centre of the goal ball.
+        goal_radius: The goal ball's radius (> 0).
+        name: The environment's name.
+
+    Returns:
+        (environment, check).
+
+    Raises:
+        ValueError: Anything ``Environment`` refuses, or a ``start`` or ``goal`` that is not a valid
+            point of the map (``check.is_valid``), naming it and the pixel.
+    """
     check = GridCheck(grid)
-    env = Environment(grid.bounds(), np.zeros((0, 2, 2)), name=f"image:{Path(path).stem}", start=start,
+    env = Environment(grid.bounds(), np.zeros((0, 2, 2)), name=name, start=start,
                       goal=goal, goal_radius=goal_radius, metadata={"occupancy": grid.describe()})
     for key, point in (("start", env.start), ("goal", env.goal)):
         if point is not None and not check.is_valid(point)[0]:

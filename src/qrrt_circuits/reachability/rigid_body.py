@@ -90,6 +90,9 @@ class RigidBodyCheck:
             default 0.02).
         name: The check's name in results (default ``"rigid-body"``).
 
+    Attributes:
+        evaluations: Pairs evaluated so far through ``reachable``.
+
     Raises:
         ValueError: Malformed ``workspace`` or ``boxes``, or non-positive lengths or resolution.
     """
@@ -112,11 +115,13 @@ class RigidBodyCheck:
                              check_float(half_lengths[1], "half_lengths[1]", 0.0, open_minimum=True))
         self.resolution = check_float(resolution, "resolution", 0.0, open_minimum=True)
         self.workspace, self.boxes, self.name = workspace, np.ascontiguousarray(boxes), name
+        self.evaluations = 0
 
     def reachable(self, parents: np.ndarray, children: np.ndarray) -> np.ndarray:
         parents, children = as_pairs(parents, children, 3)
         out = np.empty(parents.shape[0], dtype=np.bool_)
         _motions_free(parents, children, *self.half_lengths, self.resolution, self.boxes, self.workspace, out)
+        self.evaluations += int(parents.shape[0])
         return out
 
     def is_valid(self, points: np.ndarray) -> np.ndarray:

@@ -8,6 +8,9 @@ Families (each a function returning a ``Problem``):
   of side ``width`` at its centre; straight-line motions; d = 2 .. 6.
 - ``se2_gap(width)``: a 1.2 x 0.4 rectangle in SE(2) through a gap of ``width`` in a wall
   (``reachability.rigid_body``).
+- ``maze(cells, seed)``: a perfect maze of ``cells`` x ``cells`` rooms drawn by the library
+  (``world.maze``) in [0, 10]^2, from the bottom-left room to the top-right one, with the exact
+  grid check of straight segments (``reachability.grid_check``).
 - ``box_world(path)``: a ``qrrt-environment`` scenario file (the paper's motion model).
 - ``image_problem(path, pixel_size, start, goal, goal_radius)``: an occupancy image (PNG, PGM,
   PPM) with the exact grid check of straight segments (``reachability.grid_check``).
@@ -39,7 +42,7 @@ from ..reachability.rigid_body import se2_world
 from .environment import Environment
 from .spaces import RealVectorSpace, SE2Space, StateSpace
 
-__all__ = ["FAMILIES", "Problem", "box_world", "image_problem", "load_problem", "narrow_passage", "open_space",
+__all__ = ["FAMILIES", "Problem", "box_world", "image_problem", "load_problem", "maze", "narrow_passage", "open_space",
            "se2_gap", "straight_line_dynamics"]
 
 PROBLEM_FORMAT, PROBLEM_VERSION = "qrrt-problem", 1
@@ -149,6 +152,34 @@ def se2_gap(width: float = 1.2) -> Problem:
     return Problem("se2-gap", env, check, SE2Space(), GoalBall(goal, 1.0))
 
 
+def maze(cells: int = 4, seed: int = 0) -> Problem:
+    """A perfect maze of ``cells`` x ``cells`` rooms (``world.maze.maze_grid``) scaled to
+    [0, 10]^2 (pixel side 10 / (2 cells + 1)); start at the centre of the bottom-left room, goal
+    ball at the centre of the top-right room with radius 0.4 pixel sides.
+
+    Args:
+        cells: Rooms along a side, in [2, 32].
+        seed: The maze's seed (>= 0).
+
+    Returns:
+        The problem (``GridCheck`` over the maze).
+
+    Raises:
+        TypeError: A non-integer ``cells`` or ``seed``.
+        ValueError: ``cells`` outside [2, 32] or a negative ``seed``.
+    """
+    from ..reachability.grid_check import grid_world
+    from .maze import maze_grid, room_center
+
+    cells = check_int(cells, "cells", 2, 32)
+    grid = maze_grid(cells, seed, 10.0 / (2 * cells + 1))
+    start, goal = room_center(grid, 0, 0), room_center(grid, cells - 1, cells - 1)
+    radius = 0.4 * grid.pixel_size
+    name = f"maze-{cells}x{cells}-seed{seed}"
+    env, check = grid_world(grid, start, goal, radius, name=name)
+    return Problem(name, env, check, RealVectorSpace(2), GoalBall(goal, radius))
+
+
 def box_world(path: str | Path) -> Problem:
     """A ``qrrt-environment`` scenario file with the library's default motion model (the paper's
     dynamics, ``ExactCheck``).
@@ -194,6 +225,7 @@ FAMILIES: dict[str, tuple[Any, dict[str, Any]]] = {
     "open-space": (open_space, {}),
     "narrow-passage": (narrow_passage, {"dim": 2, "width": 0.5}),
     "se2-gap": (se2_gap, {"width": 1.2}),
+    "maze": (maze, {"cells": 4, "seed": 0}),
     "image": (image_problem, {"path": None, "pixel_size": None, "start": None, "goal": None, "goal_radius": None,
                               "free_threshold": 0.5, "negate": False}),
 }
