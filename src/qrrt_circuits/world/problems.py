@@ -100,7 +100,8 @@ def open_space() -> Problem:
 
 def narrow_passage(dim: int = 2, width: float = 0.5) -> Problem:
     """[0, 10]^d cut by the wall 4.5 <= x_0 <= 5.5 with a hole |x_i - 5| < width / 2 (i >= 1);
-    start (1, 5, ..., 5), goal ball (9, 5, ..., 5) of radius 0.5.
+    start (1, 2, ..., 2), goal ball (9, 2, ..., 2) of radius 0.5: the straight line between them
+    meets the wall, so every path turns through the hole.
 
     Args:
         dim: d in [2, 6].
@@ -122,16 +123,16 @@ def narrow_passage(dim: int = 2, width: float = 0.5) -> Problem:
             lower[0], upper[0] = 4.5, 5.5
             lower[axis], upper[axis] = low, high
             boxes.append([lower, upper])
-    centre = np.full(dim, 5.0)
-    start, goal = centre.copy(), centre.copy()
+    start, goal = np.full(dim, 2.0), np.full(dim, 2.0)  # level with each other, away from the hole
     start[0], goal[0] = 1.0, 9.0
     return _box_problem(f"narrow-passage-{dim}d", np.tile([0.0, 10.0], (dim, 1)), np.array(boxes), start, goal, 0.5)
 
 
 def se2_gap(width: float = 1.2) -> Problem:
     """A 1.2 x 0.4 rectangle (half-lengths 0.6, 0.2) in SE(2) through a gap of ``width`` (centred
-    at y = 5) in the wall 4.8 <= x <= 5.2 of [0, 10]^2; start (2, 2, pi / 2), goal ball (8, 8, 0)
-    of radius 1 (Euclidean in (x, y, theta)).
+    at y = 5) in the wall 4.8 <= x <= 5.2 of [0, 10]^2; start (2, 8, pi / 2), goal ball (8, 8, 0)
+    of radius 1 (Euclidean in (x, y, theta)): the straight motion between them meets the wall, so
+    every path goes down to the gap and through it.
 
     Args:
         width: The gap, in (0, 8].
@@ -147,7 +148,7 @@ def se2_gap(width: float = 1.2) -> Problem:
     wall = np.array([[[4.8, 0.0], [5.2, 5.0 - width / 2]], [[4.8, 5.0 + width / 2], [5.2, 10.0]]])
     goal = np.array([8.0, 8.0, 0.0])
     env, check = se2_world(np.array([[0.0, 10.0], [0.0, 10.0]]), wall, (0.6, 0.2),
-                           start=np.array([2.0, 2.0, math.pi / 2]), goal=goal, goal_radius=1.0, resolution=0.05,
+                           start=np.array([2.0, 8.0, math.pi / 2]), goal=goal, goal_radius=1.0, resolution=0.05,
                            name="se2-gap")
     return Problem("se2-gap", env, check, SE2Space(), GoalBall(goal, 1.0))
 
