@@ -5,7 +5,7 @@ image, beside the exact check (``qc.ExactCheck``) on box worlds of similar clutt
 
 Worlds, all 20 x 20 length units:
 
-- ``maze512``: a perfect maze (randomized depth-first search, seed 0) of 64 x 64 rooms, corridors
+- ``maze512``: a perfect maze (``qrrt_circuits.world.maze``, seed 0) of 64 x 64 rooms, corridors
   7 pixels wide and walls 1 pixel thick, cropped to 512 x 512 pixels of 20 / 512, written as a PNG
   and read with ``qc.image_world``; checked by ``GridCheck`` (straight segments, every cell
   touched);
@@ -39,34 +39,10 @@ import numpy as np  # noqa: E402
 from _common import machine, median_time, write_json  # noqa: E402
 
 import qrrt_circuits as qc  # noqa: E402
+from qrrt_circuits.world.maze import maze_free  # noqa: E402
 
 SIDE = 512
 EXTENT = 20.0
-
-
-def maze(rooms: int, corridor: int, seed: int) -> np.ndarray:
-    """A perfect maze as a bool image (True = free): ``rooms`` x ``rooms`` rooms of ``corridor``
-    pixels, walls 1 pixel thick (randomized depth-first search)."""
-    rng = np.random.default_rng(seed)
-    step = corridor + 1
-    free = np.zeros((rooms * step + 1, rooms * step + 1), dtype=bool)
-    seen = np.zeros((rooms, rooms), dtype=bool)
-    stack = [(0, 0)]
-    seen[0, 0] = True
-    free[1:1 + corridor, 1:1 + corridor] = True
-    while stack:
-        r, c = stack[-1]
-        options = [(r + dr, c + dc) for dr, dc in ((1, 0), (-1, 0), (0, 1), (0, -1))
-                   if 0 <= r + dr < rooms and 0 <= c + dc < rooms and not seen[r + dr, c + dc]]
-        if not options:
-            stack.pop()
-            continue
-        nr, nc = options[rng.integers(len(options))]
-        seen[nr, nc] = True
-        top, left = 1 + min(r, nr) * step, 1 + min(c, nc) * step
-        free[top:1 + max(r, nr) * step + corridor, left:1 + max(c, nc) * step + corridor] = True
-        stack.append((nr, nc))
-    return free
 
 
 def as_boxes(free: np.ndarray, pixel_size: float) -> np.ndarray:
@@ -119,7 +95,7 @@ def main() -> None:
     args = parser.parse_args()
     sizes = (1, 100, 1000) if args.quick else (1, 100, 10_000)
     repeats = 3 if args.quick else 9
-    free = maze(64, 7, seed=0)[:SIDE, :SIDE]
+    free = maze_free(64, seed=0, corridor=7)[:SIDE, :SIDE]
     pixel = EXTENT / SIDE
     with tempfile.TemporaryDirectory(prefix="qrrt-bench-grid-") as scratch:
         path = Path(scratch) / "maze512.png"

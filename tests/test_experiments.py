@@ -359,6 +359,7 @@ def _check_problems(summary, records):
             if solved:
                 assert row["calls_per_solution"] == round(sum(r["oracle_calls"] for r in runs) / solved, 4)
         _assert_intervals_hold(planners, summary["interval_95"][family])
+        _assert_intervals_hold(summary["details"][family], summary["details_interval_95"][family])
     assert summary["default_policy"]["chosen"] in POLICY_CANDIDATES
 
 

@@ -36,6 +36,7 @@ NOTEBOOKS = [
     "04_quantum_database_annealing.ipynb",
     "05_custom_predicate.ipynb",
     "06_would_it_pay_off.ipynb",
+    "07_plan_your_ompl_problem.ipynb",
 ]
 INTERPRETER_MARK = "kernel interpreter: "
 

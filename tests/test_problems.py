@@ -172,8 +172,9 @@ def test_mazes_are_perfect_and_seeded(cells, seed):
     assert any(not np.array_equal(maze_grid(cells, other).free, free) for other in range(seed + 1, seed + 6))
 
 
-@pytest.mark.parametrize("arguments,message", [({"cells": 1}, "cells"), ({"cells": 300}, "cells"),
-                                               ({"seed": -1}, "seed"), ({"pixel_size": 0.0}, "pixel_size")])
+@pytest.mark.parametrize("arguments,message", [({"cells": 1}, "cells"), ({"cells": 40000}, "MAX_SIDE|at most"),
+                                               ({"seed": -1}, "seed"), ({"pixel_size": 0.0}, "pixel_size"),
+                                               ({"corridor": 0}, "corridor")])
 def test_bad_maze_arguments_are_refused_by_name(arguments, message):
     from qrrt_circuits.world.maze import maze_grid
 

@@ -1,12 +1,13 @@
 """Planners for the experiments, built through the registry with the experiments' defaults
-(8 workers, 2^8 databases, one Aer thread per process so that trials can run side by side)."""
+(8 workers, 2^8 databases, the paper's search schedule, one Aer thread per process so that trials can
+run side by side)."""
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
 from ..registry import BACKENDS, PLANNERS, POLICIES, PREDICATES
-from ..search.policies.iteration import IterationPolicy
+from ..search.policies.iteration import IterationPolicy, PaperIterations
 
 if TYPE_CHECKING:
     from ..planners.base import Planner
@@ -56,7 +57,8 @@ def make_planner(kind: str, env: Environment, seed: int, backend: str = "aer", w
         backend: A ``BACKENDS`` name (quantum planners only).
         workers: Parallel workers (planners that take them).
         num_qubits: Qubits per database, 2^n entries (quantum planners only).
-        search_policy: An iteration policy, a ``POLICIES`` name or None (the planner's default).
+        search_policy: An iteration policy, a ``POLICIES`` name or None: the paper's schedule
+            (``PaperIterations()``), pinned here whatever the planners' own default is.
         predicate: A predicate, a ``PREDICATES`` name or None (the exact check).
         **options: Further planner options, passed as given.
 
@@ -66,7 +68,9 @@ def make_planner(kind: str, env: Environment, seed: int, backend: str = "aer", w
     Raises:
         ValueError: If a name is unknown or an option does not apply to ``kind``.
     """
-    if isinstance(search_policy, str):
+    if search_policy is None:  # the experiments reproduce the paper: its schedule unless they name another
+        search_policy = PaperIterations()
+    elif isinstance(search_policy, str):
         search_policy = POLICIES.create(search_policy)
     if isinstance(predicate, str):
         predicate = PREDICATES.create(predicate, env=env)

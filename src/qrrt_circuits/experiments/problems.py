@@ -71,8 +71,10 @@ POLICY_CANDIDATES = ("paper", "adaptive", "bbht")
 GOAL_BIAS = 0.05
 #: OMPL's default range: this fraction of the space's largest extent (the bounds' diagonal)
 RANGE_FRACTION = 0.2
-QUANTITIES = ("calls_per_solution", "critical_path_per_solution", "classical_checks_per_solution",
-              "wall_time_per_solution_s", "path_length", "path_length_simplified")
+#: the summary's ``ours`` (with the success rate) ...
+HEADLINE = ("calls_per_solution", "wall_time_per_solution_s")
+#: ... and its ``details``
+DETAILS = ("critical_path_per_solution", "classical_checks_per_solution", "path_length", "path_length_simplified")
 
 
 def build_problem(family: str, replicate: int) -> Problem:
@@ -182,6 +184,8 @@ class Problems(Experiment):
         seed = settings["seed"]
         ours: dict[str, dict[str, dict[str, float]]] = {}
         intervals: dict[str, dict[str, dict[str, list[float]]]] = {}
+        details: dict[str, dict[str, dict[str, float]]] = {}
+        detail_intervals: dict[str, dict[str, dict[str, list[float]]]] = {}
         ratios: dict[str, dict[str, dict[str, float]]] = {}
         ratio_intervals: dict[str, dict[str, dict[str, list[float]]]] = {}
         references = [ref for ref in ("OMPL RRT", "OMPL RRTConnect", "RRT") if ref in settings["configs"]]
@@ -189,15 +193,19 @@ class Problems(Experiment):
             rows = {config: [r for r in records if r["family"] == family and r["config"] == config]
                     for config in settings["configs"]}
             ours[family], intervals[family], ratios[family], ratio_intervals[family] = {}, {}, {}, {}
+            details[family], detail_intervals[family] = {}, {}
             for config, runs in rows.items():
                 solved = sum(int(r["reached"]) for r in runs)
                 values = {"success_rate": round(solved / len(runs), 4) if runs else math.nan}
                 spans = {"success_rate": rounded_interval(binomial_interval(solved, len(runs)), 4)}
-                for quantity in QUANTITIES:
+                for quantity in (*HEADLINE, *DETAILS):
                     values[quantity] = _rounded(_statistic(runs, quantity))
                     spans[quantity] = rounded_interval(bootstrap_interval(runs, partial(_statistic, quantity=quantity),
                                                                           seed), 4)
-                ours[family][config], intervals[family][config] = values, spans
+                ours[family][config] = {key: values[key] for key in ("success_rate", *HEADLINE)}
+                intervals[family][config] = {key: spans[key] for key in ("success_rate", *HEADLINE)}
+                details[family][config] = {key: values[key] for key in DETAILS}
+                detail_intervals[family][config] = {key: spans[key] for key in DETAILS}
                 for reference in references:
                     if reference == config:
                         continue
@@ -208,7 +216,8 @@ class Problems(Experiment):
                         ratios[family].setdefault(config, {})[key] = value
                         ratio_intervals[family].setdefault(config, {})[key] = span
         choice = choose_default_policy(ours)
-        return {"ours": ours, "paper": self.paper, "interval_95": intervals, "ratios": ratios,
+        return {"ours": ours, "paper": self.paper, "interval_95": intervals, "details": details,
+                "details_interval_95": detail_intervals, "ratios": ratios,
                 "ratios_interval_95": ratio_intervals, "default_policy": choice,
                 "note": "per family and planner: success rate within the budget; calls, critical-path calls, "
                         "classical checks and wall time per solution (all runs' totals over the solved runs: the "
@@ -267,7 +276,7 @@ def _rounded(value: float) -> float:
 
 
 def _statistic(runs: Sequence[Record], quantity: str) -> float:
-    """One quantity of ``QUANTITIES`` over runs (module docstring); inf for a cost per solution
+    """One quantity of ``HEADLINE`` or ``DETAILS`` over runs (module docstring); inf for a cost per solution
     without a solved run, NaN for a path length without one."""
     solved = [r for r in runs if int(r["reached"])]
     if quantity.startswith("path_length"):

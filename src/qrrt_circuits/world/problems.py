@@ -174,7 +174,7 @@ def maze(cells: int = 4, seed: int = 0) -> Problem:
 
     cells = check_int(cells, "cells", 2, 32)
     grid = maze_grid(cells, seed, 10.0 / (2 * cells + 1))
-    start, goal = room_center(grid, 0, 0), room_center(grid, cells - 1, cells - 1)
+    start, goal = room_center(grid, cells - 1, 0), room_center(grid, 0, cells - 1)  # bottom-left, top-right
     radius = 0.4 * grid.pixel_size
     name = f"maze-{cells}x{cells}-seed{seed}"
     env, check = grid_world(grid, start, goal, radius, name=name)
