@@ -6,7 +6,8 @@ of the summary's ``ours`` with the paper's number at the same place in ``paper``
 interval from ``interval_95`` and whether the paper's number lies outside it
 (``differs_from_paper``); where the summary resamples the paper's own estimator (``paper_design``),
 its range and verdict; where it holds the reported run of the authors' code (``authors_code``), that
-run beside ours under its design; then the run's settings and provenance. The pages' prose discusses these
+run beside ours under its design; every other block ``KEY`` of the summary that has its intervals in
+``KEY_interval_95``, number by number; then the run's settings and provenance. The pages' prose discusses these
 numbers; the tables are never typed by hand.
 """
 
@@ -87,6 +88,13 @@ def table(summary: dict[str, Any], label: str) -> str:
                         f"{_shown(_at(code['reported_per_tree_range'], path))} | "
                         f"{_shown(_at(code['ours_median_tree_range_95'], path))} | "
                         f"{_shown(_at(code['median_tree_ranges_overlap'], path))} |")
+    for key, values in summary.items():  # every other block of numbers that carries its intervals
+        spans = summary.get(f"{key}_interval_95")
+        if key == "ours" or not isinstance(values, dict) or not isinstance(spans, dict):
+            continue
+        rows += ["", f"`{key}`:", "", "| quantity | value | 95 % interval |", "|---|---|---|"]
+        for path, value in _leaves(values):
+            rows.append(f"| {' / '.join(path)} | {_shown(value)} | {_shown(_at(spans, path))} |")
     provenance = summary.get("provenance") or {}
     packages = provenance.get("packages") or {}
     made = (f"Summarized at commit `{(provenance.get('git_commit') or 'unknown')[:12]}` on "

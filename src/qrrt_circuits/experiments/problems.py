@@ -3,9 +3,11 @@ and RRTConnect on the same motion check, at equal budgets in motion checks.
 
 **Problems** (``world.problems``, built by the library): ``open-space`` (one box in [0, 10]^2),
 ``maze`` (a perfect maze of 4 x 4 rooms, a new maze per replicate: its seed is the replicate
-index), ``narrow-passage-{2,4,6}d`` (a wall with a square hole of side 0.5) and ``se2-gap`` (a
-rectangle in SE(2) through a gap). Straight segments under the exact checks (``ExactCheck``,
-``GridCheck``, ``RigidBodyCheck``).
+index), ``narrow-passage-{2,4,6}d`` (a wall with a square hole whose share of the wall's
+cross-section is 1 % in every dimension: side 10 x 0.01^(1 / (d - 1)), so 0.1 in 2-D, 2.15 in 4-D,
+3.98 in 6-D; with a fixed side the share falls as (side / 10)^(d - 1), and at side 0.5 no planner
+solved 6-D within the budget) and ``se2-gap`` (a rectangle in SE(2) through a gap). Straight
+segments under the exact checks (``ExactCheck``, ``GridCheck``, ``RigidBodyCheck``).
 
 **Planners**: RRT; RRT with OMPL's range (``max_extension`` = 0.2 of the bounds' diagonal, no
 look-ahead: the algorithm of OMPL's RRT); manager-worker parallel RRT (8 workers); q-RRT under the
@@ -69,6 +71,8 @@ LIBRARY_CONFIGS: dict[str, tuple[str, str | None, dict[str, Any]]] = {
 OMPL_CONFIGS = ("OMPL RRT", "OMPL RRTConnect")
 POLICY_CANDIDATES = ("paper", "adaptive", "bbht")
 GOAL_BIAS = 0.05
+#: the narrow passage's hole: its share of the wall's cross-section, in every dimension
+HOLE_SHARE = 0.01
 #: OMPL's default range: this fraction of the space's largest extent (the bounds' diagonal)
 RANGE_FRACTION = 0.2
 #: the summary's ``ours`` (with the success rate) ...
@@ -90,7 +94,8 @@ def build_problem(family: str, replicate: int) -> Problem:
     if family == "maze":
         return maze(4, replicate)
     if family.startswith("narrow-passage-"):
-        return narrow_passage(int(family.removeprefix("narrow-passage-").removesuffix("d")), 0.5)
+        dim = int(family.removeprefix("narrow-passage-").removesuffix("d"))
+        return narrow_passage(dim, 10.0 * HOLE_SHARE ** (1.0 / (dim - 1)))
     return {"open-space": open_space, "se2-gap": se2_gap}[family]()
 
 

@@ -1,0 +1,137 @@
+"""Time per motion check and per node of the library's RRT beside OMPL's RRT on the same check, and
+q-RRT's time per oracle call, on the problem families of ``qrrt reproduce problems``.
+
+    python benchmarks/bench_problems.py [--quick] [--out FILE]
+
+Per family, ``RUNS`` seeds of each planner plan until the goal or ``BUDGET`` motion checks:
+
+- ``rrt``: the library's RRT with OMPL's range (0.2 of the bounds' diagonal), goal bias 0.05 and no
+  look-ahead, the algorithm of OMPL's RRT;
+- ``ompl_rrt``: OMPL's ``geometric::RRT`` with its defaults (the same range and goal bias), the same
+  predicate as its motion validator (``experiments.ompl_runs``), when the ``ompl`` extra is
+  installed;
+- ``qrrt``: q-RRT with ``Adaptive()``, 2^8 databases on the exact statevector.
+
+Every planner's predicate is timed (its ``reachable`` wrapped by a timer), so a run's wall time
+splits into the time inside the check and the planner's own time. Figures, per family and planner:
+``us_per_check`` (wall time over motion checks or oracle calls), ``check_us_per_check`` (inside the
+predicate), ``own_us_per_check`` (the rest: sampling, nearest neighbours, tree, for q-RRT the
+database and the search), ``us_per_node``; and the ratios ``rrt_over_ompl_wall`` and
+``rrt_over_ompl_own`` (one run, same machine). Prints a table and writes JSON.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import os
+import time
+from collections.abc import Callable
+from typing import Any
+
+os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+from _common import machine, write_json  # noqa: E402
+
+import qrrt_circuits as qc  # noqa: E402
+from qrrt_circuits.experiments.problems import build_problem, ompl_range  # noqa: E402
+from qrrt_circuits.world.problems import Problem  # noqa: E402
+
+BUDGET = 5000
+
+
+def timed(problem: Problem) -> list[float]:
+    """Wrap the problem's ``reachable`` by a timer; returns the list the seconds are added to."""
+    spent = [0.0]
+    inner: Callable[..., Any] = problem.predicate.reachable
+
+    def reachable(parents: np.ndarray, children: np.ndarray) -> np.ndarray:
+        began = time.perf_counter()
+        try:
+            return inner(parents, children)
+        finally:
+            spent[0] += time.perf_counter() - began
+
+    problem.predicate.reachable = reachable  # type: ignore[method-assign]
+    return spent
+
+
+def run_library(family: str, planner: str, seed: int) -> dict[str, float]:
+    """One run of the library's ``rrt`` or ``qrrt`` on a fresh problem."""
+    problem = build_problem(family, 0)
+    spent = timed(problem)
+    if planner == "rrt":
+        plan = qc.RRT(problem.env, goal_bias=0.05, max_extension=ompl_range(problem), look_ahead=False, seed=seed,
+                      **problem.planner_options())
+    else:
+        plan = qc.QRRT(problem.env, backend=qc.StatevectorBackend(seed=seed), search_policy=qc.Adaptive(),
+                       goal_bias=0.05, seed=seed, **problem.planner_options())
+    began = time.perf_counter()
+    result = plan.plan(goal=problem.goal, max_oracle_calls=BUDGET)
+    wall = time.perf_counter() - began
+    return {"wall_s": wall, "check_s": spent[0], "checks": result.metrics.oracle_calls,
+            "nodes": result.metrics.nodes, "reached": float(result.reached)}
+
+
+def run_ompl(family: str, seed: int) -> dict[str, float]:
+    """One run of OMPL's RRT on a fresh problem (its node count is not read back: NaN)."""
+    from qrrt_circuits.experiments.ompl_runs import ompl_run
+
+    problem = build_problem(family, 0)
+    spent = timed(problem)
+    run = ompl_run(problem, "OMPL RRT", BUDGET, seed + 1, 0.05)
+    return {"wall_s": run.wall_time_s, "check_s": spent[0], "checks": run.motion_checks, "nodes": float("nan"),
+            "reached": float(run.reached)}
+
+
+def figures(runs: list[dict[str, float]]) -> dict[str, float]:
+    """Pooled figures of a planner's runs on one family."""
+    wall = sum(r["wall_s"] for r in runs)
+    check = sum(r["check_s"] for r in runs)
+    checks = sum(r["checks"] for r in runs)
+    nodes = sum(r["nodes"] for r in runs)
+    return {"us_per_check": 1e6 * wall / checks, "check_us_per_check": 1e6 * check / checks,
+            "own_us_per_check": 1e6 * (wall - check) / checks,
+            "us_per_node": 1e6 * wall / nodes if np.isfinite(nodes) and nodes else float("nan"),
+            "checks": float(checks), "success_rate": float(np.mean([r["reached"] for r in runs]))}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--out", default=None)
+    args = parser.parse_args()
+    families = ("open-space", "narrow-passage-2d") if args.quick else (
+        "open-space", "maze", "narrow-passage-2d", "narrow-passage-4d", "se2-gap")
+    runs = 3 if args.quick else 10
+    have_ompl = importlib.util.find_spec("ompl") is not None
+    out: dict[str, Any] = {"machine": machine(), "budget": BUDGET, "runs": runs, "ompl": have_ompl, "figures": {}}
+    header = ("family", "planner", "us/check", "in check", "own", "us/node", "success")
+    print(f"{header[0]:20s} {header[1]:9s} " + " ".join(f"{h:>9s}" for h in header[2:]))
+    for family in families:
+        for planner in ("rrt", "qrrt"):
+            run_library(family, planner, 10_000)  # warm-up: numba compilation, caches
+        rows = {planner: figures([run_library(family, planner, seed) for seed in range(runs)])
+                for planner in ("rrt", "qrrt")}
+        if have_ompl:
+            run_ompl(family, 10_000)
+            rows["ompl_rrt"] = figures([run_ompl(family, seed) for seed in range(runs)])
+            rows["ratios"] = {"rrt_over_ompl_wall": rows["rrt"]["us_per_check"] / rows["ompl_rrt"]["us_per_check"],
+                              "rrt_over_ompl_own": rows["rrt"]["own_us_per_check"]
+                              / rows["ompl_rrt"]["own_us_per_check"]}
+        out["figures"][family] = rows
+        for planner, row in rows.items():
+            if planner != "ratios":
+                print(f"{family:20s} {planner:9s} {row['us_per_check']:9.1f} {row['check_us_per_check']:9.1f} "
+                      f"{row['own_us_per_check']:9.1f} {row['us_per_node']:9.1f} {row['success_rate']:8.2f}")
+        if "ratios" in rows:
+            print(f"{family:20s} RRT / OMPL RRT: wall per check {rows['ratios']['rrt_over_ompl_wall']:.2f}x, "
+                  f"own time per check {rows['ratios']['rrt_over_ompl_own']:.2f}x")
+    if not have_ompl:
+        print("OMPL is not installed (pip install 'qrrt-circuits[ompl]'): the OMPL figures were skipped")
+    print(f"wrote {write_json('bench_problems', out, args.out)}")
+
+
+if __name__ == "__main__":
+    main()
