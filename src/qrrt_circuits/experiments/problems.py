@@ -28,7 +28,8 @@ for critical-path calls (p parallel devices), for classical checks actually made
 evaluation: the simulation's 2^n per database, look-ahead checks thrown away, verifications) and
 for wall time; path length of the solved runs, raw and after the greedy shortcut
 (``planners.paths.shortcut``, the same post-processing for every planner). Ratios to OMPL's RRT and
-RRTConnect (and to the library's RRT) resample the replicates of both planners together.
+RRTConnect (and to the library's RRT): calls, critical-path calls (one device per worker against
+OMPL's one thread) and wall time, resampling the replicates of both planners together.
 
 **The default search policy** is chosen from this experiment by a rule fixed before the run: for
 each candidate (``paper``, ``adaptive``, ``bbht``) the q-RRT calls per solution divided by the
@@ -215,6 +216,7 @@ class Problems(Experiment):
                     if reference == config:
                         continue
                     for quantity, short in (("calls_per_solution", "calls"),
+                                            ("critical_path_per_solution", "critical_path"),
                                             ("wall_time_per_solution_s", "wall_time")):
                         key = f"{short}_vs_{reference.replace(' ', '_')}"
                         value, span = _paired_ratio(runs, rows[reference], quantity, seed)
