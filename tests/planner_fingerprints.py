@@ -75,11 +75,18 @@ CASES["prrt-errors"] = (lambda: _clutter(5), lambda env: qc.ParallelRRT(env, wor
                         {"max_nodes": 60})
 CASES["prrt-goal-bias"] = (lambda: _clutter(6), lambda env: qc.ParallelRRT(env, workers=4, seed=6, goal_bias=0.1),
                            {"max_nodes": 200})
+def _paper() -> qc.PaperIterations:
+    """The paper's schedule, named: the cases fingerprint the paper's planners, whatever the default."""
+    return qc.PaperIterations()
+
+
 for _seed in range(3):
     CASES[f"qrrt-sv-{_seed}"] = (lambda s=_seed: _clutter(s),
-                                 lambda env, s=_seed: qc.QRRT(env, backend=_sv(), num_qubits=6, seed=s),
+                                 lambda env, s=_seed: qc.QRRT(env, backend=_sv(), num_qubits=6, seed=s,
+                                                              search_policy=_paper()),
                                  {"max_nodes": 40})
-CASES["qrrt-sv-calls"] = (lambda: _clutter(3), lambda env: qc.QRRT(env, backend=_sv(), num_qubits=5, seed=3),
+CASES["qrrt-sv-calls"] = (lambda: _clutter(3), lambda env: qc.QRRT(env, backend=_sv(), num_qubits=5, seed=3,
+                                                                  search_policy=_paper()),
                           {"max_oracle_calls": 90})
 CASES["qrrt-bbht"] = (lambda: _clutter(4), lambda env: qc.QRRT(env, backend=_sv(), seed=4, search_policy=qc.BBHT()),
                       {"max_nodes": 30})
@@ -94,10 +101,12 @@ CASES["qrrt-annealing"] = (lambda: qc.scenarios.paper_clutter(seed=7),
                            lambda env: qc.QRRT(env, backend=_sv(), seed=7, annealing=qc.AnnealingSchedule.paper(),
                                                search_policy=qc.FixedIterations(2)),
                            {"max_nodes": 30})
-CASES["pqrrt-shared"] = (lambda: _clutter(8), lambda env: qc.PQRRT(env, backend=_sv(), workers=8, seed=8),
+CASES["pqrrt-shared"] = (lambda: _clutter(8), lambda env: qc.PQRRT(env, backend=_sv(), workers=8, seed=8,
+                                                                  search_policy=_paper()),
                          {"max_nodes": 60})
 CASES["pqrrt-unshared"] = (lambda: _clutter(9),
-                           lambda env: qc.PQRRT(env, backend=_sv(), workers=4, shared_database=False, seed=9),
+                           lambda env: qc.PQRRT(env, backend=_sv(), workers=4, shared_database=False, seed=9,
+                                                search_policy=_paper()),
                            {"max_nodes": 40})
 CASES["pqrrt-shared-bbht-errors"] = (lambda: _clutter(10),
                                      lambda env: qc.PQRRT(env, backend=_sv(), workers=4, seed=10,
@@ -107,10 +116,11 @@ CASES["pqrrt-shared-bbht-errors"] = (lambda: _clutter(10),
 # trees past tree.BRUTE_FORCE_BELOW (400 since the grid's rewrite), so the grid answers the queries
 # (references computed at 9c3c6d4, before that rewrite)
 CASES["rrt-large"] = (lambda: _clutter(13), lambda env: qc.RRT(env, seed=13), {"max_nodes": 700, "goal_radius": 1e-9})
-CASES["qrrt-sv-large"] = (lambda: _clutter(11), lambda env: qc.QRRT(env, backend=_sv(), num_qubits=6, seed=11),
+CASES["qrrt-sv-large"] = (lambda: _clutter(11), lambda env: qc.QRRT(env, backend=_sv(), num_qubits=6, seed=11,
+                                                                   search_policy=_paper()),
                           {"max_nodes": 700, "goal_radius": 1e-9})
 CASES["pqrrt-shared-large"] = (lambda: _clutter(12), lambda env: qc.PQRRT(env, backend=_sv(), workers=8, num_qubits=6,
-                                                                        seed=12),
+                                                                        seed=12, search_policy=_paper()),
                                {"max_nodes": 700, "goal_radius": 1e-9})
 
 

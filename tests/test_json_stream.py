@@ -73,8 +73,9 @@ def test_an_empty_mapping_and_an_unserialisable_value():
 @pytest.mark.parametrize("make", [
     lambda env: qc.RRT(env, seed=1),
     lambda env: qc.ParallelRRT(env, workers=4, seed=1),
-    lambda env: qc.QRRT(env, backend=qc.StatevectorBackend(seed=1), seed=1),
-    lambda env: qc.PQRRT(env, workers=4, backend=qc.StatevectorBackend(seed=1), seed=1),
+    lambda env: qc.QRRT(env, backend=qc.StatevectorBackend(seed=1), seed=1, search_policy=qc.PaperIterations()),
+    lambda env: qc.PQRRT(env, workers=4, backend=qc.StatevectorBackend(seed=1), seed=1,
+                         search_policy=qc.PaperIterations()),
 ])
 def test_write_json_is_to_dict(make):
     """Plans ended by their node limit (no path) and, with 400 nodes, reached for the first three

@@ -62,10 +62,11 @@ def test_plan_refused_before_its_first_allocation_with_the_largest_fitting_n(env
 
 def test_the_estimate_grows_with_what_the_run_holds(env):
     sv = qc.StatevectorBackend(0)
-    base = qc.QRRT(env, backend=sv, num_qubits=10, seed=0).memory_estimate(24)
-    annealed = qc.QRRT(env, backend=sv, num_qubits=10, seed=0,
+    paper = qc.PaperIterations()  # at most 5 iterations: fewer than the 20 below
+    base = qc.QRRT(env, backend=sv, num_qubits=10, seed=0, search_policy=paper).memory_estimate(24)
+    annealed = qc.QRRT(env, backend=sv, num_qubits=10, seed=0, search_policy=paper,
                        annealing=qc.AnnealingSchedule.paper()).memory_estimate(24)
-    aer = qc.QRRT(env, backend=qc.AerBackend(0), num_qubits=10, seed=0).memory_estimate(24)
+    aer = qc.QRRT(env, backend=qc.AerBackend(0), num_qubits=10, seed=0, search_policy=paper).memory_estimate(24)
     aer_more_k = qc.QRRT(env, backend=qc.AerBackend(0), num_qubits=10, seed=0,
                          search_policy=qc.FixedIterations(20)).memory_estimate(24)
     assert base.total_bytes < annealed.total_bytes

@@ -190,7 +190,7 @@ PLANNER_SPECIFIC_OPTIONS: dict[str, tuple[str, Any]] = {
     "qubits": ("num_qubits", 8),
     "workers": ("workers", 8),
     "backend": ("backend", "aer"),
-    "policy": ("search_policy", "paper"),
+    "policy": ("search_policy", "bbht"),
 }
 
 
@@ -461,7 +461,8 @@ def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
                       help="workers (prrt, pqrrt, pqrrt-unshared; default 8)")
     plan.add_argument("--policy", "--schedule", dest="policy", type=_registered(POLICIES), default=argparse.SUPPRESS,
                       metavar="|".join(POLICIES.labels()),
-                      help=f"search policy (quantum planners, default paper; --schedule is its old name): "
+                      help=f"search policy (quantum planners, default bbht; paper: the paper's schedule; "
+                           f"--schedule is its old name): "
                            f"{POLICIES.help_text()}")
     plan.add_argument("--predicate", type=_registered(PREDICATES), default="exact",
                       metavar="|".join(PREDICATES.labels()), help=f"reachability check: {PREDICATES.help_text()}")

@@ -46,9 +46,10 @@ class Metrics:
             calls.
 
     Example:
-        >>> from qrrt_circuits import QRRT, Environment, StatevectorBackend
+        >>> from qrrt_circuits import QRRT, Environment, PaperIterations, StatevectorBackend
         >>> env = Environment([[0, 10], [0, 10]], [], start=[1, 1], goal=[9, 9], goal_radius=1.0)
-        >>> planner = QRRT(env, backend=StatevectorBackend(seed=0), num_qubits=3, seed=0)
+        >>> planner = QRRT(env, backend=StatevectorBackend(seed=0), num_qubits=3, seed=0,
+        ...                search_policy=PaperIterations())
         >>> metrics = planner.plan(max_rounds=5).metrics
         >>> metrics.oracle_calls, metrics.quantum_oracle_calls, metrics.verification_calls
         (6, 5, 1)
@@ -114,9 +115,10 @@ class PlanResult:
             set), not one of the caller's.
 
     Example:
-        >>> from qrrt_circuits import QRRT, Environment, StatevectorBackend
+        >>> from qrrt_circuits import QRRT, Environment, PaperIterations, StatevectorBackend
         >>> env = Environment([[0, 10], [0, 10]], [], start=[1, 1], goal=[9, 9], goal_radius=1.0)
-        >>> planner = QRRT(env, backend=StatevectorBackend(seed=0), num_qubits=3, seed=0)
+        >>> planner = QRRT(env, backend=StatevectorBackend(seed=0), num_qubits=3, seed=0,
+        ...                search_policy=PaperIterations())
         >>> result = planner.plan(max_rounds=5)
         >>> result.status, result.reached
         (<PlanStatus.REACHED: 'reached'>, True)
