@@ -53,6 +53,16 @@ def test_a_setup_becomes_a_problem_the_planners_take():
             assert problem.predicate.reachable(parent[None], child[None])[0]
 
 
+def test_a_problem_with_two_start_states_is_refused():
+    setup = gap_setup()
+    space = setup.getStateSpace()
+    second = space.allocState()
+    second[0], second[1] = 1.0, 2.0
+    setup.getProblemDefinition().addStartState(second)
+    with pytest.raises(ValueError, match="2 start states.*exactly one start state"):
+        problem_from_setup(setup)
+
+
 def test_a_goal_region_is_asked_through_ompl():
     class RightStrip(ob.GoalRegion):
         def __init__(self, si):

@@ -119,7 +119,7 @@ class OMPLProblem:
 
 
 def problem_from_definition(pdef: ob.ProblemDefinition, name: str = "ompl") -> OMPLProblem:
-    """The ``OMPLProblem`` of an OMPL ``ProblemDefinition`` (its first start state and its goal).
+    """The ``OMPLProblem`` of an OMPL ``ProblemDefinition`` (its one start state and its goal).
 
     Args:
         pdef: The problem definition.
@@ -129,7 +129,8 @@ def problem_from_definition(pdef: ob.ProblemDefinition, name: str = "ompl") -> O
         The problem.
 
     Raises:
-        ValueError: No start state or no goal, or a state space other than a real-vector space.
+        ValueError: No valid start state, more than one start state (the planners grow one tree
+            from one root), no goal, or a state space other than a real-vector space.
     """
     si = pdef.getSpaceInformation()
     predicate = OMPLMotionPredicate(si, name=name)
@@ -138,6 +139,9 @@ def problem_from_definition(pdef: ob.ProblemDefinition, name: str = "ompl") -> O
     first = inputs.nextStart()
     if first is None:
         raise ValueError("the OMPL problem has no valid start state (setStartState)")
+    if inputs.nextStart() is not None:  # the planners grow one tree from one root
+        raise ValueError(f"the OMPL problem has {pdef.getStartStateCount()} start states; the library's planners "
+                         "grow one tree from one start: accepted is a problem with exactly one start state")
     goal = pdef.getGoal()
     if goal is None:
         raise ValueError("the OMPL problem has no goal (setGoal or setStartAndGoalStates)")
