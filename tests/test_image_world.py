@@ -27,6 +27,7 @@ import qrrt_circuits as qc
 from qrrt_circuits.plotting import plan_dynamics
 from qrrt_circuits.reachability.grid_check import EPSILON
 from qrrt_circuits.world.image import MAX_CELLS
+from qrrt_circuits.world.maze import maze_free
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -112,34 +113,8 @@ def sampled_free(grid: qc.OccupancyGrid, parent: np.ndarray, child: np.ndarray, 
 
 
 def maze(cells: int, corridor: int, seed: int) -> np.ndarray:
-    """A perfect maze (randomized depth-first search) as a bool image, True = free: ``cells`` x
-    ``cells`` rooms of ``corridor`` pixels, walls 1 pixel thick."""
-    rng = np.random.default_rng(seed)
-    side = cells * (corridor + 1) + 1
-    free = np.zeros((side, side), dtype=bool)
-
-    def room(r: int, c: int) -> tuple[slice, slice]:
-        top, left = 1 + r * (corridor + 1), 1 + c * (corridor + 1)
-        return slice(top, top + corridor), slice(left, left + corridor)
-
-    seen = np.zeros((cells, cells), dtype=bool)
-    stack = [(0, 0)]
-    seen[0, 0] = True
-    free[room(0, 0)] = True
-    while stack:
-        r, c = stack[-1]
-        options = [(r + dr, c + dc) for dr, dc in ((1, 0), (-1, 0), (0, 1), (0, -1))
-                   if 0 <= r + dr < cells and 0 <= c + dc < cells and not seen[r + dr, c + dc]]
-        if not options:
-            stack.pop()
-            continue
-        nr, nc = options[rng.integers(len(options))]
-        seen[nr, nc] = True
-        free[room(nr, nc)] = True
-        (rs, cs), (nrs, ncs) = room(r, c), room(nr, nc)
-        free[min(rs.start, nrs.start):max(rs.stop, nrs.stop), min(cs.start, ncs.start):max(cs.stop, ncs.stop)] = True
-        stack.append((nr, nc))
-    return free
+    """A perfect maze as a bool image, True = free (``qrrt_circuits.world.maze``)."""
+    return maze_free(cells, seed, corridor)
 
 
 def write_pnm(path, magic: str, samples: np.ndarray, maxval: int = 255, comment: bool = False) -> None:
