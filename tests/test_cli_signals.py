@@ -31,9 +31,17 @@ def _environment() -> dict[str, str]:
     return env
 
 
-def _start(argv, tmp_path, env=None, **options):
+def _default_signals() -> None:
+    """In the child: the default dispositions of the signals sent here. A test run started in the
+    background (``cmd &``) or under ``nohup`` inherits SIGINT or SIGHUP ignored, and a program
+    keeps an ignored signal ignored, as a background job should."""
+    for signum in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(signum, signal.SIG_DFL)
+
+
+def _start(argv, tmp_path, env=None, preexec_fn=_default_signals, **options):
     return subprocess.Popen([*QRRT, *argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            cwd=tmp_path, env=env or _environment(), **options)
+                            cwd=tmp_path, env=env or _environment(), preexec_fn=preexec_fn, **options)
 
 
 def _wait_for(condition, process, what, timeout_s=60.0):
@@ -168,7 +176,7 @@ def test_sigterm_shuts_the_worker_pool_down_and_the_run_resumes(tmp_path):
 def test_an_ignored_sighup_stays_ignored(tmp_path):
     """Under ``nohup`` (SIGHUP ignored) the command does not stop when its terminal closes."""
     process = _start(["plan", "--planner", "rrt", "--max-nodes", "3"], tmp_path,
-                     preexec_fn=lambda: signal.signal(signal.SIGHUP, signal.SIG_IGN))
+                     preexec_fn=lambda: (_default_signals(), signal.signal(signal.SIGHUP, signal.SIG_IGN)))
     code, stdout, err = _stop(process, signal.SIGHUP, 0.3)
     assert code == 0, err
     assert "RRT on paper_clutter" in stdout
