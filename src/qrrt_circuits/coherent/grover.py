@@ -1,0 +1,56 @@
+"""Grover search with the coherent oracle (paper Alg. 2, lines 4-8), the ancillas left alone.
+
+The oracle's ancillas start and end in |0> (``oracle``), so Grover's iteration acts on the index
+register only: W = H^n on the n index qubits, Q = (reflection about W|0> on the index qubits) x
+oracle, as Qiskit's ``grover_operator`` with ``reflection_qubits`` the index. After k iterations a
+marked index is measured with probability sin^2((2k+1) theta), sin^2 theta = m / 2^n (Lemma 1),
+as with the lookup oracle.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from .._support.validation import check_int
+
+if TYPE_CHECKING:
+    from qiskit import QuantumCircuit
+
+
+def coherent_grover_circuit(oracle: QuantumCircuit, num_index_bits: int, iterations: int,
+                            measure: bool = True) -> QuantumCircuit:
+    """H^n on the index, ``iterations`` Grover iterations with ``oracle``, then (optionally) the
+    index measured into a register ``meas``.
+
+    Args:
+        oracle: A coherent oracle (``coherent_phase_oracle``): index qubits first, ancillas in |0>.
+        num_index_bits: n, 1 .. the oracle's qubits.
+        iterations: k, 0 .. 10 000.
+        measure: Measure the index qubits (default True); bit j of the result is index bit j.
+
+    Returns:
+        The ``QuantumCircuit`` (named ``coherent_grover``) on the oracle's qubits.
+
+    Raises:
+        TypeError: A non-integer n or k.
+        ValueError: n or k out of range.
+    """
+    from qiskit import ClassicalRegister, QuantumCircuit
+    from qiskit.circuit.library import grover_operator
+
+    n = check_int(num_index_bits, "num_index_bits", 1, oracle.num_qubits)
+    iterations = check_int(iterations, "iterations", 0, 10_000)
+    index = list(range(n))
+    preparation = QuantumCircuit(oracle.num_qubits, name="W")
+    preparation.h(index)
+    circuit = QuantumCircuit(*oracle.qregs, name="coherent_grover")
+    circuit.compose(preparation, inplace=True)
+    if iterations:
+        step = grover_operator(oracle, state_preparation=preparation, reflection_qubits=index)
+        for _ in range(iterations):
+            circuit.compose(step, inplace=True)
+    if measure:
+        bits = ClassicalRegister(n, "meas")
+        circuit.add_register(bits)
+        circuit.measure(index, bits)
+    return circuit
