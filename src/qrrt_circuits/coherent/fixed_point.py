@@ -112,7 +112,7 @@ class FixedPointFormat:
         if np.any(outside):
             where = int(np.argmax(outside))
             position = np.unravel_index(where, array.shape) if array.ndim else ()
-            raise ValueError(f"{name}{list(map(int, position))} = {flat[where]!r} is outside the fixed-point "
+            raise ValueError(f"{name}{list(map(int, position))} = {float(flat[where])!r} is outside the fixed-point "
                              f"range [{self.lo}, {self.hi}) of {self.bits}-bit coordinates")
         scaled = (flat - self.lo) * (self.levels / (self.hi - self.lo))
         result = np.floor(scaled).astype(np.int64)
@@ -152,8 +152,9 @@ class FixedPointFormat:
         for name, coordinates in items:
             bad = (coordinates < self.lo) | (coordinates >= self.hi)
             if np.any(bad):
+                value = float(coordinates[int(np.argmax(bad))])
                 raise ValueError(
-                    f"{name} has the coordinate {coordinates[int(np.argmax(bad))]!r}, outside the fixed-point range "
+                    f"{name} has the coordinate {value!r}, outside the fixed-point range "
                     f"[{self.lo}, {self.hi}): choose a format covering the world "
                     f"(FixedPointFormat.covering(env, bits))")
 

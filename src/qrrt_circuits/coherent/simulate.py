@@ -40,6 +40,8 @@ class PermutationResult:
         undos: The other Toffolis whose target equals the AND of the controls for every input.
         other_toffolis: Toffolis that are neither (0 for a circuit of ANDs and undos).
         tag_errors: Tagged Toffolis whose tag the simulation contradicts.
+        final: Uint64 (qubits, words): each qubit's final bits over the inputs, packed
+            (``qubit_values`` unpacks one).
     """
 
     phases: np.ndarray
@@ -49,6 +51,12 @@ class PermutationResult:
     undos: int
     other_toffolis: int
     tag_errors: int
+    final: np.ndarray
+
+    def qubit_values(self, qubit: int) -> np.ndarray:
+        """Bool (2^n,): the qubit's final value for each index."""
+        states = self.phases.shape[0]
+        return np.unpackbits(self.final[qubit].view(np.uint8), bitorder="little")[:states].astype(bool)
 
 
 def circuit_gates(circuit: QuantumCircuit) -> np.ndarray:
@@ -139,4 +147,4 @@ def simulate(gates: np.ndarray, num_qubits: int, num_index: int) -> PermutationR
     index_preserved = bool(np.array_equal(values[:num_index], initial & mask))
     ancillas_clean = not bool(np.any(values[num_index:]))
     unpacked = np.unpackbits(phase.view(np.uint8), bitorder="little")[:states].astype(bool)
-    return PermutationResult(unpacked, index_preserved, ancillas_clean, ands, undos, other, tag_errors)
+    return PermutationResult(unpacked, index_preserved, ancillas_clean, ands, undos, other, tag_errors, values)
