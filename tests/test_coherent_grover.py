@@ -2,7 +2,7 @@
 sin^2((2k+1) theta), sin^2 theta = m / 2^n (Lemma 1), within a binomial interval (tail 1e-6).
 
 Instances (``coherent_instances``): the wall world with one tree node (n = 4, 10 qubits: Aer's
-statevector), with two nodes (n = 5, 35 qubits) and with four (n = 6, 41 qubits), both on Aer's
+statevector), with two nodes (n = 5, 33 qubits) and with four (n = 6, 38 qubits), both on Aer's
 matrix-product-state method. Each circuit is transpiled once, to Aer-native gates."""
 
 import math
@@ -20,8 +20,8 @@ BASIS = ["x", "z", "h", "cx", "ccx", "u", "p", "measure"]
 SHOTS = 400
 INSTANCES = {
     "wall-1-node": (wall_instance, "statevector", 4, 10),
-    "wall-2-nodes": (lambda: grover_instance(2), "matrix_product_state", 5, 35),
-    "wall-4-nodes": (lambda: grover_instance(4), "matrix_product_state", 6, 41),
+    "wall-2-nodes": (lambda: grover_instance(2), "matrix_product_state", 5, 33),
+    "wall-4-nodes": (lambda: grover_instance(4), "matrix_product_state", 6, 38),
 }
 
 

@@ -12,6 +12,7 @@ from qrrt_circuits import Environment, LinearTrackingDynamics
 from qrrt_circuits.coherent import (
     FixedPointFormat,
     LatticeDatabase,
+    OracleOptions,
     SampledMotion,
     build_coherent_oracle,
     coherent_phase_oracle,
@@ -153,15 +154,18 @@ def test_a_world_where_every_entry_or_none_is_reachable_gives_minus_identity_or_
         assert verify_oracle(env, database, motion).ok
 
 
+OPTIONS = [OracleOptions(), OracleOptions("binary"), OracleOptions(prune=False), OracleOptions(align=False)]
+
+
 @pytest.mark.parametrize("dim", [2, 3])
-@pytest.mark.parametrize("digits", ["naf", "binary"])
-def test_every_index_state_gets_its_mark_and_clean_ancillas(dim, digits):
+@pytest.mark.parametrize("options", OPTIONS, ids=["naf", "binary", "unpruned", "unaligned"])
+def test_every_index_state_gets_its_mark_and_clean_ancillas(dim, options):
     """Seeded random worlds, databases and motions (straight lines, the paper's dynamics, random
     closed loops with cross terms), each simulated on all of its 2^n index states."""
     marked = 0
     for seed in range(12):
         env, database, motion = random_instance(seed, dim=dim, max_cell_bits=3 if dim == 2 else 2)
-        result = verify_oracle(env, database, motion, digits)
+        result = verify_oracle(env, database, motion, options)
         assert result.ok, (seed, result)
         marked += 0 < result.marked < 1 << result.index_bits
     assert marked >= 4  # most instances mark some entries and not others
@@ -183,7 +187,8 @@ def test_a_larger_instance_verifies():
 def test_naf_digits_use_fewer_ands_than_binary_and_mark_the_same():
     env, database, _ = wall_instance()
     motion = SampledMotion.straight_line(2, 9, 3)  # coefficients 7/8, 6/8, ...: 7 = 8 - 1
-    naf = build_coherent_oracle(env, database, motion, "naf")
-    binary = build_coherent_oracle(env, database, motion, "binary")
+    naf = build_coherent_oracle(env, database, motion, OracleOptions("naf"))
+    binary = build_coherent_oracle(env, database, motion, OracleOptions("binary"))
     assert naf.tally.ands < binary.tally.ands
-    assert verify_oracle(env, database, motion, "naf").ok and verify_oracle(env, database, motion, "binary").ok
+    assert verify_oracle(env, database, motion, OracleOptions("naf")).ok
+    assert verify_oracle(env, database, motion, OracleOptions("binary")).ok

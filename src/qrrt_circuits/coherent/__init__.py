@@ -12,11 +12,12 @@ from .fixed_point import FixedPointFormat
 from .grover import coherent_grover_circuit
 from .lattice import DatabaseEntries, LatticeDatabase
 from .motion import SampledMotion
-from .oracle import CoherentOracle, Layout, build_coherent_oracle, coherent_phase_oracle
-from .plan import OraclePlan, oracle_plan
+from .oracle import CoherentOracle, build_coherent_oracle, coherent_phase_oracle
+from .plan import OracleOptions, OraclePlan, oracle_plan
 from .reference import RoundingComparison, compare_with_time_sampled, reachable_reference
 from .simulate import PermutationResult, simulate
 from .verify import VerificationResult, verify_oracle
+from .walk import Layout
 
 __all__ = [
     "CoherentOracle",
@@ -26,6 +27,7 @@ __all__ = [
     "Layout",
     "LookupCost",
     "OracleCost",
+    "OracleOptions",
     "OraclePlan",
     "PermutationResult",
     "RoundingComparison",

@@ -8,8 +8,9 @@
   so none of them can be uncomputed by measurement.)
 - ``compare_chain``: [S >= T] for a constant T as the carry out of S + (2^W - T): bit by bit the
   carry is MAJ(s_i, k_i, c) = s_i AND c where k_i = 0 and s_i OR c (an AND of negations) where
-  k_i = 1, one AND each; bits that are constant 0 and a constant carry are followed classically
-  (``chain_steps``), so no gate is spent below the constant's lowest set bit. The carries stay
+  k_i = 1, one AND each; constant bits of S and a constant carry are followed classically
+  (``chain_steps``), so no gate is spent below the constant's lowest set bit or on S's constant
+  low bits. The carries stay
   allocated until the caller mirrors the block (no copy of the result, no second chain to
   uncompute it). Qiskit's ``IntegerComparatorGate`` synthesises by default as one
   multi-controlled X per value below T (exponential in W), and its carry-chain synthesis
@@ -25,7 +26,8 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from .emitter import Emitter, Literal
+    from .emitter import Emitter
+    from .tally import Literal
 
 
 def add_into(em: Emitter, source: Sequence[int], target: Sequence[int]) -> None:
@@ -73,29 +75,41 @@ def add_into(em: Emitter, source: Sequence[int], target: Sequence[int]) -> None:
             em.cx(carry[i], target[i])
 
 
-def chain_steps(present: Sequence[bool], threshold: int
+#: the kinds of the bits of S in ``chain_steps``
+ZERO, ONE, QUBIT = 0, 1, 2
+
+
+def bit_kinds(bits: Sequence[int | None], ones: int = 0) -> list[int]:
+    """Each bit's kind: ``QUBIT`` where ``bits`` has a qubit, else ``ONE`` where ``ones`` has the
+    bit set, else ``ZERO``."""
+    return [QUBIT if b is not None else ONE if ones >> i & 1 else ZERO for i, b in enumerate(bits)]
+
+
+def chain_steps(kinds: Sequence[int], threshold: int
                 ) -> tuple[list[tuple[str, int, tuple[str, int]]], tuple[str, int]]:
     """The gates of ``compare_chain`` as steps, constants followed classically.
 
     Args:
-        present: Per bit of S (least significant first), whether it is a qubit (False: constant 0).
+        kinds: Per bit of S (least significant first), ``QUBIT``, or the constant ``ZERO`` / ``ONE``.
         threshold: T, 1 <= T <= 2^W - 1.
 
     Returns:
         (steps, result): steps ``(kind, i, carry)``: ``kind`` ``"and"`` or ``"or"`` of bit i with
         the carry (one AND each), the carry being ``("bit", j)`` (bit j of S itself) or
         ``("step", s)`` (step s's qubit); ``result`` ``("const", 0 or 1)``, ``("bit", j)`` or
-        ``("step", s)``.
+        ``("step", s)``. Only the steps the result depends on are kept.
 
     Raises:
         ValueError: T outside [1, 2^W - 1].
 
     Example:
-        >>> from qrrt_circuits.coherent.arithmetic import chain_steps
-        >>> chain_steps([True] * 4, 6)  # S >= 6: k = 10 = 0b1010
+        >>> from qrrt_circuits.coherent.arithmetic import QUBIT, ZERO, chain_steps
+        >>> chain_steps([QUBIT] * 4, 6)  # S >= 6: k = 10 = 0b1010
         ([('and', 2, ('bit', 1)), ('or', 3, ('step', 0))], ('step', 1))
+        >>> chain_steps([ZERO, ZERO, QUBIT, QUBIT], 8)  # bits 0, 1 constant 0: S >= 8 is bit 3
+        ([], ('bit', 3))
     """
-    width = len(present)
+    width = len(kinds)
     if not 1 <= threshold <= (1 << width) - 1:
         raise ValueError(f"threshold must lie in [1, 2^{width} - 1], got {threshold}")
     k = (1 << width) - threshold
@@ -103,11 +117,16 @@ def chain_steps(present: Sequence[bool], threshold: int
     carry: tuple[str, int] = ("const", 0)
     for i in range(width):
         ki = (k >> i) & 1
-        if not present[i]:  # MAJ(0, k_i, c) = k_i AND c
+        if kinds[i] == ZERO:  # MAJ(0, k_i, c) = k_i AND c
             if carry[0] == "const":
                 carry = ("const", carry[1] & ki)
             elif not ki:
                 carry = ("const", 0)
+        elif kinds[i] == ONE:  # MAJ(1, k_i, c) = k_i OR c
+            if carry[0] == "const":
+                carry = ("const", carry[1] | ki)
+            elif ki:
+                carry = ("const", 1)
         elif carry == ("const", 0):
             carry = ("bit", i) if ki else ("const", 0)
         elif carry == ("const", 1):
@@ -115,7 +134,7 @@ def chain_steps(present: Sequence[bool], threshold: int
         else:
             steps.append(("or" if ki else "and", i, carry))
             carry = ("step", len(steps) - 1)
-    # keep only the steps the result depends on (a constant 0 bit can reset the carry)
+    # keep only the steps the result depends on (a constant bit can reset the carry)
     needed: list[int] = []
     ref = carry
     while ref[0] == "step":
@@ -130,15 +149,16 @@ def chain_steps(present: Sequence[bool], threshold: int
     return kept, moved(carry)
 
 
-def compare_chain(em: Emitter, bits: Sequence[int | None], threshold: int) -> Literal | bool:
+def compare_chain(em: Emitter, bits: Sequence[int | None], threshold: int, ones: int = 0) -> Literal | bool:
     """[S >= threshold] as the carry out of S + (2^W - threshold) (module text).
 
     The carries it allocates stay allocated: mirror the enclosing block to uncompute them.
 
     Args:
         em: The ``Emitter``.
-        bits: S's qubits, least significant first; None for a bit that is constant 0.
+        bits: S's qubits, least significant first; None for a constant bit (0, or 1 in ``ones``).
         threshold: T, 1 <= T <= 2^W - 1.
+        ones: The constant bits of S that are 1 (a mask; only where ``bits`` is None).
 
     Returns:
         A literal holding the answer, or a bool where it is a constant.
@@ -146,7 +166,7 @@ def compare_chain(em: Emitter, bits: Sequence[int | None], threshold: int) -> Li
     Raises:
         ValueError: T out of range.
     """
-    steps, result = chain_steps([b is not None for b in bits], threshold)
+    steps, result = chain_steps(bit_kinds(bits, ones), threshold)
 
     def qubit(ref: tuple[str, int]) -> int:
         found = bits[ref[1]] if ref[0] == "bit" else made[ref[1]]

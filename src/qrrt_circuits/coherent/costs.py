@@ -1,7 +1,7 @@
 """Qubits and Toffolis of the coherent oracle, from the constructors' closed-form tallies, beside
 the lookup oracle's.
 
-``oracle_costs`` walks the same ``oracle.emit_oracle`` as the circuit builder on a
+``oracle_costs`` walks the same ``walk.emit_oracle`` as the circuit builder on a
 ``FastCountEmitter``: no gate is stored, and every component is counted in closed form (an adder
 or an increment once per width, memoised; a comparison from its steps, ``arithmetic.chain_steps``;
 the lookup from its tree, ``qrom.qrom_tally``), so sizes far beyond what can be built (n up to 64,
@@ -27,12 +27,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..world.environment import Environment
-from .arithmetic import add_into, chain_steps, controlled_increment
-from .emitter import CountEmitter, Literal, Tally
+from .arithmetic import QUBIT, add_into, bit_kinds, chain_steps, controlled_increment
+from .emitter import CountEmitter
 from .lattice import LatticeDatabase
 from .motion import SampledMotion
-from .plan import OraclePlan, oracle_plan
+from .plan import OracleOptions, OraclePlan, oracle_plan
 from .qrom import qrom_tally
+from .tally import Literal, Tally
+from .walk import emit_oracle
 
 
 @functools.lru_cache(maxsize=1024)
@@ -68,9 +70,9 @@ class FastCountEmitter(CountEmitter):
         self.bump(extra)
         self.tally.add(tally)
 
-    def chain(self, bits: Sequence[int | None], threshold: int) -> Literal | bool:
+    def chain(self, bits: Sequence[int | None], threshold: int, ones: int = 0) -> Literal | bool:
         """Count ``compare_chain``'s steps (one AND each, 5 X for an OR) and allocate its carries."""
-        steps, result = chain_steps([b is not None for b in bits], threshold)
+        steps, result = chain_steps(bit_kinds(bits, ones), threshold)
         ors = sum(kind == "or" for kind, _, _ in steps)
         self.tally.ands += len(steps)
         self.tally.x += 5 * ors
@@ -129,8 +131,6 @@ def plan_costs(database: LatticeDatabase, plan: OraclePlan) -> OracleCost:
     Returns:
         The ``OracleCost``.
     """
-    from .oracle import emit_oracle
-
     em = FastCountEmitter()
     layout = emit_oracle(em, database, plan)
     tally = em.tally
@@ -138,16 +138,16 @@ def plan_costs(database: LatticeDatabase, plan: OraclePlan) -> OracleCost:
                       len(plan.points), plan.box_tests, plan.box_tests_kept, plan.comparisons_kept)
 
 
-def oracle_costs(env: Environment, database: LatticeDatabase, motion: SampledMotion, digits: str = "naf"
-                 ) -> OracleCost:
-    """Qubits and Toffolis of ``coherent_phase_oracle(env, database, motion, digits)`` without
+def oracle_costs(env: Environment, database: LatticeDatabase, motion: SampledMotion,
+                 options: OracleOptions | None = None) -> OracleCost:
+    """Qubits and Toffolis of ``coherent_phase_oracle(env, database, motion, options)`` without
     building it (module text).
 
     Args:
         env: The ``Environment``.
         database: The ``LatticeDatabase``.
         motion: The ``SampledMotion``.
-        digits: ``"naf"`` (default) or ``"binary"``.
+        options: ``OracleOptions`` (default: NAF digits, pruned, aligned).
 
     Returns:
         The ``OracleCost``.
@@ -155,7 +155,7 @@ def oracle_costs(env: Environment, database: LatticeDatabase, motion: SampledMot
     Raises:
         ValueError: As ``oracle.build_coherent_oracle`` (except the size limit).
     """
-    return plan_costs(database, oracle_plan(env, database, motion, digits))
+    return plan_costs(database, oracle_plan(env, database, motion, options))
 
 
 def check_buildable(env: Environment, database: LatticeDatabase, motion: SampledMotion, plan: OraclePlan,
@@ -180,7 +180,7 @@ def check_buildable(env: Environment, database: LatticeDatabase, motion: Sampled
 
     def gates_with(count: int) -> int:
         subset = Environment(env.bounds, env.boxes[:count], start=env.start)
-        return plan_costs(database, oracle_plan(subset, database, motion, plan.digits)).gates
+        return plan_costs(database, oracle_plan(subset, database, motion, plan.options)).gates
 
     low, high = 0, boxes
     if gates_with(0) > max_gates:
@@ -266,5 +266,113 @@ def toffoli_depth(gates: np.ndarray, num_qubits: int) -> int:
     return max(level, default=0)
 
 
-__all__ = ["FastCountEmitter", "LookupCost", "OracleCost", "check_buildable", "lookup_costs", "mirror_tally",
-           "oracle_costs", "plan_costs", "toffoli_depth"]
+@dataclass(frozen=True)
+class ComparisonCost:
+    """Toffolis spent on the comparisons of one oracle call (each comparison is evaluated and
+    uncomputed once in the compute half and once in the uncompute half).
+
+    Args:
+        comparisons: Comparisons per half (``OraclePlan.comparisons_kept``).
+        ands: Ours, with measurement-based uncomputation: the chains' ANDs (``compare_chain``).
+        toffolis: Ours, every CCX: twice ``ands``.
+        full_width_ands: Ours without following constants: W - 1 ANDs per chain.
+        qiskit_toffolis: With Qiskit's ``synth_integer_comparator_2s`` instead (every CCX): its
+            2 W - 3 Toffolis per call, two calls per comparison (compute, uncompute) per half.
+    """
+
+    comparisons: int
+    ands: int
+    toffolis: int
+    full_width_ands: int
+    qiskit_toffolis: int
+
+
+@functools.lru_cache(maxsize=256)
+def qiskit_comparator_toffolis(width: int) -> int:
+    """CCX gates of Qiskit's carry-chain comparator ``synth_integer_comparator_2s`` on ``width``
+    bits (its ``OrGate`` s written as X and CCX), counted on one built circuit.
+
+    Args:
+        width: W >= 2.
+
+    Returns:
+        The count (2 W - 3).
+    """
+    from qiskit import transpile
+    from qiskit.synthesis.arithmetic import synth_integer_comparator_2s
+
+    circuit = synth_integer_comparator_2s(width, (1 << (width - 1)) + 1, geq=True)
+    compiled = transpile(circuit, basis_gates=["x", "cx", "ccx"], optimization_level=0)
+    return int(compiled.count_ops().get("ccx", 0))
+
+
+def comparison_costs(plan: OraclePlan) -> ComparisonCost:
+    """The comparisons' Toffolis, ours against Qiskit's comparator and against full-width chains.
+
+    Args:
+        plan: An ``OraclePlan``.
+
+    Returns:
+        The ``ComparisonCost``.
+    """
+    ands = full = qiskit = count = 0
+    for point in plan.points:
+        groups = [point.in_bounds] + [tests for _, tests in point.boxes]
+        for comparisons in groups:
+            for comparison in comparisons:
+                form = point.forms[comparison.axis]
+                width = form.width
+                kinds = bit_kinds([None] * form.lowest, form.constant_ones) + [QUBIT] * (width - form.lowest)
+                steps, _ = chain_steps(kinds, comparison.threshold)
+                ands += 2 * len(steps)
+                full += 2 * max(width - 1, 0)
+                qiskit += 4 * qiskit_comparator_toffolis(max(width, 2))
+                count += 1
+    return ComparisonCost(count, ands, 2 * ands, full, qiskit)
+
+
+def scaling_instance(index_bits: int, boxes: int, parent_bits: int = 6, bits: int = 16, time_samples: int = 16,
+                     seed: int = 0) -> tuple[Environment, LatticeDatabase, SampledMotion]:
+    """A world, database and motion of given sizes, for costs as functions of the sizes: the
+    paper's clutter world (``scenarios.paper_clutter(seed, num_boxes=boxes)``, [0, 20]^2, d = 2),
+    ``b``-bit coordinates covering it, 2^m tree nodes uniform over its free space, (n - m) / 2 cell
+    bits per axis, and the paper's dynamics at K samples with f = b fraction bits.
+
+    Args:
+        index_bits: n, with n - m even and 2 <= n - m <= 2 b.
+        boxes: B, 0 .. 100 000.
+        parent_bits: m, 0 .. 20 (default 6: 64 nodes).
+        bits: b, 1 .. 24 (default 16).
+        time_samples: K, 2 .. 4096 (default 16).
+        seed: The world's and the nodes' seed (default 0).
+
+    Returns:
+        (env, database, motion).
+
+    Raises:
+        TypeError: A non-integer argument.
+        ValueError: An argument out of range, or n - m odd or outside [2, 2 b].
+    """
+    from .._support.validation import check_int
+    from ..reachability.dynamics import LinearTrackingDynamics
+    from ..world.scenarios import paper_clutter
+    from .fixed_point import FixedPointFormat
+
+    boxes = check_int(boxes, "boxes", 0, 100_000)
+    parent_bits = check_int(parent_bits, "parent_bits", 0, 20)
+    bits = check_int(bits, "bits", 1, 24)
+    index_bits = check_int(index_bits, "index_bits", parent_bits + 2, parent_bits + 2 * bits)
+    if (index_bits - parent_bits) % 2:
+        raise ValueError(f"index_bits - parent_bits must be even (two cell fields), got n = {index_bits}, "
+                         f"m = {parent_bits}")
+    env = paper_clutter(seed, num_boxes=boxes)
+    fmt = FixedPointFormat.covering(env, bits)
+    nodes = env.sample_free(1 << parent_bits, np.random.default_rng([0xC0E, seed]))
+    database = LatticeDatabase(fmt, (index_bits - parent_bits) // 2, nodes, parent_bits=parent_bits)
+    motion = SampledMotion.from_dynamics(LinearTrackingDynamics.paper(), time_samples, bits)
+    return env, database, motion
+
+
+__all__ = ["ComparisonCost", "FastCountEmitter", "LookupCost", "OracleCost", "check_buildable", "comparison_costs",
+           "lookup_costs", "mirror_tally", "oracle_costs", "plan_costs", "qiskit_comparator_toffolis",
+           "scaling_instance", "toffoli_depth"]

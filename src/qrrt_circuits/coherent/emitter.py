@@ -24,54 +24,9 @@ import heapq
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
-#: gate codes of ``GateEmitter.gates``
-X, CX, AND, UNDO, Z = 0, 1, 2, 3, 4
-
-Literal = tuple[int, bool]
-
-
-@dataclass
-class Tally:
-    """Gate counts. ``ands`` + ``undos`` are the CCX gates; with measurement-based uncomputation
-    only the ``ands`` cost a Toffoli.
-
-    Args:
-        x: X gates.
-        cx: CX gates.
-        ands: Toffolis computing an AND into a fresh |0> qubit.
-        undos: Toffolis uncomputing one (the qubit returns to |0>).
-        z: Z gates.
-    """
-
-    x: int = 0
-    cx: int = 0
-    ands: int = 0
-    undos: int = 0
-    z: int = 0
-
-    def add(self, other: Tally, mirrored: bool = False, times: int = 1) -> None:
-        """Add ``times`` copies of ``other`` (its ANDs and undos swapped when ``mirrored``)."""
-        self.x += times * other.x
-        self.cx += times * other.cx
-        self.z += times * other.z
-        ands, undos = (other.undos, other.ands) if mirrored else (other.ands, other.undos)
-        self.ands += times * ands
-        self.undos += times * undos
-
-    def minus(self, other: Tally) -> Tally:
-        """The counts of ``self`` less ``other``."""
-        return Tally(self.x - other.x, self.cx - other.cx, self.ands - other.ands, self.undos - other.undos,
-                     self.z - other.z)
-
-    @property
-    def toffolis(self) -> int:
-        """CCX gates: ``ands`` + ``undos``."""
-        return self.ands + self.undos
-
-    @property
-    def gates(self) -> int:
-        """All gates."""
-        return self.x + self.cx + self.ands + self.undos + self.z
+from .arithmetic import add_into, and_ladder, compare_chain, controlled_increment
+from .qrom import unary_qrom
+from .tally import AND, CX, UNDO, Literal, Tally, X, Z
 
 
 @dataclass
@@ -211,32 +166,23 @@ class Emitter:
     # ------------------------------------------------------------------ components
     def adder(self, source: Sequence[int], target: Sequence[int]) -> None:
         """target += source (mod 2^len(target)), ``arithmetic.add_into``."""
-        from .arithmetic import add_into
-
         add_into(self, source, target)
 
-    def chain(self, bits: Sequence[int | None], threshold: int) -> Literal | bool:
-        """[S >= threshold] of the bits (None: a constant 0), ``arithmetic.compare_chain``."""
-        from .arithmetic import compare_chain
-
-        return compare_chain(self, bits, threshold)
+    def chain(self, bits: Sequence[int | None], threshold: int, ones: int = 0) -> Literal | bool:
+        """[S >= threshold] of the bits (None: a constant, 1 where ``ones`` says),
+        ``arithmetic.compare_chain``."""
+        return compare_chain(self, bits, threshold, ones)
 
     def ladder(self, literals: Sequence[Literal]) -> Literal | bool:
         """The AND of literals, ``arithmetic.and_ladder``."""
-        from .arithmetic import and_ladder
-
         return and_ladder(self, literals)
 
     def increment(self, control: Literal, counter: Sequence[int]) -> None:
         """counter += 1 where ``control`` holds, ``arithmetic.controlled_increment``."""
-        from .arithmetic import controlled_increment
-
         controlled_increment(self, control, counter)
 
     def qrom(self, index: Sequence[int], data: Sequence[int], outputs: Sequence[int]) -> None:
         """outputs ^= data[index] (``qrom.unary_qrom``)."""
-        from .qrom import unary_qrom
-
         unary_qrom(self, index, data, outputs)
 
 

@@ -13,17 +13,26 @@ register shifted by k; a digit -2^k adds the register's complement r~ = 2^w - 1 
 
     acc_i = offset_i + S_i,   S_i = sum over digits of (r or r~) 2^k >= 0,
 
-and the circuit computes the unsigned S_i only (no signed arithmetic, no constant additions). The
-comparisons of the tested point are comparisons of S_i with constants, the rounding folded in:
+and the circuit computes the unsigned S_i only (no signed arithmetic). The comparisons of the
+tested point are comparisons of S_i with constants, the rounding folded in:
 
     x_i >= L  <=>  S_i >= L 2^f - offset_i,
     x_i <= U  <=>  not (S_i >= (U + 1) 2^f - offset_i).
 
-A comparison whose answer is the same for every valid entry (interval bounds of S_i over the
-cells and the tree's nodes) is settled here: an always-true one is dropped, an always-false one
-drops its box for that point (the box cannot be hit from there). The circuit then counts, per entry,
-the tested points out of bounds and the (point, box) hits; the entry is reachable iff the count is
-zero and the parent valid.
+Options (``OracleOptions``):
+
+- ``align`` (default on): S_i starts from the constant c_i = offset_i mod 2^f (X gates on the
+  accumulator, or constant bits below it), so that offset_i - c_i, and with it every threshold, is a
+  multiple of 2^f: a comparison's carry chain then passes the low f bits as constants and spends
+  its ANDs on the top bits only (``arithmetic.chain_steps``);
+- ``prune`` (default on): a comparison whose answer is the same for every valid entry (interval
+  bounds of S_i over the cells and the tree's nodes) is settled here: an always-true one is
+  dropped, an always-false one drops its box for that point (the box cannot be hit from there).
+  Off, only comparisons settled over every register value are;
+- ``digits``: the coefficients' signed digits, ``"naf"`` (default) or ``"binary"``.
+
+The circuit then counts, per entry, the tested points out of bounds and the (point, box) hits; the
+entry is reachable iff the count is zero and the parent valid.
 """
 
 from __future__ import annotations
@@ -32,7 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._support.validation import check_choice
+from .._support.validation import check_bool, check_choice
 from ..world.environment import Environment
 from .lattice import LatticeDatabase
 from .motion import SampledMotion
@@ -42,6 +51,31 @@ from .reference import grid_limits
 DIGITS = ("naf", "binary")
 
 CELL, PARENT = "cell", "parent"
+
+
+@dataclass(frozen=True)
+class OracleOptions:
+    """How the oracle is built (module text); every choice gives the same marks.
+
+    Args:
+        digits: ``"naf"`` (default) or ``"binary"`` (``signed_digits``).
+        prune: Settle comparisons over the valid entries' interval bounds (default True).
+        align: Start each sum from the constant that makes every threshold a multiple of 2^f
+            (default True).
+
+    Raises:
+        ValueError: An unknown ``digits``.
+        TypeError: A non-bool ``prune`` or ``align``.
+    """
+
+    digits: str = "naf"
+    prune: bool = True
+    align: bool = True
+
+    def __post_init__(self) -> None:
+        check_choice(self.digits, "digits", DIGITS)
+        check_bool(self.prune, "prune")
+        check_bool(self.align, "align")
 
 
 def signed_digits(value: int, form: str = "naf") -> list[tuple[int, int]]:
@@ -107,21 +141,37 @@ class Term:
 
 @dataclass(frozen=True)
 class LinearForm:
-    """acc = offset + S, S = the sum of the terms (sorted by shift), 0 <= S <= ``max_sum``.
+    """acc = offset + S, S = ``initial`` + the sum of the terms (sorted by shift), 0 <= S <= ``max_sum``.
+
+    The digits of one register move together (r and its complement), so the bounds are taken per
+    register: S's width W is that of its true maximum; the circuit adds modulo 2^W, where partial
+    sums may wrap but the total cannot.
 
     Args:
         terms: The ``Term`` s, lowest shift first.
         offset: The constant.
-        max_sum: The largest S over all register values (its bit length is the circuit's width).
+        initial: The constant S starts from (``align``; 0 otherwise).
+        max_sum: The largest S over all register values (its bit length W is the circuit's width).
         low: The smallest S over the valid entries (interval bound).
         high: The largest S over the valid entries (interval bound).
     """
 
     terms: tuple[Term, ...]
     offset: int
+    initial: int
     max_sum: int
     low: int
     high: int
+
+    @property
+    def lowest(self) -> int:
+        """The lowest bit a term touches (the accumulator's first qubit); 0 without terms."""
+        return self.terms[0].shift if self.terms else 0
+
+    @property
+    def constant_ones(self) -> int:
+        """The bits of S below ``lowest``: constants (those of ``initial``), as a mask."""
+        return self.initial & ((1 << self.lowest) - 1)
 
     @property
     def width(self) -> int:
@@ -171,7 +221,7 @@ class OraclePlan:
         box_tests: Point-box pairs before settling (points x boxes).
         box_tests_kept: Point-box pairs the circuit tests.
         comparisons_kept: Comparisons the circuit evaluates (bounds and boxes).
-        digits: The digit form used.
+        options: The ``OracleOptions`` used.
     """
 
     points: tuple[PointPlan, ...]
@@ -179,7 +229,7 @@ class OraclePlan:
     box_tests: int
     box_tests_kept: int
     comparisons_kept: int
-    digits: str
+    options: OracleOptions
 
     @property
     def increments(self) -> int:
@@ -192,23 +242,25 @@ class OraclePlan:
         return self.increments.bit_length()
 
 
-def _settle(form: LinearForm, threshold: int) -> bool | None:
-    """[S >= threshold] if the same for every valid entry, else None."""
-    if threshold <= form.low:
+def _settle(form: LinearForm, threshold: int, prune: bool) -> bool | None:
+    """[S >= threshold] if the same for every valid entry (``prune``: over the interval bounds of
+    the valid entries; else over every register value), else None."""
+    low, high = (form.low, form.high) if prune else (0, form.max_sum)
+    if threshold <= low:
         return True
-    if threshold > form.high:
+    if threshold > high:
         return False
     return None
 
 
-def _tests(forms: tuple[LinearForm, ...], low: np.ndarray, high: np.ndarray, f: int
+def _tests(forms: tuple[LinearForm, ...], low: np.ndarray, high: np.ndarray, f: int, prune: bool
            ) -> tuple[Comparison, ...] | None:
     """The comparisons of "every axis in [low, high]" left after settling; None if never true."""
     kept = []
     for i, form in enumerate(forms):
         for threshold, negated in ((int(low[i]) * (1 << f) - form.offset, False),
                                    ((int(high[i]) + 1) * (1 << f) - form.offset, True)):
-            settled = _settle(form, threshold)
+            settled = _settle(form, threshold, prune)
             if settled is None:
                 kept.append(Comparison(i, threshold, negated))
             elif settled == negated:  # this side fails for every valid entry
@@ -217,26 +269,30 @@ def _tests(forms: tuple[LinearForm, ...], low: np.ndarray, high: np.ndarray, f: 
 
 
 def _form(database: LatticeDatabase, motion: SampledMotion, matrix: np.ndarray, axis: int,
-          parent_range: tuple[np.ndarray, np.ndarray], digits: str) -> LinearForm:
+          parent_range: tuple[np.ndarray, np.ndarray], options: OracleOptions) -> LinearForm:
     f, b, a = motion.fraction_bits, database.fmt.bits, database.cell_bits
     d = database.dim
     offset = (1 << f) >> 1
     terms: list[Term] = []
-    low = high = 0
+    low = high = largest = 0
     single_node = database.parent_bits == 0
 
     def add(coefficient: int, register: str, j: int, base: int, width: int, r_low: int, r_high: int) -> None:
-        nonlocal offset, low, high
-        for k, sign in signed_digits(coefficient, digits):
+        """The digits of coefficient 2^base x r; S gains g(r) = coefficient 2^base r + c, c the
+        complements' constant, exactly bounded per register (its digits move together)."""
+        nonlocal offset, low, high, largest
+        complements = 0
+        for k, sign in signed_digits(coefficient, options.digits):
             term = Term(register, j, base + k, sign < 0, width)
             terms.append(term)
             if term.negated:
-                offset -= term.largest
-                r_lo, r_hi = (1 << width) - 1 - r_high, (1 << width) - 1 - r_low
-            else:
-                r_lo, r_hi = r_low, r_high
-            low += r_lo << term.shift
-            high += r_hi << term.shift
+                complements += term.largest
+        offset -= complements
+        scaled = coefficient << base
+        ends = sorted((scaled * r_low, scaled * r_high))
+        low += complements + ends[0]
+        high += complements + ends[1]
+        largest += complements + max(0, scaled * ((1 << width) - 1))
 
     for j in range(d):
         cell_coefficient = ((1 << f) if j == axis else 0) - int(matrix[axis, j])
@@ -249,26 +305,28 @@ def _form(database: LatticeDatabase, motion: SampledMotion, matrix: np.ndarray, 
         else:
             add(coefficient, PARENT, j, 0, b, int(parent_range[0][j]), int(parent_range[1][j]))
     terms.sort(key=lambda t: (t.shift, t.register, t.axis))
-    return LinearForm(tuple(terms), offset, sum(t.largest for t in terms), low, high)
+    initial = offset % (1 << f) if options.align and terms else 0
+    return LinearForm(tuple(terms), offset - initial, initial, initial + largest, initial + low, initial + high)
 
 
-def oracle_plan(env: Environment, database: LatticeDatabase, motion: SampledMotion, digits: str = "naf"
-                ) -> OraclePlan:
+def oracle_plan(env: Environment, database: LatticeDatabase, motion: SampledMotion,
+                options: OracleOptions | None = None) -> OraclePlan:
     """The integer plan (module text) of the oracle for a world, database and motion.
 
     Args:
         env: The ``Environment`` (inside the format's range).
         database: The ``LatticeDatabase``.
         motion: The ``SampledMotion`` (same d).
-        digits: ``"naf"`` (default) or ``"binary"`` (``signed_digits``).
+        options: ``OracleOptions`` (default: NAF digits, pruned, aligned).
 
     Returns:
         The ``OraclePlan``.
 
     Raises:
-        ValueError: Mismatched dimensions, a world outside the format, or an unknown ``digits``.
+        ValueError: Mismatched dimensions or a world outside the format.
     """
-    digits = check_choice(digits, "digits", DIGITS)
+    options = OracleOptions() if options is None else options
+    prune = options.prune
     if motion.dim != database.dim:
         raise ValueError(f"motion has d = {motion.dim}, the database d = {database.dim}")
     bounds, boxes = grid_limits(env, database)
@@ -278,15 +336,15 @@ def oracle_plan(env: Environment, database: LatticeDatabase, motion: SampledMoti
     blocked = False
     kept_boxes = comparisons = 0
     for matrix in motion.tested:
-        forms = tuple(_form(database, motion, matrix, i, parent_range, digits) for i in range(database.dim))
+        forms = tuple(_form(database, motion, matrix, i, parent_range, options) for i in range(database.dim))
 
-        in_bounds = _tests(forms, bounds[:, 0], bounds[:, 1], f)
+        in_bounds = _tests(forms, bounds[:, 0], bounds[:, 1], f, prune)
         if in_bounds is None:
             blocked = True
             in_bounds = ()
         point_boxes = []
         for index, box in enumerate(boxes):
-            kept = _tests(forms, box[0], box[1], f)
+            kept = _tests(forms, box[0], box[1], f, prune)
             if kept is None:
                 continue
             if not kept:  # inside this box for every valid entry
@@ -297,4 +355,4 @@ def oracle_plan(env: Environment, database: LatticeDatabase, motion: SampledMoti
         comparisons += len(in_bounds)
         kept_boxes += len(point_boxes)
         points.append(PointPlan(matrix, forms, in_bounds, tuple(point_boxes)))
-    return OraclePlan(tuple(points), blocked, len(points) * len(boxes), kept_boxes, comparisons, digits)
+    return OraclePlan(tuple(points), blocked, len(points) * len(boxes), kept_boxes, comparisons, options)

@@ -17,10 +17,11 @@ import functools
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from .emitter import Tally
+from .tally import Tally
 
 if TYPE_CHECKING:
-    from .emitter import Emitter, Literal
+    from .emitter import Emitter
+    from .tally import Literal
 
 
 def unary_qrom(em: Emitter, index: Sequence[int], data: Sequence[int], outputs: Sequence[int]) -> None:

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .emitter import AND, CX, UNDO, X, Z
+from .tally import AND, CX, UNDO, X, Z
 
 if TYPE_CHECKING:
     from qiskit import QuantumCircuit

@@ -17,6 +17,7 @@ from ..world.environment import Environment
 from .lattice import LatticeDatabase
 from .motion import SampledMotion
 from .oracle import build_coherent_oracle
+from .plan import OracleOptions
 from .reference import reachable_reference
 from .simulate import CCX, circuit_gates, simulate
 
@@ -56,15 +57,15 @@ class VerificationResult:
                 and self.circuit_matches_gates and self.tag_errors == 0 and self.other_toffolis == 0)
 
 
-def verify_oracle(env: Environment, database: LatticeDatabase, motion: SampledMotion, digits: str = "naf"
-                  ) -> VerificationResult:
+def verify_oracle(env: Environment, database: LatticeDatabase, motion: SampledMotion,
+                  options: OracleOptions | None = None) -> VerificationResult:
     """Build the oracle and check it on all 2^n index states (module text).
 
     Args:
         env: The ``Environment``.
         database: The ``LatticeDatabase`` (n small enough to enumerate: ``simulate``'s memory limit).
         motion: The ``SampledMotion``.
-        digits: ``"naf"`` (default) or ``"binary"``.
+        options: ``OracleOptions`` (default: NAF digits, pruned, aligned).
 
     Returns:
         The ``VerificationResult``.
@@ -72,7 +73,7 @@ def verify_oracle(env: Environment, database: LatticeDatabase, motion: SampledMo
     Raises:
         ValueError: As ``build_coherent_oracle``, or an n too large to enumerate.
     """
-    oracle = build_coherent_oracle(env, database, motion, digits)
+    oracle = build_coherent_oracle(env, database, motion, options)
     marks = reachable_reference(env, database, motion)
     tagged = oracle.gates
     read = circuit_gates(oracle.circuit)
