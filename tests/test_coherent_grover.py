@@ -57,6 +57,9 @@ def test_the_grover_circuit_acts_on_the_index_only():
     assert circuit.num_qubits == 10 and circuit.num_clbits == 4
     measured = {circuit.find_bit(inst.qubits[0]).index for inst in circuit.data if inst.operation.name == "measure"}
     assert measured == {0, 1, 2, 3}
+    middle = coherent_grover_circuit(oracle.circuit, 4, 2, index_in_middle=True)
+    assert [middle.find_bit(inst.qubits[0]).index for inst in middle.data if inst.operation.name == "measure"] == [
+        3, 4, 5, 6]
     with pytest.raises(ValueError, match=r"num_index_bits must be an integer in \[1, 10\]"):
         coherent_grover_circuit(oracle.circuit, 11, 1)
     assert np.isclose(0.375, reachable_reference(env, database, motion).mean())
