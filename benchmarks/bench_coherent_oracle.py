@@ -9,7 +9,7 @@ space, (n - m) / 2 cell bits per axis, b-bit coordinates covering the world, the
 at K time samples with f = b fraction bits):
 
 1. ``exhaustive``: ``verify_oracle`` (build, read the circuit back, simulate it on all 2^n index
-   states, compare with ``reachable_reference``) for n = 8, 10, ... (m = 2, b = 8, K = 8, B = 20),
+   states, compare with ``reachable_reference``) for n = 8, 10, ... (m = 2, b = 12, K = 8, B = 20),
    until one takes more than ``EXHAUSTIVE_BUDGET_S`` or n reaches ``EXHAUSTIVE_MAX_BITS``; the
    largest that passed is ``figures.exhaustive_max_index_bits``.
 2. ``costs``: qubits and Toffolis of one oracle call for n = 10 .. 30 and B = 10, 100, 1000
@@ -69,7 +69,7 @@ def exhaustive(quick: bool) -> list[dict]:
     rows = []
     print(f"{'n':>3s} {'qubits':>7s} {'gates':>9s} {'marked':>9s} {'seconds':>8s} ok")
     for n in range(8, (14 if quick else EXHAUSTIVE_MAX_BITS) + 1, 2):
-        env, database, motion = scaling_instance(n, 20, parent_bits=2, bits=8, time_samples=8)
+        env, database, motion = scaling_instance(n, 20, parent_bits=2, bits=12, time_samples=8)
         start = time.perf_counter()
         result = verify_oracle(env, database, motion)
         seconds = time.perf_counter() - start
