@@ -12,7 +12,8 @@ TINY = {"oracle-efficiency": 1, "wallclock": 1, "heatmaps": 2, "corridor": 2, "a
         "lemmas": 60, "scaling": 1, "oracle-check": 1,
         "tree-size": 1, "heatmap-hypotheses": 3,
         "corridor-sensitivity": 2, "search-policies": 1, "noise": 1, "resources": 1,
-        "heatmap-worlds": 5, "annealing-density": 2, "problems": 2}
+        "heatmap-worlds": 5, "annealing-density": 2, "problems": 2,
+        "coherent-oracle": 1}
 
 
 def _is_png(path):
@@ -363,6 +364,20 @@ def _check_problems(summary, records):
     assert summary["default_policy"]["chosen"] in POLICY_CANDIDATES
 
 
+def _check_coherent_oracle(summary, records):
+    for r in records:
+        if r["kind"] == "verify":  # the circuit equals its reference on every index state
+            assert r["mismatches"] == 0 and r["ancillas_clean"] == 1 and r["index_preserved"] == 1
+            assert r["entries"] == 2 ** r["index_bits"]
+        elif r["kind"] == "grover":  # within 4 binomial sd of sin^2((2k+1) theta)
+            sd = (max(r["expected"] * (1 - r["expected"]), 1e-12) / r["shots"]) ** 0.5
+            assert abs(r["hits"] / r["shots"] - r["expected"]) <= 4 * sd
+        else:
+            assert r["toffolis"] == 2 * r["oracle_ands"] and r["lookup_qrom_ands"] == 2 * (2 ** r["index_bits"] - 2)
+    assert summary["largest_verified_index_bits"] == max(summary["settings"]["verify_bits"])
+    _assert_intervals_hold(summary["ours"], summary["interval_95"])
+
+
 def _check_noise(summary, records):
     for r in records:
         if r["part"] == "sweep" and r["p2"] == 0 and r["shots"] == 0:  # zero noise: exactly the ideal
@@ -395,7 +410,8 @@ CHECKS = {"oracle-efficiency": _check_oracle_efficiency, "wallclock": _check_wal
           "tree-size": _check_tree_size, "heatmap-hypotheses": _check_heatmap_hypotheses,
           "corridor-sensitivity": _check_corridor_sensitivity, "search-policies": _check_search_policies,
           "noise": _check_noise, "resources": _check_resources, "heatmap-worlds": _check_heatmap_worlds,
-          "annealing-density": _check_annealing_density, "problems": _check_problems}
+          "annealing-density": _check_annealing_density, "problems": _check_problems,
+          "coherent-oracle": _check_coherent_oracle}
 
 
 def _comparable(records):

@@ -66,6 +66,8 @@ class TrialStream(IntEnum):
     # summaries' own draws (no trial uses them)
     PAPER_DESIGN = 41
     AUTHORS_CODE = 42
+    # coherent-oracle: the worlds of its verification and Grover replicates
+    COHERENT_ORACLE = 43
 
 
 @dataclass(frozen=True)

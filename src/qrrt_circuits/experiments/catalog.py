@@ -2,6 +2,7 @@
 
 from .annealing import Annealing
 from .annealing_density import AnnealingDensity
+from .coherent_oracle import CoherentOracle
 from .corridor import Corridor
 from .corridor_sensitivity import CorridorSensitivity
 from .heatmap_hypotheses import HeatmapHypotheses
@@ -22,7 +23,8 @@ EXPERIMENTS = {
     experiment.name: experiment
     for experiment in (OracleEfficiency(), Wallclock(), Heatmaps(), Corridor(), Annealing(), Lemmas(),
                        Scaling(), OracleCheck(), TreeSize(), HeatmapHypotheses(), HeatmapWorlds(),
-                       CorridorSensitivity(), SearchPolicies(), Noise(), Resources(), AnnealingDensity(), Problems())
+                       CorridorSensitivity(), SearchPolicies(), Noise(), Resources(), AnnealingDensity(), Problems(),
+                       CoherentOracle())
 }
 
 __all__ = ["EXPERIMENTS"]

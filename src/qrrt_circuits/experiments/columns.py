@@ -63,6 +63,10 @@ _NAMED: dict[str, ColumnKind] = {
         "free_fraction",
         # problem families
         "reached", "classical_checks", "path_length", "path_length_simplified",
+        # coherent oracle
+        "qubits", "gates", "entries", "marked", "mismatches", "ancillas_clean", "index_preserved", "rounding_compared",
+        "rounding_differs", "hits", "expected", "search_s", "toffolis", "lookup_qrom_ands",
+        "lookup_select_swap_ands",
         # searches and lemmas
         "iterations", "oracle_marked", "true_marked", "missed_good", "p_good", "repeats", "m",
         # noise
