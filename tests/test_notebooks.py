@@ -37,6 +37,7 @@ NOTEBOOKS = [
     "05_custom_predicate.ipynb",
     "06_would_it_pay_off.ipynb",
     "07_plan_your_ompl_problem.ipynb",
+    "08_coherent_oracle.ipynb",
 ]
 INTERPRETER_MARK = "kernel interpreter: "
 
