@@ -369,12 +369,15 @@ def _check_coherent_oracle(summary, records):
         if r["kind"] == "verify":  # the circuit equals its reference on every index state
             assert r["mismatches"] == 0 and r["ancillas_clean"] == 1 and r["index_preserved"] == 1
             assert r["entries"] == 2 ** r["index_bits"]
+        elif r["kind"] == "plan":  # a run that did not reach the goal spent its budget
+            assert r["reached"] == 1 or r["oracle_calls"] >= summary["settings"]["plan_budget"]
         elif r["kind"] == "grover":  # within 4 binomial sd of sin^2((2k+1) theta)
             sd = (max(r["expected"] * (1 - r["expected"]), 1e-12) / r["shots"]) ** 0.5
             assert abs(r["hits"] / r["shots"] - r["expected"]) <= 4 * sd
         else:
             assert r["toffolis"] == 2 * r["oracle_ands"] and r["lookup_qrom_ands"] == 2 * (2 ** r["index_bits"] - 2)
     assert summary["largest_verified_index_bits"] == max(summary["settings"]["verify_bits"])
+    assert set(summary["ours"]["planning"]) == set(summary["settings"]["plan_configs"])
     _assert_intervals_hold(summary["ours"], summary["interval_95"])
 
 

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from . import probability, registry
     from .planners import PQRRT, QRRT, RRT, Metrics, ParallelRRT, PlanResult, termination
+    from .planners.candidates import Candidates, LatticeCandidates, NearestParents
     from .planners.database import AnnealingSchedule
     from .planners.goals import Goal, GoalBall, GoalState
     from .planners.termination import (
@@ -65,6 +66,7 @@ _WHERE = {
     "registry": ".registry",
     **dict.fromkeys(["PQRRT", "QRRT", "RRT", "Metrics", "ParallelRRT", "PlanResult"], ".planners"),
     "AnnealingSchedule": ".planners.database",
+    **dict.fromkeys(["Candidates", "LatticeCandidates", "NearestParents"], ".planners.candidates"),
     **dict.fromkeys(["Goal", "GoalBall", "GoalState"], ".planners.goals"),
     **dict.fromkeys(["RealVectorSpace", "SE2Space", "StateSpace"], ".world.spaces"),
     "termination": ".planners.termination",
@@ -142,6 +144,7 @@ __all__ = [
     "Adaptive",
     "AerBackend",
     "AnnealingSchedule",
+    "Candidates",
     "AnyOf",
     "AuthorsCheck",
     "DatabaseSearch",
@@ -159,6 +162,7 @@ __all__ = [
     "IterationPolicy",
     "KnownOptimal",
     "IterateSequence",
+    "LatticeCandidates",
     "LinearTrackingDynamics",
     "MaxCriticalPathCalls",
     "MaxNodes",
@@ -166,6 +170,7 @@ __all__ = [
     "MaxRounds",
     "MaxWallTime",
     "Metrics",
+    "NearestParents",
     "OccupancyGrid",
     "OracleErrorModel",
     "PaperIterations",

@@ -68,6 +68,7 @@ class TrialStream(IntEnum):
     AUTHORS_CODE = 42
     # coherent-oracle: the worlds of its verification and Grover replicates
     COHERENT_ORACLE = 43
+    COHERENT_ORACLE_PLANS = 44
 
 
 @dataclass(frozen=True)

@@ -18,6 +18,12 @@ world per replicate (its seed):
   circuit's own constructors, beside the lookup oracle over the same 2^n marks (unary-iteration
   QROM and select-swap, load and unload: ``coherent.lookup_costs``).
 
+- ``plan``: q-RRT (n = 7, ``BBHT()``, budget ``PLAN_BUDGET`` oracle calls) in a corridor world with a
+  box in its middle (start (2, 10), goal ball (18, 10) of radius 2.5), its database the paper's
+  (``NearestParents``), the lattice searched by lookup, or the lattice searched by the coherent
+  circuit on Aer (``LatticeCandidates(3, bits=6)``, K = 4), every edge verified by the exact check:
+  the planning figures of the two databases side by side.
+
 The summary gives the verification counts, the Grover hit rate against theory with its binomial
 interval, the costs and, per (n, B), the **break-even test time**: with the coherent oracle one
 q-RRT oracle call costs (oracle ANDs + the diffuser's n - 2) x 10 us (the resource study's
@@ -40,20 +46,23 @@ import numpy as np
 
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
-from .intervals import binomial_interval, rounded_interval
+from .intervals import binomial_interval, bootstrap_interval, rounded_interval
 
 VERIFY_BITS = (8, 12, 16)
 GROVER_BITS = (5, 9, 13)
 COST_BITS = (10, 14, 18, 22, 26, 30)
 COST_BOXES = (10, 100, 1000)
 GROVER_SHOTS = 256
+PLAN_BUDGET = 400
+PLAN_CONFIGS = ("paper database", "lattice, lookup", "lattice, coherent")
 #: the resource study's summary, whose measured savings per quantum call the break-even reads
 RESOURCES_SUMMARY = Path("docs") / "results" / "resources" / "summary.json"
 TOFFOLI_S = 1e-5
 #: every trial's measurement columns (a kind leaves the others NaN)
-COLUMNS = ("qubits", "gates", "entries", "marked", "mismatches", "ancillas_clean", "index_preserved",
-           "rounding_compared", "rounding_differs", "iterations", "shots", "hits", "expected", "search_s",
-           "oracle_ands", "toffolis", "diffuser_ands", "lookup_qrom_ands", "lookup_select_swap_ands")
+COLUMNS = ("reached", "oracle_calls", "nodes", "qubits", "gates", "entries", "marked", "mismatches",
+           "ancillas_clean", "index_preserved", "rounding_compared", "rounding_differs", "iterations", "shots",
+           "hits", "expected", "search_s", "oracle_ands", "toffolis", "diffuser_ands", "lookup_qrom_ands",
+           "lookup_select_swap_ands")
 
 
 def _grover_instance(index_bits: int, seed: int) -> tuple[Any, Any, Any]:
@@ -85,6 +94,8 @@ class CoherentOracle(Experiment):
         return {"trials": trials or (1 if quick else 3), "verify_bits": list(VERIFY_BITS[:1] if quick else VERIFY_BITS),
                 "grover_bits": list(GROVER_BITS[:1] if quick else GROVER_BITS),
                 "cost_bits": list(COST_BITS[:2] if quick else COST_BITS), "cost_boxes": list(COST_BOXES),
+                "plan_configs": list(PLAN_CONFIGS), "plan_replicates": 2 if quick else 20,
+                "plan_budget": PLAN_BUDGET,
                 "grover_shots": GROVER_SHOTS, "toffoli_s": TOFFOLI_S, **_resource_savings(),
                 "seed": seed, "quick": quick}
 
@@ -93,14 +104,20 @@ class CoherentOracle(Experiment):
         for replicate in range(settings["trials"]):
             seed = replicate_seed(settings["seed"], replicate, TrialStream.COHERENT_ORACLE) % (2**31)
             for n in settings["verify_bits"]:
-                trials.append(Trial(f"verify-{n}-{replicate}", {"kind": "verify", "index_bits": n, "boxes": 20,
-                                                                 "replicate": replicate}, seed))
+                trials.append(Trial(f"verify-{n}-{replicate}", {"kind": "verify", "config": "", "index_bits": n,
+                                                                 "boxes": 20, "replicate": replicate}, seed))
             for n in settings["grover_bits"]:
-                trials.append(Trial(f"grover-{n}-{replicate}", {"kind": "grover", "index_bits": n, "boxes": 2,
-                                                                 "replicate": replicate}, seed))
+                trials.append(Trial(f"grover-{n}-{replicate}", {"kind": "grover", "config": "", "index_bits": n,
+                                                                 "boxes": 2, "replicate": replicate}, seed))
+        for replicate in range(settings["plan_replicates"]):
+            seed = replicate_seed(settings["seed"], replicate, TrialStream.COHERENT_ORACLE_PLANS)
+            for config in settings["plan_configs"]:
+                trials.append(Trial(f"plan-{config}-{replicate}", {"kind": "plan", "config": config, "index_bits": 7,
+                                                                    "boxes": 3, "replicate": replicate}, seed))
         for n in settings["cost_bits"]:  # counts do not depend on the replicate's draw: one world
             for boxes in settings["cost_boxes"]:
-                trials.append(Trial(f"cost-{n}-{boxes}", {"kind": "cost", "index_bits": n, "boxes": boxes,
+                trials.append(Trial(f"cost-{n}-{boxes}", {"kind": "cost", "config": "", "index_bits": n,
+                                                          "boxes": boxes,
                                                           "replicate": 0}, 0))
         return trials
 
@@ -108,6 +125,8 @@ class CoherentOracle(Experiment):
         kind = trial.params["kind"]
         if kind == "verify":
             record = _verify(trial.params["index_bits"], trial.params["boxes"], trial.seed)
+        elif kind == "plan":
+            record = _plan(trial.params["config"], trial.seed, settings["plan_budget"])
         elif kind == "grover":
             record = _grover(trial.params["index_bits"], trial.seed, settings["grover_shots"])
         else:
@@ -138,6 +157,18 @@ class CoherentOracle(Experiment):
             ours["grover"][str(n)] = {"hit_rate": round(hits / shots, 4), "expected": round(expected, 4)}
             intervals["grover"][str(n)] = {"hit_rate": rounded_interval(binomial_interval(hits, shots), 4),
                                            "expected": [round(expected, 4)] * 2}
+        plans = [r for r in records if r["kind"] == "plan"]
+        ours["planning"], intervals["planning"] = {}, {}
+        for config in settings["plan_configs"]:
+            rows = [r for r in plans if r["config"] == config]
+            solved = sum(int(r["reached"]) for r in rows)
+            calls = [int(r["oracle_calls"]) for r in rows]
+            ours["planning"][config] = {"success_rate": round(solved / len(rows), 4),
+                                        "calls_per_solution": round(sum(calls) / solved, 2) if solved else math.inf}
+            intervals["planning"][config] = {
+                "success_rate": rounded_interval(binomial_interval(solved, len(rows)), 4),
+                "calls_per_solution": rounded_interval(bootstrap_interval(
+                    rows, _calls_per_solution, settings["seed"]), 2)}
         tests_per_call, test_s = settings["tests_saved_per_call"], settings["classical_test_s"]
         cost_table: dict[str, Any] = {}
         for r in costs:
@@ -219,6 +250,30 @@ def _resource_savings() -> dict[str, float | None]:
                 "classical_test_s": float(table["test_s"])}
     except (OSError, KeyError, ValueError):
         return {"tests_saved_per_call": None, "classical_test_s": None}
+
+
+def _calls_per_solution(rows: list[Record]) -> float:
+    solved = sum(int(r["reached"]) for r in rows)
+    return sum(float(r["oracle_calls"]) for r in rows) / solved if solved else math.inf
+
+
+def _plan(config: str, seed: int, budget: int) -> Record:
+    from ..planners.candidates import LatticeCandidates, NearestParents
+    from ..planners.quantum import QRRT
+    from ..search.backends.statevector import StatevectorBackend
+    from ..world.environment import Environment
+
+    env, _, _ = _grover_instance(7, 0)
+    boxes = np.concatenate([env.boxes, [[[9.0, 9.0], [11.0, 11.0]]]])
+    world = Environment(env.bounds, boxes, start=np.array([2.0, 10.0]), goal=np.array([18.0, 10.0]), goal_radius=2.5)
+    database = {"paper database": NearestParents(), "lattice, lookup": LatticeCandidates(3, bits=6),
+                "lattice, coherent": LatticeCandidates(3, bits=6, coherent=True)}[config]
+    planner = QRRT(world, backend=StatevectorBackend(seed=seed), num_qubits=7, database=database, seed=seed)
+    result = planner.plan(max_oracle_calls=budget)
+    edges = planner.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:])
+    if not bool(np.all(edges)):
+        raise RuntimeError(f"{config}: a tree edge the exact check rejects")
+    return {"reached": int(result.reached), "oracle_calls": result.metrics.oracle_calls, "nodes": result.metrics.nodes}
 
 
 def _verify(index_bits: int, boxes: int, seed: int) -> Record:

@@ -20,7 +20,7 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import Executor
 from dataclasses import dataclass, field
 from itertools import repeat
-from typing import TypeVar
+from typing import Any, TypeVar
 
 from .._support.randomness import RandomStreams
 from ..reachability.oracle_errors import OracleErrorModel
@@ -51,6 +51,7 @@ class WorkerContext:
     database_size: int = 1
     max_extension: float | None = None
     space: StateSpace | None = None
+    candidates: Any = None  # a quantum planner's ``candidates.Candidates`` (classical planners: None)
 
     @property
     def search_backend(self) -> QuantumSearchBackend:

@@ -170,11 +170,14 @@ class Database:
         children: Float (N, d), the candidate points (Alg. 1's x_new, one per database entry).
         parents: Int (N,), the tree row of each candidate's nearest node.
         band: The annealing band (r_min, r_max) the candidates were moved into, or None.
+        lattice: The ``coherent.LatticeDatabase`` whose entries these are (``LatticeCandidates``),
+            or None.
     """
 
     children: np.ndarray
     parents: np.ndarray
     band: tuple[float, float] | None = None
+    lattice: Any = None
 
 
 def build_database(

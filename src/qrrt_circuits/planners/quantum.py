@@ -36,6 +36,7 @@ from ..search.policies.iteration import BBHT, IterationPolicy, PolicyState
 from ..world.environment import Environment
 from ..world.spaces import StateSpace
 from .base import Planner
+from .candidates import Candidates, NearestParents
 from .classical import MAX_WORKERS
 from .context import WorkerContext, map_tasks
 from .database import AnnealingSchedule
@@ -86,6 +87,10 @@ class PQRRT(Planner):
         annealing: An ``AnnealingSchedule`` for Quantum Database Annealing (Alg. 4: samples are
             drawn in distance bands around the tree that shrink with the temperature index h), or
             None (default) for uniform databases.
+        database: How each round's database is built and searched (``planners.candidates``):
+            ``NearestParents()`` (the default: the paper's samples with their nearest nodes,
+            searched by lookup) or ``LatticeCandidates(cell_bits, ..., coherent=...)`` (lattice
+            cells paired with drawn nodes, searched by lookup or by the coherent circuit on Aer).
         iterations: Deprecated alias of ``search_policy``.
 
     Raises:
@@ -110,6 +115,7 @@ class PQRRT(Planner):
         shared_database: bool = True,
         search_policy: IterationPolicy | None = None,
         annealing: AnnealingSchedule | None = None,
+        database: Candidates | None = None,
         predicate: ReachabilityPredicate | None = None,
         dynamics: LinearTrackingDynamics | None = None,
         oracle_errors: OracleErrorModel | None = None,
@@ -141,6 +147,11 @@ class PQRRT(Planner):
                        "a search policy (PaperIterations(), FixedIterations(k), KnownOptimal(), BBHT(), Adaptive())")
         if annealing is not None:
             check_instance(annealing, "annealing", AnnealingSchedule, "an AnnealingSchedule or None")
+        candidates = NearestParents() if database is None else check_instance(
+            database, "database", Candidates, "NearestParents() (the paper's), LatticeCandidates(...) or None")
+        if annealing is not None and database is not None:
+            raise ValueError("annealing draws the paper's database in bands: give annealing or database, not both")
+        candidates.check(env, self.num_qubits, oracle_errors is not None)
         super().__init__(env, predicate=predicate, dynamics=dynamics, oracle_errors=oracle_errors,
                          goal_bias=goal_bias, max_extension=max_extension, space=space, resolution=resolution,
                          seed=seed, oracle=oracle, executor=executor)
@@ -148,6 +159,7 @@ class PQRRT(Planner):
         self.shared_database = check_bool(shared_database, "shared_database")
         self.search_policy = policy
         self.annealing = annealing
+        self.candidates = candidates
 
     def memory_estimate(self, num_qubits: int | None = None) -> MemoryEstimate:
         """Estimated peak memory of one round (``qrrt_circuits._support.memory``); ``plan`` checks it, with
@@ -202,7 +214,8 @@ class PQRRT(Planner):
 
     def _context(self) -> WorkerContext:
         return WorkerContext(self.env, self.predicate, self.streams, self.goal_bias, self.oracle_errors,
-                             self.backend, self.annealing, self.database_size, self.max_extension, self.space)
+                             self.backend, self.annealing, self.database_size, self.max_extension, self.space,
+                             self.candidates)
 
     def _worker_groups(self) -> list[tuple[int, int]]:
         """(first worker, workers) per database: one group of p on a shared database, p of one."""
@@ -250,6 +263,7 @@ class PQRRT(Planner):
             "shared_database": self.shared_database,
             "search_policy": self.search_policy.describe(),
             "annealing": None if self.annealing is None else self.annealing.describe(),
+            "database": self.candidates.describe(),
         }
 
     def labels(self) -> tuple[str, ...]:
@@ -266,6 +280,7 @@ class PQRRT(Planner):
                 f"simulation: one search with {self.workers} shots stands for {self.workers} workers "
                 "measuring copies of the shared database (counted as p x k quantum oracle calls "
                 "and p verifications)")
+        labels.extend(self.candidates.labels())
         labels.extend(self.search_policy.labels())
         labels.extend(self.backend.labels())
         return tuple(labels)
@@ -289,6 +304,7 @@ class QRRT(PQRRT):
             Default 8.
         search_policy: The ``IterationPolicy`` of the searches. Default: ``BBHT()``.
         annealing: An ``AnnealingSchedule`` (Quantum Database Annealing), or None (default).
+        database: ``NearestParents()`` (default) or ``LatticeCandidates(...)``, as for ``PQRRT``.
         iterations: Deprecated alias of ``search_policy``.
 
     Raises:
@@ -306,6 +322,7 @@ class QRRT(PQRRT):
         num_qubits: int = 8,
         search_policy: IterationPolicy | None = None,
         annealing: AnnealingSchedule | None = None,
+        database: Candidates | None = None,
         predicate: ReachabilityPredicate | None = None,
         dynamics: LinearTrackingDynamics | None = None,
         oracle_errors: OracleErrorModel | None = None,
@@ -318,7 +335,7 @@ class QRRT(PQRRT):
         iterations: IterationPolicy | None = None,
     ) -> None:
         super().__init__(env, backend=backend, num_qubits=num_qubits, workers=1, shared_database=True,
-                         search_policy=search_policy, annealing=annealing, predicate=predicate,
+                         search_policy=search_policy, annealing=annealing, database=database, predicate=predicate,
                          dynamics=dynamics, oracle_errors=oracle_errors, goal_bias=goal_bias,
                          max_extension=max_extension, space=space, resolution=resolution, seed=seed,
                          oracle=oracle, iterations=iterations)

@@ -19,7 +19,7 @@ from .._support.randomness import Stream
 from ..reachability.predicate import check_answers
 from ..search.problem import DatabaseSearch, SearchOutcome
 from .context import RoundView, WorkerContext
-from .database import Database, stream_database
+from .database import Database
 
 
 def check_extensions(context: WorkerContext, view: RoundView, pairs: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
@@ -90,13 +90,11 @@ def database_outcome(children: np.ndarray, parents: np.ndarray, truth: np.ndarra
 def make_database(context: WorkerContext, view: RoundView, worker: int) -> tuple[Database, np.ndarray, np.ndarray]:
     """The database of paper Algorithm 1, lines 4-8, the true predicate on it, and the oracle's
     marks."""
-    db = stream_database(view.tree, context.database_size, context.env, context.streams, view.round_index,
-                         worker, view.goal, context.goal_bias, context.annealing,
-                         view.temperature_index, context.max_extension, context.space)
+    db = context.candidates.build(context, view, worker)
     size = db.parents.shape[0]
     truth = check_answers(context.predicate.reachable(view.tree.nodes[db.parents], db.children), size,
                           f"the predicate {context.predicate.name!r}")
-    marks = truth
+    marks = context.candidates.oracle_marks(context, db, truth)
     if context.oracle_errors is not None:
         marks = check_answers(context.oracle_errors.apply(
             truth, context.streams.generator(view.round_index, worker, Stream.ORACLE_ERRORS)), size,
@@ -108,7 +106,7 @@ def search_database(context: WorkerContext, view: RoundView, group: tuple[int, i
     """Workers ``first, ..., first + count - 1`` search one database built by worker ``first``."""
     first, count = group
     db, truth, marks = make_database(context, view, first)
-    problem = DatabaseSearch(marks, truth, context.search_backend, context.streams, view.round_index, first,
-                             memory_checked=True)  # covered by the plan's one memory check
+    problem = DatabaseSearch(marks, truth, context.candidates.search_backend(context, db), context.streams,
+                             view.round_index, first, memory_checked=True)  # covered by the plan's one memory check
     return database_outcome(db.children, db.parents, truth, view.search_policy_state.run(problem, count,
                                                                                         view.tree_nodes))
