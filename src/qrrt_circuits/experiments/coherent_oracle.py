@@ -16,7 +16,8 @@ world per replicate (its seed):
 - ``cost``: qubits, ANDs (Toffolis with measurement-based uncomputation) and CCX of one oracle call
   for n = 10 .. 30 and B = 10, 100, 1000 (m = 6, b = 16, K = 16), counted in closed form by the
   circuit's own constructors, beside the lookup oracle over the same 2^n marks (unary-iteration
-  QROM and select-swap, load and unload: ``coherent.lookup_costs``).
+  QROM and select-swap, load and unload: ``coherent.lookup_costs``); and at n = 20, B = 100 the
+  same against the coordinate bits b (K = 16) and the time samples K (b = 16).
 
 - ``plan``: q-RRT (n = 7, ``BBHT()``, budget ``PLAN_BUDGET`` oracle calls) in a corridor world with a
   box in its middle (start (2, 10), goal ball (18, 10) of radius 2.5), its database the paper's
@@ -31,7 +32,9 @@ q-RRT oracle call costs (oracle ANDs + the diffuser's n - 2) x 10 us (the resour
 it saves; the resource study measures those savings as ``break_even_tests_per_call`` (its
 ``plan`` table, read into the settings from ``docs/results/resources/summary.json`` when present:
 measured at n = 8 in the paper's world, an assumption elsewhere), so the break-even is a classical
-test slower than call time / tests saved per call.
+test slower than call time / tests saved per call; and the plan time that follows on the resource
+study's plans (its q-RRT's mean quantum calls x call time + verifications x test time, beside its
+RRT's calls x test time).
 """
 
 from __future__ import annotations
@@ -52,6 +55,9 @@ VERIFY_BITS = (8, 12, 16)
 GROVER_BITS = (5, 9, 13)
 COST_BITS = (10, 14, 18, 22, 26, 30)
 COST_BOXES = (10, 100, 1000)
+#: the precision sweeps at n = 20, B = 100: coordinate bits b (K = 16) and time samples K (b = 16)
+SWEEP_BITS = (8, 12, 16, 20, 24)
+SWEEP_SAMPLES = (4, 8, 16, 32, 64)
 GROVER_SHOTS = 256
 PLAN_BUDGET = 400
 PLAN_CONFIGS = ("paper database", "lattice, lookup", "lattice, coherent")
@@ -94,6 +100,8 @@ class CoherentOracle(Experiment):
         return {"trials": trials or (1 if quick else 3), "verify_bits": list(VERIFY_BITS[:1] if quick else VERIFY_BITS),
                 "grover_bits": list(GROVER_BITS[:1] if quick else GROVER_BITS),
                 "cost_bits": list(COST_BITS[:2] if quick else COST_BITS), "cost_boxes": list(COST_BOXES),
+                "sweep_bits": list(SWEEP_BITS[:2] if quick else SWEEP_BITS),
+                "sweep_samples": list(SWEEP_SAMPLES[:2] if quick else SWEEP_SAMPLES),
                 "plan_configs": list(PLAN_CONFIGS), "plan_replicates": 2 if quick else 20,
                 "plan_budget": PLAN_BUDGET,
                 "grover_shots": GROVER_SHOTS, "toffoli_s": TOFFOLI_S, **_resource_savings(),
@@ -119,6 +127,12 @@ class CoherentOracle(Experiment):
                 trials.append(Trial(f"cost-{n}-{boxes}", {"kind": "cost", "config": "", "index_bits": n,
                                                           "boxes": boxes,
                                                           "replicate": 0}, 0))
+        for b in settings["sweep_bits"]:
+            trials.append(Trial(f"cost-b{b}", {"kind": "cost", "config": f"b={b}", "index_bits": 20, "boxes": 100,
+                                               "replicate": 0}, 0))
+        for k in settings["sweep_samples"]:
+            trials.append(Trial(f"cost-K{k}", {"kind": "cost", "config": f"K={k}", "index_bits": 20, "boxes": 100,
+                                               "replicate": 0}, 0))
         return trials
 
     def run_trial(self, trial: Trial, settings: Settings) -> Record:
@@ -130,7 +144,9 @@ class CoherentOracle(Experiment):
         elif kind == "grover":
             record = _grover(trial.params["index_bits"], trial.seed, settings["grover_shots"])
         else:
-            record = _cost(trial.params["index_bits"], trial.params["boxes"], trial.seed)
+            sweep = dict(part.split("=") for part in trial.params["config"].split(",") if part)
+            record = _cost(trial.params["index_bits"], trial.params["boxes"], trial.seed, int(sweep.get("b", 16)),
+                           int(sweep.get("K", 16)))
         return dict.fromkeys(COLUMNS, math.nan) | record  # one header for the three kinds
 
     def summarize(self, records: list[Record], settings: Settings) -> Summary:
@@ -171,7 +187,13 @@ class CoherentOracle(Experiment):
                     rows, _calls_per_solution, settings["seed"]), 2)}
         tests_per_call, test_s = settings["tests_saved_per_call"], settings["classical_test_s"]
         cost_table: dict[str, Any] = {}
+        sweeps: dict[str, dict[str, Any]] = {"bits": {}, "time_samples": {}}
         for r in costs:
+            if r["config"]:
+                name, value = r["config"].split("=")
+                sweeps["bits" if name == "b" else "time_samples"][value] = {
+                    "qubits": r["qubits"], "oracle_ands": r["oracle_ands"]}
+                continue
             call_s = (r["oracle_ands"] + r["diffuser_ands"]) * settings["toffoli_s"]
             entry = {"qubits": r["qubits"], "oracle_ands": r["oracle_ands"], "toffolis": r["toffolis"],
                      "lookup_qrom_ands": r["lookup_qrom_ands"], "lookup_select_swap_ands": r["lookup_select_swap_ands"],
@@ -180,10 +202,14 @@ class CoherentOracle(Experiment):
             if tests_per_call is not None:
                 entry["break_even_test_s"] = call_s / tests_per_call
                 entry["measured_test_s"] = test_s
+                entry["qrrt_plan_s"] = (settings["qrrt_quantum_calls"] * call_s
+                                        + settings["qrrt_verifications"] * test_s)
+                entry["rrt_plan_s"] = settings["rrt_calls"] * test_s
             cost_table.setdefault(str(r["index_bits"]), {})[str(r["boxes"])] = entry
         largest = max((r["index_bits"] for r in verify if r["mismatches"] == 0 and r["ancillas_clean"]
                        and r["index_preserved"]), default=None)
         return {"ours": ours, "paper": self.paper, "interval_95": intervals, "costs": cost_table,
+                "cost_sweeps_n20_b100": sweeps,
                 "largest_verified_index_bits": largest,
                 "largest_verified_qubits": max((r["qubits"] for r in verify if r["index_bits"] == largest),
                                                default=None),
@@ -242,14 +268,17 @@ class CoherentOracle(Experiment):
 
 
 def _resource_savings() -> dict[str, float | None]:
-    """The classical tests saved per quantum call and the seconds of one classical test, from the
-    resource study's summary (run from the repository's root), or None where it is not there."""
+    """The classical tests saved per quantum call, the seconds of one classical test and the mean
+    calls of q-RRT's and RRT's plans, from the resource study's summary (run from the repository's
+    root), or None where it is not there."""
     try:
         table = json.loads(RESOURCES_SUMMARY.read_text())["plan"]["table"]
         return {"tests_saved_per_call": float(table["break_even_tests_per_call"]),
-                "classical_test_s": float(table["test_s"])}
+                "classical_test_s": float(table["test_s"]), "qrrt_quantum_calls": float(table["quantum_calls"]),
+                "qrrt_verifications": float(table["verifications"]), "rrt_calls": float(table["rrt_calls"])}
     except (OSError, KeyError, ValueError):
-        return {"tests_saved_per_call": None, "classical_test_s": None}
+        return dict.fromkeys(("tests_saved_per_call", "classical_test_s", "qrrt_quantum_calls", "qrrt_verifications",
+                              "rrt_calls"))
 
 
 def _calls_per_solution(rows: list[Record]) -> float:
@@ -313,11 +342,11 @@ def _grover(index_bits: int, seed: int, shots: int) -> Record:
             "hits": hits, "expected": math.sin((2 * iterations + 1) * theta) ** 2, "search_s": elapsed}
 
 
-def _cost(index_bits: int, boxes: int, seed: int) -> Record:
+def _cost(index_bits: int, boxes: int, seed: int, bits: int = 16, time_samples: int = 16) -> Record:
     from ..coherent import lookup_costs, oracle_costs
     from ..coherent.costs import scaling_instance
 
-    env, database, motion = scaling_instance(index_bits, boxes, seed=seed)
+    env, database, motion = scaling_instance(index_bits, boxes, bits=bits, time_samples=time_samples, seed=seed)
     cost = oracle_costs(env, database, motion)
     lookup = lookup_costs(index_bits)
     return {"qubits": cost.qubits, "oracle_ands": cost.ands, "toffolis": cost.toffolis,
