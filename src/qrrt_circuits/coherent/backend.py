@@ -4,10 +4,10 @@ motion check on Aer, not a lookup of the marks.
 ``CoherentOracleBackend(oracle, num_index_bits)`` searches the database its oracle circuit was built
 for (``LatticeCandidates(coherent=True)`` makes one per database): ``search(marks, k, shots,
 seed)`` runs ``coherent_grover_circuit(oracle, n, k)`` (index register in the middle of the chain)
-on ``AerSimulator(method="matrix_product_state")`` with ``seed_simulator``, transpiled once per
-search to Aer's gates. ``marks`` must be the circuit's own marks (``reachable_reference``, which the
-circuit equals entry for entry): they size the search and keep the planner's accounting (marked
-count, verification) about the same oracle; the circuit alone decides what is measured.
+on ``AerSimulator(method="matrix_product_state")`` with ``seed_simulator``, transpiled to Aer's
+gates once per iteration count. ``marks`` must be the circuit's own marks (``reachable_reference``,
+which the circuit equals entry for entry): they size the search and keep the planner's accounting
+(marked count, verification) about the same oracle; the circuit alone decides what is measured.
 """
 
 from __future__ import annotations
@@ -42,6 +42,7 @@ class CoherentOracleBackend(QuantumSearchBackend):
         self.oracle = oracle
         self.num_index_bits = check_int(num_index_bits, "num_index_bits", 1, oracle.num_qubits)
         self._rng = np.random.default_rng()
+        self._circuits: dict[int, QuantumCircuit] = {}  # transpiled once per iteration count
 
     @property
     def max_qubits(self) -> int:
@@ -61,8 +62,11 @@ class CoherentOracleBackend(QuantumSearchBackend):
         if num_qubits != self.num_index_bits:
             raise ValueError(f"this backend searches its oracle's {self.num_index_bits} index qubits, "
                              f"not {num_qubits}")
-        circuit = transpile(coherent_grover_circuit(self.oracle, num_qubits, iterations, index_in_middle=True),
-                            basis_gates=list(AER_BASIS), optimization_level=0)
+        circuit = self._circuits.get(iterations)
+        if circuit is None:
+            circuit = transpile(coherent_grover_circuit(self.oracle, num_qubits, iterations, index_in_middle=True),
+                                basis_gates=list(AER_BASIS), optimization_level=0)
+            self._circuits[iterations] = circuit
         result = AerSimulator(method="matrix_product_state").run(
             circuit, shots=shots, seed_simulator=int(rng.integers(0, 2**31 - 1)), memory=True).result()
         return np.fromiter((int(word, 2) for word in result.get_memory()), dtype=np.int64, count=shots)

@@ -10,8 +10,8 @@ import numpy as np
 
 from ..world.problems import Problem
 
-#: OMPL planners by the experiment's label
-OMPL_PLANNERS = {"OMPL RRT": "RRT", "OMPL RRTConnect": "RRTConnect"}
+#: OMPL planners by the experiment's label: (``ompl.geometric`` class, whether it takes a goal bias)
+OMPL_PLANNERS = {"OMPL RRT": ("RRT", True), "OMPL RRTConnect": ("RRTConnect", False)}
 
 
 @dataclass(frozen=True)
@@ -66,8 +66,9 @@ def ompl_run(problem: Problem, label: str, budget: int, seed: int, goal_bias: fl
     setup = setup_from_problem(problem.env, problem.predicate)
     si = setup.getSpaceInformation()
     validator = si.getMotionValidator()
-    planner = getattr(og, OMPL_PLANNERS[label])(si)
-    if label == "OMPL RRT":
+    name, takes_goal_bias = OMPL_PLANNERS[label]
+    planner = getattr(og, name)(si)
+    if takes_goal_bias:
         planner.setGoalBias(goal_bias)
     setup.setPlanner(planner)
     setup.setup()

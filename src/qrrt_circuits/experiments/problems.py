@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import importlib.util
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from functools import partial
 from pathlib import Path
 from typing import Any
@@ -58,16 +58,16 @@ from .planners import BACKEND_LABEL, make_planner
 
 FAMILIES = ("open-space", "maze", "narrow-passage-2d", "narrow-passage-4d", "narrow-passage-6d", "se2-gap")
 QUICK_FAMILIES = ("open-space", "maze", "narrow-passage-2d", "se2-gap")
-#: label -> (registry planner, search policy name or None, extra options)
-LIBRARY_CONFIGS: dict[str, tuple[str, str | None, dict[str, Any]]] = {
-    "RRT": ("rrt", None, {}),
-    "RRT range": ("rrt", None, {"look_ahead": False}),
-    "ParallelRRT": ("prrt", None, {}),
-    "QRRT paper": ("qrrt", "paper", {}),
-    "QRRT adaptive": ("qrrt", "adaptive", {}),
-    "QRRT bbht": ("qrrt", "bbht", {}),
-    "PQRRT paper": ("pqrrt", "paper", {}),
-    "PQRRT adaptive": ("pqrrt", "adaptive", {}),
+#: label -> (registry planner, search policy name or None, the extra options for a problem)
+LIBRARY_CONFIGS: dict[str, tuple[str, str | None, Callable[[Problem], dict[str, Any]]]] = {
+    "RRT": ("rrt", None, lambda problem: {}),
+    "RRT range": ("rrt", None, lambda problem: {"look_ahead": False, "max_extension": ompl_range(problem)}),
+    "ParallelRRT": ("prrt", None, lambda problem: {}),
+    "QRRT paper": ("qrrt", "paper", lambda problem: {}),
+    "QRRT adaptive": ("qrrt", "adaptive", lambda problem: {}),
+    "QRRT bbht": ("qrrt", "bbht", lambda problem: {}),
+    "PQRRT paper": ("pqrrt", "paper", lambda problem: {}),
+    "PQRRT adaptive": ("pqrrt", "adaptive", lambda problem: {}),
 }
 OMPL_CONFIGS = ("OMPL RRT", "OMPL RRTConnect")
 POLICY_CANDIDATES = ("paper", "adaptive", "bbht")
@@ -155,11 +155,9 @@ class Problems(Experiment):
         if config in OMPL_CONFIGS:
             return self._ompl_trial(problem, config, trial.seed, settings)
         kind, policy, options = LIBRARY_CONFIGS[config]
-        if config == "RRT range":
-            options = {**options, "max_extension": ompl_range(problem)}
         planner = make_planner(kind, problem.env, trial.seed, settings["backend"], settings["workers"],
                                settings["num_qubits"], search_policy=policy, goal_bias=settings["goal_bias"],
-                               **problem.planner_options(), **options)
+                               **problem.planner_options(), **options(problem))
         result = planner.plan(goal=problem.goal, max_oracle_calls=settings["budget"])
         m = result.metrics
         record = {"status": str(result.status), "reached": int(result.reached), "oracle_calls": m.oracle_calls,

@@ -104,6 +104,9 @@ class LatticeCandidates(Candidates):
         self.fraction_bits = self.bits if fraction_bits is None else check_int(fraction_bits, "fraction_bits", 0, 24)
         self.dynamics = LinearTrackingDynamics.paper() if dynamics is None else check_instance(
             dynamics, "dynamics", LinearTrackingDynamics, "a LinearTrackingDynamics or None")
+        from ..coherent import SampledMotion
+
+        self.motion = SampledMotion.from_dynamics(self.dynamics, self.time_samples, self.fraction_bits)
 
     def check(self, env: Environment, num_qubits: int, workers_see_errors: bool) -> None:
         from ..coherent import FixedPointFormat
@@ -132,17 +135,12 @@ class LatticeCandidates(Candidates):
         entries = database.entries()
         return Database(entries.samples, rows[entries.parent_index], lattice=database)
 
-    def _motion(self) -> Any:
-        from ..coherent import SampledMotion
-
-        return SampledMotion.from_dynamics(self.dynamics, self.time_samples, self.fraction_bits)
-
     def oracle_marks(self, context: WorkerContext, db: Database, truth: np.ndarray) -> np.ndarray:
         if not self.coherent:
             return truth
         from ..coherent import reachable_reference
 
-        return reachable_reference(context.env, db.lattice, self._motion())
+        return reachable_reference(context.env, db.lattice, self.motion)
 
     def search_backend(self, context: WorkerContext, db: Database) -> QuantumSearchBackend:
         if not self.coherent:
@@ -150,7 +148,7 @@ class LatticeCandidates(Candidates):
         from ..coherent import build_coherent_oracle
         from ..coherent.backend import CoherentOracleBackend
 
-        oracle = build_coherent_oracle(context.env, db.lattice, self._motion())
+        oracle = build_coherent_oracle(context.env, db.lattice, self.motion)
         return CoherentOracleBackend(oracle.circuit, db.lattice.num_index_bits)
 
     def describe(self) -> dict:
