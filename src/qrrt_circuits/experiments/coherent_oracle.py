@@ -71,6 +71,13 @@ COLUMNS = ("reached", "oracle_calls", "nodes", "qubits", "gates", "entries", "ma
            "lookup_select_swap_ands")
 
 
+#: the corridor of the searches and plans: [0, 20]^2 less y <= 7 and y >= 13
+BOUNDS = np.array([[0.0, 20.0], [0.0, 20.0]])
+CORRIDOR_WALLS = np.array([[[0.0, 0.0], [20.0, 7.0]], [[0.0, 13.0], [20.0, 20.0]]])
+#: the box in the corridor's middle that the plans go round
+MIDDLE_BOX = np.array([[[9.0, 9.0], [11.0, 11.0]]])
+
+
 def _grover_instance(index_bits: int, seed: int) -> tuple[Any, Any, Any]:
     """A corridor world: [0, 20]^2 less y <= 7 and y >= 13, two tree nodes in the corridor,
     a = (n - 1) / 2 cell bits per axis, b = max(6, a + 1), the paper's dynamics at K = 4."""
@@ -78,8 +85,7 @@ def _grover_instance(index_bits: int, seed: int) -> tuple[Any, Any, Any]:
     from ..reachability.dynamics import LinearTrackingDynamics
     from ..world.environment import Environment
 
-    env = Environment(np.array([[0.0, 20.0], [0.0, 20.0]]),
-                      np.array([[[0.0, 0.0], [20.0, 7.0]], [[0.0, 13.0], [20.0, 20.0]]]))
+    env = Environment(BOUNDS, CORRIDOR_WALLS)
     rng = np.random.default_rng(seed)
     nodes = np.column_stack([rng.uniform(1.0, 19.0, 2), rng.uniform(8.0, 12.0, 2)])
     cell_bits = (index_bits - 1) // 2
@@ -292,9 +298,8 @@ def _plan(config: str, seed: int, budget: int) -> Record:
     from ..search.backends.statevector import StatevectorBackend
     from ..world.environment import Environment
 
-    env, _, _ = _grover_instance(7, 0)
-    boxes = np.concatenate([env.boxes, [[[9.0, 9.0], [11.0, 11.0]]]])
-    world = Environment(env.bounds, boxes, start=np.array([2.0, 10.0]), goal=np.array([18.0, 10.0]), goal_radius=2.5)
+    world = Environment(BOUNDS, np.concatenate([CORRIDOR_WALLS, MIDDLE_BOX]), start=np.array([2.0, 10.0]),
+                        goal=np.array([18.0, 10.0]), goal_radius=2.5)
     database = {"paper database": NearestParents(), "lattice, lookup": LatticeCandidates(3, bits=6),
                 "lattice, coherent": LatticeCandidates(3, bits=6, coherent=True)}[config]
     planner = QRRT(world, backend=StatevectorBackend(seed=seed), num_qubits=7, database=database, seed=seed)
