@@ -266,7 +266,8 @@ def _print_comparison(result: PlanResult, peer: PlanResult) -> None:
         print(f"note: {metrics.rejected / metrics.verification_calls:.0%} of the measured candidates failed "
               f"verification. {share:.0%} of the databases' entries were reachable on average; a fixed "
               "iteration count tuned for a small share over-rotates past the peak of sin^2((2k+1)theta) "
-              "as the share grows. --policy adaptive learns the share from verified outcomes.")
+              "as the share grows, and BBHT's random counts miss often by design. --policy adaptive learns "
+              "the share from verified outcomes.")
 
 
 def _per_node(value: float, result: PlanResult) -> str:
