@@ -1,4 +1,5 @@
 import json
+import math
 
 import numpy as np
 import pytest
@@ -338,7 +339,7 @@ def _check_search_policies(summary, records):
 
 
 def _check_problems(summary, records):
-    from qrrt_circuits.experiments.problems import POLICY_CANDIDATES
+    from qrrt_circuits.experiments.problems import POLICY_CANDIDATES, TIE_MARGIN
 
     settings = summary["settings"]
     for r in records:
@@ -361,7 +362,11 @@ def _check_problems(summary, records):
                 assert row["calls_per_solution"] == round(sum(r["oracle_calls"] for r in runs) / solved, 4)
         _assert_intervals_hold(planners, summary["interval_95"][family])
         _assert_intervals_hold(summary["details"][family], summary["details_interval_95"][family])
-    assert summary["default_policy"]["chosen"] in POLICY_CANDIDATES
+    for rule in summary["default_policy"].values():
+        assert rule["chosen"] in POLICY_CANDIDATES and rule["chosen_by_root_seed"]
+        worst = {c: math.inf if v is None else v for c, v in rule["worst"].items()}  # JSON's null is inf
+        assert worst[rule["chosen"]] <= min(worst.values()) * TIE_MARGIN
+        assert abs(sum(rule["chosen_share_in_resamples"].values()) - 1) < 1e-3
 
 
 def _check_coherent_oracle(summary, records):

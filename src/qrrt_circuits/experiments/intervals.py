@@ -114,23 +114,58 @@ def bootstrap_ratio_interval(numerators: Sequence[int], denominators: Sequence[i
     return float(np.quantile(values, tail)), float(np.quantile(values, 1.0 - tail))
 
 
+def two_level_bootstrap_counts(sizes: Sequence[int], seed: int, resamples: int = RESAMPLES) -> np.ndarray:
+    """How often each run is drawn in each resample of a two-level bootstrap over worlds and runs.
+
+    One resample draws as many worlds as there are, uniformly with replacement, and for each drawn
+    world as many of its runs as it has, uniformly with replacement. A world drawn ``c`` times
+    contributes ``c * size`` independent uniform draws of its runs, so its runs' counts are one
+    multinomial draw of that total.
+
+    Args:
+        sizes: The runs of each world, in the order of the pooled runs (world 0's runs first);
+            every size >= 1.
+        seed: Seed of the resampling generator.
+        resamples: Bootstrap resamples.
+
+    Returns:
+        Int array (resamples, sum(sizes)): the count of each pooled run in each resample; each
+        row sums to sum(sizes) in expectation (exactly when all worlds have one size).
+
+    Raises:
+        ValueError: An empty ``sizes`` or a size below 1.
+    """
+    sizes = [int(size) for size in sizes]
+    if not sizes or min(sizes) < 1:
+        raise ValueError(f"sizes must be a non-empty list of sizes >= 1, got {sizes}")
+    rng = np.random.default_rng(seed)
+    worlds = rng.integers(0, len(sizes), (resamples, len(sizes)))
+    counts = np.zeros((resamples, sum(sizes)), dtype=np.int64)
+    start = 0
+    for world, size in enumerate(sizes):
+        drawn = np.count_nonzero(worlds == world, axis=1)
+        counts[:, start:start + size] = rng.multinomial(drawn * size, np.full(size, 1.0 / size))
+        start += size
+    return counts
+
+
 def two_level_bootstrap_interval(groups: Mapping[Any, Sequence[Any]], statistic: Callable[[list], float],
                                  seed: int, resamples: int = RESAMPLES,
                                  level: float = LEVEL) -> tuple[float, float]:
     """Percentile interval of ``statistic`` over a two-level bootstrap: worlds, then runs in each.
 
     One resample draws as many worlds as there are, with replacement, and inside each drawn world
-    as many of its runs as it has, with replacement; ``statistic`` is evaluated on all the runs so
-    drawn, pooled. This is the random-effects bootstrap of Davison and Hinkley, *Bootstrap Methods
-    and their Application* (1997), Sec. 3.8 (resampling at both stages). Its variance is about
-    ``(sigma_b^2 + 2 sigma_w^2 / r) / a`` for ``a`` worlds of ``r`` runs, against the true
-    ``(sigma_b^2 + sigma_w^2 / r) / a``: it is conservative where the spread between runs of one
-    world dominates, and like every percentile bootstrap it is a little narrow for few worlds
-    (``tests/test_intervals.py`` measures both).
+    as many of its runs as it has, with replacement (``two_level_bootstrap_counts``); ``statistic``
+    is evaluated on all the runs so drawn, pooled. This is the random-effects bootstrap of Davison
+    and Hinkley, *Bootstrap Methods and their Application* (1997), Sec. 3.8 (resampling at both
+    stages). Its variance is about ``(sigma_b^2 + 2 sigma_w^2 / r) / a`` for ``a`` worlds of ``r``
+    runs, against the true ``(sigma_b^2 + sigma_w^2 / r) / a``: it is conservative where the spread
+    between runs of one world dominates, and like every percentile bootstrap it is a little narrow
+    for few worlds (``tests/test_intervals.py`` measures both).
 
     Args:
         groups: World key -> that world's runs (records, or numbers); worlds without runs are
-            left out.
+            left out; worlds are taken in the order of their keys' strings.
         statistic: The number computed from a flat list of runs; resamples where it raises
             ``ValueError`` or ``ZeroDivisionError`` or gives a non-finite value are left out.
         seed: Seed of the resampling generator.
@@ -142,18 +177,19 @@ def two_level_bootstrap_interval(groups: Mapping[Any, Sequence[Any]], statistic:
         measured), NaNs if no resample is defined.
     """
     worlds = [list(runs) for _, runs in sorted(groups.items(), key=lambda item: str(item[0])) if len(runs)]
+    pooled = [run for runs in worlds for run in runs]
     if len(worlds) < 2:
-        pooled = [run for runs in worlds for run in runs]
         value = _defined(statistic, pooled) if pooled else float("nan")
         return value, value
-    rng = np.random.default_rng(seed)
-    values = np.empty(resamples)
-    for resample in range(resamples):
-        sample: list[Any] = []
-        for world in rng.integers(0, len(worlds), len(worlds)):
-            runs = worlds[world]
-            sample.extend(runs[i] for i in rng.integers(0, len(runs), len(runs)))
-        values[resample] = _defined(statistic, sample)
+    counts = two_level_bootstrap_counts([len(runs) for runs in worlds], seed, resamples)
+    values = np.array([_defined(statistic, [run for run, count in zip(pooled, row, strict=True)
+                                            for _ in range(count)]) for row in counts])
+    return percentile_interval(values, level)
+
+
+def percentile_interval(values: np.ndarray, level: float = LEVEL) -> tuple[float, float]:
+    """The (1 - level) / 2 and (1 + level) / 2 quantiles of the finite ``values`` (NaNs if none)."""
+    values = np.asarray(values, dtype=float)
     values = values[np.isfinite(values)]
     if values.size == 0:
         return float("nan"), float("nan")

@@ -6,6 +6,9 @@ Families (each a function returning a ``Problem``):
 - ``open_space()``: [0, 10]^2 with one box in the middle; straight-line motions.
 - ``narrow_passage(dim, width)``: [0, 10]^d cut by a wall 1 thick at x_0 = 5 with one square hole
   of side ``width`` at its centre; straight-line motions; d = 2 .. 6.
+- ``winding_band(dim, width, seed)``: a staircase band of width ``width`` in the (x_0, x_1) plane
+  of [0, 10]^d, from left to right with two turns drawn from ``seed``, every other axis free: a long
+  narrow passage the tree must travel along, where most samples see no part of it; d = 2 .. 6.
 - ``se2_gap(width)``: a 1.2 x 0.4 rectangle in SE(2) through a gap of ``width`` in a wall
   (``reachability.rigid_body``).
 - ``maze(cells, seed)``: a perfect maze of ``cells`` x ``cells`` rooms drawn by the library
@@ -43,7 +46,7 @@ from .environment import Environment
 from .spaces import RealVectorSpace, SE2Space, StateSpace
 
 __all__ = ["FAMILIES", "Problem", "box_world", "image_problem", "load_problem", "maze", "narrow_passage", "open_space",
-           "se2_gap", "straight_line_dynamics"]
+           "se2_gap", "winding_band", "straight_line_dynamics"]
 
 PROBLEM_FORMAT, PROBLEM_VERSION = "qrrt-problem", 1
 
@@ -126,6 +129,69 @@ def narrow_passage(dim: int = 2, width: float = 0.5) -> Problem:
     start, goal = np.full(dim, 2.0), np.full(dim, 2.0)  # level with each other, away from the hole
     start[0], goal[0] = 1.0, 9.0
     return _box_problem(f"narrow-passage-{dim}d", np.tile([0.0, 10.0], (dim, 1)), np.array(boxes), start, goal, 0.5)
+
+
+def winding_band(dim: int = 2, width: float = 0.2, seed: int = 0) -> Problem:
+    """[0, 10]^d whose free space is a staircase band in the (x_0, x_1) plane (every other axis
+    free): three horizontal legs joined by two vertical ones, each leg a rectangle of side
+    ``width`` across its axis (the legs' ends overlap by ``width / 2``, so the turns are square).
+
+    The band runs from x_0 = 0.5 to x_0 = 9.5; ``seed`` draws the two turns' abscissae a_1 in
+    [2.5, 4] and a_2 in [6, 7.5] and the legs' heights y_0, y_1, y_2 in [1.5, 8.5] with
+    |y_1 - y_0| >= 3 and |y_2 - y_1| >= 3 (rejection sampling), so the band is between about 15
+    and 23 long and a straight motion from one leg to the next meets the wall. Start (1, y_0, 5,
+    ..., 5), goal ball (9, y_2, 5, ..., 5) of radius 0.5. The obstacles are the complement of the
+    band in the plane (a grid of the legs' edges, merged along x_0), extended over the other axes.
+
+    Args:
+        dim: d in [2, 6].
+        width: The band's width, in (0, 1].
+        seed: The world's seed (>= 0): the turns and heights.
+
+    Returns:
+        The problem, named ``winding-band-{d}d-seed{seed}``.
+
+    Raises:
+        TypeError: A non-integer ``dim`` or ``seed``, or a non-real ``width``.
+        ValueError: ``dim`` outside [2, 6], ``width`` outside (0, 1] or a negative ``seed``.
+    """
+    dim = check_int(dim, "dim", 2, 6)
+    width = check_float(width, "width", 0.0, 1.0, open_minimum=True)
+    seed = check_int(seed, "seed", 0)
+    rng = np.random.default_rng([seed, 0xBA2D])
+    a1, a2 = rng.uniform(2.5, 4.0), rng.uniform(6.0, 7.5)
+    heights = [rng.uniform(1.5, 8.5)]
+    while len(heights) < 3:
+        height = rng.uniform(1.5, 8.5)
+        if abs(height - heights[-1]) >= 3.0:
+            heights.append(height)
+    y0, y1, y2 = heights
+    half = width / 2
+    legs = [(0.5, a1, y0, y0), (a1, a1, y0, y1), (a1, a2, y1, y1), (a2, a2, y1, y2), (a2, 9.5, y2, y2)]
+    free = [(min(x0, x1) - half, max(x0, x1) + half, min(ya, yb) - half, max(ya, yb) + half)
+            for x0, x1, ya, yb in legs]
+    xs = sorted({0.0, 10.0, *(v for r in free for v in r[:2])})
+    ys = sorted({0.0, 10.0, *(v for r in free for v in r[2:])})
+    boxes = []
+    for y_low, y_high in zip(ys[:-1], ys[1:], strict=True):
+        run_start = None
+        for x_low, x_high in zip(xs[:-1], xs[1:], strict=True):
+            cx, cy = (x_low + x_high) / 2, (y_low + y_high) / 2
+            blocked = not any(r[0] <= cx <= r[1] and r[2] <= cy <= r[3] for r in free)
+            if blocked and run_start is None:
+                run_start = x_low
+            if not blocked and run_start is not None:
+                boxes.append((run_start, x_low, y_low, y_high))
+                run_start = None
+        if run_start is not None:
+            boxes.append((run_start, 10.0, y_low, y_high))
+    lower, upper = np.zeros((len(boxes), dim)), np.full((len(boxes), dim), 10.0)
+    lower[:, :2] = [(box[0], box[2]) for box in boxes]
+    upper[:, :2] = [(box[1], box[3]) for box in boxes]
+    start, goal = np.full(dim, 5.0), np.full(dim, 5.0)
+    start[:2], goal[:2] = (1.0, y0), (9.0, y2)
+    return _box_problem(f"winding-band-{dim}d-seed{seed}", np.tile([0.0, 10.0], (dim, 1)),
+                        np.stack([lower, upper], axis=1), start, goal, 0.5)
 
 
 def se2_gap(width: float = 1.2) -> Problem:
@@ -225,6 +291,7 @@ def image_problem(path: str | Path, pixel_size: float, start: Any, goal: Any, go
 FAMILIES: dict[str, tuple[Any, dict[str, Any]]] = {
     "open-space": (open_space, {}),
     "narrow-passage": (narrow_passage, {"dim": 2, "width": 0.5}),
+    "winding-band": (winding_band, {"dim": 2, "width": 0.2, "seed": 0}),
     "se2-gap": (se2_gap, {"width": 1.2}),
     "maze": (maze, {"cells": 4, "seed": 0}),
     "image": (image_problem, {"path": None, "pixel_size": None, "start": None, "goal": None, "goal_radius": None,
