@@ -614,3 +614,36 @@ def test_heatmaps_share_one_colour_scale(tmp_path, monkeypatch):
     assert len(fig.axes) == 10  # nine panels and one colour bar
     assert figures.heatmap_counts(env, np.zeros((0, 2))).shape == (50, 50)
     plt.close(fig)
+
+
+def _without_nan(records):
+    return [{k: None if isinstance(v, float) and math.isnan(v) else v for k, v in r.items()} for r in records]
+
+
+def _reproducible(value):
+    """A summary part without wall times (not reproducible), NaN as None (NaN != NaN)."""
+    if isinstance(value, dict):
+        return {k: _reproducible(v) for k, v in value.items() if "wall_time" not in k}
+    if isinstance(value, list):
+        return [_reproducible(v) for v in value]
+    return None if isinstance(value, float) and math.isnan(value) else value
+
+
+def test_problems_quick_path_resumes_to_the_uninterrupted_summary(tmp_path):
+    """Two root seeds, one replicate: a run stopped after 40 trials and resumed holds every trial
+    once and summarises (family costs, intervals over worlds, the default-policy rule) exactly as
+    the uninterrupted run."""
+    whole = run_experiment("problems", out=tmp_path / "a", quick=True, trials=1, progress=False)
+    partial = run_experiment("problems", out=tmp_path / "b", quick=True, trials=1, progress=False, stop_after=40)
+    assert partial["complete"] is False and partial["finished_trials"] == 40
+    resumed = run_experiment("problems", out=tmp_path / "b", quick=True, trials=1, progress=False)
+    a = read_records(tmp_path / "a" / "problems" / "records.csv")
+    b = read_records(tmp_path / "b" / "problems" / "records.csv")
+    assert len(b) == len({r["trial_id"] for r in b}) == len(a)
+    assert {r["root_seed"] for r in b} == set(whole["settings"]["root_seeds"]) and len(whole["settings"]["root_seeds"]) == 2
+    assert _without_nan(_comparable(a)) == _without_nan(_comparable(b))  # (OMPL's runs count no nodes: NaN)
+    for key in ("interval_95", "ratios_interval_95", "worlds"):
+        assert _reproducible(resumed[key]) == _reproducible(whole[key])
+    for rule in ("QRRT", "PQRRT"):
+        for key in ("relative_cost", "chosen", "chosen_by_root_seed", "chosen_share_in_resamples"):
+            assert resumed["default_policy"][rule][key] == whole["default_policy"][rule][key]

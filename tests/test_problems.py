@@ -226,3 +226,53 @@ def test_rigid_body_checks_are_counted():
     problem = se2_gap()
     problem.predicate.reachable(np.array([[2.0, 2.0, 0.0]] * 3), np.array([[2.5, 2.0, 0.0]] * 3))
     assert problem.predicate.evaluations == 3
+
+
+
+
+@pytest.mark.parametrize("dim", [2, 4, 6])
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_the_winding_band_is_open_only_along_its_legs(dim, seed):
+    problem = qc.world.problems.winding_band(dim, 0.1, seed)
+    env, check = problem.env, problem.predicate
+    start, goal = env.start, env.goal
+    assert env.is_free(start) and env.is_free(goal)
+    assert not check.reachable(start[None], goal[None])[0]  # the straight motion meets the wall
+    off = start.copy()
+    off[1] += 0.1  # beside the first leg
+    assert not env.is_free(off)
+    along = start.copy()
+    along[0] += 1.0  # along the first leg
+    assert check.reachable(start[None], along[None])[0]
+    if dim > 2:  # every other axis is free
+        lifted = start.copy()
+        lifted[2:] = 9.5
+        assert env.is_free(lifted) and check.reachable(start[None], lifted[None])[0]
+
+
+def test_winding_bands_differ_by_seed_and_repeat_by_seed():
+    first, again, other = (qc.world.problems.winding_band(2, 0.2, s) for s in (3, 3, 4))
+    assert np.array_equal(first.env.boxes, again.env.boxes)
+    assert not np.array_equal(first.env.boxes, other.env.boxes) or not np.array_equal(first.env.goal, other.env.goal)
+
+
+def test_the_winding_band_is_solved_by_q_rrt_within_a_budget():
+    """5 bands of width 0.2 (2-D): q-RRT under Adaptive solves at least 4 within 20 000 oracle calls,
+    and every tree edge passes the check again."""
+    solved = 0
+    for seed in range(5):
+        problem = qc.world.problems.winding_band(2, 0.2, seed)
+        planner = qc.QRRT(problem.env, backend=qc.StatevectorBackend(seed=seed), num_qubits=8, seed=seed,
+                          goal_bias=0.05, search_policy=qc.Adaptive(), **problem.planner_options())
+        result = planner.plan(goal=problem.goal, max_oracle_calls=20000)
+        solved += int(result.reached)
+        assert problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
+    assert solved >= 4
+
+
+@pytest.mark.parametrize(("arguments", "message"), [({"dim": 7}, "dim"), ({"width": 0.0}, "width"),
+                                                    ({"width": 1.5}, "width"), ({"seed": -1}, "seed"),
+                                                    ({"dim": 2.5}, "dim")])
+def test_bad_winding_band_arguments_are_refused_by_name(arguments, message):
+    with pytest.raises((TypeError, ValueError), match=message):
+        qc.world.problems.winding_band(**arguments)
