@@ -309,10 +309,39 @@ class Problems(Experiment):
             for boundary in x[:-1] + 0.5:
                 ax.axvline(boundary, color="0.85", lw=0.8)
         axes[0, 0].legend(ncol=5, fontsize=7.5, loc="upper center", bbox_to_anchor=(0.5, 1.32), frameon=False)
-        axes[0, 0].set_title(f"{settings['trials']} replicates per family, budget {settings['budget']} calls",
-                             fontsize=10, pad=48)
+        axes[0, 0].set_title(f"{settings['trials']} replicates x {len(settings['root_seeds'])} root seeds per family, "
+                             f"budget {settings['budget']} calls", fontsize=10, pad=48)
         fig.tight_layout()
-        return [save(fig, out_dir / "problems.png")]
+        return [save(fig, out_dir / "problems.png"), self._plot_policies(settings, summary, out_dir)]
+
+    @staticmethod
+    def _plot_policies(settings: Settings, summary: Summary, out_dir: Path) -> Path:
+        """Each candidate policy's family ratio (its cost per solution over the best candidate's) with
+        its interval over worlds and runs, per rule (q-RRT calls, Pq-RRT critical path and calls)."""
+        rules = summary["default_policy"]
+        families = settings["families"]
+        fig, axes = new_figure(len(rules), 1, (max(9.0, 1.3 * len(families)), 3.4 * len(rules)))
+        x = np.arange(len(families), dtype=float)
+        offsets = dodge(len(POLICY_CANDIDATES), 0.6)
+        colors = _colors(POLICY_CANDIDATES)
+        for ax, (name, rule) in zip(axes[:, 0], rules.items(), strict=True):
+            for offset, candidate in zip(offsets, POLICY_CANDIDATES, strict=True):
+                ratios = rule["relative_cost"].get(candidate, {})
+                values = [_finite_or_nan(ratios.get(f)) for f in families]
+                spans = [rule["relative_cost_interval_95"].get(candidate, {}).get(f, [math.nan, math.nan])
+                         for f in families]
+                spans = [[_finite_or_nan(low), _finite_or_nan(high)] for low, high in spans]
+                with_intervals(ax, x + offset, values, spans, fmt="o", ms=4, color=colors[candidate],
+                               label=f"{candidate} (worst {_finite_or_nan(rule['worst'].get(candidate)):.2f})")
+            ax.axhline(1.5, color="0.4", ls="--", lw=0.8)
+            ax.set_yscale("log")
+            ax.set_xticks(x, families, fontsize=8)
+            ax.set_ylabel("cost / best candidate's")
+            ax.set_title(f"{name}: {rule['quantity'].replace('_', ' ')}; chosen {rule['chosen']}", fontsize=9)
+            ax.legend(fontsize=7.5, loc="upper right")
+            ax.grid(alpha=0.3, axis="y", which="both")
+        fig.tight_layout()
+        return save(fig, out_dir / "problems_policies.png")
 
 
 def _colors(configs: Sequence[str]) -> dict[str, Any]:
@@ -320,6 +349,11 @@ def _colors(configs: Sequence[str]) -> dict[str, Any]:
 
     cmap = matplotlib.colormaps["tab10"]
     return {config: cmap(i % 10) for i, config in enumerate(configs)}
+
+
+def _finite_or_nan(value: Any) -> float:
+    """A JSON number as a float for plotting: None (JSON's non-finite) and inf as NaN."""
+    return float(value) if value is not None and math.isfinite(float(value)) else math.nan
 
 
 def _rounded(value: float) -> float:
