@@ -108,10 +108,10 @@ def test_verification_uses_the_truth_not_the_marks():
 def test_adaptive_learns_from_outcomes_and_others_ignore_them():
     adaptive = qc.Adaptive().start(256)
     before = adaptive.choose_iterations(10)
-    adaptive.learn([qc.SearchOutcome(None, before, 1, ((before, False),))] * 30)
+    adaptive.learn([(qc.SearchOutcome(None, before, 1, ((before, False),)),)] * 30)
     assert adaptive.choose_iterations(10) != before
     paper = qc.PaperIterations().start(256)
-    paper.learn([qc.SearchOutcome(None, 5, 1, ((5, False),))] * 30)
+    paper.learn([(qc.SearchOutcome(None, 5, 1, ((5, False),)),)] * 30)
     assert paper.choose_iterations(3) == 5
 
 

@@ -48,6 +48,7 @@ if TYPE_CHECKING:
         KnownOptimal,
         PaperIterations,
     )
+    from .search.policies.thompson import ThompsonIterations
     from .search.problem import DatabaseSearch, SearchOutcome
     from .world import scenarios
     from .world.environment import Environment
@@ -86,6 +87,7 @@ _WHERE = {
     "circuits": ".search.circuits",
     **dict.fromkeys(["BBHT", "Adaptive", "FixedIterations", "IterationPolicy", "KnownOptimal", "PaperIterations"],
                     ".search.policies.iteration"),
+    "ThompsonIterations": ".search.policies.thompson",
     **dict.fromkeys(["DatabaseSearch", "SearchOutcome"], ".search.problem"),
     "scenarios": ".world.scenarios",
     "Environment": ".world.environment",
@@ -142,6 +144,7 @@ __all__ = [
     "QRRT",
     "RRT",
     "Adaptive",
+    "ThompsonIterations",
     "AerBackend",
     "AnnealingSchedule",
     "Candidates",

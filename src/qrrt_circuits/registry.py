@@ -28,6 +28,7 @@ if TYPE_CHECKING:
     from .search.policies.estimated import EstimatedOptimal
     from .search.policies.fixed_point import FixedPointAmplification
     from .search.policies.iteration import FixedIterations
+    from .search.policies.thompson import ThompsonIterations
     from .world.environment import Environment
 
 
@@ -117,7 +118,7 @@ class Registry:
         >>> PLANNERS.canonical("PQRRT"), "qrrt" in PLANNERS, "astar" in PLANNERS
         ('pqrrt', True, False)
         >>> POLICIES.labels()
-        ('paper', 'optimal', 'bbht', 'adaptive', 'fixed:K', 'fixed-point[:DELTA]', 'estimated')
+        ('paper', 'optimal', 'bbht', 'adaptive', 'thompson', 'fixed:K', 'fixed-point[:DELTA]', 'estimated')
         >>> POLICIES.create("fixed:2")
         FixedIterations(k=2)
         >>> PLANNERS.resolve("astar")
@@ -357,6 +358,12 @@ def _fixed_point(value: str | None) -> FixedPointAmplification:
     return FixedPointAmplification(delta=delta)
 
 
+def _thompson() -> ThompsonIterations:
+    from .search.policies.thompson import ThompsonIterations
+
+    return ThompsonIterations()
+
+
 def _estimated() -> EstimatedOptimal:
     from .search.policies.estimated import EstimatedOptimal
 
@@ -371,6 +378,7 @@ def _policies() -> Registry:
     registry.register("optimal", KnownOptimal, "optimal k for the true m (simulation knowledge)")
     registry.register("bbht", BBHT, "Boyer-Brassard-Hoyer-Tapp for unknown m")
     registry.register("adaptive", Adaptive, "k from a posterior over m/N learned from verified outcomes")
+    registry.register("thompson", _thompson, "k per database from a bandit over the plan's own databases")
     registry.register("fixed", _fixed, "always K iterations", parameter="K")
     registry.register("fixed-point", _fixed_point,
                       "fixed-point amplitude amplification (Yoder et al. 2014), P >= 1 - DELTA^2 for "

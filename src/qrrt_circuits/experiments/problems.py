@@ -23,8 +23,8 @@ in a family with one world every run is its own group, so the interval is over r
 
 **Planners**: RRT; RRT with OMPL's range (``max_extension`` = 0.2 of the bounds' diagonal, no
 look-ahead: the algorithm of OMPL's RRT); manager-worker parallel RRT (8 workers); q-RRT under the
-paper's schedule, ``Adaptive`` and ``BBHT``; Pq-RRT (8 workers, shared database) under the paper's
-schedule, ``Adaptive`` and ``BBHT``; and, when the ``ompl`` extra is installed, OMPL's RRT and RRTConnect
+paper's schedule, ``Adaptive``, ``BBHT`` and ``ThompsonIterations``; Pq-RRT (8 workers, shared
+database) under the same four; and, when the ``ompl`` extra is installed, OMPL's RRT and RRTConnect
 (``experiments.ompl_runs``). All with goal bias 0.05 (OMPL's default; RRTConnect has none),
 2^8-entry databases on the exact statevector.
 
@@ -95,12 +95,14 @@ LIBRARY_CONFIGS: dict[str, tuple[str, str | None, Callable[[Problem], dict[str, 
     "QRRT paper": ("qrrt", "paper", lambda problem: {}),
     "QRRT adaptive": ("qrrt", "adaptive", lambda problem: {}),
     "QRRT bbht": ("qrrt", "bbht", lambda problem: {}),
+    "QRRT thompson": ("qrrt", "thompson", lambda problem: {}),
     "PQRRT paper": ("pqrrt", "paper", lambda problem: {}),
     "PQRRT adaptive": ("pqrrt", "adaptive", lambda problem: {}),
     "PQRRT bbht": ("pqrrt", "bbht", lambda problem: {}),
+    "PQRRT thompson": ("pqrrt", "thompson", lambda problem: {}),
 }
 OMPL_CONFIGS = ("OMPL RRT", "OMPL RRTConnect")
-POLICY_CANDIDATES = ("paper", "adaptive", "bbht")
+POLICY_CANDIDATES = ("paper", "adaptive", "bbht", "thompson")
 GOAL_BIAS = 0.05
 #: the narrow passage's hole: its share of the wall's cross-section, in every dimension
 HOLE_SHARE = 0.01

@@ -235,7 +235,7 @@ class PQRRT(Planner):
         longest = 0
         for result in results:
             longest = max(longest, self._integrate(state, result))
-        state.search_policy_state.learn(outcome for result in results for outcome in result.outcomes)
+        state.search_policy_state.learn(result.outcomes for result in results)
         state.critical_path += longest
 
     @staticmethod

@@ -9,7 +9,7 @@ answers one question, polymorphically::
 given a database (its search, its verification and its size), run ``workers`` workers' searches
 and return one frozen outcome per worker: the verified index or None, the quantum oracle calls and
 verifications spent, and observations for learning policies. After the round the planner hands
-all outcomes back with ``state.learn(outcomes)``. The planner never asks which policy it has.
+the outcomes back, grouped by database, with ``state.learn(databases)``. The planner never asks which policy it has.
 ``state.run_many(problems, workers, tree_nodes)`` answers the same for several independent
 databases of one round: ``run`` on each, in order.
 
@@ -244,7 +244,7 @@ class PolicyState:
             quantum calls and verifications spent, and the (k, success) observations.
         """
         k = validate_iterations(self.iterations_for(problem, tree_nodes))
-        return _verified(problem, k, problem.search(k, workers, problem.shared_seed()))
+        return verified_outcomes(problem, k, problem.search(k, workers, problem.shared_seed()))
 
     def run_many(self, problems: Sequence[DatabaseSearch], workers: int,
                  tree_nodes: int) -> tuple[tuple[SearchOutcome, ...], ...]:
@@ -270,19 +270,32 @@ class PolicyState:
             success: Whether the measured entry verified.
         """
 
-    def learn(self, outcomes: Iterable[SearchOutcome]) -> None:
-        """Feed a round's outcomes back, in worker order.
+    def learn(self, databases: Iterable[Sequence[SearchOutcome]]) -> None:
+        """Feed a round's outcomes back, one group per database, in worker order.
+
+        By default each observation goes to ``observe``; a policy that learns per database
+        (``ThompsonIterations``) overrides this.
 
         Args:
-            outcomes: The round's ``SearchOutcome`` objects; each observation goes to ``observe``.
+            databases: Per database searched this round, its workers' ``SearchOutcome`` objects.
         """
-        for outcome in outcomes:
-            for iterations, success in outcome.observations:
-                self.observe(iterations, success)
+        for outcomes in databases:
+            for outcome in outcomes:
+                for iterations, success in outcome.observations:
+                    self.observe(iterations, success)
 
 
-def _verified(problem: DatabaseSearch, k: int, measured: np.ndarray) -> tuple[SearchOutcome, ...]:
-    """Each worker verifies its own measured index (k quantum calls + 1 verification each)."""
+def verified_outcomes(problem: DatabaseSearch, k: int, measured: np.ndarray) -> tuple[SearchOutcome, ...]:
+    """Each worker verifies its own measured index (k quantum calls + 1 verification each).
+
+    Args:
+        problem: The database search.
+        k: The iterations of the search that measured ``measured``.
+        measured: One measured index per worker.
+
+    Returns:
+        One ``SearchOutcome`` per worker.
+    """
     outcomes = []
     for index in measured:
         good = problem.verify(int(index))
