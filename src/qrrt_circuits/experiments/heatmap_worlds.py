@@ -15,7 +15,7 @@ so efficiencies pooled over worlds are not those of any one world. The experimen
 many single worlds (``paper_clutter`` with several obstacle counts, several world seeds each) and
 applies an acceptance rule fixed before the run to RRT alone: **a world passes when the paper's
 three RRT efficiencies (12.5 %, 11.6 % and 13.2 % at 10, 20 and 40 calls) all lie inside that
-world's 95 % intervals from its 100 RRT runs** (under one planner root seed). q-RRT's nodes and
+world's 95 % intervals from its RRT runs** (under one planner root seed). q-RRT's nodes and
 efficiencies in exactly the passing worlds, with their intervals, are then set against the paper's.
 Over all worlds, the 5 %, 50 % and 95 % quantiles of each planner's efficiency at 10 calls, and of
 q-RRT's advantage over RRT (the difference and the ratio of their efficiencies in one world), show
@@ -27,7 +27,7 @@ searched successfully with probability sin^2((2k + 1) theta), highest at f = sin
 9.5 % for k = 2, 2.0 % for k = 5. A share that grows past that peak as the tree grows lowers the
 efficiency at later cuts.
 
-A trial is one block: 100 runs of one planner variant in one world under one planner root seed, each
+A trial is one block: ``RUNS`` runs of one planner variant in one world under one planner root seed, each
 cut at 40 oracle calls (the 10- and 20-call cuts read from its history, ``cut_at``). The variants of
 one world share its planner seeds. The worlds are fixed by their obstacle count and world seed; the
 whole grid is run under several planner root seeds, and the rule is applied under each, so which
@@ -57,6 +57,10 @@ BOX_COUNTS = (100, 150, 200, 250, 300, 400, 525)
 #: the most world seeds per obstacle count (a world's planner seeds are keyed by count and seed)
 WORLDS_PER_COUNT = 1000
 CUTS = (10, 20, 40)
+#: runs of each planner variant in one world under one root seed (a full run); the rule's intervals
+#: come from these runs. The runs of a block are seeded by their index, so a block of r runs is the
+#: first r runs of a longer one.
+RUNS = 50
 #: planner root seeds of a full run (``seed``, ``seed + 1``, ...): every world is run under each
 PLANNER_ROOT_SEEDS = 3
 #: label -> (registry planner, search policy): RRT, q-RRT with the 3-call round the paper's totals
@@ -159,7 +163,7 @@ class HeatmapWorlds(Experiment):
     paper = PAPER
 
     def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
-        return {"runs": trials or (20 if quick else 100), "worlds": 2 if quick else 40, "cuts": list(CUTS),
+        return {"runs": trials or (20 if quick else RUNS), "worlds": 2 if quick else 40, "cuts": list(CUTS),
                 "box_counts": [150, 525] if quick else list(BOX_COUNTS), "num_qubits": 8,
                 "backend": "statevector", "scenario": "paper_clutter", "variants": list(VARIANTS),
                 "planner_root_seeds": [seed + i for i in range(2 if quick else PLANNER_ROOT_SEEDS)],
