@@ -7,9 +7,10 @@ drift from the results.
 
 Each row reads one number from ``docs/results/EXPERIMENT/summary.json`` (our exact check) and, where
 the experiment was also run with the authors' check, from ``docs/results/authors/EXPERIMENT/``:
-``ours``, its ``interval_95`` and the paper's number from the same summary's ``paper``. "Paper
-inside?" is computed from the interval. "explained?" is written by hand, naming where the results
-page discusses the difference, except for the rows whose summary resamples the paper's own
+``ours``, its ``interval_95`` and the paper's number from the same summary's ``paper``; each
+interval is shown with its unit (what its bootstrap resamples: trees, runs or worlds). "Paper
+inside?" is computed from the interval. "explained?" is a sentence whose every number and list is
+read from a summary (``Row.facts``), except for the rows whose summary resamples the paper's own
 estimator (``paper_design``): there it says whether the paper's number is plausible for one
 replicate of the paper's design.
 """
@@ -27,6 +28,8 @@ ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "docs" / "results"
 README = ROOT / "README.md"
 START, END = "<!-- glance:start -->", "<!-- glance:end -->"
+#: the markers around the README's generated sentence on q-RRT's lead over RRT across worlds
+ADVANTAGE_START, ADVANTAGE_END = "<!-- glance-advantage:start -->", "<!-- glance-advantage:end -->"
 
 
 @dataclass(frozen=True)
@@ -42,8 +45,15 @@ class Row:
     paper_path: tuple[str, ...] | None = None
     percent: bool = False
     #: the numbers ``explained`` quotes, read from the summaries: name -> (experiment, path); a
-    #: list is shown as its length, a pair of numbers as an interval
+    #: list is shown as its length (its items where the name is in ``itemized``), a pair of
+    #: numbers as an interval, a fraction in ``percent_facts`` as a percentage
     facts: tuple[tuple[str, str, tuple[str, ...]], ...] = ()
+    #: what the interval resamples (trees, runs, worlds), shown beside it
+    unit: str = "trees"
+    #: facts shown as their items rather than their length
+    itemized: tuple[str, ...] = ()
+    #: facts shown as percentages
+    percent_facts: tuple[str, ...] = ()
 
 
 #: "explained?" for a quantity whose summary resamples the paper's own estimator (``paper_design``)
@@ -61,25 +71,41 @@ ROWS = (
         facts=(("round", "wallclock", ("ours", "per_critical_path_call_ratio_qrrt_over_pqrrt", "aer")),
                ("paper", "wallclock", ("paper", "per_critical_path_call_ratio_qrrt_over_pqrrt")))),
     Row("Figs. 10-12", "RRT efficiency at 40 calls, `paper_clutter`", "heatmaps", ("RRT", "40", "efficiency"),
-        "explained: the paper's RRT fits only sparser worlds ({passing} of {worlds} single worlds pass)",
-        percent=True, facts=(("passing", "heatmap-worlds", ("passing_worlds",)),
-                             ("worlds", "heatmap-worlds", ("worlds_run",)))),
+        "explained: the paper's RRT fits only sparser worlds; of {worlds} single worlds {pass0}, {pass1} and "
+        "{pass2} pass under three planner root seeds, and {again} of the passing worlds pass again under "
+        "another", percent=True, unit="runs", percent_facts=("again",),
+        facts=(("worlds", "heatmap-worlds", ("worlds_run",)),
+               ("pass0", "heatmap-worlds", ("passing_worlds_by_root_seed", "0")),
+               ("pass1", "heatmap-worlds", ("passing_worlds_by_root_seed", "1")),
+               ("pass2", "heatmap-worlds", ("passing_worlds_by_root_seed", "2")),
+               ("again", "heatmap-worlds", ("pass_overlap", "fraction_passing_again")))),
     Row("Figs. 10-12", "q-RRT nodes at 40 calls, single worlds with the paper's RRT", "heatmap-worlds",
         ("QRRT", "40", "nodes"),
-        "open: with the 3-call round the paper's totals imply, {ours20} {span20} against {paper20} nodes at "
-        "20 calls", facts=(("ours20", "heatmap-worlds", ("ours", "QRRT", "20", "nodes")),
-                            ("span20", "heatmap-worlds", ("interval_95", "QRRT", "20", "nodes")),
-                            ("paper20", "heatmap-worlds", ("paper", "QRRT", "20", "nodes")))),
+        "open: with the 3-call round the paper's totals imply, {ours20} {span20} (worlds) against {paper20} nodes "
+        "at 20 calls; one passing world's own value at 40 calls ranges over {range40}", unit="worlds",
+        facts=(("ours20", "heatmap-worlds", ("ours", "QRRT", "20", "nodes")),
+               ("span20", "heatmap-worlds", ("interval_95", "QRRT", "20", "nodes")),
+               ("paper20", "heatmap-worlds", ("paper", "QRRT", "20", "nodes")),
+               ("range40", "heatmap-worlds", ("range_over_passing_worlds", "QRRT", "40", "nodes")))),
     Row("Figs. 13-14", "q-RRT nodes in the corridor (50 trials)", "corridor", ("QRRT",),
-        "open in our corridor; inside ours in a 1 x 8 corridor with 1-2 iterations, never with the paper's"),
+        "open in our corridor; of the sensitivity cells of one corridor world (width-length-clutter-distance-"
+        "iterations), the paper's pair lies inside {inside}: {cells}", unit="runs", itemized=("cells",),
+        facts=(("inside", "corridor-sensitivity", ("paper_pair_inside",)),
+               ("cells", "corridor-sensitivity", ("paper_pair_inside",)))),
     Row("Figs. 13-14", "RRT nodes in the corridor (50 trials)", "corridor", ("RRT",),
-        "open in our corridor; {rrt} {span} in that 1 x 8 corridor",
-        facts=(("rrt", "corridor-sensitivity", ("ours", "RRT", "w1.0-l8.0-c120-d3.0")),
-               ("span", "corridor-sensitivity", ("interval_95", "RRT", "w1.0-l8.0-c120-d3.0")))),
+        "open in our corridor; {rrt} {span} (runs) in the sensitivity cell closest to the paper's pair, {cell}",
+        unit="runs", itemized=("cell",),
+        facts=(("rrt", "corridor-sensitivity", ("closest_to_paper", "RRT")),
+               ("span", "corridor-sensitivity", ("closest_to_paper", "RRT_interval_95")),
+               ("cell", "corridor-sensitivity", ("closest_to_paper", "cell")))),
     Row("Figs. 15-17", "QDA mean parent distance, 16 nodes", "annealing", ("QDA", "16"),
-        "open: outside one tree's range {single}; our reading stays below it at every density, the other "
-        "readings of Alg. 4 line 7 at our density (other densities not run)",
-        paper_path=("QDA",), facts=(("single", "annealing", ("paper_design", "range_95", "QDA", "16")),)),
+        "open: outside one tree's range {single}; over {densities} world densities and {readings} readings of "
+        "Alg. 4 line 7, the paper's value is plausible for one tree in {plausible}",
+        paper_path=("QDA",),
+        facts=(("single", "annealing", ("paper_design", "range_95", "QDA", "16")),
+               ("densities", "annealing-density", ("settings", "densities")),
+               ("readings", "annealing-density", ("settings", "readings")),
+               ("plausible", "annealing-density", ("readings_reaching_paper", "plausible_for_one_tree")))),
     Row("Figs. 15-17", "uniform q-RRT mean parent distance, 16 nodes", "annealing", ("QRRT", "16"),
         "explained by the world's density (our assumption): our mean crosses it between {low}x and {high}x",
         paper_path=("QRRT",),
@@ -105,7 +131,8 @@ def _cell(summary: dict[str, Any] | None, row: Row) -> tuple[str, tuple[float, f
         return "not run", None
     ours, interval = _at(summary["ours"], row.path), _at(summary["interval_95"], row.path)
     low, high = interval
-    text = f"{_number(ours, row.percent)} [{_number(low, row.percent)}, {_number(high, row.percent)}]"
+    text = (f"{_number(ours, row.percent)} [{_number(low, row.percent)}, {_number(high, row.percent)}] "
+            f"({row.unit})")
     return text, (low, high)
 
 
@@ -113,7 +140,9 @@ def _explained(row: Row, summary: dict[str, Any]) -> str:
     """The row's "explained?" text; for ``DESIGN``, whether the paper's number is plausible for one
     replicate of the paper's own estimator, with that estimator's 95 % range."""
     if row.explained != DESIGN:
-        return row.explained.format(**{name: _fact(experiment, path) for name, experiment, path in row.facts})
+        return row.explained.format(**{name: _fact(experiment, path, itemized=name in row.itemized,
+                                                   percent=name in row.percent_facts)
+                                       for name, experiment, path in row.facts})
     design = summary["paper_design"]
     low, high = _at(design["range_95"], row.path)
     verdict = "explained" if _at(design["paper_plausible"], row.path) else "open"
@@ -129,21 +158,26 @@ def _authors_code(row: Row, summary: dict[str, Any]) -> str:
     low, high = _at(code["reported_per_tree_range"], row.path)
     ours_low, ours_high = _at(code["ours_pooled_range_95"], row.path)
     return (f"{_number(_at(code['reported_pooled'], row.path), False)} (trees {_number(low, False)}-"
-            f"{_number(high, False)}); ours so: [{_number(ours_low, False)}, {_number(ours_high, False)}]")
+            f"{_number(high, False)}); ours so: [{_number(ours_low, False)}, {_number(ours_high, False)}] (trees)")
 
 
-def _fact(experiment: str, path: tuple[str, ...], results: Path = RESULTS) -> str:
+def _fact(experiment: str, path: tuple[str, ...], results: Path = RESULTS, itemized: bool = False,
+          percent: bool = False) -> str:
     """A number an "explained" text quotes: ``path`` in the experiment's summary (a list as its
-    length, a [low, high] pair as an interval)."""
+    length, or with ``itemized`` as its items, "none" for no items; a [low, high] pair of numbers
+    as an interval; with ``percent`` a fraction as a percentage)."""
     summary = _summary(results / experiment)
     if summary is None:
         raise FileNotFoundError(f"{results / experiment / 'summary.json'} is missing")
     value = _at(summary, path)
+    if itemized:
+        items = value if isinstance(value, list) else [value]
+        return ", ".join(f"`{item}`" for item in items) if items else "none"
     if isinstance(value, list) and len(value) == 2 and all(isinstance(v, int | float) for v in value):
         return f"[{_number(value[0], False)}, {_number(value[1], False)}]"
     if isinstance(value, list):
         return str(len(value))
-    return _number(value, False)
+    return _number(value, percent)
 
 
 def _summary(folder: Path) -> dict[str, Any] | None:
@@ -182,19 +216,57 @@ def table(results: Path = RESULTS) -> str:
     return "\n".join(lines)
 
 
-def with_table(readme: str, rendered: str) -> str:
-    """``readme`` with the text between the glance markers replaced by ``rendered``."""
-    before, rest = readme.split(START, 1)
-    _, after = rest.split(END, 1)
-    return f"{before}{START}\n{rendered}\n{END}{after}"
+def advantage_sentence(results: Path = RESULTS) -> str:
+    """The README's sentence on q-RRT's lead over RRT across single worlds, from
+    ``heatmap-worlds``' ``advantage_at_10_over_worlds`` (q-RRT with 2 iterations a round).
+
+    Args:
+        results: The folder of the committed results (``docs/results``).
+
+    Returns:
+        One sentence: the worlds below RRT and the median ratio at the fewest obstacles, the
+        obstacle count from which q-RRT leads in every world, and the median ratio at the most.
+    """
+    summary = _summary(results / "heatmap-worlds")
+    if summary is None:
+        raise FileNotFoundError(f"{results / 'heatmap-worlds' / 'summary.json'} is missing")
+    counts = summary["settings"]["box_counts"]
+    worlds = summary["settings"]["worlds"]
+    advantage = {count: summary["advantage_at_10_over_worlds"][str(count)]["QRRT"] for count in counts}
+    fewest, most = counts[0], counts[-1]
+    leading = [count for index, count in enumerate(counts)
+               if all(advantage[later]["worlds_quantum_below_rrt"] == 0 for later in counts[index:])]
+    lead = (f"it is above RRT in every world from {leading[0]} boxes on" if leading
+            else "no obstacle count has it above RRT in every world")
+    return (f"q-RRT's efficiency at 10 calls against RRT's in the same world (`heatmap-worlds`, "
+            f"{worlds} worlds per obstacle count) is a deficit at low clutter: with {fewest} boxes q-RRT "
+            f"is below RRT in {advantage[fewest]['worlds_quantum_below_rrt']} of {worlds} worlds (median "
+            f"ratio {_number(advantage[fewest]['ratio'][1], False)}, where 2 iterations over-rotate); "
+            f"{lead}, with a median ratio of {_number(advantage[most]['ratio'][1], False)} at {most} boxes.")
+
+
+def _between(text: str, start: str, end: str, rendered: str) -> str:
+    before, rest = text.split(start, 1)
+    _, after = rest.split(end, 1)
+    return f"{before}{start}\n{rendered}\n{end}{after}"
+
+
+def with_table(readme: str, rendered: str, sentence: str | None = None) -> str:
+    """``readme`` with the text between the glance markers replaced by ``rendered`` and, given
+    ``sentence`` and where the README has the advantage markers, the text between those by it."""
+    readme = _between(readme, START, END, rendered)
+    if sentence is not None and ADVANTAGE_START in readme:
+        readme = _between(readme, ADVANTAGE_START, ADVANTAGE_END, sentence)
+    return readme
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--check", action="store_true", help="exit 1 if README.md's table is not the generated one")
+    parser.add_argument("--check", action="store_true",
+                        help="exit 1 if README.md's table or sentence is not the generated one")
     args = parser.parse_args(argv)
     readme = README.read_text()
-    updated = with_table(readme, table())
+    updated = with_table(readme, table(), advantage_sentence())
     if args.check:
         if updated != readme:
             print("README.md's results table differs from docs/results: run python docs/glance.py", file=sys.stderr)

@@ -122,14 +122,19 @@ def _check_heatmaps(summary, records):
 
 def _check_heatmap_worlds(summary, records):
     assert summary["round_costs"]["fitting"] == [3]  # the paper's totals fit only a 3-call round
-    variants = summary["settings"]["variants"]
-    assert variants == ["RRT", "QRRT", "QRRT_PAPER"]
+    variants, roots = summary["settings"]["variants"], summary["settings"]["planner_root_seeds"]
+    assert variants == ["RRT", "QRRT", "QRRT_PAPER"] and len(roots) >= 2
     worlds = summary["per_world"]
-    assert len(worlds) == summary["worlds_run"] == len(records) // len(variants)
-    for key, entry in worlds.items():  # the rule, re-applied to the stored intervals
-        inside = all(entry["RRT"][c]["efficiency_interval_95"][0] <= summary["paper"]["RRT"][c]["efficiency"]
-                     <= entry["RRT"][c]["efficiency_interval_95"][1] for c in ("10", "20", "40"))
-        assert entry["passes"] == inside and (key in summary["passing_worlds"]) == inside
+    assert len(worlds) == summary["worlds_run"] == len(records) // (len(variants) * len(roots))
+    for root in map(str, roots):  # the rule, re-applied to the stored intervals of each root seed
+        by_root = summary["per_root_seed"][root]
+        for key, intervals in by_root["rrt_efficiency_interval_95"].items():
+            inside = all(intervals[c][0] <= summary["paper"]["RRT"][c]["efficiency"] <= intervals[c][1]
+                         for c in ("10", "20", "40"))
+            assert (key in by_root["passing_worlds"]) == inside == (int(root) in worlds[key]["passes_under_root_seeds"])
+        assert summary["passing_worlds_by_root_seed"][root] == by_root["passing_worlds"]
+        assert by_root["pass_rate"] == round(len(by_root["passing_worlds"]) / len(worlds), 4)
+    for entry in worlds.values():
         for variant in variants:
             for cut in ("10", "20", "40"):
                 assert 0.0 <= entry[variant][cut]["reachable_fraction"] <= 1.0
@@ -138,9 +143,14 @@ def _check_heatmap_worlds(summary, records):
         # the paper's schedule spends 6 calls a round: at most ceil(b / 6) nodes a run
         for cut, most in summary["round_costs"]["paper_schedule_most_nodes"].items():
             assert entry["QRRT_PAPER"][cut]["nodes"] <= most
-    by_id = {(r["variant"], r["boxes"], r["world_seed"]): r for r in records}
-    for (_, boxes, w), record in by_id.items():  # the variants of one world share its planner seeds
-        assert record["seed"] == by_id[("RRT", boxes, w)]["seed"]
+    by_id = {(r["variant"], r["boxes"], r["world_seed"], r["planner_root_seed"]): r for r in records}
+    for (_, boxes, w, root), record in by_id.items():  # the variants of one world share its planner seeds ...
+        assert record["seed"] == by_id[("RRT", boxes, w, root)]["seed"]
+        for other in roots:  # ... and another root seed gives it other ones
+            assert other == root or record["seed"] != by_id[("RRT", boxes, w, other)]["seed"]
+    overlap = summary["pass_overlap"]
+    assert len(overlap["pairs"]) == len(roots) * (len(roots) - 1)
+    assert summary["passing_worlds_any_root_seed"] == len(overlap["in_any_root_seed"])
     for label, by_planner in summary["efficiency_at_10_quantiles_over_worlds"].items():
         for low, middle, high in by_planner.values():
             assert low <= middle <= high, label
@@ -151,6 +161,15 @@ def _check_heatmap_worlds(summary, records):
     for variant, by_cut in summary["highest_nodes_over_worlds"].items():
         for cut, best in by_cut.items():
             assert best["nodes"] == max(entry[variant][cut]["nodes"] for entry in worlds.values())
+    for variant, by_cut in summary["ours"].items():  # pooled values inside the range of the blocks' own
+        for cut, value in by_cut.items():
+            if value["nodes"] is None:
+                assert summary["passing_blocks"] == 0
+                continue
+            low, high = summary["range_over_passing_worlds"][variant][cut]["nodes"]
+            assert low <= value["nodes"] <= high
+            low, high = summary["interval_95"][variant][cut]["nodes"]
+            assert low - 0.1 <= value["nodes"] <= high + 0.1
 
 
 def _check_corridor(summary, records):

@@ -29,8 +29,24 @@ def test_the_readme_reads_in_a_minute():
 def test_the_results_table_is_the_one_the_summaries_give():
     glance = _glance()
     readme = README.read_text()
-    assert glance.with_table(readme, glance.table()) == readme, "run python docs/glance.py"
+    assert glance.with_table(readme, glance.table(), glance.advantage_sentence()) == readme, "run python docs/glance.py"
     assert glance.main(["--check"]) == 0
+
+
+def test_the_advantage_sentence_is_generated_and_names_the_deficit():
+    glance = _glance()
+    readme = README.read_text()
+    sentence = glance.advantage_sentence()
+    assert f"{glance.ADVANTAGE_START}\n{sentence}\n{glance.ADVANTAGE_END}" in readme
+    assert "deficit at low clutter" in sentence and "below RRT in" in sentence
+
+
+def test_every_explanation_quotes_the_summaries():
+    """Every "explained by / open because" cell reads its numbers from summaries (``facts``), or is
+    the paper-design verdict, which is computed."""
+    glance = _glance()
+    for row in glance.ROWS:
+        assert row.explained == glance.DESIGN or row.facts, row.quantity
 
 
 def test_the_results_table_follows_a_changed_summary(tmp_path):
@@ -48,7 +64,7 @@ def test_the_results_table_follows_a_changed_summary(tmp_path):
     summary["interval_95"]["QRRT"] = [40, 52]
     path.write_text(json.dumps(summary))
     after = glance.table(results)
-    assert before != after and "| 46 [40, 52] |" in after and "| with our check |" in after
+    assert before != after and "| 46 [40, 52] (runs) |" in after and "| with our check |" in after
 
 
 def test_the_first_example_runs():

@@ -15,11 +15,11 @@ so efficiencies pooled over worlds are not those of any one world. The experimen
 many single worlds (``paper_clutter`` with several obstacle counts, several world seeds each) and
 applies an acceptance rule fixed before the run to RRT alone: **a world passes when the paper's
 three RRT efficiencies (12.5 %, 11.6 % and 13.2 % at 10, 20 and 40 calls) all lie inside that
-world's 95 % intervals from its 100 RRT runs.** q-RRT's nodes and efficiencies in exactly the
-passing worlds, with their intervals, are then set against the paper's. Over all worlds, the 5 %,
-50 % and 95 % quantiles of each planner's efficiency at 10 calls, and of q-RRT's advantage over RRT
-(the difference and the ratio of their efficiencies in one world), show how world-dependent the
-advantage is.
+world's 95 % intervals from its RRT runs** (under one planner root seed). q-RRT's nodes and
+efficiencies in exactly the passing worlds, with their intervals, are then set against the paper's.
+Over all worlds, the 5 %, 50 % and 95 % quantiles of each planner's efficiency at 10 calls, and of
+q-RRT's advantage over RRT (the difference and the ratio of their efficiencies in one world), show
+how world-dependent the advantage is.
 
 The runs also record the reachable share of the candidates they evaluated (q-RRT: its databases'
 entries) up to each cut. With k iterations a database whose reachable share is f = sin^2 theta is
@@ -27,9 +27,14 @@ searched successfully with probability sin^2((2k + 1) theta), highest at f = sin
 9.5 % for k = 2, 2.0 % for k = 5. A share that grows past that peak as the tree grows lowers the
 efficiency at later cuts.
 
-A trial is one block: 100 runs of one planner variant in one world, each cut at 40 oracle calls (the
-10- and 20-call cuts read from its history, ``cut_at``). The variants of one world share its planner
-seeds.
+A trial is one block: ``RUNS`` runs of one planner variant in one world under one planner root seed, each
+cut at 40 oracle calls (the 10- and 20-call cuts read from its history, ``cut_at``). The variants of
+one world share its planner seeds. The worlds are fixed by their obstacle count and world seed; the
+whole grid is run under several planner root seeds, and the rule is applied under each, so which
+worlds pass, and how many pass again under another root seed, is measured rather than assumed. The
+pooled q-RRT values over the passing worlds carry an interval whose unit is the world
+(``two_level_bootstrap_interval``: worlds, then runs in each), beside the range of the passing
+worlds' own values.
 """
 
 from __future__ import annotations
@@ -43,7 +48,7 @@ import numpy as np
 from ..search.policies.iteration import FixedIterations, PaperIterations
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
-from .intervals import bootstrap_ratio_interval, differs, rounded_interval
+from .intervals import bootstrap_ratio_interval, differs, rounded_interval, two_level_bootstrap_interval
 from .measures import cut_at, dumps, loads, reachable_at
 from .planners import planner_for
 from .worlds import world
@@ -52,6 +57,12 @@ BOX_COUNTS = (100, 150, 200, 250, 300, 400, 525)
 #: the most world seeds per obstacle count (a world's planner seeds are keyed by count and seed)
 WORLDS_PER_COUNT = 1000
 CUTS = (10, 20, 40)
+#: runs of each planner variant in one world under one root seed (a full run); the rule's intervals
+#: come from these runs. The runs of a block are seeded by their index, so a block of r runs is the
+#: first r runs of a longer one.
+RUNS = 50
+#: planner root seeds of a full run (``seed``, ``seed + 1``, ...): every world is run under each
+PLANNER_ROOT_SEEDS = 3
 #: label -> (registry planner, search policy): RRT, q-RRT with the 3-call round the paper's totals
 #: imply, q-RRT with the paper's schedule (for contrast)
 VARIANTS = {"RRT": ("rrt", None), "QRRT": ("qrrt", FixedIterations(2)), "QRRT_PAPER": ("qrrt", PaperIterations())}
@@ -136,23 +147,35 @@ def passes(intervals: dict[str, list[float]], paper: dict[str, dict[str, float]]
 
 class HeatmapWorlds(Experiment):
     """The paper's heatmap numbers (Figs. 10-12) in single worlds, under a pre-stated acceptance rule
-    (see the module docstring)."""
+    (see the module docstring), repeated over several planner root seeds.
+
+    The worlds depend only on their obstacle count and world seed; the experiment's ``--seed``
+    drives the planners alone. ``settings["planner_root_seeds"]`` lists the root seeds (``seed``,
+    ``seed + 1``, ...): every world is run once under each, with planner seeds
+    ``replicate_seed(root, boxes * WORLDS_PER_COUNT + world_seed, HEATMAP_WORLDS)``, so the worlds
+    stay the same and only the planners' draws change. Whether a world passes is decided per root
+    seed; a world passing under one root seed and not under another shows the rule selecting runs
+    as well as worlds.
+    """
 
     name = "heatmap-worlds"
     title = "Heatmap numbers in single worlds: RRT calibrated per world (paper Figs. 10-12)"
     paper = PAPER
 
     def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
-        return {"runs": trials or (20 if quick else 100), "worlds": 2 if quick else 40, "cuts": list(CUTS),
+        return {"runs": trials or (20 if quick else RUNS), "worlds": 2 if quick else 40, "cuts": list(CUTS),
                 "box_counts": [150, 525] if quick else list(BOX_COUNTS), "num_qubits": 8,
                 "backend": "statevector", "scenario": "paper_clutter", "variants": list(VARIANTS),
+                "planner_root_seeds": [seed + i for i in range(2 if quick else PLANNER_ROOT_SEEDS)],
                 "acceptance_rule": ACCEPTANCE_RULE, "seed": seed, "quick": quick}
 
     def trials(self, settings: Settings) -> list[Trial]:
-        # one seed per world (obstacle count, world seed), shared by the variants; independent of the
-        # grid's other worlds (at most WORLDS_PER_COUNT world seeds per count)
-        return [Trial(f"{variant}-{boxes}-{w}", {"variant": variant, "boxes": boxes, "world_seed": w},
-                      replicate_seed(settings["seed"], boxes * WORLDS_PER_COUNT + w, TrialStream.HEATMAP_WORLDS))
+        # one seed per world (obstacle count, world seed) and planner root seed, shared by the
+        # variants; independent of the grid's other worlds (at most WORLDS_PER_COUNT world seeds a count)
+        return [Trial(f"{variant}-{boxes}-{w}-r{root}",
+                      {"variant": variant, "boxes": boxes, "world_seed": w, "planner_root_seed": root},
+                      replicate_seed(root, boxes * WORLDS_PER_COUNT + w, TrialStream.HEATMAP_WORLDS))
+                for root in settings["planner_root_seeds"]
                 for boxes in settings["box_counts"] for w in range(settings["worlds"])
                 for variant in settings["variants"]]
 
@@ -180,11 +203,19 @@ class HeatmapWorlds(Experiment):
 
     def summarize(self, records: list[Record], settings: Settings) -> Summary:
         seed, cuts, variants = settings["seed"], [str(c) for c in settings["cuts"]], settings["variants"]
-        blocks = {(r["variant"], r["boxes"], r["world_seed"]): {key: loads(r[f"{key}_json"]) for key in
-                                                                ("nodes", "calls", "reachable", "entries")}
-                  for r in records}
+        roots = [str(root) for root in settings["planner_root_seeds"]]
+        columns = ("nodes", "calls", "reachable", "entries")
+        blocks = {(r["variant"], f"{r['boxes']}-{r['world_seed']}", str(r["planner_root_seed"])):
+                  {key: loads(r[f"{key}_json"]) for key in columns} for r in records}
+        keys = [f"{boxes}-{w}" for boxes in settings["box_counts"] for w in range(settings["worlds"])]
+
+        def runs(variant: str, pairs: list[tuple[str, str]], cut: str) -> dict[str, list[int]]:
+            """The runs of ``variant`` in the (world, root seed) blocks ``pairs``, read at ``cut``, pooled."""
+            return {column: [value for key, root in pairs for value in blocks[(variant, key, root)][column][cut]]
+                    for column in columns}
 
         def measure(block: dict[str, list[int]]) -> dict[str, Any]:
+            """One world's (or pooled) values, with 95 % bootstrap intervals over its runs."""
             nodes, calls, spent, seen = block["nodes"], block["calls"], sum(block["calls"]), sum(block["entries"])
             return {"nodes": round(100.0 * sum(nodes) / len(nodes), 1),
                     "efficiency": round(sum(nodes) / spent, 4) if spent else None,
@@ -193,61 +224,66 @@ class HeatmapWorlds(Experiment):
                     "efficiency_interval_95": rounded_interval(bootstrap_ratio_interval(nodes, calls, seed)),
                     "reachable_fraction": round(sum(block["reachable"]) / seen, 4) if seen else None}
 
-        def at_cut(variant: str, keys: list[str], cut: str) -> dict[str, list[int]]:
-            """The runs of ``variant`` in the worlds ``keys``, read at ``cut``, pooled."""
-            return {column: [value for key in keys for value in blocks[(variant, *_world(per_world[key]))][column][cut]]
-                    for column in ("nodes", "calls", "reachable", "entries")}
-
+        # each world, under each root seed: the rule on its RRT runs; the passing blocks' own values
+        per_root: dict[str, dict[str, Any]] = {}
+        for root in roots:
+            rrt_intervals = {key: {cut: measure(runs("RRT", [(key, root)], cut))["efficiency_interval_95"]
+                                   for cut in cuts} for key in keys}
+            passing = [key for key in keys if passes(rrt_intervals[key], PAPER["RRT"])]
+            values = {key: {variant: {cut: measure(runs(variant, [(key, root)], cut)) for cut in cuts}
+                            for variant in variants} for key in passing}
+            per_root[root] = {
+                "passing_worlds": passing, "pass_rate": round(len(passing) / len(keys), 4),
+                "rrt_efficiency_interval_95": rrt_intervals, "passing": values,
+                "paper_inside": {variant: [key for key in passing if all(
+                    not differs(PAPER[variant][cut][name], values[key][variant][cut][f"{name}_interval_95"])
+                    for cut in cuts for name in ("nodes", "efficiency"))]
+                    for variant in variants if variant in QUANTUM},
+                **_pooled(variants, cuts, {key: [(key, root)] for key in passing}, runs, seed)}
+        # each world over all root seeds' runs: where the world itself, not one draw of runs, stands
         per_world: dict[str, dict[str, Any]] = {}
-        for boxes in settings["box_counts"]:
-            for w in range(settings["worlds"]):
-                entry: dict[str, Any] = {"boxes": boxes, "world_seed": w}
-                for variant in variants:
-                    block = blocks[(variant, boxes, w)]
-                    entry[variant] = {cut: measure({column: values[cut] for column, values in block.items()})
-                                      for cut in cuts}
-                entry["passes"] = passes({cut: entry["RRT"][cut]["efficiency_interval_95"] for cut in cuts},
-                                         PAPER["RRT"])
-                entry["paper_inside"] = {variant: all(
-                    not differs(PAPER[variant][cut][key], entry[variant][cut][f"{key}_interval_95"])
-                    for cut in cuts for key in ("nodes", "efficiency")) for variant in variants if variant in QUANTUM}
-                per_world[f"{boxes}-{w}"] = entry
-        passing = [key for key, entry in per_world.items() if entry["passes"]]
-        ours: dict[str, dict[str, dict[str, float | None]]] = {}
-        interval: dict[str, dict[str, dict[str, list[float]]]] = {}
-        differs_from_paper: dict[str, dict[str, dict[str, bool | None]]] = {}
-        reachable: dict[str, dict[str, float | None]] = {}
-        for variant in variants:  # pooled over the passing worlds' runs
-            ours[variant], interval[variant], differs_from_paper[variant], reachable[variant] = {}, {}, {}, {}
-            for cut in cuts:
-                pooled_runs = at_cut(variant, passing, cut)
-                if not pooled_runs["nodes"]:
-                    ours[variant][cut] = {"nodes": None, "efficiency": None}
-                    reachable[variant][cut] = None
-                    continue
-                pooled = measure(pooled_runs)
-                ours[variant][cut] = {"nodes": pooled["nodes"], "efficiency": pooled["efficiency"]}
-                interval[variant][cut] = {"nodes": pooled["nodes_interval_95"],
-                                          "efficiency": pooled["efficiency_interval_95"]}
-                differs_from_paper[variant][cut] = {key: differs(PAPER[variant][cut][key], interval[variant][cut][key])
-                                                    for key in ("nodes", "efficiency")}
-                reachable[variant][cut] = pooled["reachable_fraction"]
+        for key in keys:
+            boxes, w = (int(part) for part in key.split("-"))
+            entry: dict[str, Any] = {"boxes": boxes, "world_seed": w}
+            for variant in variants:
+                entry[variant] = {cut: measure(runs(variant, [(key, root) for root in roots], cut)) for cut in cuts}
+            entry["passes_under_root_seeds"] = [int(root) for root in roots if key in per_root[root]["passing_worlds"]]
+            per_world[key] = entry
+        # every passing (world, root seed) block, grouped by world: the unit of the interval is the world
+        by_world: dict[str, list[tuple[str, str]]] = {}
+        for root in roots:
+            for key in per_root[root]["passing_worlds"]:
+                by_world.setdefault(key, []).append((key, root))
+        pooled = _pooled(variants, cuts, by_world, runs, seed)
+        blocks_passing = [pair for pairs in by_world.values() for pair in pairs]
+        ours = {variant: {cut: {name: pooled["ours"][variant][cut][name] for name in ("nodes", "efficiency")}
+                          for cut in cuts} for variant in variants}
+        interval = pooled["interval_95_over_worlds"]
+        differs_from_paper = {variant: {cut: {name: differs(PAPER[variant][cut][name], interval[variant][cut][name])
+                                              if interval[variant][cut] else None for name in ("nodes", "efficiency")}
+                                        for cut in cuts} for variant in variants}
+        reachable = {variant: {cut: _fraction(runs(variant, blocks_passing, cut)) for cut in cuts}
+                     for variant in variants}
         groups = [(str(boxes), [k for k, e in per_world.items() if e["boxes"] == boxes])
                   for boxes in settings["box_counts"]] + [("all", list(per_world))]
-        spread = {label: {variant: quantiles([per_world[key][variant]["10"]["efficiency"] for key in keys])
-                          for variant in variants} for label, keys in groups}
-        advantage = {label: {variant: _advantage([per_world[key]["RRT"]["10"]["efficiency"] for key in keys],
-                                                 [per_world[key][variant]["10"]["efficiency"] for key in keys])
-                             for variant in variants if variant in QUANTUM} for label, keys in groups}
+        spread = {label: {variant: quantiles([per_world[key][variant]["10"]["efficiency"] for key in group])
+                          for variant in variants} for label, group in groups}
+        advantage = {label: {variant: _advantage([per_world[key]["RRT"]["10"]["efficiency"] for key in group],
+                                                 [per_world[key][variant]["10"]["efficiency"] for key in group])
+                             for variant in variants if variant in QUANTUM} for label, group in groups}
         highest = {variant: {cut: _highest(per_world, variant, cut) for cut in cuts}
                    for variant in variants if variant in QUANTUM}
         return {"ours": ours, "paper": {variant: PAPER[variant] for variant in variants}, "interval_95": interval,
+                "interval_unit": "worlds (two-level bootstrap: worlds, then runs in each)",
                 "differs_from_paper": differs_from_paper,
-                "acceptance_rule": ACCEPTANCE_RULE, "passing_worlds": passing,
-                "paper_inside_in_passing_worlds": {variant: [key for key in passing
-                                                             if per_world[key]["paper_inside"][variant]]
-                                                   for variant in variants if variant in QUANTUM},
-                "worlds_run": len(per_world), "per_world": per_world,
+                "acceptance_rule": ACCEPTANCE_RULE,
+                "passing_worlds_by_root_seed": {root: per_root[root]["passing_worlds"] for root in roots},
+                "pass_rate_by_root_seed": {root: per_root[root]["pass_rate"] for root in roots},
+                "pass_overlap": pass_overlap({root: per_root[root]["passing_worlds"] for root in roots}),
+                "passing_blocks": len(blocks_passing), "passing_worlds_any_root_seed": len(by_world),
+                "range_over_passing_worlds": pooled["range_over_worlds"],
+                "per_root_seed": per_root,
+                "worlds_run": len(per_world), "root_seeds_run": len(roots), "per_world": per_world,
                 "efficiency_at_10_quantiles_over_worlds": spread,
                 "advantage_at_10_over_worlds": advantage,
                 "highest_nodes_over_worlds": highest,
@@ -255,37 +291,47 @@ class HeatmapWorlds(Experiment):
                 "peak_reachable_fraction": {"QRRT": round(peak_fraction(2), 4),
                                             "QRRT_PAPER": round(peak_fraction(PaperIterations().early), 4)},
                 "round_costs": round_costs(PAPER["QRRT"]),
-                "note": "ours: pooled over the runs of the passing worlds (nodes per 100 runs); per_world gives each "
-                        "world's own values; quantiles over worlds are the 5 %, 50 % and 95 % of the worlds' "
-                        "values at 10 calls (advantage: q-RRT's efficiency minus RRT's, and their ratio over the "
-                        "worlds where RRT added a node). QRRT_PAPER (the paper's schedule) is a contrast: its "
-                        "6-call rounds cannot reach the paper's totals (round_costs). The paper's Fig. 12 caption "
-                        "says 60 calls where its text says 40; 40 is used.",
+                "note": "The rule is applied per planner root seed (per_root_seed: each seed's passing worlds, "
+                        "their own values, and the pooled values over them). ours: pooled over the runs of every "
+                        "passing (world, root seed) block (nodes per 100 runs); interval_95: a two-level bootstrap "
+                        "over the passing worlds, then the runs in each (a world passing under several root seeds "
+                        "is one world with all those runs); range_over_passing_worlds: the lowest and highest "
+                        "value of one passing block. per_world gives each world's values over all root seeds' "
+                        "runs (intervals over those runs); quantiles over worlds are the 5 %, 50 % and 95 % of the "
+                        "worlds' values at 10 calls (advantage: q-RRT's efficiency minus RRT's, and their ratio "
+                        "over the worlds where RRT added a node). pass_overlap: of the worlds passing under one "
+                        "root seed, how many pass under another. QRRT_PAPER (the paper's schedule) is a contrast: "
+                        "its 6-call rounds cannot reach the paper's totals (round_costs). The paper's Fig. 12 "
+                        "caption says 60 calls where its text says 40; 40 is used.",
                 "labels": ["phase oracle from a classical lookup of all 2^8 entries",
                            "backend: exact statevector (ideal; same statistics as Aer)",
                            "QRRT: 2 Grover iterations a round (the round the paper's call totals imply)",
                            "QRRT_PAPER: the paper's schedule (5 iterations, 3 after 10 nodes)"]}
 
     def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
-        """Left and middle: one point per world (RRT against q-RRT with 2 iterations, at 10 and 40
-        calls), the passing worlds highlighted, the paper's pair as a star. Right: the quantiles over
-        worlds of each variant's efficiency at 10 calls, by obstacle count."""
+        """Left and middle: one point per world, over all root seeds' runs (RRT against q-RRT with 2
+        iterations, at 10 and 40 calls), coloured by how many root seeds the world passes under,
+        the paper's pair as a star. Right: the quantiles over worlds of each variant's efficiency at
+        10 calls, by obstacle count."""
         fig, axes = new_figure(1, 3, (17, 4.8))
         worlds = summary["per_world"]
+        roots = len(settings["planner_root_seeds"])
+        shades = {0: ("tab:gray", 0.35)} | {n: (("tab:orange", "tab:red", "darkred")[min(n, 3) - 1], 0.9)
+                                          for n in range(1, roots + 1)}
         for ax, cut, key in ((axes[0, 0], "10", "efficiency"), (axes[0, 1], "40", "nodes")):
             for entry in worlds.values():
-                ax.scatter(entry["RRT"][cut]["efficiency"], entry["QRRT"][cut][key], s=14,
-                           color="tab:orange" if entry["passes"] else "tab:gray",
-                           alpha=0.9 if entry["passes"] else 0.4)
-            ax.scatter([], [], color="tab:orange", s=14, label="passes the RRT rule")
-            ax.scatter([], [], color="tab:gray", s=14, alpha=0.4, label="does not")
+                color, alpha = shades[len(entry["passes_under_root_seeds"])]
+                ax.scatter(entry["RRT"][cut]["efficiency"], entry["QRRT"][cut][key], s=14, color=color, alpha=alpha)
+            for count, (color, alpha) in shades.items():
+                ax.scatter([], [], color=color, alpha=alpha, s=14,
+                           label=f"passes under {count} of {roots} root seeds")
             ax.scatter([PAPER["RRT"][cut]["efficiency"]], [PAPER["QRRT"][cut][key]], marker="*", s=160,
                        color="k", label="paper")
-            ax.set_xlabel(f"RRT efficiency at {cut} calls (one world)")
+            ax.set_xlabel(f"RRT efficiency at {cut} calls (one world, all root seeds)")
             ax.set_ylabel(f"q-RRT (k = 2) {'efficiency' if key == 'efficiency' else 'nodes per 100 runs'} "
                           f"at {cut} calls")
-            ax.set_title(f"{summary['worlds_run']} single worlds, {settings['runs']} runs each, {cut} calls",
-                         fontsize=10)
+            ax.set_title(f"{summary['worlds_run']} single worlds, {roots} x {settings['runs']} runs each, "
+                         f"{cut} calls", fontsize=10)
             ax.legend(fontsize=7)
             ax.grid(alpha=0.3)
         ax = axes[0, 2]
@@ -305,8 +351,88 @@ class HeatmapWorlds(Experiment):
         return [save(fig, out_dir / "heatmap_worlds.png")]
 
 
-def _world(entry: dict[str, Any]) -> tuple[int, int]:
-    return entry["boxes"], entry["world_seed"]
+def pass_overlap(passing: dict[str, list[str]]) -> dict[str, Any]:
+    """How far the worlds passing under one planner root seed pass under another.
+
+    Args:
+        passing: Root seed -> the worlds passing under it.
+
+    Returns:
+        ``{"pairs": {"a->b": {"passing": |P_a|, "pass_again": |P_a & P_b|}}`` over ordered pairs of
+        root seeds, ``"fraction_passing_again"``: the pairs' pass_again summed over their passing
+        summed (None without a passing world or with one root seed), ``"in_every_root_seed"`` and
+        ``"in_any_root_seed"``: the worlds passing under every root seed, and under at least one}.
+    """
+    pairs = {f"{a}->{b}": {"passing": len(passing[a]), "pass_again": len(set(passing[a]) & set(passing[b]))}
+             for a in passing for b in passing if a != b}
+    total = sum(pair["passing"] for pair in pairs.values())
+    every = set.intersection(*(set(worlds) for worlds in passing.values())) if passing else set()
+    ordered = [key for worlds in passing.values() for key in worlds]
+    return {"pairs": pairs,
+            "fraction_passing_again": round(sum(p["pass_again"] for p in pairs.values()) / total, 4) if total else None,
+            "in_every_root_seed": [key for key in dict.fromkeys(ordered) if key in every],
+            "in_any_root_seed": list(dict.fromkeys(ordered))}
+
+
+def _pooled(variants: list[str], cuts: list[str], groups: dict[str, list[tuple[str, str]]],
+            runs: Any, seed: int) -> dict[str, Any]:
+    """Values pooled over the runs of several worlds, with the interval over worlds.
+
+    Args:
+        variants: The planner variants.
+        cuts: The cuts, as strings.
+        groups: World -> its (world, root seed) blocks; a world is one unit of the interval.
+        runs: ``runs(variant, blocks, cut)`` -> the pooled columns of those blocks at that cut.
+        seed: Seed of the bootstrap.
+
+    Returns:
+        ``{"ours": variant -> cut -> {"nodes" (per 100 runs), "efficiency"}} (None without
+        worlds), "interval_95_over_worlds": variant -> cut -> {"nodes", "efficiency"}: [low, high]
+        from ``two_level_bootstrap_interval`` (empty without worlds), "range_over_worlds": variant
+        -> cut -> {"nodes", "efficiency"}: [lowest, highest] value of one block}``.
+    """
+    ours: dict[str, dict[str, dict[str, float | None]]] = {}
+    interval: dict[str, dict[str, dict[str, list[float]]]] = {}
+    spread: dict[str, dict[str, dict[str, list[float]]]] = {}
+    for variant in variants:
+        ours[variant], interval[variant], spread[variant] = {}, {}, {}
+        for cut in cuts:
+            columns = {world: runs(variant, blocks, cut) for world, blocks in groups.items()}
+            pooled = runs(variant, [pair for blocks in groups.values() for pair in blocks], cut)
+            if not pooled["nodes"]:
+                ours[variant][cut], interval[variant][cut], spread[variant][cut] = (
+                    {"nodes": None, "efficiency": None}, {}, {})
+                continue
+            spent = sum(pooled["calls"])
+            ours[variant][cut] = {"nodes": round(100.0 * sum(pooled["nodes"]) / len(pooled["nodes"]), 1),
+                                  "efficiency": round(sum(pooled["nodes"]) / spent, 4) if spent else None}
+            pairs = {world: list(zip(column["nodes"], column["calls"], strict=True))
+                     for world, column in columns.items()}
+            interval[variant][cut] = {
+                "nodes": rounded_interval(two_level_bootstrap_interval(pairs, _nodes_per_100, seed), 1),
+                "efficiency": rounded_interval(two_level_bootstrap_interval(pairs, _efficiency, seed))}
+            one = [runs(variant, [pair], cut) for blocks in groups.values() for pair in blocks]
+            per_100 = [100.0 * sum(block["nodes"]) / len(block["nodes"]) for block in one]
+            efficiency = [sum(block["nodes"]) / sum(block["calls"]) for block in one if sum(block["calls"])]
+            spread[variant][cut] = {"nodes": [round(min(per_100), 1), round(max(per_100), 1)],
+                                    "efficiency": [round(min(efficiency), 4), round(max(efficiency), 4)]}
+    return {"ours": ours, "interval_95_over_worlds": interval, "range_over_worlds": spread}
+
+
+def _nodes_per_100(runs: list[tuple[int, int]]) -> float:
+    """Nodes per 100 runs of (nodes, calls) runs."""
+    return 100.0 * sum(nodes for nodes, _ in runs) / len(runs)
+
+
+def _efficiency(runs: list[tuple[int, int]]) -> float:
+    """Nodes per oracle call of (nodes, calls) runs (ZeroDivisionError without calls)."""
+    return sum(nodes for nodes, _ in runs) / sum(calls for _, calls in runs)
+
+
+def _fraction(block: dict[str, list[int]]) -> float | None:
+    """The reachable share of the candidates of pooled runs (None without candidates)."""
+    seen = sum(block["entries"])
+    return round(sum(block["reachable"]) / seen, 4) if seen else None
 
 
 def _advantage(rrt: list[float | None], quantum: list[float | None]) -> dict[str, Any]:
@@ -321,10 +447,12 @@ def _advantage(rrt: list[float | None], quantum: list[float | None]) -> dict[str
 
 
 def _highest(per_world: dict[str, dict[str, Any]], variant: str, cut: str) -> dict[str, Any]:
-    """The world where ``variant`` placed the most nodes at ``cut``, with its interval and RRT's
-    efficiency in the same world."""
+    """The world where ``variant`` placed the most nodes at ``cut`` over all root seeds' runs, with
+    its interval over those runs, RRT's efficiency in the same world and the root seeds under which
+    it passes."""
     key = max(per_world, key=lambda k: per_world[k][variant][cut]["nodes"])
     found = per_world[key]
     return {"world": key, "nodes": found[variant][cut]["nodes"],
             "nodes_interval_95": found[variant][cut]["nodes_interval_95"],
-            "rrt_efficiency": found["RRT"][cut]["efficiency"], "passes": found["passes"]}
+            "rrt_efficiency": found["RRT"][cut]["efficiency"],
+            "passes_under_root_seeds": found["passes_under_root_seeds"]}

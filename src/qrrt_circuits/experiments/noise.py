@@ -76,6 +76,12 @@ def _compiled(num_qubits: int, seed: int, iterations: int) -> QuantumCircuit:
     return noise.transpiled_grover(sweep_marks(num_qubits, seed), iterations)
 
 
+#: planning worlds of a full run, the unit of its planning intervals (over very few worlds a
+#: percentile bootstrap's 2.5 % and 97.5 % quantiles are the lowest and highest world's values, a
+#: min-max range; over 7 it is a bootstrap interval, a little narrow for so few worlds)
+PLANNING_WORLDS = 7
+
+
 class Noise(Experiment):
     """Device noise (beyond the paper, which assumes a perfect quantum computer).
 
@@ -103,7 +109,7 @@ class Noise(Experiment):
                     "device": device, "device_qubits": [], "device_iterations": [1], "device_shots": 100,
                     "planning_p2": [0.0, 1e-2], "planning_qubits": 4, "nodes": 3,
                     "planning_configs": ["QRRT adaptive"]}
-        return {"trials": trials or 3, "seed": seed, "quick": False,
+        return {"trials": trials or PLANNING_WORLDS, "seed": seed, "quick": False,
                 "sweep_qubits": [4, 5, 6, 7, 8, 9, 10], "sweep_iterations": [1, 2, 3],
                 "p2": [0.0, 1e-4, 1e-3, 3e-3, 1e-2], "p1_ratio": 0.1, "exact_max_qubits": 8, "shots": 200,
                 "device": device, "device_qubits": [4, 5, 6], "device_iterations": [1, 2, 3], "device_shots": 1000,
@@ -251,8 +257,9 @@ class Noise(Experiment):
                            "(exact binomial interval)",
                            "QRRT optimal uses the true m of each database (simulation knowledge)",
                            f"p1 = {settings['p1_ratio']:g} x p2; rz is virtual and error-free",
-                           "calls_per_node and break_even_p2: percentile bootstrap over worlds; a break-even "
-                           "interval's upper end null means beyond the largest p2"]}
+                           f"calls_per_node and break_even_p2: 95 % percentile bootstrap over the "
+                           f"{planning['worlds']} planning worlds (unit: worlds); a break-even interval's upper "
+                           "end null means beyond the largest p2"]}
 
     def _planning_summary(self, rows: list[Record], settings: Settings) -> dict[str, Any]:
         by_world: dict[int, list[Record]] = {}
@@ -296,7 +303,8 @@ class Noise(Experiment):
                                   "meaning": _crossing_meaning(value, levels)}
         return {"calls_per_node": {c: (v["mean"] if c == "RRT" else {p: x["mean"] for p, x in v.items()})
                                    for c, v in calls.items()},
-                "intervals": calls, "break_even_p2": break_even}
+                "intervals": calls, "break_even_p2": break_even, "worlds": len(worlds),
+                "interval_unit": f"worlds ({len(worlds)}; percentile bootstrap)"}
 
     def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         fig, axes = new_figure(2, 2, (11, 8.5))

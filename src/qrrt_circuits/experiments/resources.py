@@ -63,6 +63,10 @@ def database_marks(num_qubits: int, seed: int) -> np.ndarray:
     return marks
 
 
+#: plan worlds of a full run (a percentile bootstrap over them gives the plan intervals)
+PLAN_WORLDS = 10
+
+
 class Resources(Experiment):
     """Gates and time per oracle call and per plan, near term and fault tolerant (beyond the paper).
 
@@ -78,7 +82,7 @@ class Resources(Experiment):
 
     def settings(self, quick: bool, trials: int | None, seed: int) -> Settings:
         lookups = ["qrom", "select-swap"] if res.has_qualtran() else ["qrom"]
-        return {"trials": trials or (1 if quick else 10), "seed": seed, "quick": quick,
+        return {"trials": trials or (1 if quick else PLAN_WORLDS), "seed": seed, "quick": quick,
                 "qubits": [3, 4] if quick else list(range(4, 13)), "syntheses": ["diagonal", "mcz"],
                 "connectivities": list(res.CONNECTIVITIES), "lookups": lookups,
                 "ft_source": "qualtran" if res.has_qualtran() else "formula",
@@ -166,6 +170,8 @@ class Resources(Experiment):
                 "labels": ["classical times measured on the machine that ran the trials (RRT wall time / its "
                            "reachability tests; they move with its load and speed)",
                            "q-RRT plans on the exact statevector backend (same statistics as Aer)",
+                           f"plan intervals: 95 % percentile bootstrap over the {plan['worlds']} plan worlds "
+                           "(unit: worlds)",
                            f"fault-tolerant counts from {settings['ft_source']}"]}
 
     def _plan_summary(self, records: list[Record], settings: Settings, near: dict[str, dict[str, dict[str, Any]]],
@@ -217,7 +223,8 @@ class Resources(Experiment):
         table.update(num_qubits=n, lookup=lookup, fault_tolerant_call_s=call_ft, near_term_call_s=call_nt,
                      fault_tolerant_over_break_even=(call_ft / table["break_even_call_s"]
                                                      if table["break_even_call_s"] > 0 else math.inf))
-        return {"table": table, "interval_95": intervals}
+        return {"table": table, "interval_95": intervals, "worlds": len(worlds),
+                "interval_unit": f"worlds ({len(worlds)}; percentile bootstrap)"}
 
     def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         """Gate counts per call (near term, fault tolerant), the time per call against the plans'
