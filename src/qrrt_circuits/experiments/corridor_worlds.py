@@ -260,9 +260,9 @@ class CorridorWorlds(Experiment):
         shapes = design_cells(settings, "RRT")
         fig, axes = new_figure(1, len(levels), (5.0 * len(levels), 4.8))
         colors = ("black", "tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink")
-        spans = [span[1] for kind in PLANNERS for span in summary["range_over_draws"][kind].values()]
-        top = max([PAPER["QRRT"], *spans]) * 1.05
-        right = max([PAPER["RRT"], *(s[1] for s in summary["range_over_draws"]["RRT"].values())]) * 1.05
+        highs = {kind: [span[1] for block in ("range_over_draws", "interval_95")
+                        for span in summary[block][kind].values()] for kind in PLANNERS}
+        top, right = (max([PAPER[kind], *highs[kind]]) * 1.05 for kind in ("QRRT", "RRT"))
         for ax, level in zip(axes[0], levels, strict=True):
             for shape, color in zip(shapes, colors * len(shapes), strict=False):
                 r, q = cell_id(shape, "RRT"), cell_id({**shape, "iterations": level}, "QRRT")
