@@ -1,5 +1,6 @@
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -9,10 +10,11 @@ from qrrt_circuits.experiments import EXPERIMENTS, read_records, run_experiment
 from qrrt_circuits.experiments.base import TIMING_SUFFIX
 from qrrt_circuits.experiments.fitting import linear_fit, power_law_exponent, slope_through_origin
 
+RESULTS = Path(__file__).resolve().parent.parent / "docs" / "results"
 TINY = {"oracle-efficiency": 1, "wallclock": 1, "heatmaps": 2, "corridor": 2, "annealing": 1,
         "lemmas": 60, "scaling": 1, "oracle-check": 1,
         "tree-size": 1, "heatmap-hypotheses": 3,
-        "corridor-sensitivity": 2, "search-policies": 1, "noise": 1, "resources": 1,
+        "corridor-sensitivity": 2, "corridor-worlds": 2, "search-policies": 1, "noise": 1, "resources": 1,
         "heatmap-worlds": 5, "annealing-density": 2, "problems": 2,
         "coherent-oracle": 1}
 
@@ -431,11 +433,45 @@ def _check_resources(summary, records):
     assert plan["qrrt_fault_tolerant_with_table_s"] > plan["qrrt_fault_tolerant_s"]
 
 
+def _check_corridor_worlds(summary, records):
+    from qrrt_circuits.experiments.corridor_sensitivity import FACTORS, PAPER, PAPER_TRIALS, cell_id
+    from qrrt_circuits.experiments.corridor_worlds import CENTRES, design_cells, geometries
+
+    settings = summary["settings"]
+    assert len(geometries(CENTRES, FACTORS)) == 7  # the centre and its 6 one-level neighbours
+    seeds = summary["design"]["world_seeds"]
+    assert seeds == list(range(1, 1 + settings["draws"])) and summary["design"]["draws"] == settings["draws"]
+    for kind in ("RRT", "QRRT"):
+        keys = {cell_id(c, kind) for c in design_cells(settings, kind)}
+        assert set(summary["ours"][kind]) == set(summary["interval_95"][kind]) == keys
+        for key in keys:
+            per_draw = summary["per_draw"][kind][key]
+            for w in seeds:  # each draw's mean per 50 runs, from that draw's records only
+                counts = [n for r in records if r["planner"] == kind and cell_id(r, kind) == key
+                          and r["world_seed"] == w for n in json.loads(r["in_channel_json"])]
+                assert len(counts) == settings["blocks"] * settings["block_size"]
+                assert per_draw[str(w)] == pytest.approx(PAPER_TRIALS * np.mean(counts), abs=0.01)
+            assert summary["range_over_draws"][kind][key] == [min(per_draw.values()), max(per_draw.values())]
+            low, high = summary["interval_95"][kind][key]
+            assert low - 0.01 <= summary["ours"][kind][key] <= high + 0.01
+    for claim, count in summary["claims_over_worlds"].items():
+        assert count["draws"] == len(seeds) and count["holds_in"] == len(count["world_seeds"]) <= len(seeds)
+        if claim.startswith("paper_pair_inside/"):  # the rule, per draw, from the per-draw intervals
+            q = claim.split("/", 1)[1]
+            r = q.rsplit("-", 1)[0]
+            spans = summary["per_draw_interval_95"]
+            assert count["world_seeds"] == [
+                w for w in seeds if spans["QRRT"][q][str(w)][0] <= PAPER["QRRT"] <= spans["QRRT"][q][str(w)][1]
+                and spans["RRT"][r][str(w)][0] <= PAPER["RRT"] <= spans["RRT"][r][str(w)][1]]
+    assert set(summary["claims_for_the_setting"]) == set(summary["claims_over_worlds"])
+
+
 CHECKS = {"oracle-efficiency": _check_oracle_efficiency, "wallclock": _check_wallclock,
           "heatmaps": _check_heatmaps, "corridor": _check_corridor, "annealing": _check_annealing,
           "lemmas": _check_lemmas, "scaling": _check_scaling, "oracle-check": _check_oracle_check,
           "tree-size": _check_tree_size, "heatmap-hypotheses": _check_heatmap_hypotheses,
-          "corridor-sensitivity": _check_corridor_sensitivity, "search-policies": _check_search_policies,
+          "corridor-sensitivity": _check_corridor_sensitivity, "corridor-worlds": _check_corridor_worlds,
+          "search-policies": _check_search_policies,
           "noise": _check_noise, "resources": _check_resources, "heatmap-worlds": _check_heatmap_worlds,
           "annealing-density": _check_annealing_density, "problems": _check_problems,
           "coherent-oracle": _check_coherent_oracle}
@@ -465,6 +501,38 @@ def test_resume_ends_with_exactly_the_uninterrupted_trials(tmp_path):
     assert len(b) == len({r["trial_id"] for r in b}) == 8
     assert _comparable(a) == _comparable(b)
     assert resumed["ours"] == whole["ours"]
+
+
+def test_corridor_worlds_centres_are_the_factorials_paper_pair_cells():
+    """The draws rerun the geometry of every cell that holds the paper's pair in the committed
+    factorial (world seed 0), with every iteration level of the factorial."""
+    from qrrt_circuits.experiments.corridor_sensitivity import FACTORS, cell_id
+    from qrrt_circuits.experiments.corridor_worlds import CENTRES, design_cells
+
+    factorial = json.loads((RESULTS / "corridor-sensitivity" / "summary.json").read_text())
+    assert factorial["paper_pair_inside"]
+    assert {q.rsplit("-", 1)[0] for q in factorial["paper_pair_inside"]} == {cell_id(c, "RRT") for c in CENTRES}
+    settings = EXPERIMENTS["corridor-worlds"].settings(False, None, 0)
+    assert settings["factors"] == FACTORS
+    assert set(factorial["paper_pair_inside"]) <= {cell_id(c, "QRRT") for c in design_cells(settings, "QRRT")}
+
+
+def test_corridor_worlds_quick_path_resumes_to_the_uninterrupted_records(tmp_path):
+    whole = run_experiment("corridor-worlds", out=tmp_path / "a", quick=True, trials=2, progress=False)
+    partial = run_experiment("corridor-worlds", out=tmp_path / "b", quick=True, trials=2, progress=False,
+                             stop_after=5)
+    assert partial["complete"] is False and partial["finished_trials"] == 5
+    seen = []
+    resumed = run_experiment("corridor-worlds", out=tmp_path / "b", quick=True, trials=2, progress=False,
+                             on_record=seen.append)
+    total = len(EXPERIMENTS["corridor-worlds"].trials(resumed["settings"]))
+    assert resumed["complete"] and len(seen) == total - 5
+    a = read_records(tmp_path / "a" / "corridor-worlds" / "records.csv")
+    b = read_records(tmp_path / "b" / "corridor-worlds" / "records.csv")
+    assert len(b) == len({r["trial_id"] for r in b}) == total
+    assert _comparable(a) == _comparable(b)
+    for key in ("ours", "interval_95", "per_draw", "claims_over_worlds", "claims_for_the_setting"):
+        assert resumed[key] == whole[key]
 
 
 def test_other_settings_in_the_same_directory_are_refused(tmp_path):

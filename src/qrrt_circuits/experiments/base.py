@@ -49,6 +49,8 @@ class TrialStream(IntEnum):
     HEATMAP_WORLDS = 15
     # corridor-sensitivity: the runs of its factorial design (a block of runs is one trial)
     CORRIDOR_SENSITIVITY = 17
+    # corridor-worlds: the runs of its cells in each clutter draw (a block of runs is one trial)
+    CORRIDOR_WORLDS = 18
     # annealing-density: its worlds (one per replicate and density) and planner seeds
     ANNEALING_DENSITY_WORLDS = 19
     ANNEALING_DENSITY_PLANNERS = 20

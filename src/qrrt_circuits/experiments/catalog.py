@@ -5,6 +5,7 @@ from .annealing_density import AnnealingDensity
 from .coherent_oracle import CoherentOracle
 from .corridor import Corridor
 from .corridor_sensitivity import CorridorSensitivity
+from .corridor_worlds import CorridorWorlds
 from .heatmap_hypotheses import HeatmapHypotheses
 from .heatmap_worlds import HeatmapWorlds
 from .heatmaps import Heatmaps
@@ -23,8 +24,8 @@ EXPERIMENTS = {
     experiment.name: experiment
     for experiment in (OracleEfficiency(), Wallclock(), Heatmaps(), Corridor(), Annealing(), Lemmas(),
                        Scaling(), OracleCheck(), TreeSize(), HeatmapHypotheses(), HeatmapWorlds(),
-                       CorridorSensitivity(), SearchPolicies(), Noise(), Resources(), AnnealingDensity(), Problems(),
-                       CoherentOracle())
+                       CorridorSensitivity(), CorridorWorlds(), SearchPolicies(), Noise(), Resources(),
+                       AnnealingDensity(), Problems(), CoherentOracle())
 }
 
 __all__ = ["EXPERIMENTS"]

@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -152,6 +153,43 @@ def single_block_range(counts: np.ndarray, block: int, seed: int, resamples: int
     return float(np.quantile(sums, tail)), float(np.quantile(sums, 1.0 - tail))
 
 
+def run_block(params: dict[str, Any], settings: Settings, world_seed: int, seeds: Sequence[int]) -> Record:
+    """One block: one run of ``params["planner"]`` per seed in one cell of world ``world_seed``,
+    each cut at ``settings["budget"]`` oracle calls, counting its tree's nodes in the channel.
+
+    Args:
+        params: The cell (``width``, ``length``, ``clutter``, ``distance``), ``planner`` and,
+            for q-RRT, ``iterations`` (a search-policy name).
+        settings: ``scenario``, ``mouth_clearance``, ``budget``, ``backend``, ``num_qubits``
+            and the planners' options (``planner_for``).
+        world_seed: The world's seed (its clutter boxes and goal).
+        seeds: One planner seed per run.
+
+    Returns:
+        The record's measurements: ``nodes`` and ``oracle_calls`` summed over the runs, the start's
+        actual distance, and per run (``*_json``) and summed, the nodes inside the channel
+        (``in_channel``) and beyond its far mouth (``through_channel``).
+    """
+    env = world(settings["scenario"], world_seed, width=params["width"], length=params["length"],
+                clutter=params["clutter"], mouth_clearance=settings["mouth_clearance"])
+    start, distance = start_before_mouth(env, params["distance"])
+    channel = env.metadata["channel"]
+    options = {"search_policy": params["iterations"]} if params["planner"] == "QRRT" else {}
+    inside, through, nodes, calls = [], [], 0, 0
+    for seed in seeds:
+        planner = planner_for(settings, params["planner"], env, seed, settings["backend"],
+                              num_qubits=settings["num_qubits"], **options)
+        result = planner.plan(start=start, max_oracle_calls=settings["budget"])
+        kept, used = cut_at(result, settings["budget"])
+        positions = result.nodes[1: kept + 1]
+        inside.append(int(in_channel(positions, channel).sum()))
+        through.append(int((positions[:, 0] > channel[1][0]).sum()))
+        nodes, calls = nodes + kept, calls + used
+    return {"nodes": nodes, "oracle_calls": calls, "start_distance": round(distance, 3),
+            "in_channel": sum(inside), "through_channel": sum(through),
+            "in_channel_json": dumps(inside), "through_channel_json": dumps(through)}
+
+
 class CorridorSensitivity(Experiment):
     """The narrow corridor as a full factorial (beyond paper Figs. 13-14): module docstring.
 
@@ -183,27 +221,10 @@ class CorridorSensitivity(Experiment):
         return out
 
     def run_trial(self, trial: Trial, settings: Settings) -> Record:
-        params = trial.params
-        env = world(settings["scenario"], settings["world_seed"], width=params["width"], length=params["length"],
-                    clutter=params["clutter"], mouth_clearance=settings["mouth_clearance"])
-        start, distance = start_before_mouth(env, params["distance"])
-        inside, through, nodes, calls = [], [], 0, 0
-        for run in range(settings["block_size"]):
-            seed = replicate_seed(settings["seed"], params["block"] * settings["block_size"] + run,
-                                  TrialStream.CORRIDOR_SENSITIVITY)
-            options = {"search_policy": params["iterations"]} if params["planner"] == "QRRT" else {}
-            planner = planner_for(settings, params["planner"], env, seed, settings["backend"],
-                                  num_qubits=settings["num_qubits"], **options)
-            result = planner.plan(start=start, max_oracle_calls=settings["budget"])
-            kept, used = cut_at(result, settings["budget"])
-            positions = result.nodes[1: kept + 1]
-            channel = env.metadata["channel"]
-            inside.append(int(in_channel(positions, channel).sum()))
-            through.append(int((positions[:, 0] > channel[1][0]).sum()))
-            nodes, calls = nodes + kept, calls + used
-        return {"nodes": nodes, "oracle_calls": calls, "start_distance": round(distance, 3),
-                "in_channel": sum(inside), "through_channel": sum(through),
-                "in_channel_json": dumps(inside), "through_channel_json": dumps(through)}
+        first = trial.params["block"] * settings["block_size"]
+        seeds = [replicate_seed(settings["seed"], first + run, TrialStream.CORRIDOR_SENSITIVITY)
+                 for run in range(settings["block_size"])]
+        return run_block(trial.params, settings, settings["world_seed"], seeds)
 
     def summarize(self, records: list[Record], settings: Settings) -> Summary:
         seed = settings["seed"]
