@@ -32,7 +32,11 @@ each arm's reward has a Beta posterior; every database draws one sample per arm 
 the arm with the largest sampled reward per cost. The unit of learning is the database, not the
 measurement: the p measurements of one shared database are one observation (its share of distinct
 verified entries), since they are not independent of each other. Each arm's prior is the mean of
-P_k over f = m / N log-uniform on [1 / N, 1], with the weight of ``prior_strength`` databases;
+P_k over f = m / N uniform on [1 / N, 1] (about 1/2 for every k), with the weight of
+``prior_strength`` databases, so a plan starts at k = 0 (the cheapest arm) and moves to larger k as
+classical draws fail; a prior log-uniform in f (mean 0.18 at k = 0) instead starts by exploring
+k >= 1, which costs several times a short plan's calls in open space (on a synthetic model of
+Poisson-distributed m, ``benchmarks/policy_synthetic.py`` measures both against the best fixed k);
 after every database all arms forget toward their prior by the factor ``memory`` (an effective
 memory of about 1 / (1 - memory) databases), as G drifts with the tree. An arm whose cost k + 1
 already exceeds the sampled cost per node of a cheaper arm cannot win (a reward is at most 1), so
@@ -46,7 +50,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._support.validation import check_float, check_optional_int
+from ..._support.validation import check_choice, check_float, check_optional_int
 from ...probability import optimal_iterations
 from ..problem import DatabaseSearch, SearchOutcome
 from .iteration import IterationPolicy, PolicyState, verified_outcomes
@@ -55,7 +59,7 @@ __all__ = ["ThompsonIterations", "ThompsonState"]
 
 #: salt of the policy's own draw, apart from the search's seed of the same database
 _DRAW_SALT = 0x7A0B
-#: points of the log-uniform prior over the marked fraction
+#: grid points of the prior over the marked fraction
 _PRIOR_GRID = 400
 
 
@@ -71,6 +75,7 @@ class ThompsonIterations(IterationPolicy):
         memory: The factor by which every arm's evidence is kept after each database, in (0, 1]
             (default 0.95: about 20 databases).
         prior_strength: The prior's weight in databases, in (0, 1000] (default 1).
+        prior: ``"uniform"`` (f uniform on [1/N, 1], the default) or ``"log-uniform"`` (flat in log f).
         max_iterations: The largest k, in [0, 1000000], or None (default) for the optimal k for one
             marked entry (Eq. 1).
 
@@ -87,12 +92,14 @@ class ThompsonIterations(IterationPolicy):
 
     memory: float = 0.95
     prior_strength: float = 1.0
+    prior: str = "uniform"
     max_iterations: int | None = None
     name = "thompson"
 
     def __post_init__(self) -> None:
         check_float(self.memory, "memory", 0.0, 1.0, open_minimum=True)
         check_float(self.prior_strength, "prior_strength", 0.0, 1000.0, open_minimum=True)
+        check_choice(self.prior, "prior", ("uniform", "log-uniform"))
         check_optional_int(self.max_iterations, "max_iterations", 0, 1_000_000)
 
     def start(self, num_items: int) -> ThompsonState:
@@ -113,8 +120,8 @@ class ThompsonIterations(IterationPolicy):
         return 8 * (self.iterations_bound(num_items) + 1) * (4 + _PRIOR_GRID)
 
     def describe(self) -> str:
-        return (f"thompson (k per database from a bandit over verified outcomes, memory {self.memory}; "
-                "no access to the true m)")
+        return (f"thompson (k per database from a bandit over verified outcomes, memory {self.memory}, "
+                f"{self.prior} prior; no access to the true m)")
 
 
 class ThompsonState(PolicyState):
@@ -135,7 +142,8 @@ class ThompsonState(PolicyState):
     def __init__(self, policy: ThompsonIterations, num_items: int) -> None:
         super().__init__(policy, num_items)
         self.arms = np.arange(policy.iterations_bound(num_items) + 1)
-        theta = np.arcsin(np.sqrt(np.geomspace(1.0 / num_items, 1.0, _PRIOR_GRID)))
+        spaced = np.linspace if policy.prior == "uniform" else np.geomspace
+        theta = np.arcsin(np.sqrt(spaced(1.0 / num_items, 1.0, _PRIOR_GRID)))
         mean = np.clip(np.mean(np.sin(np.outer(2 * self.arms + 1, theta)) ** 2, axis=1), 1e-6, 1 - 1e-6)
         self.prior_alpha = policy.prior_strength * mean
         self.prior_beta = policy.prior_strength * (1.0 - mean)
