@@ -27,12 +27,14 @@ from tqdm import tqdm
 
 import qrrt_circuits as qc
 from qrrt_circuits._support.randomness import RandomStreams
+from qrrt_circuits.probability import expected_distinct_found, optimal_iterations
 
 QUBITS = 8
 #: (lambda, workers, budget in oracle calls)
 SCENARIOS = [(0.5, 1, 3000), (1.0, 1, 3000), (5.0, 1, 3000), (100.0, 1, 3000), (150.0, 1, 30), (30.0, 1, 100),
              (0.5, 8, 24000), (1.0, 8, 24000), (5.0, 8, 24000), (100.0, 8, 24000), (150.0, 8, 240), (30.0, 8, 800)]
-POLICIES = {"thompson": qc.ThompsonIterations(), "thompson log-uniform prior": qc.ThompsonIterations(prior="log-uniform"),
+POLICIES = {"thompson": qc.ThompsonIterations(),
+            "thompson log-uniform prior": qc.ThompsonIterations(prior="log-uniform"),
             "adaptive": qc.Adaptive(), "paper": qc.PaperIterations(), "bbht": qc.BBHT()}
 
 
@@ -41,11 +43,9 @@ def best_fixed_cost(lam: float, workers: int, num_items: int) -> float:
     marked = np.arange(num_items + 1)
     weights = poisson.pmf(marked, lam)
     weights[-1] += poisson.sf(num_items, lam)
-    theta = np.arcsin(np.sqrt(marked / num_items))
     costs = []
-    for k in range(qc.probability.optimal_iterations(num_items, 1) + 1):
-        found = np.sin((2 * k + 1) * theta) ** 2
-        distinct = np.where(marked > 0, marked * (1 - (1 - found / np.maximum(marked, 1)) ** workers), 0.0)
+    for k in range(optimal_iterations(num_items, 1) + 1):
+        distinct = np.array([expected_distinct_found(num_items, int(m), k, workers) for m in marked])
         costs.append(workers * (k + 1) / float(np.sum(weights * distinct)))
     return min(costs)
 

@@ -727,7 +727,8 @@ def test_problems_quick_path_resumes_to_the_uninterrupted_summary(tmp_path):
     a = read_records(tmp_path / "a" / "problems" / "records.csv")
     b = read_records(tmp_path / "b" / "problems" / "records.csv")
     assert len(b) == len({r["trial_id"] for r in b}) == len(a)
-    assert {r["root_seed"] for r in b} == set(whole["settings"]["root_seeds"]) and len(whole["settings"]["root_seeds"]) == 2
+    roots = whole["settings"]["root_seeds"]
+    assert {r["root_seed"] for r in b} == set(roots) and len(roots) == 2
     assert _without_nan(_comparable(a)) == _without_nan(_comparable(b))  # (OMPL's runs count no nodes: NaN)
     for key in ("interval_95", "ratios_interval_95", "worlds"):
         assert _reproducible(resumed[key]) == _reproducible(whole[key])

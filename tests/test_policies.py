@@ -14,7 +14,7 @@ from qrrt_circuits._support.randomness import RandomStreams
 from qrrt_circuits.probability import optimal_iterations, success_probability
 from qrrt_circuits.registry import POLICIES
 
-POLICY_NAMES = ["paper", "fixed:2", "optimal", "bbht", "adaptive"]
+POLICY_NAMES = ["paper", "fixed:2", "optimal", "bbht", "adaptive", "thompson"]
 
 
 def problem(marks, backend, round_index=0, first_worker=0, truth=None):

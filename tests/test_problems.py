@@ -8,7 +8,14 @@ import numpy as np
 import pytest
 
 import qrrt_circuits as qc
-from qrrt_circuits.world.problems import load_problem, narrow_passage, open_space, se2_gap, straight_line_dynamics
+from qrrt_circuits.world.problems import (
+    load_problem,
+    narrow_passage,
+    open_space,
+    se2_gap,
+    straight_line_dynamics,
+    winding_band,
+)
 
 
 def test_straight_line_motions_follow_the_segment():
@@ -233,7 +240,7 @@ def test_rigid_body_checks_are_counted():
 @pytest.mark.parametrize("dim", [2, 4, 6])
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_the_winding_band_is_open_only_along_its_legs(dim, seed):
-    problem = qc.world.problems.winding_band(dim, 0.1, seed)
+    problem = winding_band(dim, 0.1, seed)
     env, check = problem.env, problem.predicate
     start, goal = env.start, env.goal
     assert env.is_free(start) and env.is_free(goal)
@@ -251,7 +258,7 @@ def test_the_winding_band_is_open_only_along_its_legs(dim, seed):
 
 
 def test_winding_bands_differ_by_seed_and_repeat_by_seed():
-    first, again, other = (qc.world.problems.winding_band(2, 0.2, s) for s in (3, 3, 4))
+    first, again, other = (winding_band(2, 0.2, s) for s in (3, 3, 4))
     assert np.array_equal(first.env.boxes, again.env.boxes)
     assert not np.array_equal(first.env.boxes, other.env.boxes) or not np.array_equal(first.env.goal, other.env.goal)
 
@@ -261,7 +268,7 @@ def test_the_winding_band_is_solved_by_q_rrt_within_a_budget():
     and every tree edge passes the check again."""
     solved = 0
     for seed in range(5):
-        problem = qc.world.problems.winding_band(2, 0.2, seed)
+        problem = winding_band(2, 0.2, seed)
         planner = qc.QRRT(problem.env, backend=qc.StatevectorBackend(seed=seed), num_qubits=8, seed=seed,
                           goal_bias=0.05, search_policy=qc.Adaptive(), **problem.planner_options())
         result = planner.plan(goal=problem.goal, max_oracle_calls=20000)
@@ -275,4 +282,4 @@ def test_the_winding_band_is_solved_by_q_rrt_within_a_budget():
                                                     ({"dim": 2.5}, "dim")])
 def test_bad_winding_band_arguments_are_refused_by_name(arguments, message):
     with pytest.raises((TypeError, ValueError), match=message):
-        qc.world.problems.winding_band(**arguments)
+        winding_band(**arguments)

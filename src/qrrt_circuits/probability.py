@@ -79,6 +79,35 @@ def success_probability(num_items: int, num_marked: int, iterations: int) -> flo
     return good_probability(num_items, num_marked, _count(iterations, "iterations"))
 
 
+def expected_distinct_found(num_items: int, num_marked: int, iterations: int, workers: int) -> float:
+    """E[distinct marked entries measured] when p workers each measure one preparation after k
+    iterations of a shared database: m (1 - (1 - P(G) / m)^p).
+
+    After k iterations every marked entry is measured with probability P(G) / m (the proof of
+    Lemma 1); a given entry is missed by all p workers with probability (1 - P(G) / m)^p, and the
+    expectation sums over the m entries. For p = 1 it is P(G).
+
+    Args:
+        num_items: N, the database size (>= 1).
+        num_marked: m, the marked entries (0 .. N).
+        iterations: k, the Grover iterations (>= 0).
+        workers: p, the workers (>= 1).
+
+    Returns:
+        The expected number of distinct marked entries found (0 if m = 0).
+
+    Raises:
+        ValueError: N < 1, m outside [0, N], k < 0 or p < 1.
+        TypeError: A non-integer count.
+    """
+    num_items, num_marked = _marked(num_items, num_marked)
+    workers = _count(workers, "workers", 1)
+    if num_marked == 0:
+        return 0.0
+    found = good_probability(num_items, num_marked, _count(iterations, "iterations"))
+    return num_marked * (1.0 - (1.0 - found / num_marked) ** workers)
+
+
 def optimal_iterations(num_items: int, num_marked: int) -> int:
     """floor(pi / (4 theta)) with sin^2 theta = m/N, and 0 for m = 0 (paper Equation 1, DESIGN §2).
 
@@ -275,6 +304,7 @@ def expected_workers_with_errors(num_marked: int, true_marked: int, p_good: floa
 
 
 __all__ = [
+    "expected_distinct_found",
     "expected_workers_all_found",
     "expected_workers_with_errors",
     "harmonic",

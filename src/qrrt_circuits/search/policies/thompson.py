@@ -6,7 +6,7 @@ grows (most databases empty in a narrow passage, most entries reachable in open 
 that measures each database once, after k Grover iterations, with p workers sharing it (p = 1 for
 q-RRT), finds on average
 
-    D(k) = E_G[ m (1 - (1 - P_k(m) / m)^p) ]          (distinct verified entries per database)
+    D(k) = E_G[ m (1 - (1 - P_k(m) / m)^p) ]   (``probability.expected_distinct_found``)
 
 where P_k(m) = sin^2((2k + 1) theta), sin^2 theta = m / N (Eq. 1), and each worker measures a
 given marked entry with probability P_k(m) / m (the multinomial behind Lemma 1; for p = 1,
