@@ -70,7 +70,8 @@ def test_policies_including_parametric_ones():
     assert POLICIES.create("paper") == qc.PaperIterations()
     assert POLICIES.create("fixed:3") == qc.FixedIterations(3)
     assert isinstance(POLICIES.create("bbht"), qc.BBHT)
-    assert POLICIES.labels() == ("paper", "optimal", "bbht", "adaptive", "fixed:K", "fixed-point[:DELTA]", "estimated")
+    assert POLICIES.labels() == ("paper", "optimal", "bbht", "adaptive", "thompson", "fixed:K", "fixed-point[:DELTA]",
+                                "estimated")
     with pytest.raises(ValueError, match="policy fixed:K needs an integer K >= 0, got 'fixed:x'"):
         POLICIES.create("fixed:x")
     with pytest.raises(ValueError, match="unknown search policy 'fixed'"):

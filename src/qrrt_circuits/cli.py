@@ -190,7 +190,7 @@ PLANNER_SPECIFIC_OPTIONS: dict[str, tuple[str, Any]] = {
     "qubits": ("num_qubits", 8),
     "workers": ("workers", 8),
     "backend": ("backend", "aer"),
-    "policy": ("search_policy", "bbht"),
+    "policy": ("search_policy", None),  # None: the planner's own default
 }
 
 
@@ -227,7 +227,7 @@ def build_planner(args: argparse.Namespace, env: Environment, name: str | None =
     options |= problem.planner_options() if problem is not None else {
         "predicate": PREDICATES.create(args.predicate, env=env)}
     made: dict[str, Callable[[Any], Any]] = {"backend": lambda name: BACKENDS.create(name, seed=args.seed),
-                                             "policy": POLICIES.create}
+                                             "policy": lambda name: None if name is None else POLICIES.create(name)}
     for option, value in specific.items():  # each under the planner's keyword, backends and policies made
         options[PLANNER_SPECIFIC_OPTIONS[option][0]] = made[option](value) if option in made else value
     chosen = name or args.planner
@@ -266,8 +266,8 @@ def _print_comparison(result: PlanResult, peer: PlanResult) -> None:
         print(f"note: {metrics.rejected / metrics.verification_calls:.0%} of the measured candidates failed "
               f"verification. {share:.0%} of the databases' entries were reachable on average; a fixed "
               "iteration count tuned for a small share over-rotates past the peak of sin^2((2k+1)theta) "
-              "as the share grows, and BBHT's random counts miss often by design. --policy adaptive learns "
-              "the share from verified outcomes.")
+              "as the share grows, and BBHT's random counts miss often by design. --policy thompson or adaptive "
+              "learn the iteration count from verified outcomes.")
 
 
 def _per_node(value: float, result: PlanResult) -> str:
@@ -462,7 +462,8 @@ def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
                       help="workers (prrt, pqrrt, pqrrt-unshared; default 8)")
     plan.add_argument("--policy", "--schedule", dest="policy", type=_registered(POLICIES), default=argparse.SUPPRESS,
                       metavar="|".join(POLICIES.labels()),
-                      help=f"search policy (quantum planners, default bbht; paper: the paper's schedule; "
+                      help=f"search policy (quantum planners, default the planner's: thompson for qrrt, adaptive for "
+                           f"pqrrt; paper: the paper's schedule; "
                            f"--schedule is its old name): "
                            f"{POLICIES.help_text()}")
     plan.add_argument("--predicate", type=_registered(PREDICATES), default="exact",

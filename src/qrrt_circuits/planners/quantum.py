@@ -32,7 +32,8 @@ from ..reachability.dynamics import LinearTrackingDynamics
 from ..reachability.oracle_errors import OracleErrorModel
 from ..reachability.predicate import ReachabilityPredicate
 from ..search.backend import QuantumSearchBackend
-from ..search.policies.iteration import BBHT, IterationPolicy, PolicyState
+from ..search.policies.iteration import Adaptive, IterationPolicy, PolicyState
+from ..search.policies.thompson import ThompsonIterations
 from ..world.environment import Environment
 from ..world.spaces import StateSpace
 from .base import Planner
@@ -77,13 +78,11 @@ class PQRRT(Planner):
             the extra copies counted as ``duplicates``). False: each worker builds and searches its
             own database. Must be a ``bool``.
         search_policy: The ``IterationPolicy`` that decides how each worker searches a database:
-            ``BBHT()`` (the default: Boyer-Brassard-Hoyer-Tapp search for an unknown number of
-            reachable entries), ``PaperIterations()`` (the paper's schedule: 5 Grover iterations, 3
-            once the tree has more than 10 nodes), ``FixedIterations(k)``, ``KnownOptimal()`` (Eq. 1
-            with the true m), ``Adaptive()``, ``FixedPointAmplification()``, ``EstimatedOptimal()``
-            or any other ``IterationPolicy``. The default is the policy that ``qrrt reproduce
-            problems`` measured cheapest across problem families by its pre-stated rule; the
-            paper's fixed counts over-rotate where a large share of the database is reachable.
+            None (default) for ``default_search_policy()``, ``PaperIterations()`` (the paper's
+            schedule: 5 Grover iterations, 3 once the tree has more than 10 nodes),
+            ``FixedIterations(k)``, ``KnownOptimal()`` (Eq. 1 with the true m), ``BBHT()``,
+            ``Adaptive()``, ``ThompsonIterations()``, ``FixedPointAmplification()``,
+            ``EstimatedOptimal()`` or any other ``IterationPolicy``.
         annealing: An ``AnnealingSchedule`` for Quantum Database Annealing (Alg. 4: samples are
             drawn in distance bands around the tree that shrink with the temperature index h), or
             None (default) for uniform databases.
@@ -104,6 +103,13 @@ class PQRRT(Planner):
     """
 
     name = "PQRRT"
+
+    @staticmethod
+    def default_search_policy() -> IterationPolicy:
+        """Pq-RRT's default policy, ``Adaptive()``: the candidate with the smallest worst ratio to
+        the best candidate over the problem families of ``qrrt reproduce problems`` (its pre-stated
+        rule, on critical-path calls per solution; ``docs/results/problems.md``)."""
+        return Adaptive()
 
     def __init__(
         self,
@@ -142,9 +148,10 @@ class PQRRT(Planner):
             if search_policy is not None and search_policy is not iterations:
                 raise ValueError("give search_policy= or its deprecated alias iterations=, not both")
             policy = iterations
-        policy = BBHT() if policy is None else policy
+        policy = self.default_search_policy() if policy is None else policy
         check_instance(policy, "search_policy", IterationPolicy,
-                       "a search policy (PaperIterations(), FixedIterations(k), KnownOptimal(), BBHT(), Adaptive())")
+                       "a search policy (PaperIterations(), FixedIterations(k), KnownOptimal(), BBHT(), Adaptive(), "
+                       "ThompsonIterations())")
         if annealing is not None:
             check_instance(annealing, "annealing", AnnealingSchedule, "an AnnealingSchedule or None")
         candidates = NearestParents() if database is None else check_instance(
@@ -302,7 +309,8 @@ class QRRT(PQRRT):
         backend: The ``QuantumSearchBackend`` of the searches. Default: a new ``AerBackend()``.
         num_qubits: Qubits n per database (N = 2^n entries), 1 .. the backend's ``max_qubits``.
             Default 8.
-        search_policy: The ``IterationPolicy`` of the searches. Default: ``BBHT()``.
+        search_policy: The ``IterationPolicy`` of the searches, or None (default) for
+            ``default_search_policy()``.
         annealing: An ``AnnealingSchedule`` (Quantum Database Annealing), or None (default).
         database: ``NearestParents()`` (default) or ``LatticeCandidates(...)``, as for ``PQRRT``.
         iterations: Deprecated alias of ``search_policy``.
@@ -313,6 +321,13 @@ class QRRT(PQRRT):
     """
 
     name = "QRRT"
+
+    @staticmethod
+    def default_search_policy() -> IterationPolicy:
+        """q-RRT's default policy, ``ThompsonIterations()``: the candidate with the smallest worst
+        ratio to the best candidate over the problem families of ``qrrt reproduce problems`` (its
+        pre-stated rule, on calls per solution; ``docs/results/problems.md``)."""
+        return ThompsonIterations()
 
     def __init__(
         self,
