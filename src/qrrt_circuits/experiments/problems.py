@@ -429,8 +429,9 @@ def _paired_ratio(units: Sequence[tuple[str, dict[str, Record]]], counts: np.nda
     top = _statistic([unit[config] for _, unit in units if config in unit], quantity)
     bottom = _statistic([unit[reference] for _, unit in units if reference in unit], quantity)
     value = round(top / bottom, 4) if math.isfinite(top) and math.isfinite(bottom) and bottom > 0 else math.nan
-    with np.errstate(divide="ignore", invalid="ignore"):
-        resampled = _resampled(units, counts, config, quantity) / _resampled(units, counts, reference, quantity)
+    bottoms = _resampled(units, counts, reference, quantity)
+    with np.errstate(divide="ignore", invalid="ignore"):  # undefined where the reference solved none
+        resampled = np.where(np.isfinite(bottoms), _resampled(units, counts, config, quantity) / bottoms, np.nan)
     return value, rounded_interval(percentile_interval(resampled), 4)
 
 
