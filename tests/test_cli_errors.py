@@ -131,7 +131,7 @@ def test_planner_specific_options_take_their_defaults_where_they_apply(capsys):
     settings = dict(line.split(None, 1) for line in capsys.readouterr().out.splitlines()[1:12] if line.strip())
     assert settings["num_qubits"] == "8" and settings["workers"] == "8"
     assert settings["backend"].startswith("aer (method=statevector")
-    assert settings["search_policy"].startswith("bbht")
+    assert settings["search_policy"].startswith("adaptive")  # Pq-RRT's default_search_policy()
     assert main(["plan", "--planner", "prrt", "--max-nodes", "3"]) == 0
     assert "workers                  8" in capsys.readouterr().out
 
