@@ -299,11 +299,17 @@ class CorridorSensitivity(Experiment):
                 ax.plot([], [], "s", color=color, label=f"width {width}")
             for length, marker in markers.items():
                 ax.plot([], [], marker, color="gray", label=f"length {length}")
-            ax.set_xlim(0, right)
-            ax.set_ylim(0, top)
-            ax.set_title(f"q-RRT iterations: {iterations}")
-            ax.set_xlabel(f"RRT: channel nodes per {PAPER_TRIALS} runs")
-            ax.set_ylabel(f"q-RRT: channel nodes per {PAPER_TRIALS} runs")
-            ax.grid(alpha=0.3)
-            ax.legend(fontsize=7, loc="upper left")
+            pair_axes(ax, right, top, f"q-RRT iterations: {iterations}")
         return [save(fig, out_dir / "corridor_sensitivity.png")]
+
+
+def pair_axes(ax: Any, right: float, top: float, title: str) -> None:
+    """An (RRT, q-RRT) channel-node panel: limits, title, axis labels per ``PAPER_TRIALS`` runs, grid
+    and legend."""
+    ax.set_xlim(0, right)
+    ax.set_ylim(0, top)
+    ax.set_title(title)
+    ax.set_xlabel(f"RRT: channel nodes per {PAPER_TRIALS} runs")
+    ax.set_ylabel(f"q-RRT: channel nodes per {PAPER_TRIALS} runs")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="upper left")

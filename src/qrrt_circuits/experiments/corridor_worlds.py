@@ -61,6 +61,7 @@ from .corridor_sensitivity import (
     PAPER_TRIALS,
     PLANNERS,
     cell_id,
+    pair_axes,
     run_block,
 )
 from .figures import new_figure, save
@@ -275,13 +276,7 @@ class CorridorWorlds(Experiment):
                             mec="white", ms=7, lw=1.4, label=_label(shape, settings["centres"]))
             ax.plot([PAPER["RRT"]], [PAPER["QRRT"]], "*", color="gold", mec="black", ms=15, label="paper (14, 47)")
             ax.plot([0, max(top, right)], [0, max(top, right)], ":", color="gray", lw=1, label="q-RRT = RRT")
-            ax.set_xlim(0, right)
-            ax.set_ylim(0, top)
-            ax.set_title(f"q-RRT iterations: {level} ({summary['design']['draws']} draws)")
-            ax.set_xlabel(f"RRT: channel nodes per {PAPER_TRIALS} runs")
-            ax.set_ylabel(f"q-RRT: channel nodes per {PAPER_TRIALS} runs")
-            ax.grid(alpha=0.3)
-            ax.legend(fontsize=7, loc="upper left")
+            pair_axes(ax, right, top, f"q-RRT iterations: {level} ({summary['design']['draws']} draws)")
         return [save(fig, out_dir / "corridor_worlds.png")]
 
 
