@@ -63,8 +63,8 @@ def test_plan_command_writes_json_and_plot(tmp_path, capsys):
 @pytest.mark.parametrize("argv, message", [
     (["plan", "--schedule", "fixed:abc"], "fixed:K needs an integer"),
     (["plan", "--schedule", "magic"],
-     "unknown search policy 'magic'; choose one of paper, optimal, bbht, adaptive, thompson, fixed:K, fixed-point[:DELTA], "
-     "estimated"),
+     "unknown search policy 'magic'; choose one of paper, optimal, bbht, adaptive, thompson, fixed:K, "
+     "fixed-point[:DELTA], estimated"),
     (["plan", "--planner", "qrrt", "--backend", "statevector", "--qubits", "40"], "num_qubits = 40 is outside"),
 ])
 def test_plan_command_rejects_bad_input(argv, message, capsys):
