@@ -310,10 +310,10 @@ class Problems(Experiment):
             ax.grid(alpha=0.3, axis="y", which="both")
             for boundary in x[:-1] + 0.5:
                 ax.axvline(boundary, color="0.85", lw=0.8)
-        axes[0, 0].legend(ncol=5, fontsize=7.5, loc="upper center", bbox_to_anchor=(0.5, 1.32), frameon=False)
-        axes[0, 0].set_title(f"{settings['trials']} replicates x {len(settings['root_seeds'])} root seeds per family, "
-                             f"budget {settings['budget']} calls", fontsize=10, pad=48)
-        fig.tight_layout()
+        axes[0, 0].legend(ncol=7, fontsize=7.5, loc="lower center", bbox_to_anchor=(0.5, 1.02), frameon=False)
+        fig.suptitle(f"{settings['trials']} replicates x {len(settings['root_seeds'])} root seeds per family, "
+                     f"budget {settings['budget']} calls", fontsize=10)
+        fig.tight_layout(rect=(0.0, 0.0, 1.0, 0.97))
         return [save(fig, out_dir / "problems.png"), self._plot_policies(settings, summary, out_dir)]
 
     @staticmethod
@@ -349,8 +349,8 @@ class Problems(Experiment):
 def _colors(configs: Sequence[str]) -> dict[str, Any]:
     import matplotlib
 
-    cmap = matplotlib.colormaps["tab10"]
-    return {config: cmap(i % 10) for i, config in enumerate(configs)}
+    cmap = matplotlib.colormaps["tab10" if len(configs) <= 10 else "tab20"]
+    return {config: cmap(i % cmap.N) for i, config in enumerate(configs)}
 
 
 def _finite_or_nan(value: Any) -> float:
