@@ -79,7 +79,9 @@ def test_problem_files_build_their_family(tmp_path):
 
 @pytest.mark.parametrize(("fields", "message"), [
     ({"family": "labyrinth"},
-     r"\"family\" must be one of \['boxes', 'image', 'maze', 'narrow-passage', 'open-space', 'se2-gap'\]"),
+     r"\"family\" must be one of \['boxes', 'image', 'maze', 'narrow-passage', 'open-space', 'se2-gap', "
+     r"'winding-band'\]"),
+    ({"family": "winding-band", "width": 2.0}, "width"),
     ({"family": "narrow-passage", "dim": 9}, "dim must be an integer in"),
     ({"family": "narrow-passage", "width": 0}, "width must be a finite number"),
     ({"family": "narrow-passage", "depth": 1}, r"takes \['dim', 'width'\], not \['depth'\]"),

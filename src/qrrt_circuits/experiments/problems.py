@@ -76,7 +76,7 @@ from .planners import BACKEND_LABEL, make_planner
 
 FAMILIES = ("open-space", "maze", "narrow-passage-2d", "narrow-passage-4d", "narrow-passage-6d", "se2-gap",
             "winding-band-2d", "winding-band-4d", "winding-band-6d")
-QUICK_FAMILIES = ("open-space", "maze", "narrow-passage-2d", "se2-gap", "winding-band-2d")
+QUICK_FAMILIES = ("open-space", "maze", "se2-gap", "winding-band-2d")
 #: families that draw a new world per replicate (its seed is the replicate index)
 WORLD_FAMILIES = ("maze", "winding-band-2d", "winding-band-4d", "winding-band-6d")
 #: the winding band's width per dimension (module docstring)
