@@ -19,6 +19,9 @@ import numpy as np
 
 LEVEL = 0.95
 RESAMPLES = 2000
+#: fewer worlds than this give a range (min-max over single worlds), not a bootstrap interval: a
+#: percentile bootstrap over a handful of worlds covers well below its level
+MIN_BOOTSTRAP_WORLDS = 20
 
 
 def bootstrap_interval(trials: Sequence[Any], statistic: Callable[[list], float], seed: int,

@@ -29,7 +29,7 @@ from ..registry import PLANNERS, PREDICATES
 from ..search.policies.iteration import PaperIterations
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save, with_intervals
-from .intervals import bootstrap_interval, rounded_interval
+from .intervals import MIN_BOOTSTRAP_WORLDS, bootstrap_interval, rounded_interval
 from .worlds import world
 
 if TYPE_CHECKING:
@@ -63,7 +63,7 @@ def database_marks(num_qubits: int, seed: int) -> np.ndarray:
     return marks
 
 
-#: plan worlds of a full run (a percentile bootstrap over them gives the plan intervals)
+#: plan worlds of a full run (fewer than ``MIN_BOOTSTRAP_WORLDS``: the plan intervals are ranges over them)
 PLAN_WORLDS = 10
 
 
@@ -170,8 +170,7 @@ class Resources(Experiment):
                 "labels": ["classical times measured on the machine that ran the trials (RRT wall time / its "
                            "reachability tests; they move with its load and speed)",
                            "q-RRT plans on the exact statevector backend (same statistics as Aer)",
-                           f"plan intervals: 95 % percentile bootstrap over the {plan['worlds']} plan worlds "
-                           "(unit: worlds)",
+                           f"plan intervals (plan.interval): {plan['interval_kind']}",
                            f"fault-tolerant counts from {settings['ft_source']}"]}
 
     def _plan_summary(self, records: list[Record], settings: Settings, near: dict[str, dict[str, dict[str, Any]]],
@@ -218,13 +217,19 @@ class Resources(Experiment):
         def statistic(sample: list[int], key: str) -> Any:
             return derived(sample)[key]
 
-        intervals = {key: rounded_interval(bootstrap_interval(worlds, functools.partial(statistic, key=key),
-                                                              settings["seed"]), 9) for key in table}
+        if len(worlds) >= MIN_BOOTSTRAP_WORLDS:
+            intervals = {key: rounded_interval(bootstrap_interval(worlds, functools.partial(statistic, key=key),
+                                                                  settings["seed"]), 9) for key in table}
+            kind = f"95 % percentile bootstrap over {len(worlds)} worlds"
+        else:  # too few worlds for a bootstrap: the range of the single worlds' values
+            singles = [derived([w]) for w in worlds]
+            intervals = {key: rounded_interval((min(float(v[key]) for v in singles),
+                                                max(float(v[key]) for v in singles)), 9) for key in table}
+            kind = f"range over {len(worlds)} worlds (min-max of single worlds; fewer than {MIN_BOOTSTRAP_WORLDS})"
         table.update(num_qubits=n, lookup=lookup, fault_tolerant_call_s=call_ft, near_term_call_s=call_nt,
                      fault_tolerant_over_break_even=(call_ft / table["break_even_call_s"]
                                                      if table["break_even_call_s"] > 0 else math.inf))
-        return {"table": table, "interval_95": intervals, "worlds": len(worlds),
-                "interval_unit": f"worlds ({len(worlds)}; percentile bootstrap)"}
+        return {"table": table, "interval": intervals, "interval_kind": kind, "worlds": len(worlds)}
 
     def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
         """Gate counts per call (near term, fault tolerant), the time per call against the plans'
@@ -232,7 +237,7 @@ class Resources(Experiment):
         per plan."""
         fig, axes = new_figure(2, 2, (13, 9.6))
         plan = summary["plan"]["table"]
-        spans = summary["plan"]["interval_95"]
+        spans = summary["plan"]["interval"]
         ax = axes[0, 0]
         for synthesis, marker in zip(settings["syntheses"], "os", strict=False):
             for connectivity in settings["connectivities"]:
@@ -274,7 +279,8 @@ class Resources(Experiment):
                color=["tab:gray", "tab:blue", "tab:purple", "tab:orange"])
         ax.set_xticks(range(len(keys)), labels, fontsize=8)
         ax.set_yscale("log")
-        ax.set_ylabel(f"seconds per {settings['nodes']}-node plan (95 % interval)")
+        ax.set_ylabel(f"seconds per {settings['nodes']}-node plan ({summary['plan']['interval_kind'].split(' (')[0]})",
+                      fontsize=8)
         ax.set_title(f"paper_clutter plans, n = {plan['num_qubits']}, paper schedule", fontsize=10)
         ax.grid(alpha=0.3, axis="y", which="both")
         return [save(fig, out_dir / "resources.png")]
@@ -284,7 +290,7 @@ class Resources(Experiment):
                             spans: dict[str, list[float]]) -> None:
         """Seconds per oracle call (fault tolerant at ``toffoli_s`` a Toffoli; near term at the
         two-qubit depth, a lower bound) against n, and the break-even time per call of the n-qubit
-        plans with its 95 % interval; a second axis counts the seconds in classical reachability
+        plans with its interval (``plan.interval_kind``); a second axis counts the seconds in classical reachability
         tests of the measured time (the break-even's machine-independent unit)."""
         for lookup in settings["lookups"]:
             rows = sorted((r for r in records if r["part"] == "fault-tolerant" and r["lookup"] == lookup),
