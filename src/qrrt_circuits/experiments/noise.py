@@ -79,7 +79,7 @@ def _compiled(num_qubits: int, seed: int, iterations: int) -> QuantumCircuit:
 #: planning worlds of a full run, the unit of its planning intervals (over very few worlds a
 #: percentile bootstrap's 2.5 % and 97.5 % quantiles are the lowest and highest world's values, a
 #: min-max range; over 7 it is a bootstrap interval, a little narrow for so few worlds)
-PLANNING_WORLDS = 7
+PLANNING_WORLDS = 20
 
 
 class Noise(Experiment):
