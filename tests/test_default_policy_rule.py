@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from qrrt_circuits.experiments.problems import TIE_MARGIN, choose_by_worst_ratio, family_ratios
+from qrrt_circuits.experiments.default_policy import TIE_MARGIN, choose_by_worst_ratio, family_ratios
 
 ORDER = ["paper", "adaptive", "bbht"]
 

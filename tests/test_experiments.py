@@ -360,7 +360,7 @@ def _check_search_policies(summary, records):
 
 
 def _check_problems(summary, records):
-    from qrrt_circuits.experiments.problems import POLICY_CANDIDATES, TIE_MARGIN
+    from qrrt_circuits.experiments.default_policy import POLICY_CANDIDATES, TIE_MARGIN
 
     settings = summary["settings"]
     for r in records:

@@ -44,16 +44,10 @@ RRTConnect (and to the library's RRT): calls, critical-path calls (one device pe
 OMPL's one thread) and wall time, resampling the runs of both planners together (a run is one root
 seed and replicate, every planner's record of it).
 
-**The default search policy** is chosen from this experiment by a rule fixed before the run, for
-q-RRT on its calls per solution and for Pq-RRT on its critical-path calls per solution (its total
-calls reported beside): in each family, each candidate's cost per solution (all runs of all root
-seeds) over the smallest candidate's, its *family ratio* (a family no candidate solved is left out;
-a candidate that solved none there has ratio inf). The default is the candidate whose *worst*
-family ratio is smallest; candidates whose worst ratios lie within 5 % of the smallest are tied,
-and the tie goes to the lower geometric mean of the family ratios, then to the earlier candidate
-in ``POLICY_CANDIDATES``. The goal is a worst ratio of at most 1.5. The rule is also applied to
-each root seed's runs alone (``chosen_by_root_seed``) and to two-level bootstrap resamples
-(``chosen_share_in_resamples``); each family ratio has its interval over worlds and runs.
+**The default search policy** is chosen from this experiment by the rule of
+``experiments.default_policy``, fixed before the run: for q-RRT on its calls per solution, for
+Pq-RRT on its critical-path calls per solution (its total calls reported beside), the candidate
+with the smallest worst family ratio, also applied to each root seed alone and to resamples.
 """
 
 from __future__ import annotations
@@ -70,23 +64,19 @@ from ..planners.paths import path_length, shortcut
 from ..registry import POLICIES
 from ..world.problems import Problem, maze, narrow_passage, open_space, se2_gap, winding_band
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
+from .default_policy import POLICY_CANDIDATES, TIE_MARGIN, default_policies
+from .family_runs import family_counts, family_units, paired_ratio, resampled, statistic
 from .figures import dodge, new_figure, save, with_intervals
-from .intervals import RESAMPLES, binomial_interval, percentile_interval, rounded_interval, two_level_bootstrap_counts
+from .intervals import binomial_interval, percentile_interval, rounded_interval
 from .planners import BACKEND_LABEL, make_planner
 
 FAMILIES = ("open-space", "maze", "narrow-passage-2d", "narrow-passage-4d", "narrow-passage-6d", "se2-gap",
             "winding-band-2d", "winding-band-4d", "winding-band-6d")
 QUICK_FAMILIES = ("open-space", "maze", "se2-gap", "winding-band-2d")
-#: families that draw a new world per replicate (its seed is the replicate index)
-WORLD_FAMILIES = ("maze", "winding-band-2d", "winding-band-4d", "winding-band-6d")
 #: the winding band's width per dimension (module docstring)
 BAND_WIDTH = {2: 0.08, 4: 0.15, 6: 0.15}
 #: root seeds per run: ``--seed`` and the next ones
 ROOT_SEEDS, QUICK_ROOT_SEEDS = 3, 2
-#: the default-policy rule's tie margin: worst ratios within this factor of the smallest are tied
-TIE_MARGIN = 1.05
-#: bootstrap resamples of the default-policy rule (its stability)
-RULE_RESAMPLES = 400
 #: label -> (registry planner, search policy name or None, the extra options for a problem)
 LIBRARY_CONFIGS: dict[str, tuple[str, str | None, Callable[[Problem], dict[str, Any]]]] = {
     "RRT": ("rrt", None, lambda problem: {}),
@@ -102,15 +92,11 @@ LIBRARY_CONFIGS: dict[str, tuple[str, str | None, Callable[[Problem], dict[str, 
     "PQRRT thompson": ("pqrrt", "thompson", lambda problem: {}),
 }
 OMPL_CONFIGS = ("OMPL RRT", "OMPL RRTConnect")
-POLICY_CANDIDATES = ("paper", "adaptive", "bbht", "thompson")
 GOAL_BIAS = 0.05
 #: the narrow passage's hole: its share of the wall's cross-section, in every dimension
 HOLE_SHARE = 0.01
 #: OMPL's default range: this fraction of the space's largest extent (the bounds' diagonal)
 RANGE_FRACTION = 0.2
-#: the record column summed by each per-solution quantity
-QUANTITY_COLUMN = {"calls_per_solution": "oracle_calls", "critical_path_per_solution": "critical_path_calls",
-                   "classical_checks_per_solution": "classical_checks", "wall_time_per_solution_s": "wall_time_s"}
 #: the summary's ``ours`` (with the success rate) ...
 HEADLINE = ("calls_per_solution", "wall_time_per_solution_s")
 #: ... and its ``details``
@@ -239,7 +225,7 @@ class Problems(Experiment):
         for index, family in enumerate(settings["families"]):
             units = family_units(records, family)
             worlds[family] = len({world for world, _ in units})
-            counts = _counts(units, seed, index)
+            counts = family_counts(units, seed, index)
             ours[family], intervals[family], ratios[family], ratio_intervals[family] = {}, {}, {}, {}
             details[family], detail_intervals[family] = {}, {}
             for config in settings["configs"]:
@@ -248,9 +234,9 @@ class Problems(Experiment):
                 values = {"success_rate": round(solved / len(runs), 4) if runs else math.nan}
                 spans = {"success_rate": rounded_interval(binomial_interval(solved, len(runs)), 4)}
                 for quantity in (*HEADLINE, *DETAILS):
-                    values[quantity] = _rounded(_statistic(runs, quantity))
+                    values[quantity] = _rounded(statistic(runs, quantity))
                     spans[quantity] = rounded_interval(percentile_interval(
-                        _resampled(units, counts, config, quantity)), 4)
+                        resampled(units, counts, config, quantity)), 4)
                 ours[family][config] = {key: values[key] for key in ("success_rate", *HEADLINE)}
                 intervals[family][config] = {key: spans[key] for key in ("success_rate", *HEADLINE)}
                 details[family][config] = {key: values[key] for key in DETAILS}
@@ -262,13 +248,13 @@ class Problems(Experiment):
                                             ("critical_path_per_solution", "critical_path"),
                                             ("wall_time_per_solution_s", "wall_time")):
                         key = f"{short}_vs_{reference.replace(' ', '_')}"
-                        value, span = _paired_ratio(units, counts, config, reference, quantity)
+                        value, span = paired_ratio(units, counts, config, reference, quantity)
                         ratios[family].setdefault(config, {})[key] = value
                         ratio_intervals[family].setdefault(config, {})[key] = span
         return {"ours": ours, "paper": self.paper, "interval_95": intervals, "details": details,
                 "details_interval_95": detail_intervals, "ratios": ratios,
                 "ratios_interval_95": ratio_intervals, "worlds": worlds,
-                "default_policy": _default_policies(records, settings),
+                "default_policy": default_policies(records, settings),
                 "policy_candidates": list(POLICY_CANDIDATES), "tie_margin": TIE_MARGIN,
                 "note": "per family and planner: success rate within the budget; calls, critical-path calls, "
                         "classical checks and wall time per solution (all runs' totals over the solved runs: the "
@@ -360,210 +346,6 @@ def _finite_or_nan(value: Any) -> float:
 
 def _rounded(value: float) -> float:
     return round(value, 4) if math.isfinite(value) else value
-
-
-def _statistic(runs: Sequence[Record], quantity: str) -> float:
-    """One quantity of ``HEADLINE`` or ``DETAILS`` over runs (module docstring); inf for a cost per solution
-    without a solved run, NaN for a path length without one."""
-    solved = [r for r in runs if int(r["reached"])]
-    if quantity.startswith("path_length"):
-        return float(np.mean([float(r[quantity]) for r in solved])) if solved else math.nan
-    total = float(sum(float(r[QUANTITY_COLUMN[quantity]]) for r in runs))
-    return total / len(solved) if solved else math.inf
-
-
-def family_units(records: Sequence[Record], family: str) -> list[tuple[str, dict[str, Record]]]:
-    """The runs of one family as ``(world, {config: record})``, one per root seed and replicate.
-
-    A run's world is its replicate for ``WORLD_FAMILIES`` (the replicate seeds the world) and the
-    run itself otherwise (one world: every run its own group of the two-level bootstrap).
-    """
-    units: dict[tuple[int, int], dict[str, Record]] = {}
-    for record in records:
-        if record["family"] == family:
-            units.setdefault((int(record["root_seed"]), int(record["replicate"])), {})[record["config"]] = record
-    return [(f"world {replicate}" if family in WORLD_FAMILIES else f"run {root}-{replicate}", unit)
-            for (root, replicate), unit in sorted(units.items())]
-
-
-def _counts(units: Sequence[tuple[str, dict[str, Record]]], seed: int, family_index: int,
-            resamples: int = RESAMPLES) -> np.ndarray:
-    """The two-level bootstrap counts of a family's runs (``intervals.two_level_bootstrap_counts``),
-    shared by all its planners so that their ratios are paired."""
-    sizes = [sum(1 for w, _ in units if w == world) for world in dict.fromkeys(w for w, _ in units)]
-    if not sizes:
-        return np.zeros((resamples, 0), dtype=np.int64)
-    return two_level_bootstrap_counts(sizes, seed + 7919 * family_index, resamples)
-
-
-def _column(units: Sequence[tuple[str, dict[str, Record]]], config: str, key: str) -> np.ndarray:
-    """One record field of ``config`` per run (0 where the run lacks the planner or the value)."""
-    values = []
-    for _, unit in units:
-        value = float(unit[config][key]) if config in unit else 0.0
-        values.append(value if math.isfinite(value) else 0.0)
-    return np.array(values)
-
-
-def _resampled(units: Sequence[tuple[str, dict[str, Record]]], counts: np.ndarray, config: str,
-               quantity: str) -> np.ndarray:
-    """``_statistic`` of ``config``'s runs in every resample of ``counts`` (inf for a cost, NaN for
-    a path length, where a resample has no solved run)."""
-    if counts.shape[1] == 0:
-        return np.full(counts.shape[0], np.nan)
-    reached = _column(units, config, "reached")
-    solved = counts @ reached
-    if quantity.startswith("path_length"):
-        top = counts @ (_column(units, config, quantity) * reached)
-    else:
-        top = counts @ _column(units, config, QUANTITY_COLUMN[quantity])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(solved > 0, top / np.where(solved > 0, solved, 1),
-                        np.nan if quantity.startswith("path_length") else np.inf)
-
-
-def _paired_ratio(units: Sequence[tuple[str, dict[str, Record]]], counts: np.ndarray, config: str, reference: str,
-                  quantity: str) -> tuple[float, list[float]]:
-    """The ratio of ``quantity`` of ``config`` to that of ``reference`` and its two-level interval
-    (the same resampled runs for both planners)."""
-    top = _statistic([unit[config] for _, unit in units if config in unit], quantity)
-    bottom = _statistic([unit[reference] for _, unit in units if reference in unit], quantity)
-    value = round(top / bottom, 4) if math.isfinite(top) and math.isfinite(bottom) and bottom > 0 else math.nan
-    bottoms = _resampled(units, counts, reference, quantity)
-    with np.errstate(divide="ignore", invalid="ignore"):  # undefined where the reference solved none
-        resampled = np.where(np.isfinite(bottoms), _resampled(units, counts, config, quantity) / bottoms, np.nan)
-    return value, rounded_interval(percentile_interval(resampled), 4)
-
-
-def family_ratios(costs: dict[str, dict[str, float]]) -> dict[str, dict[str, float]]:
-    """Each candidate's cost over the smallest candidate's, per family (the rule's family ratio).
-
-    Args:
-        costs: Family -> candidate -> cost per solution (inf where the candidate solved none).
-
-    Returns:
-        Candidate -> family -> ratio; families where no candidate solved are left out, a candidate
-        that solved none where another did has ratio inf.
-    """
-    relative: dict[str, dict[str, float]] = {}
-    for family, by_candidate in costs.items():
-        best = min(by_candidate.values(), default=math.inf)
-        if not math.isfinite(best) or best <= 0:
-            continue
-        for candidate, cost in by_candidate.items():
-            relative.setdefault(candidate, {})[family] = cost / best if math.isfinite(cost) else math.inf
-    return relative
-
-
-def choose_by_worst_ratio(relative: dict[str, dict[str, float]], order: Sequence[str],
-                          margin: float = TIE_MARGIN) -> str | None:
-    """The default-policy rule of the module docstring on family ratios.
-
-    Args:
-        relative: Candidate -> family -> ratio (``family_ratios``).
-        order: The candidates in their tie-breaking order (earlier wins a full tie).
-        margin: Worst ratios within this factor of the smallest are tied (>= 1).
-
-    Returns:
-        The chosen candidate, or None if no candidate has a family ratio.
-    """
-    worst = {c: max(relative[c].values()) for c in order if relative.get(c)}
-    if not worst:
-        return None
-    smallest = min(worst.values())
-    tied = [c for c in order if c in worst and worst[c] <= smallest * margin]
-    return min(tied, key=lambda c: (_geometric_mean(relative[c].values()), order.index(c)))
-
-
-def _geometric_mean(values: Any) -> float:
-    values = list(values)
-    if not values:
-        return math.nan
-    return math.inf if not all(math.isfinite(v) for v in values) else float(np.exp(np.mean(np.log(values))))
-
-
-def _candidate_costs(records: Sequence[Record], families: Sequence[str], configs: dict[str, str],
-                     quantity: str) -> dict[str, dict[str, float]]:
-    costs: dict[str, dict[str, float]] = {}
-    for family in families:
-        for candidate, config in configs.items():
-            runs = [r for r in records if r["family"] == family and r["config"] == config]
-            if runs:
-                costs.setdefault(family, {})[candidate] = _statistic(runs, quantity)
-    return costs
-
-
-def choose_default_policy(records: Sequence[Record], settings: Settings, planner: str, quantity: str,
-                          resamples: int = RULE_RESAMPLES) -> dict[str, Any]:
-    """The default search policy of ``planner`` by the rule of the module docstring.
-
-    Args:
-        records: The experiment's records.
-        settings: Its settings (families, configs, root seeds, seed).
-        planner: ``"QRRT"`` or ``"PQRRT"`` (its configs ``f"{planner} {policy}"``).
-        quantity: ``"calls_per_solution"`` or ``"critical_path_per_solution"``.
-        resamples: Two-level bootstrap resamples for the intervals and the rule's stability.
-
-    Returns:
-        ``{"rule", "quantity", "relative_cost": {policy: {family: ratio}}, "relative_cost_interval_95",
-        "worst": {policy: worst ratio}, "geometric_mean", "chosen", "chosen_by_root_seed",
-        "chosen_share_in_resamples", "goal_met"}``.
-    """
-    configs = {c: f"{planner} {c}" for c in POLICY_CANDIDATES if f"{planner} {c}" in settings["configs"]}
-    families, seed = settings["families"], settings["seed"]
-    relative = family_ratios(_candidate_costs(records, families, configs, quantity))
-    order = list(configs)
-    chosen = choose_by_worst_ratio(relative, order)
-    by_root = {str(root): choose_by_worst_ratio(family_ratios(_candidate_costs(
-        [r for r in records if int(r["root_seed"]) == int(root)], families, configs, quantity)), order)
-        for root in settings["root_seeds"]}
-    spans: dict[str, dict[str, list[float]]] = {c: {} for c in configs}
-    resampled_costs: dict[str, np.ndarray] = {}  # family -> (resamples, candidates)
-    for index, family in enumerate(families):
-        units = family_units(records, family)
-        if not units:
-            continue
-        counts = _counts(units, seed, index, resamples)
-        costs = np.stack([_resampled(units, counts, config, quantity) for config in configs.values()], axis=1)
-        resampled_costs[family] = costs
-        best = costs.min(axis=1)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratios = np.where(np.isfinite(best)[:, None] & (best[:, None] > 0), costs / best[:, None], np.nan)
-        for column, candidate in enumerate(configs):
-            if family in relative.get(candidate, {}):  # inf (solved none in a resample) kept, NaN left out
-                kept = ratios[~np.isnan(ratios[:, column]), column]
-                spans[candidate][family] = ([round(float(np.quantile(kept, 0.025, method="lower")), 4),
-                                             round(float(np.quantile(kept, 0.975, method="higher")), 4)]
-                                            if kept.size else [math.nan, math.nan])
-    shares = dict.fromkeys(configs, 0)
-    for row in range(resamples):
-        picked = choose_by_worst_ratio(family_ratios(
-            {family: dict(zip(configs, map(float, costs[row]), strict=True))
-             for family, costs in resampled_costs.items()}), order)
-        if picked is not None:
-            shares[picked] += 1
-    worst = {c: _rounded(max(v.values())) for c, v in relative.items() if v}
-    return {"rule": "per family, each candidate's cost per solution over the smallest candidate's; the candidate "
-                    "with the smallest worst family ratio wins; worst ratios within 5 % are tied and go to the "
-                    "lower geometric mean, then to the earlier candidate",
-            "quantity": quantity,
-            "relative_cost": {c: {f: _rounded(v) for f, v in fam.items()} for c, fam in relative.items()},
-            "relative_cost_interval_95": spans, "worst": worst,
-            "geometric_mean": {c: _rounded(_geometric_mean(v.values())) for c, v in relative.items()},
-            "chosen": chosen, "chosen_by_root_seed": by_root,
-            "chosen_share_in_resamples": {c: round(n / resamples, 4) for c, n in shares.items()},
-            "goal_met": bool(chosen is not None and worst[chosen] <= 1.5)}
-
-
-def _default_policies(records: Sequence[Record], settings: Settings) -> dict[str, Any]:
-    """The rule for q-RRT (calls) and Pq-RRT (critical path; its total calls beside)."""
-    out: dict[str, Any] = {}
-    for key, planner, quantity in (("QRRT", "QRRT", "calls_per_solution"),
-                                   ("PQRRT", "PQRRT", "critical_path_per_solution"),
-                                   ("PQRRT_total_calls", "PQRRT", "calls_per_solution")):
-        if any(f"{planner} {c}" in settings["configs"] for c in POLICY_CANDIDATES):
-            out[key] = choose_default_policy(records, settings, planner, quantity)
-    return out
 
 
 def _evaluations(problem: Problem) -> int:
