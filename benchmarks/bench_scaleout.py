@@ -98,7 +98,7 @@ def warm_throughput(experiment: str, jobs: int, repeats: int) -> dict:
     have already run 4 trials (imports, world, simulators warm); serial runs them in this process."""
     from concurrent.futures import as_completed
 
-    from qrrt_circuits._support.execution import get_executor
+    from qrrt_circuits.execution import get_executor
     from qrrt_circuits.experiments import EXPERIMENTS
     from qrrt_circuits.experiments.runner import execute_trial
 

@@ -67,7 +67,6 @@ templates_path = ["_templates"]
 exclude_patterns = [
     "_build",
     "**/.ipynb_checkpoints",
-    "DESIGN.md",  # included by design.md
     "results/_generated",  # included by the results pages
 ]
 include_patterns = ["**"]

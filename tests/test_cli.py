@@ -49,7 +49,7 @@ def test_plan_command_writes_json_and_plot(tmp_path, capsys):
     import json
 
     out_json, out_png = tmp_path / "r.json", tmp_path / "t.png"
-    assert main(["plan", "--planner", "qrrt", "--backend", "statevector", "--schedule", "adaptive",
+    assert main(["plan", "--planner", "qrrt", "--backend", "statevector", "--policy", "adaptive",
                  "--max-nodes", "15", "--seed", "2", "--json", str(out_json), "--plot", str(out_png)]) == 0
     out = capsys.readouterr().out
     assert "oracle_calls" in out and "classical lookup" in out
@@ -61,8 +61,8 @@ def test_plan_command_writes_json_and_plot(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["plan", "--schedule", "fixed:abc"], "fixed:K needs an integer"),
-    (["plan", "--schedule", "magic"],
+    (["plan", "--policy", "fixed:abc"], "fixed:K needs an integer"),
+    (["plan", "--policy", "magic"],
      "unknown search policy 'magic'; choose one of paper, optimal, bbht, adaptive, thompson, fixed:K, "
      "fixed-point[:DELTA], estimated"),
     (["plan", "--planner", "qrrt", "--backend", "statevector", "--qubits", "40"], "num_qubits = 40 is outside"),

@@ -44,7 +44,7 @@ CASES = [
     (["reproduce", "lemmas", "--executor", "process", "--jobs", "100000"], "jobs must be an integer in [1, "),
     (["plan", "--planner", "rrt", "--qubits", "30"], "--qubits does not apply to --planner rrt"),
     (["plan", "--planner", "rrt", "--backend", "statevector"], "--backend does not apply to --planner rrt"),
-    (["plan", "--planner", "prrt", "--policy", "bbht"], "--policy (--schedule) does not apply to --planner prrt"),
+    (["plan", "--planner", "prrt", "--policy", "bbht"], "--policy does not apply to --planner prrt"),
     (["plan", "--planner", "qrrt", "--workers", "4"], "--workers does not apply to --planner qrrt"),
     (["plan", "--planner", "rrt", "--max-rounds", "10000000000000", "--stall-rounds", "10000000000000"],
      "max_rounds = 10000000000000: this plan could need about"),
@@ -156,10 +156,10 @@ def test_a_failed_plot_write_is_named_and_the_json_is_still_written(tmp_path):
     assert json.loads((tmp_path / "tree.json").read_text())["status"] == "max_nodes"
 
 
-def test_schedule_is_named_with_policy_when_refused():
-    run = subprocess.run([sys.executable, "-m", "qrrt_circuits.cli", "plan", "--planner", "rrt", "--schedule", "bbht"],
+def test_the_old_schedule_option_is_gone():
+    run = subprocess.run([sys.executable, "-m", "qrrt_circuits.cli", "plan", "--planner", "qrrt", "--schedule", "bbht"],
                          capture_output=True, text=True, timeout=120)
-    assert run.returncode == 2 and "--policy (--schedule) does not apply to --planner rrt" in run.stderr
+    assert run.returncode == 2 and "unrecognized arguments: --schedule bbht" in run.stderr
 
 
 def test_a_symbolic_link_loop_as_output_is_refused_in_one_line(tmp_path):

@@ -7,7 +7,7 @@ import psutil
 import pytest
 from summaries import results_of
 
-from qrrt_circuits._support.execution import get_executor
+from qrrt_circuits.execution import get_executor
 from qrrt_circuits.experiments import read_records, run_experiment
 from qrrt_circuits.experiments.base import TIMING_SUFFIX
 
@@ -22,7 +22,7 @@ def dask_client(tmp_path_factory):
     scratch = tmp_path_factory.mktemp("dask")
     import dask
 
-    from qrrt_circuits._support.execution import NO_DASHBOARD
+    from qrrt_circuits.execution import NO_DASHBOARD
 
     # the scheduler, too, keeps its scratch space (and lock files) under "temporary-directory"
     with dask.config.set({"temporary-directory": str(scratch)}), \
@@ -97,7 +97,7 @@ def test_killed_process_pool_worker_is_replaced(tmp_path):
                 killed.append(process.pid)
                 return
 
-    from qrrt_circuits._support.execution import WorkerPool
+    from qrrt_circuits.execution import WorkerPool
 
     with WorkerPool("process", jobs=2) as pool:
         assert pool.executor is not None  # started before the sweep: every trial goes to a worker
@@ -135,7 +135,7 @@ def _is_warm(executor) -> bool:
 
 
 def test_one_worker_pool_serves_several_sweeps_and_starts_only_when_needed(tmp_path):
-    from qrrt_circuits._support.execution import WorkerPool
+    from qrrt_circuits.execution import WorkerPool
 
     serial = run_experiment("oracle-efficiency", out=tmp_path / "serial", quick=True, trials=2, progress=False)
     with WorkerPool("process", jobs=1) as pool:
@@ -215,7 +215,7 @@ def test_client_runs_trials_while_a_new_pool_starts_and_each_trial_runs_once(tmp
     trial is recorded exactly once, with the records serial execution gives."""
     import functools
 
-    from qrrt_circuits._support.execution import WorkerPool
+    from qrrt_circuits.execution import WorkerPool
     from qrrt_circuits.experiments import runner
 
     ran_here = []
@@ -247,7 +247,7 @@ def test_reproducing_several_experiments_makes_each_summary_while_the_next_trial
     the background thread, not by the thread that runs the next experiment's trials."""
     import threading
 
-    from qrrt_circuits._support.execution import WorkerPool
+    from qrrt_circuits.execution import WorkerPool
     from qrrt_circuits.experiments import EXPERIMENTS
     from qrrt_circuits.experiments.runner import run_experiments
 
@@ -284,7 +284,7 @@ def test_reproducing_several_experiments_makes_each_summary_while_the_next_trial
 
 def test_local_workers_are_limited_per_core():
     """100 000 local workers were accepted (each a Python process with Qiskit, Aer and numba)."""
-    from qrrt_circuits._support.execution import JOBS_PER_CORE, check_executor_args, max_local_jobs
+    from qrrt_circuits.execution import JOBS_PER_CORE, check_executor_args, max_local_jobs
 
     limit = max_local_jobs()
     assert limit == JOBS_PER_CORE * (os.cpu_count() or 1)
@@ -293,16 +293,3 @@ def test_local_workers_are_limited_per_core():
         check_executor_args("process", limit + 1, None)
     assert check_executor_args("serial", limit + 1, None) == limit + 1  # unused by the serial executor
 
-
-def test_the_public_module_gives_the_executors_without_a_warning():
-    import importlib
-    import sys
-    import warnings
-
-    from qrrt_circuits._support import execution as implementation
-
-    sys.modules.pop("qrrt_circuits.execution", None)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        public = importlib.import_module("qrrt_circuits.execution")
-    assert public.WorkerPool is implementation.WorkerPool and public.get_executor is implementation.get_executor

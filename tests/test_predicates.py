@@ -97,25 +97,13 @@ def test_builtin_predicates_describe_themselves(clutter):
         qc.LinearTrackingDynamics.paper().describe()
     sampled = qc.TimeSampledCheck(clutter, time_samples=30)
     assert sampled.describe()["sound"] is False and sampled.describe()["time_samples"] == 30
-    # the deprecated spelling returns the same kind of object
-    with pytest.warns(DeprecationWarning, match="TimeSampledCheck"):
-        alias = qc.ExactCheck(clutter, check="time_samples", time_samples=30)
-    assert isinstance(alias, qc.TimeSampledCheck) and isinstance(alias, qc.ReachabilityPredicate)
-    rng = np.random.default_rng(1)
-    parents, children = clutter.sample_free(200, rng), clutter.sample_uniform(200, rng)
-    assert np.array_equal(alias.reachable(parents, children), sampled.reachable(parents, children))
+    assert isinstance(sampled, qc.ReachabilityPredicate)
 
 
 def test_planner_records_the_dynamics_its_predicate_follows(clutter):
     dynamics = qc.LinearTrackingDynamics(np.diag([-1.0, -2.0]), np.eye(2), np.zeros((2, 2)))
     result = qc.RRT(clutter, dynamics=dynamics, seed=0).plan(max_nodes=3)
     assert plan_dynamics(result).describe() == dynamics.describe()
-    # oracle= is a deprecated alias of predicate=
-    oracle = qc.ExactCheck(clutter)
-    with pytest.warns(DeprecationWarning, match="use predicate="):
-        planner = qc.RRT(clutter, oracle=oracle, seed=0)
-    with pytest.warns(DeprecationWarning, match="Planner.predicate"):
-        assert planner.predicate is oracle and planner.oracle is oracle
 
 
 class NoName:
@@ -133,9 +121,6 @@ def test_bad_predicates_are_refused_with_the_reason(clutter):
         qc.RRT(clutter, predicate=StraightLine(env3))
     with pytest.raises(ValueError, match="give dynamics= or predicate=, not both"):
         qc.RRT(clutter, predicate=StraightLine(clutter), dynamics=qc.LinearTrackingDynamics.paper())
-    with pytest.raises(ValueError, match="give predicate= or its deprecated alias oracle=, not both"), \
-            pytest.warns(DeprecationWarning):
-        qc.RRT(clutter, predicate=StraightLine(clutter), oracle=qc.ExactCheck(clutter))
 
 
 @pytest.mark.parametrize("time_samples", [7, 30])

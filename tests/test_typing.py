@@ -22,7 +22,7 @@ import qrrt_circuits
 
 #: public modules documented beyond ``qrrt_circuits.__all__`` (``EXTRA_MODULES`` in docs/conf.py)
 #: and the experiments' entry points
-EXTRA_MODULES = ("qrrt_circuits.plotting", "qrrt_circuits._support.execution", "qrrt_circuits.experiments")
+EXTRA_MODULES = ("qrrt_circuits.plotting", "qrrt_circuits.execution", "qrrt_circuits.experiments")
 
 
 def _ours(obj: object) -> bool:

@@ -94,23 +94,8 @@ _WHERE = {
     "OccupancyGrid": ".world.image",
 }
 
-#: deprecated name -> its replacement (a name of ``_WHERE``)
-_DEPRECATED = {
-    "SearchPolicy": "IterationPolicy",
-    "PaperSchedule": "PaperIterations",
-    "ReachabilityOracle": "ExactCheck",
-}
-
-
 def __getattr__(name: str) -> Any:
-    """A public name, imported on first use (``_WHERE``) and cached in this module; deprecated
-    names (they warn); ``__version__``."""
-    if name in _DEPRECATED:
-        from ._support.deprecation import warn_deprecated
-
-        new = _DEPRECATED[name]
-        warn_deprecated(f"qrrt_circuits.{name}", f"qrrt_circuits.{new}")
-        return globals()[new] if new in globals() else __getattr__(new)
+    """A public name, imported on first use (``_WHERE``) and cached in this module; ``__version__``."""
     if name == "__version__":
         value: Any = _version()
     elif name in _WHERE:

@@ -209,8 +209,7 @@ def _planner_specific(args: argparse.Namespace) -> dict[str, Any]:
             chosen[option] = default if value is None else value
         elif value is not None:
             takers = [name for name in PLANNERS.names() if keyword in PLANNERS.resolve(name).options()]
-            shown = "--policy (--schedule)" if option == "policy" else f"--{option}"
-            raise ValueError(f"{shown} does not apply to --planner {args.planner} (it applies to "
+            raise ValueError(f"--{option} does not apply to --planner {args.planner} (it applies to "
                              f"{', '.join(takers)}); leave it out")
     return chosen
 
@@ -367,7 +366,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 # ----------------------------------------------------------------------------------------- reproduce
 def cmd_reproduce(args: argparse.Namespace) -> int:
-    from ._support.execution import WorkerPool
+    from .execution import WorkerPool
     from .experiments import EXPERIMENTS
     from .experiments.runner import check_experiment_arguments, run_experiments
 
@@ -460,12 +459,10 @@ def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
                       help="database of 2^qubits (quantum planners; default 8)")
     plan.add_argument("--workers", type=_positive_int, default=argparse.SUPPRESS,
                       help="workers (prrt, pqrrt, pqrrt-unshared; default 8)")
-    plan.add_argument("--policy", "--schedule", dest="policy", type=_registered(POLICIES), default=argparse.SUPPRESS,
+    plan.add_argument("--policy", type=_registered(POLICIES), default=argparse.SUPPRESS,
                       metavar="|".join(POLICIES.labels()),
                       help=f"search policy (quantum planners, default the planner's: thompson for qrrt, adaptive for "
-                           f"pqrrt; paper: the paper's schedule; "
-                           f"--schedule is its old name): "
-                           f"{POLICIES.help_text()}")
+                           f"pqrrt; paper: the paper's schedule): {POLICIES.help_text()}")
     plan.add_argument("--predicate", type=_registered(PREDICATES), default="exact",
                       metavar="|".join(PREDICATES.labels()), help=f"reachability check: {PREDICATES.help_text()}")
     plan.add_argument("--goal-bias", type=float, default=0.0, help="probability of sampling the goal, in [0, 1)")

@@ -19,7 +19,7 @@ from typing import Any, SupportsFloat
 import numpy as np
 
 from .. import probability as pr
-from ..reachability.exact import OracleErrorModel
+from ..reachability.oracle_errors import OracleErrorModel
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save, with_intervals
 from .intervals import binomial_interval, rounded_interval

@@ -37,7 +37,7 @@ from .base import Experiment, Record, Settings, Summary, Trial
 from .records import RecordSchema, RecordWriter, check_records_header, read_records
 
 if TYPE_CHECKING:
-    from .._support.execution import WorkerPool
+    from ..execution import WorkerPool
 
 __all__ = ["check_experiment_arguments", "execute_trial", "read_records", "run_experiment", "run_experiments"]
 
@@ -145,7 +145,7 @@ def _started_executor(pool: WorkerPool) -> Executor:
 def _check_arguments(name: str, trials: int | None, seed: int, executor: str | Executor | WorkerPool | None,
                      jobs: int | None, scheduler: str | None, predicate: str) -> str | None:
     """Refuse bad arguments before any work; returns the executor kind (None for an object)."""
-    from .._support.execution import check_executor_args
+    from ..execution import check_executor_args
     from ..registry import PREDICATES
     from .catalog import EXPERIMENTS
 
@@ -264,7 +264,7 @@ def _execute(kind: str | None, executor: str | Executor | WorkerPool | None, nam
              on_restart: Callable[[int], None] | None) -> None:
     """Run ``todo`` serially, on a given executor or ``WorkerPool``, or on a pool built here; a
     pool whose executor breaks is renewed and the unfinished trials resubmitted."""
-    from .._support.execution import WorkerPool
+    from ..execution import WorkerPool
 
     if not todo:
         return
@@ -344,7 +344,7 @@ def run_experiment(
     """Run (or resume) experiment ``name`` into ``out/name``; returns the summary.
 
     ``executor``: ``"serial"`` (default), ``"process"``, ``"dask"`` (built here with ``jobs`` and
-    ``scheduler``, see ``qrrt_circuits._support.execution``), an open ``qrrt_circuits._support.execution.WorkerPool``
+    ``scheduler``, see ``qrrt_circuits.execution``), an open ``qrrt_circuits.execution.WorkerPool``
     (kept across several experiments, renewed if it breaks) or any ``concurrent.futures.Executor``.
     Records are written as trials finish, in whatever order. If a local process pool breaks (a
     worker died), a new pool is started (a given ``WorkerPool`` is renewed) and the unfinished trials resubmitted, up to

@@ -28,7 +28,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._support.deprecation import warn_deprecated
 from .._support.memory import MemoryEstimate, OutOfMemory, PlanSize
 from .._support.randomness import RandomStreams, Stream
 from .._support.validation import check_float, check_instance, check_real_array, check_seed
@@ -64,15 +63,6 @@ if TYPE_CHECKING:
 __all__ = ["Metrics", "PlanResult", "Planner", "RunState"]
 
 
-def __getattr__(name: str) -> Any:
-    """Deprecated names of this module."""
-    if name == "DEFAULT_MAX_ROUNDS":
-        warn_deprecated("qrrt_circuits.planners.base.DEFAULT_MAX_ROUNDS",
-                        "qrrt_circuits.planners.termination.DEFAULT_MAX_ROUNDS")
-        return _termination.DEFAULT_MAX_ROUNDS
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
 #: the members a state space must have (``world.spaces.StateSpace``)
 SPACE_MEMBERS = ("dim", "distance", "interpolate", "nearest", "check_bounds", "describe")
 
@@ -95,15 +85,9 @@ def check_space(space: Any, env: Environment) -> StateSpace:
 
 
 def resolve_predicate(env: Environment, predicate: ReachabilityPredicate | None,
-                      oracle: ReachabilityPredicate | None, dynamics: LinearTrackingDynamics | None,
-                      resolution: float) -> ReachabilityPredicate:
-    """The planner's predicate: ``predicate=`` (or its deprecated alias ``oracle=``), else the sound
-    ``ExactCheck`` built with ``dynamics`` and ``resolution``."""
-    if oracle is not None:
-        warn_deprecated("the planners' oracle= argument", "predicate=")
-        if predicate is not None and predicate is not oracle:
-            raise ValueError("give predicate= or its deprecated alias oracle=, not both")
-        predicate = oracle
+                      dynamics: LinearTrackingDynamics | None, resolution: float) -> ReachabilityPredicate:
+    """The planner's predicate: ``predicate=``, else the sound ``ExactCheck`` built with
+    ``dynamics`` and ``resolution``."""
     if predicate is None:
         if dynamics is not None:
             check_instance(dynamics, "dynamics", LinearTrackingDynamics, "a LinearTrackingDynamics")
@@ -164,7 +148,6 @@ class Planner:
             the workers' tasks (a ``ParallelRRT`` worker's reachability test, a ``PQRRT``
             database's search), or None (default) to run them in-process, with the same results.
             Not pickled with the planner.
-        oracle: Deprecated alias of ``predicate``.
 
     Raises:
         TypeError: ``env`` not an ``Environment``, a non-integer ``seed``, a non-real
@@ -172,8 +155,8 @@ class Planner:
             or a ``predicate`` that lacks the members of the ``ReachabilityPredicate`` protocol.
         ValueError: ``goal_bias`` outside [0, 1), a ``max_extension`` that is not finite and > 0, a
             negative ``seed``, a dimension mismatch
-            between ``env`` and ``predicate`` or ``dynamics``, both ``predicate`` and ``oracle``
-            (or both ``predicate`` and ``dynamics``) given, or, for the default predicate, a
+            between ``env`` and ``predicate`` or ``dynamics``, both ``predicate`` and ``dynamics``
+            given, or, for the default predicate, a
             ``resolution`` that is not finite and > 0 or one too fine for the workspace
             (``ExactCheck``).
     """
@@ -192,12 +175,11 @@ class Planner:
         space: StateSpace | None = None,
         resolution: float = 0.01,
         seed: int | None = None,
-        oracle: ReachabilityPredicate | None = None,
         executor: Executor | None = None,
     ) -> None:
         check_instance(env, "env", Environment, "an Environment")
         self.env = env
-        self.predicate = resolve_predicate(env, predicate, oracle, dynamics, resolution)
+        self.predicate = resolve_predicate(env, predicate, dynamics, resolution)
         try:
             bias: float | None = check_float(goal_bias, "goal_bias", 0.0, 1.0)
         except ValueError:
@@ -214,12 +196,6 @@ class Planner:
         self.seed = check_seed(seed)
         self.streams = RandomStreams.from_seed(self.seed)
         self.executor = executor
-
-    @property
-    def oracle(self) -> ReachabilityPredicate:
-        """Deprecated alias of ``predicate``."""
-        warn_deprecated("Planner.oracle", "Planner.predicate")
-        return self.predicate
 
     def rng(self, round_index: int, worker: int = 0, stream: int = Stream.CANDIDATES) -> np.random.Generator:
         """The generator of one (round, worker, stream): independent of call order and executor.

@@ -97,7 +97,7 @@ class ParallelRRT(Planner):
     ``oracle_errors``). ``RRT`` is the case p = 1.
 
     The arguments every planner takes (``env``, ``predicate``, ``dynamics``, ``oracle_errors``,
-    ``goal_bias``, ``max_extension``, ``resolution``, ``seed``, ``executor`` and the deprecated ``oracle``) are
+    ``goal_bias``, ``max_extension``, ``space``, ``resolution``, ``seed`` and ``executor``) are
     documented on ``Planner``. Without an ``executor`` the rounds are tested in batches (module
     docstring); with one, each worker's test is one task.
 
@@ -131,14 +131,13 @@ class ParallelRRT(Planner):
         resolution: float = 0.01,
         executor: Executor | None = None,
         seed: int | None = None,
-        oracle: ReachabilityPredicate | None = None,
         look_ahead: bool = True,
     ) -> None:
         self.workers = check_int(workers, "workers", 1, MAX_WORKERS)
         self.look_ahead = check_bool(look_ahead, "look_ahead")
         super().__init__(env, predicate=predicate, dynamics=dynamics, oracle_errors=oracle_errors,
                          goal_bias=goal_bias, max_extension=max_extension, space=space, resolution=resolution,
-                         seed=seed, oracle=oracle, executor=executor)
+                         seed=seed, executor=executor)
 
     def _run(self, state: RunState, condition: TerminationCondition, began: float) -> PlanStatus:
         """Rounds in batches: the candidates of the next B rounds drawn and tested together, then
@@ -251,9 +250,8 @@ class RRT(ParallelRRT):
     counted as a ``verification_call`` (DESIGN §2).
 
     The arguments every planner takes (``env``, ``predicate``, ``dynamics``, ``oracle_errors``,
-    ``goal_bias``, ``max_extension``, ``resolution``, ``seed`` and the deprecated ``oracle``; not
-    ``executor``) are documented on ``Planner``, with what they raise; ``look_ahead`` on
-    ``ParallelRRT``.
+    ``goal_bias``, ``max_extension``, ``space``, ``resolution`` and ``seed``; not ``executor``) are
+    documented on ``Planner``, with what they raise; ``look_ahead`` on ``ParallelRRT``.
     """
 
     name = "RRT"
@@ -270,9 +268,8 @@ class RRT(ParallelRRT):
         space: StateSpace | None = None,
         resolution: float = 0.01,
         seed: int | None = None,
-        oracle: ReachabilityPredicate | None = None,
         look_ahead: bool = True,
     ) -> None:
         super().__init__(env, workers=1, predicate=predicate, dynamics=dynamics, oracle_errors=oracle_errors,
                          goal_bias=goal_bias, max_extension=max_extension, space=space, resolution=resolution,
-                         seed=seed, oracle=oracle, look_ahead=look_ahead)
+                         seed=seed, look_ahead=look_ahead)

@@ -25,7 +25,6 @@ from __future__ import annotations
 from collections.abc import Callable
 from concurrent.futures import Executor
 
-from .._support.deprecation import warn_deprecated
 from .._support.memory import MemoryEstimate, database_bytes, database_resident_bytes
 from .._support.validation import check_bool, check_instance, check_int
 from ..reachability.dynamics import LinearTrackingDynamics
@@ -61,7 +60,7 @@ class PQRRT(Planner):
     Quantum Database Annealing (Alg. 4). ``QRRT`` is the case p = 1 (Alg. 2).
 
     The arguments every planner takes (``env``, ``predicate``, ``dynamics``, ``oracle_errors``,
-    ``goal_bias``, ``max_extension``, ``resolution``, ``seed``, ``executor`` and the deprecated ``oracle``) are
+    ``goal_bias``, ``max_extension``, ``space``, ``resolution``, ``seed`` and ``executor``) are
     documented on ``Planner``. On an ``executor`` each database's search is one task; without one
     the round's databases are searched in turn, with the same results.
 
@@ -90,7 +89,6 @@ class PQRRT(Planner):
             ``NearestParents()`` (the default: the paper's samples with their nearest nodes,
             searched by lookup) or ``LatticeCandidates(cell_bits, ..., coherent=...)`` (lattice
             cells paired with drawn nodes, searched by lookup or by the coherent circuit on Aer).
-        iterations: Deprecated alias of ``search_policy``.
 
     Raises:
         TypeError: A non-integer ``num_qubits`` or ``workers``, a ``backend`` that is not a
@@ -98,8 +96,7 @@ class PQRRT(Planner):
             ``annealing`` that is not an ``AnnealingSchedule``, a non-bool ``shared_database``, or
             an argument ``Planner`` refuses.
         ValueError: ``num_qubits`` < 1 or above the backend's ``max_qubits``, ``workers`` outside
-            [1, 4096], both ``search_policy`` and ``iterations`` given, or an argument ``Planner``
-            refuses.
+            [1, 4096], or an argument ``Planner`` refuses.
     """
 
     name = "PQRRT"
@@ -131,8 +128,6 @@ class PQRRT(Planner):
         resolution: float = 0.01,
         executor: Executor | None = None,
         seed: int | None = None,
-        oracle: ReachabilityPredicate | None = None,
-        iterations: IterationPolicy | None = None,
     ) -> None:
         self.num_qubits = check_int(num_qubits, "num_qubits", 1)
         self.workers = check_int(workers, "workers", 1, MAX_WORKERS)
@@ -142,13 +137,7 @@ class PQRRT(Planner):
             backend = AerBackend()
         check_instance(backend, "backend", QuantumSearchBackend, "a QuantumSearchBackend")
         backend.check_qubits(self.num_qubits)
-        policy = search_policy
-        if iterations is not None:
-            warn_deprecated("the quantum planners' iterations= argument", "search_policy=")
-            if search_policy is not None and search_policy is not iterations:
-                raise ValueError("give search_policy= or its deprecated alias iterations=, not both")
-            policy = iterations
-        policy = self.default_search_policy() if policy is None else policy
+        policy = self.default_search_policy() if search_policy is None else search_policy
         check_instance(policy, "search_policy", IterationPolicy,
                        "a search policy (PaperIterations(), FixedIterations(k), KnownOptimal(), BBHT(), Adaptive(), "
                        "ThompsonIterations())")
@@ -161,7 +150,7 @@ class PQRRT(Planner):
         candidates.check(env, self.num_qubits, oracle_errors is not None)
         super().__init__(env, predicate=predicate, dynamics=dynamics, oracle_errors=oracle_errors,
                          goal_bias=goal_bias, max_extension=max_extension, space=space, resolution=resolution,
-                         seed=seed, oracle=oracle, executor=executor)
+                         seed=seed, executor=executor)
         self.backend = backend
         self.shared_database = check_bool(shared_database, "shared_database")
         self.search_policy = policy
@@ -196,12 +185,6 @@ class PQRRT(Planner):
             search_bytes=concurrent * search,
             policy_bytes=self.search_policy.state_bytes(size),
         )
-
-    @property
-    def iterations_policy(self) -> IterationPolicy:
-        """Deprecated alias of ``search_policy``."""
-        warn_deprecated("PQRRT.iterations_policy", "PQRRT.search_policy")
-        return self.search_policy
 
     @property
     def database_size(self) -> int:
@@ -302,7 +285,7 @@ class QRRT(PQRRT):
     verifies. With ``annealing`` this is Quantum Database Annealing (Alg. 4).
 
     The arguments every planner takes (``env``, ``predicate``, ``dynamics``, ``oracle_errors``,
-    ``goal_bias``, ``max_extension``, ``resolution``, ``seed`` and the deprecated ``oracle``; not ``executor``) are
+    ``goal_bias``, ``max_extension``, ``space``, ``resolution`` and ``seed``; not ``executor``) are
     documented on ``Planner``; the others are ``PQRRT``'s, with the same meaning and defaults.
 
     Args:
@@ -313,7 +296,6 @@ class QRRT(PQRRT):
             ``default_search_policy()``.
         annealing: An ``AnnealingSchedule`` (Quantum Database Annealing), or None (default).
         database: ``NearestParents()`` (default) or ``LatticeCandidates(...)``, as for ``PQRRT``.
-        iterations: Deprecated alias of ``search_policy``.
 
     Raises:
         TypeError: An argument of the wrong type, as for ``PQRRT``.
@@ -346,11 +328,8 @@ class QRRT(PQRRT):
         space: StateSpace | None = None,
         resolution: float = 0.01,
         seed: int | None = None,
-        oracle: ReachabilityPredicate | None = None,
-        iterations: IterationPolicy | None = None,
     ) -> None:
         super().__init__(env, backend=backend, num_qubits=num_qubits, workers=1, shared_database=True,
                          search_policy=search_policy, annealing=annealing, database=database, predicate=predicate,
                          dynamics=dynamics, oracle_errors=oracle_errors, goal_bias=goal_bias,
-                         max_extension=max_extension, space=space, resolution=resolution, seed=seed,
-                         oracle=oracle, iterations=iterations)
+                         max_extension=max_extension, space=space, resolution=resolution, seed=seed)

@@ -175,14 +175,6 @@ class PlanResult:
                 f"such as max_oracle_calls or max_time_s, to change it)")
 
     @property
-    def budget_exhausted(self) -> bool:
-        """Deprecated: ``not reached`` (a termination condition ended the plan)."""
-        from .._support.deprecation import warn_deprecated
-
-        warn_deprecated("PlanResult.budget_exhausted", "not PlanResult.reached")
-        return not self.reached
-
-    @property
     def tree(self) -> nx.DiGraph:
         """The tree as a networkx DiGraph (edges parent -> child, node attribute ``pos``)."""
         import networkx as nx

@@ -8,14 +8,12 @@ rejected, and a collision-free one is only rejected if it passes within
 (``ExactCheck.false_rejection_bound``; the derivation is in ``qrrt_circuits.reachability.collision``).
 
 ``ExactCheck`` implements the ``ReachabilityPredicate`` protocol
-(``qrrt_circuits.reachability.predicate``). ``OracleErrorModel`` lives in
-``qrrt_circuits.reachability.oracle_errors`` and is re-exported here.
+(``qrrt_circuits.reachability.predicate``).
 """
 
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 
@@ -23,10 +21,9 @@ from .._support.validation import check_positive_float
 from ..world.environment import Environment
 from .collision import trajectories_free
 from .dynamics import MAX_PROPAGATOR_BYTES, LinearTrackingDynamics
-from .oracle_errors import OracleErrorModel
 from .predicate import as_pairs
 
-__all__ = ["OracleErrorModel", "ExactCheck"]
+__all__ = ["ExactCheck"]
 
 
 def chord_grid(
@@ -137,9 +134,6 @@ class ExactCheck:
         env: The ``Environment``.
         dynamics: ``LinearTrackingDynamics`` of the same dimension d (default: the paper's).
         resolution: The collision resolution in length units, > 0 (default 0.01).
-        check: ``"exact"`` (this class) or ``"time_samples"``, a deprecated alias of
-            ``TimeSampledCheck(env, dynamics, time_samples=time_samples)``, which is returned instead.
-        time_samples: K for ``check="time_samples"``; unused otherwise.
 
     Attributes:
         env: The environment.
@@ -148,9 +142,9 @@ class ExactCheck:
         evaluations: Pairs evaluated so far.
 
     Raises:
-        ValueError: An unknown ``check``, a dynamics dimension other than ``env.dim``, a
-            ``resolution`` that is not a finite number > 0, or one so fine for the workspace's
-            extent that the chord grid would exceed ``max_chords(d)`` chords (estimated by
+        ValueError: A dynamics dimension other than ``env.dim``, a ``resolution`` that is not a
+            finite number > 0, or one so fine for the workspace's extent that the chord grid would
+            exceed ``max_chords(d)`` chords (estimated by
             ``LinearTrackingDynamics.chord_count_estimate`` before it is built; the message gives
             the finest resolution that fits).
         TypeError: A non-numeric ``resolution``.
@@ -167,30 +161,12 @@ class ExactCheck:
     """
 
     name = "exact"
-    check = "exact"
-
-    def __new__(cls, env: Environment, dynamics: LinearTrackingDynamics | None = None,
-                resolution: float = 0.01, check: str = "exact", time_samples: int = 50) -> Any:
-        # Any: a ExactCheck, or for check="time_samples" a TimeSampledCheck (the alias)
-        if check == "time_samples":
-            from .._support.deprecation import warn_deprecated
-            from .time_sampled import TimeSampledCheck
-
-            warn_deprecated("ExactCheck(check='time_samples', time_samples=K)",
-                            "TimeSampledCheck(env, dynamics, time_samples=K)")
-
-            return TimeSampledCheck(env, dynamics, time_samples=time_samples)
-        if check != "exact":
-            raise ValueError(f"check must be 'exact' or 'time_samples', got {check!r}")
-        return super().__new__(cls)
 
     def __init__(
         self,
         env: Environment,
         dynamics: LinearTrackingDynamics | None = None,
         resolution: float = 0.01,
-        check: str = "exact",
-        time_samples: int = 50,
     ) -> None:
         dynamics = LinearTrackingDynamics.paper() if dynamics is None else dynamics
         if dynamics.dim != env.dim:
@@ -209,9 +185,6 @@ class ExactCheck:
         self._lower = np.ascontiguousarray(env.boxes[:, 0])
         self._upper = np.ascontiguousarray(env.boxes[:, 1])
         self._bounds = np.ascontiguousarray(env.bounds)
-
-    def __getnewargs__(self) -> tuple[Environment]:  # pickling goes through __new__ with the env (check stays exact)
-        return (self.env,)
 
     @property
     def dim(self) -> int:
@@ -276,13 +249,3 @@ class ExactCheck:
         )
         self.evaluations += int(parents.shape[0])
         return out
-
-
-def __getattr__(name: str) -> Any:
-    """Deprecated names of this module."""
-    if name == "ReachabilityOracle":
-        from .._support.deprecation import warn_deprecated
-
-        warn_deprecated("ReachabilityOracle", "ExactCheck")
-        return ExactCheck
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

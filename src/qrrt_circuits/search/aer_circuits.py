@@ -40,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from qiskit import QuantumCircuit
-from qiskit.circuit import CircuitInstruction, Gate, Measure, Operation, Qubit
+from qiskit.circuit import CircuitInstruction, Measure, Operation, Qubit
 from qiskit.circuit.library import DiagonalGate, MCPhaseGate, PauliGate, PhaseGate, UnitaryGate
 
 from .._support.validation import check_int
@@ -63,16 +63,12 @@ Step = tuple[Operation, tuple[Qubit, ...]]
 
 
 def _diagonal_gate(phases: np.ndarray) -> DiagonalGate:
-    """A ``DiagonalGate`` of ``phases`` (entries +-1.0) without its per-entry Python validation.
+    """A ``DiagonalGate`` of ``phases`` (entries +-1.0), through its documented constructor.
 
-    ``DiagonalGate(list)`` checks every entry in Python and stores it as a ``complex``; the
-    entries here are +-1 by construction, so the gate is made from the list of floats directly
-    (``Operator`` and Aer read the same values; a circuit copies float parameters faster than
-    complex ones)."""
-    gate = DiagonalGate.__new__(DiagonalGate)
-    Gate.__init__(gate, "diagonal", int(phases.shape[0]).bit_length() - 1, [])
-    gate._params = phases.astype(float).tolist()
-    return gate
+    The gate checks and converts every entry in Python; given a list of Python ``complex`` (the
+    type it stores) it does so about twice as fast as from floats or from an array, which makes
+    this the cheapest documented way to build it."""
+    return DiagonalGate(phases.astype(complex).tolist())
 
 
 def parity_signs(num_qubits: int) -> np.ndarray:

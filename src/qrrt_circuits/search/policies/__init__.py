@@ -7,8 +7,6 @@ planner round runs through; ``fixed_point`` fixed-point amplitude amplification;
 iteration count from an amplitude estimate of m.
 """
 
-from typing import Any
-
 from .iteration import (
     BBHT,
     Adaptive,
@@ -24,10 +22,3 @@ from .thompson import ThompsonIterations, ThompsonState
 
 __all__ = ["BBHT", "Adaptive", "AdaptiveState", "BBHTOutcome", "FixedIterations", "IterationPolicy", "KnownOptimal",
            "PaperIterations", "PolicyState", "ThompsonIterations", "ThompsonState"]
-
-
-def __getattr__(name: str) -> Any:
-    """Deprecated names of this package."""
-    from . import iteration
-
-    return iteration.__getattr__(name)

@@ -44,7 +44,6 @@ from typing import Any
 
 import numpy as np
 
-from ..._support.deprecation import warn_deprecated
 from ..._support.validation import check_choice, check_float, check_int, check_optional_int
 from ...probability import optimal_iterations
 from ..backend import QuantumSearchBackend
@@ -166,17 +165,6 @@ class IterationPolicy:
         raise NotImplementedError
 
 
-def __getattr__(name: str) -> Any:
-    """Deprecated names of this module."""
-    if name == "SearchPolicy":
-        warn_deprecated("SearchPolicy", "IterationPolicy")
-        return IterationPolicy
-    if name == "PaperSchedule":
-        warn_deprecated("PaperSchedule", "PaperIterations")
-        return PaperIterations
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
 class PolicyState:
     """Per-plan mutable state of a policy; the default runs one search with ``shots = workers``.
 
@@ -208,11 +196,6 @@ class PolicyState:
             TypeError: Policies that choose k inside their own loop (``BBHT``, ``EstimatedOptimal``).
         """
         return self.policy._iterations(self.num_items, tree_nodes, num_marked)
-
-    def iterations(self, tree_nodes: int, num_marked: int | None = None) -> int:
-        """Deprecated alias of ``choose_iterations``."""
-        warn_deprecated("PolicyState.iterations(...)", "PolicyState.choose_iterations(...)")
-        return self.choose_iterations(tree_nodes, num_marked)
 
     def iterations_for(self, problem: DatabaseSearch, tree_nodes: int) -> int:
         """The policy's k for ``problem`` (``IterationPolicy.iterations_for``).

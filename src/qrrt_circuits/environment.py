@@ -1,5 +1,0 @@
-"""Deprecated location of ``qrrt_circuits.world.environment`` (importing it warns)."""
-
-from qrrt_circuits._support.deprecation import moved_module
-
-moved_module(__name__, "qrrt_circuits.world.environment")
