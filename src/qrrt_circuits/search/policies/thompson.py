@@ -23,7 +23,7 @@ k = 5, then 3, and ``KnownOptimal`` would need each database's m.
 Where many databases are empty (a share pi of G at m = 0), every k pays for them alike: C(k)
 grows by 1 / (1 - pi) for all k, and k* does not move. A search that keeps going until it finds
 an entry pays for an empty database up to its cap instead: BBHT's cap of 4.5 sqrt(N) iterations
-plus its verifications (about 90 calls at N = 256) against k* + 1 here.
+(72 at N = 256) plus one verification per attempt, against k* + 1 here.
 
 ``ThompsonIterations`` learns D(k) from the plan's own databases as a budgeted multi-armed bandit
 (Xia, Li, Qin, Yu and Liu, "Thompson sampling for budgeted multi-armed bandits", IJCAI 2015): arm
