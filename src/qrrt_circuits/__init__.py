@@ -37,9 +37,9 @@ if TYPE_CHECKING:
     from .search.backends.aer import AerBackend
     from .search.backends.sampler import SamplerBackend
     from .search.backends.statevector import StatevectorBackend
-    from .search.fixed_point import IterateSequence
+    from .search.iterate_sequence import IterateSequence
     from .search.policies.estimated import EstimatedOptimal
-    from .search.policies.fixed_point import FixedPointAmplification
+    from .search.policies.fixed_point_amplification import FixedPointAmplification
     from .search.policies.iteration import (
         BBHT,
         Adaptive,

@@ -26,7 +26,7 @@ if TYPE_CHECKING:
     from .reachability.time_sampled import TimeSampledCheck
     from .search import AerBackend, SamplerBackend, StatevectorBackend
     from .search.policies.estimated import EstimatedOptimal
-    from .search.policies.fixed_point import FixedPointAmplification
+    from .search.policies.fixed_point_amplification import FixedPointAmplification
     from .search.policies.iteration import FixedIterations
     from .search.policies.thompson import ThompsonIterations
     from .world.environment import Environment
@@ -346,7 +346,7 @@ def _fixed(value: str) -> FixedIterations:
 
 
 def _fixed_point(value: str | None) -> FixedPointAmplification:
-    from .search.policies.fixed_point import FixedPointAmplification
+    from .search.policies.fixed_point_amplification import FixedPointAmplification
 
     if value is None:
         return FixedPointAmplification()

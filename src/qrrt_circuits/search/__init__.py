@@ -15,9 +15,9 @@ if TYPE_CHECKING:
     from .backends.aer import AerBackend
     from .backends.sampler import SamplerBackend
     from .backends.statevector import StatevectorBackend
-    from .fixed_point import IterateSequence
+    from .iterate_sequence import IterateSequence
     from .policies.estimated import EstimatedOptimal
-    from .policies.fixed_point import FixedPointAmplification
+    from .policies.fixed_point_amplification import FixedPointAmplification
     from .problem import DatabaseSearch, SearchOutcome
 
 #: public name -> the submodule that defines it ("" for a submodule itself)
@@ -25,8 +25,8 @@ _WHERE = {
     "AerBackend": ".backends.aer",
     "DatabaseSearch": ".problem",
     "EstimatedOptimal": ".policies.estimated",
-    "FixedPointAmplification": ".policies.fixed_point",
-    "IterateSequence": ".fixed_point",
+    "FixedPointAmplification": ".policies.fixed_point_amplification",
+    "IterateSequence": ".iterate_sequence",
     "QuantumSearchBackend": ".backend",
     "SamplerBackend": ".backends.sampler",
     "SearchOutcome": ".problem",

@@ -7,7 +7,7 @@ iterative amplitude estimation (``"iae"``; Grinko, Gacon, Zoufal and Woerner, np
 
 The ``EstimationProblem`` is built from our circuits: the state preparation A = H^n (the paper's
 W), the Grover operator Q = one standard iterate (phase oracle diag((-1)^marks), then the
-inversion about the mean; ``circuits.phase_oracle`` and ``fixed_point.append_state_reflection``
+inversion about the mean; ``circuits.phase_oracle`` and ``iterate_sequence.append_state_reflection``
 with alpha = pi), and the good states are the marked indices (all n qubits are objective qubits;
 a measured bitstring b is index int(b, 2), Qiskit's little-endian order). qiskit-algorithms'
 estimators run Q^k A|0> circuits through a ``SamplerV2``: here qiskit-aer's
@@ -44,7 +44,7 @@ from qiskit.primitives import BaseSamplerV2
 from qiskit.primitives.containers.sampler_pub import SamplerPub
 
 from .circuits import phase_oracle
-from .fixed_point import append_state_reflection
+from .iterate_sequence import append_state_reflection
 from .requests import validate_marks
 
 if TYPE_CHECKING:

@@ -25,7 +25,7 @@ from .._support.randomness import RandomStreams, Stream
 from .backend import QuantumSearchBackend
 
 if TYPE_CHECKING:
-    from .fixed_point import IterateSequence
+    from .iterate_sequence import IterateSequence
 
 
 @dataclass(frozen=True)

@@ -28,13 +28,13 @@ from ..._support.validation import check_int
 from ..aer_circuits import simulation_synthesis_for
 from ..backend import QuantumSearchBackend, seed_stream
 from ..circuits import SYNTHESES, aer_grover_circuit, aer_literal_grover_circuit, oracle_cx_estimate
-from ..fixed_point import generalized_grover_circuit
+from ..iterate_sequence import generalized_grover_circuit
 
 if TYPE_CHECKING:
     from qiskit import QuantumCircuit
     from qiskit_aer.noise import NoiseModel
 
-    from ..fixed_point import IterateSequence
+    from ..iterate_sequence import IterateSequence
 
 METHODS = ("statevector", "automatic")
 #: circuits on fewer qubits run single-threaded (Aer's default statevector_parallel_threshold)

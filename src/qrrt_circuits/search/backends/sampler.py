@@ -23,14 +23,14 @@ from qiskit.transpiler import generate_preset_pass_manager
 
 from ..backend import QuantumSearchBackend, seed_stream
 from ..circuits import BASIS_GATES, SYNTHESES, grover_circuit
-from ..fixed_point import generalized_grover_circuit
+from ..iterate_sequence import generalized_grover_circuit
 
 if TYPE_CHECKING:
     from qiskit import QuantumCircuit
     from qiskit.primitives import BaseSamplerV2
     from qiskit.providers import BackendV2
 
-    from ..fixed_point import IterateSequence
+    from ..iterate_sequence import IterateSequence
 
 
 #: held from setting a per-call seed on a sampler to its run's result (samplers may be shared)

@@ -63,7 +63,7 @@ def chebyshev(order: float, x: float) -> float:
         ValueError: x < -1.
 
     Example:
-        >>> from qrrt_circuits.search.fixed_point import chebyshev
+        >>> from qrrt_circuits.search.iterate_sequence import chebyshev
         >>> round(chebyshev(2, 0.5), 6)  # T_2(x) = 2 x^2 - 1
         -0.5
     """
@@ -143,7 +143,7 @@ def fixed_point_iterates(delta: float, min_fraction: float, length_rule: str = "
             ``length_rule``.
 
     Example:
-        >>> from qrrt_circuits.search.fixed_point import fixed_point_iterates
+        >>> from qrrt_circuits.search.iterate_sequence import fixed_point_iterates
         >>> fixed_point_iterates(0.5, 0.05)
         3
     """
@@ -205,7 +205,7 @@ def fixed_point_success_probability(delta: float, iterates: int, fraction: float
             range.
 
     Example:
-        >>> from qrrt_circuits.search.fixed_point import fixed_point_success_probability
+        >>> from qrrt_circuits.search.iterate_sequence import fixed_point_success_probability
         >>> round(fixed_point_success_probability(0.5, 3, 0.05), 4)  # >= 1 - 0.5^2
         0.9003
     """
