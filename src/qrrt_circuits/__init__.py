@@ -38,16 +38,12 @@ if TYPE_CHECKING:
     from .search.backends.sampler import SamplerBackend
     from .search.backends.statevector import StatevectorBackend
     from .search.iterate_sequence import IterateSequence
+    from .search.policies.adaptive import Adaptive
+    from .search.policies.base import IterationPolicy
+    from .search.policies.bbht import BBHT
     from .search.policies.estimated import EstimatedOptimal
     from .search.policies.fixed_point_amplification import FixedPointAmplification
-    from .search.policies.iteration import (
-        BBHT,
-        Adaptive,
-        FixedIterations,
-        IterationPolicy,
-        KnownOptimal,
-        PaperIterations,
-    )
+    from .search.policies.schedules import FixedIterations, KnownOptimal, PaperIterations
     from .search.policies.thompson import ThompsonIterations
     from .search.problem import DatabaseSearch, SearchOutcome
     from .world import scenarios
@@ -85,8 +81,10 @@ _WHERE = {
     **dict.fromkeys(["AerBackend", "EstimatedOptimal", "FixedPointAmplification", "IterateSequence",
                      "SamplerBackend", "StatevectorBackend"], ".search"),
     "circuits": ".search.circuits",
-    **dict.fromkeys(["BBHT", "Adaptive", "FixedIterations", "IterationPolicy", "KnownOptimal", "PaperIterations"],
-                    ".search.policies.iteration"),
+    "IterationPolicy": ".search.policies.base",
+    **dict.fromkeys(["FixedIterations", "KnownOptimal", "PaperIterations"], ".search.policies.schedules"),
+    "BBHT": ".search.policies.bbht",
+    "Adaptive": ".search.policies.adaptive",
     "ThompsonIterations": ".search.policies.thompson",
     **dict.fromkeys(["DatabaseSearch", "SearchOutcome"], ".search.problem"),
     "scenarios": ".world.scenarios",

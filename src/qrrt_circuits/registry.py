@@ -27,7 +27,7 @@ if TYPE_CHECKING:
     from .search import AerBackend, SamplerBackend, StatevectorBackend
     from .search.policies.estimated import EstimatedOptimal
     from .search.policies.fixed_point_amplification import FixedPointAmplification
-    from .search.policies.iteration import FixedIterations
+    from .search.policies.schedules import FixedIterations
     from .search.policies.thompson import ThompsonIterations
     from .world.environment import Environment
 
@@ -336,7 +336,7 @@ def _backends() -> Registry:
 
 # ----------------------------------------------------------------------------------------- policies
 def _fixed(value: str) -> FixedIterations:
-    from .search.policies.iteration import FixedIterations
+    from .search.policies.schedules import FixedIterations
 
     try:
         k = int(value)
@@ -371,7 +371,9 @@ def _estimated() -> EstimatedOptimal:
 
 
 def _policies() -> Registry:
-    from .search.policies.iteration import BBHT, Adaptive, KnownOptimal, PaperIterations
+    from .search.policies.adaptive import Adaptive
+    from .search.policies.bbht import BBHT
+    from .search.policies.schedules import KnownOptimal, PaperIterations
 
     registry = Registry("search policy")
     registry.register("paper", PaperIterations, "5 iterations, 3 after 10 nodes (the authors' code)")

@@ -7,7 +7,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from ..registry import BACKENDS, PLANNERS, POLICIES, PREDICATES
-from ..search.policies.iteration import IterationPolicy, PaperIterations
+from ..search.policies.base import IterationPolicy
+from ..search.policies.schedules import PaperIterations
 
 if TYPE_CHECKING:
     from ..planners.base import Planner

@@ -28,7 +28,7 @@ from ..iterate_sequence import (
 )
 from ..problem import DatabaseSearch, SearchOutcome
 from ..requests import MAX_ITERATIONS
-from .iteration import IterationPolicy, PolicyState
+from .base import IterationPolicy, PolicyState
 
 __all__ = ["FixedPointAmplification", "FixedPointState"]
 
