@@ -90,7 +90,7 @@ def test_no_module_is_an_alias_of_another():
     "qrrt_circuits.search.noisy", "qrrt_circuits.search.sampler", "qrrt_circuits.search.statevector",
     "qrrt_circuits.search.schedules", "qrrt_circuits._support.deprecation", "qrrt_circuits._support.execution",
     "qrrt_circuits.search.fixed_point", "qrrt_circuits.search.policies.fixed_point",
-    "qrrt_circuits.coherent.fixed_point", "qrrt_circuits.search.policies.iteration",
+    "qrrt_circuits.coherent.fixed_point", "qrrt_circuits.search.policies.iteration", "qrrt_circuits.search.backend",
 ])
 def test_an_old_module_path_is_gone(old):
     with pytest.raises(ModuleNotFoundError):

@@ -33,8 +33,8 @@ if TYPE_CHECKING:
     from .reachability.predicate import ReachabilityPredicate
     from .reachability.time_sampled import TimeSampledCheck
     from .search import circuits
-    from .search.backend import QuantumSearchBackend, SearchRequest, SearchResult
     from .search.backends.aer import AerBackend
+    from .search.backends.base import QuantumSearchBackend, SearchRequest, SearchResult
     from .search.backends.sampler import SamplerBackend
     from .search.backends.statevector import StatevectorBackend
     from .search.iterate_sequence import IterateSequence
@@ -76,7 +76,7 @@ _WHERE = {
     "OracleErrorModel": ".reachability.oracle_errors",
     "ReachabilityPredicate": ".reachability.predicate",
     "TimeSampledCheck": ".reachability.time_sampled",
-    **dict.fromkeys(["QuantumSearchBackend", "SearchRequest", "SearchResult"], ".search.backend"),
+    **dict.fromkeys(["QuantumSearchBackend", "SearchRequest", "SearchResult"], ".search.backends.base"),
     # (these import Qiskit: the circuits, Aer, the sampler, amplitude estimation, or its circuit types)
     **dict.fromkeys(["AerBackend", "EstimatedOptimal", "FixedPointAmplification", "IterateSequence",
                      "SamplerBackend", "StatevectorBackend"], ".search"),

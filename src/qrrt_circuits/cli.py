@@ -32,7 +32,7 @@ if TYPE_CHECKING:
     from .planners.base import Planner
     from .planners.result import PlanResult
     from .registry import Registry
-    from .search.backend import QuantumSearchBackend, SearchResult
+    from .search.backends.base import QuantumSearchBackend, SearchResult
     from .world.environment import Environment
     from .world.problems import Problem
 
@@ -75,7 +75,7 @@ def cmd_search(args: argparse.Namespace) -> int:
     iterations = (probability.optimal_iterations(num_items, args.marked)
                   if args.iterations is None else args.iterations)
     from ._support.memory import OutOfMemory, check_fits, out_of_memory
-    from .search.backend import validate_iterations, validate_shots
+    from .search.backends.base import validate_iterations, validate_shots
 
     shots = validate_shots(args.shots)
     estimate = _search_estimate(backend, shots, validate_iterations(iterations), args.marked)

@@ -13,7 +13,7 @@ from ..search.policies.schedules import PaperIterations
 if TYPE_CHECKING:
     from ..planners.base import Planner
     from ..reachability.predicate import ReachabilityPredicate
-    from ..search.backend import QuantumSearchBackend
+    from ..search.backends.base import QuantumSearchBackend
     from ..world.environment import Environment
 
 #: how each backend is described in summaries

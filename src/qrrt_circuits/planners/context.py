@@ -25,7 +25,7 @@ from typing import Any, TypeVar
 from .._support.randomness import RandomStreams
 from ..reachability.oracle_errors import OracleErrorModel
 from ..reachability.predicate import ReachabilityPredicate
-from ..search.backend import QuantumSearchBackend
+from ..search.backends.base import QuantumSearchBackend
 from ..search.policies.base import PolicyState
 from ..world.environment import Environment
 from ..world.spaces import StateSpace

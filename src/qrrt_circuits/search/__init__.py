@@ -11,8 +11,8 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from . import circuits
-    from .backend import QuantumSearchBackend, SearchRequest, SearchResult
     from .backends.aer import AerBackend
+    from .backends.base import QuantumSearchBackend, SearchRequest, SearchResult
     from .backends.sampler import SamplerBackend
     from .backends.statevector import StatevectorBackend
     from .iterate_sequence import IterateSequence
@@ -27,11 +27,11 @@ _WHERE = {
     "EstimatedOptimal": ".policies.estimated",
     "FixedPointAmplification": ".policies.fixed_point_amplification",
     "IterateSequence": ".iterate_sequence",
-    "QuantumSearchBackend": ".backend",
+    "QuantumSearchBackend": ".backends.base",
     "SamplerBackend": ".backends.sampler",
     "SearchOutcome": ".problem",
-    "SearchRequest": ".backend",
-    "SearchResult": ".backend",
+    "SearchRequest": ".backends.base",
+    "SearchResult": ".backends.base",
     "StatevectorBackend": ".backends.statevector",
     "circuits": "",
 }

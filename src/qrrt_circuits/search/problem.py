@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .._support.randomness import RandomStreams, Stream
-from .backend import QuantumSearchBackend
+from .backends.base import QuantumSearchBackend
 
 if TYPE_CHECKING:
     from .iterate_sequence import IterateSequence

@@ -26,9 +26,9 @@ from qiskit_aer import AerSimulator
 
 from ..._support.validation import check_int
 from ..aer_circuits import simulation_synthesis_for
-from ..backend import QuantumSearchBackend, seed_stream
 from ..circuits import SYNTHESES, aer_grover_circuit, aer_literal_grover_circuit, oracle_cx_estimate
 from ..iterate_sequence import generalized_grover_circuit
+from .base import QuantumSearchBackend, seed_stream
 
 if TYPE_CHECKING:
     from qiskit import QuantumCircuit

@@ -21,9 +21,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from qiskit.transpiler import generate_preset_pass_manager
 
-from ..backend import QuantumSearchBackend, seed_stream
 from ..circuits import BASIS_GATES, SYNTHESES, grover_circuit
 from ..iterate_sequence import generalized_grover_circuit
+from .base import QuantumSearchBackend, seed_stream
 
 if TYPE_CHECKING:
     from qiskit import QuantumCircuit

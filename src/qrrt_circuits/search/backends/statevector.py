@@ -17,9 +17,9 @@ import numpy as np
 
 from ..._support.validation import check_bool, check_int
 from ...probability import good_probability
-from ..backend import QuantumSearchBackend
 from ..iterate_sequence import statevector_after
 from ..requests import seed_stream, validate_iterations, validate_marks
+from .base import QuantumSearchBackend
 
 if TYPE_CHECKING:
     from ..iterate_sequence import IterateSequence

@@ -31,7 +31,7 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 
 from ...probability import optimal_iterations
-from ..backend import QuantumSearchBackend
+from ..backends.base import QuantumSearchBackend
 from ..problem import DatabaseSearch, SearchOutcome
 from ..requests import validate_iterations
 

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..backend import QuantumSearchBackend
+from ..backends.base import QuantumSearchBackend
 from ..iterate_sequence import (
     LENGTH_RULES,
     IterateSequence,
