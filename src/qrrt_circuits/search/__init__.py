@@ -19,6 +19,7 @@ if TYPE_CHECKING:
     from .policies.estimated import EstimatedOptimal
     from .policies.fixed_point_amplification import FixedPointAmplification
     from .problem import DatabaseSearch, SearchOutcome
+    from .synthesis import OracleSynthesis
 
 #: public name -> the submodule that defines it ("" for a submodule itself)
 _WHERE = {
@@ -27,6 +28,7 @@ _WHERE = {
     "EstimatedOptimal": ".policies.estimated",
     "FixedPointAmplification": ".policies.fixed_point_amplification",
     "IterateSequence": ".iterate_sequence",
+    "OracleSynthesis": ".synthesis",
     "QuantumSearchBackend": ".backends.base",
     "SamplerBackend": ".backends.sampler",
     "SearchOutcome": ".problem",
@@ -42,6 +44,7 @@ __all__ = [
     "EstimatedOptimal",
     "FixedPointAmplification",
     "IterateSequence",
+    "OracleSynthesis",
     "QuantumSearchBackend",
     "SamplerBackend",
     "SearchOutcome",

@@ -46,6 +46,7 @@ from qiskit.primitives.containers.sampler_pub import SamplerPub
 from .circuits import phase_oracle
 from .iterate_sequence import append_state_reflection
 from .requests import validate_marks
+from .synthesis import OracleSynthesis
 
 if TYPE_CHECKING:
     from qiskit.primitives import PrimitiveJob
@@ -55,7 +56,7 @@ if TYPE_CHECKING:
 AER_NATIVE = frozenset({"h", "x", "p", "diagonal", "mcphase", "measure", "barrier", "unitary"})
 
 
-def grover_iterate(marks: np.ndarray, synthesis: str = "auto") -> QuantumCircuit:
+def grover_iterate(marks: np.ndarray, synthesis: str | OracleSynthesis = "auto") -> QuantumCircuit:
     """Q = -S_s(pi) S_t(pi): the phase oracle, then the inversion about the mean (Aer-native).
 
     One standard Grover iterate (the paper's Alg. 2 / 3 loop body; Yoder et al.'s G(pi, pi)).
@@ -78,7 +79,7 @@ def grover_iterate(marks: np.ndarray, synthesis: str = "auto") -> QuantumCircuit
     return circuit
 
 
-def estimation_problem(marks: np.ndarray, synthesis: str = "auto") -> EstimationProblem:
+def estimation_problem(marks: np.ndarray, synthesis: str | OracleSynthesis = "auto") -> EstimationProblem:
     """qiskit-algorithms' ``EstimationProblem`` for the marked fraction a = m / N of ``marks``.
 
     State preparation A = H^n (the paper's W), Grover operator ``grover_iterate(marks)``, all n
@@ -343,7 +344,7 @@ def likelihood_ratio_interval(theta_mle: float, powers: Sequence[int], good_coun
 
 def estimate_marked_fraction(marks: np.ndarray, *, alpha: float, shots: int, rng: np.random.Generator,
                              method: str = "mlae", schedule: int = 3, epsilon: float = 0.05,
-                             synthesis: str = "auto") -> AmplitudeEstimate:
+                             synthesis: str | OracleSynthesis = "auto") -> AmplitudeEstimate:
     """Estimate the marked fraction of ``marks`` with confidence 1 - ``alpha`` on a seeded Aer
     ``SamplerV2`` of ``shots`` shots per circuit.
 
