@@ -15,6 +15,8 @@ from .commands.plan import PLOT_FORMATS, cmd_plan
 from .commands.reproduce import cmd_compare_checks, cmd_reproduce
 from .commands.search import cmd_search
 
+#: the first line of ``qrrt --help`` (the package docstring's first line)
+DESCRIPTION = "The ``qrrt`` command line: ``search``, ``plan`` and ``reproduce``."
 
 def _positive_int(text: str) -> int:
     value = int(text)
@@ -154,9 +156,8 @@ def _add_compare_checks_parser(sub: _Subparsers, formatter: _Formatter) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     from .. import __version__
-    from . import __doc__ as description
 
-    parser = argparse.ArgumentParser(prog="qrrt", description=(description or "").splitlines()[0])
+    parser = argparse.ArgumentParser(prog="qrrt", description=DESCRIPTION)
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     formatter = argparse.ArgumentDefaultsHelpFormatter
