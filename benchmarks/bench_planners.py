@@ -109,7 +109,7 @@ class PartTimer:
 
     def __enter__(self) -> PartTimer:
         from qrrt_circuits.planners.tree import Tree
-        from qrrt_circuits.search.backend import QuantumSearchBackend
+        from qrrt_circuits.search.backends.base import QuantumSearchBackend
         from qrrt_circuits.world.environment import Environment
 
         self._wrap(Tree, "nearest", "nearest")

@@ -14,7 +14,7 @@ from qrrt_circuits._support.randomness import RandomStreams
 from qrrt_circuits.probability import optimal_iterations
 from qrrt_circuits.registry import POLICIES
 from qrrt_circuits.search.estimation import estimate_marked_fraction, estimation_problem, grover_iterate
-from qrrt_circuits.search.fixed_point import IterateSequence, generalized_grover_circuit
+from qrrt_circuits.search.iterate_sequence import IterateSequence, generalized_grover_circuit
 
 
 def test_grover_operator_is_the_standard_iterate():

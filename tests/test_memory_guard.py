@@ -476,7 +476,7 @@ def test_the_gate_by_gate_mcz_estimate_covers_its_instructions():
 def test_a_sequence_is_held_to_its_own_circuits_footprint(small_memory):
     """``search_sequence`` builds its circuit gate by gate with the CX-based form: 12 marked entries
     at n = 20 take the mcz form, which fits in 300 MiB where the bound over every m does not."""
-    from qrrt_circuits.search.fixed_point import IterateSequence
+    from qrrt_circuits.search.iterate_sequence import IterateSequence
 
     backend = qc.AerBackend(0)
     assert backend.sequence_peak_bytes(20, 8, 1) > small_memory
@@ -545,7 +545,7 @@ def test_a_direct_search_checks_once_per_call(counted_reads):
     assert len(counted_reads) == 1
     backend.search_many([qc.SearchRequest(marks, k, 2, seed=k) for k in range(5)])
     assert len(counted_reads) == 2
-    from qrrt_circuits.search.fixed_point import IterateSequence
+    from qrrt_circuits.search.iterate_sequence import IterateSequence
 
     backend.search_sequence(marks, IterateSequence.grover(2), shots=3)
     assert len(counted_reads) == 3

@@ -89,6 +89,8 @@ def test_no_module_is_an_alias_of_another():
     "qrrt_circuits.search.estimated_policy", "qrrt_circuits.search.fixed_point_policy",
     "qrrt_circuits.search.noisy", "qrrt_circuits.search.sampler", "qrrt_circuits.search.statevector",
     "qrrt_circuits.search.schedules", "qrrt_circuits._support.deprecation", "qrrt_circuits._support.execution",
+    "qrrt_circuits.search.fixed_point", "qrrt_circuits.search.policies.fixed_point",
+    "qrrt_circuits.coherent.fixed_point", "qrrt_circuits.search.policies.iteration", "qrrt_circuits.search.backend",
 ])
 def test_an_old_module_path_is_gone(old):
     with pytest.raises(ModuleNotFoundError):
@@ -98,8 +100,8 @@ def test_an_old_module_path_is_gone(old):
 @pytest.mark.parametrize("module, name", [
     ("qrrt_circuits", "SearchPolicy"), ("qrrt_circuits", "PaperSchedule"), ("qrrt_circuits", "ReachabilityOracle"),
     ("qrrt_circuits.search.policies", "SearchPolicy"), ("qrrt_circuits.search.policies", "PaperSchedule"),
-    ("qrrt_circuits.search.policies.iteration", "SearchPolicy"),
-    ("qrrt_circuits.search.policies.iteration", "PaperSchedule"),
+    ("qrrt_circuits.search.policies.base", "SearchPolicy"),
+    ("qrrt_circuits.search.policies.schedules", "PaperSchedule"),
     ("qrrt_circuits.reachability.exact", "ReachabilityOracle"),
     ("qrrt_circuits.reachability.exact", "OracleErrorModel"),
     ("qrrt_circuits.planners", "DEFAULT_MAX_ROUNDS"), ("qrrt_circuits.planners.base", "DEFAULT_MAX_ROUNDS"),

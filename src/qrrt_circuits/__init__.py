@@ -33,21 +33,17 @@ if TYPE_CHECKING:
     from .reachability.predicate import ReachabilityPredicate
     from .reachability.time_sampled import TimeSampledCheck
     from .search import circuits
-    from .search.backend import QuantumSearchBackend, SearchRequest, SearchResult
     from .search.backends.aer import AerBackend
+    from .search.backends.base import QuantumSearchBackend, SearchRequest, SearchResult
     from .search.backends.sampler import SamplerBackend
     from .search.backends.statevector import StatevectorBackend
-    from .search.fixed_point import IterateSequence
+    from .search.iterate_sequence import IterateSequence
+    from .search.policies.adaptive import Adaptive
+    from .search.policies.base import IterationPolicy
+    from .search.policies.bbht import BBHT
     from .search.policies.estimated import EstimatedOptimal
-    from .search.policies.fixed_point import FixedPointAmplification
-    from .search.policies.iteration import (
-        BBHT,
-        Adaptive,
-        FixedIterations,
-        IterationPolicy,
-        KnownOptimal,
-        PaperIterations,
-    )
+    from .search.policies.fixed_point_amplification import FixedPointAmplification
+    from .search.policies.schedules import FixedIterations, KnownOptimal, PaperIterations
     from .search.policies.thompson import ThompsonIterations
     from .search.problem import DatabaseSearch, SearchOutcome
     from .world import scenarios
@@ -80,13 +76,15 @@ _WHERE = {
     "OracleErrorModel": ".reachability.oracle_errors",
     "ReachabilityPredicate": ".reachability.predicate",
     "TimeSampledCheck": ".reachability.time_sampled",
-    **dict.fromkeys(["QuantumSearchBackend", "SearchRequest", "SearchResult"], ".search.backend"),
+    **dict.fromkeys(["QuantumSearchBackend", "SearchRequest", "SearchResult"], ".search.backends.base"),
     # (these import Qiskit: the circuits, Aer, the sampler, amplitude estimation, or its circuit types)
     **dict.fromkeys(["AerBackend", "EstimatedOptimal", "FixedPointAmplification", "IterateSequence",
                      "SamplerBackend", "StatevectorBackend"], ".search"),
     "circuits": ".search.circuits",
-    **dict.fromkeys(["BBHT", "Adaptive", "FixedIterations", "IterationPolicy", "KnownOptimal", "PaperIterations"],
-                    ".search.policies.iteration"),
+    "IterationPolicy": ".search.policies.base",
+    **dict.fromkeys(["FixedIterations", "KnownOptimal", "PaperIterations"], ".search.policies.schedules"),
+    "BBHT": ".search.policies.bbht",
+    "Adaptive": ".search.policies.adaptive",
     "ThompsonIterations": ".search.policies.thompson",
     **dict.fromkeys(["DatabaseSearch", "SearchOutcome"], ".search.problem"),
     "scenarios": ".world.scenarios",

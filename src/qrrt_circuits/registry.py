@@ -26,8 +26,8 @@ if TYPE_CHECKING:
     from .reachability.time_sampled import TimeSampledCheck
     from .search import AerBackend, SamplerBackend, StatevectorBackend
     from .search.policies.estimated import EstimatedOptimal
-    from .search.policies.fixed_point import FixedPointAmplification
-    from .search.policies.iteration import FixedIterations
+    from .search.policies.fixed_point_amplification import FixedPointAmplification
+    from .search.policies.schedules import FixedIterations
     from .search.policies.thompson import ThompsonIterations
     from .world.environment import Environment
 
@@ -336,7 +336,7 @@ def _backends() -> Registry:
 
 # ----------------------------------------------------------------------------------------- policies
 def _fixed(value: str) -> FixedIterations:
-    from .search.policies.iteration import FixedIterations
+    from .search.policies.schedules import FixedIterations
 
     try:
         k = int(value)
@@ -346,7 +346,7 @@ def _fixed(value: str) -> FixedIterations:
 
 
 def _fixed_point(value: str | None) -> FixedPointAmplification:
-    from .search.policies.fixed_point import FixedPointAmplification
+    from .search.policies.fixed_point_amplification import FixedPointAmplification
 
     if value is None:
         return FixedPointAmplification()
@@ -371,7 +371,9 @@ def _estimated() -> EstimatedOptimal:
 
 
 def _policies() -> Registry:
-    from .search.policies.iteration import BBHT, Adaptive, KnownOptimal, PaperIterations
+    from .search.policies.adaptive import Adaptive
+    from .search.policies.bbht import BBHT
+    from .search.policies.schedules import KnownOptimal, PaperIterations
 
     registry = Registry("search policy")
     registry.register("paper", PaperIterations, "5 iterations, 3 after 10 nodes (the authors' code)")

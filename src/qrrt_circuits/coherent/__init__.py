@@ -8,10 +8,10 @@ Entry points: ``coherent_phase_oracle(env, database, motion)`` (the circuit) and
 """
 
 from .costs import LookupCost, OracleCost, lookup_costs, oracle_costs
-from .fixed_point import FixedPointFormat
 from .grover import coherent_grover_circuit
 from .lattice import DatabaseEntries, LatticeDatabase
 from .motion import SampledMotion
+from .number_format import FixedPointFormat
 from .oracle import CoherentOracle, build_coherent_oracle, coherent_phase_oracle
 from .plan import OracleOptions, OraclePlan, oracle_plan
 from .reference import RoundingComparison, compare_with_time_sampled, reachable_reference

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .._support.validation import check_int
-from ..search.backend import QuantumSearchBackend
+from ..search.backends.base import QuantumSearchBackend
 
 if TYPE_CHECKING:
     from qiskit import QuantumCircuit

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._support.validation import check_int, check_optional_int, check_real_array
-from .fixed_point import FixedPointFormat
+from .number_format import FixedPointFormat
 
 #: the widest index register a database accepts (the costs scale to it; only small ones are enumerated)
 MAX_INDEX_BITS = 64

@@ -8,7 +8,7 @@ matrix e (``motion.SampledMotion.tested``, f fraction bits), the tested point is
 per axis (the exact value u_c + (e / 2^f)(u_p - u_c) rounded to nearest, ties up). The entry is
 reachable iff its parent is a tree node (``valid``) and every tested point lies in the workspace
 and in no obstacle, both tested exactly on the grid: ``ceil_index(low) <= x <= floor_index(high)``
-per axis (``fixed_point``; boxes are closed, as in ``Environment``). This is the marks the
+per axis (``number_format``; boxes are closed, as in ``Environment``). This is the marks the
 coherent oracle flips (``reachable_reference``), computed here without the circuit's
 decomposition (no digits, no thresholds folded into offsets), so that the two can check each
 other.

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..planners.database import AnnealingSchedule
 from ..reachability.dynamics import LinearTrackingDynamics
-from ..search.policies.iteration import FixedIterations
+from ..search.policies.schedules import FixedIterations
 from .base import Experiment, PaperComparison, PaperNumber, Record, Settings, Summary, Trial, TrialStream, paired_trials
 from .figures import new_figure, save, tree_on_world
 from .intervals import bootstrap_interval, differs, rounded_interval

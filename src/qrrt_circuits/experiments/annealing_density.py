@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from ..planners.database import AnnealingSchedule
-from ..search.policies.iteration import FixedIterations
+from ..search.policies.schedules import FixedIterations
 from ..world.scenarios import CLUTTER_BOXES, CLUTTER_SIZE
 from .base import (
     Experiment,

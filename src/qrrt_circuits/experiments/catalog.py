@@ -2,7 +2,7 @@
 
 from .annealing import Annealing
 from .annealing_density import AnnealingDensity
-from .coherent_oracle import CoherentOracle
+from .coherent_oracle import CoherentOracleExperiment
 from .corridor import Corridor
 from .corridor_sensitivity import CorridorSensitivity
 from .corridor_worlds import CorridorWorlds
@@ -25,7 +25,7 @@ EXPERIMENTS = {
     for experiment in (OracleEfficiency(), Wallclock(), Heatmaps(), Corridor(), Annealing(), Lemmas(),
                        Scaling(), OracleCheck(), TreeSize(), HeatmapHypotheses(), HeatmapWorlds(),
                        CorridorSensitivity(), CorridorWorlds(), SearchPolicies(), Noise(), Resources(),
-                       AnnealingDensity(), Problems(), CoherentOracle())
+                       AnnealingDensity(), Problems(), CoherentOracleExperiment())
 }
 
 __all__ = ["EXPERIMENTS"]

@@ -94,7 +94,7 @@ def _grover_instance(index_bits: int, seed: int) -> tuple[Any, Any, Any]:
     return env, database, SampledMotion.from_dynamics(LinearTrackingDynamics.paper(), 4, bits)
 
 
-class CoherentOracle(Experiment):
+class CoherentOracleExperiment(Experiment):
     """The coherent reachability oracle: verified, searched on Aer, costed (module docstring)."""
 
     name = "coherent-oracle"

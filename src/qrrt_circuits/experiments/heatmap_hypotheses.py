@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from ..search.policies.iteration import FixedIterations, PaperIterations
+from ..search.policies.schedules import FixedIterations, PaperIterations
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import bootstrap_ratio_interval, differs, rounded_interval

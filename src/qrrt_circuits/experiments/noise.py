@@ -30,7 +30,8 @@ from ..hardware import noise
 from ..probability import good_probability
 from ..registry import PLANNERS, PREDICATES
 from ..search.backends.noisy import depolarizing_backend, fake_device_backend
-from ..search.policies.iteration import Adaptive, KnownOptimal
+from ..search.policies.adaptive import Adaptive
+from ..search.policies.schedules import KnownOptimal
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import binomial_interval, bootstrap_interval, rounded_interval
@@ -41,7 +42,7 @@ if TYPE_CHECKING:
     from numpy.typing import ArrayLike
     from qiskit import QuantumCircuit
 
-    from ..search.policies.iteration import IterationPolicy
+    from ..search.policies.base import IterationPolicy
 
 #: label -> q-RRT's search policy (its class)
 QRRT_CONFIGS: dict[str, Callable[[], IterationPolicy]] = {"QRRT adaptive": Adaptive, "QRRT optimal": KnownOptimal}

@@ -7,12 +7,13 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from ..registry import BACKENDS, PLANNERS, POLICIES, PREDICATES
-from ..search.policies.iteration import IterationPolicy, PaperIterations
+from ..search.policies.base import IterationPolicy
+from ..search.policies.schedules import PaperIterations
 
 if TYPE_CHECKING:
     from ..planners.base import Planner
     from ..reachability.predicate import ReachabilityPredicate
-    from ..search.backend import QuantumSearchBackend
+    from ..search.backends.base import QuantumSearchBackend
     from ..world.environment import Environment
 
 #: how each backend is described in summaries

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..hardware import resources as res
 from ..registry import PLANNERS, PREDICATES
-from ..search.policies.iteration import PaperIterations
+from ..search.policies.schedules import PaperIterations
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save, with_intervals
 from .intervals import MIN_BOOTSTRAP_WORLDS, bootstrap_interval, rounded_interval

@@ -14,7 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..search.policies.iteration import BBHT, Adaptive, IterationPolicy, KnownOptimal
+from ..search.policies.adaptive import Adaptive
+from ..search.policies.base import IterationPolicy
+from ..search.policies.bbht import BBHT
+from ..search.policies.schedules import KnownOptimal
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .fitting import power_law_exponent

@@ -27,8 +27,8 @@ from typing import Any
 import numpy as np
 
 from ..registry import POLICIES
+from ..search.policies.base import IterationPolicy
 from ..search.policies.estimated import EstimatedOptimal, EstimatedOptimalState
-from ..search.policies.iteration import IterationPolicy
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, paired_trials
 from .figures import dodge, new_figure, save, with_intervals
 from .intervals import bootstrap_interval, bootstrap_ratio_interval, rounded_interval

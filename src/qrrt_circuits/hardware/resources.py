@@ -43,6 +43,7 @@ import numpy as np
 
 from .._support.validation import check_choice, check_int, check_positive_float
 from ..search.requests import validate_marks
+from ..search.synthesis import OracleSynthesis
 
 if TYPE_CHECKING:
     from qiskit import QuantumCircuit
@@ -105,7 +106,7 @@ def coupling_map(connectivity: str, num_qubits: int) -> CouplingMap | None:
     return CouplingMap.from_heavy_hex(HEAVY_HEX_DISTANCE)
 
 
-def iteration_circuit(marks: np.ndarray, synthesis: str = "diagonal") -> QuantumCircuit:
+def iteration_circuit(marks: np.ndarray, synthesis: str | OracleSynthesis = "diagonal") -> QuantumCircuit:
     """One Grover iteration Q = grover_operator(phase_oracle(marks, synthesis), H^n): one oracle call.
 
     Args:
@@ -126,7 +127,7 @@ def iteration_circuit(marks: np.ndarray, synthesis: str = "diagonal") -> Quantum
     return grover_operator(phase_oracle(marks, synthesis), state_preparation=uniform_preparation(n))
 
 
-def near_term_counts(marks: np.ndarray, synthesis: str = "diagonal", connectivity: str = "all-to-all",
+def near_term_counts(marks: np.ndarray, synthesis: str | OracleSynthesis = "diagonal", connectivity: str = "all-to-all",
                      optimization_level: int = 1) -> NearTermCount:
     """Two-qubit gate count and depth of one iteration on ``connectivity`` (see the module text).
 
@@ -145,14 +146,14 @@ def near_term_counts(marks: np.ndarray, synthesis: str = "diagonal", connectivit
         TypeError: A non-integer ``optimization_level``.
     """
     marks, n = validate_marks(marks)
-    check_choice(synthesis, "synthesis", ("diagonal", "mcz"))
+    synthesis = OracleSynthesis(check_choice(synthesis, "synthesis", (OracleSynthesis.DIAGONAL, OracleSynthesis.MCZ)))
     connectivity = check_choice(connectivity, "connectivity", CONNECTIVITIES)
     check_int(optimization_level, "optimization_level", 0, 3)
     if n > 14:
         raise ValueError(f"near_term_counts transpiles the circuit: n must be <= 14, got {n}")
     compiled = transpile_to(iteration_circuit(marks, synthesis), connectivity, optimization_level)
     used = {compiled.find_bit(q).index for inst in compiled.data for q in inst.qubits}
-    return NearTermCount(n, int(marks.sum()), synthesis, connectivity,
+    return NearTermCount(n, int(marks.sum()), synthesis.value, connectivity,
                          int(compiled.count_ops().get("cx", 0)),
                          int(compiled.depth(lambda inst: inst.operation.num_qubits == 2)),
                          int(compiled.depth()), len(used))

@@ -58,7 +58,7 @@ from .termination import (
 )
 
 if TYPE_CHECKING:
-    from ..search.policies.iteration import PolicyState
+    from ..search.policies.base import PolicyState
 
 __all__ = ["Metrics", "PlanResult", "Planner", "RunState"]
 

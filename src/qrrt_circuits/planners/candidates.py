@@ -28,7 +28,7 @@ from ..reachability.dynamics import LinearTrackingDynamics
 from .database import Database, stream_database
 
 if TYPE_CHECKING:
-    from ..search.backend import QuantumSearchBackend
+    from ..search.backends.base import QuantumSearchBackend
     from ..world.environment import Environment
     from .context import RoundView, WorkerContext
 

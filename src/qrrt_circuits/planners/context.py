@@ -25,8 +25,8 @@ from typing import Any, TypeVar
 from .._support.randomness import RandomStreams
 from ..reachability.oracle_errors import OracleErrorModel
 from ..reachability.predicate import ReachabilityPredicate
-from ..search.backend import QuantumSearchBackend
-from ..search.policies.iteration import PolicyState
+from ..search.backends.base import QuantumSearchBackend
+from ..search.policies.base import PolicyState
 from ..world.environment import Environment
 from ..world.spaces import StateSpace
 from .database import AnnealingSchedule

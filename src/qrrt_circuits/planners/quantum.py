@@ -30,8 +30,9 @@ from .._support.validation import check_bool, check_instance, check_int
 from ..reachability.dynamics import LinearTrackingDynamics
 from ..reachability.oracle_errors import OracleErrorModel
 from ..reachability.predicate import ReachabilityPredicate
-from ..search.backend import QuantumSearchBackend
-from ..search.policies.iteration import Adaptive, IterationPolicy, PolicyState
+from ..search.backends.base import QuantumSearchBackend
+from ..search.policies.adaptive import Adaptive
+from ..search.policies.base import IterationPolicy, PolicyState
 from ..search.policies.thompson import ThompsonIterations
 from ..world.environment import Environment
 from ..world.spaces import StateSpace

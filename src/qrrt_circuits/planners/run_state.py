@@ -11,7 +11,7 @@ from .termination import Progress
 from .tree import Tree
 
 if TYPE_CHECKING:  # annotations only (context imports the search modules)
-    from ..search.policies.iteration import PolicyState
+    from ..search.policies.base import PolicyState
     from .context import WorkerContext
 
 HISTORY_KEYS = ("oracle_calls", "critical_path", "nodes", "entries", "reachable")

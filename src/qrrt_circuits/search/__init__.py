@@ -11,27 +11,29 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from . import circuits
-    from .backend import QuantumSearchBackend, SearchRequest, SearchResult
     from .backends.aer import AerBackend
+    from .backends.base import QuantumSearchBackend, SearchRequest, SearchResult
     from .backends.sampler import SamplerBackend
     from .backends.statevector import StatevectorBackend
-    from .fixed_point import IterateSequence
+    from .iterate_sequence import IterateSequence
     from .policies.estimated import EstimatedOptimal
-    from .policies.fixed_point import FixedPointAmplification
+    from .policies.fixed_point_amplification import FixedPointAmplification
     from .problem import DatabaseSearch, SearchOutcome
+    from .synthesis import OracleSynthesis
 
 #: public name -> the submodule that defines it ("" for a submodule itself)
 _WHERE = {
     "AerBackend": ".backends.aer",
     "DatabaseSearch": ".problem",
     "EstimatedOptimal": ".policies.estimated",
-    "FixedPointAmplification": ".policies.fixed_point",
-    "IterateSequence": ".fixed_point",
-    "QuantumSearchBackend": ".backend",
+    "FixedPointAmplification": ".policies.fixed_point_amplification",
+    "IterateSequence": ".iterate_sequence",
+    "OracleSynthesis": ".synthesis",
+    "QuantumSearchBackend": ".backends.base",
     "SamplerBackend": ".backends.sampler",
     "SearchOutcome": ".problem",
-    "SearchRequest": ".backend",
-    "SearchResult": ".backend",
+    "SearchRequest": ".backends.base",
+    "SearchResult": ".backends.base",
     "StatevectorBackend": ".backends.statevector",
     "circuits": "",
 }
@@ -42,6 +44,7 @@ __all__ = [
     "EstimatedOptimal",
     "FixedPointAmplification",
     "IterateSequence",
+    "OracleSynthesis",
     "QuantumSearchBackend",
     "SamplerBackend",
     "SearchOutcome",

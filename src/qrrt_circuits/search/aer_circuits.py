@@ -45,8 +45,7 @@ from qiskit.circuit.library import DiagonalGate, MCPhaseGate, PauliGate, PhaseGa
 
 from .._support.validation import check_int
 from .requests import validate_iterations, validate_marks
-
-AER_SYNTHESES = ("auto", "diagonal", "mcz")
+from .synthesis import OracleSynthesis
 
 #: the largest group of qubits one Walsh-Hadamard block acts on (wider blocks cost more arithmetic
 #: per amplitude, narrower ones more instructions)
@@ -127,7 +126,7 @@ def _parts(num_qubits: int, block: int) -> _Parts:
     return _Parts(num_qubits, block)
 
 
-def simulation_synthesis(marks: np.ndarray) -> str:
+def simulation_synthesis(marks: np.ndarray) -> OracleSynthesis:
     """The oracle form Aer runs fastest (``"diagonal"`` or ``"mcz"``): a ``diagonal`` costs its
     2^n entries, the ``mcz`` form two instructions per flipped entry (min(m, N - m) of them).
 
@@ -143,17 +142,19 @@ def simulation_synthesis(marks: np.ndarray) -> str:
     return choose_simulation_synthesis(validate_marks(marks)[0])
 
 
-def choose_simulation_synthesis(marks: np.ndarray) -> str:
+def choose_simulation_synthesis(marks: np.ndarray) -> OracleSynthesis:
     """``simulation_synthesis`` of marks already validated (a bool array of length 2^n)."""
     return simulation_synthesis_for(marks.shape[0].bit_length() - 1, int(np.count_nonzero(marks)))
 
 
-def simulation_synthesis_for(num_qubits: int, marked: int) -> str:
+def simulation_synthesis_for(num_qubits: int, marked: int) -> OracleSynthesis:
     """``simulation_synthesis`` of any marks with m = ``marked`` entries among 2^n: ``"diagonal"``
     if 2^n <= ``ENTRIES_PER_INSTRUCTION`` (2 min(m, 2^n - m) + 1), else ``"mcz"``."""
     entries = 1 << num_qubits
     flipped = min(marked, entries - marked)
-    return "diagonal" if entries <= ENTRIES_PER_INSTRUCTION * (2 * flipped + 1) else "mcz"
+    if entries <= ENTRIES_PER_INSTRUCTION * (2 * flipped + 1):
+        return OracleSynthesis.DIAGONAL
+    return OracleSynthesis.MCZ
 
 
 def _sparse_oracles(parts: _Parts, marks: np.ndarray, iterations: int) -> tuple[list[list[Step]], float]:
@@ -194,7 +195,7 @@ def _x_string(parts: _Parts, mask: int) -> list[Step]:
 
 
 def aer_grover_circuit(
-    marks: np.ndarray, iterations: int, measure: bool = True, synthesis: str = "auto",
+    marks: np.ndarray, iterations: int, measure: bool = True, synthesis: str | OracleSynthesis = "auto",
     block: int = WALSH_HADAMARD_BLOCK,
 ) -> QuantumCircuit:
     """W|0>, ``iterations`` Grover iterations and (if ``measure``) measurement into the classical
@@ -274,7 +275,7 @@ class GroverProgram:
         return circuit
 
 
-def aer_grover_program(marks: np.ndarray, iterations: int, synthesis: str = "auto",
+def aer_grover_program(marks: np.ndarray, iterations: int, synthesis: str | OracleSynthesis = "auto",
                        block: int = WALSH_HADAMARD_BLOCK) -> GroverProgram:
     """The instructions of ``aer_grover_circuit(marks, iterations, synthesis=synthesis,
     block=block)`` as a ``GroverProgram`` (same arguments, same checks).
@@ -295,16 +296,15 @@ def aer_grover_program(marks: np.ndarray, iterations: int, synthesis: str = "aut
     """
     marks, n = validate_marks(marks)
     iterations = validate_iterations(iterations)
-    if synthesis not in AER_SYNTHESES:
-        raise ValueError(f"synthesis must be one of {AER_SYNTHESES}, got {synthesis!r}")
+    synthesis = OracleSynthesis.parse(synthesis)
     block = check_int(block, "block", 1, 10)
-    if synthesis == "auto":
+    if synthesis is OracleSynthesis.AUTO:
         synthesis = choose_simulation_synthesis(marks)
     parts = _parts(n, block)
     steps: list[Step] = list(parts.walsh)
     phase = 0.0
     if iterations:
-        if synthesis == "diagonal":
+        if synthesis is OracleSynthesis.DIAGONAL:
             signs = np.where(marks, -1.0, 1.0)
             first: Step = (_diagonal_gate(signs * parts.signs), parts.qubits)
             rest: Step = (_diagonal_gate(signs), parts.qubits) if iterations > 1 else first

@@ -28,10 +28,11 @@ from qiskit.circuit.library import DiagonalGate, grover_operator
 
 from .aer_circuits import aer_grover_circuit, simulation_synthesis
 from .requests import validate_iterations, validate_marks
+from .synthesis import OracleSynthesis
 
 __all__ = [
     "BASIS_GATES",
-    "SYNTHESES",
+    "OracleSynthesis",
     "ResourceCount",
     "ResourceEstimate",
     "aer_grover_circuit",
@@ -45,13 +46,11 @@ __all__ = [
     "uniform_preparation",
 ]
 
-#: the phase-oracle constructions ``phase_oracle(marks, synthesis=...)`` accepts
-SYNTHESES = ("auto", "diagonal", "mcz")
 #: the gate set ``resource_estimate`` transpiles to (IBM's native basis)
 BASIS_GATES = ("cx", "rz", "sx", "x")
 
 
-def phase_oracle(marks: np.ndarray, synthesis: str = "auto") -> QuantumCircuit:
+def phase_oracle(marks: np.ndarray, synthesis: str | OracleSynthesis = "auto") -> QuantumCircuit:
     """The paper's phase oracle X (Algorithm 2, line 7): a circuit on n qubits equal to diag((-1)^marks).
 
     Args:
@@ -69,12 +68,11 @@ def phase_oracle(marks: np.ndarray, synthesis: str = "auto") -> QuantumCircuit:
             ``synthesis``.
     """
     marks, n = validate_marks(marks)
-    if synthesis not in SYNTHESES:
-        raise ValueError(f"synthesis must be one of {SYNTHESES}, got {synthesis!r}")
-    if synthesis == "auto":
+    synthesis = OracleSynthesis.parse(synthesis)
+    if synthesis is OracleSynthesis.AUTO:
         synthesis = choose_synthesis(marks)
     circuit = QuantumCircuit(n, name="oracle")
-    if synthesis == "diagonal":
+    if synthesis is OracleSynthesis.DIAGONAL:
         circuit.append(DiagonalGate(np.where(marks, -1.0, 1.0).tolist()), range(n))
         return circuit
     full = (1 << n) - 1
@@ -126,7 +124,7 @@ def oracle_cx_estimate(num_qubits: int, num_marked: int) -> dict[str, int]:
     return {"diagonal": diagonal, "mcz": num_marked * _mcz_cx_count(num_qubits)}
 
 
-def choose_synthesis(marks: np.ndarray) -> str:
+def choose_synthesis(marks: np.ndarray) -> OracleSynthesis:
     """The oracle synthesis with the fewer estimated CX gates (``oracle_cx_estimate``).
 
     This is the hardware-cost choice that ``resource_estimate`` and
@@ -143,7 +141,7 @@ def choose_synthesis(marks: np.ndarray) -> str:
     """
     marks, n = validate_marks(marks)
     estimate = oracle_cx_estimate(n, int(np.count_nonzero(marks)))
-    return "mcz" if estimate["mcz"] < estimate["diagonal"] else "diagonal"
+    return OracleSynthesis.MCZ if estimate["mcz"] < estimate["diagonal"] else OracleSynthesis.DIAGONAL
 
 
 def uniform_preparation(num_qubits: int) -> QuantumCircuit:
@@ -166,7 +164,7 @@ def uniform_preparation(num_qubits: int) -> QuantumCircuit:
 
 
 def grover_circuit(
-    marks: np.ndarray, iterations: int, measure: bool = True, synthesis: str = "auto"
+    marks: np.ndarray, iterations: int, measure: bool = True, synthesis: str | OracleSynthesis = "auto"
 ) -> QuantumCircuit:
     """The Grover search circuit of one worker (paper Algorithm 2, lines 4-8).
 
@@ -203,7 +201,7 @@ def grover_circuit(
 
 
 def aer_literal_grover_circuit(
-    marks: np.ndarray, iterations: int, measure: bool = True, synthesis: str = "auto"
+    marks: np.ndarray, iterations: int, measure: bool = True, synthesis: str | OracleSynthesis = "auto"
 ) -> QuantumCircuit:
     """The Grover circuit gate by gate from Aer-native gates, for noisy simulation: H^n, then per
     iteration the oracle (``phase_oracle``: CX-based ``synthesis`` choice, as on hardware) followed
@@ -296,7 +294,7 @@ class ResourceEstimate:
 
 
 def resource_estimate(
-    marks: np.ndarray, iterations: int, synthesis: str = "auto", optimization_level: int = 1
+    marks: np.ndarray, iterations: int, synthesis: str | OracleSynthesis = "auto", optimization_level: int = 1
 ) -> ResourceEstimate:
     """Qubits, CX count and depth of the Grover circuit in the basis [cx, rz, sx, x].
 
@@ -331,7 +329,8 @@ def resource_estimate(
     iterations = validate_iterations(iterations)
     if n > 14:
         raise ValueError(f"resource_estimate transpiles the full circuit: n must be <= 14, got {n}")
-    chosen = choose_synthesis(marks) if synthesis == "auto" else synthesis
+    synthesis = OracleSynthesis.parse(synthesis)
+    chosen = choose_synthesis(marks) if synthesis is OracleSynthesis.AUTO else synthesis
     circuit = grover_circuit(marks, iterations, measure=False, synthesis=chosen)
     counts = []
     for ancillas in (0, 1):
@@ -341,4 +340,4 @@ def resource_estimate(
                              optimization_level=optimization_level, seed_transpiler=0)
         counts.append(ResourceCount(n + ancillas, int(compiled.count_ops().get("cx", 0)),
                                     int(compiled.depth()), int(compiled.size())))
-    return ResourceEstimate(n, int(np.count_nonzero(marks)), iterations, chosen, *counts)
+    return ResourceEstimate(n, int(np.count_nonzero(marks)), iterations, chosen.value, *counts)

@@ -7,7 +7,7 @@ iterative amplitude estimation (``"iae"``; Grinko, Gacon, Zoufal and Woerner, np
 
 The ``EstimationProblem`` is built from our circuits: the state preparation A = H^n (the paper's
 W), the Grover operator Q = one standard iterate (phase oracle diag((-1)^marks), then the
-inversion about the mean; ``circuits.phase_oracle`` and ``fixed_point.append_state_reflection``
+inversion about the mean; ``circuits.phase_oracle`` and ``iterate_sequence.append_state_reflection``
 with alpha = pi), and the good states are the marked indices (all n qubits are objective qubits;
 a measured bitstring b is index int(b, 2), Qiskit's little-endian order). qiskit-algorithms'
 estimators run Q^k A|0> circuits through a ``SamplerV2``: here qiskit-aer's
@@ -44,8 +44,9 @@ from qiskit.primitives import BaseSamplerV2
 from qiskit.primitives.containers.sampler_pub import SamplerPub
 
 from .circuits import phase_oracle
-from .fixed_point import append_state_reflection
+from .iterate_sequence import append_state_reflection
 from .requests import validate_marks
+from .synthesis import OracleSynthesis
 
 if TYPE_CHECKING:
     from qiskit.primitives import PrimitiveJob
@@ -55,7 +56,7 @@ if TYPE_CHECKING:
 AER_NATIVE = frozenset({"h", "x", "p", "diagonal", "mcphase", "measure", "barrier", "unitary"})
 
 
-def grover_iterate(marks: np.ndarray, synthesis: str = "auto") -> QuantumCircuit:
+def grover_iterate(marks: np.ndarray, synthesis: str | OracleSynthesis = "auto") -> QuantumCircuit:
     """Q = -S_s(pi) S_t(pi): the phase oracle, then the inversion about the mean (Aer-native).
 
     One standard Grover iterate (the paper's Alg. 2 / 3 loop body; Yoder et al.'s G(pi, pi)).
@@ -78,7 +79,7 @@ def grover_iterate(marks: np.ndarray, synthesis: str = "auto") -> QuantumCircuit
     return circuit
 
 
-def estimation_problem(marks: np.ndarray, synthesis: str = "auto") -> EstimationProblem:
+def estimation_problem(marks: np.ndarray, synthesis: str | OracleSynthesis = "auto") -> EstimationProblem:
     """qiskit-algorithms' ``EstimationProblem`` for the marked fraction a = m / N of ``marks``.
 
     State preparation A = H^n (the paper's W), Grover operator ``grover_iterate(marks)``, all n
@@ -343,7 +344,7 @@ def likelihood_ratio_interval(theta_mle: float, powers: Sequence[int], good_coun
 
 def estimate_marked_fraction(marks: np.ndarray, *, alpha: float, shots: int, rng: np.random.Generator,
                              method: str = "mlae", schedule: int = 3, epsilon: float = 0.05,
-                             synthesis: str = "auto") -> AmplitudeEstimate:
+                             synthesis: str | OracleSynthesis = "auto") -> AmplitudeEstimate:
     """Estimate the marked fraction of ``marks`` with confidence 1 - ``alpha`` on a seeded Aer
     ``SamplerV2`` of ``shots`` shots per circuit.
 

@@ -22,10 +22,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .._support.randomness import RandomStreams, Stream
-from .backend import QuantumSearchBackend
+from .backends.base import QuantumSearchBackend
 
 if TYPE_CHECKING:
-    from .fixed_point import IterateSequence
+    from .iterate_sequence import IterateSequence
 
 
 @dataclass(frozen=True)

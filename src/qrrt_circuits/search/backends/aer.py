@@ -26,15 +26,16 @@ from qiskit_aer import AerSimulator
 
 from ..._support.validation import check_int
 from ..aer_circuits import simulation_synthesis_for
-from ..backend import QuantumSearchBackend, seed_stream
-from ..circuits import SYNTHESES, aer_grover_circuit, aer_literal_grover_circuit, oracle_cx_estimate
-from ..fixed_point import generalized_grover_circuit
+from ..circuits import aer_grover_circuit, aer_literal_grover_circuit, oracle_cx_estimate
+from ..iterate_sequence import generalized_grover_circuit
+from ..synthesis import OracleSynthesis
+from .base import QuantumSearchBackend, seed_stream
 
 if TYPE_CHECKING:
     from qiskit import QuantumCircuit
     from qiskit_aer.noise import NoiseModel
 
-    from ..fixed_point import IterateSequence
+    from ..iterate_sequence import IterateSequence
 
 METHODS = ("statevector", "automatic")
 #: circuits on fewer qubits run single-threaded (Aer's default statevector_parallel_threshold)
@@ -70,7 +71,7 @@ class AerBackend(QuantumSearchBackend):
             and ``"matrix_product_state"`` are refused (``UNSUPPORTED_METHODS``: their
             instruction sets lack the ``mcphase`` gate of the circuit).
         synthesis: The oracle's form: ``"auto"`` (``simulation_synthesis``, or with a noise model
-            the CX-based ``choose_synthesis``), ``"diagonal"`` or ``"mcz"`` (``SYNTHESES``).
+            the CX-based ``choose_synthesis``), ``"diagonal"`` or ``"mcz"`` (``OracleSynthesis``).
         noise_model: A ``qiskit_aer.noise.NoiseModel`` passed to the simulator as is, or None.
             With one, the gate-by-gate circuit runs, so per-gate noise acts on the paper's gates.
         device: One of ``AerSimulator().available_devices()`` for this qiskit-aer build:
@@ -99,7 +100,7 @@ class AerBackend(QuantumSearchBackend):
         self,
         seed: int | np.random.Generator | None = None,
         method: str = "statevector",
-        synthesis: str = "auto",
+        synthesis: str | OracleSynthesis = "auto",
         noise_model: NoiseModel | None = None,
         device: str = "CPU",
         max_parallel_threads: int = 0,
@@ -115,8 +116,7 @@ class AerBackend(QuantumSearchBackend):
         if device not in available:
             raise ValueError(f"device must be one of {tuple(available)} for this qiskit-aer build, got {device!r} "
                              "(device='GPU' needs qiskit-aer-gpu and an NVIDIA GPU)")
-        if synthesis not in SYNTHESES:
-            raise ValueError(f"synthesis must be one of {SYNTHESES}, got {synthesis!r}")
+        synthesis = OracleSynthesis.parse(synthesis)
         check_int(max_parallel_threads, "max_parallel_threads", 0, 4096)
         self._rng = seed_stream(seed)
         self.method = method
@@ -154,14 +154,14 @@ class AerBackend(QuantumSearchBackend):
     #: form's bound whenever ``simulation_synthesis`` picks ``mcz`` (f < 2^n / 600)
     AER_BYTES_PER_MCZ_INSTRUCTION = 4096
 
-    def synthesis_for(self, num_qubits: int) -> str:
+    def synthesis_for(self, num_qubits: int) -> OracleSynthesis:
         """The ``synthesis`` a circuit on ``num_qubits`` qubits is built with: the constructor's,
         except ``"auto"`` on the GPU above ``GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS`` qubits, which is
         ``"mcz"`` (Aer's GPU buffer for an n-qubit diagonal is 16 * 4^n bytes). The device is read
         from the simulator's options, so one set there after construction counts too."""
         on_gpu = getattr(self.simulator.options, "device", self.device) == "GPU"
-        if self.synthesis == "auto" and on_gpu and num_qubits > GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS:
-            return "mcz"
+        if self.synthesis is OracleSynthesis.AUTO and on_gpu and num_qubits > GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS:
+            return OracleSynthesis.MCZ
         return self.synthesis
 
     @property
@@ -169,7 +169,7 @@ class AerBackend(QuantumSearchBackend):
         """Whether searches build the gate-by-gate circuit (a noise model at construction)."""
         return self._build is aer_literal_grover_circuit
 
-    def oracle_form(self, num_qubits: int, marked: int) -> str:
+    def oracle_form(self, num_qubits: int, marked: int) -> OracleSynthesis:
         """The oracle form a search of m = ``marked`` entries among 2^n is built with:
         ``synthesis_for(n)`` where it names one; else (``"auto"``) ``simulation_synthesis``'s
         choice (``"mcz"`` when 2^n > ENTRIES_PER_INSTRUCTION (2 min(m, 2^n - m) + 1)), or with a
@@ -235,9 +235,9 @@ class AerBackend(QuantumSearchBackend):
             check_int(marked, "marked", 0, entries)
         diagonal = (self.AER_BYTES_PER_ENTRY + self.AER_BYTES_PER_ENTRY_PER_ITERATION * iterations) << num_qubits
         synthesis = self.synthesis_for(num_qubits) if marked is None else self._form(num_qubits, marked, literal)
-        if synthesis == "diagonal":
+        if synthesis is OracleSynthesis.DIAGONAL:
             body = diagonal
-        elif synthesis == "mcz":
+        elif synthesis is OracleSynthesis.MCZ:
             worst = marked if marked is not None else (entries if literal else entries // 2)
             body = self._mcz_bytes(num_qubits, iterations, worst, literal)
         elif literal:  # "auto" over every m: the CX-based choice takes the mcz form only while m c_n < 2^n - 2,
@@ -248,16 +248,16 @@ class AerBackend(QuantumSearchBackend):
             body = diagonal  # simulation_synthesis picks the mcz form only where it is the smaller
         return body + self.BYTES_PER_SHOT * shots
 
-    def _form(self, num_qubits: int, marked: int, literal: bool) -> str:
+    def _form(self, num_qubits: int, marked: int, literal: bool) -> OracleSynthesis:
         """The form built for m marked entries: ``synthesis_for(n)`` where it names one; for
         ``"auto"`` the CX-based choice in the gate-by-gate circuit (an MCZ's CX count is transpiled
         once per n and cached), else ``simulation_synthesis``'s."""
         synthesis = self.synthesis_for(num_qubits)
-        if synthesis != "auto":
+        if synthesis is not OracleSynthesis.AUTO:
             return synthesis
         if literal:
             estimate = oracle_cx_estimate(num_qubits, marked)
-            return "mcz" if estimate["mcz"] < estimate["diagonal"] else "diagonal"
+            return OracleSynthesis.MCZ if estimate["mcz"] < estimate["diagonal"] else OracleSynthesis.DIAGONAL
         return simulation_synthesis_for(num_qubits, marked)
 
     def _mcz_bytes(self, num_qubits: int, iterations: int, marked: int, literal: bool) -> int:

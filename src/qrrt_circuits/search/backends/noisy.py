@@ -22,6 +22,7 @@ import numpy as np
 
 from ..._support.validation import check_choice, check_probability
 from ...hardware.noise import depolarizing_noise_model, fake_device
+from ..synthesis import OracleSynthesis
 from .sampler import SamplerBackend
 
 if TYPE_CHECKING:
@@ -54,7 +55,7 @@ class NoisySamplerBackend(SamplerBackend):
     name = "noisy-sampler"
 
     def __init__(self, sampler: BaseSamplerV2, noise: str, backend: BackendV2 | None = None,
-                 seed: int | np.random.Generator | None = None, synthesis: str = "auto") -> None:
+                 seed: int | np.random.Generator | None = None, synthesis: str | OracleSynthesis = "auto") -> None:
         super().__init__(sampler, backend=backend, seed=seed, synthesis=synthesis)
         self.noise = noise
 
@@ -68,7 +69,8 @@ class NoisySamplerBackend(SamplerBackend):
 
 
 def depolarizing_backend(p1: float, p2: float, method: str = "statevector",
-                         seed: int | np.random.Generator | None = None, synthesis: str = "auto") -> NoisySamplerBackend:
+                         seed: int | np.random.Generator | None = None,
+                         synthesis: str | OracleSynthesis = "auto") -> NoisySamplerBackend:
     """Aer's SamplerV2 with depolarizing errors p1 (sx, x) and p2 (cx) after transpiling to [cx, rz, sx, x].
 
     The noise model is ``qrrt_circuits.hardware.noise.depolarizing_noise_model(p1, p2)`` on an all-to-all

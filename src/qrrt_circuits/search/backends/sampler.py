@@ -21,16 +21,17 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from qiskit.transpiler import generate_preset_pass_manager
 
-from ..backend import QuantumSearchBackend, seed_stream
-from ..circuits import BASIS_GATES, SYNTHESES, grover_circuit
-from ..fixed_point import generalized_grover_circuit
+from ..circuits import BASIS_GATES, grover_circuit
+from ..iterate_sequence import generalized_grover_circuit
+from ..synthesis import OracleSynthesis
+from .base import QuantumSearchBackend, seed_stream
 
 if TYPE_CHECKING:
     from qiskit import QuantumCircuit
     from qiskit.primitives import BaseSamplerV2
     from qiskit.providers import BackendV2
 
-    from ..fixed_point import IterateSequence
+    from ..iterate_sequence import IterateSequence
 
 
 #: held from setting a per-call seed on a sampler to its run's result (samplers may be shared)
@@ -92,12 +93,11 @@ class SamplerBackend(QuantumSearchBackend):
     BYTES_PER_SHOT = 400
 
     def __init__(self, sampler: BaseSamplerV2, backend: BackendV2 | None = None, optimization_level: int = 1,
-                 synthesis: str = "auto", cache_size: int = 128, max_qubits: int | None = None,
+                 synthesis: str | OracleSynthesis = "auto", cache_size: int = 128, max_qubits: int | None = None,
                  seed: int | np.random.Generator | None = None) -> None:
         if not hasattr(sampler, "run"):
             raise ValueError("sampler must be a qiskit BaseSamplerV2 (an object with .run(pubs, shots=...))")
-        if synthesis not in SYNTHESES:
-            raise ValueError(f"synthesis must be one of {SYNTHESES}, got {synthesis!r}")
+        synthesis = OracleSynthesis.parse(synthesis)
         if optimization_level not in (0, 1, 2, 3):
             raise ValueError(f"optimization_level must be 0, 1, 2 or 3, got {optimization_level}")
         self.sampler = sampler

@@ -17,12 +17,12 @@ import numpy as np
 
 from ..._support.validation import check_bool, check_int
 from ...probability import good_probability
-from ..backend import QuantumSearchBackend
-from ..fixed_point import statevector_after
+from ..iterate_sequence import statevector_after
 from ..requests import seed_stream, validate_iterations, validate_marks
+from .base import QuantumSearchBackend
 
 if TYPE_CHECKING:
-    from ..fixed_point import IterateSequence
+    from ..iterate_sequence import IterateSequence
 
 BYTES_PER_ENTRY = 32  # amplitudes (8) + probabilities (8) + index lists (8) + marks, with slack
 

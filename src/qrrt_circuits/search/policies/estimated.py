@@ -24,7 +24,7 @@ from ..._support.validation import check_choice, check_float, check_int
 from ...probability import optimal_iterations
 from ..estimation import METHODS, AmplitudeEstimate, estimate_marked_fraction
 from ..problem import DatabaseSearch, SearchOutcome
-from .iteration import IterationPolicy, PolicyState
+from .base import IterationPolicy, PolicyState
 
 __all__ = ["EstimatedOptimal", "EstimatedOptimalState"]
 

@@ -53,7 +53,7 @@ import numpy as np
 from ..._support.validation import check_choice, check_float, check_optional_int
 from ...probability import optimal_iterations
 from ..problem import DatabaseSearch, SearchOutcome
-from .iteration import IterationPolicy, PolicyState, verified_outcomes
+from .base import IterationPolicy, PolicyState, verified_outcomes
 
 __all__ = ["ThompsonIterations", "ThompsonState"]
 

@@ -10,7 +10,7 @@ Oracle calls are counted as DESIGN §2 says: one per Grover iteration per prepar
 ``oracle_calls = iterations * shots``.
 
 ``search_sequence(marks, sequence, shots, seed)`` runs generalized iterates G(alpha_j, beta_j)
-instead (an ``IterateSequence``, ``search/fixed_point.py``: fixed-point amplitude amplification);
+instead (an ``IterateSequence``, ``search/iterate_sequence.py``: fixed-point amplitude amplification);
 each iterate queries the oracle once, so ``oracle_calls = len(sequence) * shots`` as well.
 
 Memory: each call of ``search``, ``search_many`` and ``search_sequence`` checks its estimated peak
@@ -28,10 +28,10 @@ from typing import TYPE_CHECKING, TypeAlias, TypeVar
 
 import numpy as np
 
-from .._support import memory
-from .._support.memory import MemoryEstimate, OutOfMemory, check_fits, out_of_memory
-from .._support.validation import check_seed
-from .requests import (
+from ..._support import memory
+from ..._support.memory import MemoryEstimate, OutOfMemory, check_fits, out_of_memory
+from ..._support.validation import check_seed
+from ..requests import (
     MAX_ITERATIONS,
     MAX_SHOTS,
     SearchRequest,
@@ -44,7 +44,7 @@ from .requests import (
 )
 
 if TYPE_CHECKING:
-    from .fixed_point import IterateSequence
+    from ..iterate_sequence import IterateSequence
 
 #: a validated request: (marks, num_qubits, iterations, shots, rng)
 _Prepared: TypeAlias = tuple[np.ndarray, int, int, int, "int | np.random.Generator | None"]
@@ -372,7 +372,7 @@ class QuantumSearchBackend(abc.ABC):
     def _prepare_sequence(self, marks: np.ndarray, sequence: IterateSequence,
                           shots: int) -> tuple[np.ndarray, int, int]:
         """(marks, n, shots) of a validated ``search_sequence`` call."""
-        from .fixed_point import IterateSequence
+        from ..iterate_sequence import IterateSequence
 
         marks, num_qubits = validate_marks(marks)
         if not isinstance(sequence, IterateSequence):

@@ -13,7 +13,7 @@ from tolerances import binomial_counts, within_binomial
 import qrrt_circuits as qc
 from qrrt_circuits.probability import good_probability
 from qrrt_circuits.registry import POLICIES
-from qrrt_circuits.search.fixed_point import (
+from qrrt_circuits.search.iterate_sequence import (
     IterateSequence,
     fixed_point_iterates,
     fixed_point_phases,

@@ -40,6 +40,7 @@ import numpy as np
 
 from .._support.validation import check_float, check_int
 from .requests import MAX_ITERATIONS, validate_marks
+from .synthesis import OracleSynthesis
 
 if TYPE_CHECKING:
     from qiskit import QuantumCircuit
@@ -63,7 +64,7 @@ def chebyshev(order: float, x: float) -> float:
         ValueError: x < -1.
 
     Example:
-        >>> from qrrt_circuits.search.fixed_point import chebyshev
+        >>> from qrrt_circuits.search.iterate_sequence import chebyshev
         >>> round(chebyshev(2, 0.5), 6)  # T_2(x) = 2 x^2 - 1
         -0.5
     """
@@ -143,7 +144,7 @@ def fixed_point_iterates(delta: float, min_fraction: float, length_rule: str = "
             ``length_rule``.
 
     Example:
-        >>> from qrrt_circuits.search.fixed_point import fixed_point_iterates
+        >>> from qrrt_circuits.search.iterate_sequence import fixed_point_iterates
         >>> fixed_point_iterates(0.5, 0.05)
         3
     """
@@ -205,7 +206,7 @@ def fixed_point_success_probability(delta: float, iterates: int, fraction: float
             range.
 
     Example:
-        >>> from qrrt_circuits.search.fixed_point import fixed_point_success_probability
+        >>> from qrrt_circuits.search.iterate_sequence import fixed_point_success_probability
         >>> round(fixed_point_success_probability(0.5, 3, 0.05), 4)  # >= 1 - 0.5^2
         0.9003
     """
@@ -370,7 +371,7 @@ def statevector_after(marks: np.ndarray, sequence: IterateSequence) -> np.ndarra
 
 
 # ----------------------------------------------------------------------------------------- circuits
-def phase_oracle_beta(marks: np.ndarray, beta: float, synthesis: str = "diagonal") -> QuantumCircuit:
+def phase_oracle_beta(marks: np.ndarray, beta: float, synthesis: str | OracleSynthesis = "diagonal") -> QuantumCircuit:
     """S_t(beta) = diag(e^{i beta marks}) on n qubits. ``"diagonal"``: one ``DiagonalGate``;
     ``"mcz"``: one multi-controlled phase(beta) per marked index, conjugated by X on its zero bits
     (``"auto"`` picks the cheaper as ``circuits.choose_synthesis`` does).
@@ -386,18 +387,17 @@ def phase_oracle_beta(marks: np.ndarray, beta: float, synthesis: str = "diagonal
     Raises:
         ValueError: ``marks`` not of length 2^n or not boolean, or an unknown ``synthesis``.
     """
-    from .circuits import SYNTHESES, _flip, choose_synthesis
+    from .circuits import _flip, choose_synthesis
 
     marks, n = validate_marks(marks)
-    if synthesis not in SYNTHESES:
-        raise ValueError(f"synthesis must be one of {SYNTHESES}, got {synthesis!r}")
-    if synthesis == "auto":
+    synthesis = OracleSynthesis.parse(synthesis)
+    if synthesis is OracleSynthesis.AUTO:
         synthesis = choose_synthesis(marks)
     from qiskit import QuantumCircuit
     from qiskit.circuit.library import DiagonalGate
 
     circuit = QuantumCircuit(n, name=f"oracle({beta:.3f})")
-    if synthesis == "diagonal":
+    if synthesis is OracleSynthesis.DIAGONAL:
         circuit.append(DiagonalGate(np.where(marks, np.exp(1j * beta), 1.0).tolist()), range(n))
         return circuit
     full = (1 << n) - 1
@@ -436,7 +436,7 @@ def append_state_reflection(circuit: QuantumCircuit, alpha: float) -> None:
 
 
 def generalized_grover_circuit(marks: np.ndarray, sequence: IterateSequence, measure: bool = True,
-                               synthesis: str = "auto") -> QuantumCircuit:
+                               synthesis: str | OracleSynthesis = "auto") -> QuantumCircuit:
     """H^n |0>, then G(alpha_j, beta_j) = -S_s(alpha_j) S_t(beta_j) for j = 1..l, from gates Aer runs
     natively (h, x, diagonal, mcphase); the sign of each G is the circuit's global phase, so the
     circuit's operator equals the product of the G's times H^n exactly. Measured into ``meas``.

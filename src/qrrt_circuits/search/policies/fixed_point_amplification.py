@@ -1,5 +1,5 @@
 """``FixedPointAmplification``: a search policy that cannot overshoot (Yoder, Low and Chuang, PRL
-113, 210501, 2014; circuits and phases in ``search/fixed_point.py``).
+113, 210501, 2014; circuits and phases in ``search/iterate_sequence.py``).
 
 Every worker runs the same sequence of l generalized Grover iterates, chosen once from the target
 error ``delta`` and the lower bound ``min_fraction`` = w on the marked fraction, then measures
@@ -17,8 +17,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..backend import QuantumSearchBackend
-from ..fixed_point import (
+from ..backends.base import QuantumSearchBackend
+from ..iterate_sequence import (
     LENGTH_RULES,
     IterateSequence,
     check_delta,
@@ -28,7 +28,7 @@ from ..fixed_point import (
 )
 from ..problem import DatabaseSearch, SearchOutcome
 from ..requests import MAX_ITERATIONS
-from .iteration import IterationPolicy, PolicyState
+from .base import IterationPolicy, PolicyState
 
 __all__ = ["FixedPointAmplification", "FixedPointState"]
 

@@ -1,0 +1,229 @@
+"""``qrrt plan``: plan on a scenario, a scenario file or a problem file; print, plot, write JSON."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+
+    from ...planners.base import Planner
+    from ...planners.result import PlanResult
+    from ...world.environment import Environment
+    from ...world.problems import Problem
+
+
+
+PLOT_FORMATS = (".png", ".pdf", ".svg", ".jpg", ".jpeg")
+
+
+def _load_environment(args: argparse.Namespace) -> Environment:
+    if args.scenario_file:
+        from ...world.environment import Environment
+
+        if Path(args.scenario_file).is_dir():
+            raise ValueError(f"--scenario-file: {args.scenario_file!r} is a folder, not a scenario file")
+        if not Path(args.scenario_file).is_file():
+            raise ValueError(f"--scenario-file: no such file {args.scenario_file!r}")
+        return Environment.load(args.scenario_file)
+    from ...registry import SCENARIOS
+
+    return SCENARIOS.create(args.scenario, seed=args.scenario_seed)
+
+
+def _load_problem(args: argparse.Namespace) -> Problem | None:
+    """The ``--problem`` file's problem, or None; refused beside the options it replaces."""
+    if args.problem is None:
+        return None
+    given = [option for option, given in (("--scenario-file", args.scenario_file is not None),
+                                          ("--scenario", args.scenario != "paper_clutter"),
+                                          ("--predicate", args.predicate != "exact")) if given]
+    if given:
+        raise ValueError(f"--problem fixes the world and the motion check: leave out {', '.join(given)}")
+    if Path(args.problem).is_dir():
+        raise ValueError(f"--problem: {args.problem!r} is a folder, not a problem file")
+    from ...world.problems import load_problem
+
+    return load_problem(args.problem)
+
+
+#: ``qrrt plan``'s options that only some planners take: option -> (the planner's keyword, the
+#: default used where the planner takes it and the option is not given)
+PLANNER_SPECIFIC_OPTIONS: dict[str, tuple[str, Any]] = {
+    "qubits": ("num_qubits", 8),
+    "workers": ("workers", 8),
+    "backend": ("backend", "aer"),
+    "policy": ("search_policy", None),  # None: the planner's own default
+}
+
+
+def _planner_specific(args: argparse.Namespace) -> dict[str, Any]:
+    """The planner-specific options of ``args`` (``PLANNER_SPECIFIC_OPTIONS``), defaults filled in
+    for the ones the planner takes; one that was given but that the planner does not take is
+    refused (``ValueError``) instead of being ignored."""
+    from ...registry import PLANNERS
+
+    accepted = PLANNERS.resolve(args.planner).options()
+    given = vars(args)
+    chosen: dict[str, Any] = {}
+    for option, (keyword, default) in PLANNER_SPECIFIC_OPTIONS.items():
+        value = given.get(option)
+        if keyword in accepted:
+            chosen[option] = default if value is None else value
+        elif value is not None:
+            takers = [name for name in PLANNERS.names() if keyword in PLANNERS.resolve(name).options()]
+            raise ValueError(f"--{option} does not apply to --planner {args.planner} (it applies to "
+                             f"{', '.join(takers)}); leave it out")
+    return chosen
+
+
+def build_planner(args: argparse.Namespace, env: Environment, name: str | None = None,
+                  problem: Problem | None = None) -> Planner:
+    """The planner the arguments name (or planner ``name`` with the same options, as far as it
+    takes them), with only the options that apply to it; a planner-specific option given to a
+    planner that does not take it (``--qubits`` with ``rrt``) is refused."""
+    from ...registry import BACKENDS, PLANNERS, POLICIES, PREDICATES
+
+    specific = _planner_specific(args)
+    options: dict[str, Any] = {"goal_bias": args.goal_bias, "max_extension": args.max_extension, "seed": args.seed}
+    options |= problem.planner_options() if problem is not None else {
+        "predicate": PREDICATES.create(args.predicate, env=env)}
+    made: dict[str, Callable[[Any], Any]] = {"backend": lambda name: BACKENDS.create(name, seed=args.seed),
+                                             "policy": lambda name: None if name is None else POLICIES.create(name)}
+    for option, value in specific.items():  # each under the planner's keyword, backends and policies made
+        options[PLANNER_SPECIFIC_OPTIONS[option][0]] = made[option](value) if option in made else value
+    chosen = name or args.planner
+    planner: Planner = PLANNERS.create(chosen, env=env, **PLANNERS.applicable(chosen, options))
+    return planner
+
+
+#: the classical planner each quantum planner is compared with: the same round structure without
+#: quantum search (one worker for q-RRT, p workers on one tree snapshot for Pq-RRT)
+CLASSICAL_PEERS = {"qrrt": "rrt", "pqrrt": "prrt", "pqrrt-unshared": "prrt"}
+#: the share of verified measurements above which the output says the iterations over-rotate
+OVER_ROTATION_SHARE = 0.5
+
+
+def _print_comparison(result: PlanResult, peer: PlanResult) -> None:
+    """The quantum plan beside its classical peer's, in the same world and with the same seed,
+    predicate and limits; the critical path named; a note where most measurements failed."""
+    rows: list[tuple[str, Callable[[PlanResult], str]]] = [
+        ("status", lambda r: f"{r.status}{' (safety limit)' if r.safety_limit else ''}"),
+        ("nodes", lambda r: str(r.metrics.nodes)),
+        ("oracle calls", lambda r: str(r.metrics.oracle_calls)),
+        ("oracle calls per node", lambda r: _per_node(r.metrics.oracle_calls, r)),
+        ("critical-path calls", lambda r: str(r.metrics.critical_path_oracle_calls)),
+        ("critical-path calls per node", lambda r: _per_node(r.metrics.critical_path_oracle_calls, r)),
+        ("wall ms per node", lambda r: _per_node(r.metrics.wall_time_s * 1e3, r)),
+    ]
+    print(f"beside {peer.planner} (the same world, seed, predicate and limits; `--no-compare` skips it):")
+    print(f"  {'':30s} {result.planner:>14s} {peer.planner:>14s}")
+    for label, value in rows:
+        print(f"  {label:30s} {value(result):>14s} {value(peer):>14s}")
+    print("  (critical-path calls: per round, the most calls any one worker made: the time of parallel devices)")
+    metrics = result.metrics
+    if metrics.verification_calls and metrics.rejected / metrics.verification_calls > OVER_ROTATION_SHARE:
+        entries = int(result.history["entries"].sum())
+        share = int(result.history["reachable"].sum()) / entries if entries else 0.0
+        print(f"note: {metrics.rejected / metrics.verification_calls:.0%} of the measured candidates failed "
+              f"verification. {share:.0%} of the databases' entries were reachable on average; a fixed "
+              "iteration count tuned for a small share over-rotates past the peak of sin^2((2k+1)theta) "
+              "as the share grows, and BBHT's random counts miss often by design. --policy thompson or adaptive "
+              "learn the iteration count from verified outcomes.")
+
+
+def _per_node(value: float, result: PlanResult) -> str:
+    return f"{value / result.metrics.nodes:.2f}" if result.metrics.nodes else "-"
+
+
+def _print_plan(result: PlanResult, env: Environment, seed: int) -> None:
+    metrics = result.metrics
+    print(f"{result.planner} on {env.name} (seed {seed}): {result.status}: {result.status_text}")
+    for key, value in result.settings.items():
+        if key in ("start", "goal", "termination", "oracle_errors", "dynamics"):
+            continue
+        if isinstance(value, dict):  # the predicate: its settings without the dynamics matrices
+            value = ", ".join(f"{k}={v}" for k, v in value.items() if k != "dynamics")
+        print(f"  {key:24s} {value}")
+    print("metrics:")
+    for key, value in metrics.as_dict().items():
+        shown = f"{value:.3f}" if isinstance(value, float) else str(value)
+        print(f"  {key:28s} {shown:>12s}")
+    if metrics.nodes:
+        print(f"  {'oracle_calls per node':28s} {metrics.oracle_calls / metrics.nodes:12.2f}")
+        print(f"  {'wall ms per node':28s} {metrics.wall_time_s * 1e3 / metrics.nodes:12.2f}")
+    if result.path is not None:
+        print(f"path: {len(result.path)} nodes")
+    for label in result.labels:
+        print(f"note: {label}")
+
+
+def _write_plan_outputs(args: argparse.Namespace, result: PlanResult, env: Environment) -> None:
+    """Write ``--json`` and ``--plot``; if a write fails (a full disk), the other is still written
+    and one ``OSError`` names every failed output and says the plan finished."""
+    from ..._support.output_files import write_replacing
+
+    failures = []
+    if args.json:
+        try:  # streamed chunk by chunk (PlanResult.write_json), not built as one string
+            write_replacing(Path(args.json), result.write_json)
+            print(f"wrote {args.json}")
+        except (OSError, MemoryError) as exc:
+            failures.append(f"--json: writing {args.json!r} failed ({_write_failure(exc)})")
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        from ...plotting import plot_tree
+
+        fig, ax = plt.subplots(figsize=(7, 7))
+        try:
+            plot_tree(env, result, ax=ax)
+            suffix = Path(args.plot).suffix.lower().lstrip(".")
+            write_replacing(Path(args.plot), lambda handle: fig.savefig(handle, format=suffix, dpi=130,
+                                                                         bbox_inches="tight"), binary=True)
+            print(f"wrote {args.plot}")
+        except (OSError, MemoryError) as exc:
+            failures.append(f"--plot: writing {args.plot!r} failed ({_write_failure(exc)})")
+        finally:
+            plt.close(fig)
+    if failures:
+        raise OSError(f"{'; '.join(failures)}; the plan finished (its metrics are printed above) but "
+                      f"{'these outputs were' if len(failures) > 1 else 'this output was'} not (completely) written")
+
+
+def _write_failure(exc: OSError | MemoryError) -> str:
+    """Why an output was not written, in a few words (a file replaced whole is left as it was)."""
+    if isinstance(exc, MemoryError):
+        return f"out of memory: {' '.join(str(exc).split()) or 'MemoryError'}"
+    return str(exc.strerror or exc)
+
+
+def cmd_plan(args: argparse.Namespace) -> int:
+    from ..._support.output_files import check_output_file, same_file
+    from ...registry import PLANNERS
+
+    check_output_file(args.json, "--json")
+    check_output_file(args.plot, "--plot", PLOT_FORMATS)
+    if args.json and args.plot and same_file(args.json, args.plot):
+        raise ValueError(f"--json and --plot name the same file {args.plot!r} (the plot would overwrite the JSON)")
+    problem = _load_problem(args)
+    env = _load_environment(args) if problem is None else problem.env
+    planner = build_planner(args, env, problem=problem)
+    # (the plan makes its one memory check before it allocates anything, and words a MemoryError as
+    # one OutOfMemory line; --json adds no memory per node: PlanResult.write_json streams the arrays
+    # chunk by chunk; the outputs are written only once the plan has finished)
+    limits = {"max_nodes": args.max_nodes, "max_oracle_calls": args.max_oracle_calls, "max_rounds": args.max_rounds,
+              "max_critical_path_calls": args.max_critical_path_calls, "stall_rounds": args.stall_rounds}
+    goal = None if problem is None else problem.goal
+    result = planner.plan(goal=goal, **limits)
+    _print_plan(result, env, args.seed)
+    peer = CLASSICAL_PEERS.get(PLANNERS.canonical(args.planner))
+    if peer is not None and not args.no_compare:
+        _print_comparison(result, build_planner(args, env, peer, problem).plan(goal=goal, **limits))
+    _write_plan_outputs(args, result, env)
+    return 0
