@@ -5,17 +5,19 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import os
 import signal
 import sys
+import threading
 from collections.abc import Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
-if TYPE_CHECKING:
-
-    pass
-
-
+#: C libraries that call back into Python where an exception is printed and dropped (llvmlite's
+#: object-cache notification while numba compiles): a signal handled inside one is delivered again
+FOREIGN_CALLBACKS = (os.path.join("llvmlite", "binding"),)
+#: the delay before a signal that landed in a foreign callback is delivered again
+REDELIVERY_S = 0.01
 
 #: the signals that stop a command the way Ctrl-C does, besides SIGINT
 STOP_SIGNALS = tuple(getattr(signal, name) for name in ("SIGTERM", "SIGHUP") if hasattr(signal, name))
@@ -40,6 +42,7 @@ class _Received:
 
     signum: int | None = None
     deferring: bool = False
+    redelivering: bool = False
 
     @contextlib.contextmanager
     def deferred(self) -> Iterator[None]:
@@ -72,16 +75,22 @@ def _stop_signals() -> Iterator[_Received]:
     Outside the main thread (where Python cannot set handlers) nothing changes."""
     received = _Received()
 
-    def stop(signum: int, frame: object) -> None:
-        if received.signum is None:
+    def stop(signum: int, frame: Any) -> None:
+        if received.signum is None or received.redelivering:
             received.signum = signum
-            if not received.deferring:
+            received.redelivering = False
+            if _in_foreign_callback(frame):
+                _deliver_again(signum, received)
+            elif not received.deferring:
                 raise Terminated(signum)
 
-    def interrupt(signum: int, frame: object) -> None:
+    def interrupt(signum: int, frame: Any) -> None:
         if received.signum is None:
             received.signum = signum
-        if not received.deferring:
+        received.redelivering = False
+        if _in_foreign_callback(frame):
+            _deliver_again(signum, received)
+        elif not received.deferring:
             raise KeyboardInterrupt
 
     saved: dict[int, Any] = {}
@@ -100,6 +109,20 @@ def _stop_signals() -> Iterator[_Received]:
     finally:
         for signum, previous in saved.items():
             signal.signal(signum, previous)
+
+
+def _in_foreign_callback(frame: Any) -> bool:
+    """Whether the handler interrupted Python code that a C library called (``FOREIGN_CALLBACKS``):
+    an exception raised there would be printed as "Exception ignored" and lost."""
+    return frame is not None and any(part in frame.f_code.co_filename for part in FOREIGN_CALLBACKS)
+
+
+def _deliver_again(signum: int, received: _Received) -> None:
+    """Send ``signum`` to this process again after ``REDELIVERY_S``, once the callback has returned."""
+    received.redelivering = True
+    timer = threading.Timer(REDELIVERY_S, os.kill, (os.getpid(), signum))
+    timer.daemon = True
+    timer.start()
 
 
 def _chain(exc: BaseException) -> Iterator[BaseException]:
