@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,6 +31,10 @@ README = ROOT / "README.md"
 START, END = "<!-- glance:start -->", "<!-- glance:end -->"
 #: the markers around the README's generated sentence on q-RRT's lead over RRT across worlds
 ADVANTAGE_START, ADVANTAGE_END = "<!-- glance-advantage:start -->", "<!-- glance-advantage:end -->"
+POLICY_START, POLICY_END = "<!-- glance-policy:start -->", "<!-- glance-policy:end -->"
+#: the search policies' names in the rule's summaries -> their classes
+POLICY_CLASSES = {"paper": "PaperIterations()", "adaptive": "Adaptive()", "bbht": "BBHT()",
+                  "thompson": "ThompsonIterations()"}
 
 
 @dataclass(frozen=True)
@@ -255,18 +260,58 @@ def advantage_sentence(results: Path = RESULTS) -> str:
             f"{lead}, with a median ratio of {_number(advantage[most]['ratio'][1], False)} at {most} boxes.")
 
 
+def policy_sentence(results: Path = RESULTS) -> str:
+    """The README's sentence on the default search policies, from the ``default_policy`` of
+    ``problems`` (the rule's run) and of ``confirmation/problems`` (three more root seeds).
+
+    Args:
+        results: The folder of the committed results (``docs/results``).
+
+    Returns:
+        One sentence: each planner's chosen policy with its worst family ratio and that family,
+        then what the confirmation run chose and its worst ratio.
+    """
+    runs = []
+    for folder in (results / "problems", results / "confirmation" / "problems"):
+        summary = _summary(folder)
+        if summary is None:
+            raise FileNotFoundError(f"{folder / 'summary.json'} is missing")
+        runs.append(summary)
+
+    def worst(rule: dict[str, Any]) -> tuple[str, str]:
+        chosen = rule["chosen"]
+        ratios = {family: math.inf if value is None else value
+                  for family, value in rule["relative_cost"][chosen].items()}
+        family = max(ratios, key=lambda name: ratios[name])
+        return POLICY_CLASSES[chosen], f"{_number(ratios[family], False)} on {family}"
+
+    first, second = (run["default_policy"] for run in runs)
+    roots = [", ".join(str(root) for root in run["settings"]["root_seeds"]) for run in runs]
+    parts = []
+    for planner, label in (("QRRT", "q-RRT (calls)"), ("PQRRT", "Pq-RRT (critical path)")):
+        policy, ratio = worst(first[planner])
+        again, again_ratio = worst(second[planner])
+        parts.append(f"{label}: `{policy}`, worst ratio {ratio}; on root seeds {roots[1]} the rule picks "
+                     f"`{again}`, worst ratio {again_ratio}")
+    return (f"By the rule on root seeds {roots[0]} (`docs/results/problems/summary.json`, "
+            f"`default_policy`): " + "; ".join(parts) + ".")
+
+
 def _between(text: str, start: str, end: str, rendered: str) -> str:
     before, rest = text.split(start, 1)
     _, after = rest.split(end, 1)
     return f"{before}{start}\n{rendered}\n{end}{after}"
 
 
-def with_table(readme: str, rendered: str, sentence: str | None = None) -> str:
+def with_table(readme: str, rendered: str, sentence: str | None = None, policy: str | None = None) -> str:
     """``readme`` with the text between the glance markers replaced by ``rendered`` and, given
-    ``sentence`` and where the README has the advantage markers, the text between those by it."""
+    ``sentence`` (``policy``) and where the README has the advantage (policy) markers, the text
+    between those by it."""
     readme = _between(readme, START, END, rendered)
     if sentence is not None and ADVANTAGE_START in readme:
         readme = _between(readme, ADVANTAGE_START, ADVANTAGE_END, sentence)
+    if policy is not None and POLICY_START in readme:
+        readme = _between(readme, POLICY_START, POLICY_END, policy)
     return readme
 
 
@@ -276,7 +321,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="exit 1 if README.md's table or sentence is not the generated one")
     args = parser.parse_args(argv)
     readme = README.read_text()
-    updated = with_table(readme, table(), advantage_sentence())
+    updated = with_table(readme, table(), advantage_sentence(), policy_sentence())
     if args.check:
         if updated != readme:
             print("README.md's results table differs from docs/results: run python docs/glance.py", file=sys.stderr)

@@ -4,6 +4,7 @@ summaries, its example runnable; and no prose narrates the project's own history
 from __future__ import annotations
 
 import importlib.util
+import json
 import re
 import sys
 from pathlib import Path
@@ -39,6 +40,20 @@ def test_the_advantage_sentence_is_generated_and_names_the_deficit():
     sentence = glance.advantage_sentence()
     assert f"{glance.ADVANTAGE_START}\n{sentence}\n{glance.ADVANTAGE_END}" in readme
     assert "deficit at low clutter" in sentence and "below RRT in" in sentence
+
+
+def test_the_default_policy_sentence_is_generated_from_both_seed_sets():
+    """The README's sentence on the defaults names each planner's chosen policy and its worst
+    family ratio, read from the rule's summary and from the confirmation run's."""
+    glance = _glance()
+    readme = README.read_text()
+    sentence = glance.policy_sentence()
+    assert f"{glance.POLICY_START}\n{sentence}\n{glance.POLICY_END}" in readme
+    rule = json.loads((glance.RESULTS / "problems" / "summary.json").read_text())["default_policy"]
+    for planner in ("QRRT", "PQRRT"):
+        chosen = rule[planner]["chosen"]
+        assert f"`{glance.POLICY_CLASSES[chosen]}`, worst ratio" in sentence
+    assert "root seeds 3, 4, 5" in sentence
 
 
 def test_every_explanation_quotes_the_summaries():
