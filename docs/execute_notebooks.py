@@ -1,7 +1,7 @@
 """Execute ``notebooks/*.ipynb`` in place, so the repository stores each tutorial with its outputs
 (a repository browser then shows its figures): ``python docs/execute_notebooks.py [NAME ...]``.
 
-Run it after editing a notebook; ``tests/test_notebooks.py`` fails on a stored notebook with a code
+Run it after editing a notebook; ``tests/project/test_notebooks.py`` fails on a stored notebook with a code
 cell that was not executed in order, an error output, or no figure. The docs build executes the
 notebooks again, so the site always shows the outputs of the current code.
 """

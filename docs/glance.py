@@ -2,7 +2,7 @@
 
 ``python docs/glance.py`` rewrites the table between the README's ``<!-- glance:start -->`` and
 ``<!-- glance:end -->`` markers; ``python docs/glance.py --check`` exits 1 if the committed table
-differs from what the summaries give (``tests/test_readme.py`` runs the check), so the table cannot
+differs from what the summaries give (``tests/project/test_readme.py`` runs the check), so the table cannot
 drift from the results.
 
 Each row reads one number from ``docs/results/EXPERIMENT/summary.json`` (our exact check) and, where

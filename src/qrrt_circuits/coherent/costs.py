@@ -6,7 +6,7 @@ the lookup oracle's.
 or an increment once per width, memoised; a comparison from its steps, ``arithmetic.chain_steps``;
 the lookup from its tree, ``qrom.qrom_tally``), so sizes far beyond what can be built (n up to 64,
 thousands of boxes) are counted in seconds. For buildable sizes the counts equal the built
-circuit's (``tests/test_coherent_costs.py``).
+circuit's (``tests/coherent/test_coherent_costs.py``).
 
 Counts (``OracleCost``): ``ands`` is the Toffoli count with measurement-based uncomputation (an
 AND costs one Toffoli, 4 T, its undo none; Gidney 2018); ``toffolis`` counts every CCX, undos

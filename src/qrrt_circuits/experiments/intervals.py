@@ -164,7 +164,7 @@ def two_level_bootstrap_interval(groups: Mapping[Any, Sequence[Any]], statistic:
     stages). Its variance is about ``(sigma_b^2 + 2 sigma_w^2 / r) / a`` for ``a`` worlds of ``r``
     runs, against the true ``(sigma_b^2 + sigma_w^2 / r) / a``: it is conservative where the spread
     between runs of one world dominates, and like every percentile bootstrap it is a little narrow
-    for few worlds (``tests/test_intervals.py`` measures both).
+    for few worlds (``tests/experiments/test_intervals.py`` measures both).
 
     Args:
         groups: World key -> that world's runs (records, or numbers); worlds without runs are

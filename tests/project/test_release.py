@@ -14,7 +14,7 @@ import pytest
 import qrrt_circuits as qc
 from qrrt_circuits.cli import main
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 PYPROJECT_VERSION = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
 
 

@@ -10,7 +10,7 @@ from qrrt_circuits.experiments import EXPERIMENTS, read_records, run_experiment
 from qrrt_circuits.experiments.base import TIMING_SUFFIX
 from qrrt_circuits.experiments.fitting import linear_fit, power_law_exponent, slope_through_origin
 
-RESULTS = Path(__file__).resolve().parent.parent / "docs" / "results"
+RESULTS = Path(__file__).resolve().parents[2] / "docs" / "results"
 TINY = {"oracle-efficiency": 1, "wallclock": 1, "heatmaps": 2, "corridor": 2, "annealing": 1,
         "lemmas": 60, "scaling": 1, "oracle-check": 1,
         "tree-size": 1, "heatmap-hypotheses": 3,

@@ -192,7 +192,7 @@ def test_main_restores_the_signal_handlers_it_installed(capsys):
 
 
 def test_the_exit_statuses_are_documented_where_the_command_line_is():
-    page = Path(__file__).resolve().parent.parent / "docs" / "explanations" / "planners.md"
+    page = Path(__file__).resolve().parents[2] / "docs" / "explanations" / "planners.md"
     readme = " ".join(page.read_text().split())
     for status in cli.EXIT_STATUSES:
         if status:

@@ -17,7 +17,7 @@ import qrrt_circuits as qc
 from qrrt_circuits.reachability.predicate import check_predicate
 from qrrt_circuits.registry import PREDICATES
 
-DATA = Path(__file__).resolve().parent / "data" / "authors_check"
+DATA = Path(__file__).resolve().parents[1] / "data" / "authors_check"
 BOUNDS = np.array([[0.0, 20.0], [0.0, 20.0]])
 GROUPS = [(world, family) for world in (0, 1) for family in ("global", "local")]
 RTOL = 1e-3  # ode45's default RelTol

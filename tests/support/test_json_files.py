@@ -11,7 +11,7 @@ import pytest
 
 from qrrt_circuits._support import json_files
 
-RESULTS = Path(__file__).resolve().parent.parent / "docs" / "results"
+RESULTS = Path(__file__).resolve().parents[2] / "docs" / "results"
 
 
 def _strict_load(text):

@@ -27,7 +27,7 @@ from jupyter_client.kernelspec import KernelSpecManager
 from jupyter_client.manager import AsyncKernelManager
 from traitlets import default
 
-NOTEBOOKS_DIR = Path(__file__).resolve().parent.parent / "notebooks"
+NOTEBOOKS_DIR = Path(__file__).resolve().parents[2] / "notebooks"
 DOCS_EXECUTION_CACHE = NOTEBOOKS_DIR.parent / "docs" / "_build" / ".jupyter_cache"
 NOTEBOOKS = [
     "01_grover_search_on_aer.ipynb",

@@ -7,7 +7,7 @@ records never decrease, and the file is only ever appended to (what it held up t
 break is still its first bytes).
 
 The run is the real ``corridor`` experiment (real plans on Aer) with its figures left out, so
-that the ~1 400 resumes stay fast; ``tests/test_records.py`` tears a run with figures at its line
+that the ~1 400 resumes stay fast; ``tests/experiments/test_records.py`` tears a run with figures at its line
 boundaries.
 """
 

@@ -26,7 +26,7 @@ import qrrt_circuits as qc
 
 pytest.importorskip("sphinx", reason="the API reference's rule reads doc comments with Sphinx (extra docs)")
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "docs"))
 from api_names import public_names  # noqa: E402  (the reference's own rule, beside docs/conf.py)
 

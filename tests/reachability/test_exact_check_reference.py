@@ -11,7 +11,7 @@ import pytest
 
 import qrrt_circuits as qc
 
-DATA = Path(__file__).parent / "data" / "authors_check"
+DATA = Path(__file__).resolve().parents[1] / "data" / "authors_check"
 
 
 def reference_world(world: int) -> qc.Environment:
