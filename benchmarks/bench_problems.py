@@ -36,7 +36,7 @@ from _common import machine, write_json  # noqa: E402
 
 import qrrt_circuits as qc  # noqa: E402
 from qrrt_circuits.experiments.problems import build_problem, ompl_range  # noqa: E402
-from qrrt_circuits.world.problems import Problem  # noqa: E402
+from qrrt_circuits.problems.families import Problem  # noqa: E402
 
 BUDGET = 5000
 

@@ -127,7 +127,7 @@ def run_ompl_rrt(env: Environment, start: np.ndarray, goal: np.ndarray, goal_rad
 
 
 if __name__ == "__main__":
-    from qrrt_circuits.world import scenarios
+    from qrrt_circuits.problems import scenarios
 
     print(f"{'seed':>4} {'reached':>7} {'nodes':>5} {'checks':>6} {'ms/node':>8} {'edges ok':>8}"
           f" {'repeat':>6}")

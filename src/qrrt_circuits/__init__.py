@@ -10,10 +10,20 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from . import probability, registry
-    from .planners import PQRRT, QRRT, RRT, Metrics, ParallelRRT, PlanResult, termination
+    from .planners import PQRRT, QRRT, RRT, Metrics, ParallelRRT, PlanResult, Planner
+    from .planners.options import (
+        ParallelOptions,
+        ParallelQuantumOptions,
+        PlannerOptions,
+        QuantumOptions,
+        RRTOptions,
+    )
     from .planners.candidates import Candidates, LatticeCandidates, NearestParents
     from .planners.database import AnnealingSchedule
-    from .planners.goals import Goal, GoalBall, GoalState
+    from .problems.families import grid_problem, image_problem, load_problem
+    from .problems.goals import Goal, GoalBall, GoalState
+    from .problems.problem import Problem
+    from .problems.scenarios import annealing_field, lattice, narrow_corridor, paper_clutter
     from .planners.termination import (
         AnyOf,
         MaxCriticalPathCalls,
@@ -32,7 +42,6 @@ if TYPE_CHECKING:
     from .reachability.oracle_errors import OracleErrorModel
     from .reachability.predicate import ReachabilityPredicate
     from .reachability.time_sampled import TimeSampledCheck
-    from .search import circuits
     from .search.backends.aer import AerBackend
     from .search.backends.base import QuantumSearchBackend, SearchRequest, SearchResult
     from .search.backends.sampler import SamplerBackend
@@ -46,7 +55,6 @@ if TYPE_CHECKING:
     from .search.policies.schedules import FixedIterations, KnownOptimal, PaperIterations
     from .search.policies.thompson import ThompsonIterations
     from .search.problem import DatabaseSearch, SearchOutcome
-    from .world import scenarios
     from .world.environment import Environment
     from .world.image import OccupancyGrid
     from .world.spaces import RealVectorSpace, SE2Space, StateSpace
@@ -61,12 +69,16 @@ if TYPE_CHECKING:
 _WHERE = {
     "probability": ".probability",
     "registry": ".registry",
-    **dict.fromkeys(["PQRRT", "QRRT", "RRT", "Metrics", "ParallelRRT", "PlanResult"], ".planners"),
+    **dict.fromkeys(["PQRRT", "QRRT", "RRT", "Metrics", "ParallelRRT", "PlanResult", "Planner"], ".planners"),
+    **dict.fromkeys(["ParallelOptions", "ParallelQuantumOptions", "PlannerOptions", "QuantumOptions", "RRTOptions"],
+                    ".planners.options"),
+    "Problem": ".problems.problem",
+    **dict.fromkeys(["grid_problem", "image_problem", "load_problem"], ".problems.families"),
+    **dict.fromkeys(["annealing_field", "lattice", "narrow_corridor", "paper_clutter"], ".problems.scenarios"),
     "AnnealingSchedule": ".planners.database",
     **dict.fromkeys(["Candidates", "LatticeCandidates", "NearestParents"], ".planners.candidates"),
-    **dict.fromkeys(["Goal", "GoalBall", "GoalState"], ".planners.goals"),
+    **dict.fromkeys(["Goal", "GoalBall", "GoalState"], ".problems.goals"),
     **dict.fromkeys(["RealVectorSpace", "SE2Space", "StateSpace"], ".world.spaces"),
-    "termination": ".planners.termination",
     **dict.fromkeys(["AnyOf", "MaxCriticalPathCalls", "MaxNodes", "MaxOracleCalls", "MaxRounds", "MaxWallTime",
                      "PlanStatus", "Stall", "TerminationCondition"], ".planners.termination"),
     "AuthorsCheck": ".reachability.authors_check",
@@ -80,14 +92,12 @@ _WHERE = {
     # (these import Qiskit: the circuits, Aer, the sampler, amplitude estimation, or its circuit types)
     **dict.fromkeys(["AerBackend", "EstimatedOptimal", "FixedPointAmplification", "IterateSequence",
                      "SamplerBackend", "StatevectorBackend"], ".search"),
-    "circuits": ".search.circuits",
     "IterationPolicy": ".search.policies.base",
     **dict.fromkeys(["FixedIterations", "KnownOptimal", "PaperIterations"], ".search.policies.schedules"),
     "BBHT": ".search.policies.bbht",
     "Adaptive": ".search.policies.adaptive",
     "ThompsonIterations": ".search.policies.thompson",
     **dict.fromkeys(["DatabaseSearch", "SearchOutcome"], ".search.problem"),
-    "scenarios": ".world.scenarios",
     "Environment": ".world.environment",
     "OccupancyGrid": ".world.image",
 }
@@ -162,6 +172,20 @@ __all__ = [
     "PaperIterations",
     "ParallelRRT",
     "PlanResult",
+    "Planner",
+    "PlannerOptions",
+    "ParallelOptions",
+    "ParallelQuantumOptions",
+    "Problem",
+    "QuantumOptions",
+    "RRTOptions",
+    "annealing_field",
+    "grid_problem",
+    "image_problem",
+    "lattice",
+    "load_problem",
+    "narrow_corridor",
+    "paper_clutter",
     "PlanStatus",
     "QuantumSearchBackend",
     "ExactCheck",
@@ -174,11 +198,8 @@ __all__ = [
     "StatevectorBackend",
     "TerminationCondition",
     "TimeSampledCheck",
-    "circuits",
     "grid_world",
     "image_world",
     "probability",
     "registry",
-    "scenarios",
-    "termination",
 ]

@@ -393,7 +393,7 @@ def _policies() -> Registry:
 
 # ----------------------------------------------------------------------------------------- scenarios
 def _scenarios() -> Registry:
-    from .world import scenarios
+    from .problems import scenarios
 
     registry = Registry("scenario")
     registry.register("paper_clutter", scenarios.paper_clutter, "20 x 20, 525 boxes (paper Fig. 9-12)")

@@ -7,7 +7,7 @@ import pytest
 from conftest import make_backend
 
 import qrrt_circuits as qc
-from qrrt_circuits.planners.goals import first_satisfying, sample_goal
+from qrrt_circuits.problems.goals import first_satisfying, sample_goal
 
 
 @pytest.fixture(scope="module")

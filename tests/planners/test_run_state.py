@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from qrrt_circuits.planners.goals import GoalBall, in_ball
+from qrrt_circuits.problems.goals import GoalBall, in_ball
 from qrrt_circuits.planners.run_state import RunState
 
 

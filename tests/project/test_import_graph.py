@@ -97,7 +97,7 @@ LAYER_EXCEPTIONS = {
     ("qrrt_circuits._support.worker_warmup", "qrrt_circuits.experiments.worlds"),
     ("qrrt_circuits._support.worker_warmup", "qrrt_circuits.reachability.exact"),
     # a problem's goal region is the planners' GoalBall (goals belong with the problem)
-    ("qrrt_circuits.world.problems", "qrrt_circuits.planners.goals"),
+    ("qrrt_circuits.problems.families", "qrrt_circuits.problems.goals"),
     # the OMPL planner adapter reads the package version for OMPL's planner name
     ("qrrt_circuits.adapters.ompl_planning", "qrrt_circuits"),
 }

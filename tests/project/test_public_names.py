@@ -13,8 +13,8 @@ import qrrt_circuits as qc
 ROOT = Path(qc.__file__).resolve().parent
 
 #: names of ``qc.__all__`` that are modules living below a subpackage: ``qc.scenarios`` is
-#: ``qrrt_circuits.world.scenarios``, imported under that path only (no module file aliases it)
-NAMESPACE_MODULES = {"scenarios": "qrrt_circuits.world.scenarios",
+#: ``qrrt_circuits.problems.scenarios``, imported under that path only (no module file aliases it)
+NAMESPACE_MODULES = {"scenarios": "qrrt_circuits.problems.scenarios",
                      "termination": "qrrt_circuits.planners.termination",
                      "circuits": "qrrt_circuits.search.circuits"}
 

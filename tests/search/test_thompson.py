@@ -11,7 +11,7 @@ from scipy.stats import poisson
 import qrrt_circuits as qc
 from qrrt_circuits._support.randomness import RandomStreams
 from qrrt_circuits.probability import expected_distinct_found, optimal_iterations
-from qrrt_circuits.world.problems import open_space
+from qrrt_circuits.problems.families import open_space
 
 
 def _stream(policy: qc.IterationPolicy, backend: qc.QuantumSearchBackend, mean_marked: float, databases: int,

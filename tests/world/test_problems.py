@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import qrrt_circuits as qc
-from qrrt_circuits.world.problems import (
+from qrrt_circuits.problems.families import (
     load_problem,
     narrow_passage,
     open_space,
@@ -192,7 +192,7 @@ def test_bad_maze_arguments_are_refused_by_name(arguments, message):
 
 
 def test_the_maze_problem_is_solved_through_its_corridors():
-    from qrrt_circuits.world.problems import maze
+    from qrrt_circuits.problems.families import maze
 
     problem = maze(4, seed=2)
     assert problem.env.bounds.tolist() == [[0.0, 10.0], [0.0, 10.0]]

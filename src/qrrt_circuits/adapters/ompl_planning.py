@@ -34,7 +34,7 @@ import numpy as np
 
 from .._support.validation import check_float, check_int
 from ..planners.base import Planner
-from ..planners.goals import Goal, GoalState
+from ..problems.goals import Goal, GoalState
 from ..planners.result import PlanResult
 from ..planners.termination import PlanStatus, Progress, TerminationCondition
 from ..reachability.predicate import ReachabilityPredicate

@@ -355,7 +355,7 @@ def scaling_instance(index_bits: int, boxes: int, parent_bits: int = 6, bits: in
     """
     from .._support.validation import check_int
     from ..reachability.dynamics import LinearTrackingDynamics
-    from ..world.scenarios import paper_clutter
+    from ..problems.scenarios import paper_clutter
     from .number_format import FixedPointFormat
 
     boxes = check_int(boxes, "boxes", 0, 100_000)

@@ -36,7 +36,7 @@ import numpy as np
 
 from ..planners.database import AnnealingSchedule
 from ..search.policies.schedules import FixedIterations
-from ..world.scenarios import CLUTTER_BOXES, CLUTTER_SIZE
+from ..problems.scenarios import CLUTTER_BOXES, CLUTTER_SIZE
 from .base import (
     Experiment,
     PaperComparison,

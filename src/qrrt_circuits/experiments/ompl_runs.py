@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..world.problems import Problem
+from ..problems.families import Problem
 
 #: OMPL planners by the experiment's label: (``ompl.geometric`` class, whether it takes a goal bias)
 OMPL_PLANNERS = {"OMPL RRT": ("RRT", True), "OMPL RRTConnect": ("RRTConnect", False)}

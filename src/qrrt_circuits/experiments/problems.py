@@ -1,7 +1,7 @@
 """Beyond the paper: every planner of the library on standard problem families, beside OMPL's RRT
 and RRTConnect on the same motion check, at equal budgets in motion checks.
 
-**Problems** (``world.problems``, built by the library): ``open-space`` (one box in [0, 10]^2),
+**Problems** (``problems.families``, built by the library): ``open-space`` (one box in [0, 10]^2),
 ``maze`` (a perfect maze of 4 x 4 rooms, a new maze per replicate: its seed is the replicate
 index), ``narrow-passage-{2,4,6}d`` (a wall with a square hole whose share of the wall's
 cross-section is 1 % in every dimension: side 10 x 0.01^(1 / (d - 1)), so 0.1 in 2-D, 2.15 in 4-D,
@@ -62,7 +62,7 @@ import numpy as np
 
 from ..planners.paths import path_length, shortcut
 from ..registry import POLICIES
-from ..world.problems import Problem, maze, narrow_passage, open_space, se2_gap, winding_band
+from ..problems.families import Problem, maze, narrow_passage, open_space, se2_gap, winding_band
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .default_policy import POLICY_CANDIDATES, TIE_MARGIN, default_policies
 from .family_runs import family_counts, family_units, paired_ratio, resampled, statistic

@@ -24,28 +24,18 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from concurrent.futures import Executor
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
 from .._support.memory import MemoryEstimate, OutOfMemory, PlanSize
 from .._support.randomness import RandomStreams, Stream
-from .._support.validation import check_float, check_instance, check_real_array, check_seed
-from ..reachability.dynamics import LinearTrackingDynamics
-from ..reachability.exact import ExactCheck
-from ..reachability.oracle_errors import OracleErrorModel
-from ..reachability.predicate import (
-    ReachabilityPredicate,
-    can_leave,
-    check_predicate,
-    check_within_space,
-    valid_states,
-)
-from ..world.environment import Environment
-from ..world.spaces import RealVectorSpace, StateSpace
+from .._support.validation import check_instance
+from ..problems.goals import Goal, ball_of, check_reachable_by
+from ..problems.problem import Problem
 from . import termination as _termination
 from .context import RoundView, WorkerContext
-from .goals import Goal, GoalBall, ball_of, check_goal, first_satisfying
+from .options import PlannerOptions
 from .result import Metrics, PlanResult
 from .run_state import RunState
 from .termination import (
@@ -63,139 +53,57 @@ if TYPE_CHECKING:
 __all__ = ["Metrics", "PlanResult", "Planner", "RunState"]
 
 
-#: the members a state space must have (``world.spaces.StateSpace``)
-SPACE_MEMBERS = ("dim", "distance", "interpolate", "nearest", "check_bounds", "describe")
-
-
-def check_space(space: Any, env: Environment) -> StateSpace:
-    """``space`` if it implements ``StateSpace`` in ``env``'s dimension and accepts its bounds.
-
-    Raises:
-        TypeError: A member of ``SPACE_MEMBERS`` missing.
-        ValueError: A dimension mismatch, or bounds the space refuses (``check_bounds``).
-    """
-    missing = [member for member in SPACE_MEMBERS if not hasattr(space, member)]
-    if missing:
-        raise TypeError(f"space must be a StateSpace (RealVectorSpace, SE2Space, ...); {type(space).__name__} lacks "
-                        f"{', '.join(missing)}")
-    if space.dim != env.dim:
-        raise ValueError(f"dimension mismatch: the space has d = {space.dim}, the environment has d = {env.dim}")
-    space.check_bounds(env.bounds)
-    return space
-
-
-def resolve_predicate(env: Environment, predicate: ReachabilityPredicate | None,
-                      dynamics: LinearTrackingDynamics | None, resolution: float) -> ReachabilityPredicate:
-    """The planner's predicate: ``predicate=``, else the sound ``ExactCheck`` built with
-    ``dynamics`` and ``resolution``."""
-    if predicate is None:
-        if dynamics is not None:
-            check_instance(dynamics, "dynamics", LinearTrackingDynamics, "a LinearTrackingDynamics")
-            if dynamics.dim != env.dim:
-                raise ValueError(f"dimension mismatch: the dynamics act in d = {dynamics.dim}, the environment "
-                                 f"has d = {env.dim}")
-        return ExactCheck(env, dynamics, resolution=resolution)
-    if dynamics is not None:
-        raise ValueError("give dynamics= or predicate=, not both (a predicate carries its own motion model)")
-    check_predicate(predicate, env.dim)
-    check_within_space(predicate, env.bounds)
-    return predicate
-
-
 class Planner:
-    """Base class of the planners: checks the problem, runs rounds until the goal or the
-    termination condition, and reports.
+    """Base class of the planners: an algorithm with its settings (``options``) that plans any
+    ``Problem`` in rounds until the goal or the termination condition, and reports.
 
-    Subclasses define one round (``_round``: the paper's Alg. 1-3; ``ParallelRRT`` records its
-    rounds in batches, ``_run``) and their own settings. ``RRT``, ``ParallelRRT``, ``QRRT`` and
-    ``PQRRT`` document only their own arguments; the ones they share are documented here, once.
-
-    Arguments every planner takes (all keyword-only after ``env``):
+    Subclasses define one round (``_round``: the paper's Alg. 1-3) and their options class
+    (``Options``: every setting declared once, with its check and help; ``planners.options``).
 
     Args:
-        env: The ``Environment``: workspace bounds, obstacles and the default start, goal and goal
-            radius.
-        predicate: The ``ReachabilityPredicate`` that decides whether a child is reachable from its
-            parent (its ``dim`` must equal ``env.dim``). Default: the sound ``ExactCheck``
-            of ``env`` built with ``dynamics`` and ``resolution``.
-        dynamics: A ``LinearTrackingDynamics`` (same ``dim`` as ``env``) for the default predicate;
-            give it only without ``predicate`` (a predicate carries its own motion model). Default:
-            ``LinearTrackingDynamics.paper()``.
-        oracle_errors: An ``OracleErrorModel`` that corrupts the answers the algorithm sees (false
-            positives and negatives): the reachability tests of the classical planners, the marks
-            of the phase oracle of the quantum planners; or None (default) for exact answers. No
-            wrong answer adds a node: a classical planner verifies a positive answer with the true
-            predicate (one more verification call) before it adds the node, and a quantum
-            planner's finalizer verifies every measured entry, so an error costs oracle calls only.
-        goal_bias: Probability in [0, 1) that a sample is drawn in the goal ball instead of
-            uniformly in the workspace. Default 0 (the paper's uniform sampling).
-        max_extension: The longest step from a parent (OMPL's RRT ``range``): a candidate farther
-            from its nearest node is moved toward it until the distance is ``max_extension``
-            (``database.steer``), for the classical tests and the quantum databases alike. A finite
-            number > 0, or None (default: the raw samples, as the paper's algorithms take them).
-        space: The ``StateSpace`` whose metric picks nearest nodes and steers candidates
-            (``world.spaces``: ``RealVectorSpace``, ``SE2Space``, or your own); its ``dim`` must
-            be ``env.dim`` and it must accept ``env.bounds``. Default ``RealVectorSpace(env.dim)``
-            (Euclidean, the paper's).
-        resolution: Clearance of the default ``ExactCheck`` in length units (> 0, finite;
-            default 0.01): a free trajectory is accepted if it passes farther than (1 + sqrt(d)) *
-            resolution from every obstacle and 2 * resolution from the workspace boundary. Unused
-            when ``predicate`` is given.
-        seed: Non-negative integer seed of the keyed random streams (one generator per (round,
-            worker, stream), so results do not depend on the executor or the order of the calls), or
-            None (default) for fresh entropy.
+        options: The planner's ``Options``, whole; or None (default) to build them from
+            ``keywords``.
         executor: ``ParallelRRT`` and ``PQRRT`` only: a ``concurrent.futures.Executor`` that runs
             the workers' tasks (a ``ParallelRRT`` worker's reachability test, a ``PQRRT``
             database's search), or None (default) to run them in-process, with the same results.
             Not pickled with the planner.
+        **keywords: The options one by one (``QRRT(num_qubits=6, seed=0)``); see ``Options``.
 
     Raises:
-        TypeError: ``env`` not an ``Environment``, a non-integer ``seed``, a non-real
-            ``goal_bias`` or ``resolution``, ``dynamics`` or ``oracle_errors`` of the wrong class,
-            or a ``predicate`` that lacks the members of the ``ReachabilityPredicate`` protocol.
-        ValueError: ``goal_bias`` outside [0, 1), a ``max_extension`` that is not finite and > 0, a
-            negative ``seed``, a dimension mismatch
-            between ``env`` and ``predicate`` or ``dynamics``, both ``predicate`` and ``dynamics``
-            given, or, for the default predicate, a
-            ``resolution`` that is not finite and > 0 or one too fine for the workspace
-            (``ExactCheck``).
+        TypeError: An option this planner does not take (naming it and the ones it takes), options
+            of another planner's class, options and keywords both given, or an option of the wrong
+            type.
+        ValueError: An option out of its range (naming it and the range).
     """
 
     name = "planner"
+    #: the planner's options class: every setting it takes, declared once
+    Options: ClassVar[type[PlannerOptions]] = PlannerOptions
+    #: whether the planner takes an ``executor``
+    takes_executor: ClassVar[bool] = False
 
-    def __init__(
-        self,
-        env: Environment,
-        *,
-        predicate: ReachabilityPredicate | None = None,
-        dynamics: LinearTrackingDynamics | None = None,
-        oracle_errors: OracleErrorModel | None = None,
-        goal_bias: float = 0.0,
-        max_extension: float | None = None,
-        space: StateSpace | None = None,
-        resolution: float = 0.01,
-        seed: int | None = None,
-        executor: Executor | None = None,
-    ) -> None:
-        check_instance(env, "env", Environment, "an Environment")
-        self.env = env
-        self.predicate = resolve_predicate(env, predicate, dynamics, resolution)
-        try:
-            bias: float | None = check_float(goal_bias, "goal_bias", 0.0, 1.0)
-        except ValueError:
-            bias = None
-        if bias is None or bias >= 1.0:  # one message for 1, 1.5, -0.5 and NaN: the range is [0, 1)
-            raise ValueError(f"goal_bias must be a finite number in [0.0, 1.0), got {goal_bias!r}")
-        self.goal_bias = bias
-        self.max_extension = None if max_extension is None else check_float(
-            max_extension, "max_extension", 0.0, open_minimum=True)
-        self.space = RealVectorSpace(env.dim) if space is None else check_space(space, env)
-        if oracle_errors is not None:
-            check_instance(oracle_errors, "oracle_errors", OracleErrorModel, "an OracleErrorModel or None")
-        self.oracle_errors = oracle_errors
-        self.seed = check_seed(seed)
-        self.streams = RandomStreams.from_seed(self.seed)
+    def __init__(self, options: PlannerOptions | None = None, /, *, executor: Executor | None = None,
+                 **keywords: Any) -> None:
+        if options is None:
+            options = self.Options.create(self.name, **keywords)
+        elif keywords:
+            raise TypeError(f"give {self.name} its options or keywords, not both (got options and "
+                            f"{', '.join(sorted(keywords))})")
+        check_instance(options, "options", self.Options, f"{self.Options.__name__} (the options of {self.name})")
+        if executor is not None and not self.takes_executor:
+            raise TypeError(f"{self.name} does not take executor= (its rounds have one task)")
+        self.options = self._complete(options)
+        self.streams = RandomStreams.from_seed(self.options.seed)
         self.executor = executor
+
+    def _complete(self, options: Any) -> Any:
+        """The options with the planner's own defaults filled in (none here)."""
+        return options
+
+    @property
+    def seed(self) -> int | None:
+        """The seed of the planner's random streams."""
+        return self.options.seed
 
     def rng(self, round_index: int, worker: int = 0, stream: int = Stream.CANDIDATES) -> np.random.Generator:
         """The generator of one (round, worker, stream): independent of call order and executor.
@@ -222,25 +130,23 @@ class Planner:
     # ----------------------------------------------------------------- planning
     def plan(
         self,
-        start: np.ndarray | None = None,
-        goal: Goal | np.ndarray | None = None,
-        goal_radius: float | None = None,
+        problem: Problem,
+        termination: TerminationCondition | None = None,
+        *,
         max_oracle_calls: int | None = None,
         max_nodes: int | None = None,
         max_rounds: int | None = None,
         max_time_s: float | None = None,
-        *,
         max_critical_path_calls: int | None = None,
         stall_rounds: int | None = None,
-        termination: TerminationCondition | None = None,
     ) -> PlanResult:
-        """Grow a tree from ``start`` until a node satisfies the goal (a node in the goal ball, as
-        in the paper) or the termination condition ends the plan.
+        """Grow a tree from the problem's start until a node satisfies its goal (a node in the goal
+        ball, as in the paper) or the termination condition ends the plan (OMPL's ``solve(ptc)``).
 
         The paper's Alg. 1 for RRT, Alg. 2 for q-RRT, Alg. 3 for Pq-RRT; Alg. 4 with an annealing
         schedule.
 
-        The ``max_*`` and ``stall_rounds`` keywords are shorthands for the conditions of
+        The keyword budgets are shorthands for the conditions of
         ``qrrt_circuits.planners.termination``; they combine (any of them ends the plan) with
         ``termination``. Safety limits are added so that every plan ends (``termination.safety_limits``):
         without a budget of the caller's, a round limit (``DEFAULT_MAX_ROUNDS``) and a stall limit
@@ -253,15 +159,9 @@ class Planner:
         by less than one round's cost.
 
         Args:
-            start: Root of the tree, shape (d,); default the environment's start. A start on the
-                workspace boundary, which the exact check can never leave, is refused.
-            goal: A goal point, shape (d,) (default the environment's goal), the centre of a ball of
-                ``goal_radius``; or any ``Goal`` (``GoalBall``, ``GoalState``, a region of your own
-                with ``is_satisfied``): it needs ``sample`` where ``goal_bias > 0``, and a goal
-                without volume (``GoalState``) needs ``goal_bias > 0``. A start that already
-                satisfies the goal is reached at once.
-            goal_radius: Radius of the goal ball (> 0) with a goal point; default the environment's.
-                Not given with a ``Goal``.
+            problem: The ``Problem`` (world, state space, motion check, start and goal; checked
+                when it was built). A start that already satisfies the goal is reached at once.
+            termination: Any ``TerminationCondition`` (compose them with ``|``), or None.
             max_oracle_calls: End after this many oracle calls (DESIGN §2 counting).
             max_nodes: End once the tree has this many nodes besides the root.
             max_rounds: End after this many rounds.
@@ -269,7 +169,6 @@ class Planner:
             max_critical_path_calls: End after this many critical-path oracle calls (per round the
                 largest of any worker: the time of p parallel quantum devices).
             stall_rounds: End after this many consecutive rounds without a new node.
-            termination: Any ``TerminationCondition`` (compose them with ``|``).
 
         Returns:
             A frozen ``PlanResult``: ``status`` (``PlanStatus``: ``"reached"`` or the condition that
@@ -278,18 +177,20 @@ class Planner:
             simulation shortcut the numbers depend on).
 
         Raises:
-            ValueError: A point outside the workspace or inside an obstacle, a start or goal the
-                predicate's own validity check rejects (``is_valid``), a boundary start, a
-                non-positive radius or budget, an estimated peak memory that exceeds the available
-                memory (naming ``num_qubits``, ``max_nodes`` or ``max_rounds`` and the largest
-                value that fits), or a dimension mismatch, before any work.
-            TypeError: An argument of the wrong type (e.g. a ``termination`` that is not a
-                ``TerminationCondition``).
+            TypeError: A ``problem`` that is not a ``Problem``, a ``termination`` that is not a
+                ``TerminationCondition``, a budget of the wrong type, or a goal without ``sample``
+                with ``goal_bias > 0``.
+            ValueError: A non-positive budget, a goal without volume with ``goal_bias == 0``, a
+                setting this problem cannot serve, or an estimated peak memory that exceeds the
+                available memory (naming ``num_qubits``, ``max_nodes`` or ``max_rounds`` and the
+                largest value that fits), before any work.
             qrrt_circuits._support.memory.OutOfMemory: A ``MemoryError`` while the plan ran (one line: the
                 size to lower, what the allocator reported, the largest smaller value whose
                 estimate fits in the memory available when the plan started).
         """
-        start, region = self._check_problem(start, goal, goal_radius)
+        check_instance(problem, "problem", Problem, "a Problem (qrrt_circuits.Problem.build(env, start, goal, "
+                                                    "goal_radius), a scenario or a problem family)")
+        check_reachable_by(problem.goal, self.options.goal_bias)
         condition = from_budgets(max_oracle_calls, max_nodes, max_rounds, max_time_s,
                                  max_critical_path_calls, stall_rounds)
         if termination is not None:
@@ -299,30 +200,30 @@ class Planner:
         defaults = (_termination.DEFAULT_MAX_ROUNDS, _termination.DEFAULT_STALL_ROUNDS, _termination.DEFAULT_MAX_NODES)
         safety = frozenset(limit.status for limit in safety_limits(condition, *defaults))
         condition = with_defaults(condition, *defaults)
-        self._check_ready()
-        round_estimate, num_qubits = self._round_memory()
-        size = PlanSize(limits.node_limit, self._max_new_nodes_per_round(), limits.round_limit, self.env.dim,
+        self._check_serves(problem)
+        round_estimate, num_qubits = self._round_memory(problem.dim)
+        size = PlanSize(limits.node_limit, self._max_new_nodes_per_round(), limits.round_limit, problem.dim,
                         round_estimate, num_qubits, default_nodes=limits.default_nodes,
                         default_rounds=limits.default_rounds)
         size.check()  # the plan's one memory check, before its first allocation
         try:
-            return self._plan_checked(start, region, condition, safety)
+            return self._plan_checked(problem, condition, safety)
         except OutOfMemory:
             raise
         except MemoryError as error:  # (its frames, and the plan's arrays, are released before the message)
             raise size.out_of_memory(error) from error
 
-    def _plan_checked(self, start: np.ndarray, goal: Goal, condition: TerminationCondition,
+    def _plan_checked(self, problem: Problem, condition: TerminationCondition,
                       safety: frozenset[PlanStatus]) -> PlanResult:
         """The plan after its checks: the run state, the rounds and the result (``safety``: the
         statuses of the safety limits added to the caller's condition)."""
-        state = RunState(start, goal)
+        state = RunState(problem.start, problem.goal)
         state.policy_state = self._start_policy()
-        state.context = self._context()
+        state.context = self._context(problem)
         began = time.perf_counter()
         status = self._run(state, condition, began)
         elapsed = time.perf_counter() - began
-        return self._result(state, status, elapsed, start, goal, condition, status in safety)
+        return self._result(state, status, elapsed, problem, condition, status in safety)
 
     def _run(self, state: RunState, condition: TerminationCondition, began: float) -> PlanStatus:
         """The round loop: check the condition before every round, run the round, record it; until
@@ -335,75 +236,18 @@ class Planner:
             state.end_round()
         return PlanStatus.REACHED
 
-    def _check_problem(self, start: np.ndarray | None, goal: Goal | np.ndarray | None,
-                       goal_radius: float | None) -> tuple[np.ndarray, Goal]:
-        """The start as a point and the goal as a ``Goal``, each checked against the environment
-        (bounds, obstacles) and the predicate's own validity check before any work."""
-        env = self.env
-        start = env.start if start is None else start
-        if start is None:
-            raise ValueError("start is required (the environment sets none)")
-        start = self._checked_point("start", start)
-        if isinstance(goal, Goal):  # a goal object: the goal radius belongs to a goal point
-            if goal_radius is not None:
-                raise ValueError("goal_radius is given with a goal point, not with a Goal object "
-                                 f"({type(goal).__name__} carries its own extent)")
-            region = check_goal(goal, env.dim, self.goal_bias)
-            ball = ball_of(region)
-            if ball is not None:  # a ball's centre (a goal state) must be a valid point
-                self._checked_point("goal", ball[0])
-        else:
-            point = env.goal if goal is None else goal
-            radius = env.goal_radius if goal_radius is None else goal_radius
-            if point is None or radius is None:
-                raise ValueError("goal and goal_radius are required (the environment sets none)")
-            region = GoalBall(self._checked_point("goal", point), check_float(radius, "goal_radius", 0.0,
-                                                                               open_minimum=True))
-        reached = first_satisfying(region, start[None]) == 0  # a start in the goal ends at once
-        if not reached and not can_leave(self.predicate, start):
-            raise ValueError(
-                f"start {start.tolist()} lies on the workspace boundary {env.bounds.tolist()}: the "
-                f"{self.predicate.name} check rejects every motion from it, so no node could ever be "
-                "added (move the start inside the workspace)")
-        return start, region
-
-    def _checked_point(self, name: str, point: Any) -> np.ndarray:
-        """``point`` as d finite coordinates inside the bounds, free of the environment's obstacles
-        and valid under the predicate's own validity check (``is_valid``)."""
-        env = self.env
-        if point is None or isinstance(point, str | bytes):
-            raise ValueError(f"{name} must be {env.dim} numbers, got {point!r}")
-        try:
-            point = check_real_array(point, name).reshape(-1)  # booleans and strings refused
-        except ValueError as exc:
-            raise ValueError(f"{name} must be {env.dim} numbers, got {point!r}") from exc
-        if point.shape != (env.dim,):
-            raise ValueError(
-                f"dimension mismatch: {name} has {point.shape[0]} coordinates, the environment "
-                f"has d = {env.dim}"
-            )
-        if not np.all(np.isfinite(point)):
-            raise ValueError(f"{name} must be finite, got {point.tolist()}")
-        if not env.in_bounds(point):
-            raise ValueError(f"{name} {point.tolist()} is out of bounds {env.bounds.tolist()}")
-        if not env.is_free(point):
-            raise ValueError(f"{name} {point.tolist()} is in collision with an obstacle")
-        if not valid_states(self.predicate, point[None])[0]:
-            raise ValueError(f"{name} {point.tolist()} is not a valid state: the {self.predicate.name} "
-                             f"check's own validity check (is_valid) rejects it")
-        return np.array(point, dtype=float)
-
-    def _check_ready(self) -> None:
-        """Subclasses validate their own settings before any work."""
+    def _check_serves(self, problem: Problem) -> None:
+        """Refuse, before any work, a problem this planner's settings cannot serve (none here)."""
 
     def _max_new_nodes_per_round(self) -> int:
         """The most nodes one round can add (1 here; p for p workers): the bound the memory check
         (``memory.PlanSize``) sizes the tree by."""
         return 1
 
-    def _round_memory(self) -> tuple[Callable[[int], MemoryEstimate] | None, int]:
-        """What the plan's memory check adds for one round: (its ``MemoryEstimate`` as a function
-        of n, the plan's n); (None, 0) here, a plan without databases."""
+    def _round_memory(self, dim: int) -> tuple[Callable[[int], MemoryEstimate] | None, int]:
+        """What the plan's memory check adds for one round in dimension ``dim``: (its
+        ``MemoryEstimate`` as a function of n, the plan's n); (None, 0) here, a plan without
+        databases."""
         return None, 0
 
     def _start_policy(self) -> PolicyState | None:
@@ -412,10 +256,10 @@ class Planner:
     def _round(self, state: RunState) -> None:
         raise NotImplementedError
 
-    def _context(self) -> WorkerContext:
+    def _context(self, problem: Problem) -> WorkerContext:
         """What workers need for this plan (subclasses add their backend, schedule, sizes)."""
-        return WorkerContext(self.env, self.predicate, self.streams, self.goal_bias, self.oracle_errors,
-                             max_extension=self.max_extension, space=self.space)
+        return WorkerContext(problem.env, problem.predicate, problem.space, self.streams, self.options.goal_bias,
+                             self.options.oracle_errors, max_extension=self.options.max_extension)
 
     def _view(self, state: RunState, temperature_index: int = 0) -> RoundView:
         return RoundView(state.tree, state.goal, state.rounds, temperature_index,
@@ -423,12 +267,9 @@ class Planner:
 
     # ----------------------------------------------------------------- reporting
     def settings(self) -> dict:
-        """Everything that fixes this planner's answers (JSON-able; recorded in the result)."""
-        predicate = self.predicate.describe()
-        return {"planner": self.name, "seed": self.seed, "goal_bias": self.goal_bias,
-                "max_extension": self.max_extension, "space": self.space.describe(), "predicate": predicate,
-                "dynamics": predicate.get("dynamics"),
-                "oracle_errors": None if self.oracle_errors is None else self.oracle_errors.describe()}
+        """Everything of the planner's that fixes its answers: its name and options (JSON-able;
+        recorded in every result beside the problem's parts)."""
+        return {"planner": self.name} | self.options.describe()
 
     def labels(self) -> tuple[str, ...]:
         """Every simulation shortcut this planner's numbers depend on (copied into each result).
@@ -438,7 +279,7 @@ class Planner:
         """
         return ()
 
-    def _result(self, state: RunState, status: PlanStatus, elapsed: float, start: np.ndarray, goal: Goal,
+    def _result(self, state: RunState, status: PlanStatus, elapsed: float, problem: Problem,
                 condition: TerminationCondition, safety_limit: bool = False) -> PlanResult:
         tree = state.tree
         path = None
@@ -461,11 +302,10 @@ class Planner:
             wall_time_s=elapsed,
             wasted_checks=state.wasted_checks,
         )
-        ball = ball_of(goal)
-        settings = self.settings() | {"start": start.tolist(), "goal": None if ball is None else ball[0].tolist(),
-                                      "goal_radius": None if ball is None else ball[1],
-                                      "goal_region": goal.describe(), "termination": condition.describe(),
-                                      "environment": self.env.name}
+        predicate = problem.predicate.describe()
+        settings = self.settings() | problem.describe() | {
+            "space": problem.space.describe(), "predicate": predicate, "dynamics": predicate.get("dynamics"),
+            "termination": condition.describe()}
         history = {key: np.asarray(value, dtype=np.int64) for key, value in state.history.items()}
         return PlanResult(
             status=status,

@@ -26,26 +26,20 @@ from __future__ import annotations
 
 import math
 import time
-from concurrent.futures import Executor
 
 import numpy as np
 
 from .._support.randomness import Stream, uniform_draws
-from .._support.validation import check_bool, check_int
-from ..reachability.dynamics import LinearTrackingDynamics
-from ..reachability.oracle_errors import OracleErrorModel
-from ..reachability.predicate import ReachabilityPredicate, check_answers
-from ..world.environment import Environment
-from ..world.spaces import StateSpace
+from ..problems.goals import sample_goal
+from ..reachability.predicate import check_answers
 from .base import Planner
 from .context import map_tasks
 from .database import steer
-from .goals import sample_goal
+from .options import MAX_WORKERS, ParallelOptions, RRTOptions
 from .run_state import RunState
 from .termination import PlanStatus, TerminationCondition
 from .workers import check_extensions
 
-MAX_WORKERS = 4096
 #: the most rounds one batch tests ahead
 MAX_BATCH_ROUNDS = 256
 #: the most memory one batch's candidates may take (at least one round is tested whatever its size):
@@ -96,48 +90,19 @@ class ParallelRRT(Planner):
     call, counted as a ``verification_call`` (DESIGN §2); a round's critical path is 1 call (2 with
     ``oracle_errors``). ``RRT`` is the case p = 1.
 
-    The arguments every planner takes (``env``, ``predicate``, ``dynamics``, ``oracle_errors``,
-    ``goal_bias``, ``max_extension``, ``space``, ``resolution``, ``seed`` and ``executor``) are
-    documented on ``Planner``. Without an ``executor`` the rounds are tested in batches (module
-    docstring); with one, each worker's test is one task.
-
-    Args:
-        workers: Number p of workers, i.e. extensions per round, in [1, ``MAX_WORKERS``] (4096).
-            Default 8.
-        look_ahead: Whether rounds are tested in batches ahead of the tree (default True). The
-            plan is the same either way; a batch tests rounds a node makes stale
-            (``Metrics.wasted_checks``), which costs little with the compiled checks and much with
-            an expensive user predicate: False tests one round at a time (B = 1), so the predicate
-            is asked exactly once per oracle call.
-
-    Raises:
-        TypeError: A non-integer ``workers``, or an argument ``Planner`` refuses.
-        ValueError: ``workers`` outside [1, 4096], or an argument ``Planner`` refuses.
+    Its options are ``ParallelOptions`` (``workers``, ``look_ahead`` and what every planner takes);
+    it takes an ``executor`` (``Planner``). Without an ``executor`` the rounds are tested in
+    batches (module docstring); with one, each worker's test is one task.
     """
 
     name = "ParallelRRT"
+    Options = ParallelOptions
+    takes_executor = True
 
-    def __init__(
-        self,
-        env: Environment,
-        *,
-        workers: int = 8,
-        predicate: ReachabilityPredicate | None = None,
-        dynamics: LinearTrackingDynamics | None = None,
-        oracle_errors: OracleErrorModel | None = None,
-        goal_bias: float = 0.0,
-        max_extension: float | None = None,
-        space: StateSpace | None = None,
-        resolution: float = 0.01,
-        executor: Executor | None = None,
-        seed: int | None = None,
-        look_ahead: bool = True,
-    ) -> None:
-        self.workers = check_int(workers, "workers", 1, MAX_WORKERS)
-        self.look_ahead = check_bool(look_ahead, "look_ahead")
-        super().__init__(env, predicate=predicate, dynamics=dynamics, oracle_errors=oracle_errors,
-                         goal_bias=goal_bias, max_extension=max_extension, space=space, resolution=resolution,
-                         seed=seed, executor=executor)
+    @property
+    def workers(self) -> int:
+        """p, the workers of a round."""
+        return int(self.options.workers)
 
     def _run(self, state: RunState, condition: TerminationCondition, began: float) -> PlanStatus:
         """Rounds in batches: the candidates of the next B rounds drawn and tested together, then
@@ -147,8 +112,9 @@ class ParallelRRT(Planner):
         B is ``batch_rounds`` (at most ``batch_round_limit``) in-process, 1 on an executor."""
         workers = self.workers
         changed = recorded = 0
-        most = batch_round_limit(workers, self.env.dim) if self.executor is None and self.look_ahead else 1
-        drawn = np.empty((0, self.env.dim))  # candidates drawn for rounds first, first + 1, ... not yet recorded
+        context = state.worker_context
+        most = batch_round_limit(workers, context.env.dim) if self.executor is None and self.options.look_ahead else 1
+        drawn = np.empty((0, context.env.dim))  # candidates drawn for rounds first, first + 1, ... not yet recorded
         while state.goal_node is None:
             ended = condition.ended_by(state.progress(time.perf_counter() - began))
             if ended is not None:
@@ -163,8 +129,8 @@ class ParallelRRT(Planner):
                 keys[:, 2] = int(Stream.CANDIDATES)
                 drawn = np.concatenate((drawn[:kept * workers], self._candidates(state, keys)))
             samples = drawn[:ahead * workers]  # kept raw: a round tested again is steered from its new parents
-            parents = self.space.nearest(state.tree, samples)
-            children = steer(self.space, state.tree.nodes[parents], samples, self.max_extension)
+            parents = context.space.nearest(state.tree, samples)
+            children = steer(context.space, state.tree.nodes[parents], samples, context.max_extension)
             truth = self._test(state, state.tree.nodes[parents], children)
             for offset in range(ahead):
                 if offset:  # (the first round's check came before the draws)
@@ -187,9 +153,10 @@ class ParallelRRT(Planner):
     def _test(self, state: RunState, origins: np.ndarray, children: np.ndarray) -> np.ndarray:
         """The predicate on every (parent position, child) pair: one call in-process, one task per
         worker on an executor."""
-        name = f"the predicate {self.predicate.name!r}"
+        predicate = state.worker_context.predicate
+        name = f"the predicate {predicate.name!r}"
         if self.executor is None or children.shape[0] <= 1:
-            return check_answers(self.predicate.reachable(origins, children), children.shape[0], name)
+            return check_answers(predicate.reachable(origins, children), children.shape[0], name)
         pairs = [(origins[row:row + 1], children[row:row + 1]) for row in range(children.shape[0])]
         answers = map_tasks(self.executor, check_extensions, state.worker_context, self._view(state), pairs)
         return np.concatenate([check_answers(answer, 1, name) for answer in answers])
@@ -198,13 +165,14 @@ class ParallelRRT(Planner):
         """The samples ``build_database(tree, 1, ...)`` draws from each key's generator: uniform
         in the workspace (``Environment.sample_uniform``: low + (high - low) * u), and with goal
         bias the next double decides, a biased one redrawn in the goal ball by the generator."""
-        dim = self.env.dim
-        biased = self.goal_bias > 0
+        env, goal_bias = state.worker_context.env, self.options.goal_bias
+        dim = env.dim
+        biased = goal_bias > 0
         draws = uniform_draws(self.streams, keys, dim + int(biased))
-        low, high = self.env.bounds[:, 0], self.env.bounds[:, 1]
+        low, high = env.bounds[:, 0], env.bounds[:, 1]
         children = low + (high - low) * draws[:, :dim]
         if biased:
-            for row in np.flatnonzero(draws[:, dim] < self.goal_bias):
+            for row in np.flatnonzero(draws[:, dim] < goal_bias):
                 rng = self.streams.generator(*keys[row])
                 rng.random(dim + 1)  # the doubles used above
                 children[row] = sample_goal(state.goal, 1, rng)[0]
@@ -214,7 +182,7 @@ class ParallelRRT(Planner):
                 truth: np.ndarray) -> None:
         """One round's counters and nodes from its workers' tests, as ``_round`` records them."""
         longest = 1
-        errors = self.oracle_errors
+        errors = self.options.oracle_errors
         for worker in range(children.shape[0]):
             true = bool(truth[worker])
             state.verification_calls += 1
@@ -247,29 +215,14 @@ class RRT(ParallelRRT):
     """Classical RRT (paper Algorithm 1): one sample, nearest node and reachability test per round.
 
     ``ParallelRRT`` with one worker and no executor. Each reachability test is one oracle call,
-    counted as a ``verification_call`` (DESIGN §2).
-
-    The arguments every planner takes (``env``, ``predicate``, ``dynamics``, ``oracle_errors``,
-    ``goal_bias``, ``max_extension``, ``space``, ``resolution`` and ``seed``; not ``executor``) are
-    documented on ``Planner``, with what they raise; ``look_ahead`` on ``ParallelRRT``.
+    counted as a ``verification_call`` (DESIGN §2). Its options are ``RRTOptions``.
     """
 
     name = "RRT"
+    Options = RRTOptions
+    takes_executor = False
 
-    def __init__(
-        self,
-        env: Environment,
-        *,
-        predicate: ReachabilityPredicate | None = None,
-        dynamics: LinearTrackingDynamics | None = None,
-        oracle_errors: OracleErrorModel | None = None,
-        goal_bias: float = 0.0,
-        max_extension: float | None = None,
-        space: StateSpace | None = None,
-        resolution: float = 0.01,
-        seed: int | None = None,
-        look_ahead: bool = True,
-    ) -> None:
-        super().__init__(env, workers=1, predicate=predicate, dynamics=dynamics, oracle_errors=oracle_errors,
-                         goal_bias=goal_bias, max_extension=max_extension, space=space, resolution=resolution,
-                         seed=seed, look_ahead=look_ahead)
+    @property
+    def workers(self) -> int:
+        """1: RRT's round is one worker's."""
+        return 1

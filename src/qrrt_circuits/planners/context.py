@@ -30,7 +30,7 @@ from ..search.policies.base import PolicyState
 from ..world.environment import Environment
 from ..world.spaces import StateSpace
 from .database import AnnealingSchedule
-from .goals import Goal
+from ..problems.goals import Goal
 from .tree import Tree
 
 T = TypeVar("T")
@@ -43,6 +43,7 @@ class WorkerContext:
 
     env: Environment
     predicate: ReachabilityPredicate
+    space: StateSpace
     streams: RandomStreams
     goal_bias: float = 0.0
     oracle_errors: OracleErrorModel | None = None
@@ -50,7 +51,6 @@ class WorkerContext:
     annealing: AnnealingSchedule | None = None
     database_size: int = 1
     max_extension: float | None = None
-    space: StateSpace | None = None
     candidates: Any = None  # a quantum planner's ``candidates.Candidates`` (classical planners: None)
 
     @property

@@ -20,7 +20,7 @@ from .._support.randomness import RandomStreams, Stream
 from .._support.validation import check_choice, check_float, check_int
 from ..world.environment import Environment
 from ..world.spaces import RealVectorSpace, StateSpace
-from .goals import Goal
+from ..problems.goals import Goal
 from .placement import PLACEMENTS, uniform_samples
 from .tree import Tree
 

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..world.environment import Environment
 from ..world.spaces import StateSpace
-from .goals import Goal, sample_goal
+from ..problems.goals import Goal, sample_goal
 from .tree import Tree
 
 __all__ = ["ADMIT_DRAWS_PER_ENTRY", "PLACEMENTS", "Placement", "uniform_samples"]

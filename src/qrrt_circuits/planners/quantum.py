@@ -22,27 +22,26 @@ p parallel quantum devices.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
-from concurrent.futures import Executor
+from typing import Any, ClassVar
 
 from .._support.memory import MemoryEstimate, database_bytes, database_resident_bytes
-from .._support.validation import check_bool, check_instance, check_int
-from ..reachability.dynamics import LinearTrackingDynamics
-from ..reachability.oracle_errors import OracleErrorModel
-from ..reachability.predicate import ReachabilityPredicate
+from ..problems.problem import Problem
 from ..search.backends.base import QuantumSearchBackend
 from ..search.policies.adaptive import Adaptive
 from ..search.policies.base import IterationPolicy, PolicyState
 from ..search.policies.thompson import ThompsonIterations
-from ..world.environment import Environment
-from ..world.spaces import StateSpace
 from .base import Planner
 from .candidates import Candidates, NearestParents
-from .classical import MAX_WORKERS
 from .context import WorkerContext, map_tasks
 from .database import AnnealingSchedule
+from .options import ParallelQuantumOptions, PlannerOptions, QuantumOptions
 from .run_state import RunState
 from .workers import DatabaseOutcome, search_database
+
+#: the paper's database, which annealing draws in bands
+PAPER_DATABASE = NearestParents()
 
 ORACLE_LOOKUP_LABEL = (
     "simulation: the phase oracle is built from a classical lookup of all 2^n database entries "
@@ -60,47 +59,15 @@ class PQRRT(Planner):
     phase oracle in simulation is reported as ``simulation_checks``. With ``annealing`` this is
     Quantum Database Annealing (Alg. 4). ``QRRT`` is the case p = 1 (Alg. 2).
 
-    The arguments every planner takes (``env``, ``predicate``, ``dynamics``, ``oracle_errors``,
-    ``goal_bias``, ``max_extension``, ``space``, ``resolution``, ``seed`` and ``executor``) are
-    documented on ``Planner``. On an ``executor`` each database's search is one task; without one
-    the round's databases are searched in turn, with the same results.
-
-    Args:
-        backend: The ``QuantumSearchBackend`` that simulates each Grover search (its ``max_qubits``
-            must allow ``num_qubits``). Default: a new ``AerBackend()`` (qiskit-aer statevector
-            sampling).
-        num_qubits: Qubits n per database, so each database holds N = 2^n (sample, nearest parent)
-            entries; an integer >= 1 and at most the backend's ``max_qubits``. ``plan`` refuses
-            an n whose round, with the tree, does not fit in the available memory. Default 8.
-        workers: Number p of quantum workers per round, in [1, ``MAX_WORKERS``] (4096). Default 8.
-        shared_database: True (default): the manager builds one database per round and its p workers
-            all search it (Alg. 3 as printed; a solution measured by several workers is added once,
-            the extra copies counted as ``duplicates``). False: each worker builds and searches its
-            own database. Must be a ``bool``.
-        search_policy: The ``IterationPolicy`` that decides how each worker searches a database:
-            None (default) for ``default_search_policy()``, ``PaperIterations()`` (the paper's
-            schedule: 5 Grover iterations, 3 once the tree has more than 10 nodes),
-            ``FixedIterations(k)``, ``KnownOptimal()`` (Eq. 1 with the true m), ``BBHT()``,
-            ``Adaptive()``, ``ThompsonIterations()``, ``FixedPointAmplification()``,
-            ``EstimatedOptimal()`` or any other ``IterationPolicy``.
-        annealing: An ``AnnealingSchedule`` for Quantum Database Annealing (Alg. 4: samples are
-            drawn in distance bands around the tree that shrink with the temperature index h), or
-            None (default) for uniform databases.
-        database: How each round's database is built and searched (``planners.candidates``):
-            ``NearestParents()`` (the default: the paper's samples with their nearest nodes,
-            searched by lookup) or ``LatticeCandidates(cell_bits, ..., coherent=...)`` (lattice
-            cells paired with drawn nodes, searched by lookup or by the coherent circuit on Aer).
-
-    Raises:
-        TypeError: A non-integer ``num_qubits`` or ``workers``, a ``backend`` that is not a
-            ``QuantumSearchBackend``, a ``search_policy`` that is not an ``IterationPolicy``, an
-            ``annealing`` that is not an ``AnnealingSchedule``, a non-bool ``shared_database``, or
-            an argument ``Planner`` refuses.
-        ValueError: ``num_qubits`` < 1 or above the backend's ``max_qubits``, ``workers`` outside
-            [1, 4096], or an argument ``Planner`` refuses.
+    Its options are ``ParallelQuantumOptions`` (``backend``, ``num_qubits``, ``workers``,
+    ``shared_database``, ``search_policy``, ``annealing``, ``database`` and what every planner
+    takes); it takes an ``executor`` (``Planner``). On an ``executor`` each database's search is one
+    task; without one the round's databases are searched in turn, with the same results.
     """
 
     name = "PQRRT"
+    Options: ClassVar[type[PlannerOptions]] = ParallelQuantumOptions
+    takes_executor = True
 
     @staticmethod
     def default_search_policy() -> IterationPolicy:
@@ -109,56 +76,64 @@ class PQRRT(Planner):
         rule, on critical-path calls per solution; ``docs/results/problems.md``)."""
         return Adaptive()
 
-    def __init__(
-        self,
-        env: Environment,
-        *,
-        backend: QuantumSearchBackend | None = None,
-        num_qubits: int = 8,
-        workers: int = 8,
-        shared_database: bool = True,
-        search_policy: IterationPolicy | None = None,
-        annealing: AnnealingSchedule | None = None,
-        database: Candidates | None = None,
-        predicate: ReachabilityPredicate | None = None,
-        dynamics: LinearTrackingDynamics | None = None,
-        oracle_errors: OracleErrorModel | None = None,
-        goal_bias: float = 0.0,
-        max_extension: float | None = None,
-        space: StateSpace | None = None,
-        resolution: float = 0.01,
-        executor: Executor | None = None,
-        seed: int | None = None,
-    ) -> None:
-        self.num_qubits = check_int(num_qubits, "num_qubits", 1)
-        self.workers = check_int(workers, "workers", 1, MAX_WORKERS)
-        if backend is None:
+    def _complete(self, options: Any) -> Any:
+        """The options with the planner's defaults: a new ``AerBackend()``, the planner's
+        ``default_search_policy()`` and the paper's database, where none is given."""
+        changes: dict[str, Any] = {}
+        if options.backend is None:
             from ..search.backends.aer import AerBackend  # qiskit and Aer are imported only when used
 
-            backend = AerBackend()
-        check_instance(backend, "backend", QuantumSearchBackend, "a QuantumSearchBackend")
-        backend.check_qubits(self.num_qubits)
-        policy = self.default_search_policy() if search_policy is None else search_policy
-        check_instance(policy, "search_policy", IterationPolicy,
-                       "a search policy (PaperIterations(), FixedIterations(k), KnownOptimal(), BBHT(), Adaptive(), "
-                       "ThompsonIterations())")
-        if annealing is not None:
-            check_instance(annealing, "annealing", AnnealingSchedule, "an AnnealingSchedule or None")
-        candidates = NearestParents() if database is None else check_instance(
-            database, "database", Candidates, "NearestParents() (the paper's), LatticeCandidates(...) or None")
-        if annealing is not None and database is not None:
-            raise ValueError("annealing draws the paper's database in bands: give annealing or database, not both")
-        candidates.check(env, self.num_qubits, oracle_errors is not None)
-        super().__init__(env, predicate=predicate, dynamics=dynamics, oracle_errors=oracle_errors,
-                         goal_bias=goal_bias, max_extension=max_extension, space=space, resolution=resolution,
-                         seed=seed, executor=executor)
-        self.backend = backend
-        self.shared_database = check_bool(shared_database, "shared_database")
-        self.search_policy = policy
-        self.annealing = annealing
-        self.candidates = candidates
+            changes["backend"] = AerBackend()
+        if options.search_policy is None:
+            changes["search_policy"] = self.default_search_policy()
+        if options.database is None and options.annealing is None:  # (annealing draws the paper's in bands)
+            changes["database"] = NearestParents()
+        return options.replace(**changes) if changes else options
 
-    def memory_estimate(self, num_qubits: int | None = None) -> MemoryEstimate:
+    @property
+    def backend(self) -> QuantumSearchBackend:
+        """The search backend."""
+        backend: QuantumSearchBackend = self.options.backend
+        return backend
+
+    @property
+    def num_qubits(self) -> int:
+        """n, the qubits of each database."""
+        return int(self.options.num_qubits)
+
+    @property
+    def workers(self) -> int:
+        """p, the workers of a round."""
+        return int(self.options.workers)
+
+    @property
+    def shared_database(self) -> bool:
+        """Whether the workers search one shared database."""
+        return bool(self.options.shared_database)
+
+    @property
+    def search_policy(self) -> IterationPolicy:
+        """The search policy (the planner's default where none was given)."""
+        policy: IterationPolicy = self.options.search_policy
+        return policy
+
+    @property
+    def annealing(self) -> AnnealingSchedule | None:
+        """Quantum Database Annealing's schedule, or None."""
+        schedule: AnnealingSchedule | None = self.options.annealing
+        return schedule
+
+    @property
+    def candidates(self) -> Candidates:
+        """How each database is built and searched."""
+        candidates: Candidates | None = self.options.database
+        return PAPER_DATABASE if candidates is None else candidates
+
+    def _check_serves(self, problem: Problem) -> None:
+        """Refuse a database this problem cannot hold (``Candidates.check``)."""
+        self.candidates.check(problem.env, self.num_qubits, self.options.oracle_errors is not None)
+
+    def memory_estimate(self, dim: int, num_qubits: int | None = None) -> MemoryEstimate:
         """Estimated peak memory of one round (``qrrt_circuits._support.memory``); ``plan`` checks it, with
         the tree and the round history, once before the plan allocates anything.
 
@@ -168,6 +143,7 @@ class PQRRT(Planner):
         (``IterationPolicy.search_peak_bytes``), plus the policy's state.
 
         Args:
+            dim: The problem's dimension d.
             num_qubits: Qubits n to estimate for (databases of 2^n entries); default the planner's
                 own ``num_qubits``.
 
@@ -181,8 +157,8 @@ class PQRRT(Planner):
         search = self.search_policy.search_peak_bytes(self.backend, n, shots)
         return MemoryEstimate(
             n,
-            database_bytes=concurrent * database_bytes(n, self.env.dim, self.annealing is not None),
-            resident_bytes=concurrent * database_resident_bytes(n, self.env.dim),
+            database_bytes=concurrent * database_bytes(n, dim, self.annealing is not None),
+            resident_bytes=concurrent * database_resident_bytes(n, dim),
             search_bytes=concurrent * search,
             policy_bytes=self.search_policy.state_bytes(size),
         )
@@ -199,14 +175,15 @@ class PQRRT(Planner):
         """p: each worker adds at most one node a round."""
         return self.workers
 
-    def _round_memory(self) -> tuple[Callable[[int], MemoryEstimate] | None, int]:
-        """One round's ``memory_estimate`` as a function of n, and the plan's n."""
-        return self.memory_estimate, self.num_qubits
+    def _round_memory(self, dim: int) -> tuple[Callable[[int], MemoryEstimate] | None, int]:
+        """One round's ``memory_estimate`` in dimension ``dim`` as a function of n, and the plan's n."""
+        return functools.partial(self.memory_estimate, dim), self.num_qubits
 
-    def _context(self) -> WorkerContext:
-        return WorkerContext(self.env, self.predicate, self.streams, self.goal_bias, self.oracle_errors,
-                             self.backend, self.annealing, self.database_size, self.max_extension, self.space,
-                             self.candidates)
+    def _context(self, problem: Problem) -> WorkerContext:
+        options = self.options
+        return WorkerContext(problem.env, problem.predicate, problem.space, self.streams, options.goal_bias,
+                             options.oracle_errors, self.backend, self.annealing, self.database_size,
+                             options.max_extension, self.candidates)
 
     def _worker_groups(self) -> list[tuple[int, int]]:
         """(first worker, workers) per database: one group of p on a shared database, p of one."""
@@ -247,15 +224,7 @@ class PQRRT(Planner):
 
     # ------------------------------------------------------------------ reporting
     def settings(self) -> dict:
-        return super().settings() | {
-            "backend": self.backend.describe(),
-            "num_qubits": self.num_qubits,
-            "workers": self.workers,
-            "shared_database": self.shared_database,
-            "search_policy": self.search_policy.describe(),
-            "annealing": None if self.annealing is None else self.annealing.describe(),
-            "database": self.candidates.describe(),
-        }
+        return super().settings() | {"workers": self.workers, "shared_database": self.shared_database}
 
     def labels(self) -> tuple[str, ...]:
         """The simulation shortcuts of this planner: the classical lookup behind the phase oracle,
@@ -285,25 +254,14 @@ class QRRT(PQRRT):
     ``search_policy`` decides, measure, verify classically (1 oracle call) and add the entry if it
     verifies. With ``annealing`` this is Quantum Database Annealing (Alg. 4).
 
-    The arguments every planner takes (``env``, ``predicate``, ``dynamics``, ``oracle_errors``,
-    ``goal_bias``, ``max_extension``, ``space``, ``resolution`` and ``seed``; not ``executor``) are
-    documented on ``Planner``; the others are ``PQRRT``'s, with the same meaning and defaults.
-
-    Args:
-        backend: The ``QuantumSearchBackend`` of the searches. Default: a new ``AerBackend()``.
-        num_qubits: Qubits n per database (N = 2^n entries), 1 .. the backend's ``max_qubits``.
-            Default 8.
-        search_policy: The ``IterationPolicy`` of the searches, or None (default) for
-            ``default_search_policy()``.
-        annealing: An ``AnnealingSchedule`` (Quantum Database Annealing), or None (default).
-        database: ``NearestParents()`` (default) or ``LatticeCandidates(...)``, as for ``PQRRT``.
-
-    Raises:
-        TypeError: An argument of the wrong type, as for ``PQRRT``.
-        ValueError: An argument out of range, as for ``PQRRT``.
+    Its options are ``QuantumOptions`` (``backend``, ``num_qubits``, ``search_policy``,
+    ``annealing``, ``database`` and what every planner takes), with ``PQRRT``'s meaning and
+    defaults; it takes no executor.
     """
 
     name = "QRRT"
+    Options: ClassVar[type[PlannerOptions]] = QuantumOptions
+    takes_executor = False
 
     @staticmethod
     def default_search_policy() -> IterationPolicy:
@@ -312,25 +270,12 @@ class QRRT(PQRRT):
         pre-stated rule, on calls per solution; ``docs/results/problems.md``)."""
         return ThompsonIterations()
 
-    def __init__(
-        self,
-        env: Environment,
-        *,
-        backend: QuantumSearchBackend | None = None,
-        num_qubits: int = 8,
-        search_policy: IterationPolicy | None = None,
-        annealing: AnnealingSchedule | None = None,
-        database: Candidates | None = None,
-        predicate: ReachabilityPredicate | None = None,
-        dynamics: LinearTrackingDynamics | None = None,
-        oracle_errors: OracleErrorModel | None = None,
-        goal_bias: float = 0.0,
-        max_extension: float | None = None,
-        space: StateSpace | None = None,
-        resolution: float = 0.01,
-        seed: int | None = None,
-    ) -> None:
-        super().__init__(env, backend=backend, num_qubits=num_qubits, workers=1, shared_database=True,
-                         search_policy=search_policy, annealing=annealing, database=database, predicate=predicate,
-                         dynamics=dynamics, oracle_errors=oracle_errors, goal_bias=goal_bias,
-                         max_extension=max_extension, space=space, resolution=resolution, seed=seed)
+    @property
+    def workers(self) -> int:
+        """1: q-RRT's round is one worker's."""
+        return 1
+
+    @property
+    def shared_database(self) -> bool:
+        """True: one worker searches its one database."""
+        return True

@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .goals import Goal, first_satisfying
+from ..problems.goals import Goal, first_satisfying
 from .termination import Progress
 from .tree import Tree
 

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -220,19 +221,15 @@ class GridCheck:
         return f"GridCheck({self.grid!r})"
 
 
-def image_world(path: str | Path, pixel_size: float, start: np.ndarray, goal: np.ndarray, goal_radius: float,
-                free_threshold: float = 0.5, negate: bool = False,
+def image_world(path: str | Path, pixel_size: float, free_threshold: float = 0.5, negate: bool = False,
                 origin: tuple[float, float] = (0.0, 0.0)) -> tuple[Environment, GridCheck]:
-    """The planning problem of an occupancy image: an ``Environment`` with the grid's bounds and no
-    boxes (every obstacle is in the grid), and the ``GridCheck`` to plan with
-    (``predicate=check``). The planners refuse a start or goal that ``check.is_valid`` rejects.
+    """The world of an occupancy image: an ``Environment`` with the grid's bounds and no boxes
+    (every obstacle is in the grid), and the ``GridCheck`` of its straight segments
+    (``problems.families.image_problem`` adds a start and a goal).
 
     Args:
         path: A PNG, PGM or PPM file (``OccupancyGrid.from_image``).
         pixel_size: The side of a pixel in world units (a finite number > 0).
-        start: (x, y).
-        goal: (x, y), the centre of the goal ball.
-        goal_radius: The goal ball's radius (> 0).
         free_threshold: A pixel is free where its grey value is >= this (in [0, 1]; default 0.5).
         negate: Read 1 - grey instead of grey (default False: white free).
         origin: The world position of the image's bottom-left corner (default (0, 0)).
@@ -241,10 +238,8 @@ def image_world(path: str | Path, pixel_size: float, start: np.ndarray, goal: np
         (environment, check); the environment is named after the file's stem.
 
     Raises:
-        ValueError: Anything ``OccupancyGrid.from_image`` or ``Environment`` refuses, or a
-            ``start`` or ``goal`` that is not a valid point of the map (``check.is_valid``: outside
-            the bounds, or in or on the boundary of an occupied cell), naming it and the pixel.
-        TypeError: A non-numeric ``pixel_size``, ``free_threshold`` or ``goal_radius``.
+        ValueError: Anything ``OccupancyGrid.from_image`` refuses.
+        TypeError: A non-numeric ``pixel_size`` or ``free_threshold``.
 
     Example:
         >>> import os, tempfile
@@ -252,41 +247,44 @@ def image_world(path: str | Path, pixel_size: float, start: np.ndarray, goal: np
         >>> path = os.path.join(tempfile.mkdtemp(), "room.pgm")
         >>> with open(path, "wb") as handle:  # a 4 x 4 room with one black pixel
         ...     _ = handle.write(b"P5 4 4 255\\n" + bytes([255] * 5 + [0] + [255] * 10))
-        >>> env, check = qc.image_world(path, 1.0, start=[0.5, 0.5], goal=[3.5, 3.5], goal_radius=0.4)
+        >>> env, check = qc.image_world(path, 1.0)
         >>> env.bounds.tolist(), check.is_valid([[1.5, 2.5], [0.5, 0.5]]).tolist()
         ([[0.0, 4.0], [0.0, 4.0]], [False, True])
     """
     grid = OccupancyGrid.from_image(path, pixel_size, free_threshold, negate, origin)
-    return grid_world(grid, start, goal, goal_radius, name=f"image:{Path(path).stem}")
+    return grid_world(grid, name=f"image:{Path(path).stem}")
 
 
-def grid_world(grid: OccupancyGrid, start: np.ndarray, goal: np.ndarray, goal_radius: float,
-               name: str = "grid") -> tuple[Environment, GridCheck]:
-    """The planning problem of an ``OccupancyGrid``: an ``Environment`` with the grid's bounds and
-    no boxes, and the grid's ``GridCheck`` (``image_world`` for a grid read from an image).
+def grid_world(grid: OccupancyGrid, name: str = "grid") -> tuple[Environment, GridCheck]:
+    """The world of an ``OccupancyGrid``: an ``Environment`` with the grid's bounds and no boxes,
+    and the grid's ``GridCheck`` (``image_world`` for a grid read from an image).
 
     Args:
         grid: The grid.
-        start: (x, y).
-        goal: (x, y), the centre of the goal ball.
-        goal_radius: The goal ball's radius (> 0).
         name: The environment's name.
 
     Returns:
         (environment, check).
-
-    Raises:
-        ValueError: Anything ``Environment`` refuses, or a ``start`` or ``goal`` that is not a valid
-            point of the map (``check.is_valid``), naming it and the pixel.
     """
     check = GridCheck(grid)
-    env = Environment(grid.bounds(), np.zeros((0, 2, 2)), name=name, start=start,
-                      goal=goal, goal_radius=goal_radius, metadata={"occupancy": grid.describe()})
-    for key, point in (("start", env.start), ("goal", env.goal)):
-        if point is not None and not check.is_valid(point)[0]:
-            raise ValueError(f"{key} {point.tolist()} is not a free point of the map: {_why_invalid(grid, point)}; "
-                             f"accepted: a point inside a free cell, within the bounds {grid.bounds().tolist()}")
-    return env, check
+    return Environment(grid.bounds(), np.zeros((0, 2, 2)), name=name, metadata={"occupancy": grid.describe()}), check
+
+
+def check_map_point(check: GridCheck, name: str, point: Any) -> None:
+    """Refuse ``point`` unless it is a free point of the map (``check.is_valid``).
+
+    Args:
+        check: The grid's check.
+        name: The point's name for the message (``"start"``, ``"goal"``).
+        point: (x, y).
+
+    Raises:
+        ValueError: A point outside the bounds or in or on an occupied cell, naming the pixel.
+    """
+    point = np.asarray(point, dtype=float).reshape(-1)
+    if point.shape == (2,) and np.all(np.isfinite(point)) and not check.is_valid(point)[0]:
+        raise ValueError(f"{name} {point.tolist()} is not a free point of the map: {_why_invalid(check.grid, point)}; "
+                         f"accepted: a point inside a free cell, within the bounds {check.grid.bounds().tolist()}")
 
 
 def _why_invalid(grid: OccupancyGrid, point: np.ndarray) -> str:

@@ -141,19 +141,15 @@ class RigidBodyCheck:
                 "resolution": self.resolution, "boxes": len(self.boxes), "sound": True}
 
 
-def se2_world(workspace: np.ndarray, boxes: np.ndarray, half_lengths: tuple[float, float], start: np.ndarray,
-              goal: np.ndarray, goal_radius: float, resolution: float = 0.02,
+def se2_world(workspace: np.ndarray, boxes: np.ndarray, half_lengths: tuple[float, float], resolution: float = 0.02,
               name: str = "se2") -> tuple[Environment, RigidBodyCheck]:
     """The environment (x, y, theta bounds, no boxes of its own) and the check of a rectangle among
-    ``boxes``: plan with ``space=SE2Space(), predicate=check``.
+    ``boxes``: a problem with ``space=SE2Space(), predicate=check``.
 
     Args:
         workspace: (2, 2) plane bounds.
         boxes: (B, 2, 2) obstacles.
         half_lengths: The rectangle's (a, b).
-        start: (x, y, theta).
-        goal: (x, y, theta), the centre of the goal ball (Euclidean in the coordinates).
-        goal_radius: The goal ball's radius.
         resolution: The check's resolution.
         name: The world's name.
 
@@ -161,6 +157,4 @@ def se2_world(workspace: np.ndarray, boxes: np.ndarray, half_lengths: tuple[floa
         (environment, check).
     """
     check = RigidBodyCheck(workspace, boxes, half_lengths, resolution, name=f"{name}-rigid-body")
-    env = Environment(check.bounds(), np.zeros((0, 2, 3)), start=start, goal=goal, goal_radius=goal_radius,
-                      name=name)
-    return env, check
+    return Environment(check.bounds(), np.zeros((0, 2, 3)), name=name), check

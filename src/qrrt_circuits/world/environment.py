@@ -7,9 +7,12 @@ closed box ``bounds``. Environments round-trip through a documented JSON format:
       "format": "qrrt-environment", "version": 1, "name": "paper_clutter",
       "bounds": [[low_0, high_0], ..., [low_{d-1}, high_{d-1}]],
       "boxes": [[[lower_0, ..., lower_{d-1}], [upper_0, ..., upper_{d-1}]], ...],
-      "start": [..] | null, "goal": [..] | null, "goal_radius": float | null,
       "metadata": {...}
     }
+
+A scenario file is this format with the problem's ``"start"``, ``"goal"`` and ``"goal_radius"``
+beside the geometry (``problems.families.box_world`` reads it, ``save_box_world`` writes it);
+``Environment.load`` reads the geometry of such a file.
 """
 
 from __future__ import annotations
@@ -56,31 +59,23 @@ class Environment:
     """The world (DESIGN §3, §4): workspace ``bounds`` (d, 2) and box obstacles ``boxes`` (k, 2, d).
 
     ``boxes[i, 0]`` is the lower corner of box i and ``boxes[i, 1]`` its upper corner; boxes and
-    the workspace are closed. ``start``, ``goal`` and ``goal_radius`` are optional: scenarios fill
-    them in. Arrays are stored read-only; the object is frozen.
+    the workspace are closed. The environment is geometry only: the start and the goal belong to
+    the ``Problem``. Arrays are stored read-only; the object is frozen.
 
     Args:
         bounds: Float (d, 2), d >= 2: low < high per axis, within [-1e12, 1e12] (``MAX_EXTENT``).
         boxes: Float (k, 2, d), k >= 0: lower corner <= upper corner on every axis.
         name: The scenario's name (``"custom"`` by default).
-        start: Float (d,) or None.
-        goal: Float (d,) or None.
-        goal_radius: A float > 0 or None.
         metadata: Free-form JSON-serialisable dict (scenario parameters).
 
     Raises:
         ValueError: Non-numeric or non-finite arrays, wrong shapes, low >= high on an axis, bounds
-            beyond ``MAX_EXTENT``, a box with lower > upper, a start / goal without d coordinates,
-            or a ``goal_radius`` that is not > 0.
-        TypeError: A non-numeric ``goal_radius``.
+            beyond ``MAX_EXTENT``, or a box with lower > upper.
     """
 
     bounds: np.ndarray
     boxes: np.ndarray
     name: str = "custom"
-    start: np.ndarray | None = None
-    goal: np.ndarray | None = None
-    goal_radius: float | None = None
     metadata: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -114,17 +109,6 @@ class Environment:
         boxes.setflags(write=False)
         object.__setattr__(self, "bounds", bounds)
         object.__setattr__(self, "boxes", boxes)
-        for key in ("start", "goal"):
-            value = getattr(self, key)
-            if value is not None:
-                point = _as_float_array(value, key).reshape(-1)
-                if point.shape != (d,):
-                    raise ValueError(f"{key} must have {d} coordinates, got {point.shape[0]}")
-                point.setflags(write=False)
-                object.__setattr__(self, key, point)
-        if self.goal_radius is not None:
-            object.__setattr__(self, "goal_radius", check_float(self.goal_radius, "goal_radius", 0.0,
-                                                                open_minimum=True))
 
     @property
     def dim(self) -> int:
@@ -288,8 +272,7 @@ class Environment:
         """The environment as JSON-able data in the format of the module docstring.
 
         Returns:
-            A dict with ``format``, ``version``, ``name``, ``bounds``, ``boxes``, ``start``,
-            ``goal``, ``goal_radius`` and ``metadata``.
+            A dict with ``format``, ``version``, ``name``, ``bounds``, ``boxes`` and ``metadata``.
         """
         return {
             "format": FORMAT_NAME,
@@ -297,9 +280,6 @@ class Environment:
             "name": self.name,
             "bounds": self.bounds.tolist(),
             "boxes": self.boxes.tolist(),
-            "start": None if self.start is None else self.start.tolist(),
-            "goal": None if self.goal is None else self.goal.tolist(),
-            "goal_radius": self.goal_radius,
             "metadata": dict(self.metadata),
         }
 
@@ -309,7 +289,8 @@ class Environment:
 
         Args:
             data: A dict with ``"format": "qrrt-environment"``, ``"version": 1``, ``bounds`` and
-                ``boxes`` (the other keys optional).
+                ``boxes`` (the other keys optional; a scenario file's ``start``, ``goal`` and
+                ``goal_radius`` are the problem's, read by ``problems.families.box_world``).
 
         Returns:
             The ``Environment``.
@@ -344,9 +325,6 @@ class Environment:
             bounds=bounds,
             boxes=boxes,
             name=str(data.get("name", "custom"))[:200],
-            start=data.get("start"),
-            goal=data.get("goal"),
-            goal_radius=data.get("goal_radius"),
             metadata=_metadata(data.get("metadata")),
         )
 

@@ -12,7 +12,7 @@ if TYPE_CHECKING:
     from ...planners.base import Planner
     from ...planners.result import PlanResult
     from ...world.environment import Environment
-    from ...world.problems import Problem
+    from ...problems.families import Problem
 
 
 
@@ -44,7 +44,7 @@ def _load_problem(args: argparse.Namespace) -> Problem | None:
         raise ValueError(f"--problem fixes the world and the motion check: leave out {', '.join(given)}")
     if Path(args.problem).is_dir():
         raise ValueError(f"--problem: {args.problem!r} is a folder, not a problem file")
-    from ...world.problems import load_problem
+    from ...problems.families import load_problem
 
     return load_problem(args.problem)
 

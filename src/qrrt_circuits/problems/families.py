@@ -30,49 +30,25 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from .._support.validation import check_float, check_int
-from ..planners.goals import Goal, GoalBall
 from ..reachability.dynamics import LinearTrackingDynamics
 from ..reachability.exact import ExactCheck
-from ..reachability.predicate import ReachabilityPredicate
+from ..reachability.grid_check import check_map_point, grid_world, image_world
 from ..reachability.rigid_body import se2_world
-from .environment import Environment
-from .spaces import RealVectorSpace, SE2Space, StateSpace
+from ..world.environment import Environment
+from ..world.image import OccupancyGrid
+from ..world.spaces import SE2Space
+from .problem import Problem
 
-__all__ = ["FAMILIES", "Problem", "box_world", "image_problem", "load_problem", "maze", "narrow_passage", "open_space",
-           "se2_gap", "winding_band", "straight_line_dynamics"]
+__all__ = ["FAMILIES", "box_world", "grid_problem", "image_problem", "load_problem", "maze", "narrow_passage",
+           "open_space", "save_box_world", "se2_gap", "straight_line_dynamics", "winding_band"]
 
 PROBLEM_FORMAT, PROBLEM_VERSION = "qrrt-problem", 1
-
-
-@dataclass(frozen=True, eq=False)
-class Problem:
-    """A planning problem: plan it with ``Planner(problem.env, **problem.planner_options())`` and
-    ``planner.plan(goal=problem.goal, ...)``.
-
-    Attributes:
-        name: The problem's name.
-        env: Bounds and start (and the boxes the default check sees, for box worlds).
-        predicate: The motion check.
-        space: The state space.
-        goal: The goal.
-    """
-
-    name: str
-    env: Environment
-    predicate: ReachabilityPredicate
-    space: StateSpace
-    goal: Goal
-
-    def planner_options(self) -> dict[str, Any]:
-        """The planner keywords this problem fixes: ``predicate`` and ``space``."""
-        return {"predicate": self.predicate, "space": self.space}
 
 
 def straight_line_dynamics(dim: int) -> LinearTrackingDynamics:
@@ -90,9 +66,8 @@ def straight_line_dynamics(dim: int) -> LinearTrackingDynamics:
 
 def _box_problem(name: str, bounds: np.ndarray, boxes: np.ndarray, start: np.ndarray, goal: np.ndarray,
                  goal_radius: float) -> Problem:
-    env = Environment(bounds, boxes, start=start, goal=goal, goal_radius=goal_radius, name=name)
-    check = ExactCheck(env, straight_line_dynamics(env.dim))
-    return Problem(name, env, check, RealVectorSpace(env.dim), GoalBall(goal, goal_radius))
+    env = Environment(bounds, boxes, name=name)
+    return Problem.build(env, start, goal, goal_radius, predicate=ExactCheck(env, straight_line_dynamics(env.dim)))
 
 
 def open_space() -> Problem:
@@ -213,10 +188,8 @@ def se2_gap(width: float = 1.2) -> Problem:
     width = check_float(width, "width", 0.0, 8.0, open_minimum=True)
     wall = np.array([[[4.8, 0.0], [5.2, 5.0 - width / 2]], [[4.8, 5.0 + width / 2], [5.2, 10.0]]])
     goal = np.array([8.0, 8.0, 0.0])
-    env, check = se2_world(np.array([[0.0, 10.0], [0.0, 10.0]]), wall, (0.6, 0.2),
-                           start=np.array([2.0, 8.0, math.pi / 2]), goal=goal, goal_radius=1.0, resolution=0.05,
-                           name="se2-gap")
-    return Problem("se2-gap", env, check, SE2Space(), GoalBall(goal, 1.0))
+    env, check = se2_world(np.array([[0.0, 10.0], [0.0, 10.0]]), wall, (0.6, 0.2), resolution=0.05, name="se2-gap")
+    return Problem.build(env, np.array([2.0, 8.0, math.pi / 2]), goal, 1.0, predicate=check, space=SE2Space())
 
 
 def maze(cells: int = 4, seed: int = 0) -> Problem:
@@ -235,38 +208,93 @@ def maze(cells: int = 4, seed: int = 0) -> Problem:
         TypeError: A non-integer ``cells`` or ``seed``.
         ValueError: ``cells`` outside [2, 32] or a negative ``seed``.
     """
-    from ..reachability.grid_check import grid_world
-    from .maze import maze_grid, room_center
+    from ..world.maze import maze_grid, room_center
 
     cells = check_int(cells, "cells", 2, 32)
     grid = maze_grid(cells, seed, 10.0 / (2 * cells + 1))
     start, goal = room_center(grid, cells - 1, 0), room_center(grid, 0, cells - 1)  # bottom-left, top-right
     radius = 0.4 * grid.pixel_size
     name = f"maze-{cells}x{cells}-seed{seed}"
-    env, check = grid_world(grid, start, goal, radius, name=name)
-    return Problem(name, env, check, RealVectorSpace(2), GoalBall(goal, radius))
+    return grid_problem(grid, start, goal, radius, name=name)
+
+
+def grid_problem(grid: OccupancyGrid, start: Any, goal: Any, goal_radius: float, name: str = "grid") -> Problem:
+    """An ``OccupancyGrid`` as a problem: the grid's bounds, the ``GridCheck`` of straight segments,
+    R^2 and the goal ball.
+
+    Args:
+        grid: The grid.
+        start: (x, y), a free point of the map.
+        goal: (x, y), the goal ball's centre, a free point of the map.
+        goal_radius: Its radius (> 0).
+        name: The problem's name.
+
+    Returns:
+        The problem.
+
+    Raises:
+        ValueError: A start or goal that is not a free point of the map (naming the pixel), or
+            what ``Problem`` refuses.
+    """
+    env, check = grid_world(grid, name=name)
+    for key, point in (("start", start), ("goal", goal)):
+        check_map_point(check, key, point)
+    return Problem.build(env, start, goal, goal_radius, predicate=check)
 
 
 def box_world(path: str | Path) -> Problem:
-    """A ``qrrt-environment`` scenario file with the library's default motion model (the paper's
-    dynamics, ``ExactCheck``).
+    """A ``qrrt-environment`` scenario file (its geometry with ``start``, ``goal`` and
+    ``goal_radius``) with the library's default motion model (the paper's dynamics, ``ExactCheck``).
 
     Args:
         path: The scenario file.
 
     Returns:
         The problem.
+
+    Raises:
+        ValueError: What ``Environment.load`` refuses, or a file without ``start``, ``goal`` and
+            ``goal_radius`` or with values ``Problem.build`` refuses; the message starts with the
+            path.
     """
     env = Environment.load(path)
-    if env.start is None or env.goal is None or env.goal_radius is None:
-        raise ValueError(f"{path}: a problem's scenario needs start, goal and goal_radius")
-    return Problem(env.name, env, ExactCheck(env), RealVectorSpace(env.dim), GoalBall(env.goal, env.goal_radius))
+    data = json.loads(Path(path).read_text(encoding="utf-8"))
+    missing = [key for key in ("start", "goal", "goal_radius") if data.get(key) is None]
+    if missing:
+        raise ValueError(f"{path}: a problem's scenario needs start, goal and goal_radius (missing {', '.join(missing)})")
+    try:
+        return Problem.build(env, data["start"], data["goal"], data["goal_radius"])
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{path}: {exc}") from exc
+
+
+def save_box_world(problem: Problem, path: str | Path) -> Path:
+    """Write ``problem`` as a ``qrrt-environment`` scenario file (``box_world`` reads it back with
+    the default exact check).
+
+    Args:
+        problem: A problem whose goal is a ball (``GoalBall``).
+        path: The file (overwritten).
+
+    Returns:
+        The path written.
+
+    Raises:
+        ValueError: A goal that is not a ball.
+    """
+    centre, radius = getattr(problem.goal, "centre", None), getattr(problem.goal, "radius", None)
+    if centre is None or radius is None:
+        raise ValueError(f"a scenario file holds a goal ball; the problem's goal is {problem.goal!r}")
+    data = problem.env.to_dict() | {"start": problem.start.tolist(), "goal": np.asarray(centre).tolist(),
+                                    "goal_radius": float(radius)}
+    path = Path(path)
+    path.write_text(json.dumps(data, indent=1))
+    return path
 
 
 def image_problem(path: str | Path, pixel_size: float, start: Any, goal: Any, goal_radius: float,
                   free_threshold: float = 0.5, negate: bool = False) -> Problem:
-    """An occupancy image as a problem: the grid's bounds, the ``GridCheck`` of straight segments,
-    R^2 and the goal ball.
+    """An occupancy image as a problem (``grid_problem`` of the image's grid).
 
     Args:
         path: A PNG, PGM or PPM file.
@@ -278,13 +306,13 @@ def image_problem(path: str | Path, pixel_size: float, start: Any, goal: Any, go
         negate: Read 1 - grey instead (black free).
 
     Returns:
-        The problem.
-    """
-    from ..reachability.grid_check import image_world
+        The problem, named ``image:STEM``.
 
-    env, check = image_world(path, pixel_size, np.asarray(start, dtype=float), np.asarray(goal, dtype=float),
-                             goal_radius, free_threshold=free_threshold, negate=negate)
-    return Problem(env.name, env, check, RealVectorSpace(2), GoalBall(np.asarray(goal, dtype=float), goal_radius))
+    Raises:
+        ValueError: What ``OccupancyGrid.from_image`` or ``grid_problem`` refuses.
+    """
+    env, check = image_world(path, pixel_size, free_threshold=free_threshold, negate=negate)
+    return grid_problem(check.grid, start, goal, goal_radius, name=env.name)
 
 
 #: family name -> (builder, its JSON arguments and their defaults)

@@ -279,21 +279,19 @@ def first_satisfying(goal: Goal, points: np.ndarray) -> int:
     return int(hits[0]) if hits.size else -1
 
 
-def check_goal(goal: Any, dim: int, goal_bias: float) -> Goal:
-    """Return ``goal`` if a plan can use it: the ``Goal`` protocol in dimension ``dim``, with
-    ``sample`` where ``goal_bias > 0``, and drawable where it has no volume.
+def check_goal(goal: Any, dim: int) -> Goal:
+    """Return ``goal`` if it implements the ``Goal`` protocol in dimension ``dim``.
 
     Args:
         goal: The object to check.
         dim: The environment's d.
-        goal_bias: The planner's goal bias.
 
     Returns:
         ``goal`` itself.
 
     Raises:
-        TypeError: A member of the protocol missing, or ``sample`` missing with ``goal_bias > 0``.
-        ValueError: A dimension mismatch, or a goal without volume and ``goal_bias == 0``.
+        TypeError: A member of the protocol missing.
+        ValueError: A dimension mismatch.
     """
     missing = [member for member in REQUIRED_MEMBERS if not hasattr(goal, member)]
     if missing:
@@ -301,6 +299,24 @@ def check_goal(goal: Any, dim: int, goal_bias: float) -> Goal:
                         f"{type(goal).__name__} lacks {', '.join(missing)}")
     if goal.dim != dim:
         raise ValueError(f"dimension mismatch: the goal has d = {goal.dim}, the environment has d = {dim}")
+    return goal
+
+
+def check_reachable_by(goal: Goal, goal_bias: float) -> Goal:
+    """Return ``goal`` if a planner with ``goal_bias`` can end in it: with ``sample`` where
+    ``goal_bias > 0``, and drawable where it has no volume.
+
+    Args:
+        goal: A checked ``Goal``.
+        goal_bias: The planner's goal bias.
+
+    Returns:
+        ``goal`` itself.
+
+    Raises:
+        TypeError: ``sample`` missing with ``goal_bias > 0``.
+        ValueError: A goal without volume and ``goal_bias == 0``.
+    """
     if goal_bias > 0 and not hasattr(goal, "sample"):
         raise TypeError(f"goal_bias = {goal_bias} draws candidates in the goal, but {type(goal).__name__} has no "
                         "sample(count, rng): give it one, or goal_bias = 0")

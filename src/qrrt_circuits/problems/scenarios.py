@@ -1,5 +1,5 @@
-"""Seeded scenarios of DESIGN §4. Each returns an ``Environment`` with ``start``, ``goal`` and
-``goal_radius`` filled in. Same seed, same world."""
+"""Seeded scenarios of DESIGN §4. Each returns a ``Problem``: the world (its ``Environment``), a
+start, a goal ball and the sound exact check of the paper's motion model. Same seed, same world."""
 
 from __future__ import annotations
 
@@ -9,7 +9,8 @@ from collections.abc import Callable
 import numpy as np
 
 from .._support.validation import check_float, check_int, check_seed
-from .environment import Environment
+from ..world.environment import Environment
+from .problem import Problem
 
 #: the side of the paper's square cluttered workspace
 CLUTTER_SIZE = 20.0
@@ -67,7 +68,7 @@ def _world_rng(name: str, seed: int | None) -> np.random.Generator:
 
 
 def paper_clutter(seed: int | None = 0, num_boxes: int = CLUTTER_BOXES,
-                  size: float = CLUTTER_SIZE) -> Environment:
+                  size: float = CLUTTER_SIZE) -> Problem:
     """[0, 20]^2 with 525 boxes of sides U(0.25, 0.85): the authors' comparison world (DESIGN §4).
 
     Boxes lie fully inside the square and may overlap. Start and goal are uniform free points at
@@ -80,7 +81,7 @@ def paper_clutter(seed: int | None = 0, num_boxes: int = CLUTTER_BOXES,
         size: Side of the square, > 1.7 (twice the largest box side).
 
     Returns:
-        The ``Environment`` with ``start``, ``goal``, ``goal_radius`` and metadata set.
+        The ``Problem``: its world (``metadata`` set), start, goal ball and exact check.
 
     Raises:
         ValueError: A negative ``seed`` or ``num_boxes``, or ``size`` <= 1.7.
@@ -97,13 +98,13 @@ def paper_clutter(seed: int | None = 0, num_boxes: int = CLUTTER_BOXES,
     boxes = _random_boxes(rng, num_boxes, bounds[:, 0], bounds[:, 1])
     env = Environment(bounds, boxes, name="paper_clutter")
     start, goal = _start_goal(env, rng, size / 2, GOAL_RADIUS)
-    return Environment(bounds, boxes, name="paper_clutter", start=start, goal=goal,
-                       goal_radius=GOAL_RADIUS,
-                       metadata={"seed": seed, "num_boxes": num_boxes, "side_range": SIDE_RANGE})
+    world = Environment(bounds, boxes, name="paper_clutter",
+                        metadata={"seed": seed, "num_boxes": num_boxes, "side_range": SIDE_RANGE})
+    return Problem.build(world, start, goal, GOAL_RADIUS)
 
 
 def narrow_corridor(seed: int | None = 0, width: float = 0.4, length: float = 4.0,
-                    clutter: int = 120, mouth_clearance: float = 1.5) -> Environment:
+                    clutter: int = 120, mouth_clearance: float = 1.5) -> Problem:
     """[0, 20]^2 split by two blocks leaving one horizontal channel through the middle (paper §V.C).
 
     The channel is ``width`` wide and ``length`` long, centred in the square: the blocks fill
@@ -124,7 +125,7 @@ def narrow_corridor(seed: int | None = 0, width: float = 0.4, length: float = 4.
             beside the mouth).
 
     Returns:
-        The ``Environment`` with ``start``, ``goal``, ``goal_radius`` and metadata set.
+        The ``Problem``: its world (``metadata`` set), start, goal ball and exact check.
 
     Raises:
         ValueError: A negative ``seed``, or ``width``, ``length``, ``clutter`` or
@@ -176,14 +177,13 @@ def narrow_corridor(seed: int | None = 0, width: float = 0.4, length: float = 4.
             break
     else:
         raise RuntimeError(f"could not place start and goal beside a channel {width} wide and {length} long")
-    return Environment(env.bounds, boxes, name="narrow_corridor", start=start, goal=goal,
-                       goal_radius=GOAL_RADIUS,
-                       metadata={"seed": seed, "channel": [[x0, y0], [x1, y1]],
-                                 "width": width, "length": length, "clutter": clutter,
-                                 "mouth_clearance": mouth_clearance})
+    world = Environment(env.bounds, boxes, name="narrow_corridor",
+                        metadata={"seed": seed, "channel": [[x0, y0], [x1, y1]], "width": width, "length": length,
+                                  "clutter": clutter, "mouth_clearance": mouth_clearance})
+    return Problem.build(world, start, goal, GOAL_RADIUS)
 
 
-def annealing_field(seed: int | None = 0, num_boxes: int = 6025, side: float | None = None) -> Environment:
+def annealing_field(seed: int | None = 0, num_boxes: int = 6025, side: float | None = None) -> Problem:
     """The Quantum Database Annealing world (paper §V.D, DESIGN §4).
 
     ``num_boxes`` boxes with ``paper_clutter``'s sides U(0.25, 0.85) on a square whose side keeps
@@ -199,7 +199,7 @@ def annealing_field(seed: int | None = 0, num_boxes: int = 6025, side: float | N
             ``paper_clutter``'s density).
 
     Returns:
-        The ``Environment`` with ``start``, ``goal``, ``goal_radius`` and metadata set.
+        The ``Problem``: its world (``metadata`` set), start, goal ball and exact check.
 
     Raises:
         ValueError: A negative ``seed`` or ``num_boxes``, or ``side`` <= 1.7 or not finite.
@@ -220,11 +220,11 @@ def annealing_field(seed: int | None = 0, num_boxes: int = 6025, side: float | N
     start, goal = _start_goal(env, rng, size / 2, GOAL_RADIUS)
     metadata = {"seed": seed, "num_boxes": num_boxes} if side is None else {"seed": seed, "num_boxes": num_boxes,
                                                                            "side": size}
-    return Environment(bounds, boxes, name="annealing_field", start=start, goal=goal,
-                       goal_radius=GOAL_RADIUS, metadata=metadata)
+    return Problem.build(Environment(bounds, boxes, name="annealing_field", metadata=metadata), start, goal,
+                         GOAL_RADIUS)
 
 
-def lattice(seed: int | None = 0, size: int = 72, blocked_fraction: float = 0.5) -> Environment:
+def lattice(seed: int | None = 0, size: int = 72, blocked_fraction: float = 0.5) -> Problem:
     """A grid of unit cells, a fraction blocked at random (the predecessor paper's world, DESIGN §4).
 
     round(``blocked_fraction`` * size^2) of the ``size`` x ``size`` cells are blocked (blocked
@@ -237,8 +237,8 @@ def lattice(seed: int | None = 0, size: int = 72, blocked_fraction: float = 0.5)
         blocked_fraction: r, in [0, 1) (default 0.5).
 
     Returns:
-        The ``Environment`` on [0, L]^2 with ``start``, ``goal``, ``goal_radius`` and metadata
-        (including the component's cell count).
+        The ``Problem`` on [0, L]^2: its world (``metadata`` with the component's cell count),
+        start, goal ball and exact check.
 
     Raises:
         ValueError: A negative ``seed``, ``size`` out of range, ``blocked_fraction`` outside
@@ -279,14 +279,14 @@ def lattice(seed: int | None = 0, size: int = 72, blocked_fraction: float = 0.5)
     far = cells[distances >= np.quantile(distances, 0.9)]
     second = far[rng.integers(len(far))]
     bounds = np.array([[0.0, size], [0.0, size]])
-    return Environment(bounds, np.array(boxes, dtype=float).reshape(-1, 2, 2), name="lattice",
-                       start=first + 0.5, goal=second + 0.5, goal_radius=0.45,
-                       metadata={"seed": seed, "size": size, "blocked_fraction": blocked_fraction,
-                                 "component_cells": int(sizes[largest - 1])})
+    world = Environment(bounds, np.array(boxes, dtype=float).reshape(-1, 2, 2), name="lattice",
+                        metadata={"seed": seed, "size": size, "blocked_fraction": blocked_fraction,
+                                  "component_cells": int(sizes[largest - 1])})
+    return Problem.build(world, first + 0.5, second + 0.5, 0.45)
 
 
 #: every scenario's builder by name
-SCENARIOS: dict[str, Callable[..., Environment]] = {
+SCENARIOS: dict[str, Callable[..., Problem]] = {
     "paper_clutter": paper_clutter,
     "narrow_corridor": narrow_corridor,
     "annealing_field": annealing_field,
@@ -294,7 +294,7 @@ SCENARIOS: dict[str, Callable[..., Environment]] = {
 }
 
 
-def by_name(name: str, seed: int | None = 0) -> Environment:
+def by_name(name: str, seed: int | None = 0) -> Problem:
     """Build a scenario from its name (one of ``SCENARIOS``).
 
     Args:
@@ -302,7 +302,7 @@ def by_name(name: str, seed: int | None = 0) -> Environment:
         seed: Non-negative integer (same seed, same world; default 0) or None (fresh entropy).
 
     Returns:
-        The ``Environment``.
+        The ``Problem``.
 
     Raises:
         ValueError: An unknown ``name`` or a negative ``seed``.
@@ -311,8 +311,8 @@ def by_name(name: str, seed: int | None = 0) -> Environment:
 
     Example:
         >>> from qrrt_circuits import scenarios
-        >>> env = scenarios.by_name("narrow_corridor")
-        >>> env.name, env.dim, env.goal_radius
+        >>> problem = scenarios.by_name("narrow_corridor")
+        >>> problem.name, problem.dim, problem.goal.radius
         ('narrow_corridor', 2, 0.75)
     """
     if name not in SCENARIOS:
