@@ -130,7 +130,7 @@ def run_case(name: str):
     budgets = dict(budgets)
     radius = budgets.pop("goal_radius", None)
     if radius is not None:  # the same goal centre with another radius
-        problem = problem.replace(goal=qc.GoalBall(problem.goal.centre, radius))
+        problem = problem.with_goal_radius(radius)
     return make().plan(problem, **budgets)
 
 

@@ -10,7 +10,9 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from . import probability, registry
-    from .planners import PQRRT, QRRT, RRT, Metrics, ParallelRRT, PlanResult, Planner
+    from .planners import PQRRT, QRRT, RRT, Metrics, ParallelRRT, Planner, PlanResult
+    from .planners.candidates import Candidates, LatticeCandidates, NearestParents
+    from .planners.database import AnnealingSchedule
     from .planners.options import (
         ParallelOptions,
         ParallelQuantumOptions,
@@ -18,12 +20,6 @@ if TYPE_CHECKING:
         QuantumOptions,
         RRTOptions,
     )
-    from .planners.candidates import Candidates, LatticeCandidates, NearestParents
-    from .planners.database import AnnealingSchedule
-    from .problems.families import grid_problem, image_problem, load_problem
-    from .problems.goals import Goal, GoalBall, GoalState
-    from .problems.problem import Problem
-    from .problems.scenarios import annealing_field, lattice, narrow_corridor, paper_clutter
     from .planners.termination import (
         AnyOf,
         MaxCriticalPathCalls,
@@ -35,6 +31,10 @@ if TYPE_CHECKING:
         Stall,
         TerminationCondition,
     )
+    from .problems.families import grid_problem, image_problem, load_problem
+    from .problems.goals import Goal, GoalBall, GoalState
+    from .problems.problem import Problem
+    from .problems.scenarios import annealing_field, lattice, narrow_corridor, paper_clutter
     from .reachability.authors_check import AuthorsCheck
     from .reachability.dynamics import LinearTrackingDynamics
     from .reachability.exact import ExactCheck

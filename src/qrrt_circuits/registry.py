@@ -20,6 +20,7 @@ if TYPE_CHECKING:
     import numpy as np
     from qiskit_aer.noise import NoiseModel
 
+    from .planners.base import Planner
     from .reachability.authors_check import AuthorsCheck
     from .reachability.dynamics import LinearTrackingDynamics
     from .reachability.exact import ExactCheck
@@ -47,6 +48,10 @@ class Entry:
         tags: Free labels (``"classical"``, ``"quantum"``, ``"parallel"``).
         parameter_optional: Whether the parameter may be left out (``fixed-point`` or
             ``fixed-point:0.3``); the factory then gets None.
+        declared: The keyword options the factory takes, where it declares them (a planner's
+            ``Options``); None to read them from the factory's signature.
+        specs: The declarations of those options (``planners.options.OptionSpec``: check, help,
+            flag), for a planner; empty otherwise.
 
     Example:
         >>> from qrrt_circuits.registry import POLICIES
@@ -62,6 +67,8 @@ class Entry:
     parameter: str | None = None  # e.g. "K" for "fixed:K"
     tags: frozenset[str] = field(default_factory=frozenset)
     parameter_optional: bool = False
+    declared: frozenset[str] | None = None
+    specs: tuple[Any, ...] = ()
 
     @property
     def label(self) -> str:
@@ -88,12 +95,14 @@ class Entry:
         """The keyword options the factory accepts.
 
         Returns:
-            The names of the factory's keyword (or positional-or-keyword) parameters, looking
-            through ``functools.partial``.
+            The declared options, or the names of the factory's keyword (or positional-or-keyword)
+            parameters, looking through ``functools.partial``.
 
         Raises:
             ValueError: A factory without an inspectable signature (a builtin type).
         """
+        if self.declared is not None:
+            return self.declared
         target = self.factory
         while isinstance(target, functools.partial):
             target = target.func
@@ -134,7 +143,8 @@ class Registry:
 
     def register(self, name: str, factory: Callable[..., Any], help: str, *, aliases: tuple[str, ...] = (),
                  parameter: str | None = None, tags: tuple[str, ...] = (),
-                 parameter_optional: bool = False) -> Entry:
+                 parameter_optional: bool = False, declared: frozenset[str] | None = None,
+                 specs: tuple[Any, ...] = ()) -> Entry:
         """Add a named factory.
 
         Args:
@@ -146,6 +156,8 @@ class Registry:
             parameter: The parameter's placeholder (``"K"``) for an entry written ``name:VALUE``.
             tags: Free labels.
             parameter_optional: Whether the bare name is accepted too (the factory gets None).
+            declared: The options the factory takes, where it declares them (else its signature's).
+            specs: Their declarations (a planner's ``OptionSpec``s).
 
         Returns:
             The new ``Entry``.
@@ -153,7 +165,8 @@ class Registry:
         Raises:
             ValueError: ``name`` or an alias already registered.
         """
-        entry = Entry(name, factory, help, tuple(aliases), parameter, frozenset(tags), parameter_optional)
+        entry = Entry(name, factory, help, tuple(aliases), parameter, frozenset(tags), parameter_optional, declared,
+                      specs)
         for key in (name, *aliases):
             if key in self._lookup:
                 raise ValueError(f"{self.kind} name {key!r} is registered twice")
@@ -227,7 +240,7 @@ class Registry:
 
     def create(self, name: str, /, **options: Any) -> Any:
         """Build the object ``name`` stands for, with ``options``; an option the entry does not
-        take is refused (use ``applicable`` to keep only the ones that apply).
+        take is refused, naming it.
 
         Args:
             name: A canonical name, an alias, or ``name:VALUE`` (the value is passed to the factory
@@ -252,28 +265,6 @@ class Registry:
             return entry.factory(value, **options)
         return entry.factory(**options)
 
-    def applicable(self, name: str, options: dict[str, Any]) -> dict[str, Any]:
-        """The subset of ``options`` that ``name`` takes.
-
-        Args:
-            name: A canonical name, an alias, or ``name:VALUE``.
-            options: Candidate keyword options.
-
-        Returns:
-            A new dict with only the options the entry's factory accepts.
-
-        Raises:
-            TypeError: ``name`` is not a string.
-            ValueError: An unknown name.
-
-        Example:
-            >>> from qrrt_circuits.registry import BACKENDS
-            >>> BACKENDS.applicable("statevector", {"seed": 1, "method": "statevector"})
-            {'seed': 1}
-        """
-        accepted = self.resolve(name).options()
-        return {key: value for key, value in options.items() if key in accepted}
-
     def help_text(self) -> str:
         """``label: help`` for every entry, joined by ``"; "`` (CLI help).
 
@@ -284,22 +275,48 @@ class Registry:
 
 
 # ----------------------------------------------------------------------------------------- planners
+def register_planner(registry: Registry, name: str, planner: type[Planner], help: str, *,
+                     fixed: dict[str, Any] | None = None, aliases: tuple[str, ...] = (),
+                     tags: tuple[str, ...] = ()) -> Entry:
+    """Register a planner class under ``name``: its factory is the class with ``fixed`` options
+    bound, and what it takes is what its ``Options`` declare (and ``executor`` where it takes one),
+    less the fixed ones. A planner written outside the package registers the same way.
+
+    Args:
+        registry: ``PLANNERS`` (or another planner registry).
+        name: The canonical name.
+        planner: A ``Planner`` subclass.
+        help: One line for the CLI's help.
+        fixed: Options this entry binds (``shared_database=False``), no longer given by the user.
+        aliases: Other names.
+        tags: Free labels (``"classical"``, ``"quantum"``, ``"parallel"``).
+
+    Returns:
+        The new ``Entry``.
+    """
+    from .planners.options import option_specs
+
+    fixed = fixed or {}
+    specs = tuple(spec for spec in option_specs(planner.Options) if spec.name not in fixed)
+    declared = frozenset({spec.name for spec in specs} | ({"executor"} if planner.takes_executor else set()))
+    return registry.register(name, functools.partial(planner, **fixed) if fixed else planner, help,
+                             aliases=aliases, tags=tags, declared=declared, specs=specs)
+
+
 def _planners() -> Registry:
     from .planners import PQRRT, QRRT, RRT, ParallelRRT
 
     registry = Registry("planner")
-    registry.register("rrt", RRT, "classical RRT, 1 reachability test a round", aliases=("RRT",),
-                      tags=("classical",))
-    registry.register("prrt", ParallelRRT, "manager-worker parallel RRT (workers tests a round)",
-                      aliases=("ParallelRRT", "parallel-rrt"), tags=("classical", "parallel"))
-    registry.register("qrrt", QRRT, "q-RRT: Grover search of one database a round", aliases=("QRRT",),
-                      tags=("quantum",))
-    registry.register("pqrrt", functools.partial(PQRRT, shared_database=True),
-                      "Pq-RRT: workers measure one shared database", aliases=("PQRRT", "pqrrt-shared"),
-                      tags=("quantum", "parallel"))
-    registry.register("pqrrt-unshared", functools.partial(PQRRT, shared_database=False),
-                      "Pq-RRT: each worker builds and searches its own database",
-                      aliases=("PQRRT-unshared",), tags=("quantum", "parallel"))
+    register_planner(registry, "rrt", RRT, "classical RRT, 1 reachability test a round", aliases=("RRT",),
+                     tags=("classical",))
+    register_planner(registry, "prrt", ParallelRRT, "manager-worker parallel RRT (workers tests a round)",
+                     aliases=("ParallelRRT", "parallel-rrt"), tags=("classical", "parallel"))
+    register_planner(registry, "qrrt", QRRT, "q-RRT: Grover search of one database a round", aliases=("QRRT",),
+                     tags=("quantum",))
+    register_planner(registry, "pqrrt", PQRRT, "Pq-RRT: workers measure one shared database",
+                     fixed={"shared_database": True}, aliases=("PQRRT", "pqrrt-shared"), tags=("quantum", "parallel"))
+    register_planner(registry, "pqrrt-unshared", PQRRT, "Pq-RRT: each worker builds and searches its own database",
+                     fixed={"shared_database": False}, aliases=("PQRRT-unshared",), tags=("quantum", "parallel"))
     return registry
 
 

@@ -11,8 +11,8 @@ then plans with OMPL's notion of a valid motion::
     from qrrt_circuits.adapters.ompl import OMPLMotionPredicate, from_environment
 
     predicate = OMPLMotionPredicate(si)          # an ob.SpaceInformation you built and set up
-    predicate = from_environment(env)            # or: OMPL checks for a qc.Environment
-    result = qc.RRT(env, predicate=predicate, seed=0).plan(max_nodes=100)
+    predicate = from_environment(problem.env)    # or: OMPL checks for a qc.Environment
+    result = qc.RRT(seed=0).plan(problem.replace(predicate=predicate), max_nodes=100)
 
 Notes:
 

@@ -2,11 +2,11 @@
 ``ompl`` extra, OMPL >= 2.0).
 
 - **In**: ``problem_from_setup(setup)`` reads an ``ompl.geometric.SimpleSetup`` on a
-  ``RealVectorStateSpace``: an ``Environment`` with the space's bounds and the setup's start (no
-  boxes: every check goes to OMPL), an ``OMPLMotionPredicate`` asking the setup's motion validator
-  and validity checker, and the goal (``GoalState`` for OMPL's goal state, else an
+  ``RealVectorStateSpace`` as a ``Problem``: an ``Environment`` with the space's bounds (no boxes:
+  every check goes to OMPL), an ``OMPLMotionPredicate`` asking the setup's motion validator and
+  validity checker, the setup's start and the goal (``GoalState`` for OMPL's goal state, else an
   ``OMPLGoalRegion`` asking ``isSatisfied`` and drawing with ``sampleGoal`` where OMPL can).
-- **Out**: ``LibraryPlanner(si, factory)`` is an ``ompl.base.Planner``: ``SimpleSetup.solve``
+- **Out**: ``LibraryPlanner(si, planner, name)`` is an ``ompl.base.Planner``: ``SimpleSetup.solve``
   runs any planner of the library on the setup's problem, ends it when OMPL's termination
   condition says so and stores the path as OMPL's solution; ``last_result`` keeps the
   ``PlanResult`` (oracle calls counted as DESIGN §2 says).
@@ -28,17 +28,19 @@ import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
-from .._support.validation import check_float, check_int
+from .._support.validation import check_float, check_instance, check_int
 from ..planners.base import Planner
-from ..problems.goals import Goal, GoalState
 from ..planners.result import PlanResult
 from ..planners.termination import PlanStatus, Progress, TerminationCondition
+from ..problems.goals import Goal, GoalState, ball_of
+from ..problems.problem import Problem
 from ..reachability.predicate import ReachabilityPredicate
 from ..world.environment import Environment
+from ..world.spaces import RealVectorSpace
 from .ompl import INSTALL_HINT, OMPLMotionPredicate, real_vector_space
 
 try:
@@ -49,12 +51,8 @@ except ImportError as exc:  # pragma: no cover - the same hint as adapters.ompl
     raise ImportError(f"qrrt_circuits.adapters.ompl_planning needs the OMPL Python bindings; install them with "
                       f"{INSTALL_HINT}") from exc
 
-__all__ = ["LibraryPlanner", "OMPLGoalRegion", "OMPLProblem", "OMPLTermination", "PredicateMotionValidator",
+__all__ = ["LibraryPlanner", "OMPLGoalRegion", "OMPLTermination", "PredicateMotionValidator",
            "benchmark_log", "problem_from_setup", "setup_from_problem"]
-
-#: a factory of the library's planners for one problem: (environment, predicate) -> planner
-PlannerFactory = Callable[[Environment, ReachabilityPredicate], Planner]
-
 
 def _coordinates(state: Any, dim: int) -> np.ndarray:
     return np.array([state[axis] for axis in range(dim)], dtype=float)
@@ -102,24 +100,11 @@ class OMPLGoalRegion:
         return {"kind": "ompl", "type": type(self.goal).__name__}
 
 
-@dataclass(frozen=True)
-class OMPLProblem:
-    """An OMPL problem in the library's terms: plan with
-    ``planner = factory(problem.env, problem.predicate); planner.plan(goal=problem.goal, ...)``.
-
-    Attributes:
-        env: The space's bounds and the start (no boxes: every check goes to ``predicate``).
-        predicate: The ``OMPLMotionPredicate`` of the setup's ``SpaceInformation``.
-        goal: The goal, as a ``Goal``.
-    """
-
-    env: Environment
-    predicate: OMPLMotionPredicate
-    goal: Goal
-
-
-def problem_from_definition(pdef: ob.ProblemDefinition, name: str = "ompl") -> OMPLProblem:
-    """The ``OMPLProblem`` of an OMPL ``ProblemDefinition`` (its one start state and its goal).
+def problem_from_definition(pdef: ob.ProblemDefinition, name: str = "ompl") -> Problem:
+    """The ``Problem`` of an OMPL ``ProblemDefinition``: an environment with the space's bounds
+    and no boxes (every check goes to OMPL), the ``OMPLMotionPredicate`` of its ``SpaceInformation``,
+    R^d, its one start state and its goal (``GoalState`` for a goal state, else
+    ``OMPLGoalRegion``).
 
     Args:
         pdef: The problem definition.
@@ -130,7 +115,8 @@ def problem_from_definition(pdef: ob.ProblemDefinition, name: str = "ompl") -> O
 
     Raises:
         ValueError: No valid start state, more than one start state (the planners grow one tree
-            from one root), no goal, or a state space other than a real-vector space.
+            from one root), no goal, a state space other than a real-vector space, or what
+            ``Problem`` refuses.
     """
     si = pdef.getSpaceInformation()
     predicate = OMPLMotionPredicate(si, name=name)
@@ -147,17 +133,18 @@ def problem_from_definition(pdef: ob.ProblemDefinition, name: str = "ompl") -> O
         raise ValueError("the OMPL problem has no goal (setGoal or setStartAndGoalStates)")
     dim = predicate.dim
     start = _coordinates(first, dim)
-    env = Environment(predicate.bounds(), np.zeros((0, 2, dim)), start=start, name=name)
+    env = Environment(predicate.bounds(), np.zeros((0, 2, dim)), name=name)
     region: Goal
     if goal.hasType(ob.GoalType.GOAL_STATE):
         region = GoalState(_coordinates(goal.getState(), dim), goal.getThreshold())
     else:
         region = OMPLGoalRegion(goal, si, dim)
-    return OMPLProblem(env, predicate, region)
+    return Problem(env, start, region, predicate, RealVectorSpace(dim), name)
 
 
-def problem_from_setup(setup: og.SimpleSetup, name: str = "ompl") -> OMPLProblem:
-    """The ``OMPLProblem`` of an ``ompl.geometric.SimpleSetup`` (set up here if it is not yet).
+def problem_from_setup(setup: og.SimpleSetup, name: str = "ompl") -> Problem:
+    """The ``Problem`` of an ``ompl.geometric.SimpleSetup`` (set up here if it is not yet;
+    ``problem_from_definition``).
 
     Args:
         setup: The setup, with its state space, validity checker, start and goal.
@@ -192,31 +179,30 @@ class OMPLTermination(TerminationCondition):
 class LibraryPlanner(ob.Planner):
     """A planner of this library as an ``ompl.base.Planner``.
 
-    ``solve(ptc)`` reads the planner's ``ProblemDefinition`` (``problem_from_definition``), builds
-    the library's planner with ``factory(env, predicate)``, plans until the goal or OMPL's
-    termination condition, and adds the path, if any, as an exact solution.
+    ``solve(ptc)`` reads the planner's ``ProblemDefinition`` (``problem_from_definition``), plans
+    it with the library's planner until the goal or OMPL's termination condition, and adds the
+    path, if any, as an exact solution.
 
     Args:
         si: The ``SpaceInformation``.
-        factory: ``(env, predicate) -> Planner``, e.g.
-            ``lambda env, predicate: qc.QRRT(env, predicate=predicate, goal_bias=0.05, seed=0)``.
+        planner: The library's ``Planner`` (any, a planner of your own included), e.g.
+            ``qc.QRRT(goal_bias=0.05, seed=0)``; each ``solve`` plans afresh with its settings.
         name: The planner's name in OMPL's output and benchmark logs.
 
     Attributes:
         last_result: The ``PlanResult`` of the last ``solve``, or None.
     """
 
-    def __init__(self, si: ob.SpaceInformation, factory: PlannerFactory, name: str) -> None:
+    def __init__(self, si: ob.SpaceInformation, planner: Planner, name: str) -> None:
         super().__init__(si, name)
-        self.factory = factory
+        self.planner = check_instance(planner, "planner", Planner, "a Planner of this library (qc.RRT(), ...)")
         self.last_result: PlanResult | None = None
         self.last_checks = 0
 
     def solve(self, ptc: Any) -> ob.PlannerStatus:
         problem = problem_from_definition(self.getProblemDefinition(), self.getName())
-        planner = self.factory(problem.env, problem.predicate)
-        result = planner.plan(goal=problem.goal, termination=OMPLTermination(ptc))
-        self.last_result, self.last_checks = result, problem.predicate.evaluations
+        result = self.planner.plan(problem, OMPLTermination(ptc))
+        self.last_result, self.last_checks = result, cast(OMPLMotionPredicate, problem.predicate).evaluations
         if not result.reached or result.path is None:
             return ob.PlannerStatus(ob.PlannerStatus.TIMEOUT)
         si = self.getSpaceInformation()
@@ -251,31 +237,29 @@ class PredicateMotionValidator(ob.MotionValidator):
                                              _coordinates(second, self.dim)[None])[0])
 
 
-def setup_from_problem(env: Environment, predicate: ReachabilityPredicate, goal: np.ndarray | None = None,
-                       goal_radius: float | None = None) -> og.SimpleSetup:
+def setup_from_problem(problem: Problem) -> og.SimpleSetup:
     """An ``ompl.geometric.SimpleSetup`` for a problem of this library, so that OMPL's planners plan
-    it on the same checks: a ``RealVectorStateSpace`` with ``env``'s bounds, a validity checker
+    it on the same checks: a ``RealVectorStateSpace`` with the world's bounds, a validity checker
     (the predicate's ``is_valid`` where it has one, else ``env.is_free``), the predicate as the
-    motion validator (``PredicateMotionValidator``), ``env``'s start and the goal ball as OMPL's
-    goal state with ``goal_radius`` as its threshold.
+    motion validator (``PredicateMotionValidator``), the start, and the goal ball as OMPL's goal
+    state with its radius as the threshold.
 
     Args:
-        env: The environment.
-        predicate: The motion check.
-        goal: The goal's centre (default ``env.goal``).
-        goal_radius: Its radius (default ``env.goal_radius``).
+        problem: The problem (its goal a ball: ``GoalBall`` or ``GoalState``).
 
     Returns:
         The set-up ``SimpleSetup``; ``setup.getSpaceInformation().getMotionValidator().checks``
         counts the motions OMPL's planners check.
 
     Raises:
-        ValueError: No start, goal or radius.
+        ValueError: A goal that is not a ball.
     """
-    goal = env.goal if goal is None else np.asarray(goal, dtype=float)
-    goal_radius = env.goal_radius if goal_radius is None else goal_radius
-    if env.start is None or goal is None or goal_radius is None:
-        raise ValueError("setup_from_problem needs a start, a goal and a goal radius")
+    ball = ball_of(problem.goal)
+    if ball is None:
+        raise ValueError(f"setup_from_problem needs a ball goal (OMPL's goal state and threshold), got "
+                         f"{problem.goal!r}")
+    goal, goal_radius = ball
+    env, predicate = problem.env, problem.predicate
     dim = env.dim
     setup = og.SimpleSetup(real_vector_space(env.bounds))
     is_valid = getattr(predicate, "is_valid", None)
@@ -287,7 +271,7 @@ def setup_from_problem(env: Environment, predicate: ReachabilityPredicate, goal:
     setup.setStateValidityChecker(valid)
     si = setup.getSpaceInformation()
     si.setMotionValidator(PredicateMotionValidator(si, predicate))
-    setup.setStartAndGoalStates(_state(si, np.asarray(env.start, dtype=float)), _state(si, goal), float(goal_radius))
+    setup.setStartAndGoalStates(_state(si, problem.start), _state(si, goal), float(goal_radius))
     setup.setup()
     return setup
 

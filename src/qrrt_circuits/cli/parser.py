@@ -69,7 +69,8 @@ def _add_search_parser(sub: _Subparsers, formatter: _Formatter) -> None:
 
 
 def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
-    from ..registry import BACKENDS, PLANNERS, POLICIES, PREDICATES, SCENARIOS
+    from ..registry import PLANNERS, PREDICATES, SCENARIOS
+    from .planner_flags import add_planner_flags
 
     plan = sub.add_parser("plan", help="plan a path with one planner and print its metrics",
                           formatter_class=formatter)
@@ -83,24 +84,11 @@ def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
                       help="seed of the scenario's random world")
     plan.add_argument("--planner", type=_registered(PLANNERS), choices=PLANNERS.names(), default="pqrrt",
                       help=PLANNERS.help_text())
-    # the planner-specific options are absent unless given (their defaults are PLANNER_SPECIFIC_OPTIONS'),
-    # so that one given to a planner that does not take it is refused instead of ignored
-    plan.add_argument("--backend", type=_registered(BACKENDS), choices=BACKENDS.names(), default=argparse.SUPPRESS,
-                      help=f"(quantum planners; default aer) {BACKENDS.help_text()}")
-    plan.add_argument("--qubits", type=_positive_int, default=argparse.SUPPRESS,
-                      help="database of 2^qubits (quantum planners; default 8)")
-    plan.add_argument("--workers", type=_positive_int, default=argparse.SUPPRESS,
-                      help="workers (prrt, pqrrt, pqrrt-unshared; default 8)")
-    plan.add_argument("--policy", type=_registered(POLICIES), default=argparse.SUPPRESS,
-                      metavar="|".join(POLICIES.labels()),
-                      help=f"search policy (quantum planners, default the planner's: thompson for qrrt, adaptive for "
-                           f"pqrrt; paper: the paper's schedule): {POLICIES.help_text()}")
     plan.add_argument("--predicate", type=_registered(PREDICATES), default="exact",
                       metavar="|".join(PREDICATES.labels()), help=f"reachability check: {PREDICATES.help_text()}")
-    plan.add_argument("--goal-bias", type=float, default=0.0, help="probability of sampling the goal, in [0, 1)")
-    plan.add_argument("--max-extension", type=float, default=None,
-                      help="longest step from a parent (OMPL's RRT range), > 0 (default: none, the raw samples)")
-    plan.add_argument("--seed", type=_nonnegative_int, default=0, help="the plan's seed")
+    # the planners' options, one flag each, from their declarations; a flag only some planners take is
+    # absent unless given, so that one given to a planner that does not take it is refused
+    add_planner_flags(plan)
     # (a help text with %(default)s keeps argparse from appending "(default: None)" after it)
     plan.add_argument("--max-nodes", type=_positive_int, default=None,
                       help="node limit (default %(default)s: the limit of 1000000 nodes always in force)")

@@ -179,7 +179,7 @@ def check_buildable(env: Environment, database: LatticeDatabase, motion: Sampled
     boxes = env.num_boxes
 
     def gates_with(count: int) -> int:
-        subset = Environment(env.bounds, env.boxes[:count], start=env.start)
+        subset = Environment(env.bounds, env.boxes[:count])
         return plan_costs(database, oracle_plan(subset, database, motion, plan.options)).gates
 
     low, high = 0, boxes
@@ -354,8 +354,8 @@ def scaling_instance(index_bits: int, boxes: int, parent_bits: int = 6, bits: in
         ValueError: An argument out of range, or n - m odd or outside [2, 2 b].
     """
     from .._support.validation import check_int
-    from ..reachability.dynamics import LinearTrackingDynamics
     from ..problems.scenarios import paper_clutter
+    from ..reachability.dynamics import LinearTrackingDynamics
     from .number_format import FixedPointFormat
 
     boxes = check_int(boxes, "boxes", 0, 100_000)
@@ -365,7 +365,7 @@ def scaling_instance(index_bits: int, boxes: int, parent_bits: int = 6, bits: in
     if (index_bits - parent_bits) % 2:
         raise ValueError(f"index_bits - parent_bits must be even (two cell fields), got n = {index_bits}, "
                          f"m = {parent_bits}")
-    env = paper_clutter(seed, num_boxes=boxes)
+    env = paper_clutter(seed, num_boxes=boxes).env
     fmt = FixedPointFormat.covering(env, bits)
     nodes = env.sample_free(1 << parent_bits, np.random.default_rng([0xC0E, seed]))
     database = LatticeDatabase(fmt, (index_bits - parent_bits) // 2, nodes, parent_bits=parent_bits)

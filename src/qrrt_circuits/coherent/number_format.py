@@ -136,19 +136,17 @@ class FixedPointFormat:
     def check_environment(self, env: Environment) -> None:
         """Refuse a world whose coordinates the format cannot represent.
 
-        The workspace bounds, every box corner and the start (when set) must lie in [lo, hi).
+        The workspace bounds and every box corner must lie in [lo, hi) (so every state does).
 
         Args:
             env: The ``Environment``.
 
         Raises:
-            ValueError: The first coordinate outside [lo, hi), named (``env.bounds[axis]``,
-                ``env.boxes[i]``, ``env.start``) with the range.
+            ValueError: The first coordinate outside [lo, hi), named (``env.bounds``,
+                ``env.boxes[i]``) with the range.
         """
         items: list[tuple[str, np.ndarray]] = [("env.bounds", env.bounds.reshape(-1))]
         items += [(f"env.boxes[{i}]", box.reshape(-1)) for i, box in enumerate(env.boxes)]
-        if env.start is not None:
-            items.append(("env.start", env.start))
         for name, coordinates in items:
             bad = (coordinates < self.lo) | (coordinates >= self.hi)
             if np.any(bad):
@@ -161,7 +159,7 @@ class FixedPointFormat:
     @classmethod
     def covering(cls, env: Environment, bits: int) -> FixedPointFormat:
         """The format of ``bits`` whose range just covers the world: lo = the smallest coordinate of
-        the bounds, boxes and start, and hi such that the largest one is grid point 2^b - 1.
+        the bounds and boxes, and hi such that the largest one is grid point 2^b - 1.
 
         Args:
             env: The ``Environment``.
@@ -183,8 +181,6 @@ class FixedPointFormat:
         """
         bits = check_int(bits, "bits", 1, MAX_BITS)
         coordinates = [env.bounds.reshape(-1), env.boxes.reshape(-1)]
-        if env.start is not None:
-            coordinates.append(env.start)
         values = np.concatenate(coordinates)
         lo, top = float(values.min()), float(values.max())
         hi = lo + (top - lo) * (1 << bits) / ((1 << bits) - 1)

@@ -22,7 +22,7 @@ from .base import Experiment, PaperComparison, PaperNumber, Record, Settings, Su
 from .figures import new_figure, save, tree_on_world
 from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import dumps, loads, rounded
-from .planners import planner_for
+from .planners import experiment_problem, make_planner
 from .worlds import world
 
 METHODS = ("QDA", "QRRT")
@@ -114,15 +114,15 @@ class Annealing(Experiment):
                              TrialStream.ANNEALING_WORLDS, TrialStream.ANNEALING_PLANNERS)
 
     def run_trial(self, trial: Trial, settings: Settings) -> Record:
-        env = world(settings["scenario"], trial.params["world_seed"])
+        problem = experiment_problem(settings, world(settings["scenario"], trial.params["world_seed"]))
         annealing = None
         if trial.params["method"] == "QDA":
             annealing = AnnealingSchedule(bands=tuple((low, high) for low, high in settings["bands"]),
                                           switch_at=(settings["switch_at"],), counter="nodes")
-        planner = planner_for(settings, "QRRT", env, trial.seed, settings["backend"],
+        planner = make_planner("QRRT", trial.seed, settings["backend"],
                                num_qubits=settings["num_qubits"],
                                search_policy=FixedIterations(settings["iterations"]), annealing=annealing)
-        result = planner.plan(max_nodes=max(settings["sizes"]))
+        result = planner.plan(problem, max_nodes=max(settings["sizes"]))
         distances = np.linalg.norm(result.nodes[1:] - result.nodes[result.parents[1:]], axis=1)
         record: Record = {"nodes": result.metrics.nodes, "oracle_calls": result.metrics.oracle_calls,
                   "rounds": result.metrics.rounds}
@@ -185,7 +185,7 @@ class Annealing(Experiment):
         per method the distances to the parent in every tree: the first 16 nodes (the summary's
         16-node mean) and all 48."""
         first = {r["method"]: r for r in records if r["replicate"] == 0}
-        env = world(settings["scenario"], first["QDA"]["world_seed"])
+        env = world(settings["scenario"], first["QDA"]["world_seed"]).env
         sizes = settings["sizes"]
         colors = {"QDA": "tab:red", "QRRT": "tab:blue"}
         distances = {method: [parent_distances(r) for r in records if r["method"] == method] for method in METHODS}

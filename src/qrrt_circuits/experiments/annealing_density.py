@@ -35,8 +35,8 @@ from typing import Any
 import numpy as np
 
 from ..planners.database import AnnealingSchedule
-from ..search.policies.schedules import FixedIterations
 from ..problems.scenarios import CLUTTER_BOXES, CLUTTER_SIZE
+from ..search.policies.schedules import FixedIterations
 from .base import (
     Experiment,
     PaperComparison,
@@ -51,7 +51,7 @@ from .base import (
 from .figures import new_figure, save, with_intervals
 from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import dumps, loads, rounded
-from .planners import planner_for
+from .planners import experiment_problem, make_planner
 from .worlds import world
 
 #: the box density of each point, relative to ``annealing_field``'s default
@@ -148,17 +148,18 @@ class AnnealingDensity(Experiment):
 
     def run_trial(self, trial: Trial, settings: Settings) -> Record:
         params = trial.params
-        env = world(settings["scenario"], params["world_seed"], num_boxes=settings["num_boxes"],
-                    side=side(params["density"]))
+        problem = experiment_problem(settings, world(settings["scenario"], params["world_seed"],
+                                                     num_boxes=settings["num_boxes"], side=side(params["density"])))
+        env = problem.env
         annealing = None
         if params["method"] == "QDA":
             annealing = AnnealingSchedule(bands=tuple((low, high) for low, high in settings["bands"]),
                                           switch_at=(settings["switch_at"],), counter=params["counter"],
                                           placement=params["placement"])
-        planner = planner_for(settings, "QRRT", env, trial.seed, settings["backend"],
+        planner = make_planner("QRRT", trial.seed, settings["backend"],
                               num_qubits=settings["num_qubits"],
                               search_policy=FixedIterations(settings["iterations"]), annealing=annealing)
-        result = planner.plan(max_nodes=settings["size"], max_rounds=settings["max_rounds"])
+        result = planner.plan(problem, max_nodes=settings["size"], max_rounds=settings["max_rounds"])
         distances = np.linalg.norm(result.nodes[1:] - result.nodes[result.parents[1:]], axis=1)[: settings["size"]]
         return {"status": result.status, "nodes": result.metrics.nodes, "rounds": result.metrics.rounds,
                 "oracle_calls": result.metrics.oracle_calls, "free_fraction": env.free_fraction(),

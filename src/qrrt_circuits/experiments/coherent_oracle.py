@@ -295,16 +295,17 @@ def _calls_per_solution(rows: list[Record]) -> float:
 def _plan(config: str, seed: int, budget: int) -> Record:
     from ..planners.candidates import LatticeCandidates, NearestParents
     from ..planners.quantum import QRRT
+    from ..problems.problem import Problem
     from ..search.backends.statevector import StatevectorBackend
     from ..world.environment import Environment
 
-    world = Environment(BOUNDS, np.concatenate([CORRIDOR_WALLS, MIDDLE_BOX]), start=np.array([2.0, 10.0]),
-                        goal=np.array([18.0, 10.0]), goal_radius=2.5)
+    world = Environment(BOUNDS, np.concatenate([CORRIDOR_WALLS, MIDDLE_BOX]))
+    problem = Problem.build(world, [2.0, 10.0], [18.0, 10.0], 2.5)
     database = {"paper database": NearestParents(), "lattice, lookup": LatticeCandidates(3, bits=6),
                 "lattice, coherent": LatticeCandidates(3, bits=6, coherent=True)}[config]
-    planner = QRRT(world, backend=StatevectorBackend(seed=seed), num_qubits=7, database=database, seed=seed)
-    result = planner.plan(max_oracle_calls=budget)
-    edges = planner.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:])
+    planner = QRRT(backend=StatevectorBackend(seed=seed), num_qubits=7, database=database, seed=seed)
+    result = planner.plan(problem, max_oracle_calls=budget)
+    edges = problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:])
     if not bool(np.all(edges)):
         raise RuntimeError(f"{config}: a tree edge the exact check rejects")
     return {"reached": int(result.reached), "oracle_calls": result.metrics.oracle_calls, "nodes": result.metrics.nodes}

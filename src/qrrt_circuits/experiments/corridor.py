@@ -22,7 +22,7 @@ from .base import (
 from .figures import new_figure, node_heatmap, save
 from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import cut_at, dumps, loads, reachable_fraction, rounded
-from .planners import planner_for
+from .planners import experiment_problem, make_planner
 from .worlds import world
 
 PLANNERS = ("RRT", "QRRT")
@@ -66,10 +66,11 @@ class Corridor(Experiment):
                 for kind in PLANNERS for i in range(settings["trials"])]
 
     def run_trial(self, trial: Trial, settings: Settings) -> Record:
-        env = world(settings["scenario"], settings["world_seed"])
-        planner = planner_for(settings, trial.params["planner"], env, trial.seed, settings["backend"],
+        problem = experiment_problem(settings, world(settings["scenario"], settings["world_seed"]))
+        env = problem.env
+        planner = make_planner(trial.params["planner"], trial.seed, settings["backend"],
                                num_qubits=settings["num_qubits"])
-        result = planner.plan(max_oracle_calls=settings["budget"])
+        result = planner.plan(problem, max_oracle_calls=settings["budget"])
         nodes, calls = cut_at(result, settings["budget"])
         positions = result.nodes[1 : nodes + 1]
         channel = env.metadata["channel"]
@@ -107,15 +108,12 @@ class Corridor(Experiment):
                                numbers)
 
     def plot(self, records: list[Record], settings: Settings, summary: Summary, out_dir: Path) -> list[Path]:
-        env = world(settings["scenario"], settings["world_seed"])
+        problem = world(settings["scenario"], settings["world_seed"])
         fig, axes = new_figure(1, len(PLANNERS), (5.2 * len(PLANNERS), 4.6))
         for col, kind in enumerate(PLANNERS):
             clouds = [np.array(loads(r["positions_json"])).reshape(-1, 2) for r in records if r["planner"] == kind]
             points = np.concatenate(clouds) if clouds else np.zeros((0, 2))
-            node_heatmap(axes[0, col], env, points,
+            node_heatmap(axes[0, col], problem, points,
                          f"{kind}: {summary['ours'][kind]} nodes in the channel "
-                         f"{summary['interval_95'][kind]} (paper {self.paper[kind]})",
-                         goal=env.goal, radius=env.goal_radius)
-            if env.start is not None:  # narrow_corridor always has a start
-                axes[0, col].plot(*env.start, "o", color="tab:green")
+                         f"{summary['interval_95'][kind]} (paper {self.paper[kind]})")
         return [save(fig, out_dir / "corridor.png")]

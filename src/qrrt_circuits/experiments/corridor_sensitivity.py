@@ -53,7 +53,7 @@ from .corridor import in_channel
 from .figures import new_figure, save
 from .intervals import LEVEL, RESAMPLES, bootstrap_ratio_interval, differs, rounded_interval
 from .measures import cut_at, dumps, loads
-from .planners import planner_for
+from .planners import experiment_problem, make_planner
 from .worlds import world
 
 if TYPE_CHECKING:
@@ -170,16 +170,18 @@ def run_block(params: dict[str, Any], settings: Settings, world_seed: int, seeds
         actual distance, and per run (``*_json``) and summed, the nodes inside the channel
         (``in_channel``) and beyond its far mouth (``through_channel``).
     """
-    env = world(settings["scenario"], world_seed, width=params["width"], length=params["length"],
-                clutter=params["clutter"], mouth_clearance=settings["mouth_clearance"])
+    problem = experiment_problem(settings, world(settings["scenario"], world_seed, width=params["width"],
+                                                 length=params["length"], clutter=params["clutter"],
+                                                 mouth_clearance=settings["mouth_clearance"]))
+    env = problem.env
     start, distance = start_before_mouth(env, params["distance"])
     channel = env.metadata["channel"]
     options = {"search_policy": params["iterations"]} if params["planner"] == "QRRT" else {}
     inside, through, nodes, calls = [], [], 0, 0
     for seed in seeds:
-        planner = planner_for(settings, params["planner"], env, seed, settings["backend"],
+        planner = make_planner(params["planner"], seed, settings["backend"],
                               num_qubits=settings["num_qubits"], **options)
-        result = planner.plan(start=start, max_oracle_calls=settings["budget"])
+        result = planner.plan(problem.replace(start=start), max_oracle_calls=settings["budget"])
         kept, used = cut_at(result, settings["budget"])
         positions = result.nodes[1: kept + 1]
         inside.append(int(in_channel(positions, channel).sum()))

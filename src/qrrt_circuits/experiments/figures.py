@@ -17,6 +17,7 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
     from matplotlib.image import AxesImage
 
+    from ..problems.problem import Problem
     from ..reachability.dynamics import LinearTrackingDynamics
     from ..world.environment import Environment
     from .base import PaperComparison
@@ -87,33 +88,30 @@ def heatmap_counts(env: Environment, points: np.ndarray, bins: int = 50) -> np.n
     return counts
 
 
-def node_heatmap(ax: Axes, env: Environment, points: np.ndarray, title: str, bins: int = 50,
-                 goal: np.ndarray | None = None, radius: float | None = None,
+def node_heatmap(ax: Axes, problem: Problem, points: np.ndarray, title: str, bins: int = 50,
                  norm: Normalize | None = None) -> AxesImage | None:
-    """2-D histogram of node positions over the workspace with the obstacles drawn on top.
+    """2-D histogram of node positions over the workspace with the obstacles, the start and a ball
+    goal drawn on top.
 
     Args:
         ax: The axes to draw on.
-        env: The world (its bounds, obstacles and start).
+        problem: The problem (its world's bounds and obstacles, its start and goal).
         points: (N, >=2) node positions; the first two coordinates are binned.
         title: The axes' title.
         bins: Histogram bins per axis.
-        goal: The goal's centre, drawn as a circle of ``radius`` when given.
-        radius: The goal's radius (required with ``goal``).
         norm: The colour scale shared by several panels (the caller draws their one colour bar),
             or None (default) for this panel's own logarithmic scale and colour bar.
 
     Returns:
         The histogram's image (for a shared colour bar), or None without points.
-
-    Raises:
-        ValueError: If ``goal`` is given without ``radius``.
     """
     from matplotlib.colors import LogNorm
     from matplotlib.patches import Circle
 
     from ..plotting import plot_environment
+    from ..problems.goals import ball_of
 
+    env = problem.env
     (x0, x1), (y0, y1) = env.bounds[0], env.bounds[1]
     image = None
     if len(points):
@@ -127,13 +125,11 @@ def node_heatmap(ax: Axes, env: Environment, points: np.ndarray, title: str, bin
         if own_scale:
             ax.figure.colorbar(image, ax=ax, fraction=0.046, pad=0.03, label="nodes")
     plot_environment(env, ax, color="0.35")
-    if env.start is not None:
-        ax.plot(*env.start[:2], "o", color="tab:green", ms=6, zorder=4)
-    if goal is not None:
-        if radius is None:
-            raise ValueError("node_heatmap: a goal needs its radius")
-        centre: Any = goal[:2]  # an array; matplotlib takes any (x, y) sequence
-        ax.add_patch(Circle(centre, radius, fill=False, color="tab:red", lw=2, zorder=4))
+    ax.plot(*problem.start[:2], "o", color="tab:green", ms=6, zorder=4)
+    ball = ball_of(problem.goal)
+    if ball is not None:
+        centre: Any = ball[0][:2]  # an array; matplotlib takes any (x, y) sequence
+        ax.add_patch(Circle(centre, ball[1], fill=False, color="tab:red", lw=2, zorder=4))
     ax.set_title(title, fontsize=9)
     return image
 

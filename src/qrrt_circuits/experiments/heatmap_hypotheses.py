@@ -31,7 +31,7 @@ from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, rep
 from .figures import new_figure, save
 from .intervals import bootstrap_ratio_interval, differs, rounded_interval
 from .measures import cut_at
-from .planners import planner_for
+from .planners import experiment_problem, make_planner
 from .worlds import world
 
 BOX_COUNTS = (50, 100, 150, 200, 250, 300, 400, 525)
@@ -123,11 +123,12 @@ class HeatmapHypotheses(Experiment):
                 for i in range(settings["trials"])]
 
     def run_trial(self, trial: Trial, settings: Settings) -> Record:
-        env = world(settings["scenario"], trial.params["world_seed"], num_boxes=trial.params["boxes"])
+        problem = experiment_problem(settings, world(settings["scenario"], trial.params["world_seed"],
+                                                     num_boxes=trial.params["boxes"]))
         planner_name, policy = VARIANTS[trial.params["variant"]]
-        planner = planner_for(settings, planner_name, env, trial.seed, settings["backend"],
+        planner = make_planner(planner_name, trial.seed, settings["backend"],
                               num_qubits=settings["num_qubits"], search_policy=policy)
-        result = planner.plan(max_oracle_calls=max(settings["cuts"]))
+        result = planner.plan(problem, max_oracle_calls=max(settings["cuts"]))
         record: Record = {"status": str(result.status)}
         for cut in settings["cuts"]:
             record[f"nodes_at_{cut}"], record[f"calls_at_{cut}"] = cut_at(result, cut)

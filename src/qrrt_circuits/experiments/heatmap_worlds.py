@@ -50,7 +50,7 @@ from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, rep
 from .figures import new_figure, save
 from .intervals import bootstrap_ratio_interval, differs, rounded_interval, two_level_bootstrap_interval
 from .measures import cut_at, dumps, loads, reachable_at
-from .planners import planner_for
+from .planners import experiment_problem, make_planner
 from .worlds import world
 
 BOX_COUNTS = (100, 150, 200, 250, 300, 400, 525)
@@ -180,7 +180,8 @@ class HeatmapWorlds(Experiment):
                 for variant in settings["variants"]]
 
     def run_trial(self, trial: Trial, settings: Settings) -> Record:
-        env = world(settings["scenario"], trial.params["world_seed"], num_boxes=trial.params["boxes"])
+        problem = experiment_problem(settings, world(settings["scenario"], trial.params["world_seed"],
+                                                     num_boxes=trial.params["boxes"]))
         planner_name, policy = VARIANTS[trial.params["variant"]]
         options: dict[str, Any] = {} if policy is None else {"search_policy": policy}
         nodes: dict[str, list[int]] = {str(cut): [] for cut in settings["cuts"]}
@@ -188,9 +189,9 @@ class HeatmapWorlds(Experiment):
         reachable: dict[str, list[int]] = {str(cut): [] for cut in settings["cuts"]}
         entries: dict[str, list[int]] = {str(cut): [] for cut in settings["cuts"]}
         for run in range(settings["runs"]):  # the planners of one world share their seeds across variants
-            planner = planner_for(settings, planner_name, env, replicate_seed(trial.seed, run),
+            planner = make_planner(planner_name, replicate_seed(trial.seed, run),
                                   settings["backend"], num_qubits=settings["num_qubits"], **options)
-            result = planner.plan(max_oracle_calls=max(settings["cuts"]))
+            result = planner.plan(problem, max_oracle_calls=max(settings["cuts"]))
             for cut in settings["cuts"]:
                 placed, spent = cut_at(result, cut)
                 nodes[str(cut)].append(placed)

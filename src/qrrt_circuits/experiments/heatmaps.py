@@ -35,7 +35,7 @@ from .base import (
 from .figures import heatmap_counts, new_figure, node_heatmap, save
 from .intervals import bootstrap_ratio_interval, differs, rounded_interval
 from .measures import cut_at, dumps, loads, reachable_fraction, rounded
-from .planners import BACKEND_LABEL, planner_for
+from .planners import BACKEND_LABEL, experiment_problem, make_planner
 from .worlds import world
 
 PLANNERS = ("RRT", "QRRT", "PQRRT")
@@ -71,14 +71,14 @@ class Heatmaps(Experiment):
                 for kind in PLANNERS for i in range(settings["trials"])]
 
     def run_trial(self, trial: Trial, settings: Settings) -> Record:
-        env = world(settings["scenario"], settings["world_seed"])
-        planner = planner_for(settings, trial.params["planner"], env, trial.seed, settings["backend"],
+        problem = experiment_problem(settings, world(settings["scenario"], settings["world_seed"]))
+        planner = make_planner(trial.params["planner"], trial.seed, settings["backend"],
                                settings["workers"], settings["num_qubits"])
         critical = trial.params["planner"] == "PQRRT"
         if critical:
-            result = planner.plan(max_critical_path_calls=max(settings["cuts"]))
+            result = planner.plan(problem, max_critical_path_calls=max(settings["cuts"]))
         else:
-            result = planner.plan(max_oracle_calls=max(settings["cuts"]))
+            result = planner.plan(problem, max_oracle_calls=max(settings["cuts"]))
         record: Record = {"cut_on": "critical_path" if critical else "oracle_calls"}
         for cut in settings["cuts"]:
             nodes, calls = cut_at(result, cut, "critical_path" if critical else "oracle_calls")
@@ -157,7 +157,8 @@ class Heatmaps(Experiment):
         (``save(..., tight=False)``)."""
         from matplotlib.colors import LogNorm
 
-        env = world(settings["scenario"], settings["world_seed"])
+        problem = world(settings["scenario"], settings["world_seed"])
+        env = problem.env
         cuts = settings["cuts"]
         rows, cols = len(PLANNERS), len(cuts)
         fig, axes = new_figure(rows, cols, (4.4 * cols + 1.0, 4.3 * rows))
@@ -181,8 +182,7 @@ class Heatmaps(Experiment):
                     f"[{low:.1%}, {high:.1%}]")
             if paper:
                 text += f"\npaper: {paper['nodes']} nodes, {paper['efficiency']:.1%}"
-            drawn = node_heatmap(axes[index // cols, index % cols], env, points, text, goal=env.goal,
-                                 radius=env.goal_radius, norm=norm)
+            drawn = node_heatmap(axes[index // cols, index % cols], problem, points, text, norm=norm)
             image = drawn or image
         if image is not None:
             fig.colorbar(image, cax=fig.add_axes((0.92, 0.2, 0.015, 0.6)),

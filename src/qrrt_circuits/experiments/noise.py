@@ -28,13 +28,14 @@ import numpy as np
 
 from ..hardware import noise
 from ..probability import good_probability
-from ..registry import PLANNERS, PREDICATES
+from ..registry import PLANNERS
 from ..search.backends.noisy import depolarizing_backend, fake_device_backend
 from ..search.policies.adaptive import Adaptive
 from ..search.policies.schedules import KnownOptimal
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import binomial_interval, bootstrap_interval, rounded_interval
+from .planners import experiment_problem
 from .worlds import world
 
 if TYPE_CHECKING:
@@ -197,17 +198,15 @@ class Noise(Experiment):
                 "method": f"{settings['device']} noise model (statevector trajectories)"}
 
     def _run_planning(self, trial: Trial, settings: Settings) -> Record:
-        env = world("paper_clutter", trial.params["world_seed"])
+        problem = experiment_problem(settings, world("paper_clutter", trial.params["world_seed"]))
         config, p2 = trial.params["config"], trial.params["p2"]
-        options: dict[str, Any] = {"env": env, "seed": trial.seed,
-                                   "predicate": PREDICATES.create(settings["predicate"], env=env)}
         if config == "RRT":
-            planner = PLANNERS.create("RRT", **options)
+            planner = PLANNERS.create("RRT", seed=trial.seed)
         else:
             backend = depolarizing_backend(settings["p1_ratio"] * p2, p2, method="statevector")
             planner = PLANNERS.create("QRRT", backend=backend, num_qubits=settings["planning_qubits"],
-                                      search_policy=QRRT_CONFIGS[config](), **options)
-        result = planner.plan(max_nodes=settings["nodes"])
+                                      search_policy=QRRT_CONFIGS[config](), seed=trial.seed)
+        result = planner.plan(problem, max_nodes=settings["nodes"])
         m = result.metrics
         return {"status": str(result.status), "nodes": m.nodes, "oracle_calls": m.oracle_calls,
                 "quantum_oracle_calls": m.quantum_oracle_calls, "verification_calls": m.verification_calls,

@@ -63,7 +63,7 @@ def ompl_run(problem: Problem, label: str, budget: int, seed: int, goal_bias: fl
     ou.setLogLevel(ou.LOG_NONE)  # (setSeed after the first run logs that sampling "already started";
     ou.RNG.setSeed(int(seed))  # the planners made after it draw from the new seed all the same)
     ou.setLogLevel(ou.LOG_WARN)
-    setup = setup_from_problem(problem.env, problem.predicate)
+    setup = setup_from_problem(problem)
     si = setup.getSpaceInformation()
     validator = si.getMotionValidator()
     name, takes_goal_bias = OMPL_PLANNERS[label]

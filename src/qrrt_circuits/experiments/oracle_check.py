@@ -131,11 +131,12 @@ class OracleCheck(Experiment):
                 for check in settings["checks"] for kind in PLANNERS for i in range(settings["trials"])]
 
     def run_trial(self, trial: Trial, settings: Settings) -> Record:
-        env = world(settings["scenario"], settings["world_seed"])
-        predicate = make_predicate(env, trial.params["check"])
-        planner = make_planner(trial.params["planner"], env, trial.seed, settings["backend"],
-                               num_qubits=settings["num_qubits"], predicate=predicate)
-        result = planner.plan(max_oracle_calls=settings["budget"])
+        problem = world(settings["scenario"], settings["world_seed"])
+        env = problem.env
+        planner = make_planner(trial.params["planner"], trial.seed, settings["backend"],
+                               num_qubits=settings["num_qubits"])
+        result = planner.plan(problem.replace(predicate=make_predicate(env, trial.params["check"])),
+                              max_oracle_calls=settings["budget"])
         nodes, calls = cut_at(result, settings["budget"])
         children = np.arange(1, nodes + 1)
         parents, ends = result.nodes[result.parents[children]], result.nodes[children]

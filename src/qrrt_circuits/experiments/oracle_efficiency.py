@@ -20,7 +20,7 @@ from .figures import new_figure, save
 from .fitting import linear_fit
 from .intervals import bootstrap_interval, differs, rounded_interval
 from .measures import dumps, growth_curve, loads
-from .planners import BACKEND_LABEL, planner_for
+from .planners import BACKEND_LABEL, experiment_problem, make_planner
 from .random_bound_fit import random_bound_slopes
 from .worlds import world
 
@@ -53,10 +53,10 @@ class OracleEfficiency(Experiment):
                              TrialStream.PAPER_WORLDS, TrialStream.PAPER_PLANNERS)
 
     def run_trial(self, trial: Trial, settings: Settings) -> Record:
-        env = world(settings["scenario"], trial.params["world_seed"])
-        planner = planner_for(settings, trial.params["planner"], env, trial.seed, settings["backend"],
+        problem = experiment_problem(settings, world(settings["scenario"], trial.params["world_seed"]))
+        planner = make_planner(trial.params["planner"], trial.seed, settings["backend"],
                                settings["workers"], settings["num_qubits"])
-        result = planner.plan(max_nodes=settings["nodes"])
+        result = planner.plan(problem, max_nodes=settings["nodes"])
         m = result.metrics
         return {"status": result.status, "nodes": m.nodes, "oracle_calls": m.oracle_calls,
                 "quantum_oracle_calls": m.quantum_oracle_calls,

@@ -12,9 +12,8 @@ from ..search.policies.schedules import PaperIterations
 
 if TYPE_CHECKING:
     from ..planners.base import Planner
-    from ..reachability.predicate import ReachabilityPredicate
+    from ..problems.problem import Problem
     from ..search.backends.base import QuantumSearchBackend
-    from ..world.environment import Environment
 
 #: how each backend is described in summaries
 BACKEND_LABEL = {
@@ -43,68 +42,61 @@ def make_backend(name: str) -> QuantumSearchBackend:
     return backend
 
 
-def make_planner(kind: str, env: Environment, seed: int, backend: str = "aer", workers: int = 8,
-                 num_qubits: int = 8, search_policy: IterationPolicy | str | None = None,
-                 predicate: ReachabilityPredicate | str | None = None, **options: Any) -> Planner:
+def make_planner(kind: str, seed: int, backend: str = "aer", workers: int = 8, num_qubits: int = 8,
+                 search_policy: IterationPolicy | str | None = None, **options: Any) -> Planner:
     """The registry planner ``kind`` (``RRT``, ``ParallelRRT``, ``QRRT``, ``PQRRT``, ``PQRRT-unshared``
-    or their lower-case names). Options a planner does not take (a backend for RRT, workers for
-    q-RRT) are left out; ``options`` are passed as given. ``predicate`` is a predicate object, a
-    ``PREDICATES`` name (built on ``env``) or None (the planner's default, the exact check).
+    or their lower-case names) with the experiment's settings.
+
+    The experiment's settings (``seed``, ``backend``, ``workers``, ``num_qubits``,
+    ``search_policy``) are shared by every planner of an experiment: each goes to the planners that
+    declare it (RRT has no workers, the classical planners no backend). Any further option is passed
+    as given and refused by a planner that does not take it (``Registry.create``).
 
     Args:
         kind: A ``PLANNERS`` name.
-        env: The world to plan in.
         seed: The planner's seed.
-        backend: A ``BACKENDS`` name (quantum planners only).
-        workers: Parallel workers (planners that take them).
-        num_qubits: Qubits per database, 2^n entries (quantum planners only).
+        backend: A ``BACKENDS`` name (for the quantum planners).
+        workers: Parallel workers (for the planners that take them).
+        num_qubits: Qubits per database, 2^n entries (for the quantum planners).
         search_policy: An iteration policy, a ``POLICIES`` name or None: the paper's schedule
             (``PaperIterations()``), pinned here whatever the planners' own default is.
-        predicate: A predicate, a ``PREDICATES`` name or None (the exact check).
         **options: Further planner options, passed as given.
 
     Returns:
         The planner.
 
     Raises:
-        ValueError: If a name is unknown or an option does not apply to ``kind``.
+        ValueError: If a name is unknown or a further option does not apply to ``kind``.
     """
     if search_policy is None:  # the experiments reproduce the paper: its schedule unless they name another
         search_policy = PaperIterations()
     elif isinstance(search_policy, str):
         search_policy = POLICIES.create(search_policy)
-    if isinstance(predicate, str):
-        predicate = PREDICATES.create(predicate, env=env)
-    if predicate is not None:
-        options["predicate"] = predicate
-    defaults: dict[str, Any] = {"workers": workers, "num_qubits": num_qubits, "search_policy": search_policy,
-                                "seed": seed}
-    if "quantum" in PLANNERS.resolve(kind).tags:
-        defaults["backend"] = make_backend(backend)
-    planner: Planner = PLANNERS.create(kind, env=env, **PLANNERS.applicable(kind, defaults), **options)
+    takes = PLANNERS.resolve(kind).options()
+    shared: dict[str, Any] = {"seed": seed, "workers": workers, "num_qubits": num_qubits,
+                              "search_policy": search_policy}
+    if "backend" in takes:
+        shared["backend"] = make_backend(backend)
+    planner: Planner = PLANNERS.create(kind, **{key: value for key, value in shared.items() if key in takes},
+                                       **options)
     return planner
 
 
-def planner_for(settings: dict[str, Any], kind: str, env: Environment, seed: int, backend: str = "aer",
-                workers: int = 8, num_qubits: int = 8, **options: Any) -> Planner:
-    """``make_planner`` with the experiment's predicate (``settings["predicate"]``; the exact check
-    when the settings name none).
+def experiment_problem(settings: dict[str, Any], problem: Problem) -> Problem:
+    """``problem`` with the experiment's predicate (``settings["predicate"]``, a ``PREDICATES``
+    name built on the problem's world); the problem itself when the settings name none.
 
     Args:
         settings: The experiment's settings (its ``predicate``, if any).
-        kind: A ``PLANNERS`` name.
-        env: The world to plan in.
-        seed: The planner's seed.
-        backend: A ``BACKENDS`` name (quantum planners only).
-        workers: Parallel workers (planners that take them).
-        num_qubits: Qubits per database (quantum planners only).
-        **options: Further ``make_planner`` options.
+        problem: The world's problem.
 
     Returns:
-        The planner.
+        The problem to plan.
 
     Raises:
-        ValueError: If a name is unknown or an option does not apply to ``kind``.
+        ValueError: If the predicate's name is unknown.
     """
-    return make_planner(kind, env, seed, backend, workers, num_qubits, predicate=settings.get("predicate"),
-                        **options)
+    name = settings.get("predicate")
+    if name is None:
+        return problem
+    return problem.replace(predicate=PREDICATES.create(name, env=problem.env))

@@ -61,8 +61,8 @@ from typing import Any
 import numpy as np
 
 from ..planners.paths import path_length, shortcut
-from ..registry import POLICIES
 from ..problems.families import Problem, maze, narrow_passage, open_space, se2_gap, winding_band
+from ..registry import POLICIES
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .default_policy import POLICY_CANDIDATES, TIE_MARGIN, default_policies
 from .family_runs import family_counts, family_units, paired_ratio, resampled, statistic
@@ -183,10 +183,10 @@ class Problems(Experiment):
         if config in OMPL_CONFIGS:
             return self._ompl_trial(problem, config, trial.seed, settings)
         kind, policy, options = LIBRARY_CONFIGS[config]
-        planner = make_planner(kind, problem.env, trial.seed, settings["backend"], settings["workers"],
+        planner = make_planner(kind, trial.seed, settings["backend"], settings["workers"],
                                settings["num_qubits"], search_policy=policy, goal_bias=settings["goal_bias"],
-                               **problem.planner_options(), **options(problem))
-        result = planner.plan(goal=problem.goal, max_oracle_calls=settings["budget"])
+                               **options(problem))
+        result = planner.plan(problem, max_oracle_calls=settings["budget"])
         m = result.metrics
         record = {"status": str(result.status), "reached": int(result.reached), "oracle_calls": m.oracle_calls,
                   "critical_path_calls": m.critical_path_oracle_calls, "simulation_checks": m.simulation_checks,

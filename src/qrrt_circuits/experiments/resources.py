@@ -25,11 +25,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..hardware import resources as res
-from ..registry import PLANNERS, PREDICATES
+from ..registry import PLANNERS
 from ..search.policies.schedules import PaperIterations
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save, with_intervals
 from .intervals import MIN_BOOTSTRAP_WORLDS, bootstrap_interval, rounded_interval
+from .planners import experiment_problem
 from .worlds import world
 
 if TYPE_CHECKING:
@@ -131,19 +132,15 @@ class Resources(Experiment):
                 "t_count": count.t_count, "toffoli_equivalents": count.toffoli_equivalents, "source": count.source}
 
     def _run_plan(self, trial: Trial, settings: Settings) -> Record:
-        env = world("paper_clutter", trial.params["world_seed"])
-        if env.start is None:
-            raise ValueError("paper_clutter must have a start")
-        options: dict[str, Any] = {"env": env, "seed": trial.seed,
-                                   "predicate": PREDICATES.create(settings["predicate"], env=env)}
+        problem = experiment_problem(settings, world("paper_clutter", trial.params["world_seed"]))
         # compile the predicate's kernels before the timed plan (a first call in a process JIT-compiles)
-        options["predicate"].reachable(env.start[None, :], env.start[None, :])
+        problem.predicate.reachable(problem.start[None, :], problem.start[None, :])
         if trial.params["planner"] == "RRT":
-            planner = PLANNERS.create("RRT", **options)
+            planner = PLANNERS.create("RRT", seed=trial.seed)
         else:
             planner = PLANNERS.create("QRRT", backend=plan_backend(), num_qubits=settings["plan_qubits"],
-                                      search_policy=PaperIterations(), **options)
-        result = planner.plan(max_nodes=settings["nodes"])
+                                      search_policy=PaperIterations(), seed=trial.seed)
+        result = planner.plan(problem, max_nodes=settings["nodes"])
         m = result.metrics
         return {"status": str(result.status), "nodes": m.nodes, "oracle_calls": m.oracle_calls,
                 "quantum_oracle_calls": m.quantum_oracle_calls, "verification_calls": m.verification_calls,

@@ -23,7 +23,7 @@ from .figures import new_figure, save
 from .fitting import power_law_exponent
 from .intervals import bootstrap_interval, rounded_interval
 from .measures import reachable_fraction
-from .planners import BACKEND_LABEL, planner_for
+from .planners import BACKEND_LABEL, experiment_problem, make_planner
 from .worlds import world
 
 #: label -> q-RRT's search policy (its class), or None for RRT
@@ -64,14 +64,15 @@ class Scaling(Experiment):
         return out
 
     def run_trial(self, trial: Trial, settings: Settings) -> Record:
-        env = world("paper_clutter", trial.params["world_seed"], num_boxes=trial.params["boxes"])
+        problem = experiment_problem(settings, world("paper_clutter", trial.params["world_seed"],
+                                                     num_boxes=trial.params["boxes"]))
         make_policy = CONFIGS[trial.params["config"]]
         if make_policy is None:  # RRT
-            planner = planner_for(settings, "RRT", env, trial.seed)
+            planner = make_planner("RRT", trial.seed)
         else:
-            planner = planner_for(settings, "QRRT", env, trial.seed, settings["backend"],
+            planner = make_planner("QRRT", trial.seed, settings["backend"],
                                    num_qubits=settings["num_qubits"], search_policy=make_policy())
-        result = planner.plan(max_nodes=settings["nodes"])
+        result = planner.plan(problem, max_nodes=settings["nodes"])
         m = result.metrics
         return {"nodes": m.nodes, "oracle_calls": m.oracle_calls,
                 "calls_per_node": m.oracle_calls / max(m.nodes, 1),

@@ -33,7 +33,7 @@ from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, pai
 from .figures import dodge, new_figure, save, with_intervals
 from .intervals import bootstrap_interval, bootstrap_ratio_interval, rounded_interval
 from .measures import dumps
-from .planners import planner_for
+from .planners import experiment_problem, make_planner
 from .tree_size import (
     calls_at_sizes,
     fraction_interval,
@@ -167,12 +167,12 @@ class SearchPolicies(Experiment):
                              TrialStream.SEARCH_POLICIES_PLANNERS)
 
     def run_trial(self, trial: Trial, settings: Settings) -> Record:
-        env = world(settings["scenario"], trial.params["world_seed"])
+        problem = experiment_problem(settings, world(settings["scenario"], trial.params["world_seed"]))
         planner_name, policy_name = CONFIGS[trial.params["config"]]
         policy = _policy(policy_name)
-        planner = planner_for(settings, planner_name, env, trial.seed, settings["backend"], settings["workers"],
+        planner = make_planner(planner_name, trial.seed, settings["backend"], settings["workers"],
                               settings["num_qubits"], search_policy=policy)
-        result = planner.plan(env.start, env.goal, 1e-9, max_nodes=max(settings["sizes"]))
+        result = planner.plan(problem.with_goal_radius(1e-9), max_nodes=max(settings["sizes"]))
         m = result.metrics
         estimation = k_total = 0
         if isinstance(policy, _LoggedEstimatedOptimal):

@@ -25,7 +25,7 @@ from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, pai
 from .figures import new_figure, save
 from .intervals import bootstrap_interval, bootstrap_ratio_interval, rounded_interval
 from .measures import dumps, loads
-from .planners import planner_for
+from .planners import experiment_problem, make_planner
 from .worlds import world
 
 if TYPE_CHECKING:
@@ -233,11 +233,11 @@ class TreeSize(Experiment):
         return paired_trials(settings, variants, TrialStream.TREE_SIZE_WORLDS, TrialStream.TREE_SIZE_PLANNERS)
 
     def run_trial(self, trial: Trial, settings: Settings) -> Record:
-        env = world(settings["scenario"], trial.params["world_seed"])
+        problem = experiment_problem(settings, world(settings["scenario"], trial.params["world_seed"]))
         planner_name, policy = CONFIGS[trial.params["config"]]
-        planner = planner_for(settings, planner_name, env, trial.seed, settings["backend"], settings["workers"],
+        planner = make_planner(planner_name, trial.seed, settings["backend"], settings["workers"],
                               settings["num_qubits"], search_policy=policy)
-        result = planner.plan(env.start, env.goal, 1e-9, max_nodes=max(settings["sizes"]))
+        result = planner.plan(problem.with_goal_radius(1e-9), max_nodes=max(settings["sizes"]))
         return {"status": str(result.status), "nodes": result.metrics.nodes, "rounds": result.metrics.rounds,
                 "oracle_calls": result.metrics.oracle_calls,
                 "points_json": dumps(calls_at_sizes(result, settings["sizes"])),

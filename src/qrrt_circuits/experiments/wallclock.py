@@ -33,7 +33,7 @@ from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, pai
 from .figures import new_figure, save, with_intervals, wrapped
 from .fitting import linear_fit, slope_through_origin
 from .intervals import bootstrap_interval, differs, rounded_interval
-from .planners import planner_for
+from .planners import experiment_problem, make_planner
 from .worlds import world
 
 CONFIGS = (("RRT", "none"), ("ParallelRRT", "none"), ("QRRT", "aer"), ("QRRT", "statevector"),
@@ -157,13 +157,13 @@ class Wallclock(Experiment):
         return paired_trials(settings, variants, TrialStream.PAPER_WORLDS, TrialStream.PAPER_PLANNERS)
 
     def run_trial(self, trial: Trial, settings: Settings) -> Record:
-        env = world(settings["scenario"], trial.params["world_seed"])
+        problem = experiment_problem(settings, world(settings["scenario"], trial.params["world_seed"]))
         backend = trial.params["backend"]
-        planner = planner_for(settings, trial.params["planner"], env, trial.seed,
+        planner = make_planner(trial.params["planner"], trial.seed,
                                "statevector" if backend == "none" else backend,
                                settings["workers"], settings["num_qubits"])
-        planner.plan(max_rounds=2)  # warm-up: compile kernels, build simulators
-        result = planner.plan(max_nodes=settings["nodes"])
+        planner.plan(problem, max_rounds=2)  # warm-up: compile kernels, build simulators
+        result = planner.plan(problem, max_nodes=settings["nodes"])
         m = result.metrics
         return {"status": result.status, "nodes": m.nodes, "oracle_calls": m.oracle_calls,
                 "critical_path_oracle_calls": m.critical_path_oracle_calls,

@@ -31,7 +31,7 @@ import numpy as np
 from .._support.memory import MemoryEstimate, OutOfMemory, PlanSize
 from .._support.randomness import RandomStreams, Stream
 from .._support.validation import check_instance
-from ..problems.goals import Goal, ball_of, check_reachable_by
+from ..problems.goals import check_reachable_by
 from ..problems.problem import Problem
 from . import termination as _termination
 from .context import RoundView, WorkerContext

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 import time
+from typing import ClassVar
 
 import numpy as np
 
@@ -35,7 +36,7 @@ from ..reachability.predicate import check_answers
 from .base import Planner
 from .context import map_tasks
 from .database import steer
-from .options import MAX_WORKERS, ParallelOptions, RRTOptions
+from .options import ParallelOptions, RRTOptions
 from .run_state import RunState
 from .termination import PlanStatus, TerminationCondition
 from .workers import check_extensions
@@ -96,7 +97,7 @@ class ParallelRRT(Planner):
     """
 
     name = "ParallelRRT"
-    Options = ParallelOptions
+    Options: ClassVar[type[PlannerOptions]] = ParallelOptions
     takes_executor = True
 
     @property
@@ -219,7 +220,7 @@ class RRT(ParallelRRT):
     """
 
     name = "RRT"
-    Options = RRTOptions
+    Options: ClassVar[type[PlannerOptions]] = RRTOptions
     takes_executor = False
 
     @property

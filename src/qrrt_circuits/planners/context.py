@@ -23,6 +23,7 @@ from itertools import repeat
 from typing import Any, TypeVar
 
 from .._support.randomness import RandomStreams
+from ..problems.goals import Goal
 from ..reachability.oracle_errors import OracleErrorModel
 from ..reachability.predicate import ReachabilityPredicate
 from ..search.backends.base import QuantumSearchBackend
@@ -30,7 +31,6 @@ from ..search.policies.base import PolicyState
 from ..world.environment import Environment
 from ..world.spaces import StateSpace
 from .database import AnnealingSchedule
-from ..problems.goals import Goal
 from .tree import Tree
 
 T = TypeVar("T")

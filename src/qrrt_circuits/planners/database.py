@@ -18,9 +18,9 @@ import numpy as np
 
 from .._support.randomness import RandomStreams, Stream
 from .._support.validation import check_choice, check_float, check_int
+from ..problems.goals import Goal
 from ..world.environment import Environment
 from ..world.spaces import RealVectorSpace, StateSpace
-from ..problems.goals import Goal
 from .placement import PLACEMENTS, uniform_samples
 from .tree import Tree
 

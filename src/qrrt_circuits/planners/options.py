@@ -49,6 +49,8 @@ class OptionSpec:
             its accepted range.
         help: One line for documentation and the command line.
         flag: The ``qrrt plan`` flag (``"--qubits"``), or None for an option given in Python only.
+        text: How the flag's text becomes the value before ``check`` (``int``, ``float``; ``str``
+            for an object the command line names from a registry).
         describe: The option's value as JSON (default: the value itself).
     """
 
@@ -57,13 +59,14 @@ class OptionSpec:
     check: Callable[[Any, str], Any]
     help: str
     flag: str | None = None
+    text: Callable[[str], Any] = str
     describe: Callable[[Any], Any] = lambda value: value
 
 
 def declare(default: Any, check: Callable[[Any, str], Any], help: str, flag: str | None = None,
-            describe: Callable[[Any], Any] | None = None) -> Any:
+            text: Callable[[str], Any] = str, describe: Callable[[Any], Any] | None = None) -> Any:
     """A dataclass field that carries its ``OptionSpec`` (the name is the field's)."""
-    metadata = {"check": check, "help": help, "flag": flag}
+    metadata = {"check": check, "help": help, "flag": flag, "text": text}
     if describe is not None:
         metadata["describe"] = describe
     return field(default=default, metadata=metadata)
@@ -79,7 +82,8 @@ def option_specs(options_type: type[PlannerOptions]) -> tuple[OptionSpec, ...]:
         One ``OptionSpec`` per field.
     """
     return tuple(OptionSpec(item.name, item.default, item.metadata["check"], item.metadata["help"],
-                            item.metadata["flag"], item.metadata.get("describe", lambda value: value))
+                            item.metadata["flag"], item.metadata["text"],
+                            item.metadata.get("describe", lambda value: value))
                  for item in fields(options_type))
 
 
@@ -104,7 +108,7 @@ def _instance(kind: type, what: str) -> Callable[[Any, str], Any]:
 def _workers() -> Any:
     """The ``workers`` option of the parallel planners."""
     return declare(8, lambda value, name: check_int(value, name, 1, MAX_WORKERS),
-                   f"workers per round, in [1, {MAX_WORKERS}]", "--workers")
+                   f"workers per round, in [1, {MAX_WORKERS}]", "--workers", int)
 
 
 def _describe(value: Any) -> Any:
@@ -138,15 +142,16 @@ class PlannerOptions:
         ValueError: An option out of its range (naming it and the range).
     """
 
-    goal_bias: float = declare(0.0, _goal_bias, "probability of sampling the goal, in [0, 1)", "--goal-bias")
+    goal_bias: float = declare(0.0, _goal_bias, "probability of sampling the goal, in [0, 1)", "--goal-bias", float)
     max_extension: float | None = declare(
         None, _optional(lambda value, name: check_float(value, name, 0.0, open_minimum=True)),
-        "longest step from a parent (OMPL's RRT range), > 0 (default: none, the raw samples)", "--max-extension")
+        "longest step from a parent (OMPL's RRT range), > 0; None: the raw samples", "--max-extension",
+        float)
     oracle_errors: OracleErrorModel | None = declare(
         None, _optional(_instance(OracleErrorModel, "an OracleErrorModel or None")),
         "an OracleErrorModel corrupting the answers the algorithm sees (default: exact answers)",
         describe=_describe)
-    seed: int | None = declare(None, lambda value, name: check_seed(value, name), "the plan's seed", "--seed")
+    seed: int | None = declare(None, lambda value, name: check_seed(value, name), "the plan's seed", "--seed", int)
 
     def __post_init__(self) -> None:
         for spec in option_specs(type(self)):
@@ -242,13 +247,13 @@ class QuantumOptions(PlannerOptions):
 
     backend: QuantumSearchBackend | None = declare(
         None, _optional(_instance(QuantumSearchBackend, "a QuantumSearchBackend")),
-        "the search backend (default aer)", "--backend", describe=_describe)
+        "the search backend", "--backend", describe=_describe)
     num_qubits: int = declare(8, lambda value, name: check_int(value, name, 1), "database of 2^qubits entries",
-                              "--qubits")
+                              "--qubits", int)
     search_policy: IterationPolicy | None = declare(
         None, _optional(_instance(IterationPolicy, "a search policy (PaperIterations(), FixedIterations(k), "
                                                    "KnownOptimal(), BBHT(), Adaptive(), ThompsonIterations())")),
-        "search policy (default the planner's: thompson for qrrt, adaptive for pqrrt)", "--policy",
+        "search policy", "--policy",
         describe=_describe)
     annealing: AnnealingSchedule | None = declare(
         None, _optional(_instance(AnnealingSchedule, "an AnnealingSchedule or None")),

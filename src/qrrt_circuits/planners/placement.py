@@ -17,9 +17,9 @@ import abc
 
 import numpy as np
 
+from ..problems.goals import Goal, sample_goal
 from ..world.environment import Environment
 from ..world.spaces import StateSpace
-from ..problems.goals import Goal, sample_goal
 from .tree import Tree
 
 __all__ = ["ADMIT_DRAWS_PER_ENTRY", "PLACEMENTS", "Placement", "uniform_samples"]

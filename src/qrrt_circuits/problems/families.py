@@ -261,7 +261,8 @@ def box_world(path: str | Path) -> Problem:
     data = json.loads(Path(path).read_text(encoding="utf-8"))
     missing = [key for key in ("start", "goal", "goal_radius") if data.get(key) is None]
     if missing:
-        raise ValueError(f"{path}: a problem's scenario needs start, goal and goal_radius (missing {', '.join(missing)})")
+        raise ValueError(f"{path}: a problem's scenario needs start, goal and goal_radius "
+                         f"(missing {', '.join(missing)})")
     try:
         return Problem.build(env, data["start"], data["goal"], data["goal_radius"])
     except (TypeError, ValueError) as exc:

@@ -223,6 +223,24 @@ class Problem:
         """
         return dataclasses.replace(self, **changes)
 
+    def with_goal_radius(self, radius: float) -> Problem:
+        """The same problem with a goal ball of ``radius`` about the goal's centre (a radius of
+        1e-9 grows a tree that in effect never reaches the goal: tree-size experiments).
+
+        Args:
+            radius: The new radius (> 0, finite).
+
+        Returns:
+            The checked problem.
+
+        Raises:
+            ValueError: A goal that is not a ball (no centre), or a radius that is not > 0.
+        """
+        ball = ball_of(self.goal)
+        if ball is None:
+            raise ValueError(f"with_goal_radius needs a ball goal (a centre and a radius), got {self.goal!r}")
+        return self.replace(goal=GoalBall(ball[0], check_float(radius, "radius", 0.0, open_minimum=True)))
+
     def describe(self) -> dict:
         """What results record of the problem: its name, start, goal and environment.
 

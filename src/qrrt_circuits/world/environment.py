@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._support.validation import check_float, check_int, check_real_array
+from .._support.validation import check_int, check_real_array
 
 if TYPE_CHECKING:
     from ..reachability.collision import GridIndex

@@ -5,97 +5,62 @@ from __future__ import annotations
 import argparse
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
 
     from ...planners.base import Planner
     from ...planners.result import PlanResult
-    from ...world.environment import Environment
-    from ...problems.families import Problem
+    from ...problems.problem import Problem
 
 
 
 PLOT_FORMATS = (".png", ".pdf", ".svg", ".jpg", ".jpeg")
 
 
-def _load_environment(args: argparse.Namespace) -> Environment:
+def _load_problem(args: argparse.Namespace) -> Problem:
+    """The problem the arguments name: a ``--problem`` file (refused beside the options it
+    replaces), a ``--scenario-file``, or a ``--scenario``; with the ``--predicate`` check."""
+    if args.problem is not None:
+        given = [option for option, given in (("--scenario-file", args.scenario_file is not None),
+                                              ("--scenario", args.scenario != "paper_clutter"),
+                                              ("--predicate", args.predicate != "exact")) if given]
+        if given:
+            raise ValueError(f"--problem fixes the world and the motion check: leave out {', '.join(given)}")
+        if Path(args.problem).is_dir():
+            raise ValueError(f"--problem: {args.problem!r} is a folder, not a problem file")
+        from ...problems.families import load_problem
+
+        return load_problem(args.problem)
+    from ...registry import PREDICATES
+
     if args.scenario_file:
-        from ...world.environment import Environment
+        from ...problems.families import box_world
 
         if Path(args.scenario_file).is_dir():
             raise ValueError(f"--scenario-file: {args.scenario_file!r} is a folder, not a scenario file")
         if not Path(args.scenario_file).is_file():
             raise ValueError(f"--scenario-file: no such file {args.scenario_file!r}")
-        return Environment.load(args.scenario_file)
-    from ...registry import SCENARIOS
+        problem: Problem = box_world(args.scenario_file)
+    else:
+        from ...registry import SCENARIOS
 
-    return SCENARIOS.create(args.scenario, seed=args.scenario_seed)
-
-
-def _load_problem(args: argparse.Namespace) -> Problem | None:
-    """The ``--problem`` file's problem, or None; refused beside the options it replaces."""
-    if args.problem is None:
-        return None
-    given = [option for option, given in (("--scenario-file", args.scenario_file is not None),
-                                          ("--scenario", args.scenario != "paper_clutter"),
-                                          ("--predicate", args.predicate != "exact")) if given]
-    if given:
-        raise ValueError(f"--problem fixes the world and the motion check: leave out {', '.join(given)}")
-    if Path(args.problem).is_dir():
-        raise ValueError(f"--problem: {args.problem!r} is a folder, not a problem file")
-    from ...problems.families import load_problem
-
-    return load_problem(args.problem)
+        problem = SCENARIOS.create(args.scenario, seed=args.scenario_seed)
+    return problem.replace(predicate=PREDICATES.create(args.predicate, env=problem.env))
 
 
-#: ``qrrt plan``'s options that only some planners take: option -> (the planner's keyword, the
-#: default used where the planner takes it and the option is not given)
-PLANNER_SPECIFIC_OPTIONS: dict[str, tuple[str, Any]] = {
-    "qubits": ("num_qubits", 8),
-    "workers": ("workers", 8),
-    "backend": ("backend", "aer"),
-    "policy": ("search_policy", None),  # None: the planner's own default
-}
-
-
-def _planner_specific(args: argparse.Namespace) -> dict[str, Any]:
-    """The planner-specific options of ``args`` (``PLANNER_SPECIFIC_OPTIONS``), defaults filled in
-    for the ones the planner takes; one that was given but that the planner does not take is
-    refused (``ValueError``) instead of being ignored."""
+def build_planner(args: argparse.Namespace, name: str | None = None) -> Planner:
+    """The planner the arguments name (or planner ``name`` with the same flags, as far as it
+    takes them): its options from the flags (``planner_flags``); a flag given to a planner that
+    does not take it (``--qubits`` with ``rrt``) is refused, naming the planners that take it."""
     from ...registry import PLANNERS
+    from ..planner_flags import planner_options
 
-    accepted = PLANNERS.resolve(args.planner).options()
-    given = vars(args)
-    chosen: dict[str, Any] = {}
-    for option, (keyword, default) in PLANNER_SPECIFIC_OPTIONS.items():
-        value = given.get(option)
-        if keyword in accepted:
-            chosen[option] = default if value is None else value
-        elif value is not None:
-            takers = [name for name in PLANNERS.names() if keyword in PLANNERS.resolve(name).options()]
-            raise ValueError(f"--{option} does not apply to --planner {args.planner} (it applies to "
-                             f"{', '.join(takers)}); leave it out")
-    return chosen
-
-
-def build_planner(args: argparse.Namespace, env: Environment, name: str | None = None,
-                  problem: Problem | None = None) -> Planner:
-    """The planner the arguments name (or planner ``name`` with the same options, as far as it
-    takes them), with only the options that apply to it; a planner-specific option given to a
-    planner that does not take it (``--qubits`` with ``rrt``) is refused."""
-    from ...registry import BACKENDS, PLANNERS, POLICIES, PREDICATES
-
-    specific = _planner_specific(args)
-    options: dict[str, Any] = {"goal_bias": args.goal_bias, "max_extension": args.max_extension, "seed": args.seed}
-    options |= problem.planner_options() if problem is not None else {
-        "predicate": PREDICATES.create(args.predicate, env=env)}
-    made: dict[str, Callable[[Any], Any]] = {"backend": lambda name: BACKENDS.create(name, seed=args.seed),
-                                             "policy": lambda name: None if name is None else POLICIES.create(name)}
-    for option, value in specific.items():  # each under the planner's keyword, backends and policies made
-        options[PLANNER_SPECIFIC_OPTIONS[option][0]] = made[option](value) if option in made else value
     chosen = name or args.planner
-    planner: Planner = PLANNERS.create(chosen, env=env, **PLANNERS.applicable(chosen, options))
+    options = planner_options(args, args.planner)
+    if name is not None:  # a peer takes the flags it shares with the chosen planner
+        options = {key: value for key, value in options.items() if key in PLANNERS.resolve(chosen).options()}
+    planner: Planner = PLANNERS.create(chosen, **options)
     return planner
 
 
@@ -138,9 +103,9 @@ def _per_node(value: float, result: PlanResult) -> str:
     return f"{value / result.metrics.nodes:.2f}" if result.metrics.nodes else "-"
 
 
-def _print_plan(result: PlanResult, env: Environment, seed: int) -> None:
+def _print_plan(result: PlanResult, problem: Problem, seed: int) -> None:
     metrics = result.metrics
-    print(f"{result.planner} on {env.name} (seed {seed}): {result.status}: {result.status_text}")
+    print(f"{result.planner} on {problem.name} (seed {seed}): {result.status}: {result.status_text}")
     for key, value in result.settings.items():
         if key in ("start", "goal", "termination", "oracle_errors", "dynamics"):
             continue
@@ -160,7 +125,7 @@ def _print_plan(result: PlanResult, env: Environment, seed: int) -> None:
         print(f"note: {label}")
 
 
-def _write_plan_outputs(args: argparse.Namespace, result: PlanResult, env: Environment) -> None:
+def _write_plan_outputs(args: argparse.Namespace, result: PlanResult, problem: Problem) -> None:
     """Write ``--json`` and ``--plot``; if a write fails (a full disk), the other is still written
     and one ``OSError`` names every failed output and says the plan finished."""
     from ..._support.output_files import write_replacing
@@ -182,7 +147,7 @@ def _write_plan_outputs(args: argparse.Namespace, result: PlanResult, env: Envir
 
         fig, ax = plt.subplots(figsize=(7, 7))
         try:
-            plot_tree(env, result, ax=ax)
+            plot_tree(problem.env, result, ax=ax)
             suffix = Path(args.plot).suffix.lower().lstrip(".")
             write_replacing(Path(args.plot), lambda handle: fig.savefig(handle, format=suffix, dpi=130,
                                                                          bbox_inches="tight"), binary=True)
@@ -212,18 +177,16 @@ def cmd_plan(args: argparse.Namespace) -> int:
     if args.json and args.plot and same_file(args.json, args.plot):
         raise ValueError(f"--json and --plot name the same file {args.plot!r} (the plot would overwrite the JSON)")
     problem = _load_problem(args)
-    env = _load_environment(args) if problem is None else problem.env
-    planner = build_planner(args, env, problem=problem)
+    planner = build_planner(args)
     # (the plan makes its one memory check before it allocates anything, and words a MemoryError as
     # one OutOfMemory line; --json adds no memory per node: PlanResult.write_json streams the arrays
     # chunk by chunk; the outputs are written only once the plan has finished)
     limits = {"max_nodes": args.max_nodes, "max_oracle_calls": args.max_oracle_calls, "max_rounds": args.max_rounds,
               "max_critical_path_calls": args.max_critical_path_calls, "stall_rounds": args.stall_rounds}
-    goal = None if problem is None else problem.goal
-    result = planner.plan(goal=goal, **limits)
-    _print_plan(result, env, args.seed)
+    result = planner.plan(problem, **limits)
+    _print_plan(result, problem, args.seed)
     peer = CLASSICAL_PEERS.get(PLANNERS.canonical(args.planner))
     if peer is not None and not args.no_compare:
-        _print_comparison(result, build_planner(args, env, peer, problem).plan(goal=goal, **limits))
-    _write_plan_outputs(args, result, env)
+        _print_comparison(result, build_planner(args, peer).plan(problem, **limits))
+    _write_plan_outputs(args, result, problem)
     return 0
