@@ -36,7 +36,7 @@ from ..reachability.predicate import check_answers
 from .base import Planner
 from .context import map_tasks
 from .database import steer
-from .options import ParallelOptions, RRTOptions
+from .options import ParallelOptions, PlannerOptions, RRTOptions
 from .run_state import RunState
 from .termination import PlanStatus, TerminationCondition
 from .workers import check_extensions
