@@ -52,7 +52,7 @@ from qrrt_circuits.experiments.planners import make_planner
 planner, backend, worlds, nodes = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
 replay, unreachable = sys.argv[5] == "1", sys.argv[6] == "1"
 goal = {"goal_radius": 1e-9} if unreachable else {}
-envs = [qc.scenarios.paper_clutter(seed=seed) for seed in range(worlds)]
+envs = [qc.paper_clutter(seed=seed) for seed in range(worlds)]
 make_planner(planner, envs[0], 0, backend).plan(max_rounds=5)  # compile and warm up
 
 

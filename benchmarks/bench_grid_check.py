@@ -104,7 +104,7 @@ def main() -> None:
                                               goal_radius=0.1)
     assert np.array_equal(grid_check.grid.free, free)
     box_env = qc.Environment([[0.0, EXTENT], [0.0, EXTENT]], as_boxes(free, pixel), name="maze512-boxes")
-    clutter = qc.scenarios.paper_clutter(seed=0)
+    clutter = qc.paper_clutter(seed=0)
     worlds = {
         "maze512": (maze_env, grid_check, grid_check.is_valid),
         "maze512-boxes": (box_env, qc.ExactCheck(box_env), box_env.is_free),

@@ -64,14 +64,14 @@ def _peak() -> int:
 def run_plan_case(backend_name: str, n: int, k: int | None) -> dict:
     import qrrt_circuits as qc
 
-    env = qc.scenarios.paper_clutter(seed=0)
+    env = qc.paper_clutter(seed=0)
     backend = qc.AerBackend(seed=0) if backend_name == "aer" else qc.StatevectorBackend(seed=0)
     policy = qc.PaperIterations() if k is None else qc.FixedIterations(k)
-    qc.QRRT(env, backend=backend, num_qubits=4, seed=0, search_policy=policy).plan(max_rounds=2)  # warm up
+    qc.QRRT(backend=backend, num_qubits=4, seed=0, search_policy=policy).plan(env, max_rounds=2)  # warm up
     base = _rss()
-    planner = qc.QRRT(env, backend=backend, num_qubits=n, seed=0, search_policy=policy)
+    planner = qc.QRRT(backend=backend, num_qubits=n, seed=0, search_policy=policy)
     estimate = planner.memory_estimate()
-    planner.plan(max_rounds=1)
+    planner.plan(env, max_rounds=1)
     return {"case": "plan", "backend": backend_name, "num_qubits": n,
             "iterations": policy.iterations_bound(1 << n), "measured_bytes": _peak() - base,
             "estimated_bytes": estimate.total_bytes, "estimate": estimate.describe()}
@@ -128,18 +128,18 @@ def run_plan_limits_case(kind: str, dim: int, limit: int) -> dict:
     env, walled_in, outside = _walled_world(dim, 18.0)
     dynamics = None if dim == 2 else qc.LinearTrackingDynamics(-np.eye(dim), np.eye(dim), np.eye(dim))
     if kind == "tree":  # 4 096 workers fill the world outside the wall; the goal is unreachable
-        planner = qc.ParallelRRT(env, workers=4096, seed=0, dynamics=dynamics)
-        qc.ParallelRRT(env, workers=8, seed=0, dynamics=dynamics).plan(outside, walled_in, 0.5, max_rounds=3)
+        planner = qc.ParallelRRT(workers=4096, seed=0, dynamics=dynamics)
+        qc.ParallelRRT(workers=8, seed=0, dynamics=dynamics).plan(env, outside, walled_in, 0.5, max_rounds=3)
         base = _rss()
         began = time.perf_counter()
-        result = planner.plan(outside, walled_in, 0.5, max_nodes=limit)
+        result = planner.plan(env, outside, walled_in, 0.5, max_nodes=limit)
         nodes_per_round, rounds = 4096, result.metrics.rounds
     else:  # RRT rounds from a walled-in start: nodes only inside the small walled cube, the history grows
-        planner = qc.RRT(env, seed=0, dynamics=dynamics)
-        planner.plan(walled_in, outside, 0.5, max_rounds=3)  # warm up
+        planner = qc.RRT(seed=0, dynamics=dynamics)
+        planner.plan(env, walled_in, outside, 0.5, max_rounds=3)  # warm up
         base = _rss()
         began = time.perf_counter()
-        result = planner.plan(walled_in, outside, 0.5, max_rounds=limit, stall_rounds=limit)
+        result = planner.plan(env, walled_in, outside, 0.5, max_rounds=limit, stall_rounds=limit)
         nodes_per_round, rounds = 1, limit
     tree, history = plan_bytes(limit if kind == "tree" else qc.termination.DEFAULT_MAX_NODES, nodes_per_round,
                                rounds, dim)
@@ -188,10 +188,10 @@ def run_plan_batch_case(check: str, dim: int, rounds: int) -> dict:
     else:
         env, start, goal = _walled_world(dim, 18.0)
         options = {"dynamics": None if dim == 2 else qc.LinearTrackingDynamics(-np.eye(dim), np.eye(dim), np.eye(dim))}
-    qc.ParallelRRT(env, workers=8, seed=0, **options).plan(start, goal, 0.5, max_rounds=3)
+    qc.ParallelRRT(workers=8, seed=0, **options).plan(env, start, goal, 0.5, max_rounds=3)
     base = _rss()
     began = time.perf_counter()
-    result = qc.ParallelRRT(env, workers=4096, seed=0, **options).plan(start, goal, 0.5, max_rounds=rounds,
+    result = qc.ParallelRRT(workers=4096, seed=0, **options).plan(env, start, goal, 0.5, max_rounds=rounds,
                                                                       stall_rounds=rounds)
     seconds = time.perf_counter() - began
     measured = _peak() - base
@@ -216,7 +216,7 @@ def run_output_case(how: str, nodes: int) -> dict:
     import qrrt_circuits as qc
 
     env, walled_in, outside = _walled_world(2, 18.0)
-    result = qc.ParallelRRT(env, workers=4096, seed=0).plan(outside, walled_in, 0.5, max_nodes=nodes)
+    result = qc.ParallelRRT(workers=4096, seed=0).plan(env, outside, walled_in, 0.5, max_nodes=nodes)
     with open("/proc/self/clear_refs", "w") as handle:  # the peak from here on (Linux)
         handle.write("5")
     base = _rss()

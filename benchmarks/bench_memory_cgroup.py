@@ -38,10 +38,10 @@ from qrrt_circuits._support import memory
 n, guarded = int(sys.argv[1]), sys.argv[2] == "guarded"
 if not guarded:
     memory.cgroup_available_bytes = lambda: None
-env = qc.scenarios.paper_clutter(seed=0)
-planner = qc.QRRT(env, backend=qc.StatevectorBackend(0, max_qubits=24), num_qubits=n, seed=0)
+env = qc.paper_clutter(seed=0)
+planner = qc.QRRT(backend=qc.StatevectorBackend(0, max_qubits=24), num_qubits=n, seed=0)
 try:
-    planner.plan(max_rounds=1)
+    planner.plan(env, max_rounds=1)
 except ValueError as error:
     print("refused:", error)
 else:

@@ -54,8 +54,8 @@ def uniform_tree(size: int, rng: np.random.Generator) -> Tree:
 def planner_tree(size: int) -> Tree:
     """The tree q-RRT (statevector, n = 8) grows on paper_clutter world 0 toward an unreachable
     goal, to ``size`` nodes: the trees the planners query (clustered around the start)."""
-    env = qc.scenarios.paper_clutter(seed=0)
-    result = qc.QRRT(env, backend=qc.StatevectorBackend(), seed=0).plan(max_nodes=size - 1, goal_radius=1e-9)
+    env = qc.paper_clutter(seed=0)
+    result = qc.QRRT(backend=qc.StatevectorBackend(), seed=0).plan(env, max_nodes=size - 1, goal_radius=1e-9)
     tree = Tree(result.nodes[0])
     for node, parent in zip(result.nodes[1:], result.parents[1:], strict=True):
         tree.add(node, int(parent))

@@ -242,9 +242,9 @@ def main() -> None:
     nodes = 30 if args.quick else args.nodes
     big_nodes = 300 if args.quick else args.big_nodes
     big_seeds = 1 if args.quick else args.big_seeds
-    worlds = [qc.scenarios.paper_clutter(seed=s) for s in range(seeds)]
-    qc.RRT(worlds[0], seed=0).plan(max_rounds=5)  # compile the oracle kernel
-    qc.QRRT(worlds[0], backend=qc.StatevectorBackend(), seed=0).plan(max_rounds=5)  # and the tree's
+    worlds = [qc.paper_clutter(seed=s) for s in range(seeds)]
+    qc.RRT(seed=0).plan(worlds[0], max_rounds=5)  # compile the oracle kernel
+    qc.QRRT(backend=qc.StatevectorBackend(), seed=0).plan(worlds[0], max_rounds=5)  # and the tree's
     try:
         from ompl_rrt import ompl_available, run_ompl_rrt
     except ImportError:

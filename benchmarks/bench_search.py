@@ -363,7 +363,7 @@ def bench_reachability(quick: bool) -> list[dict]:
     rows = []
     count = 20000 if quick else 200000
     for scenario in ("paper_clutter", "annealing_field"):
-        env = qc.scenarios.by_name(scenario, seed=0)
+        env = qc.by_name(scenario, seed=0)
         oracle = qc.ExactCheck(env)
         rng = np.random.default_rng(1)
         parents = env.sample_free(count, rng)

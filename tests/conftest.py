@@ -11,7 +11,7 @@ import qrrt_circuits as qc
 
 @pytest.fixture(scope="session")
 def clutter():
-    return qc.scenarios.paper_clutter(seed=0)
+    return qc.paper_clutter(seed=0)
 
 
 def make_backend(name: str, seed: int):

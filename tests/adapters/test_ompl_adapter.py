@@ -109,10 +109,10 @@ def assert_edges_free_up_to_ompl_resolution(env: qc.Environment, result, segment
 
 
 PLANNERS = {
-    "rrt": lambda env, predicate: qc.RRT(env, predicate=predicate, seed=0),
-    "qrrt": lambda env, predicate: qc.QRRT(env, backend=qc.StatevectorBackend(seed=0), num_qubits=6,
+    "rrt": lambda env, predicate: qc.RRT(predicate=predicate, seed=0),
+    "qrrt": lambda env, predicate: qc.QRRT(backend=qc.StatevectorBackend(seed=0), num_qubits=6,
                                           predicate=predicate, seed=0),
-    "pqrrt-shared-aer": lambda env, predicate: qc.PQRRT(env, backend=qc.AerBackend(seed=0), workers=4,
+    "pqrrt-shared-aer": lambda env, predicate: qc.PQRRT(backend=qc.AerBackend(seed=0), workers=4,
                                                        num_qubits=5, shared_database=True,
                                                        predicate=predicate, seed=0),
 }
@@ -175,10 +175,10 @@ def test_an_invalid_start_or_goal_under_ompls_validity_check_is_refused():
     predicate = OMPLMotionPredicate(si)
     assert predicate.is_valid(np.array([[2.0, 2.0], [5.0, 5.0], [11.0, 5.0]])).tolist() == [False, True, False]
     with pytest.raises(ValueError, match=r"start \[2.0, 2.0\] is not a valid state: the ompl check's own validity"):
-        qc.RRT(env, predicate=predicate, seed=0).plan(max_nodes=3)
+        qc.RRT(predicate=predicate, seed=0).plan(env, max_nodes=3)
     with pytest.raises(ValueError, match=r"goal \[2.0, 2.0\] is not a valid state"):
-        qc.RRT(env, predicate=predicate, seed=0).plan(start=[8, 8], goal=[2, 2], max_nodes=3)
-    result = qc.RRT(env, predicate=predicate, seed=0).plan(start=[5, 5], max_nodes=3)
+        qc.RRT(predicate=predicate, seed=0).plan(env, start=[8, 8], goal=[2, 2], max_nodes=3)
+    result = qc.RRT(predicate=predicate, seed=0).plan(env, start=[5, 5], max_nodes=3)
     assert result.metrics.nodes >= 3
 
 
@@ -187,4 +187,4 @@ def test_an_environment_wider_than_ompls_space_is_refused():
                          goal_radius=0.5)
     predicate = OMPLMotionPredicate(real_vector_si(2, 0.0, 10.0))
     with pytest.raises(ValueError, match=r"outside the ompl check's state space \[\[0.0, 10.0\], \[0.0, 10.0\]\]"):
-        qc.QRRT(env, predicate=predicate, backend=qc.StatevectorBackend(seed=0), num_qubits=3, seed=0)
+        qc.QRRT(predicate=predicate, backend=qc.StatevectorBackend(seed=0), num_qubits=3, seed=0)

@@ -44,8 +44,8 @@ def test_a_setup_becomes_a_problem_the_planners_take():
     assert problem.env.bounds.tolist() == [[0.0, 10.0], [0.0, 10.0]] and problem.env.start.tolist() == [1.0, 1.0]
     assert isinstance(problem.goal, qc.GoalState) and problem.goal.threshold == 0.5
     assert problem.predicate.is_valid(np.array([[5.0, 1.0], [5.0, 5.0]])).tolist() == [False, True]
-    for make in (lambda: qc.RRT(problem.env, predicate=problem.predicate, goal_bias=0.05, seed=0),
-                 lambda: qc.QRRT(problem.env, predicate=problem.predicate, backend=qc.StatevectorBackend(seed=0),
+    for make in (lambda: qc.RRT(predicate=problem.predicate, goal_bias=0.05, seed=0),
+                 lambda: qc.QRRT(predicate=problem.predicate, backend=qc.StatevectorBackend(seed=0),
                                  num_qubits=4, goal_bias=0.05, search_policy=qc.Adaptive(), seed=0)):
         result = make().plan(goal=problem.goal, max_oracle_calls=20000)
         assert result.reached and np.linalg.norm(result.path[-1] - [9, 9]) <= 0.5
@@ -77,14 +77,14 @@ def test_a_goal_region_is_asked_through_ompl():
     problem = problem_from_setup(setup)
     assert isinstance(problem.goal, OMPLGoalRegion) and not hasattr(problem.goal, "sample")
     assert problem.goal.is_satisfied(np.array([[9.5, 1.0], [8.0, 1.0]])).tolist() == [True, False]
-    result = qc.RRT(problem.env, predicate=problem.predicate, seed=1).plan(goal=problem.goal, max_oracle_calls=20000)
+    result = qc.RRT(predicate=problem.predicate, seed=1).plan(problem.env, goal=problem.goal, max_oracle_calls=20000)
     assert result.reached and result.path[-1][0] >= 9.0
 
 
 def test_library_planners_solve_through_simple_setup():
     setup = gap_setup()
     def make(env, predicate):
-        return qc.RRT(env, predicate=predicate, goal_bias=0.05, seed=2)
+        return qc.RRT(predicate=predicate, goal_bias=0.05, seed=2)
 
     planner = LibraryPlanner(setup.getSpaceInformation(), make, "RRT-lib")
     setup.setPlanner(planner)
@@ -104,8 +104,7 @@ def test_benchmark_logs_carry_oracle_calls_that_ompls_statistics_read(tmp_path):
 
     planners = {
         "RRT (OMPL)": og.RRT,
-        "q-RRT": library("q-RRT", lambda env, predicate: qc.QRRT(
-            env, predicate=predicate, backend=qc.StatevectorBackend(seed=0), num_qubits=4, goal_bias=0.05,
+        "q-RRT": library("q-RRT", lambda env, predicate: qc.QRRT(predicate=predicate, backend=qc.StatevectorBackend(seed=0), num_qubits=4, goal_bias=0.05,
             search_policy=qc.Adaptive(), seed=0)),
     }
     log = tmp_path / "run.log"
@@ -150,7 +149,7 @@ def test_benchmark_logs_of_a_library_problem_count_every_planners_motion_checks(
     setup = setup_from_problem(clutter, qc.ExactCheck(clutter))
 
     def rrt(env, predicate):
-        return qc.RRT(env, predicate=predicate, goal_bias=0.05, seed=0, look_ahead=False)
+        return qc.RRT(predicate=predicate, goal_bias=0.05, seed=0, look_ahead=False)
 
     rows = benchmark_log(setup, {"RRTConnect (OMPL)": og.RRTConnect,
                                  "RRT (library)": lambda si: LibraryPlanner(si, rrt, "RRT (library)")},

@@ -21,8 +21,8 @@ def test_pq_rrt_is_printed_beside_parallel_rrt_planned_alike(capsys):
     main(["plan", "--planner", "pqrrt", "--backend", "statevector", "--max-nodes", "40", "--seed", "3"])
     output = capsys.readouterr().out
     assert "beside ParallelRRT (the same world, seed, predicate and limits" in output
-    env = qc.scenarios.paper_clutter(seed=0)
-    peer = qc.ParallelRRT(env, workers=8, seed=3).plan(max_nodes=40).metrics
+    env = qc.paper_clutter(seed=0)
+    peer = qc.ParallelRRT(workers=8, seed=3).plan(env, max_nodes=40).metrics
     assert _row(output, "oracle calls")[1] == str(peer.oracle_calls)
     assert _row(output, "critical-path calls")[1] == str(peer.critical_path_oracle_calls)
     assert _row(output, "nodes")[1] == str(peer.nodes)

@@ -23,7 +23,7 @@ from qrrt_circuits import cli
 pytestmark = pytest.mark.xdist_group("numba-cache")  # one filled cache for the module
 
 PLAN = ["plan", "--planner", "rrt", "--max-nodes", "3"]
-FILL = ["-c", "import qrrt_circuits as qc; qc.scenarios.paper_clutter(seed=0)"]
+FILL = ["-c", "import qrrt_circuits as qc; qc.paper_clutter(seed=0)"]
 
 
 def _python(argv, cwd, **env):

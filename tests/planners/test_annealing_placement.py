@@ -84,8 +84,8 @@ def test_admit_refuses_a_band_no_sample_reaches(clutter):
 @pytest.mark.parametrize("placement", PLACEMENTS)
 def test_every_placement_plans_edges_in_the_hot_band(placement, clutter):
     schedule = qc.AnnealingSchedule(bands=(BAND,), placement=placement)
-    planner = qc.QRRT(clutter, backend=qc.StatevectorBackend(0), search_policy=qc.FixedIterations(2),
+    planner = qc.QRRT(backend=qc.StatevectorBackend(0), search_policy=qc.FixedIterations(2),
                       annealing=schedule, seed=0)
-    result = planner.plan(max_nodes=6)
+    result = planner.plan(clutter, max_nodes=6)
     distances = np.linalg.norm(result.nodes[1:] - result.nodes[result.parents[1:]], axis=1)
     assert result.metrics.nodes == 6 and np.all((distances >= BAND[0] - 1e-9) & (distances <= BAND[1] + 1e-9))

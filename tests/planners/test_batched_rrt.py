@@ -45,13 +45,13 @@ BUDGETS = ({"max_nodes": 40}, {"max_oracle_calls": 73}, {"max_rounds": 31}, {"st
 
 @pytest.mark.parametrize("seed", range(24))
 def test_batched_rrt_equals_sequential_rrt(seed, executor):
-    env = qc.scenarios.paper_clutter(seed=seed % 6)
+    env = qc.paper_clutter(seed=seed % 6)
     budgets = BUDGETS[seed % len(BUDGETS)]
     options = {"goal_bias": 0.15} if seed % 4 == 1 else {}
     if seed % 4 == 2:
         options["oracle_errors"] = qc.OracleErrorModel(false_positive=0.2, false_negative=0.1)
-    batched = qc.RRT(env, seed=seed, **options).plan(**budgets)
-    sequential = _sequential(qc.RRT(env, seed=seed, **options), executor).plan(**budgets)
+    batched = qc.RRT(seed=seed, **options).plan(env, **budgets)
+    sequential = _sequential(qc.RRT(seed=seed, **options), executor).plan(**budgets)
     _same(batched, sequential)
     if "max_oracle_calls" in budgets and not batched.reached and not options:
         assert batched.metrics.oracle_calls == budgets["max_oracle_calls"]  # stops exactly there
@@ -59,23 +59,23 @@ def test_batched_rrt_equals_sequential_rrt(seed, executor):
 
 @pytest.mark.parametrize("seed", range(8))
 def test_batched_parallel_rrt_equals_sequential(seed, executor):
-    env = qc.scenarios.paper_clutter(seed=seed % 3)
+    env = qc.paper_clutter(seed=seed % 3)
     workers = (2, 3, 8)[seed % 3]
     budgets = BUDGETS[seed % len(BUDGETS)]
     options = {"oracle_errors": qc.OracleErrorModel(false_positive=0.1, false_negative=0.1)} if seed % 4 == 3 else {}
-    batched = qc.ParallelRRT(env, workers=workers, seed=seed, **options).plan(**budgets)
-    sequential = _sequential(qc.ParallelRRT(env, workers=workers, seed=seed, **options), executor).plan(**budgets)
+    batched = qc.ParallelRRT(workers=workers, seed=seed, **options).plan(env, **budgets)
+    sequential = _sequential(qc.ParallelRRT(workers=workers, seed=seed, **options), executor).plan(**budgets)
     _same(batched, sequential)
 
 
 def test_wasted_checks_are_the_tests_of_rounds_that_never_ran():
-    env = qc.scenarios.paper_clutter(seed=3)
-    result = qc.RRT(env, seed=3).plan(max_nodes=50)
+    env = qc.paper_clutter(seed=3)
+    result = qc.RRT(seed=3).plan(env, max_nodes=50)
     metrics = result.metrics
     assert metrics.oracle_calls == metrics.rounds == metrics.verification_calls
     assert metrics.wasted_checks > 0
     predicate = qc.ExactCheck(env)  # counts every pair it evaluates
-    again = qc.RRT(env, seed=3, predicate=predicate).plan(max_nodes=50)
+    again = qc.RRT(seed=3, predicate=predicate).plan(env, max_nodes=50)
     assert predicate.evaluations == again.metrics.oracle_calls + again.metrics.wasted_checks
     assert again.metrics.wasted_checks == metrics.wasted_checks
 
@@ -105,10 +105,10 @@ def test_without_look_ahead_the_predicate_is_asked_once_per_oracle_call(clutter,
             return self.inner.describe()
 
     batched, single = Counting(), Counting()
-    ahead = qc.ParallelRRT(clutter, workers=workers, predicate=batched, seed=4).plan(max_nodes=20)
-    once = qc.ParallelRRT(clutter, workers=workers, predicate=single, seed=4, look_ahead=False).plan(max_nodes=20)
+    ahead = qc.ParallelRRT(workers=workers, predicate=batched, seed=4).plan(clutter, max_nodes=20)
+    once = qc.ParallelRRT(workers=workers, predicate=single, seed=4, look_ahead=False).plan(clutter, max_nodes=20)
     assert np.array_equal(ahead.nodes, once.nodes) and ahead.metrics.oracle_calls == once.metrics.oracle_calls
     assert once.metrics.wasted_checks == 0 and single.pairs == once.metrics.oracle_calls
     assert batched.pairs == ahead.metrics.oracle_calls + ahead.metrics.wasted_checks > single.pairs
     with pytest.raises(TypeError, match="look_ahead"):
-        qc.RRT(clutter, look_ahead="no")
+        qc.RRT(look_ahead="no")

@@ -32,9 +32,9 @@ class RightEdge:
 
 
 def _planners(env, **kwargs):
-    return {"RRT": qc.RRT(env, seed=1, **kwargs),
-            "QRRT": qc.QRRT(env, backend=make_backend("statevector", 1), num_qubits=5, seed=1, **kwargs),
-            "PQRRT": qc.PQRRT(env, backend=make_backend("aer", 1), num_qubits=5, workers=3, seed=1, **kwargs)}
+    return {"RRT": qc.RRT(seed=1, **kwargs),
+            "QRRT": qc.QRRT(backend=make_backend("statevector", 1), num_qubits=5, seed=1, **kwargs),
+            "PQRRT": qc.PQRRT(backend=make_backend("aer", 1), num_qubits=5, workers=3, seed=1, **kwargs)}
 
 
 def test_a_ball_goal_is_the_environments_goal(open_world):
@@ -55,14 +55,14 @@ def test_an_exact_goal_state_is_reached_exactly_through_goal_bias(open_world, na
     options = {"goal_bias": 0.1, "max_extension": 3.0}
     for seed in range(20):
         if name == "RRT":
-            planner = qc.RRT(open_world, seed=seed, **options)
+            planner = qc.RRT(seed=seed, **options)
         elif name == "QRRT":
-            planner = qc.QRRT(open_world, backend=make_backend("statevector", seed), num_qubits=4, seed=seed,
+            planner = qc.QRRT(backend=make_backend("statevector", seed), num_qubits=4, seed=seed,
                               **options)
         else:
-            planner = qc.PQRRT(open_world, backend=make_backend("statevector", seed), num_qubits=4, workers=2,
+            planner = qc.PQRRT(backend=make_backend("statevector", seed), num_qubits=4, workers=2,
                                seed=seed, **options)
-        result = planner.plan(goal=target, max_oracle_calls=4000)
+        result = planner.plan(open_world, goal=target, max_oracle_calls=4000)
         if result.reached:
             reached += 1
             assert np.array_equal(result.path[-1], [9.0, 1.0])
@@ -71,14 +71,14 @@ def test_an_exact_goal_state_is_reached_exactly_through_goal_bias(open_world, na
 
 def test_a_region_goal_with_its_own_sampler(open_world):
     for name, planner in _planners(open_world, goal_bias=0.05).items():
-        result = planner.plan(goal=RightEdge(), max_oracle_calls=5000)
+        result = planner.plan(open_world, goal=RightEdge(), max_oracle_calls=5000)
         assert result.reached and result.path[-1][0] >= 9.0, name
         assert result.settings["goal"] is None and result.settings["goal_region"] == {"kind": "x >= 9"}
         assert not RightEdge().is_satisfied(result.nodes[:result.goal_node]).any()  # the first one ends it
 
 
 def test_a_start_inside_the_goal_is_reached_at_once(open_world):
-    result = qc.RRT(open_world, seed=0).plan(start=[9.5, 5], goal=RightEdge(), max_rounds=5)
+    result = qc.RRT(seed=0).plan(open_world, start=[9.5, 5], goal=RightEdge(), max_rounds=5)
     assert result.reached and result.metrics.rounds == 0
 
 
@@ -113,19 +113,19 @@ class NoSampler:
 
 
 @pytest.mark.parametrize(("make", "goal", "extra", "error", "message"), [
-    (lambda env: qc.RRT(env, seed=0), qc.GoalState([9, 1]), {}, ValueError,
+    (lambda env: qc.RRT(seed=0), qc.GoalState([9, 1]), {}, ValueError,
      r"goal_bias = 0, but the goal GoalState\(state=\[9.0, 1.0\], threshold=1e-09\) has no volume"),
-    (lambda env: qc.RRT(env, seed=0, goal_bias=0.1), NoSampler(), {}, TypeError,
+    (lambda env: qc.RRT(seed=0, goal_bias=0.1), NoSampler(), {}, TypeError,
      "goal_bias = 0.1 draws candidates in the goal, but NoSampler has no sample"),
-    (lambda env: qc.RRT(env, seed=0), qc.GoalBall([9, 1], 0.5), {"goal_radius": 1.0}, ValueError,
+    (lambda env: qc.RRT(seed=0), qc.GoalBall([9, 1], 0.5), {"goal_radius": 1.0}, ValueError,
      "goal_radius is given with a goal point, not with a Goal object"),
-    (lambda env: qc.RRT(env, seed=0), qc.GoalBall([12, 1], 0.5), {}, ValueError,
+    (lambda env: qc.RRT(seed=0), qc.GoalBall([12, 1], 0.5), {}, ValueError,
      r"goal \[12.0, 1.0\] is out of bounds"),
-    (lambda env: qc.RRT(env, seed=0, goal_bias=0.1), qc.GoalState([5, 3]), {}, ValueError,
+    (lambda env: qc.RRT(seed=0, goal_bias=0.1), qc.GoalState([5, 3]), {}, ValueError,
      r"goal \[5.0, 3.0\] is in collision with an obstacle"),
-    (lambda env: qc.RRT(env, seed=0), qc.GoalBall([1, 1, 1], 0.5), {}, ValueError,
+    (lambda env: qc.RRT(seed=0), qc.GoalBall([1, 1, 1], 0.5), {}, ValueError,
      "dimension mismatch: the goal has d = 3, the environment has d = 2"),
-    (lambda env: qc.RRT(env, seed=0), "somewhere", {}, ValueError, "goal must be 2 numbers, got 'somewhere'"),
+    (lambda env: qc.RRT(seed=0), "somewhere", {}, ValueError, "goal must be 2 numbers, got 'somewhere'"),
 ])
 def test_bad_goals_are_refused_before_planning(open_world, make, goal, extra, error, message):
     with pytest.raises(error, match=message):

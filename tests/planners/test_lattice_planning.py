@@ -27,9 +27,9 @@ def _on_lattice(points: np.ndarray, bits: int, cell_bits: int) -> bool:
 def test_lattice_plans_reach_the_goal_with_checked_edges(coherent):
     reached = 0
     for seed in range(4):
-        planner = qc.QRRT(CORRIDOR, backend=qc.StatevectorBackend(seed=0), num_qubits=7, seed=seed,
+        planner = qc.QRRT(backend=qc.StatevectorBackend(seed=0), num_qubits=7, seed=seed,
                           database=qc.LatticeCandidates(3, bits=6, coherent=coherent))
-        result = planner.plan(max_oracle_calls=400)
+        result = planner.plan(CORRIDOR, max_oracle_calls=400)
         reached += result.reached
         assert planner.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
         assert _on_lattice(result.nodes[1:], 6, 3)  # every node but the root is a cell centre
@@ -67,7 +67,7 @@ def test_bad_lattice_planners_are_refused_before_planning(options, message):
     if options.get("oracle_errors") == "errors":
         options = {"oracle_errors": qc.OracleErrorModel(false_positive=0.1)}
     with pytest.raises(ValueError, match=message):
-        qc.QRRT(CORRIDOR, backend=qc.StatevectorBackend(seed=0), **({"num_qubits": 7} | options),
+        qc.QRRT(backend=qc.StatevectorBackend(seed=0), **({"num_qubits": 7} | options),
                 database=qc.LatticeCandidates(3, bits=6, coherent=True))
 
 

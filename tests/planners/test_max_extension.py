@@ -24,10 +24,10 @@ def test_steer_caps_the_step_and_keeps_the_direction():
 
 
 def _make(name, env, backend, **kwargs):
-    return {"RRT": lambda: qc.RRT(env, seed=3, **kwargs),
-            "ParallelRRT": lambda: qc.ParallelRRT(env, workers=4, seed=3, **kwargs),
-            "QRRT": lambda: qc.QRRT(env, backend=make_backend(backend, 3), num_qubits=6, seed=3, **kwargs),
-            "PQRRT": lambda: qc.PQRRT(env, backend=make_backend(backend, 3), num_qubits=6, workers=4, seed=3,
+    return {"RRT": lambda: qc.RRT(seed=3, **kwargs),
+            "ParallelRRT": lambda: qc.ParallelRRT(workers=4, seed=3, **kwargs),
+            "QRRT": lambda: qc.QRRT(backend=make_backend(backend, 3), num_qubits=6, seed=3, **kwargs),
+            "PQRRT": lambda: qc.PQRRT(backend=make_backend(backend, 3), num_qubits=6, workers=4, seed=3,
                                       **kwargs)}[name]()
 
 
@@ -44,9 +44,9 @@ def test_every_edge_is_at_most_the_range_and_valid(clutter, name, backend):
 
 
 def test_a_range_gives_the_same_plan_on_an_executor(clutter):
-    alone = qc.ParallelRRT(clutter, workers=4, seed=5, max_extension=1.0).plan(max_nodes=15)
+    alone = qc.ParallelRRT(workers=4, seed=5, max_extension=1.0).plan(clutter, max_nodes=15)
     with ThreadPoolExecutor(2) as pool:
-        pooled = qc.ParallelRRT(clutter, workers=4, seed=5, max_extension=1.0, executor=pool).plan(max_nodes=15)
+        pooled = qc.ParallelRRT(workers=4, seed=5, max_extension=1.0, executor=pool).plan(clutter, max_nodes=15)
     assert np.array_equal(alone.nodes, pooled.nodes) and np.array_equal(alone.parents, pooled.parents)
     assert alone.metrics.oracle_calls == pooled.metrics.oracle_calls
 
@@ -60,7 +60,7 @@ def test_a_range_gives_the_same_plan_on_an_executor(clutter):
     (True, TypeError, "max_extension"),
 ])
 def test_a_bad_range_is_refused_before_planning(clutter, value, error, message):
-    for make in (lambda: qc.RRT(clutter, max_extension=value),
-                 lambda: qc.QRRT(clutter, backend=qc.StatevectorBackend(seed=0), num_qubits=3, max_extension=value)):
+    for make in (lambda: qc.RRT(max_extension=value),
+                 lambda: qc.QRRT(backend=qc.StatevectorBackend(seed=0), num_qubits=3, max_extension=value)):
         with pytest.raises(error, match=message):
             make()

@@ -42,8 +42,8 @@ def test_metrics_identities_and_every_edge_rechecked(name, clutter):
 
 
 def test_rrt_oracle_calls_are_its_reachability_tests(clutter):
-    planner = qc.RRT(clutter, seed=1)
-    result = planner.plan(max_rounds=300)
+    planner = qc.RRT(seed=1)
+    result = planner.plan(clutter, max_rounds=300)
     assert result.metrics.oracle_calls == 300 == result.metrics.rounds
     # batched rounds: every evaluation is a round's test or a dropped test of a later round
     assert planner.predicate.evaluations == 300 + result.metrics.wasted_checks
@@ -51,24 +51,24 @@ def test_rrt_oracle_calls_are_its_reachability_tests(clutter):
 
 
 def test_parallel_rrt_counts_per_worker_and_critical_path(clutter):
-    result = qc.ParallelRRT(clutter, workers=5, seed=2).plan(max_rounds=40)
+    result = qc.ParallelRRT(workers=5, seed=2).plan(clutter, max_rounds=40)
     assert result.metrics.oracle_calls == 200
     assert result.metrics.critical_path_oracle_calls == 40
 
 
 def test_quantum_counting_with_fixed_iterations(clutter):
     k, p, rounds = 3, 4, 25
-    result = qc.PQRRT(clutter, backend=qc.StatevectorBackend(seed=0), workers=p,
-                      search_policy=qc.FixedIterations(k), seed=0).plan(max_rounds=rounds)
+    result = qc.PQRRT(backend=qc.StatevectorBackend(seed=0), workers=p,
+                      search_policy=qc.FixedIterations(k), seed=0).plan(clutter, max_rounds=rounds)
     m = result.metrics
     assert m.quantum_oracle_calls == rounds * p * k
     assert m.verification_calls == rounds * p
     assert m.critical_path_oracle_calls == rounds * (k + 1)
     assert m.simulation_checks == rounds * 256 and m.databases == rounds
     assert m.nodes + m.duplicates + m.rejected == rounds * p
-    unshared = qc.PQRRT(clutter, backend=qc.StatevectorBackend(seed=0), workers=p,
+    unshared = qc.PQRRT(backend=qc.StatevectorBackend(seed=0), workers=p,
                         shared_database=False, search_policy=qc.FixedIterations(k),
-                        seed=0).plan(max_rounds=rounds)
+                        seed=0).plan(clutter, max_rounds=rounds)
     assert unshared.metrics.databases == rounds * p
     assert unshared.metrics.simulation_checks == rounds * p * 256
     assert unshared.metrics.duplicates == 0
@@ -81,8 +81,8 @@ def test_qrrt_adds_nodes_at_the_grover_rate(backend_name, clutter):
     binomial interval of the rounds' probabilities (normal bound with the exact variance)."""
     k, rounds, observed, mean, variance = 2, 120, 0, 0.0, 0.0
     for seed in range(3):
-        result = qc.QRRT(clutter, backend=make_backend(backend_name, seed), search_policy=qc.FixedIterations(k),
-                         seed=seed).plan(max_rounds=rounds)
+        result = qc.QRRT(backend=make_backend(backend_name, seed), search_policy=qc.FixedIterations(k),
+                         seed=seed).plan(clutter, max_rounds=rounds)
         p = np.array([qc.probability.success_probability(256, int(m), k) for m in result.history["reachable"]])
         observed += result.metrics.nodes
         mean += p.sum()
@@ -93,8 +93,8 @@ def test_qrrt_adds_nodes_at_the_grover_rate(backend_name, clutter):
 
 def test_shared_database_duplicates_are_dropped(clutter):
     # 32 workers on a 16-entry database: many measure the same solution
-    result = qc.PQRRT(clutter, backend=qc.StatevectorBackend(seed=0), num_qubits=4, workers=32,
-                      search_policy=qc.FixedIterations(1), seed=0).plan(max_rounds=20)
+    result = qc.PQRRT(backend=qc.StatevectorBackend(seed=0), num_qubits=4, workers=32,
+                      search_policy=qc.FixedIterations(1), seed=0).plan(clutter, max_rounds=20)
     assert result.metrics.duplicates > 0
     rows = {tuple(row) for row in result.nodes}
     assert len(rows) == len(result.nodes)
@@ -104,7 +104,7 @@ def test_shared_database_duplicates_are_dropped(clutter):
 def test_same_seed_same_tree(backend_name, clutter):
     def run():
         backend = qc.AerBackend() if backend_name == "aer" else qc.StatevectorBackend()
-        return qc.PQRRT(clutter, backend=backend, workers=4, seed=9).plan(max_rounds=15)
+        return qc.PQRRT(backend=backend, workers=4, seed=9).plan(clutter, max_rounds=15)
 
     a, b = run(), run()
     assert np.array_equal(a.nodes, b.nodes) and np.array_equal(a.parents, b.parents)
@@ -137,8 +137,8 @@ def test_unreachable_goal_ends_without_reaching():
     boxes = np.array([[[14, 14], [18, 14.5]], [[14, 17.5], [18, 18]], [[14, 14], [14.5, 18]],
                       [[17.5, 14], [18, 18]]], dtype=float)
     env = Environment(np.array([[0, 20], [0, 20]]), boxes)
-    for planner in (qc.RRT(env, seed=0), qc.QRRT(env, backend=qc.StatevectorBackend(0), seed=0)):
-        result = planner.plan([2, 2], [16, 16], 0.5, max_oracle_calls=400)
+    for planner in (qc.RRT(seed=0), qc.QRRT(backend=qc.StatevectorBackend(0), seed=0)):
+        result = planner.plan(clutter, [2, 2], [16, 16], 0.5, max_oracle_calls=400)
         assert result.status == qc.PlanStatus.MAX_ORACLE_CALLS == "max_oracle_calls"
         assert result.path is None and not result.reached
         assert 400 <= result.metrics.oracle_calls < 400 + 7
@@ -153,7 +153,7 @@ def test_default_round_limit_ends_a_plan_with_no_budget(monkeypatch):
     boxes = np.array([[[14, 14], [18, 14.5]], [[14, 17.5], [18, 18]], [[14, 14], [14.5, 18]],
                       [[17.5, 14], [18, 18]]], dtype=float)
     env = Environment(np.array([[0, 20], [0, 20]]), boxes)
-    result = qc.RRT(env, seed=0).plan([1, 1], [16, 16], 0.5)
+    result = qc.RRT(seed=0).plan(env, [1, 1], [16, 16], 0.5)
     assert result.status == "max_rounds" and result.metrics.rounds == 17
     assert result.settings["termination"] == {"max_rounds": 17, "stall_rounds": termination.DEFAULT_STALL_ROUNDS,
                                               "max_nodes": termination.DEFAULT_MAX_NODES}
@@ -181,11 +181,11 @@ def test_bbht_terminates_with_no_solution_and_respects_its_bound():
 
 
 def test_known_optimal_is_labelled_and_adaptive_is_not(clutter):
-    known = qc.QRRT(clutter, backend=qc.StatevectorBackend(0), search_policy=qc.KnownOptimal(),
-                    seed=0).plan(max_rounds=5)
+    known = qc.QRRT(backend=qc.StatevectorBackend(0), search_policy=qc.KnownOptimal(),
+                    seed=0).plan(clutter, max_rounds=5)
     assert any("true marked count" in label for label in known.labels)
-    adaptive = qc.QRRT(clutter, backend=qc.StatevectorBackend(0), search_policy=qc.Adaptive(),
-                       seed=0).plan(max_rounds=5)
+    adaptive = qc.QRRT(backend=qc.StatevectorBackend(0), search_policy=qc.Adaptive(),
+                       seed=0).plan(clutter, max_rounds=5)
     assert not any("true marked count" in label for label in adaptive.labels)
     assert any("classical lookup" in label for label in adaptive.labels)
 
@@ -215,9 +215,9 @@ def test_adaptive_posterior_covers_the_hidden_fraction_and_picks_its_argmax(mark
 
 def test_annealing_first_band_distance(clutter):
     schedule = qc.AnnealingSchedule(bands=[(2.7, 4.2), (0.8, 2.0)], switch_at=[1000])
-    planner = qc.QRRT(clutter, backend=qc.StatevectorBackend(0), search_policy=qc.FixedIterations(2),
+    planner = qc.QRRT(backend=qc.StatevectorBackend(0), search_policy=qc.FixedIterations(2),
                       annealing=schedule, seed=0)
-    result = planner.plan(max_nodes=25)
+    result = planner.plan(clutter, max_nodes=25)
     distances = np.linalg.norm(result.nodes[1:] - result.nodes[result.parents[1:]], axis=1)
     assert 2.7 <= distances.min() and distances.max() <= 4.2
     assert abs(distances.mean() - 3.45) < 5 * (1.5 / math.sqrt(12)) / math.sqrt(len(distances))
@@ -234,31 +234,31 @@ def test_annealing_first_band_distance(clutter):
 ])
 def test_bad_plan_input(kwargs, message, clutter):
     with pytest.raises(ValueError, match=message):
-        qc.RRT(clutter, seed=0).plan(**kwargs)
+        qc.RRT(seed=0).plan(clutter, **kwargs)
 
 
 def test_start_or_goal_in_collision_names_which(clutter):
     inside = clutter.boxes[0].mean(axis=0)
     with pytest.raises(ValueError, match="start .* is in collision"):
-        qc.RRT(clutter).plan(start=inside)
+        qc.RRT().plan(clutter, start=inside)
     with pytest.raises(ValueError, match="goal .* is in collision"):
-        qc.QRRT(clutter, backend=qc.StatevectorBackend(0)).plan(goal=inside)
+        qc.QRRT(backend=qc.StatevectorBackend(0)).plan(clutter, goal=inside)
 
 
 def test_bad_planner_settings(clutter):
     with pytest.raises(ValueError, match=r"workers must be an integer in \[1, 4096\], got 0"):
-        qc.PQRRT(clutter, backend=qc.StatevectorBackend(0), workers=0)
+        qc.PQRRT(backend=qc.StatevectorBackend(0), workers=0)
     with pytest.raises(ValueError, match=r"workers must be an integer in \[1, 4096\], got 0"):
-        qc.ParallelRRT(clutter, workers=0)
+        qc.ParallelRRT(workers=0)
     with pytest.raises(TypeError, match="workers must be an integer"):
-        qc.ParallelRRT(clutter, workers=2.5)
+        qc.ParallelRRT(workers=2.5)
     with pytest.raises(ValueError, match="num_qubits = 40 is outside"):
-        qc.QRRT(clutter, backend=qc.StatevectorBackend(0), num_qubits=40)
+        qc.QRRT(backend=qc.StatevectorBackend(0), num_qubits=40)
     with pytest.raises(ValueError, match=r"r_min must be <= r_max"):
         qc.AnnealingSchedule(bands=[(3.0, 1.0)])
     with pytest.raises(ValueError, match="switch_at"):
         qc.AnnealingSchedule(bands=[(1.0, 2.0), (0.5, 1.0)], switch_at=[])
     with pytest.raises(ValueError, match="dimension mismatch"):
-        qc.RRT(clutter, dynamics=qc.LinearTrackingDynamics(-np.eye(3), np.eye(3), np.zeros((3, 3))))
+        qc.RRT(dynamics=qc.LinearTrackingDynamics(-np.eye(3), np.eye(3), np.zeros((3, 3))))
     with pytest.raises(ValueError, match="k must be an integer"):
         qc.FixedIterations(-1)

@@ -15,11 +15,11 @@ def make(name, env, seed):
     backend = qc.StatevectorBackend()
     common = {"seed": seed, "goal_bias": GOAL_BIAS}
     return {
-        "RRT": lambda: qc.RRT(env, **common),
-        "ParallelRRT": lambda: qc.ParallelRRT(env, workers=8, **common),
-        "QRRT": lambda: qc.QRRT(env, backend=backend, **common),
-        "PQRRT": lambda: qc.PQRRT(env, backend=backend, workers=8, **common),
-        "PQRRT-unshared": lambda: qc.PQRRT(env, backend=backend, workers=8, shared_database=False,
+        "RRT": lambda: qc.RRT(**common),
+        "ParallelRRT": lambda: qc.ParallelRRT(workers=8, **common),
+        "QRRT": lambda: qc.QRRT(backend=backend, **common),
+        "PQRRT": lambda: qc.PQRRT(backend=backend, workers=8, **common),
+        "PQRRT-unshared": lambda: qc.PQRRT(backend=backend, workers=8, shared_database=False,
                                            **common),
     }[name]()
 
@@ -30,7 +30,7 @@ def test_reaches_goal_in_95_percent_of_seeds(name):
     dynamics = qc.LinearTrackingDynamics.paper()
     reached = 0
     for seed in SEEDS:
-        env = qc.scenarios.paper_clutter(seed=seed)
+        env = qc.paper_clutter(seed=seed)
         result = make(name, env, seed).plan(max_nodes=NODE_BUDGET)
         reached += result.status == "reached"
         assert_path_valid(result)

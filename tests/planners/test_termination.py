@@ -60,7 +60,7 @@ def test_wall_time_condition_on_progress_and_on_a_plan(walled):
     assert condition.ended_by(progress(elapsed_s=0.49)) is None
     assert condition.ended_by(progress(elapsed_s=0.5)) == "max_time_s"
     # a limit far below one round's time ends the plan before its first round
-    result = qc.RRT(walled, seed=0).plan([1, 1], [16, 16], 0.5, max_time_s=1e-12)
+    result = qc.RRT(seed=0).plan(walled, [1, 1], [16, 16], 0.5, max_time_s=1e-12)
     assert result.status == "max_time_s" and result.metrics.rounds == 0
 
 
@@ -77,7 +77,7 @@ def test_combined_conditions_name_the_first_that_fires():
 
 @pytest.mark.parametrize("budget", [400, 401])
 def test_oracle_call_budget_on_a_plan(budget, walled):
-    for planner in (qc.RRT(walled, seed=0), qc.QRRT(walled, backend=qc.StatevectorBackend(0), seed=0,
+    for planner in (qc.RRT(seed=0), qc.QRRT(backend=qc.StatevectorBackend(0), seed=0,
                                                      search_policy=qc.FixedIterations(2))):
         result = planner.plan([2, 2], [16, 16], 0.5, max_oracle_calls=budget)
         calls = result.history["oracle_calls"]
@@ -90,8 +90,8 @@ def test_critical_path_budget_stops_parallel_workers_on_their_own_time(walled):
     """Pq-RRT with p = 8 workers and k = 2: each round costs 8 x 3 calls but 3 on the critical path,
     so a critical-path budget of 40 ends the plan after ceil(40 / 3) = 14 rounds."""
     k, p, budget = 2, 8, 40
-    result = qc.PQRRT(walled, backend=qc.StatevectorBackend(0), workers=p, search_policy=qc.FixedIterations(k),
-                      seed=1).plan([2, 2], [16, 16], 0.5, max_critical_path_calls=budget)
+    result = qc.PQRRT(backend=qc.StatevectorBackend(0), workers=p, search_policy=qc.FixedIterations(k),
+                      seed=1).plan(walled, [2, 2], [16, 16], 0.5, max_critical_path_calls=budget)
     rounds = math.ceil(budget / (k + 1))
     assert result.status == "max_critical_path_calls"
     assert result.metrics.rounds == rounds
@@ -100,10 +100,10 @@ def test_critical_path_budget_stops_parallel_workers_on_their_own_time(walled):
 
 
 def test_max_nodes_and_rounds_on_a_plan(clutter):
-    result = qc.ParallelRRT(clutter, workers=4, seed=3).plan(max_nodes=12)
+    result = qc.ParallelRRT(workers=4, seed=3).plan(clutter, max_nodes=12)
     assert result.status == "max_nodes" and 12 <= result.metrics.nodes < 12 + 4
     assert result.history["nodes"][-2] < 12
-    result = qc.RRT(clutter, seed=3).plan(max_rounds=25)
+    result = qc.RRT(seed=3).plan(clutter, max_rounds=25)
     assert result.status == "max_rounds" and result.metrics.rounds == 25
 
 
@@ -120,20 +120,20 @@ def test_stall_ends_a_plan_that_cannot_add_nodes(planner_name, boxed_in):
 
 def test_stall_counts_consecutive_rounds_only(clutter):
     """Stall counts rounds since the last new node, not all empty rounds."""
-    result = qc.RRT(clutter, seed=5).plan(max_nodes=30, stall_rounds=10_000)
+    result = qc.RRT(seed=5).plan(clutter, max_nodes=30, stall_rounds=10_000)
     empty = int(np.sum(np.diff(np.concatenate([[0], result.history["nodes"]])) == 0))
     assert result.status == "max_nodes" and empty > 10  # many empty rounds, never 10 000 in a row
 
 
 def test_termination_argument_combines_with_the_shorthands(walled):
-    result = qc.RRT(walled, seed=0).plan([1, 1], [16, 16], 0.5, termination=qc.MaxRounds(30),
+    result = qc.RRT(seed=0).plan(walled, [1, 1], [16, 16], 0.5, termination=qc.MaxRounds(30),
                                          max_oracle_calls=12)
     assert result.status == "max_oracle_calls" and result.metrics.rounds == 12
     assert result.settings["termination"] == {"max_rounds": 30, "max_oracle_calls": 12,
                                               "max_nodes": DEFAULT_MAX_NODES}  # budgets: no stall limit
     assert not result.safety_limit and "ended by a limit you set" in result.status_text
     with pytest.raises(TypeError, match="termination must be a TerminationCondition"):
-        qc.RRT(walled).plan([1, 1], [16, 16], 0.5, termination=30)
+        qc.RRT().plan(walled, [1, 1], [16, 16], 0.5, termination=30)
 
 
 def test_a_round_limit_is_always_in_force():
@@ -148,7 +148,7 @@ def test_a_round_limit_is_always_in_force():
 
 def test_start_inside_the_goal_ball_is_reached_at_once(clutter):
     start = clutter.start
-    result = qc.RRT(clutter, seed=0).plan(start, start, 0.5, max_rounds=10)
+    result = qc.RRT(seed=0).plan(clutter, start, start, 0.5, max_rounds=10)
     assert result.status == "reached" and result.metrics.rounds == 0 and result.goal_node == 0
     assert np.array_equal(result.path, start[None])
 
@@ -162,9 +162,9 @@ def test_start_inside_the_goal_ball_is_reached_at_once(clutter):
     ({"max_time_s": True}, TypeError, "max_time_s must be a real number"),
 ])
 def test_bad_limits_are_refused_before_any_work(kwargs, error, message, clutter):
-    planner = qc.RRT(clutter, seed=0)
+    planner = qc.RRT(seed=0)
     with pytest.raises(error, match=message):
-        planner.plan(**kwargs)
+        planner.plan(clutter, **kwargs)
     assert planner.predicate.evaluations == 0
 
 
@@ -174,7 +174,7 @@ def test_default_stall_ends_a_plan_given_only_a_node_budget(monkeypatch, boxed_i
     from qrrt_circuits.planners import termination
 
     monkeypatch.setattr(termination, "DEFAULT_STALL_ROUNDS", 25)
-    result = qc.RRT(boxed_in, seed=0).plan([5, 5], [15, 15], 0.5, max_nodes=5)
+    result = qc.RRT(seed=0).plan(boxed_in, [5, 5], [15, 15], 0.5, max_nodes=5)
     assert result.status == "stalled" and result.metrics.rounds == 25
     assert result.to_dict()["safety_limit"] is True
     assert with_defaults(qc.Stall(3)) == (qc.Stall(3) | qc.MaxRounds(termination.DEFAULT_MAX_ROUNDS)
@@ -207,7 +207,7 @@ def test_a_world_of_1e5_boxes_where_nothing_can_be_added_stalls(planner_name):
     assert env.num_boxes > 100_000 and env.is_free(start) and env.is_free(goal)
     options = {"seed": 0, "workers": 2, "num_qubits": 4, "backend": qc.StatevectorBackend(0)}
     planner = PLANNERS.create(planner_name, env=env, **PLANNERS.applicable(planner_name, options))
-    result = planner.plan(start, goal, 0.5, max_nodes=3, stall_rounds=4)
+    result = planner.plan(clutter, start, goal, 0.5, max_nodes=3, stall_rounds=4)
     assert result.status == "stalled" and result.metrics.nodes == 0 and result.metrics.rounds == 4
 
 
@@ -235,21 +235,21 @@ def test_a_start_on_the_boundary_is_refused_before_any_work(planner_name, start,
     options = {"seed": 0, "workers": 2, "num_qubits": 4, "backend": qc.StatevectorBackend(0)}
     planner = PLANNERS.create(planner_name, env=walled, **PLANNERS.applicable(planner_name, options))
     with pytest.raises(ValueError, match=r"start \[.*\] lies on the workspace boundary .*rejects every motion"):
-        planner.plan(start, [10, 10], 0.5, max_nodes=5)
+        planner.plan(clutter, start, [10, 10], 0.5, max_nodes=5)
     assert planner.predicate.evaluations == 0
 
 
 def test_boundary_refusal_follows_the_predicate_and_the_goal():
-    env = qc.scenarios.paper_clutter(seed=0)
+    env = qc.paper_clutter(seed=0)
     with pytest.raises(ValueError, match=r"start \[0.0, 5.0\] lies on the workspace boundary"):
-        qc.RRT(env, seed=0).plan(start=[0.0, 5.0], max_nodes=5)  # the issue's reproduction
+        qc.RRT(seed=0).plan(env, start=[0.0, 5.0], max_nodes=5)  # the issue's reproduction
     # the time-sampled check tests points only: a boundary start can leave it, so it is not refused
-    sampled = qc.RRT(env, seed=0, predicate=qc.TimeSampledCheck(env))
-    assert sampled.plan(start=[0.0, 5.0], max_nodes=2).status == "max_nodes"
+    sampled = qc.RRT(seed=0, predicate=qc.TimeSampledCheck(env))
+    assert sampled.plan(env, start=[0.0, 5.0], max_nodes=2).status == "max_nodes"
     # a boundary start inside the goal ball is reached at once, not refused
-    assert qc.RRT(env, seed=0).plan(start=[0.0, 5.0], goal=[0.2, 5.0], goal_radius=0.5).status == "reached"
+    assert qc.RRT(seed=0).plan(env, start=[0.0, 5.0], goal=[0.2, 5.0], goal_radius=0.5).status == "reached"
     with pytest.raises(ValueError, match=r"start \[2.0, 5.0\] is in collision with an obstacle"):
-        qc.RRT(env, seed=0).plan(start=[2.0, 5.0], max_nodes=5)
+        qc.RRT(seed=0).plan(env, start=[2.0, 5.0], max_nodes=5)
 
 
 @pytest.mark.parametrize("planner_name", ["rrt", "qrrt"])
@@ -260,7 +260,7 @@ def test_a_start_just_inside_the_boundary_margin_ends_stalled(planner_name, wall
 
     options = {"seed": 0, "num_qubits": 4, "backend": qc.StatevectorBackend(0)}
     planner = PLANNERS.create(planner_name, env=walled, **PLANNERS.applicable(planner_name, options))
-    result = planner.plan([1e-7, 5.0], [10, 10], 0.5, max_nodes=5, stall_rounds=20)
+    result = planner.plan(clutter, [1e-7, 5.0], [10, 10], 0.5, max_nodes=5, stall_rounds=20)
     assert result.status == "stalled" and result.metrics.nodes == 0
 
 
@@ -271,10 +271,10 @@ def test_a_node_limit_is_always_in_force(walled, monkeypatch):
     from qrrt_circuits.planners import termination
 
     monkeypatch.setattr(termination, "DEFAULT_MAX_NODES", 40)
-    result = qc.ParallelRRT(walled, workers=8, seed=0).plan([1, 1], [16, 16], 0.5)
+    result = qc.ParallelRRT(workers=8, seed=0).plan(walled, [1, 1], [16, 16], 0.5)
     assert result.status == "max_nodes" and 40 <= result.metrics.nodes < 40 + 8
     assert result.settings["termination"]["max_nodes"] == 40
-    own = qc.ParallelRRT(walled, workers=8, seed=0).plan([1, 1], [16, 16], 0.5, max_nodes=60)
+    own = qc.ParallelRRT(workers=8, seed=0).plan(walled, [1, 1], [16, 16], 0.5, max_nodes=60)
     assert own.status == "max_nodes" and 60 <= own.metrics.nodes < 68
     assert own.settings["termination"]["max_nodes"] == 60
 
@@ -296,12 +296,12 @@ def test_limits_whose_tree_or_history_exceed_memory_are_refused_before_any_work(
     from qrrt_circuits._support import memory
 
     monkeypatch.setattr(memory, "available_memory", lambda: (1 << 30, memory.MACHINE_SOURCE))
-    planner = qc.RRT(walled, seed=0)
+    planner = qc.RRT(seed=0)
     with pytest.raises(ValueError, match=r"max_rounds = 1000000000: .* the largest max_rounds that fits is about"):
-        planner.plan([16, 16], [1, 1], 0.5, max_rounds=10**9, stall_rounds=10**9)
+        planner.plan(walled, clutter, [16, 16], [1, 1], 0.5, max_rounds=10**9, stall_rounds=10**9)
     with pytest.raises(ValueError, match=r"max_nodes = 1000000000: .* the largest max_nodes that fits is about"):
-        qc.ParallelRRT(walled, workers=4096, seed=0).plan([1, 1], [16, 16], 0.5, max_nodes=10**9)
-    assert planner.plan([16, 16], [1, 1], 0.5, max_rounds=50, stall_rounds=50).metrics.rounds == 50
+        qc.ParallelRRT(workers=4096, seed=0).plan(walled, [1, 1], [16, 16], 0.5, max_nodes=10**9)
+    assert planner.plan(walled, clutter, [16, 16], [1, 1], 0.5, max_rounds=50, stall_rounds=50).metrics.rounds == 50
 
 
 @pytest.mark.parametrize("dim", [2, 4])
@@ -372,9 +372,9 @@ class _OwnLimit(_UserCondition):
 ])
 def test_a_user_condition_with_a_bad_node_limit_is_refused(walled, value, error, message):
     with pytest.raises(error, match=message):
-        qc.RRT(walled, seed=0).plan([1, 1], [16, 16], 0.5, termination=_OwnLimit(value), max_rounds=30)
+        qc.RRT(seed=0).plan(walled, [1, 1], [16, 16], 0.5, termination=_OwnLimit(value), max_rounds=30)
     with pytest.raises(error, match=message):
-        qc.RRT(walled, seed=0).plan([1, 1], [16, 16], 0.5, termination=_OwnLimit(value) | qc.Stall(5))
+        qc.RRT(seed=0).plan(walled, [1, 1], [16, 16], 0.5, termination=_OwnLimit(value) | qc.Stall(5))
 
 
 def test_numpy_limits_are_python_ints_and_the_memory_check_sees_them(walled, monkeypatch):
@@ -388,11 +388,11 @@ def test_numpy_limits_are_python_ints_and_the_memory_check_sees_them(walled, mon
     assert type(limit.limit) is int
     monkeypatch.setattr(memory, "available_memory", lambda: (1 << 30, memory.MACHINE_SOURCE))
     with pytest.raises(ValueError, match="max_rounds = 72057594037927936"):
-        qc.RRT(walled, seed=0).plan([1, 1], [16, 16], 0.5, termination=limit, max_nodes=5)
+        qc.RRT(seed=0).plan(walled, [1, 1], [16, 16], 0.5, termination=limit, max_nodes=5)
     with pytest.raises(ValueError, match="max_nodes = 288230376151711744"):
-        qc.ParallelRRT(walled, workers=4096, seed=0).plan([1, 1], [16, 16], 0.5,
+        qc.ParallelRRT(workers=4096, seed=0).plan(walled, [1, 1], [16, 16], 0.5,
                                                           termination=qc.MaxNodes(np.int64(2**58)))
-    result = qc.RRT(walled, seed=0).plan([1, 1], [16, 16], 0.5, termination=qc.MaxRounds(np.int64(7)))
+    result = qc.RRT(seed=0).plan(walled, [1, 1], [16, 16], 0.5, termination=qc.MaxRounds(np.int64(7)))
     assert result.metrics.rounds == 7 and json.dumps(result.settings["termination"])
 
 
@@ -411,7 +411,7 @@ def test_describe_merges_user_settings_without_comparing_them(walled):
     """Only this module's limits take the smaller value; a user's keys keep the last value (a
     minimum over None or dicts raised after the plan had run)."""
     for first, last in ((None, None), ({"x": 1}, {"x": 2}), ([1], "s")):
-        result = qc.RRT(walled, seed=0).plan([1, 1], [16, 16], 0.5, max_rounds=5,
+        result = qc.RRT(seed=0).plan(walled, [1, 1], [16, 16], 0.5, max_rounds=5,
                                              termination=_UserCondition(first) | _UserCondition(last))
         assert result.settings["termination"]["user_note"] == last
 
@@ -481,9 +481,9 @@ def test_an_anyof_subclass_with_its_own_test_is_checked_every_round(clutter):
             return qc.PlanStatus.MAX_TIME if progress.rounds >= 7 else super().ended_by(progress)
 
     condition = Cancelled((qc.MaxNodes(500), qc.MaxRounds(1000), qc.Stall(300)))
-    result = qc.RRT(clutter, seed=0).plan(termination=condition, goal_radius=1e-9)
+    result = qc.RRT(seed=0).plan(clutter, termination=condition, goal_radius=1e-9)
     assert result.status == qc.PlanStatus.MAX_TIME and result.metrics.rounds == 7
-    nested = qc.RRT(clutter, seed=0).plan(termination=Cancelled((qc.MaxNodes(500),)), goal_radius=1e-9)
+    nested = qc.RRT(seed=0).plan(clutter, termination=Cancelled((qc.MaxNodes(500),)), goal_radius=1e-9)
     assert nested.status == qc.PlanStatus.MAX_TIME and nested.metrics.rounds == 7  # kept when the defaults are added
 
 
@@ -504,8 +504,8 @@ def test_rounds_that_add_more_nodes_than_the_planners_bound_end_at_the_node_limi
 
     ends = []
     for condition in (qc.MaxNodes(40), _EveryRound(qc.MaxNodes(40))):
-        planner = qc.QRRT(clutter, backend=qc.StatevectorBackend(), search_policy=Greedy(0), seed=1)
-        result = planner.plan(termination=condition, goal_radius=1e-9)
+        planner = qc.QRRT(backend=qc.StatevectorBackend(), search_policy=Greedy(0), seed=1)
+        result = planner.plan(walled, clutter, termination=condition, goal_radius=1e-9)
         ends.append((str(result.status), result.metrics.rounds, result.metrics.nodes))
     assert ends[0] == ends[1] and ends[0][0] == "max_nodes" and ends[0][2] == 40
 
@@ -518,8 +518,8 @@ def test_a_budget_is_never_cut_by_a_safety_limit(monkeypatch, boxed_in, planner)
 
     monkeypatch.setattr(termination, "DEFAULT_STALL_ROUNDS", 25)
     monkeypatch.setattr(termination, "DEFAULT_MAX_ROUNDS", 40)
-    make = {"RRT": lambda: qc.RRT(boxed_in, seed=0),
-            "QRRT": lambda: qc.QRRT(boxed_in, backend=qc.StatevectorBackend(seed=0), num_qubits=3, seed=0)}[planner]
+    make = {"RRT": lambda: qc.RRT(seed=0),
+            "QRRT": lambda: qc.QRRT(backend=qc.StatevectorBackend(seed=0), num_qubits=3, seed=0)}[planner]
     result = make().plan([5, 5], [15, 15], 0.5, max_oracle_calls=300)
     assert result.status == "max_oracle_calls" and not result.safety_limit
     assert 300 <= result.metrics.oracle_calls and result.metrics.nodes == 0

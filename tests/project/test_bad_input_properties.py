@@ -109,13 +109,13 @@ QUANTUM_ARGUMENTS = [
 def test_quantum_planner_arguments(name, values, data):
     value = data.draw(values)
     options = {"backend": qc.StatevectorBackend(0), "num_qubits": 4} | {name: value}
-    refused(lambda: qc.PQRRT(ENV, **options), name)
+    refused(lambda: qc.PQRRT(**options), name)
 
 
 @SETTINGS
 @given(workers=bad_int(1, 4096))
 def test_parallel_rrt_workers(workers):
-    refused(lambda: qc.ParallelRRT(ENV, workers=workers), "workers")
+    refused(lambda: qc.ParallelRRT(workers=workers), "workers")
 
 
 CALLS = {
@@ -208,8 +208,8 @@ PLAN_ARGUMENTS = [
 
 
 @pytest.mark.parametrize("name, values", PLAN_ARGUMENTS, ids=[a for a, _ in PLAN_ARGUMENTS])
-@pytest.mark.parametrize("make", [lambda: qc.RRT(ENV, seed=0),
-                                  lambda: qc.QRRT(ENV, backend=qc.StatevectorBackend(0), num_qubits=4, seed=0)],
+@pytest.mark.parametrize("make", [lambda: qc.RRT(seed=0),
+                                  lambda: qc.QRRT(backend=qc.StatevectorBackend(0), num_qubits=4, seed=0)],
                          ids=["rrt", "qrrt"])
 @SETTINGS
 @given(data=st.data())
@@ -266,7 +266,7 @@ def test_scenario_file_fields(field, value):
     assert env.dim == 2
     if env.start is not None and env.goal is not None and env.goal_radius is not None:
         try:
-            qc.RRT(env, seed=0).plan(max_rounds=3)
+            qc.RRT(seed=0).plan(env, max_rounds=3)
         except ValueError as exc:
             assert "start" in str(exc) or "goal" in str(exc)
 

@@ -6,13 +6,13 @@ import pytest
 import qrrt_circuits as qc
 from qrrt_circuits.reachability.dynamics import LinearTrackingDynamics
 
-ENV = qc.scenarios.paper_clutter(seed=0)
+ENV = qc.paper_clutter(seed=0)
 
 CASES = {
-    "goal_bias": lambda v: qc.RRT(ENV, goal_bias=v),
+    "goal_bias": lambda v: qc.RRT(goal_bias=v),
     "resolution": lambda v: qc.ExactCheck(ENV, resolution=v),
-    "goal_radius": lambda v: qc.RRT(ENV, seed=0).plan(goal_radius=v, max_rounds=1),
-    "max_time_s": lambda v: qc.RRT(ENV, seed=0).plan(max_time_s=v, max_rounds=1),
+    "goal_radius": lambda v: qc.RRT(seed=0).plan(ENV, goal_radius=v, max_rounds=1),
+    "max_time_s": lambda v: qc.RRT(seed=0).plan(ENV, max_time_s=v, max_rounds=1),
     "MaxWallTime": lambda v: qc.MaxWallTime(v),
     "false_positive": lambda v: qc.OracleErrorModel(false_positive=v),
     "cap_factor": lambda v: qc.BBHT(cap_factor=v),

@@ -20,9 +20,9 @@ def _imported_after(code: str) -> list[str]:
 def test_importing_the_package_and_planning_on_the_statevector_imports_none_of_them():
     assert _imported_after(
         "import qrrt_circuits as qc\n"
-        "env = qc.scenarios.paper_clutter(seed=0)\n"
-        "assert qc.QRRT(env, backend=qc.StatevectorBackend(), seed=0).plan(max_nodes=10).metrics.nodes == 10\n"
-        "assert qc.RRT(env, seed=0).plan(max_nodes=10).metrics.nodes == 10\n"
+        "env = qc.paper_clutter(seed=0)\n"
+        "assert qc.QRRT(backend=qc.StatevectorBackend(), seed=0).plan(env, max_nodes=10).metrics.nodes == 10\n"
+        "assert qc.RRT(seed=0).plan(env, max_nodes=10).metrics.nodes == 10\n"
     ) == []
 
 

@@ -21,7 +21,7 @@ NAMESPACE_MODULES = {"scenarios": "qrrt_circuits.problems.scenarios",
 
 @pytest.fixture(scope="module")
 def env():
-    return qc.scenarios.paper_clutter(seed=0)
+    return qc.paper_clutter(seed=0)
 
 
 def test_every_public_name_resolves():
@@ -113,17 +113,17 @@ def test_an_old_name_is_gone(module, name):
 
 def test_old_arguments_and_attributes_are_gone(env):
     predicate = qc.ExactCheck(env)
-    for make in (lambda: qc.RRT(env, oracle=predicate), lambda: qc.ParallelRRT(env, oracle=predicate),
-                 lambda: qc.QRRT(env, backend=qc.StatevectorBackend(), oracle=predicate),
-                 lambda: qc.PQRRT(env, backend=qc.StatevectorBackend(), oracle=predicate),
-                 lambda: qc.QRRT(env, backend=qc.StatevectorBackend(), iterations=qc.FixedIterations(2)),
-                 lambda: qc.PQRRT(env, backend=qc.StatevectorBackend(), iterations=qc.FixedIterations(2)),
+    for make in (lambda: qc.RRT(oracle=predicate), lambda: qc.ParallelRRT(oracle=predicate),
+                 lambda: qc.QRRT(backend=qc.StatevectorBackend(), oracle=predicate),
+                 lambda: qc.PQRRT(backend=qc.StatevectorBackend(), oracle=predicate),
+                 lambda: qc.QRRT(backend=qc.StatevectorBackend(), iterations=qc.FixedIterations(2)),
+                 lambda: qc.PQRRT(backend=qc.StatevectorBackend(), iterations=qc.FixedIterations(2)),
                  lambda: qc.ExactCheck(env, check="time_samples"),
                  lambda: qc.ExactCheck(env, time_samples=9)):
         with pytest.raises(TypeError, match="unexpected keyword argument"):
             make()
-    planner = qc.PQRRT(env, backend=qc.StatevectorBackend(), predicate=predicate, seed=0)
+    planner = qc.PQRRT(backend=qc.StatevectorBackend(), predicate=predicate, seed=0)
     assert planner.predicate is predicate and not hasattr(planner, "oracle")
     assert not hasattr(planner, "iterations_policy") and not hasattr(predicate, "check")
     assert not hasattr(qc.PaperIterations().start(256), "iterations")
-    assert not hasattr(qc.RRT(env, seed=0).plan(max_rounds=3, goal_radius=1e-9), "budget_exhausted")
+    assert not hasattr(qc.RRT(seed=0).plan(env, max_rounds=3, goal_radius=1e-9), "budget_exhausted")

@@ -11,13 +11,13 @@ import qrrt_circuits as qc
 
 @pytest.mark.parametrize("backend_name", ALL_BACKENDS)
 def test_unshared_pqrrt_on_threads_plans_as_in_process(backend_name):
-    env = qc.scenarios.paper_clutter(seed=3)
+    env = qc.paper_clutter(seed=3)
     plans = []
     for executor in (None, ThreadPoolExecutor(6), ThreadPoolExecutor(6)):
-        planner = qc.PQRRT(env, backend=make_backend(backend_name, 11), num_qubits=4, workers=6,
+        planner = qc.PQRRT(backend=make_backend(backend_name, 11), num_qubits=4, workers=6,
                            shared_database=False, search_policy=qc.FixedIterations(1), seed=7,
                            executor=executor)
-        plans.append(planner.plan(max_rounds=4, goal_radius=1e-9))
+        plans.append(planner.plan(env, max_rounds=4, goal_radius=1e-9))
         if executor is not None:
             executor.shutdown()
     serial = plans[0]

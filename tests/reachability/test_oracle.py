@@ -187,7 +187,7 @@ def test_a_workspace_too_large_for_the_default_resolution_is_refused():
     with pytest.raises(ValueError, match="resolution = 0.01 on a workspace 2.82843e\\+12 across needs up to about"):
         qc.ExactCheck(huge)
     with pytest.raises(ValueError, match="resolution = 0.01"):
-        qc.RRT(huge)
+        qc.RRT()
 
 
 def test_the_chord_grid_refuses_more_intervals_than_asked():

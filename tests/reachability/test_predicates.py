@@ -78,8 +78,8 @@ def test_a_user_predicate_in_three_dimensions():
     lower = rng.uniform(0, 9, size=(40, 3))
     env = qc.Environment(np.array([[0, 10]] * 3, dtype=float), np.stack([lower, lower + 0.8], axis=1))
     start, goal = env.sample_free(2, rng)
-    result = qc.QRRT(env, backend=qc.StatevectorBackend(0), num_qubits=6, predicate=StraightLine(env),
-                     seed=0).plan(start, goal, 1.0, max_nodes=25)
+    result = qc.QRRT(backend=qc.StatevectorBackend(0), num_qubits=6, predicate=StraightLine(env),
+                     seed=0).plan(env, start, goal, 1.0, max_nodes=25)
     assert result.nodes.shape[1] == 3 and result.metrics.nodes >= 1
     curves = edge_curves(result.nodes, result.parents, None, samples=5)
     # straight edges: the middle sample is the midpoint of parent and child
@@ -102,7 +102,7 @@ def test_builtin_predicates_describe_themselves(clutter):
 
 def test_planner_records_the_dynamics_its_predicate_follows(clutter):
     dynamics = qc.LinearTrackingDynamics(np.diag([-1.0, -2.0]), np.eye(2), np.zeros((2, 2)))
-    result = qc.RRT(clutter, dynamics=dynamics, seed=0).plan(max_nodes=3)
+    result = qc.RRT(dynamics=dynamics, seed=0).plan(clutter, max_nodes=3)
     assert plan_dynamics(result).describe() == dynamics.describe()
 
 
@@ -115,12 +115,12 @@ class NoName:
 
 def test_bad_predicates_are_refused_with_the_reason(clutter):
     with pytest.raises(TypeError, match="lacks name, describe"):
-        qc.RRT(clutter, predicate=NoName())
+        qc.RRT(predicate=NoName())
     env3 = qc.Environment(np.array([[0, 1]] * 3, dtype=float), np.zeros((0, 2, 3)))
     with pytest.raises(ValueError, match="dimension mismatch: the predicate works in d = 3"):
-        qc.RRT(clutter, predicate=StraightLine(env3))
+        qc.RRT(predicate=StraightLine(env3))
     with pytest.raises(ValueError, match="give dynamics= or predicate=, not both"):
-        qc.RRT(clutter, predicate=StraightLine(clutter), dynamics=qc.LinearTrackingDynamics.paper())
+        qc.RRT(predicate=StraightLine(clutter), dynamics=qc.LinearTrackingDynamics.paper())
 
 
 @pytest.mark.parametrize("time_samples", [7, 30])
@@ -185,16 +185,16 @@ def test_a_user_predicates_own_validity_and_space_are_respected():
     env = qc.Environment(np.array([[0.0, 10.0], [0.0, 10.0]]), np.zeros((0, 2, 2)), start=[3, 3.5], goal=[9, 9],
                          goal_radius=0.5)
     with pytest.raises(ValueError, match=r"start \[3.0, 3.5\] is not a valid state: the disc check"):
-        qc.RRT(env, predicate=Disc(), seed=0).plan(max_nodes=2)
-    assert qc.RRT(env, predicate=Disc(), seed=0).plan(start=[6, 6], max_nodes=2).metrics.nodes == 2
+        qc.RRT(predicate=Disc(), seed=0).plan(env, max_nodes=2)
+    assert qc.RRT(predicate=Disc(), seed=0).plan(env, start=[6, 6], max_nodes=2).metrics.nodes == 2
     wide = qc.Environment(np.array([[0.0, 12.0], [0.0, 10.0]]), np.zeros((0, 2, 2)), start=[6, 6], goal=[9, 9],
                           goal_radius=0.5)
     with pytest.raises(ValueError, match=r"reach outside the disc check's state space"):
-        qc.RRT(wide, predicate=Disc(), seed=0)
+        qc.RRT(predicate=Disc(), seed=0)
 
     class Miscounting(Disc):
         def is_valid(self, points):
             return np.ones(len(points) + 1, dtype=bool)
 
     with pytest.raises(ValueError, match="disc.is_valid must return 1 booleans for 1 points"):
-        qc.RRT(env, predicate=Miscounting(), seed=0).plan(start=[6, 6], max_nodes=2)
+        qc.RRT(predicate=Miscounting(), seed=0).plan(env, start=[6, 6], max_nodes=2)

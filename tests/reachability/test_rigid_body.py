@@ -83,9 +83,9 @@ def test_q_rrt_turns_the_body_through_the_gap():
                            goal_radius=1.0, resolution=0.05)
     reached = 0
     for seed in range(5):
-        planner = qc.QRRT(env, predicate=check, space=SE2Space(), backend=qc.StatevectorBackend(seed=seed),
+        planner = qc.QRRT(predicate=check, space=SE2Space(), backend=qc.StatevectorBackend(seed=seed),
                           num_qubits=6, seed=seed, max_extension=1.0, search_policy=qc.Adaptive())
-        result = planner.plan(max_oracle_calls=6000)
+        result = planner.plan(env, max_oracle_calls=6000)
         assert check.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
         if result.reached:
             reached += 1
@@ -111,4 +111,4 @@ def test_bad_rigid_bodies_are_refused(kwargs, message):
 def test_a_start_where_the_body_overlaps_the_wall_is_refused():
     env, check = se2_world(WORKSPACE, WALL, (0.6, 0.2), start=[5.0, 2.0, 0.0], goal=[8, 8, 0.0], goal_radius=1.0)
     with pytest.raises(ValueError, match=r"start \[5.0, 2.0, 0.0\] is not a valid state"):
-        qc.RRT(env, predicate=check, space=SE2Space(), seed=0).plan(max_rounds=3)
+        qc.RRT(predicate=check, space=SE2Space(), seed=0).plan(env, max_rounds=3)

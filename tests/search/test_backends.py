@@ -160,8 +160,8 @@ def test_sampler_backend_is_seeded_per_search_when_the_sampler_allows_it(clutter
     from qiskit_aer.primitives import SamplerV2
 
     def plan(sampler):
-        return qc.PQRRT(clutter, backend=qc.SamplerBackend(sampler), num_qubits=5, workers=3,
-                        seed=11).plan(max_rounds=8)
+        return qc.PQRRT(backend=qc.SamplerBackend(sampler), num_qubits=5, workers=3,
+                        seed=11).plan(clutter, max_rounds=8)
 
     a, b = plan(SamplerV2()), plan(SamplerV2())
     assert np.array_equal(a.nodes, b.nodes) and a.metrics.oracle_calls == b.metrics.oracle_calls

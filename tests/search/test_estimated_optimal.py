@@ -97,8 +97,8 @@ def test_policy_inside_the_planners_counts_the_estimation(workers, shared, clutt
     states = []
     policy = recording_policy(states, shots=8)
     rounds = 6
-    result = qc.PQRRT(clutter, backend=qc.StatevectorBackend(0), num_qubits=6, workers=workers,
-                      shared_database=shared, search_policy=policy, seed=8).plan(max_rounds=rounds)
+    result = qc.PQRRT(backend=qc.StatevectorBackend(0), num_qubits=6, workers=workers,
+                      shared_database=shared, search_policy=policy, seed=8).plan(clutter, max_rounds=rounds)
     m = result.metrics
     history = states[0].history
     per_database = workers if shared else 1

@@ -144,8 +144,8 @@ def test_policy_inside_the_planners_costs_l_plus_one_per_worker(workers, shared,
     per round."""
     policy = qc.FixedPointAmplification(delta=0.4, min_fraction=0.1)
     rounds = 15
-    result = qc.PQRRT(clutter, backend=qc.StatevectorBackend(0), workers=workers, shared_database=shared,
-                      search_policy=policy, seed=4).plan(max_rounds=rounds)
+    result = qc.PQRRT(backend=qc.StatevectorBackend(0), workers=workers, shared_database=shared,
+                      search_policy=policy, seed=4).plan(clutter, max_rounds=rounds)
     m = result.metrics
     searches = workers * rounds
     assert m.databases == rounds * (1 if shared else workers)
@@ -159,8 +159,8 @@ def test_policy_inside_the_planners_costs_l_plus_one_per_worker(workers, shared,
 
 def test_qrrt_with_fixed_point_on_aer(clutter):
     policy = qc.FixedPointAmplification(delta=0.5, min_fraction=0.1)
-    result = qc.QRRT(clutter, backend=qc.AerBackend(seed=1), num_qubits=6, search_policy=policy,
-                     seed=3).plan(max_rounds=6)
+    result = qc.QRRT(backend=qc.AerBackend(seed=1), num_qubits=6, search_policy=policy,
+                     seed=3).plan(clutter, max_rounds=6)
     m = result.metrics
     assert m.quantum_oracle_calls == policy.iterates * m.rounds
     assert m.oracle_calls == (policy.iterates + 1) * m.rounds == m.critical_path_oracle_calls

@@ -124,8 +124,8 @@ def test_every_policy_inside_the_planners(name, shared, clutter):
     """The planners use every policy through the same path: metric identities hold, the critical
     path is the largest worker's calls per round, and fixed-k policies cost exactly p (k + 1)."""
     workers, rounds = 4, 12
-    result = qc.PQRRT(clutter, backend=qc.StatevectorBackend(0), workers=workers, shared_database=shared,
-                      search_policy=POLICIES.create(name), seed=2).plan(max_rounds=rounds)
+    result = qc.PQRRT(backend=qc.StatevectorBackend(0), workers=workers, shared_database=shared,
+                      search_policy=POLICIES.create(name), seed=2).plan(clutter, max_rounds=rounds)
     m = result.metrics
     assert m.oracle_calls == m.quantum_oracle_calls + m.verification_calls
     assert m.nodes + m.duplicates + m.rejected == m.verification_calls

@@ -71,9 +71,9 @@ def test_unshared_pqrrt_round_searched_together_equals_one_by_one(policy, seed, 
     """Without an executor, unshared Pq-RRT hands a round's searches to the backend together; on
     an executor each database is searched by its own task. Same trees and counts, bit for bit."""
     def plan(executor):
-        planner = qc.PQRRT(clutter, backend=qc.AerBackend(), num_qubits=5, workers=4, shared_database=False,
+        planner = qc.PQRRT(backend=qc.AerBackend(), num_qubits=5, workers=4, shared_database=False,
                            search_policy=policy, seed=seed, executor=executor)
-        return planner.plan(max_rounds=6)
+        return planner.plan(clutter, max_rounds=6)
 
     together = plan(None)
     with ThreadPoolExecutor(max_workers=1) as pool:
@@ -99,7 +99,7 @@ def test_a_state_overriding_run_keeps_its_run_in_run_many(clutter):
         def start(self, num_items):
             return OneIterationState(self, num_items)
 
-    planner = qc.PQRRT(clutter, backend=qc.StatevectorBackend(), num_qubits=4, workers=3, shared_database=False,
+    planner = qc.PQRRT(backend=qc.StatevectorBackend(), num_qubits=4, workers=3, shared_database=False,
                        search_policy=OneIteration(1), seed=0)
-    result = planner.plan(max_rounds=2)
+    result = planner.plan(clutter, max_rounds=2)
     assert OneIterationState.calls == 3 * result.metrics.rounds

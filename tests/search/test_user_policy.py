@@ -32,12 +32,12 @@ class TwoIterationsState(PolicyState):
 
 @pytest.mark.parametrize("workers, shared", [(1, True), (4, True), (3, False)])
 def test_a_users_policy_plans_as_the_builtin_with_the_same_behaviour(workers, shared):
-    env = qc.scenarios.paper_clutter(seed=2)
+    env = qc.paper_clutter(seed=2)
     plans = []
     for policy in (qc.FixedIterations(2), TwoIterations()):
-        planner = qc.PQRRT(env, backend=qc.StatevectorBackend(), num_qubits=6, workers=workers,
+        planner = qc.PQRRT(backend=qc.StatevectorBackend(), num_qubits=6, workers=workers,
                            shared_database=shared, search_policy=policy, seed=5)
-        plans.append(planner.plan(max_nodes=30))
+        plans.append(planner.plan(env, max_nodes=30))
     builtin, user = plans
     assert np.array_equal(builtin.nodes, user.nodes) and np.array_equal(builtin.parents, user.parents)
     assert builtin.metrics.oracle_calls == user.metrics.oracle_calls

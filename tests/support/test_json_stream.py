@@ -71,16 +71,16 @@ def test_an_empty_mapping_and_an_unserialisable_value():
 
 
 @pytest.mark.parametrize("make", [
-    lambda env: qc.RRT(env, seed=1),
-    lambda env: qc.ParallelRRT(env, workers=4, seed=1),
-    lambda env: qc.QRRT(env, backend=qc.StatevectorBackend(seed=1), seed=1, search_policy=qc.PaperIterations()),
-    lambda env: qc.PQRRT(env, workers=4, backend=qc.StatevectorBackend(seed=1), seed=1,
+    lambda env: qc.RRT(seed=1),
+    lambda env: qc.ParallelRRT(workers=4, seed=1),
+    lambda env: qc.QRRT(backend=qc.StatevectorBackend(seed=1), seed=1, search_policy=qc.PaperIterations()),
+    lambda env: qc.PQRRT(workers=4, backend=qc.StatevectorBackend(seed=1), seed=1,
                          search_policy=qc.PaperIterations()),
 ])
 def test_write_json_is_to_dict(make):
     """Plans ended by their node limit (no path) and, with 400 nodes, reached for the first three
     planners (a path), every planner."""
-    env = qc.scenarios.paper_clutter(seed=1)
+    env = qc.paper_clutter(seed=1)
     paths = []
     for max_nodes in (3, 400):
         result = make(env).plan(max_nodes=max_nodes)
@@ -97,7 +97,7 @@ def test_write_json_holds_one_chunk_not_the_tree(tmp_path):
     import dataclasses
     import tracemalloc
 
-    small = qc.RRT(qc.scenarios.paper_clutter(seed=1), seed=1).plan(max_nodes=3)
+    small = qc.RRT(qc.paper_clutter(seed=1), seed=1).plan(max_nodes=3)
     rows = 50_000
     rng = np.random.default_rng(0)
     big = dataclasses.replace(small, nodes=rng.random((rows, 2)), parents=rng.integers(0, rows, rows))
@@ -131,7 +131,7 @@ def test_string_arrays_holding_the_row_separator_stay_valid():
 def test_to_dict_takes_scalars_with_tolist_as_before():
     import dataclasses
 
-    small = qc.RRT(qc.scenarios.paper_clutter(seed=1), seed=1).plan(max_nodes=3)
+    small = qc.RRT(qc.paper_clutter(seed=1), seed=1).plan(max_nodes=3)
     odd = dataclasses.replace(small, history={"x": np.int64(3), "y": np.float64(0.5)})
     assert odd.to_dict()["history"] == {"x": 3, "y": 0.5}
     handle = io.StringIO()

@@ -21,7 +21,7 @@ MIB = 1 << 20
 
 @pytest.fixture(scope="module")
 def env():
-    return qc.scenarios.paper_clutter(seed=0)
+    return qc.paper_clutter(seed=0)
 
 
 @pytest.fixture
@@ -50,11 +50,11 @@ def _largest(message: str) -> int:
                          ids=["statevector", "aer"])
 def test_plan_refused_before_its_first_allocation_with_the_largest_fitting_n(env, small_memory, make_backend):
     backend = make_backend()
-    planner = qc.PQRRT(env, backend=backend, num_qubits=28, seed=0)  # construction allocates nothing
+    planner = qc.PQRRT(backend=backend, num_qubits=28, seed=0)  # construction allocates nothing
     before = _peak_rss()
     with pytest.raises(ValueError, match=r"num_qubits = 28: this plan could need about .* at its peak .*more "
                                          r"than the 300 MiB of memory available \(MemAvailable\)") as info:
-        planner.plan(max_rounds=1)
+        planner.plan(env, max_rounds=1)
     assert _peak_rss() - before < 64 * MIB  # refused before the 2^28-entry database was built
     largest = _largest(str(info.value))
     assert _plan_total(planner, largest) <= small_memory < _plan_total(planner, largest + 1)
@@ -63,11 +63,11 @@ def test_plan_refused_before_its_first_allocation_with_the_largest_fitting_n(env
 def test_the_estimate_grows_with_what_the_run_holds(env):
     sv = qc.StatevectorBackend(0)
     paper = qc.PaperIterations()  # at most 5 iterations: fewer than the 20 below
-    base = qc.QRRT(env, backend=sv, num_qubits=10, seed=0, search_policy=paper).memory_estimate(24)
-    annealed = qc.QRRT(env, backend=sv, num_qubits=10, seed=0, search_policy=paper,
+    base = qc.QRRT(backend=sv, num_qubits=10, seed=0, search_policy=paper).memory_estimate(24)
+    annealed = qc.QRRT(backend=sv, num_qubits=10, seed=0, search_policy=paper,
                        annealing=qc.AnnealingSchedule.paper()).memory_estimate(24)
-    aer = qc.QRRT(env, backend=qc.AerBackend(0), num_qubits=10, seed=0, search_policy=paper).memory_estimate(24)
-    aer_more_k = qc.QRRT(env, backend=qc.AerBackend(0), num_qubits=10, seed=0,
+    aer = qc.QRRT(backend=qc.AerBackend(0), num_qubits=10, seed=0, search_policy=paper).memory_estimate(24)
+    aer_more_k = qc.QRRT(backend=qc.AerBackend(0), num_qubits=10, seed=0,
                          search_policy=qc.FixedIterations(20)).memory_estimate(24)
     assert base.total_bytes < annealed.total_bytes
     assert base.total_bytes < aer.total_bytes < aer_more_k.total_bytes
@@ -117,9 +117,9 @@ class Nowhere:  # a predicate that costs nothing: the round's memory is its data
     def reachable(self, parents, children):
         return np.zeros(len(children), dtype=bool)
 
-env = qc.scenarios.paper_clutter(seed=0)
+env = qc.paper_clutter(seed=0)
 def planner(n, workers):
-    return qc.PQRRT(env, backend=qc.StatevectorBackend(0), num_qubits=n, workers=workers, shared_database=False,
+    return qc.PQRRT(backend=qc.StatevectorBackend(0), num_qubits=n, workers=workers, shared_database=False,
                     search_policy=qc.FixedIterations(1), seed=0, predicate=Nowhere())
 planner(8, 2).plan(max_rounds=1)  # compiled code loaded before the measurement
 big = planner(20, int(sys.argv[1]))
@@ -134,7 +134,7 @@ def test_unshared_databases_are_counted_once_per_worker_without_an_executor(env)
     1.8 GiB at p = 64), and it covers the peak a round adds at n = 20, measured in a fresh process
     (the peak reset just before the round)."""
     def estimate(workers):
-        return qc.PQRRT(env, backend=qc.StatevectorBackend(0), num_qubits=16, workers=workers,
+        return qc.PQRRT(backend=qc.StatevectorBackend(0), num_qubits=16, workers=workers,
                         shared_database=False, seed=0).memory_estimate()
 
     one, eight = estimate(1), estimate(8)
@@ -148,9 +148,9 @@ def test_unshared_databases_are_counted_once_per_worker_without_an_executor(env)
 
 def test_adaptive_with_a_huge_table_is_refused_before_allocating_it(env):
     policy = qc.Adaptive(grid_size=100_000, max_iterations=1_000_000)  # a 2.4 TB success table
-    planner = qc.QRRT(env, backend=qc.StatevectorBackend(0), num_qubits=8, seed=0, search_policy=policy)
+    planner = qc.QRRT(backend=qc.StatevectorBackend(0), num_qubits=8, seed=0, search_policy=policy)
     with pytest.raises(ValueError, match=r"num_qubits = 8: this plan could need about .*search policy"):
-        planner.plan(max_rounds=1)
+        planner.plan(env, max_rounds=1)
 
 
 @pytest.mark.parametrize("make_backend", [lambda: qc.StatevectorBackend(0, max_qubits=24),
@@ -274,7 +274,7 @@ for axis in range(dim):  # a wall around the corner cube [16, 20]^d: the goal (1
 env = qc.Environment(np.array([[0.0, 20.0]] * dim), np.array(boxes))
 dynamics = None if dim == 2 else qc.LinearTrackingDynamics(-np.eye(dim), np.eye(dim), np.eye(dim))
 def plan(workers, **limits):
-    return qc.ParallelRRT(env, workers=workers, seed=0, dynamics=dynamics).plan(
+    return qc.ParallelRRT(workers=workers, seed=0, dynamics=dynamics).plan(env, 
         np.full(dim, 2.0), np.full(dim, 18.0), 0.5, **limits)
 plan(8, max_rounds=3)  # compiled code loaded before the measurement,
 plan(64, max_nodes=1000)  # the nearest-node grid's too (from 400 nodes): compiled inside it on a cold cache
@@ -354,10 +354,10 @@ def test_a_plan_in_a_small_control_group_is_refused(tmp_path, monkeypatch, env):
 
     _cgroup(tmp_path, monkeypatch, str(512 * MIB), 100 * MIB, "")
     monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 20 * 1024 * MIB)
-    planner = qc.QRRT(env, backend=qc.StatevectorBackend(0, max_qubits=24), num_qubits=24, seed=0)
+    planner = qc.QRRT(backend=qc.StatevectorBackend(0, max_qubits=24), num_qubits=24, seed=0)
     with pytest.raises(ValueError, match=r"num_qubits = 24: .* more than the 412 MiB of memory available "
                                          r"\(the memory control group's room\)"):
-        planner.plan(max_rounds=1)
+        planner.plan(env, max_rounds=1)
 
 
 @pytest.mark.parametrize("version", [2, 1])
@@ -524,13 +524,13 @@ def counted_reads(monkeypatch):
 
 
 @pytest.mark.parametrize("make_planner", [
-    lambda env: qc.QRRT(env, backend=qc.StatevectorBackend(0), num_qubits=8, seed=0),
-    lambda env: qc.PQRRT(env, backend=qc.AerBackend(0), num_qubits=6, workers=3, shared_database=False, seed=0),
-    lambda env: qc.PQRRT(env, backend=qc.StatevectorBackend(0), num_qubits=6, workers=2, seed=0,
+    lambda env: qc.QRRT(backend=qc.StatevectorBackend(0), num_qubits=8, seed=0),
+    lambda env: qc.PQRRT(backend=qc.AerBackend(0), num_qubits=6, workers=3, shared_database=False, seed=0),
+    lambda env: qc.PQRRT(backend=qc.StatevectorBackend(0), num_qubits=6, workers=2, seed=0,
                          search_policy=qc.BBHT()),
-    lambda env: qc.QRRT(env, backend=qc.AerBackend(0), num_qubits=6, seed=0,
+    lambda env: qc.QRRT(backend=qc.AerBackend(0), num_qubits=6, seed=0,
                         search_policy=qc.FixedPointAmplification()),
-    lambda env: qc.RRT(env, seed=0),
+    lambda env: qc.RRT(seed=0),
 ], ids=["qrrt", "pqrrt-unshared-aer", "bbht", "fixed-point-aer", "rrt"])
 def test_a_plan_reads_the_available_memory_once_whatever_its_rounds(env, counted_reads, make_planner):
     result = make_planner(env).plan(max_rounds=12)
@@ -554,7 +554,7 @@ def test_a_direct_search_checks_once_per_call(counted_reads):
 def test_the_plan_check_counts_the_round_the_tree_and_the_history_together(env):
     """Each part alone fits where the sum does not: the plan's one check refuses the sum, naming the
     larger part (here the tree's node limit)."""
-    planner = qc.PQRRT(env, backend=qc.StatevectorBackend(0), num_qubits=20, workers=8, seed=0)
+    planner = qc.PQRRT(backend=qc.StatevectorBackend(0), num_qubits=20, workers=8, seed=0)
     size = memory.PlanSize(2_000_000, 8, 10**6, 2, planner.memory_estimate, 20)
     estimate = size.estimate()
     available = estimate.total_bytes - 1
@@ -568,7 +568,7 @@ def test_the_plan_check_counts_the_round_the_tree_and_the_history_together(env):
 
 
 def test_the_fixed_point_policy_is_sized_by_its_sequence_circuit(env):
-    planner = qc.QRRT(env, backend=qc.AerBackend(0), num_qubits=16, seed=0,
+    planner = qc.QRRT(backend=qc.AerBackend(0), num_qubits=16, seed=0,
                       search_policy=qc.FixedPointAmplification())
     policy = planner.search_policy
     assert planner.memory_estimate().search_bytes == planner.backend.sequence_peak_bytes(16, 1, policy.iterates)
@@ -687,9 +687,9 @@ def test_a_memory_error_in_a_plan_is_one_out_of_memory_line(env, monkeypatch):
     from qrrt_circuits.planners import workers
 
     monkeypatch.setattr(workers, "make_database", _unable_to_allocate)
-    planner = qc.QRRT(env, backend=qc.StatevectorBackend(0), num_qubits=10, seed=0)
+    planner = qc.QRRT(backend=qc.StatevectorBackend(0), num_qubits=10, seed=0)
     with pytest.raises(memory.OutOfMemory) as info:
-        planner.plan(max_rounds=3)
+        planner.plan(env, max_rounds=3)
     message = str(info.value)
     assert "\n" not in message and isinstance(info.value.__cause__, MemoryError)
     assert re.fullmatch(r"num_qubits = 10: this plan ran out of memory \(Unable to allocate .*\) with an estimated "
@@ -706,7 +706,7 @@ def test_a_memory_error_growing_a_classical_tree_names_the_limit(env, monkeypatc
     with pytest.raises(memory.OutOfMemory, match=r"^max_nodes = 1000000 \(the default: the plan was given none\): "
                                                  r"this plan ran out of memory .*the largest max_nodes below 1000000 "
                                                  r"whose estimate fits"):
-        qc.ParallelRRT(env, workers=64, seed=0).plan()  # the tree (a million nodes) outweighs the history
+        qc.ParallelRRT(workers=64, seed=0).plan(env)  # the tree (a million nodes) outweighs the history
 
 
 def test_a_memory_error_in_a_direct_search_is_one_out_of_memory_line(monkeypatch):

@@ -102,7 +102,7 @@ def test_a_plan_refuses_a_start_of_booleans_or_strings(clutter, start):
     import qrrt_circuits as qc
 
     with pytest.raises(ValueError, match="start must be 2 numbers"):
-        qc.RRT(clutter, seed=0).plan(start=start, max_nodes=2)
+        qc.RRT(seed=0).plan(clutter, start=start, max_nodes=2)
 
 
 def test_not_json_is_rejected(tmp_path):
@@ -120,7 +120,7 @@ def test_higher_dimension_environment():
 
 
 def test_paper_clutter_matches_design():
-    env = qc.scenarios.paper_clutter(seed=3)
+    env = qc.paper_clutter(seed=3)
     sides = env.boxes[:, 1] - env.boxes[:, 0]
     assert env.num_boxes == 525
     assert np.all((sides >= 0.25) & (sides <= 0.85))
@@ -131,17 +131,17 @@ def test_paper_clutter_matches_design():
 
 
 def test_scenarios_are_seeded():
-    for name in qc.scenarios.SCENARIOS:
-        a = qc.scenarios.by_name(name, seed=7)
-        b = qc.scenarios.by_name(name, seed=7)
-        c = qc.scenarios.by_name(name, seed=8)
+    for name in qc.SCENARIOS:
+        a = qc.by_name(name, seed=7)
+        b = qc.by_name(name, seed=7)
+        c = qc.by_name(name, seed=8)
         assert np.array_equal(a.boxes, b.boxes) and np.array_equal(a.start, b.start)
         assert not np.array_equal(a.boxes, c.boxes)
 
 
 def test_annealing_field_matches_clutter_density():
-    field = qc.scenarios.annealing_field(seed=0)
-    clutter = qc.scenarios.paper_clutter(seed=0)
+    field = qc.annealing_field(seed=0)
+    clutter = qc.paper_clutter(seed=0)
     assert field.num_boxes == 6025
     assert 67 < field.bounds[0, 1] < 69
     # the two worlds draw boxes from one distribution at one expected density; their free fractions
@@ -155,20 +155,20 @@ def test_annealing_field_matches_clutter_density():
 
 
 def test_annealing_field_side_sets_the_density():
-    default = qc.scenarios.annealing_field(seed=2)
-    same = qc.scenarios.annealing_field(seed=2, side=float(default.bounds[0, 1]))
+    default = qc.annealing_field(seed=2)
+    same = qc.annealing_field(seed=2, side=float(default.bounds[0, 1]))
     assert np.array_equal(default.boxes, same.boxes) and "side" not in default.metadata
-    dense = qc.scenarios.annealing_field(seed=2, side=40.0)
+    dense = qc.annealing_field(seed=2, side=40.0)
     assert dense.num_boxes == 6025 and dense.bounds[0, 1] == 40.0 and dense.metadata["side"] == 40.0
     assert dense.free_fraction() < default.free_fraction()
     with pytest.raises(ValueError, match="side must be"):
-        qc.scenarios.annealing_field(seed=2, side=1.7)
+        qc.annealing_field(seed=2, side=1.7)
     with pytest.raises(TypeError, match="side must be a real number"):
-        qc.scenarios.annealing_field(seed=2, side="40")
+        qc.annealing_field(seed=2, side="40")
 
 
 def test_narrow_corridor_channel():
-    env = qc.scenarios.narrow_corridor(seed=1)
+    env = qc.narrow_corridor(seed=1)
     (x0, y0), (x1, y1) = env.metadata["channel"]
     assert y1 - y0 == pytest.approx(0.4) and x1 - x0 == pytest.approx(4.0)
     xs = np.linspace(x0 - 0.5, x1 + 0.5, 200)
@@ -183,7 +183,7 @@ def test_narrow_corridor_channel():
 
 @pytest.mark.parametrize(("width", "length"), [(0.4, 4.0), (1.0, 2.0), (2.0, 8.0)])
 def test_narrow_corridor_geometry_sets_the_channel(width, length):
-    env = qc.scenarios.narrow_corridor(seed=0, width=width, length=length, clutter=0)
+    env = qc.narrow_corridor(seed=0, width=width, length=length, clutter=0)
     (x0, y0), (x1, y1) = env.metadata["channel"]
     assert (x1 - x0, y1 - y0) == (pytest.approx(length), pytest.approx(width))
     assert (x0 + x1) / 2 == pytest.approx(10.0) and (y0 + y1) / 2 == pytest.approx(10.0)
@@ -201,10 +201,10 @@ def test_narrow_corridor_geometry_sets_the_channel(width, length):
 
 def test_narrow_corridor_clutter_count_and_defaults():
     for clutter in (0, 60, 240):
-        env = qc.scenarios.narrow_corridor(seed=3, clutter=clutter)
+        env = qc.narrow_corridor(seed=3, clutter=clutter)
         assert env.num_boxes == 2 + clutter and env.metadata["clutter"] == clutter
-    default = qc.scenarios.narrow_corridor(seed=0)  # the corridor experiment's world
-    explicit = qc.scenarios.narrow_corridor(seed=0, width=0.4, length=4.0, clutter=120, mouth_clearance=1.5)
+    default = qc.narrow_corridor(seed=0)  # the corridor experiment's world
+    explicit = qc.narrow_corridor(seed=0, width=0.4, length=4.0, clutter=120, mouth_clearance=1.5)
     assert np.array_equal(default.boxes, explicit.boxes) and np.array_equal(default.start, explicit.start)
     assert default.metadata["channel"] == [[8.0, 9.8], [12.0, 10.2]]
 
@@ -219,18 +219,18 @@ def test_narrow_corridor_clutter_count_and_defaults():
 ])
 def test_narrow_corridor_refuses_bad_geometry(options, error, match):
     with pytest.raises(error, match=match):
-        qc.scenarios.narrow_corridor(seed=0, **options)
+        qc.narrow_corridor(seed=0, **options)
 
 
 def test_narrow_corridor_says_when_clutter_has_no_room():
     # a channel 9.9 wide with clearance 5 leaves no place for a box off the wall and the mouths
     with pytest.raises(RuntimeError, match="could not place 1 clutter boxes"):
-        qc.scenarios.narrow_corridor(seed=0, width=9.9, length=11.0, clutter=1, mouth_clearance=5.0)
+        qc.narrow_corridor(seed=0, width=9.9, length=11.0, clutter=1, mouth_clearance=5.0)
 
 def test_lattice_start_goal_connected():
     from scipy import ndimage
 
-    env = qc.scenarios.lattice(seed=2, size=30)
+    env = qc.lattice(seed=2, size=30)
     cells = np.stack(np.meshgrid(np.arange(30) + 0.5, np.arange(30) + 0.5, indexing="ij"), -1)
     free = env.is_free(cells)
     labels, _ = ndimage.label(free)
@@ -241,8 +241,8 @@ def test_lattice_start_goal_connected():
 
 def test_bad_scenario_arguments():
     with pytest.raises(ValueError, match="seed"):
-        qc.scenarios.paper_clutter(seed=-1)
+        qc.paper_clutter(seed=-1)
     with pytest.raises(ValueError, match="blocked_fraction"):
-        qc.scenarios.lattice(blocked_fraction=1.5)
+        qc.lattice(blocked_fraction=1.5)
     with pytest.raises(ValueError, match="unknown scenario"):
-        qc.scenarios.by_name("nope")
+        qc.by_name("nope")

@@ -410,9 +410,9 @@ def _recheck_edges(result, check) -> None:
 
 def test_rrt_and_q_rrt_plan_through_the_maze_and_every_edge_rechecks(maze_world):
     env, check = maze_world
-    rrt = qc.RRT(env, predicate=check, max_extension=1.0, goal_bias=0.05, seed=0).plan(max_oracle_calls=20_000)
-    qrrt = qc.QRRT(env, predicate=check, backend=qc.StatevectorBackend(seed=0), num_qubits=5, max_extension=1.0,
-                   goal_bias=0.05, search_policy=qc.Adaptive(), seed=0).plan(max_oracle_calls=20_000)
+    rrt = qc.RRT(predicate=check, max_extension=1.0, goal_bias=0.05, seed=0).plan(env, max_oracle_calls=20_000)
+    qrrt = qc.QRRT(predicate=check, backend=qc.StatevectorBackend(seed=0), num_qubits=5, max_extension=1.0,
+                   goal_bias=0.05, search_policy=qc.Adaptive(), seed=0).plan(env, max_oracle_calls=20_000)
     for result in (rrt, qrrt):
         assert result.reached, result.status_text
         _recheck_edges(result, check)
@@ -467,7 +467,7 @@ def test_image_world_refuses_a_start_or_goal_off_the_free_cells(maze_world, tmp_
 def test_planners_refuse_a_start_in_an_occupied_cell(maze_world):
     env, check = maze_world
     with pytest.raises(ValueError, match=r"start \[0.25, 0.25\] is not a valid state: the grid check"):
-        qc.RRT(env, predicate=check, seed=0).plan(start=[0.25, 0.25], max_nodes=5)
+        qc.RRT(predicate=check, seed=0).plan(env, start=[0.25, 0.25], max_nodes=5)
 
 
 # ----------------------------------------------------------------------------- bad input

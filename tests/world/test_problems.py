@@ -45,8 +45,8 @@ def test_the_narrow_passage_is_open_only_through_its_hole(dim):
 @pytest.mark.parametrize("make", [open_space, lambda: narrow_passage(2, 1.0), lambda: narrow_passage(3, 1.5)])
 def test_families_are_solved_by_rrt_and_q_rrt(make):
     problem = make()
-    for planner in (qc.RRT(problem.env, seed=0, goal_bias=0.05, max_extension=2.0, **problem.planner_options()),
-                    qc.QRRT(problem.env, backend=qc.StatevectorBackend(seed=0), num_qubits=6, seed=0, goal_bias=0.05,
+    for planner in (qc.RRT(seed=0, goal_bias=0.05, max_extension=2.0, **problem.planner_options()),
+                    qc.QRRT(backend=qc.StatevectorBackend(seed=0), num_qubits=6, seed=0, goal_bias=0.05,
                             max_extension=2.0, search_policy=qc.Adaptive(), **problem.planner_options())):
         result = planner.plan(goal=problem.goal, max_oracle_calls=30000)
         assert result.reached, (problem.name, planner.name)
@@ -56,7 +56,7 @@ def test_families_are_solved_by_rrt_and_q_rrt(make):
 def test_the_se2_gap_problem_plans_in_se2():
     problem = se2_gap()
     assert problem.space.describe()["kind"] == "SE2" and problem.env.dim == 3
-    result = qc.RRT(problem.env, seed=1, max_extension=1.0, **problem.planner_options()).plan(
+    result = qc.RRT(seed=1, max_extension=1.0, **problem.planner_options()).plan(problem.env, 
         goal=problem.goal, max_oracle_calls=20000)
     assert result.reached and problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
 
@@ -146,7 +146,7 @@ def test_an_image_problem_file_plans_on_its_grid(tmp_path):
                   goal_radius=0.5)
     problem = load_problem(path)
     assert problem.env.bounds.tolist() == [[0.0, 10.0], [0.0, 10.0]]
-    result = qc.RRT(problem.env, seed=0, goal_bias=0.05, **problem.planner_options()).plan(
+    result = qc.RRT(seed=0, goal_bias=0.05, **problem.planner_options()).plan(problem.env, 
         goal=problem.goal, max_oracle_calls=20000)
     assert result.reached and problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
     with pytest.raises(ValueError, match='family "image" needs'):
@@ -196,8 +196,8 @@ def test_the_maze_problem_is_solved_through_its_corridors():
 
     problem = maze(4, seed=2)
     assert problem.env.bounds.tolist() == [[0.0, 10.0], [0.0, 10.0]]
-    for planner in (qc.RRT(problem.env, seed=0, goal_bias=0.05, **problem.planner_options()),
-                    qc.QRRT(problem.env, backend=qc.StatevectorBackend(seed=0), seed=0, goal_bias=0.05,
+    for planner in (qc.RRT(seed=0, goal_bias=0.05, **problem.planner_options()),
+                    qc.QRRT(backend=qc.StatevectorBackend(seed=0), seed=0, goal_bias=0.05,
                             search_policy=qc.Adaptive(), **problem.planner_options())):
         result = planner.plan(goal=problem.goal, max_oracle_calls=20000)
         assert result.reached
@@ -218,7 +218,7 @@ def test_the_shortcut_keeps_checked_motions_and_never_lengthens():
     from qrrt_circuits.planners.paths import path_length, shortcut
 
     problem = narrow_passage(2, 0.5)
-    result = qc.RRT(problem.env, seed=3, goal_bias=0.05, max_extension=1.0, **problem.planner_options()).plan(
+    result = qc.RRT(seed=3, goal_bias=0.05, max_extension=1.0, **problem.planner_options()).plan(problem.env, 
         goal=problem.goal, max_oracle_calls=20000)
     assert result.reached
     short = shortcut(result.path, problem.predicate)
@@ -271,9 +271,9 @@ def test_the_winding_band_is_solved_by_q_rrt_within_a_budget():
     solved = 0
     for seed in range(5):
         problem = winding_band(2, 0.2, seed)
-        planner = qc.QRRT(problem.env, backend=qc.StatevectorBackend(seed=seed), num_qubits=8, seed=seed,
+        planner = qc.QRRT(backend=qc.StatevectorBackend(seed=seed), num_qubits=8, seed=seed,
                           goal_bias=0.05, search_policy=qc.Adaptive(), **problem.planner_options())
-        result = planner.plan(goal=problem.goal, max_oracle_calls=20000)
+        result = planner.plan(problem.env, goal=problem.goal, max_oracle_calls=20000)
         solved += int(result.reached)
         assert problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
     assert solved >= 4

@@ -70,8 +70,8 @@ class ShortMoves:
 
 
 @pytest.mark.parametrize("make", [
-    lambda env: qc.RRT(env, predicate=ShortMoves(), space=qc.SE2Space(), seed=0, max_extension=1.5),
-    lambda env: qc.QRRT(env, predicate=ShortMoves(), space=qc.SE2Space(), backend=qc.StatevectorBackend(seed=0),
+    lambda env: qc.RRT(predicate=ShortMoves(), space=qc.SE2Space(), seed=0, max_extension=1.5),
+    lambda env: qc.QRRT(predicate=ShortMoves(), space=qc.SE2Space(), backend=qc.StatevectorBackend(seed=0),
                         num_qubits=4, seed=0, max_extension=1.5),
 ])
 def test_planners_plan_in_se2(make):
@@ -85,15 +85,15 @@ def test_planners_plan_in_se2(make):
 
 def test_bad_spaces_are_refused(clutter):
     with pytest.raises(ValueError, match="dimension mismatch: the space has d = 3, the environment has d = 2"):
-        qc.RRT(clutter, space=qc.SE2Space())
+        qc.RRT(space=qc.SE2Space())
     with pytest.raises(ValueError, match=r"SE2Space needs environment bounds for \(x, y, theta\)"):
         qc.SE2Space().check_bounds(np.zeros((2, 2)))
     wide = qc.Environment(np.array([[0.0, 1.0], [0.0, 1.0], [0.0, 7.0]]), np.zeros((0, 2, 3)))
     with pytest.raises(ValueError, match=r"theta bounds \[-pi, pi\]"):
-        qc.RRT(wide, space=qc.SE2Space(), predicate=ShortMoves())
+        qc.RRT(space=qc.SE2Space(), predicate=ShortMoves())
     with pytest.raises(ValueError, match="dimension mismatch: the space has d = 3"):
-        qc.RRT(clutter, space=qc.RealVectorSpace(3))
+        qc.RRT(space=qc.RealVectorSpace(3))
     with pytest.raises(TypeError, match="space must be a StateSpace"):
-        qc.RRT(clutter, space="se2")
+        qc.RRT(space="se2")
     with pytest.raises(ValueError, match="angle_weight must be a finite number >= 0.0"):
         qc.SE2Space(angle_weight=-1.0)
