@@ -25,6 +25,7 @@ import numpy as np
 from _common import machine, median_time, write_json
 
 import qrrt_circuits as qc
+from planner_checks import posed
 from qrrt_circuits.planners.tree import Tree, _brute_block
 
 QUERIES = 256
@@ -55,7 +56,7 @@ def planner_tree(size: int) -> Tree:
     """The tree q-RRT (statevector, n = 8) grows on paper_clutter world 0 toward an unreachable
     goal, to ``size`` nodes: the trees the planners query (clustered around the start)."""
     env = qc.paper_clutter(seed=0)
-    result = qc.QRRT(backend=qc.StatevectorBackend(), seed=0).plan(env, max_nodes=size - 1, goal_radius=1e-9)
+    result = qc.QRRT(backend=qc.StatevectorBackend(), seed=0).plan(posed(env, goal_radius=1e-9), max_nodes=size - 1)
     tree = Tree(result.nodes[0])
     for node, parent in zip(result.nodes[1:], result.parents[1:], strict=True):
         tree.add(node, int(parent))

@@ -42,3 +42,24 @@ def assert_path_valid(result):
         assert np.array_equal(result.path, result.nodes[chain[::-1]])
     else:
         assert result.path is None
+
+
+def posed(world, start=None, goal=None, goal_radius=None, **parts):
+    """The problem a test plans: an ``Environment`` with a start, a goal point (with its radius) or
+    ``Goal``, and optional parts (``predicate``, ``space``, ``dynamics``, ``resolution``); or a
+    ``Problem`` with the given start, goal or radius replaced (the rest kept)."""
+    import qrrt_circuits as qc
+
+    if isinstance(world, qc.Environment):
+        return qc.Problem.build(world, start, goal, goal_radius, **parts)
+    problem = world
+    changes = dict(parts)
+    if start is not None:
+        changes["start"] = start
+    if goal is not None:
+        changes["goal"] = goal if isinstance(goal, qc.Goal) else qc.GoalBall(
+            goal, goal_radius if goal_radius is not None else problem.goal.radius)
+    elif goal_radius is not None:
+        return problem.replace(**changes).with_goal_radius(goal_radius) if changes else \
+            problem.with_goal_radius(goal_radius)
+    return problem.replace(**changes) if changes else problem

@@ -168,8 +168,7 @@ def test_import_without_ompl_names_the_extra(monkeypatch):
 def test_an_invalid_start_or_goal_under_ompls_validity_check_is_refused():
     """OMPL's own validity checker decides (here: a disc at (2, 2) invalid that the box world does
     not know), as OMPL refuses "no valid initial states"."""
-    env = qc.Environment(np.array([[0.0, 10.0], [0.0, 10.0]]), np.zeros((0, 2, 2)), start=[2, 2], goal=[9, 9],
-                         goal_radius=0.5)
+    env = qc.Problem.build(qc.Environment(np.array([[0.0, 10.0], [0.0, 10.0]]), np.zeros((0, 2, 2))), [2, 2], [9, 9], 0.5)
     si = real_vector_si(2, 0.0, 10.0)
     si.setStateValidityChecker(lambda state: (state[0] - 2) ** 2 + (state[1] - 2) ** 2 > 0.25)
     predicate = OMPLMotionPredicate(si)
@@ -177,14 +176,13 @@ def test_an_invalid_start_or_goal_under_ompls_validity_check_is_refused():
     with pytest.raises(ValueError, match=r"start \[2.0, 2.0\] is not a valid state: the ompl check's own validity"):
         qc.RRT(predicate=predicate, seed=0).plan(env, max_nodes=3)
     with pytest.raises(ValueError, match=r"goal \[2.0, 2.0\] is not a valid state"):
-        qc.RRT(predicate=predicate, seed=0).plan(env, start=[8, 8], goal=[2, 2], max_nodes=3)
-    result = qc.RRT(predicate=predicate, seed=0).plan(env, start=[5, 5], max_nodes=3)
+        qc.RRT(predicate=predicate, seed=0).plan(posed(env, start=[8, 8], goal=[2, 2]), max_nodes=3)
+    result = qc.RRT(predicate=predicate, seed=0).plan(posed(env, start=[5, 5]), max_nodes=3)
     assert result.metrics.nodes >= 3
 
 
 def test_an_environment_wider_than_ompls_space_is_refused():
-    env = qc.Environment(np.array([[0.0, 20.0], [0.0, 20.0]]), np.zeros((0, 2, 2)), start=[1, 1], goal=[9, 9],
-                         goal_radius=0.5)
+    env = qc.Problem.build(qc.Environment(np.array([[0.0, 20.0], [0.0, 20.0]]), np.zeros((0, 2, 2))), [1, 1], [9, 9], 0.5)
     predicate = OMPLMotionPredicate(real_vector_si(2, 0.0, 10.0))
     with pytest.raises(ValueError, match=r"outside the ompl check's state space \[\[0.0, 10.0\], \[0.0, 10.0\]\]"):
         qc.QRRT(predicate=predicate, backend=qc.StatevectorBackend(seed=0), num_qubits=3, seed=0)

@@ -77,7 +77,7 @@ def test_a_goal_region_is_asked_through_ompl():
     problem = problem_from_setup(setup)
     assert isinstance(problem.goal, OMPLGoalRegion) and not hasattr(problem.goal, "sample")
     assert problem.goal.is_satisfied(np.array([[9.5, 1.0], [8.0, 1.0]])).tolist() == [True, False]
-    result = qc.RRT(predicate=problem.predicate, seed=1).plan(problem.env, goal=problem.goal, max_oracle_calls=20000)
+    result = qc.RRT(predicate=problem.predicate, seed=1).plan(posed(problem.env, goal=problem.goal), max_oracle_calls=20000)
     assert result.reached and result.path[-1][0] >= 9.0
 
 

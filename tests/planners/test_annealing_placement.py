@@ -44,8 +44,8 @@ def test_default_placement_is_the_band():
 def test_clamp_projects_each_sample_onto_the_band(clutter):
     """The same samples and parents as without annealing; each moved along parent -> sample to
     min(max(r, r_min), r_max)."""
-    tree = _tree(clutter)
-    raw, clamped = _database(clutter, tree, None), _database(clutter, tree, "clamp")
+    tree = _tree(clutter.env)
+    raw, clamped = _database(clutter.env, tree, None), _database(clutter.env, tree, "clamp")
     assert np.array_equal(raw.parents, clamped.parents)
     r = _distances(tree, raw)
     assert np.allclose(_distances(tree, clamped), np.clip(r, *BAND))
@@ -57,8 +57,8 @@ def test_clamp_projects_each_sample_onto_the_band(clutter):
 
 def test_annulus_distance_is_uniform_over_the_annulus_area(clutter):
     """r = sqrt(U(a^2, b^2)): mean 2/3 (b^3 - a^3) / (b^2 - a^2), E[r^2] = (a^2 + b^2) / 2."""
-    tree = _tree(clutter)
-    r = _distances(tree, _database(clutter, tree, "annulus"))
+    tree = _tree(clutter.env)
+    r = _distances(tree, _database(clutter.env, tree, "annulus"))
     a, b = BAND
     assert np.all((r >= a - 1e-9) & (r <= b + 1e-9))
     mean = 2 / 3 * (b**3 - a**3) / (b**2 - a**2)
@@ -67,18 +67,18 @@ def test_annulus_distance_is_uniform_over_the_annulus_area(clutter):
 
 
 def test_admit_keeps_samples_in_the_band_with_their_nearest_parent(clutter):
-    tree = _tree(clutter)
-    database = _database(clutter, tree, "admit", size=256)
+    tree = _tree(clutter.env)
+    database = _database(clutter.env, tree, "admit", size=256)
     r = _distances(tree, database)
     assert database.children.shape == (256, 2) and np.all((r >= BAND[0]) & (r <= BAND[1]))
     assert np.array_equal(database.parents, tree.nearest(database.children))
 
 
 def test_admit_refuses_a_band_no_sample_reaches(clutter):
-    tree = _tree(clutter)
+    tree = _tree(clutter.env)
     schedule = qc.AnnealingSchedule(bands=((100.0, 200.0),), placement="admit")
     with pytest.raises(RuntimeError, match="admitted to the band"):
-        build_database(tree, 2, clutter, np.random.default_rng(0), annealing=schedule)
+        build_database(tree, 2, clutter.env, np.random.default_rng(0), annealing=schedule)
 
 
 @pytest.mark.parametrize("placement", PLACEMENTS)

@@ -51,7 +51,7 @@ def test_batched_rrt_equals_sequential_rrt(seed, executor):
     if seed % 4 == 2:
         options["oracle_errors"] = qc.OracleErrorModel(false_positive=0.2, false_negative=0.1)
     batched = qc.RRT(seed=seed, **options).plan(env, **budgets)
-    sequential = _sequential(qc.RRT(seed=seed, **options), executor).plan(**budgets)
+    sequential = _sequential(qc.RRT(seed=seed, **options), executor).plan(env, **budgets)
     _same(batched, sequential)
     if "max_oracle_calls" in budgets and not batched.reached and not options:
         assert batched.metrics.oracle_calls == budgets["max_oracle_calls"]  # stops exactly there
@@ -64,7 +64,7 @@ def test_batched_parallel_rrt_equals_sequential(seed, executor):
     budgets = BUDGETS[seed % len(BUDGETS)]
     options = {"oracle_errors": qc.OracleErrorModel(false_positive=0.1, false_negative=0.1)} if seed % 4 == 3 else {}
     batched = qc.ParallelRRT(workers=workers, seed=seed, **options).plan(env, **budgets)
-    sequential = _sequential(qc.ParallelRRT(workers=workers, seed=seed, **options), executor).plan(**budgets)
+    sequential = _sequential(qc.ParallelRRT(workers=workers, seed=seed, **options), executor).plan(env, **budgets)
     _same(batched, sequential)
 
 
@@ -74,8 +74,8 @@ def test_wasted_checks_are_the_tests_of_rounds_that_never_ran():
     metrics = result.metrics
     assert metrics.oracle_calls == metrics.rounds == metrics.verification_calls
     assert metrics.wasted_checks > 0
-    predicate = qc.ExactCheck(env)  # counts every pair it evaluates
-    again = qc.RRT(seed=3, predicate=predicate).plan(env, max_nodes=50)
+    predicate = qc.ExactCheck(env.env)  # counts every pair it evaluates
+    again = qc.RRT(seed=3).plan(env.replace(predicate=predicate), max_nodes=50)
     assert predicate.evaluations == again.metrics.oracle_calls + again.metrics.wasted_checks
     assert again.metrics.wasted_checks == metrics.wasted_checks
 
@@ -95,7 +95,7 @@ def test_without_look_ahead_the_predicate_is_asked_once_per_oracle_call(clutter,
         dim, name = 2, "counting"
 
         def __init__(self):
-            self.inner, self.pairs = qc.ExactCheck(clutter), 0
+            self.inner, self.pairs = qc.ExactCheck(clutter.env), 0
 
         def reachable(self, parents, children):
             self.pairs += len(np.atleast_2d(children))
@@ -105,8 +105,9 @@ def test_without_look_ahead_the_predicate_is_asked_once_per_oracle_call(clutter,
             return self.inner.describe()
 
     batched, single = Counting(), Counting()
-    ahead = qc.ParallelRRT(workers=workers, predicate=batched, seed=4).plan(clutter, max_nodes=20)
-    once = qc.ParallelRRT(workers=workers, predicate=single, seed=4, look_ahead=False).plan(clutter, max_nodes=20)
+    ahead = qc.ParallelRRT(workers=workers, seed=4).plan(clutter.replace(predicate=batched), max_nodes=20)
+    once = qc.ParallelRRT(workers=workers, seed=4, look_ahead=False).plan(clutter.replace(predicate=single),
+                                                                          max_nodes=20)
     assert np.array_equal(ahead.nodes, once.nodes) and ahead.metrics.oracle_calls == once.metrics.oracle_calls
     assert once.metrics.wasted_checks == 0 and single.pairs == once.metrics.oracle_calls
     assert batched.pairs == ahead.metrics.oracle_calls + ahead.metrics.wasted_checks > single.pairs

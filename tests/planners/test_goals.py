@@ -7,13 +7,14 @@ import pytest
 from conftest import make_backend
 
 import qrrt_circuits as qc
+from planner_checks import posed
 from qrrt_circuits.problems.goals import first_satisfying, sample_goal
 
 
 @pytest.fixture(scope="module")
 def open_world():
-    return qc.Environment(np.array([[0.0, 10.0], [0.0, 10.0]]), np.array([[[4.0, 0.0], [6.0, 6.0]]]),
-                          start=[1, 1], goal=[9, 1], goal_radius=0.5, name="wall")
+    wall = qc.Environment(np.array([[0.0, 10.0], [0.0, 10.0]]), np.array([[[4.0, 0.0], [6.0, 6.0]]]), name="wall")
+    return qc.Problem.build(wall, [1, 1], [9, 1], 0.5)
 
 
 class RightEdge:
@@ -39,8 +40,9 @@ def _planners(env, **kwargs):
 
 def test_a_ball_goal_is_the_environments_goal(open_world):
     for name, planner in _planners(open_world).items():
-        by_point = planner.plan(max_oracle_calls=3000)
-        by_goal = _planners(open_world)[name].plan(goal=qc.GoalBall([9, 1], 0.5), max_oracle_calls=3000)
+        by_point = planner.plan(open_world, max_oracle_calls=3000)
+        by_goal = _planners(open_world)[name].plan(posed(open_world, goal=qc.GoalBall([9, 1], 0.5)),
+                                                   max_oracle_calls=3000)
         assert np.array_equal(by_point.nodes, by_goal.nodes), name
         assert by_goal.settings["goal"] == [9.0, 1.0] and by_goal.settings["goal_radius"] == 0.5
         assert by_goal.settings["goal_region"] == {"kind": "ball", "centre": [9.0, 1.0], "radius": 0.5}
@@ -62,7 +64,7 @@ def test_an_exact_goal_state_is_reached_exactly_through_goal_bias(open_world, na
         else:
             planner = qc.PQRRT(backend=make_backend("statevector", seed), num_qubits=4, workers=2,
                                seed=seed, **options)
-        result = planner.plan(open_world, goal=target, max_oracle_calls=4000)
+        result = planner.plan(posed(open_world, goal=target), max_oracle_calls=4000)
         if result.reached:
             reached += 1
             assert np.array_equal(result.path[-1], [9.0, 1.0])
@@ -71,14 +73,14 @@ def test_an_exact_goal_state_is_reached_exactly_through_goal_bias(open_world, na
 
 def test_a_region_goal_with_its_own_sampler(open_world):
     for name, planner in _planners(open_world, goal_bias=0.05).items():
-        result = planner.plan(open_world, goal=RightEdge(), max_oracle_calls=5000)
+        result = planner.plan(posed(open_world, goal=RightEdge()), max_oracle_calls=5000)
         assert result.reached and result.path[-1][0] >= 9.0, name
         assert result.settings["goal"] is None and result.settings["goal_region"] == {"kind": "x >= 9"}
         assert not RightEdge().is_satisfied(result.nodes[:result.goal_node]).any()  # the first one ends it
 
 
 def test_a_start_inside_the_goal_is_reached_at_once(open_world):
-    result = qc.RRT(seed=0).plan(open_world, start=[9.5, 5], goal=RightEdge(), max_rounds=5)
+    result = qc.RRT(seed=0).plan(posed(open_world, start=[9.5, 5], goal=RightEdge()), max_rounds=5)
     assert result.reached and result.metrics.rounds == 0
 
 
@@ -125,11 +127,12 @@ class NoSampler:
      r"goal \[5.0, 3.0\] is in collision with an obstacle"),
     (lambda env: qc.RRT(seed=0), qc.GoalBall([1, 1, 1], 0.5), {}, ValueError,
      "dimension mismatch: the goal has d = 3, the environment has d = 2"),
-    (lambda env: qc.RRT(seed=0), "somewhere", {}, ValueError, "goal must be 2 numbers, got 'somewhere'"),
+    (lambda env: qc.RRT(seed=0), "somewhere", {"goal_radius": 0.5}, ValueError,
+     "goal must be 2 numbers, got 'somewhere'"),
 ])
 def test_bad_goals_are_refused_before_planning(open_world, make, goal, extra, error, message):
     with pytest.raises(error, match=message):
-        make(open_world).plan(goal=goal, max_rounds=3, **extra)
+        make(open_world).plan(qc.Problem.build(open_world.env, [1, 1], goal, **extra), max_rounds=3)
 
 
 @pytest.mark.parametrize(("args", "message"), [

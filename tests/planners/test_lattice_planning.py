@@ -11,13 +11,13 @@ import qrrt_circuits as qc
 from qrrt_circuits.coherent import FixedPointFormat
 
 BOXES = np.array([[[0.0, 0.0], [20.0, 7.0]], [[0.0, 13.0], [20.0, 20.0]], [[9.0, 9.0], [11.0, 11.0]]])
-CORRIDOR = qc.Environment(np.array([[0.0, 20.0], [0.0, 20.0]]), BOXES, start=[2.0, 10.0], goal=[18.0, 10.0],
-                          goal_radius=2.5)
+CORRIDOR = qc.Problem.build(qc.Environment(np.array([[0.0, 20.0], [0.0, 20.0]]), BOXES), [2.0, 10.0], [18.0, 10.0],
+                            2.5)
 
 
 def _on_lattice(points: np.ndarray, bits: int, cell_bits: int) -> bool:
     """Whether every point is a cell centre of the 2^a-per-axis lattice on the b-bit grid."""
-    fmt = FixedPointFormat.covering(CORRIDOR, bits)
+    fmt = FixedPointFormat.covering(CORRIDOR.env, bits)
     grid = (points - fmt.lo) / fmt.step
     shift = 1 << (bits - cell_bits)
     return bool(np.allclose(grid, np.round(grid)) and np.all(np.round(grid) % shift == shift // 2))
@@ -31,7 +31,7 @@ def test_lattice_plans_reach_the_goal_with_checked_edges(coherent):
                           database=qc.LatticeCandidates(3, bits=6, coherent=coherent))
         result = planner.plan(CORRIDOR, max_oracle_calls=400)
         reached += result.reached
-        assert planner.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
+        assert CORRIDOR.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
         assert _on_lattice(result.nodes[1:], 6, 3)  # every node but the root is a cell centre
         assert result.settings["database"] == {"kind": "lattice", "cell_bits": 3, "bits": 6, "coherent": coherent,
                                                "time_samples": 4, "fraction_bits": 6}
@@ -44,10 +44,10 @@ def test_the_coherent_backend_measures_what_its_circuit_marks():
     from qrrt_circuits.coherent.backend import CoherentOracleBackend
     from qrrt_circuits.probability import optimal_iterations
 
-    database = LatticeDatabase(FixedPointFormat.covering(CORRIDOR, 6), 3, np.array([[3.0, 10.0], [17.0, 10.0]]))
+    database = LatticeDatabase(FixedPointFormat.covering(CORRIDOR.env, 6), 3, np.array([[3.0, 10.0], [17.0, 10.0]]))
     motion = SampledMotion.from_dynamics(qc.LinearTrackingDynamics.paper(), 4, 6)
-    marks = reachable_reference(CORRIDOR, database, motion)
-    backend = CoherentOracleBackend(build_coherent_oracle(CORRIDOR, database, motion).circuit, 7)
+    marks = reachable_reference(CORRIDOR.env, database, motion)
+    backend = CoherentOracleBackend(build_coherent_oracle(CORRIDOR.env, database, motion).circuit, 7)
     k = optimal_iterations(marks.size, int(marks.sum()))
     shots = 200
     result = backend.search(marks, k, shots, seed=3)
@@ -66,9 +66,9 @@ def test_the_coherent_backend_measures_what_its_circuit_marks():
 def test_bad_lattice_planners_are_refused_before_planning(options, message):
     if options.get("oracle_errors") == "errors":
         options = {"oracle_errors": qc.OracleErrorModel(false_positive=0.1)}
-    with pytest.raises(ValueError, match=message):
+    with pytest.raises(ValueError, match=message):  # (the settings a world cannot serve: when planned)
         qc.QRRT(backend=qc.StatevectorBackend(seed=0), **({"num_qubits": 7} | options),
-                database=qc.LatticeCandidates(3, bits=6, coherent=True))
+                database=qc.LatticeCandidates(3, bits=6, coherent=True)).plan(CORRIDOR, max_rounds=1)
 
 
 @pytest.mark.parametrize(("arguments", "message"), [({"cell_bits": 0}, "cell_bits"), ({"cell_bits": 7}, "cell_bits"),

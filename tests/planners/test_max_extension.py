@@ -34,12 +34,12 @@ def _make(name, env, backend, **kwargs):
 @pytest.mark.parametrize(("name", "backend"), [("RRT", None), ("ParallelRRT", None), ("QRRT", "statevector"),
                                              ("QRRT", "aer"), ("PQRRT", "statevector"), ("PQRRT", "aer")])
 def test_every_edge_is_at_most_the_range_and_valid(clutter, name, backend):
-    result = _make(name, clutter, backend, max_extension=1.5).plan(max_nodes=25)
+    result = _make(name, clutter, backend, max_extension=1.5).plan(clutter, max_nodes=25)
     steps = np.linalg.norm(result.nodes[1:] - result.nodes[result.parents[1:]], axis=1)
     assert result.metrics.nodes >= 25 and steps.max() <= 1.5 + 1e-9
     assert result.settings["max_extension"] == 1.5
-    assert_tree_edges_valid(clutter, qc.LinearTrackingDynamics.paper(), result)
-    raw = _make(name, clutter, backend).plan(max_nodes=25)  # without a range some step is longer
+    assert_tree_edges_valid(clutter.env, qc.LinearTrackingDynamics.paper(), result)
+    raw = _make(name, clutter, backend).plan(clutter, max_nodes=25)  # without a range some step is longer
     assert np.linalg.norm(raw.nodes[1:] - raw.nodes[raw.parents[1:]], axis=1).max() > 1.5
 
 

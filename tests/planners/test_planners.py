@@ -8,6 +8,7 @@ from planner_checks import assert_path_valid, assert_tree_edges_valid
 from tolerances import binomial_counts, z_bound
 
 import qrrt_circuits as qc
+from planner_checks import posed
 from qrrt_circuits.registry import PLANNERS
 from qrrt_circuits.world.environment import Environment
 
@@ -16,10 +17,11 @@ METRIC_KEYS = {"oracle_calls", "quantum_oracle_calls", "verification_calls",
                "duplicates", "rejected", "wall_time_s", "wasted_checks"}
 
 
-def make(name, env, seed, **kw):
+def make(name, seed, **kw):
     """The registry's planner ``name`` on the exact statevector, 8 workers where it has workers."""
     defaults = {"seed": seed, "workers": 8, "backend": qc.StatevectorBackend(seed=seed)}
-    return PLANNERS.create(name, env=env, **PLANNERS.applicable(name, defaults), **kw)
+    takes = PLANNERS.resolve(name).options()
+    return PLANNERS.create(name, **{key: value for key, value in defaults.items() if key in takes}, **kw)
 
 
 PLANNER_NAMES = list(PLANNERS)  # every registered planner
@@ -27,14 +29,14 @@ PLANNER_NAMES = list(PLANNERS)  # every registered planner
 
 @pytest.mark.parametrize("name", PLANNER_NAMES)
 def test_metrics_identities_and_every_edge_rechecked(name, clutter):
-    result = make(name, clutter, seed=3).plan(max_nodes=60)
+    result = make(name, seed=3).plan(clutter, max_nodes=60)
     m = result.metrics
     assert set(m.keys()) == METRIC_KEYS
     assert m.oracle_calls == m.quantum_oracle_calls + m.verification_calls
     assert m.nodes == len(result.nodes) - 1 and result.parents[0] == -1
     assert m.rounds == len(result.history["oracle_calls"])
     assert m.critical_path_oracle_calls <= m.oracle_calls
-    assert_tree_edges_valid(clutter, qc.LinearTrackingDynamics.paper(), result)
+    assert_tree_edges_valid(clutter.env, qc.LinearTrackingDynamics.paper(), result)
     assert_path_valid(result)
     graph = result.tree
     assert graph.number_of_nodes() == m.nodes + 1 and graph.number_of_edges() == m.nodes
@@ -42,11 +44,11 @@ def test_metrics_identities_and_every_edge_rechecked(name, clutter):
 
 
 def test_rrt_oracle_calls_are_its_reachability_tests(clutter):
-    planner = qc.RRT(seed=1)
-    result = planner.plan(clutter, max_rounds=300)
+    problem = clutter.replace(predicate=qc.ExactCheck(clutter.env))  # its own count of evaluations
+    result = qc.RRT(seed=1).plan(problem, max_rounds=300)
     assert result.metrics.oracle_calls == 300 == result.metrics.rounds
     # batched rounds: every evaluation is a round's test or a dropped test of a later round
-    assert planner.predicate.evaluations == 300 + result.metrics.wasted_checks
+    assert problem.predicate.evaluations == 300 + result.metrics.wasted_checks
     assert result.metrics.quantum_oracle_calls == 0 and result.metrics.simulation_checks == 0
 
 
@@ -113,9 +115,9 @@ def test_same_seed_same_tree(backend_name, clutter):
 
 @pytest.mark.parametrize("name", ["ParallelRRT", "PQRRT-unshared"])
 def test_executor_does_not_change_the_result(name, clutter):
-    serial = make(name, clutter, seed=4).plan(max_rounds=12)
+    serial = make(name, seed=4).plan(clutter, max_rounds=12)
     with ThreadPoolExecutor(max_workers=3) as pool:
-        threaded = make(name, clutter, seed=4, executor=pool).plan(max_rounds=12)
+        threaded = make(name, seed=4, executor=pool).plan(clutter, max_rounds=12)
     assert np.array_equal(serial.nodes, threaded.nodes)
     assert serial.metrics.oracle_calls == threaded.metrics.oracle_calls
 
@@ -125,9 +127,9 @@ def test_process_pool_executor_gives_the_serial_result(name, clutter):
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
-    serial = make(name, clutter, seed=6).plan(max_rounds=4)
+    serial = make(name, seed=6).plan(clutter, max_rounds=4)
     with ProcessPoolExecutor(max_workers=2, mp_context=multiprocessing.get_context("spawn")) as pool:
-        parallel = make(name, clutter, seed=6, executor=pool).plan(max_rounds=4)
+        parallel = make(name, seed=6, executor=pool).plan(clutter, max_rounds=4)
     assert np.array_equal(serial.nodes, parallel.nodes)
     assert serial.metrics.oracle_calls == parallel.metrics.oracle_calls
 
@@ -138,7 +140,7 @@ def test_unreachable_goal_ends_without_reaching():
                       [[17.5, 14], [18, 18]]], dtype=float)
     env = Environment(np.array([[0, 20], [0, 20]]), boxes)
     for planner in (qc.RRT(seed=0), qc.QRRT(backend=qc.StatevectorBackend(0), seed=0)):
-        result = planner.plan(clutter, [2, 2], [16, 16], 0.5, max_oracle_calls=400)
+        result = planner.plan(posed(env, start=[2, 2], goal=[16, 16], goal_radius=0.5), max_oracle_calls=400)
         assert result.status == qc.PlanStatus.MAX_ORACLE_CALLS == "max_oracle_calls"
         assert result.path is None and not result.reached
         assert 400 <= result.metrics.oracle_calls < 400 + 7
@@ -153,7 +155,7 @@ def test_default_round_limit_ends_a_plan_with_no_budget(monkeypatch):
     boxes = np.array([[[14, 14], [18, 14.5]], [[14, 17.5], [18, 18]], [[14, 14], [14.5, 18]],
                       [[17.5, 14], [18, 18]]], dtype=float)
     env = Environment(np.array([[0, 20], [0, 20]]), boxes)
-    result = qc.RRT(seed=0).plan(env, [1, 1], [16, 16], 0.5)
+    result = qc.RRT(seed=0).plan(posed(env, start=[1, 1], goal=[16, 16], goal_radius=0.5))
     assert result.status == "max_rounds" and result.metrics.rounds == 17
     assert result.settings["termination"] == {"max_rounds": 17, "stall_rounds": termination.DEFAULT_STALL_ROUNDS,
                                               "max_nodes": termination.DEFAULT_MAX_NODES}
@@ -230,19 +232,28 @@ def test_annealing_first_band_distance(clutter):
     ({"goal_radius": 0}, "goal_radius must be"),
     ({"goal_radius": -2}, "goal_radius must be"),
     ({"start": [1, 2, 3]}, "dimension mismatch: start has 3 coordinates"),
-    ({"max_nodes": 0}, "max_nodes must be an integer >= 1"),
 ])
-def test_bad_plan_input(kwargs, message, clutter):
+def test_bad_problem_input(kwargs, message, clutter):
+    arguments = {"start": clutter.start, "goal": clutter.goal.centre, "goal_radius": 0.75} | kwargs
     with pytest.raises(ValueError, match=message):
-        qc.RRT(seed=0).plan(clutter, **kwargs)
+        qc.Problem.build(clutter.env, **arguments)
+
+
+def test_bad_plan_input(clutter):
+    with pytest.raises(ValueError, match="max_nodes must be an integer >= 1"):
+        qc.RRT(seed=0).plan(clutter, max_nodes=0)
+    with pytest.raises(TypeError, match="problem must be a Problem"):
+        qc.RRT(seed=0).plan(clutter.env, max_nodes=3)
+    with pytest.raises(TypeError, match="takes 2 positional arguments|positional"):
+        qc.RRT(seed=0).plan(clutter, None, 100)  # the budgets are keyword-only
 
 
 def test_start_or_goal_in_collision_names_which(clutter):
-    inside = clutter.boxes[0].mean(axis=0)
+    inside = clutter.env.boxes[0].mean(axis=0)
     with pytest.raises(ValueError, match="start .* is in collision"):
-        qc.RRT().plan(clutter, start=inside)
+        qc.RRT().plan(posed(clutter, start=inside))
     with pytest.raises(ValueError, match="goal .* is in collision"):
-        qc.QRRT(backend=qc.StatevectorBackend(0)).plan(clutter, goal=inside)
+        qc.QRRT(backend=qc.StatevectorBackend(0)).plan(posed(clutter, goal=inside))
 
 
 def test_bad_planner_settings(clutter):
@@ -259,6 +270,9 @@ def test_bad_planner_settings(clutter):
     with pytest.raises(ValueError, match="switch_at"):
         qc.AnnealingSchedule(bands=[(1.0, 2.0), (0.5, 1.0)], switch_at=[])
     with pytest.raises(ValueError, match="dimension mismatch"):
-        qc.RRT(dynamics=qc.LinearTrackingDynamics(-np.eye(3), np.eye(3), np.zeros((3, 3))))
+        qc.Problem.build(clutter.env, clutter.start, clutter.goal,
+                         dynamics=qc.LinearTrackingDynamics(-np.eye(3), np.eye(3), np.zeros((3, 3))))
+    with pytest.raises(TypeError, match="RRT does not take dynamics"):
+        qc.RRT(dynamics=qc.LinearTrackingDynamics.paper())
     with pytest.raises(ValueError, match="k must be an integer"):
         qc.FixedIterations(-1)

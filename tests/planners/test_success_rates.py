@@ -31,8 +31,8 @@ def test_reaches_goal_in_95_percent_of_seeds(name):
     reached = 0
     for seed in SEEDS:
         env = qc.paper_clutter(seed=seed)
-        result = make(name, env, seed).plan(max_nodes=NODE_BUDGET)
+        result = make(name, env, seed).plan(env, max_nodes=NODE_BUDGET)
         reached += result.status == "reached"
         assert_path_valid(result)
-        assert_tree_edges_valid(env, dynamics, result)
+        assert_tree_edges_valid(env.env, dynamics, result)
     assert reached >= 0.95 * len(SEEDS), f"{name} reached the goal in {reached}/20 worlds"

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import qrrt_circuits as qc
+from planner_checks import posed
 from qrrt_circuits.planners.termination import (
     DEFAULT_MAX_NODES,
     Progress,
@@ -36,6 +37,14 @@ def boxed_in():
     return Environment(np.array([[0, 20], [0, 20]]), np.array(boxes, dtype=float))
 
 
+def _applicable(name, options):
+    """The options the registry's planner ``name`` takes."""
+    from qrrt_circuits.registry import PLANNERS
+
+    takes = PLANNERS.resolve(name).options()
+    return {key: value for key, value in options.items() if key in takes}
+
+
 def progress(**values):
     base = {"oracle_calls": 0, "critical_path_oracle_calls": 0, "nodes": 0, "rounds": 0,
             "rounds_without_new_node": 0, "elapsed_s": 0.0}
@@ -60,7 +69,7 @@ def test_wall_time_condition_on_progress_and_on_a_plan(walled):
     assert condition.ended_by(progress(elapsed_s=0.49)) is None
     assert condition.ended_by(progress(elapsed_s=0.5)) == "max_time_s"
     # a limit far below one round's time ends the plan before its first round
-    result = qc.RRT(seed=0).plan(walled, [1, 1], [16, 16], 0.5, max_time_s=1e-12)
+    result = qc.RRT(seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), max_time_s=1e-12)
     assert result.status == "max_time_s" and result.metrics.rounds == 0
 
 
@@ -79,7 +88,7 @@ def test_combined_conditions_name_the_first_that_fires():
 def test_oracle_call_budget_on_a_plan(budget, walled):
     for planner in (qc.RRT(seed=0), qc.QRRT(backend=qc.StatevectorBackend(0), seed=0,
                                                      search_policy=qc.FixedIterations(2))):
-        result = planner.plan([2, 2], [16, 16], 0.5, max_oracle_calls=budget)
+        result = planner.plan(posed(walled, start=[2, 2], goal=[16, 16], goal_radius=0.5), max_oracle_calls=budget)
         calls = result.history["oracle_calls"]
         assert result.status == "max_oracle_calls"
         # the plan stops after the first round that reaches the budget, and not before
@@ -91,7 +100,7 @@ def test_critical_path_budget_stops_parallel_workers_on_their_own_time(walled):
     so a critical-path budget of 40 ends the plan after ceil(40 / 3) = 14 rounds."""
     k, p, budget = 2, 8, 40
     result = qc.PQRRT(backend=qc.StatevectorBackend(0), workers=p, search_policy=qc.FixedIterations(k),
-                      seed=1).plan(walled, [2, 2], [16, 16], 0.5, max_critical_path_calls=budget)
+                      seed=1).plan(posed(walled, start=[2, 2], goal=[16, 16], goal_radius=0.5), max_critical_path_calls=budget)
     rounds = math.ceil(budget / (k + 1))
     assert result.status == "max_critical_path_calls"
     assert result.metrics.rounds == rounds
@@ -112,8 +121,8 @@ def test_stall_ends_a_plan_that_cannot_add_nodes(planner_name, boxed_in):
     from qrrt_circuits.registry import PLANNERS
 
     options = {"seed": 0, "workers": 3, "num_qubits": 5, "backend": qc.StatevectorBackend(0)}
-    planner = PLANNERS.create(planner_name, env=boxed_in, **PLANNERS.applicable(planner_name, options))
-    result = planner.plan([5, 5], [15, 15], 0.5, stall_rounds=9, max_nodes=50)
+    planner = PLANNERS.create(planner_name, **_applicable(planner_name, options))
+    result = planner.plan(posed(boxed_in, start=[5, 5], goal=[15, 15], goal_radius=0.5), stall_rounds=9, max_nodes=50)
     assert result.status == qc.PlanStatus.STALLED
     assert result.metrics.nodes == 0 and result.metrics.rounds == 9
 
@@ -126,14 +135,13 @@ def test_stall_counts_consecutive_rounds_only(clutter):
 
 
 def test_termination_argument_combines_with_the_shorthands(walled):
-    result = qc.RRT(seed=0).plan(walled, [1, 1], [16, 16], 0.5, termination=qc.MaxRounds(30),
-                                         max_oracle_calls=12)
+    result = qc.RRT(seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), termination=qc.MaxRounds(30), max_oracle_calls=12)
     assert result.status == "max_oracle_calls" and result.metrics.rounds == 12
     assert result.settings["termination"] == {"max_rounds": 30, "max_oracle_calls": 12,
                                               "max_nodes": DEFAULT_MAX_NODES}  # budgets: no stall limit
     assert not result.safety_limit and "ended by a limit you set" in result.status_text
     with pytest.raises(TypeError, match="termination must be a TerminationCondition"):
-        qc.RRT().plan(walled, [1, 1], [16, 16], 0.5, termination=30)
+        qc.RRT().plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), termination=30)
 
 
 def test_a_round_limit_is_always_in_force():
@@ -148,7 +156,7 @@ def test_a_round_limit_is_always_in_force():
 
 def test_start_inside_the_goal_ball_is_reached_at_once(clutter):
     start = clutter.start
-    result = qc.RRT(seed=0).plan(clutter, start, start, 0.5, max_rounds=10)
+    result = qc.RRT(seed=0).plan(posed(clutter, start=start, goal=start, goal_radius=0.5), max_rounds=10)
     assert result.status == "reached" and result.metrics.rounds == 0 and result.goal_node == 0
     assert np.array_equal(result.path, start[None])
 
@@ -162,10 +170,10 @@ def test_start_inside_the_goal_ball_is_reached_at_once(clutter):
     ({"max_time_s": True}, TypeError, "max_time_s must be a real number"),
 ])
 def test_bad_limits_are_refused_before_any_work(kwargs, error, message, clutter):
-    planner = qc.RRT(seed=0)
+    problem = clutter.replace(predicate=qc.ExactCheck(clutter.env))
     with pytest.raises(error, match=message):
-        planner.plan(clutter, **kwargs)
-    assert planner.predicate.evaluations == 0
+        qc.RRT(seed=0).plan(problem, **kwargs)
+    assert problem.predicate.evaluations == 0
 
 
 def test_default_stall_ends_a_plan_given_only_a_node_budget(monkeypatch, boxed_in):
@@ -174,7 +182,7 @@ def test_default_stall_ends_a_plan_given_only_a_node_budget(monkeypatch, boxed_i
     from qrrt_circuits.planners import termination
 
     monkeypatch.setattr(termination, "DEFAULT_STALL_ROUNDS", 25)
-    result = qc.RRT(seed=0).plan(boxed_in, [5, 5], [15, 15], 0.5, max_nodes=5)
+    result = qc.RRT(seed=0).plan(posed(boxed_in, start=[5, 5], goal=[15, 15], goal_radius=0.5), max_nodes=5)
     assert result.status == "stalled" and result.metrics.rounds == 25
     assert result.to_dict()["safety_limit"] is True
     assert with_defaults(qc.Stall(3)) == (qc.Stall(3) | qc.MaxRounds(termination.DEFAULT_MAX_ROUNDS)
@@ -206,8 +214,8 @@ def test_a_world_of_1e5_boxes_where_nothing_can_be_added_stalls(planner_name):
     env, start, goal = _tiled()
     assert env.num_boxes > 100_000 and env.is_free(start) and env.is_free(goal)
     options = {"seed": 0, "workers": 2, "num_qubits": 4, "backend": qc.StatevectorBackend(0)}
-    planner = PLANNERS.create(planner_name, env=env, **PLANNERS.applicable(planner_name, options))
-    result = planner.plan(clutter, start, goal, 0.5, max_nodes=3, stall_rounds=4)
+    planner = PLANNERS.create(planner_name, **_applicable(planner_name, options))
+    result = planner.plan(posed(env, start=start, goal=goal, goal_radius=0.5), max_nodes=3, stall_rounds=4)
     assert result.status == "stalled" and result.metrics.nodes == 0 and result.metrics.rounds == 4
 
 
@@ -233,23 +241,22 @@ def test_a_start_on_the_boundary_is_refused_before_any_work(planner_name, start,
     from qrrt_circuits.registry import PLANNERS
 
     options = {"seed": 0, "workers": 2, "num_qubits": 4, "backend": qc.StatevectorBackend(0)}
-    planner = PLANNERS.create(planner_name, env=walled, **PLANNERS.applicable(planner_name, options))
+    planner = PLANNERS.create(planner_name, **_applicable(planner_name, options))
     with pytest.raises(ValueError, match=r"start \[.*\] lies on the workspace boundary .*rejects every motion"):
-        planner.plan(clutter, start, [10, 10], 0.5, max_nodes=5)
-    assert planner.predicate.evaluations == 0
+        planner.plan(posed(walled, start=start, goal=[10, 10], goal_radius=0.5), max_nodes=5)
 
 
 def test_boundary_refusal_follows_the_predicate_and_the_goal():
     env = qc.paper_clutter(seed=0)
     with pytest.raises(ValueError, match=r"start \[0.0, 5.0\] lies on the workspace boundary"):
-        qc.RRT(seed=0).plan(env, start=[0.0, 5.0], max_nodes=5)  # the issue's reproduction
+        qc.RRT(seed=0).plan(posed(env, start=[0.0, 5.0]), max_nodes=5)  # the issue's reproduction
     # the time-sampled check tests points only: a boundary start can leave it, so it is not refused
-    sampled = qc.RRT(seed=0, predicate=qc.TimeSampledCheck(env))
-    assert sampled.plan(env, start=[0.0, 5.0], max_nodes=2).status == "max_nodes"
+    sampled = posed(env, start=[0.0, 5.0], predicate=qc.TimeSampledCheck(env.env))
+    assert qc.RRT(seed=0).plan(sampled, max_nodes=2).status == "max_nodes"
     # a boundary start inside the goal ball is reached at once, not refused
-    assert qc.RRT(seed=0).plan(env, start=[0.0, 5.0], goal=[0.2, 5.0], goal_radius=0.5).status == "reached"
+    assert qc.RRT(seed=0).plan(posed(env, start=[0.0, 5.0], goal=[0.2, 5.0], goal_radius=0.5)).status == "reached"
     with pytest.raises(ValueError, match=r"start \[2.0, 5.0\] is in collision with an obstacle"):
-        qc.RRT(seed=0).plan(env, start=[2.0, 5.0], max_nodes=5)
+        qc.RRT(seed=0).plan(posed(env, start=[2.0, 5.0]), max_nodes=5)
 
 
 @pytest.mark.parametrize("planner_name", ["rrt", "qrrt"])
@@ -259,8 +266,9 @@ def test_a_start_just_inside_the_boundary_margin_ends_stalled(planner_name, wall
     from qrrt_circuits.registry import PLANNERS
 
     options = {"seed": 0, "num_qubits": 4, "backend": qc.StatevectorBackend(0)}
-    planner = PLANNERS.create(planner_name, env=walled, **PLANNERS.applicable(planner_name, options))
-    result = planner.plan(clutter, [1e-7, 5.0], [10, 10], 0.5, max_nodes=5, stall_rounds=20)
+    planner = PLANNERS.create(planner_name, **_applicable(planner_name, options))
+    result = planner.plan(posed(walled, start=[1e-7, 5.0], goal=[10, 10], goal_radius=0.5), max_nodes=5,
+                          stall_rounds=20)
     assert result.status == "stalled" and result.metrics.nodes == 0
 
 
@@ -271,10 +279,10 @@ def test_a_node_limit_is_always_in_force(walled, monkeypatch):
     from qrrt_circuits.planners import termination
 
     monkeypatch.setattr(termination, "DEFAULT_MAX_NODES", 40)
-    result = qc.ParallelRRT(workers=8, seed=0).plan(walled, [1, 1], [16, 16], 0.5)
+    result = qc.ParallelRRT(workers=8, seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5))
     assert result.status == "max_nodes" and 40 <= result.metrics.nodes < 40 + 8
     assert result.settings["termination"]["max_nodes"] == 40
-    own = qc.ParallelRRT(workers=8, seed=0).plan(walled, [1, 1], [16, 16], 0.5, max_nodes=60)
+    own = qc.ParallelRRT(workers=8, seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), max_nodes=60)
     assert own.status == "max_nodes" and 60 <= own.metrics.nodes < 68
     assert own.settings["termination"]["max_nodes"] == 60
 
@@ -298,10 +306,12 @@ def test_limits_whose_tree_or_history_exceed_memory_are_refused_before_any_work(
     monkeypatch.setattr(memory, "available_memory", lambda: (1 << 30, memory.MACHINE_SOURCE))
     planner = qc.RRT(seed=0)
     with pytest.raises(ValueError, match=r"max_rounds = 1000000000: .* the largest max_rounds that fits is about"):
-        planner.plan(walled, clutter, [16, 16], [1, 1], 0.5, max_rounds=10**9, stall_rounds=10**9)
+        planner.plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), max_rounds=10**9,
+                     stall_rounds=10**9)
     with pytest.raises(ValueError, match=r"max_nodes = 1000000000: .* the largest max_nodes that fits is about"):
-        qc.ParallelRRT(workers=4096, seed=0).plan(walled, [1, 1], [16, 16], 0.5, max_nodes=10**9)
-    assert planner.plan(walled, clutter, [16, 16], [1, 1], 0.5, max_rounds=50, stall_rounds=50).metrics.rounds == 50
+        qc.ParallelRRT(workers=4096, seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), max_nodes=10**9)
+    assert planner.plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), max_rounds=50,
+                        stall_rounds=50).metrics.rounds == 50
 
 
 @pytest.mark.parametrize("dim", [2, 4])
@@ -372,9 +382,9 @@ class _OwnLimit(_UserCondition):
 ])
 def test_a_user_condition_with_a_bad_node_limit_is_refused(walled, value, error, message):
     with pytest.raises(error, match=message):
-        qc.RRT(seed=0).plan(walled, [1, 1], [16, 16], 0.5, termination=_OwnLimit(value), max_rounds=30)
+        qc.RRT(seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), termination=_OwnLimit(value), max_rounds=30)
     with pytest.raises(error, match=message):
-        qc.RRT(seed=0).plan(walled, [1, 1], [16, 16], 0.5, termination=_OwnLimit(value) | qc.Stall(5))
+        qc.RRT(seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), termination=_OwnLimit(value) | qc.Stall(5))
 
 
 def test_numpy_limits_are_python_ints_and_the_memory_check_sees_them(walled, monkeypatch):
@@ -388,11 +398,10 @@ def test_numpy_limits_are_python_ints_and_the_memory_check_sees_them(walled, mon
     assert type(limit.limit) is int
     monkeypatch.setattr(memory, "available_memory", lambda: (1 << 30, memory.MACHINE_SOURCE))
     with pytest.raises(ValueError, match="max_rounds = 72057594037927936"):
-        qc.RRT(seed=0).plan(walled, [1, 1], [16, 16], 0.5, termination=limit, max_nodes=5)
+        qc.RRT(seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), termination=limit, max_nodes=5)
     with pytest.raises(ValueError, match="max_nodes = 288230376151711744"):
-        qc.ParallelRRT(workers=4096, seed=0).plan(walled, [1, 1], [16, 16], 0.5,
-                                                          termination=qc.MaxNodes(np.int64(2**58)))
-    result = qc.RRT(seed=0).plan(walled, [1, 1], [16, 16], 0.5, termination=qc.MaxRounds(np.int64(7)))
+        qc.ParallelRRT(workers=4096, seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), termination=qc.MaxNodes(np.int64(2**58)))
+    result = qc.RRT(seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), termination=qc.MaxRounds(np.int64(7)))
     assert result.metrics.rounds == 7 and json.dumps(result.settings["termination"])
 
 
@@ -411,8 +420,7 @@ def test_describe_merges_user_settings_without_comparing_them(walled):
     """Only this module's limits take the smaller value; a user's keys keep the last value (a
     minimum over None or dicts raised after the plan had run)."""
     for first, last in ((None, None), ({"x": 1}, {"x": 2}), ([1], "s")):
-        result = qc.RRT(seed=0).plan(walled, [1, 1], [16, 16], 0.5, max_rounds=5,
-                                             termination=_UserCondition(first) | _UserCondition(last))
+        result = qc.RRT(seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), max_rounds=5, termination=_UserCondition(first) | _UserCondition(last))
         assert result.settings["termination"]["user_note"] == last
 
 
@@ -464,7 +472,7 @@ def test_a_wrapped_condition_ends_a_plan_where_the_condition_does(planner_name, 
     statuses = set()
     for seed, condition in enumerate((qc.MaxNodes(23), qc.MaxRounds(41), qc.Stall(2),
                                       qc.MaxNodes(30) | qc.Stall(4) | qc.MaxRounds(90))):
-        results = [make_planner(planner_name, clutter, seed, "statevector").plan(termination=chosen, goal_radius=1e-9)
+        results = [make_planner(planner_name, seed, "statevector").plan(clutter.with_goal_radius(1e-9), chosen)
                    for chosen in (condition, _EveryRound(condition))]
         fast, every = results
         assert fast.status == every.status
@@ -481,9 +489,9 @@ def test_an_anyof_subclass_with_its_own_test_is_checked_every_round(clutter):
             return qc.PlanStatus.MAX_TIME if progress.rounds >= 7 else super().ended_by(progress)
 
     condition = Cancelled((qc.MaxNodes(500), qc.MaxRounds(1000), qc.Stall(300)))
-    result = qc.RRT(seed=0).plan(clutter, termination=condition, goal_radius=1e-9)
+    result = qc.RRT(seed=0).plan(posed(clutter, goal_radius=1e-9), termination=condition)
     assert result.status == qc.PlanStatus.MAX_TIME and result.metrics.rounds == 7
-    nested = qc.RRT(seed=0).plan(clutter, termination=Cancelled((qc.MaxNodes(500),)), goal_radius=1e-9)
+    nested = qc.RRT(seed=0).plan(posed(clutter, goal_radius=1e-9), termination=Cancelled((qc.MaxNodes(500),)))
     assert nested.status == qc.PlanStatus.MAX_TIME and nested.metrics.rounds == 7  # kept when the defaults are added
 
 
@@ -505,7 +513,7 @@ def test_rounds_that_add_more_nodes_than_the_planners_bound_end_at_the_node_limi
     ends = []
     for condition in (qc.MaxNodes(40), _EveryRound(qc.MaxNodes(40))):
         planner = qc.QRRT(backend=qc.StatevectorBackend(), search_policy=Greedy(0), seed=1)
-        result = planner.plan(walled, clutter, termination=condition, goal_radius=1e-9)
+        result = planner.plan(clutter.with_goal_radius(1e-9), termination=condition)
         ends.append((str(result.status), result.metrics.rounds, result.metrics.nodes))
     assert ends[0] == ends[1] and ends[0][0] == "max_nodes" and ends[0][2] == 40
 
@@ -520,14 +528,14 @@ def test_a_budget_is_never_cut_by_a_safety_limit(monkeypatch, boxed_in, planner)
     monkeypatch.setattr(termination, "DEFAULT_MAX_ROUNDS", 40)
     make = {"RRT": lambda: qc.RRT(seed=0),
             "QRRT": lambda: qc.QRRT(backend=qc.StatevectorBackend(seed=0), num_qubits=3, seed=0)}[planner]
-    result = make().plan([5, 5], [15, 15], 0.5, max_oracle_calls=300)
+    result = make().plan(posed(boxed_in, start=[5, 5], goal=[15, 15], goal_radius=0.5), max_oracle_calls=300)
     assert result.status == "max_oracle_calls" and not result.safety_limit
     assert 300 <= result.metrics.oracle_calls and result.metrics.nodes == 0
     assert result.settings["termination"]["max_rounds"] == 301 and "stall_rounds" not in result.settings["termination"]
-    timed = make().plan([5, 5], [15, 15], 0.5, max_critical_path_calls=100)
+    timed = make().plan(posed(boxed_in, start=[5, 5], goal=[15, 15], goal_radius=0.5), max_critical_path_calls=100)
     assert timed.status == "max_critical_path_calls" and timed.metrics.critical_path_oracle_calls >= 100
     # without a budget the safety limits end it, and say so
-    unbounded = make().plan([5, 5], [15, 15], 0.5, max_nodes=3)
+    unbounded = make().plan(posed(boxed_in, start=[5, 5], goal=[15, 15], goal_radius=0.5), max_nodes=3)
     assert unbounded.status == "stalled" and unbounded.safety_limit and unbounded.metrics.rounds == 25
 
 

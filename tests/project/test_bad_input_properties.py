@@ -16,12 +16,13 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import qrrt_circuits as qc
+from qrrt_circuits.problems.families import box_world
 
 SETTINGS = settings(max_examples=12, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 
-ENV = qc.Environment(np.array([[0.0, 10.0], [0.0, 10.0]]), np.array([[[4.0, 4.0], [5.0, 5.0]]]),
-                     start=[1.0, 1.0], goal=[9.0, 9.0], goal_radius=0.5)
+ENV = qc.Problem.build(qc.Environment(np.array([[0.0, 10.0], [0.0, 10.0]]), np.array([[[4.0, 4.0], [5.0, 5.0]]])),
+                       [1.0, 1.0], [9.0, 9.0], 0.5)
 
 # ------------------------------------------------------------------------------ bad values
 HUGE_INTS = st.sampled_from([10**18, 2**63, 10**40, 10**400])
@@ -77,8 +78,6 @@ def refused(call, *names: str) -> None:
 PLANNER_ARGUMENTS = [
     ("seed", bad_int(0, none_valid=True)),
     ("goal_bias", bad_float(0.0, 1.0).filter(lambda v: not isinstance(v, float) or v != 1.0) | st.just(1.0)),
-    ("resolution", bad_float(0.0, None, open_minimum=True)),
-    ("predicate", st.one_of(st.integers(), st.text(max_size=3), st.just(object()))),
     ("oracle_errors", st.one_of(st.integers(), st.text(max_size=3), st.just(0.1))),
 ]
 
@@ -90,7 +89,7 @@ PLANNER_ARGUMENTS = [
 def test_planner_arguments(planner, name, values, data):
     value = data.draw(values)
     extra = {"backend": qc.StatevectorBackend(0), "num_qubits": 4} if planner in (qc.QRRT, qc.PQRRT) else {}
-    refused(lambda: planner(ENV, **extra, **{name: value}), name)
+    refused(lambda: planner(**extra, **{name: value}), name)
 
 
 QUANTUM_ARGUMENTS = [
@@ -169,11 +168,11 @@ CALLS = {
         st.none(), st.integers(), st.floats(), st.text(min_size=1, max_size=3), st.just([[1, 2]]),
         st.just([[[5, 5], [4, 4]]]), st.just([[[1, 1, 1], [2, 2, 2]]]), st.just([[[math.nan, 1], [2, 2]]])),
         "boxes"),
-    "Environment.start": (lambda v: qc.Environment([[0, 10], [0, 10]], [], start=v), st.one_of(
+    "Problem.start": (lambda v: qc.Problem.build(ENV.env, v, [9.0, 9.0], 0.5), st.one_of(
         st.text(min_size=1, max_size=3), st.just([1.0]), st.just([1, 2, 3]), st.tuples(NON_FINITE, st.just(1.0))),
         "start"),
-    "Environment.goal_radius": (lambda v: qc.Environment([[0, 10], [0, 10]], [], goal_radius=v),
-                                bad_float(0.0, None, open_minimum=True, none_valid=True), "goal_radius"),
+    "Problem.goal_radius": (lambda v: qc.Problem.build(ENV.env, [1.0, 1.0], [9.0, 9.0], v),
+                            bad_float(0.0, None, open_minimum=True), "goal_radius"),
     "LinearTrackingDynamics.horizon": (lambda v: qc.LinearTrackingDynamics(-np.eye(2), np.eye(2), np.eye(2),
                                                                            horizon=v),
                                        bad_float(0.0, None, open_minimum=True), "horizon"),
@@ -194,10 +193,26 @@ def test_constructor_arguments(key, data):
 
 
 # ------------------------------------------------------------------------------ plan
-PLAN_ARGUMENTS = [
+PROBLEM_ARGUMENTS = [
     ("start", bad_point()),
     ("goal", bad_point()),
-    ("goal_radius", bad_float(0.0, None, open_minimum=True, none_valid=True)),
+    ("goal_radius", bad_float(0.0, None, open_minimum=True)),
+    ("resolution", bad_float(0.0, None, open_minimum=True)),
+    ("predicate", st.one_of(st.integers(), st.text(max_size=3), st.just(object()))),
+    ("space", st.one_of(st.integers(), st.text(max_size=3), st.just(qc.SE2Space()))),
+]
+
+
+@pytest.mark.parametrize("name, values", PROBLEM_ARGUMENTS, ids=[a for a, _ in PROBLEM_ARGUMENTS])
+@SETTINGS
+@given(data=st.data())
+def test_problem_arguments_refused_when_built(name, values, data):
+    value = data.draw(values)
+    arguments = {"start": [1.0, 1.0], "goal": [9.0, 9.0], "goal_radius": 0.5} | {name: value}
+    refused(lambda: qc.Problem.build(ENV.env, **arguments), name, "dimension mismatch")
+
+
+PLAN_ARGUMENTS = [
     ("max_nodes", bad_int(1, none_valid=True)),
     ("max_oracle_calls", bad_int(1, none_valid=True)),
     ("max_rounds", bad_int(1, none_valid=True)),
@@ -216,9 +231,10 @@ PLAN_ARGUMENTS = [
 def test_plan_arguments_refused_before_any_work(make, name, values, data):
     planner = make()
     value = data.draw(values)
+    problem = ENV.replace(predicate=qc.ExactCheck(ENV.env))
     budget = {} if name in ("max_rounds",) else {"max_rounds": 3}
-    refused(lambda: planner.plan(**budget, **{name: value}), name, "dimension mismatch")
-    assert planner.predicate.evaluations == 0
+    refused(lambda: planner.plan(problem, **budget, **{name: value}), name)
+    assert problem.predicate.evaluations == 0
 
 
 # ------------------------------------------------------------------------------ search
@@ -240,7 +256,7 @@ def test_search_arguments(backend, data):
 
 
 # ------------------------------------------------------------------------------ scenario files
-VALID = ENV.to_dict()
+VALID = ENV.env.to_dict() | {"start": [1.0, 1.0], "goal": [9.0, 9.0], "goal_radius": 0.5}
 JSON_VALUES = st.recursive(
     st.one_of(st.none(), st.booleans(), st.integers(min_value=-10**400, max_value=10**400), st.floats(),
               st.text(max_size=4)),
@@ -258,17 +274,13 @@ def test_scenario_file_fields(field, value):
         path = Path(folder) / "world.json"
         path.write_text(json.dumps(data))
         try:
-            env = qc.Environment.load(path)
+            problem = box_world(path)
         except (ValueError, TypeError) as exc:
             assert str(path) in str(exc) and field in str(exc), str(exc)
             return
-    # accepted: then it is a valid world that plans (under a small budget) without another error
-    assert env.dim == 2
-    if env.start is not None and env.goal is not None and env.goal_radius is not None:
-        try:
-            qc.RRT(seed=0).plan(env, max_rounds=3)
-        except ValueError as exc:
-            assert "start" in str(exc) or "goal" in str(exc)
+    # accepted: then it is a valid problem that plans (under a small budget) without another error
+    assert problem.dim == 2
+    qc.RRT(seed=0).plan(problem, max_rounds=3)
 
 
 @SETTINGS

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import qrrt_circuits as qc
+from planner_checks import posed
 from qrrt_circuits.reachability.dynamics import LinearTrackingDynamics
 
 ENV = qc.paper_clutter(seed=0)
@@ -11,7 +12,7 @@ ENV = qc.paper_clutter(seed=0)
 CASES = {
     "goal_bias": lambda v: qc.RRT(goal_bias=v),
     "resolution": lambda v: qc.ExactCheck(ENV, resolution=v),
-    "goal_radius": lambda v: qc.RRT(seed=0).plan(ENV, goal_radius=v, max_rounds=1),
+    "goal_radius": lambda v: qc.RRT(seed=0).plan(posed(ENV, goal_radius=v), max_rounds=1),
     "max_time_s": lambda v: qc.RRT(seed=0).plan(ENV, max_time_s=v, max_rounds=1),
     "MaxWallTime": lambda v: qc.MaxWallTime(v),
     "false_positive": lambda v: qc.OracleErrorModel(false_positive=v),

@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 import qrrt_circuits as qc
+from planner_checks import posed
 
 ROOT = Path(qc.__file__).resolve().parent
 
@@ -126,4 +127,4 @@ def test_old_arguments_and_attributes_are_gone(env):
     assert planner.predicate is predicate and not hasattr(planner, "oracle")
     assert not hasattr(planner, "iterations_policy") and not hasattr(predicate, "check")
     assert not hasattr(qc.PaperIterations().start(256), "iterations")
-    assert not hasattr(qc.RRT(seed=0).plan(env, max_rounds=3, goal_radius=1e-9), "budget_exhausted")
+    assert not hasattr(qc.RRT(seed=0).plan(posed(env, goal_radius=1e-9), max_rounds=3), "budget_exhausted")

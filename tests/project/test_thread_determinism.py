@@ -7,6 +7,7 @@ import pytest
 from conftest import ALL_BACKENDS, make_backend
 
 import qrrt_circuits as qc
+from planner_checks import posed
 
 
 @pytest.mark.parametrize("backend_name", ALL_BACKENDS)
@@ -17,7 +18,7 @@ def test_unshared_pqrrt_on_threads_plans_as_in_process(backend_name):
         planner = qc.PQRRT(backend=make_backend(backend_name, 11), num_qubits=4, workers=6,
                            shared_database=False, search_policy=qc.FixedIterations(1), seed=7,
                            executor=executor)
-        plans.append(planner.plan(env, max_rounds=4, goal_radius=1e-9))
+        plans.append(planner.plan(posed(env, goal_radius=1e-9), max_rounds=4))
         if executor is not None:
             executor.shutdown()
     serial = plans[0]

@@ -7,6 +7,7 @@ from conftest import BACKENDS, make_backend
 from reference import penetration_and_clearance
 
 import qrrt_circuits as qc
+from planner_checks import posed
 from qrrt_circuits.plotting import edge_curves, plan_dynamics
 from qrrt_circuits.reachability.predicate import check_predicate
 from qrrt_circuits.registry import PLANNERS
@@ -79,7 +80,7 @@ def test_a_user_predicate_in_three_dimensions():
     env = qc.Environment(np.array([[0, 10]] * 3, dtype=float), np.stack([lower, lower + 0.8], axis=1))
     start, goal = env.sample_free(2, rng)
     result = qc.QRRT(backend=qc.StatevectorBackend(0), num_qubits=6, predicate=StraightLine(env),
-                     seed=0).plan(env, start, goal, 1.0, max_nodes=25)
+                     seed=0).plan(posed(env, start=start, goal=goal, goal_radius=1.0), max_nodes=25)
     assert result.nodes.shape[1] == 3 and result.metrics.nodes >= 1
     curves = edge_curves(result.nodes, result.parents, None, samples=5)
     # straight edges: the middle sample is the midpoint of parent and child
@@ -182,13 +183,11 @@ def test_a_user_predicates_own_validity_and_space_are_respected():
         def bounds(self):
             return np.array([[0.0, 10.0], [0.0, 10.0]])
 
-    env = qc.Environment(np.array([[0.0, 10.0], [0.0, 10.0]]), np.zeros((0, 2, 2)), start=[3, 3.5], goal=[9, 9],
-                         goal_radius=0.5)
+    env = qc.Problem.build(qc.Environment(np.array([[0.0, 10.0], [0.0, 10.0]]), np.zeros((0, 2, 2))), [3, 3.5], [9, 9], 0.5)
     with pytest.raises(ValueError, match=r"start \[3.0, 3.5\] is not a valid state: the disc check"):
         qc.RRT(predicate=Disc(), seed=0).plan(env, max_nodes=2)
-    assert qc.RRT(predicate=Disc(), seed=0).plan(env, start=[6, 6], max_nodes=2).metrics.nodes == 2
-    wide = qc.Environment(np.array([[0.0, 12.0], [0.0, 10.0]]), np.zeros((0, 2, 2)), start=[6, 6], goal=[9, 9],
-                          goal_radius=0.5)
+    assert qc.RRT(predicate=Disc(), seed=0).plan(posed(env, start=[6, 6]), max_nodes=2).metrics.nodes == 2
+    wide = qc.Problem.build(qc.Environment(np.array([[0.0, 12.0], [0.0, 10.0]]), np.zeros((0, 2, 2))), [6, 6], [9, 9], 0.5)
     with pytest.raises(ValueError, match=r"reach outside the disc check's state space"):
         qc.RRT(predicate=Disc(), seed=0)
 
@@ -197,4 +196,4 @@ def test_a_user_predicates_own_validity_and_space_are_respected():
             return np.ones(len(points) + 1, dtype=bool)
 
     with pytest.raises(ValueError, match="disc.is_valid must return 1 booleans for 1 points"):
-        qc.RRT(predicate=Miscounting(), seed=0).plan(env, start=[6, 6], max_nodes=2)
+        qc.RRT(predicate=Miscounting(), seed=0).plan(posed(env, start=[6, 6]), max_nodes=2)

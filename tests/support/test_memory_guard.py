@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import qrrt_circuits as qc
+from planner_checks import posed
 from qrrt_circuits import cli
 from qrrt_circuits._support import memory
 
@@ -274,8 +275,7 @@ for axis in range(dim):  # a wall around the corner cube [16, 20]^d: the goal (1
 env = qc.Environment(np.array([[0.0, 20.0]] * dim), np.array(boxes))
 dynamics = None if dim == 2 else qc.LinearTrackingDynamics(-np.eye(dim), np.eye(dim), np.eye(dim))
 def plan(workers, **limits):
-    return qc.ParallelRRT(workers=workers, seed=0, dynamics=dynamics).plan(env, 
-        np.full(dim, 2.0), np.full(dim, 18.0), 0.5, **limits)
+    return qc.ParallelRRT(workers=workers, seed=0, dynamics=dynamics).plan(posed(env, start=np.full(dim, 2.0), goal=np.full(dim, 18.0), goal_radius=0.5), **limits)
 plan(8, max_rounds=3)  # compiled code loaded before the measurement,
 plan(64, max_nodes=1000)  # the nearest-node grid's too (from 400 nodes): compiled inside it on a cold cache
 results = []

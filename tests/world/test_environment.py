@@ -6,6 +6,7 @@ import pytest
 from tolerances import z_bound
 
 import qrrt_circuits as qc
+from planner_checks import posed
 from qrrt_circuits.world.environment import Environment
 
 
@@ -92,8 +93,7 @@ def test_bounds_refuse_booleans_and_strings_that_numpy_would_read_as_numbers(val
 
 
 def test_integer_and_float_arrays_of_any_width_are_accepted():
-    env = Environment(np.array([[0, 10], [0, 10]], dtype=np.int32), [[[1, 1], [2.5, 2.5]]],
-                      start=np.array([0.5, 0.5], dtype=np.float32), goal=(9, 9), goal_radius=1)
+    env = qc.Problem.build(Environment(np.array([[0, 10], [0, 10]], dtype=np.int32), [[[1, 1], [2.5, 2.5]]]), np.array([0.5, 0.5], dtype=np.float32), (9, 9), 1)
     assert env.bounds.dtype == float and env.boxes.tolist() == [[[1.0, 1.0], [2.5, 2.5]]]
 
 
@@ -102,7 +102,7 @@ def test_a_plan_refuses_a_start_of_booleans_or_strings(clutter, start):
     import qrrt_circuits as qc
 
     with pytest.raises(ValueError, match="start must be 2 numbers"):
-        qc.RRT(seed=0).plan(clutter, start=start, max_nodes=2)
+        qc.RRT(seed=0).plan(posed(clutter, start=start), max_nodes=2)
 
 
 def test_not_json_is_rejected(tmp_path):

@@ -24,6 +24,7 @@ import numpy as np
 import pytest
 
 import qrrt_circuits as qc
+from planner_checks import posed
 from qrrt_circuits.plotting import plan_dynamics
 from qrrt_circuits.reachability.grid_check import EPSILON
 from qrrt_circuits.world.image import MAX_CELLS
@@ -467,7 +468,7 @@ def test_image_world_refuses_a_start_or_goal_off_the_free_cells(maze_world, tmp_
 def test_planners_refuse_a_start_in_an_occupied_cell(maze_world):
     env, check = maze_world
     with pytest.raises(ValueError, match=r"start \[0.25, 0.25\] is not a valid state: the grid check"):
-        qc.RRT(predicate=check, seed=0).plan(env, start=[0.25, 0.25], max_nodes=5)
+        qc.RRT(predicate=check, seed=0).plan(posed(env, start=[0.25, 0.25]), max_nodes=5)
 
 
 # ----------------------------------------------------------------------------- bad input

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import qrrt_circuits as qc
+from planner_checks import posed
 from qrrt_circuits.problems.families import (
     load_problem,
     narrow_passage,
@@ -56,8 +57,7 @@ def test_families_are_solved_by_rrt_and_q_rrt(make):
 def test_the_se2_gap_problem_plans_in_se2():
     problem = se2_gap()
     assert problem.space.describe()["kind"] == "SE2" and problem.env.dim == 3
-    result = qc.RRT(seed=1, max_extension=1.0, **problem.planner_options()).plan(problem.env, 
-        goal=problem.goal, max_oracle_calls=20000)
+    result = qc.RRT(seed=1, max_extension=1.0, **problem.planner_options()).plan(posed(problem.env, goal=problem.goal), max_oracle_calls=20000)
     assert result.reached and problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
 
 
@@ -146,8 +146,7 @@ def test_an_image_problem_file_plans_on_its_grid(tmp_path):
                   goal_radius=0.5)
     problem = load_problem(path)
     assert problem.env.bounds.tolist() == [[0.0, 10.0], [0.0, 10.0]]
-    result = qc.RRT(seed=0, goal_bias=0.05, **problem.planner_options()).plan(problem.env, 
-        goal=problem.goal, max_oracle_calls=20000)
+    result = qc.RRT(seed=0, goal_bias=0.05, **problem.planner_options()).plan(posed(problem.env, goal=problem.goal), max_oracle_calls=20000)
     assert result.reached and problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
     with pytest.raises(ValueError, match='family "image" needs'):
         load_problem(_write(tmp_path, family="image", image="door.png"))
@@ -218,8 +217,7 @@ def test_the_shortcut_keeps_checked_motions_and_never_lengthens():
     from qrrt_circuits.planners.paths import path_length, shortcut
 
     problem = narrow_passage(2, 0.5)
-    result = qc.RRT(seed=3, goal_bias=0.05, max_extension=1.0, **problem.planner_options()).plan(problem.env, 
-        goal=problem.goal, max_oracle_calls=20000)
+    result = qc.RRT(seed=3, goal_bias=0.05, max_extension=1.0, **problem.planner_options()).plan(posed(problem.env, goal=problem.goal), max_oracle_calls=20000)
     assert result.reached
     short = shortcut(result.path, problem.predicate)
     assert np.array_equal(short[0], result.path[0]) and np.array_equal(short[-1], result.path[-1])
@@ -273,7 +271,7 @@ def test_the_winding_band_is_solved_by_q_rrt_within_a_budget():
         problem = winding_band(2, 0.2, seed)
         planner = qc.QRRT(backend=qc.StatevectorBackend(seed=seed), num_qubits=8, seed=seed,
                           goal_bias=0.05, search_policy=qc.Adaptive(), **problem.planner_options())
-        result = planner.plan(problem.env, goal=problem.goal, max_oracle_calls=20000)
+        result = planner.plan(posed(problem.env, goal=problem.goal), max_oracle_calls=20000)
         solved += int(result.reached)
         assert problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
     assert solved >= 4

@@ -76,7 +76,7 @@ class ShortMoves:
 ])
 def test_planners_plan_in_se2(make):
     bounds = np.array([[0.0, 10.0], [0.0, 10.0], [-PI, PI]])
-    env = qc.Environment(bounds, np.zeros((0, 2, 3)), start=[1, 1, 0], goal=[9, 9, 3.0], goal_radius=1.0)
+    env = qc.Problem.build(qc.Environment(bounds, np.zeros((0, 2, 3))), [1, 1, 0], [9, 9, 3.0], 1.0)
     result = make(env).plan(max_oracle_calls=5000)
     assert result.reached and result.settings["space"] == {"kind": "SE2", "angle_weight": 0.5}
     steps = qc.SE2Space().distance(result.nodes[result.parents[1:]], result.nodes[1:])

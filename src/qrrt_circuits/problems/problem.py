@@ -204,7 +204,8 @@ class Problem:
         else:
             if goal_radius is None:
                 raise ValueError("goal_radius is required with a goal point (a ball's radius, > 0)")
-            region = GoalBall(goal, check_float(goal_radius, "goal_radius", 0.0, open_minimum=True))
+            region = GoalBall(_checked_point("goal", goal, env, predicate),
+                              check_float(goal_radius, "goal_radius", 0.0, open_minimum=True))
         return cls(env, start, region, predicate, RealVectorSpace(env.dim) if space is None else space, name)
 
     @property
