@@ -6,10 +6,9 @@ none. ``.ci/run`` builds the docs *before* it runs the test suite, so in CI the 
 on a build of the same commit.
 
 The names checked: every name of ``qrrt_circuits.__all__``; every public name of the public
-submodules in it (``probability``, ``registry``, ``scenarios``, ``termination``, ``circuits``);
-every ``qc.NAME`` of the code blocks of DESIGN §3 and §7 (the public contract), the functions its
-§3 lists by name, and the attributes its code reads from the objects it builds (``env.bounds``,
-``res.indices``, ``result.path``, ...).
+submodules in it (``probability``, ``registry``); every ``qc.NAME`` of the code blocks of DESIGN §3
+and §7 (the public contract), the functions its §3 lists by name, and the attributes its code reads
+from the objects it builds (``problem.env``, ``env.bounds``, ``res.indices``, ``result.path``, ...).
 """
 
 from __future__ import annotations
@@ -35,6 +34,7 @@ DESIGN = ROOT / "docs" / "DESIGN.md"
 
 #: the variables of DESIGN's code blocks and the class of the object each one holds
 DESIGN_VARIABLES = {
+    "problem": "Problem",
     "env": "Environment",
     "dyn": "LinearTrackingDynamics",
     "oracle": "ExactCheck",
@@ -134,7 +134,7 @@ def public_paths() -> list[str]:
 def test_design_contract_is_parsed():
     """Guard against the parser silently finding nothing (e.g. after a DESIGN reformat)."""
     paths = contract_paths()
-    for expected in ("PQRRT", "scenarios.paper_clutter", "circuits.grover_circuit", "probability.prob_all_same",
+    for expected in ("PQRRT", "paper_clutter", "Problem.build", "Problem.with_goal_radius", "probability.prob_all_same",
                      "PlanResult.path", "SearchResult.indices", "registry.PLANNERS.create"):
         assert expected in paths, (expected, paths)
 
