@@ -11,7 +11,14 @@ import qrrt_circuits as qc
 
 @pytest.fixture(scope="session")
 def clutter():
+    """The paper's clutter problem (world seed 0)."""
     return qc.paper_clutter(seed=0)
+
+
+@pytest.fixture(scope="session")
+def clutter_world(clutter):
+    """Its world: the 20 x 20 environment with 525 boxes."""
+    return clutter.env
 
 
 def make_backend(name: str, seed: int):

@@ -67,5 +67,5 @@ def test_horizon_outside_its_range_is_refused(horizon):
 
 def test_the_longest_horizon_builds_an_exact_check(clutter):
     dynamics = qc.LinearTrackingDynamics.paper(horizon=1e6)
-    oracle = qc.ExactCheck(clutter, dynamics)
+    oracle = qc.ExactCheck(clutter.env, dynamics)
     assert oracle.reachable(np.array([[1.0, 1.0]]), np.array([[1.5, 1.2]])).shape == (1,)

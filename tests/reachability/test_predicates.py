@@ -51,11 +51,11 @@ def segment_depth(env, parent, child, spacing=0.001):
 @pytest.mark.parametrize("backend_name", BACKENDS)
 @pytest.mark.parametrize("planner_name", list(PLANNERS))
 def test_a_user_predicate_plans_with_every_planner_and_backend(planner_name, backend_name, clutter):
-    predicate = StraightLine(clutter)
-    options = {"seed": 4, "workers": 3, "num_qubits": 6, "backend": make_backend(backend_name, 4),
-               "predicate": predicate}
-    planner = PLANNERS.create(planner_name, env=clutter, **PLANNERS.applicable(planner_name, options))
-    result = planner.plan(max_nodes=15)
+    predicate = StraightLine(clutter.env)
+    options = {"seed": 4, "workers": 3, "num_qubits": 6, "backend": make_backend(backend_name, 4)}
+    takes = PLANNERS.resolve(planner_name).options()
+    planner = PLANNERS.create(planner_name, **{key: value for key, value in options.items() if key in takes})
+    result = planner.plan(clutter.replace(predicate=predicate), max_nodes=15)
     assert result.metrics.nodes >= 15 and result.settings["predicate"] == predicate.describe()
     assert result.settings["dynamics"] is None and plan_dynamics(result) is None
     # classical planners evaluate the predicate once per test (plus the tests they made ahead for
@@ -71,7 +71,7 @@ def test_a_user_predicate_plans_with_every_planner_and_backend(planner_name, bac
     assert predicate.reachable(result.nodes[parents], result.nodes[children]).all()
     # the predicate samples every 0.01, so an edge may clip a corner by less than that, never more
     for child, parent in zip(children, parents, strict=True):
-        assert segment_depth(clutter, result.nodes[parent], result.nodes[child]) <= predicate.spacing
+        assert segment_depth(clutter.env, result.nodes[parent], result.nodes[child]) <= predicate.spacing
 
 
 def test_a_user_predicate_in_three_dimensions():
@@ -79,8 +79,8 @@ def test_a_user_predicate_in_three_dimensions():
     lower = rng.uniform(0, 9, size=(40, 3))
     env = qc.Environment(np.array([[0, 10]] * 3, dtype=float), np.stack([lower, lower + 0.8], axis=1))
     start, goal = env.sample_free(2, rng)
-    result = qc.QRRT(backend=qc.StatevectorBackend(0), num_qubits=6, predicate=StraightLine(env),
-                     seed=0).plan(posed(env, start=start, goal=goal, goal_radius=1.0), max_nodes=25)
+    result = qc.QRRT(backend=qc.StatevectorBackend(0), num_qubits=6, seed=0).plan(
+        posed(env, start=start, goal=goal, goal_radius=1.0, predicate=StraightLine(env)), max_nodes=25)
     assert result.nodes.shape[1] == 3 and result.metrics.nodes >= 1
     curves = edge_curves(result.nodes, result.parents, None, samples=5)
     # straight edges: the middle sample is the midpoint of parent and child
@@ -90,20 +90,21 @@ def test_a_user_predicate_in_three_dimensions():
 
 
 def test_builtin_predicates_describe_themselves(clutter):
-    exact = qc.ExactCheck(clutter)
+    exact = qc.ExactCheck(clutter.env)
     assert check_predicate(exact, 2) is exact
     description = exact.describe()
     assert description["name"] == "exact" and description["resolution"] == 0.01 and description["sound"]
     assert qc.LinearTrackingDynamics.from_description(description["dynamics"]).describe() == \
         qc.LinearTrackingDynamics.paper().describe()
-    sampled = qc.TimeSampledCheck(clutter, time_samples=30)
+    sampled = qc.TimeSampledCheck(clutter.env, time_samples=30)
     assert sampled.describe()["sound"] is False and sampled.describe()["time_samples"] == 30
     assert isinstance(sampled, qc.ReachabilityPredicate)
 
 
 def test_planner_records_the_dynamics_its_predicate_follows(clutter):
     dynamics = qc.LinearTrackingDynamics(np.diag([-1.0, -2.0]), np.eye(2), np.zeros((2, 2)))
-    result = qc.RRT(dynamics=dynamics, seed=0).plan(clutter, max_nodes=3)
+    problem = qc.Problem.build(clutter.env, clutter.start, clutter.goal, dynamics=dynamics)
+    result = qc.RRT(seed=0).plan(problem, max_nodes=3)
     assert plan_dynamics(result).describe() == dynamics.describe()
 
 
@@ -116,12 +117,20 @@ class NoName:
 
 def test_bad_predicates_are_refused_with_the_reason(clutter):
     with pytest.raises(TypeError, match="lacks name, describe"):
-        qc.RRT(predicate=NoName())
+        clutter.replace(predicate=NoName())
     env3 = qc.Environment(np.array([[0, 1]] * 3, dtype=float), np.zeros((0, 2, 3)))
     with pytest.raises(ValueError, match="dimension mismatch: the predicate works in d = 3"):
-        qc.RRT(predicate=StraightLine(env3))
+        clutter.replace(predicate=StraightLine(env3))
     with pytest.raises(ValueError, match="give dynamics= or predicate=, not both"):
-        qc.RRT(predicate=StraightLine(clutter), dynamics=qc.LinearTrackingDynamics.paper())
+        qc.Problem.build(clutter.env, clutter.start, clutter.goal, predicate=StraightLine(clutter.env),
+                         dynamics=qc.LinearTrackingDynamics.paper())
+
+    class WordyDescription(StraightLine):
+        def describe(self):
+            return "a straight line"
+
+    with pytest.raises(TypeError, match=r"predicate.describe\(\) must return a dict"):  # before any plan
+        clutter.replace(predicate=WordyDescription(clutter.env))
 
 
 @pytest.mark.parametrize("time_samples", [7, 30])
@@ -129,10 +138,10 @@ def test_time_sampled_check_in_chunks_answers_as_in_one_piece(clutter, time_samp
     from qrrt_circuits.reachability import time_sampled
 
     rng = np.random.default_rng(3)
-    parents, children = clutter.sample_free(301, rng), clutter.sample_uniform(301, rng)
-    whole = qc.TimeSampledCheck(clutter, time_samples=time_samples).reachable(parents, children)
+    parents, children = clutter.env.sample_free(301, rng), clutter.env.sample_uniform(301, rng)
+    whole = qc.TimeSampledCheck(clutter.env, time_samples=time_samples).reachable(parents, children)
     monkeypatch.setattr(time_sampled, "CHUNK_COORDINATES", 2 * (3 * time_samples + 1))  # 3 pairs a chunk, a remainder
-    chunked = qc.TimeSampledCheck(clutter, time_samples=time_samples)
+    chunked = qc.TimeSampledCheck(clutter.env, time_samples=time_samples)
     assert np.array_equal(chunked.reachable(parents, children), whole)
     assert chunked.evaluations == 301 and 0 < whole.sum() < 301
 
@@ -142,8 +151,8 @@ def test_time_sampled_check_memory_does_not_grow_with_pairs_times_samples(clutte
     import tracemalloc
 
     rng = np.random.default_rng(4)
-    parents, children = clutter.sample_free(128, rng), clutter.sample_uniform(128, rng)
-    check = qc.TimeSampledCheck(clutter, time_samples=100_000)
+    parents, children = clutter.env.sample_free(128, rng), clutter.env.sample_uniform(128, rng)
+    check = qc.TimeSampledCheck(clutter.env, time_samples=100_000)
     tracemalloc.start()
     try:
         check.reachable(parents, children)
@@ -183,17 +192,18 @@ def test_a_user_predicates_own_validity_and_space_are_respected():
         def bounds(self):
             return np.array([[0.0, 10.0], [0.0, 10.0]])
 
-    env = qc.Problem.build(qc.Environment(np.array([[0.0, 10.0], [0.0, 10.0]]), np.zeros((0, 2, 2))), [3, 3.5], [9, 9], 0.5)
+    env = qc.Environment(np.array([[0.0, 10.0], [0.0, 10.0]]), np.zeros((0, 2, 2)))
     with pytest.raises(ValueError, match=r"start \[3.0, 3.5\] is not a valid state: the disc check"):
-        qc.RRT(predicate=Disc(), seed=0).plan(env, max_nodes=2)
-    assert qc.RRT(predicate=Disc(), seed=0).plan(posed(env, start=[6, 6]), max_nodes=2).metrics.nodes == 2
-    wide = qc.Problem.build(qc.Environment(np.array([[0.0, 12.0], [0.0, 10.0]]), np.zeros((0, 2, 2))), [6, 6], [9, 9], 0.5)
+        posed(env, start=[3, 3.5], goal=[9, 9], goal_radius=0.5, predicate=Disc())
+    problem = posed(env, start=[6, 6], goal=[9, 9], goal_radius=0.5, predicate=Disc())
+    assert qc.RRT(seed=0).plan(problem, max_nodes=2).metrics.nodes == 2
+    wide = qc.Environment(np.array([[0.0, 12.0], [0.0, 10.0]]), np.zeros((0, 2, 2)))
     with pytest.raises(ValueError, match=r"reach outside the disc check's state space"):
-        qc.RRT(predicate=Disc(), seed=0)
+        posed(wide, start=[6, 6], goal=[9, 9], goal_radius=0.5, predicate=Disc())
 
     class Miscounting(Disc):
         def is_valid(self, points):
             return np.ones(len(points) + 1, dtype=bool)
 
     with pytest.raises(ValueError, match="disc.is_valid must return 1 booleans for 1 points"):
-        qc.RRT(predicate=Miscounting(), seed=0).plan(posed(env, start=[6, 6]), max_nodes=2)
+        posed(env, start=[6, 6], goal=[9, 9], goal_radius=0.5, predicate=Miscounting())

@@ -79,13 +79,13 @@ def test_the_motion_check_is_sound_and_rejects_only_near_contacts():
 def test_q_rrt_turns_the_body_through_the_gap():
     """The 1.2 x 0.4 body plans through the 1.2-wide gap: 4 of 5 seeds or more reach the goal within
     the budget, every path crosses the wall's x, and every edge re-checks."""
-    env, check = se2_world(WORKSPACE, WALL, (0.6, 0.2), start=[2, 2, math.pi / 2], goal=[8, 8, 0.0],
-                           goal_radius=1.0, resolution=0.05)
+    env, check = se2_world(WORKSPACE, WALL, (0.6, 0.2), resolution=0.05)
+    problem = qc.Problem.build(env, [2, 2, math.pi / 2], [8, 8, 0.0], 1.0, predicate=check, space=SE2Space())
     reached = 0
     for seed in range(5):
-        planner = qc.QRRT(predicate=check, space=SE2Space(), backend=qc.StatevectorBackend(seed=seed),
-                          num_qubits=6, seed=seed, max_extension=1.0, search_policy=qc.Adaptive())
-        result = planner.plan(env, max_oracle_calls=6000)
+        planner = qc.QRRT(backend=qc.StatevectorBackend(seed=seed), num_qubits=6, seed=seed, max_extension=1.0,
+                          search_policy=qc.Adaptive())
+        result = planner.plan(problem, max_oracle_calls=6000)
         assert check.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
         if result.reached:
             reached += 1
@@ -109,6 +109,6 @@ def test_bad_rigid_bodies_are_refused(kwargs, message):
 
 
 def test_a_start_where_the_body_overlaps_the_wall_is_refused():
-    env, check = se2_world(WORKSPACE, WALL, (0.6, 0.2), start=[5.0, 2.0, 0.0], goal=[8, 8, 0.0], goal_radius=1.0)
+    env, check = se2_world(WORKSPACE, WALL, (0.6, 0.2))
     with pytest.raises(ValueError, match=r"start \[5.0, 2.0, 0.0\] is not a valid state"):
-        qc.RRT(predicate=check, space=SE2Space(), seed=0).plan(env, max_rounds=3)
+        qc.Problem.build(env, [5.0, 2.0, 0.0], [8, 8, 0.0], 1.0, predicate=check, space=SE2Space())
