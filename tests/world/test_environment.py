@@ -7,21 +7,23 @@ from tolerances import z_bound
 
 import qrrt_circuits as qc
 from planner_checks import posed
+from qrrt_circuits.problems import scenarios
+from qrrt_circuits.problems.families import box_world, save_box_world
 from qrrt_circuits.world.environment import Environment
 
 
-def test_is_free_matches_brute_force(clutter):
+def test_is_free_matches_brute_force(clutter_world):
     rng = np.random.default_rng(123)
-    points = clutter.sample_uniform(3000, rng)
-    lo, hi = clutter.boxes[:, 0], clutter.boxes[:, 1]
+    points = clutter_world.sample_uniform(3000, rng)
+    lo, hi = clutter_world.boxes[:, 0], clutter_world.boxes[:, 1]
     inside = np.any(np.all((points[:, None] >= lo) & (points[:, None] <= hi), axis=2), axis=1)
-    assert np.array_equal(clutter.is_free(points), ~inside)
+    assert np.array_equal(clutter_world.is_free(points), ~inside)
 
 
-def test_is_free_keeps_leading_shape_and_rejects_out_of_bounds(clutter):
+def test_is_free_keeps_leading_shape_and_rejects_out_of_bounds(clutter_world):
     points = np.zeros((3, 4, 2)) - 1.0
-    assert clutter.is_free(points).shape == (3, 4)
-    assert not clutter.is_free(points).any()
+    assert clutter_world.is_free(points).shape == (3, 4)
+    assert not clutter_world.is_free(points).any()
 
 
 def test_box_boundary_is_in_collision():
@@ -30,22 +32,25 @@ def test_box_boundary_is_in_collision():
     assert env.is_free(np.array([4.0 + 1e-9, 3.0]))
 
 
-def test_sample_free_is_free_and_seeded(clutter):
-    a = clutter.sample_free(500, np.random.default_rng(5))
-    b = clutter.sample_free(500, np.random.default_rng(5))
+def test_sample_free_is_free_and_seeded(clutter_world):
+    a = clutter_world.sample_free(500, np.random.default_rng(5))
+    b = clutter_world.sample_free(500, np.random.default_rng(5))
     assert a.shape == (500, 2)
-    assert clutter.is_free(a).all()
+    assert clutter_world.is_free(a).all()
     assert np.array_equal(a, b)
 
 
 def test_json_round_trip(tmp_path, clutter):
-    path = clutter.save(tmp_path / "world.json")
+    path = clutter.env.save(tmp_path / "world.json")
     loaded = Environment.load(path)
-    assert np.array_equal(loaded.bounds, clutter.bounds)
-    assert np.array_equal(loaded.boxes, clutter.boxes)
-    assert np.array_equal(loaded.start, clutter.start)
-    assert loaded.goal_radius == clutter.goal_radius
-    assert loaded.name == "paper_clutter"
+    assert np.array_equal(loaded.bounds, clutter.env.bounds)
+    assert np.array_equal(loaded.boxes, clutter.env.boxes)
+    assert loaded.name == "paper_clutter" and loaded.metadata["num_boxes"] == clutter.env.metadata["num_boxes"]
+    scenario = save_box_world(clutter, tmp_path / "scenario.json")  # the geometry with start and goal
+    problem = box_world(scenario)
+    assert np.array_equal(problem.start, clutter.start) and problem.goal.radius == clutter.goal.radius
+    assert np.array_equal(problem.env.boxes, clutter.env.boxes)
+    assert np.array_equal(Environment.load(scenario).boxes, clutter.env.boxes)
 
 
 def _write(tmp_path, data):
@@ -66,7 +71,6 @@ def _write(tmp_path, data):
         ({"bounds": [["0", "10"], [0, 10]]}, "bounds must hold real numbers, got '"),
         ({"bounds": [[False, True], [0, 10]]}, "bounds must hold real numbers, got (True|False)"),
         ({"boxes": [[[1, 1], [2, "2"]]]}, "boxes must hold real numbers"),
-        ({"start": [True, 1.5], "goal": [5, 5], "goal_radius": 1.0}, "start must hold real numbers"),
         ({"version": True}, "'version' must be 1, got True"),
     ],
 )
@@ -93,16 +97,16 @@ def test_bounds_refuse_booleans_and_strings_that_numpy_would_read_as_numbers(val
 
 
 def test_integer_and_float_arrays_of_any_width_are_accepted():
-    env = qc.Problem.build(Environment(np.array([[0, 10], [0, 10]], dtype=np.int32), [[[1, 1], [2.5, 2.5]]]), np.array([0.5, 0.5], dtype=np.float32), (9, 9), 1)
+    env = Environment(np.array([[0, 10], [0, 10]], dtype=np.int32), [[[1, 1], [2.5, 2.5]]])
+    problem = qc.Problem.build(env, np.array([0.5, 0.5], dtype=np.float32), (9, 9), 1)
     assert env.bounds.dtype == float and env.boxes.tolist() == [[[1.0, 1.0], [2.5, 2.5]]]
+    assert problem.start.dtype == float and problem.goal.radius == 1.0
 
 
 @pytest.mark.parametrize("start", [[True, True], ["1", "1.5"], np.array([1, 1], dtype=bool)])
-def test_a_plan_refuses_a_start_of_booleans_or_strings(clutter, start):
-    import qrrt_circuits as qc
-
+def test_a_problem_refuses_a_start_of_booleans_or_strings(clutter, start):
     with pytest.raises(ValueError, match="start must be 2 numbers"):
-        qc.RRT(seed=0).plan(posed(clutter, start=start), max_nodes=2)
+        posed(clutter, start=start)
 
 
 def test_not_json_is_rejected(tmp_path):
@@ -120,28 +124,29 @@ def test_higher_dimension_environment():
 
 
 def test_paper_clutter_matches_design():
-    env = qc.paper_clutter(seed=3)
+    problem = qc.paper_clutter(seed=3)
+    env = problem.env
     sides = env.boxes[:, 1] - env.boxes[:, 0]
     assert env.num_boxes == 525
     assert np.all((sides >= 0.25) & (sides <= 0.85))
     assert np.all(env.boxes[:, 0] >= 0) and np.all(env.boxes[:, 1] <= 20)
-    assert env.is_free(env.start) and env.is_free(env.goal)
-    assert env.goal_radius == 0.75
+    assert env.is_free(problem.start) and env.is_free(problem.goal.centre)
+    assert problem.goal.radius == 0.75 and problem.predicate.name == "exact"
     assert 0.6 < env.free_fraction() < 0.75
 
 
 def test_scenarios_are_seeded():
-    for name in qc.SCENARIOS:
-        a = qc.by_name(name, seed=7)
-        b = qc.by_name(name, seed=7)
-        c = qc.by_name(name, seed=8)
-        assert np.array_equal(a.boxes, b.boxes) and np.array_equal(a.start, b.start)
-        assert not np.array_equal(a.boxes, c.boxes)
+    for name in scenarios.SCENARIOS:
+        a = scenarios.by_name(name, seed=7)
+        b = scenarios.by_name(name, seed=7)
+        c = scenarios.by_name(name, seed=8)
+        assert np.array_equal(a.env.boxes, b.env.boxes) and np.array_equal(a.start, b.start)
+        assert not np.array_equal(a.env.boxes, c.env.boxes)
 
 
 def test_annealing_field_matches_clutter_density():
-    field = qc.annealing_field(seed=0)
-    clutter = qc.paper_clutter(seed=0)
+    field = qc.annealing_field(seed=0).env
+    clutter = qc.paper_clutter(seed=0).env
     assert field.num_boxes == 6025
     assert 67 < field.bounds[0, 1] < 69
     # the two worlds draw boxes from one distribution at one expected density; their free fractions
@@ -155,10 +160,10 @@ def test_annealing_field_matches_clutter_density():
 
 
 def test_annealing_field_side_sets_the_density():
-    default = qc.annealing_field(seed=2)
-    same = qc.annealing_field(seed=2, side=float(default.bounds[0, 1]))
+    default = qc.annealing_field(seed=2).env
+    same = qc.annealing_field(seed=2, side=float(default.bounds[0, 1])).env
     assert np.array_equal(default.boxes, same.boxes) and "side" not in default.metadata
-    dense = qc.annealing_field(seed=2, side=40.0)
+    dense = qc.annealing_field(seed=2, side=40.0).env
     assert dense.num_boxes == 6025 and dense.bounds[0, 1] == 40.0 and dense.metadata["side"] == 40.0
     assert dense.free_fraction() < default.free_fraction()
     with pytest.raises(ValueError, match="side must be"):
@@ -168,7 +173,8 @@ def test_annealing_field_side_sets_the_density():
 
 
 def test_narrow_corridor_channel():
-    env = qc.narrow_corridor(seed=1)
+    problem = qc.narrow_corridor(seed=1)
+    env = problem.env
     (x0, y0), (x1, y1) = env.metadata["channel"]
     assert y1 - y0 == pytest.approx(0.4) and x1 - x0 == pytest.approx(4.0)
     xs = np.linspace(x0 - 0.5, x1 + 0.5, 200)
@@ -177,13 +183,13 @@ def test_narrow_corridor_channel():
     ys = np.linspace(0, 20, 2001)
     wall = env.is_free(np.stack([np.full_like(ys, 10.0), ys], axis=1))
     assert np.all(wall == ((ys > y0) & (ys < y1)))
-    assert env.start[0] < x0 and env.goal[0] > x1
+    assert problem.start[0] < x0 and problem.goal.centre[0] > x1
 
 
 
 @pytest.mark.parametrize(("width", "length"), [(0.4, 4.0), (1.0, 2.0), (2.0, 8.0)])
 def test_narrow_corridor_geometry_sets_the_channel(width, length):
-    env = qc.narrow_corridor(seed=0, width=width, length=length, clutter=0)
+    env = qc.narrow_corridor(seed=0, width=width, length=length, clutter=0).env
     (x0, y0), (x1, y1) = env.metadata["channel"]
     assert (x1 - x0, y1 - y0) == (pytest.approx(length), pytest.approx(width))
     assert (x0 + x1) / 2 == pytest.approx(10.0) and (y0 + y1) / 2 == pytest.approx(10.0)
@@ -201,12 +207,12 @@ def test_narrow_corridor_geometry_sets_the_channel(width, length):
 
 def test_narrow_corridor_clutter_count_and_defaults():
     for clutter in (0, 60, 240):
-        env = qc.narrow_corridor(seed=3, clutter=clutter)
+        env = qc.narrow_corridor(seed=3, clutter=clutter).env
         assert env.num_boxes == 2 + clutter and env.metadata["clutter"] == clutter
     default = qc.narrow_corridor(seed=0)  # the corridor experiment's world
     explicit = qc.narrow_corridor(seed=0, width=0.4, length=4.0, clutter=120, mouth_clearance=1.5)
-    assert np.array_equal(default.boxes, explicit.boxes) and np.array_equal(default.start, explicit.start)
-    assert default.metadata["channel"] == [[8.0, 9.8], [12.0, 10.2]]
+    assert np.array_equal(default.env.boxes, explicit.env.boxes) and np.array_equal(default.start, explicit.start)
+    assert default.env.metadata["channel"] == [[8.0, 9.8], [12.0, 10.2]]
 
 
 @pytest.mark.parametrize(("options", "error", "match"), [
@@ -230,12 +236,13 @@ def test_narrow_corridor_says_when_clutter_has_no_room():
 def test_lattice_start_goal_connected():
     from scipy import ndimage
 
-    env = qc.lattice(seed=2, size=30)
+    problem = qc.lattice(seed=2, size=30)
     cells = np.stack(np.meshgrid(np.arange(30) + 0.5, np.arange(30) + 0.5, indexing="ij"), -1)
-    free = env.is_free(cells)
+    free = problem.env.is_free(cells)
     labels, _ = ndimage.label(free)
-    s = labels[int(env.start[0]), int(env.start[1])]
-    assert s > 0 and s == labels[int(env.goal[0]), int(env.goal[1])]
+    s = labels[int(problem.start[0]), int(problem.start[1])]
+    goal = problem.goal.centre
+    assert s > 0 and s == labels[int(goal[0]), int(goal[1])]
     assert abs(free.mean() - 0.5) < 0.01
 
 
@@ -245,4 +252,4 @@ def test_bad_scenario_arguments():
     with pytest.raises(ValueError, match="blocked_fraction"):
         qc.lattice(blocked_fraction=1.5)
     with pytest.raises(ValueError, match="unknown scenario"):
-        qc.by_name("nope")
+        scenarios.by_name("nope")
