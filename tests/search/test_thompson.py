@@ -116,9 +116,9 @@ def test_q_rrt_and_pq_rrt_plan_with_it():
     for make in (qc.QRRT, qc.PQRRT):
         reached = 0
         for seed in range(8):
-            planner = make(problem.env, backend=qc.StatevectorBackend(seed=seed), num_qubits=8, seed=seed,
-                           goal_bias=0.05, search_policy=qc.ThompsonIterations(), **problem.planner_options())
-            result = planner.plan(goal=problem.goal, max_oracle_calls=2000)
+            planner = make(backend=qc.StatevectorBackend(seed=seed), num_qubits=8, seed=seed,
+                           goal_bias=0.05, search_policy=qc.ThompsonIterations())
+            result = planner.plan(problem, max_oracle_calls=2000)
             reached += int(result.reached)
             assert problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
             assert any("thompson" in str(value) for value in result.settings.values())

@@ -391,12 +391,11 @@ def maze_world(tmp_path_factory):
     room, goal in the bottom-right one."""
     path = tmp_path_factory.mktemp("maze") / "maze.png"
     plt.imsave(path, maze(4, 3, seed=1).astype(float), cmap="gray", vmin=0.0, vmax=1.0)
-    env, check = qc.image_world(path, 0.5, start=[1.25, 7.25], goal=[7.25, 1.25], goal_radius=0.5)
-    return env, check
+    return qc.image_problem(path, 0.5, start=[1.25, 7.25], goal=[7.25, 1.25], goal_radius=0.5)
 
 
 def test_image_world_builds_the_environment(maze_world):
-    env, check = maze_world
+    env, check = maze_world.env, maze_world.predicate
     assert env.bounds.tolist() == [[0.0, 8.5], [0.0, 8.5]] and env.num_boxes == 0
     assert env.name == "image:maze" and env.metadata["occupancy"]["free_cells"] == int(check.grid.free.sum())
     assert np.array_equal(check.grid.free, maze(4, 3, seed=1))
@@ -410,10 +409,10 @@ def _recheck_edges(result, check) -> None:
 
 
 def test_rrt_and_q_rrt_plan_through_the_maze_and_every_edge_rechecks(maze_world):
-    env, check = maze_world
-    rrt = qc.RRT(predicate=check, max_extension=1.0, goal_bias=0.05, seed=0).plan(env, max_oracle_calls=20_000)
-    qrrt = qc.QRRT(predicate=check, backend=qc.StatevectorBackend(seed=0), num_qubits=5, max_extension=1.0,
-                   goal_bias=0.05, search_policy=qc.Adaptive(), seed=0).plan(env, max_oracle_calls=20_000)
+    check = maze_world.predicate
+    rrt = qc.RRT(max_extension=1.0, goal_bias=0.05, seed=0).plan(maze_world, max_oracle_calls=20_000)
+    qrrt = qc.QRRT(backend=qc.StatevectorBackend(seed=0), num_qubits=5, max_extension=1.0,
+                   goal_bias=0.05, search_policy=qc.Adaptive(), seed=0).plan(maze_world, max_oracle_calls=20_000)
     for result in (rrt, qrrt):
         assert result.reached, result.status_text
         _recheck_edges(result, check)
@@ -430,17 +429,18 @@ def test_ompl_plans_the_same_maze_on_the_grid_check(maze_world):
 
     from qrrt_circuits.adapters.ompl_planning import setup_from_problem
 
-    env, check = maze_world
+    check = maze_world.predicate
     ou.RNG.setSeed(0)
     ou.setLogLevel(ou.LOG_NONE)
-    setup = setup_from_problem(env, check)
+    setup = setup_from_problem(maze_world)
     planner = og.RRT(setup.getSpaceInformation())
     planner.setRange(1.0)
     setup.setPlanner(planner)
     assert str(setup.solve(30.0)) == "Exact solution"
     path = setup.getSolutionPath()
     points = np.array([[path.getState(i)[0], path.getState(i)[1]] for i in range(path.getStateCount())])
-    assert np.linalg.norm(points[0] - env.start) == 0.0 and np.linalg.norm(points[-1] - env.goal) <= 0.5
+    assert np.linalg.norm(points[0] - maze_world.start) == 0.0
+    assert np.linalg.norm(points[-1] - maze_world.goal.centre) <= 0.5
     for p, c in zip(points[:-1], points[1:], strict=True):
         assert exact_free(check.grid, p, c), (p.tolist(), c.tolist())
 
@@ -460,15 +460,14 @@ def test_image_world_refuses_a_start_or_goal_off_the_free_cells(maze_world, tmp_
     for key, point, why in cases:
         arguments = {"start": [1.25, 7.25], "goal": [7.25, 1.25]} | {key: point}
         with pytest.raises(ValueError, match=rf"{key} \[.*\] is not a free point of the map: {why}; {accepted}"):
-            qc.image_world(path, 0.5, goal_radius=0.5, **arguments)
-    env, _ = qc.image_world(path, 0.5, start=[0.75, 7.25], goal=[7.25, 1.25], goal_radius=0.5)  # beside the wall
-    assert env.start.tolist() == [0.75, 7.25]
+            qc.image_problem(path, 0.5, goal_radius=0.5, **arguments)
+    beside = qc.image_problem(path, 0.5, start=[0.75, 7.25], goal=[7.25, 1.25], goal_radius=0.5)  # beside the wall
+    assert beside.start.tolist() == [0.75, 7.25]
 
 
 def test_planners_refuse_a_start_in_an_occupied_cell(maze_world):
-    env, check = maze_world
     with pytest.raises(ValueError, match=r"start \[0.25, 0.25\] is not a valid state: the grid check"):
-        qc.RRT(predicate=check, seed=0).plan(posed(env, start=[0.25, 0.25]), max_nodes=5)
+        posed(maze_world, start=[0.25, 0.25])
 
 
 # ----------------------------------------------------------------------------- bad input

@@ -46,10 +46,10 @@ def test_the_narrow_passage_is_open_only_through_its_hole(dim):
 @pytest.mark.parametrize("make", [open_space, lambda: narrow_passage(2, 1.0), lambda: narrow_passage(3, 1.5)])
 def test_families_are_solved_by_rrt_and_q_rrt(make):
     problem = make()
-    for planner in (qc.RRT(seed=0, goal_bias=0.05, max_extension=2.0, **problem.planner_options()),
+    for planner in (qc.RRT(seed=0, goal_bias=0.05, max_extension=2.0),
                     qc.QRRT(backend=qc.StatevectorBackend(seed=0), num_qubits=6, seed=0, goal_bias=0.05,
-                            max_extension=2.0, search_policy=qc.Adaptive(), **problem.planner_options())):
-        result = planner.plan(goal=problem.goal, max_oracle_calls=30000)
+                            max_extension=2.0, search_policy=qc.Adaptive())):
+        result = planner.plan(problem, max_oracle_calls=30000)
         assert result.reached, (problem.name, planner.name)
         assert problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
 
@@ -57,7 +57,7 @@ def test_families_are_solved_by_rrt_and_q_rrt(make):
 def test_the_se2_gap_problem_plans_in_se2():
     problem = se2_gap()
     assert problem.space.describe()["kind"] == "SE2" and problem.env.dim == 3
-    result = qc.RRT(seed=1, max_extension=1.0, **problem.planner_options()).plan(posed(problem.env, goal=problem.goal), max_oracle_calls=20000)
+    result = qc.RRT(seed=1, max_extension=1.0).plan(problem, max_oracle_calls=20000)
     assert result.reached and problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
 
 
@@ -146,7 +146,7 @@ def test_an_image_problem_file_plans_on_its_grid(tmp_path):
                   goal_radius=0.5)
     problem = load_problem(path)
     assert problem.env.bounds.tolist() == [[0.0, 10.0], [0.0, 10.0]]
-    result = qc.RRT(seed=0, goal_bias=0.05, **problem.planner_options()).plan(posed(problem.env, goal=problem.goal), max_oracle_calls=20000)
+    result = qc.RRT(seed=0, goal_bias=0.05).plan(problem, max_oracle_calls=20000)
     assert result.reached and problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
     with pytest.raises(ValueError, match='family "image" needs'):
         load_problem(_write(tmp_path, family="image", image="door.png"))
@@ -195,10 +195,10 @@ def test_the_maze_problem_is_solved_through_its_corridors():
 
     problem = maze(4, seed=2)
     assert problem.env.bounds.tolist() == [[0.0, 10.0], [0.0, 10.0]]
-    for planner in (qc.RRT(seed=0, goal_bias=0.05, **problem.planner_options()),
+    for planner in (qc.RRT(seed=0, goal_bias=0.05),
                     qc.QRRT(backend=qc.StatevectorBackend(seed=0), seed=0, goal_bias=0.05,
-                            search_policy=qc.Adaptive(), **problem.planner_options())):
-        result = planner.plan(goal=problem.goal, max_oracle_calls=20000)
+                            search_policy=qc.Adaptive())):
+        result = planner.plan(problem, max_oracle_calls=20000)
         assert result.reached
         assert problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
     assert load_problem(_write_maze(problem)).env.metadata == problem.env.metadata
@@ -217,7 +217,7 @@ def test_the_shortcut_keeps_checked_motions_and_never_lengthens():
     from qrrt_circuits.planners.paths import path_length, shortcut
 
     problem = narrow_passage(2, 0.5)
-    result = qc.RRT(seed=3, goal_bias=0.05, max_extension=1.0, **problem.planner_options()).plan(posed(problem.env, goal=problem.goal), max_oracle_calls=20000)
+    result = qc.RRT(seed=3, goal_bias=0.05, max_extension=1.0).plan(problem, max_oracle_calls=20000)
     assert result.reached
     short = shortcut(result.path, problem.predicate)
     assert np.array_equal(short[0], result.path[0]) and np.array_equal(short[-1], result.path[-1])
@@ -242,7 +242,7 @@ def test_rigid_body_checks_are_counted():
 def test_the_winding_band_is_open_only_along_its_legs(dim, seed):
     problem = winding_band(dim, 0.1, seed)
     env, check = problem.env, problem.predicate
-    start, goal = env.start, env.goal
+    start, goal = problem.start.copy(), problem.goal.centre
     assert env.is_free(start) and env.is_free(goal)
     assert not check.reachable(start[None], goal[None])[0]  # the straight motion meets the wall
     off = start.copy()
@@ -260,7 +260,7 @@ def test_the_winding_band_is_open_only_along_its_legs(dim, seed):
 def test_winding_bands_differ_by_seed_and_repeat_by_seed():
     first, again, other = (winding_band(2, 0.2, s) for s in (3, 3, 4))
     assert np.array_equal(first.env.boxes, again.env.boxes)
-    assert not np.array_equal(first.env.boxes, other.env.boxes) or not np.array_equal(first.env.goal, other.env.goal)
+    assert not np.array_equal(first.env.boxes, other.env.boxes) or not np.array_equal(first.goal.centre, other.goal.centre)
 
 
 def test_the_winding_band_is_solved_by_q_rrt_within_a_budget():
@@ -270,8 +270,8 @@ def test_the_winding_band_is_solved_by_q_rrt_within_a_budget():
     for seed in range(5):
         problem = winding_band(2, 0.2, seed)
         planner = qc.QRRT(backend=qc.StatevectorBackend(seed=seed), num_qubits=8, seed=seed,
-                          goal_bias=0.05, search_policy=qc.Adaptive(), **problem.planner_options())
-        result = planner.plan(posed(problem.env, goal=problem.goal), max_oracle_calls=20000)
+                          goal_bias=0.05, search_policy=qc.Adaptive())
+        result = planner.plan(problem, max_oracle_calls=20000)
         solved += int(result.reached)
         assert problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:]).all()
     assert solved >= 4

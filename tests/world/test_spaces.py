@@ -70,14 +70,14 @@ class ShortMoves:
 
 
 @pytest.mark.parametrize("make", [
-    lambda env: qc.RRT(predicate=ShortMoves(), space=qc.SE2Space(), seed=0, max_extension=1.5),
-    lambda env: qc.QRRT(predicate=ShortMoves(), space=qc.SE2Space(), backend=qc.StatevectorBackend(seed=0),
-                        num_qubits=4, seed=0, max_extension=1.5),
+    lambda: qc.RRT(seed=0, max_extension=1.5),
+    lambda: qc.QRRT(backend=qc.StatevectorBackend(seed=0), num_qubits=4, seed=0, max_extension=1.5),
 ])
 def test_planners_plan_in_se2(make):
     bounds = np.array([[0.0, 10.0], [0.0, 10.0], [-PI, PI]])
-    env = qc.Problem.build(qc.Environment(bounds, np.zeros((0, 2, 3))), [1, 1, 0], [9, 9, 3.0], 1.0)
-    result = make(env).plan(max_oracle_calls=5000)
+    problem = qc.Problem.build(qc.Environment(bounds, np.zeros((0, 2, 3))), [1, 1, 0], [9, 9, 3.0], 1.0,
+                               predicate=ShortMoves(), space=qc.SE2Space())
+    result = make().plan(problem, max_oracle_calls=5000)
     assert result.reached and result.settings["space"] == {"kind": "SE2", "angle_weight": 0.5}
     steps = qc.SE2Space().distance(result.nodes[result.parents[1:]], result.nodes[1:])
     assert steps.max() <= 1.5 + 1e-9 and np.all(np.abs(result.nodes[:, 2]) <= PI)
@@ -85,15 +85,17 @@ def test_planners_plan_in_se2(make):
 
 def test_bad_spaces_are_refused(clutter):
     with pytest.raises(ValueError, match="dimension mismatch: the space has d = 3, the environment has d = 2"):
-        qc.RRT(space=qc.SE2Space())
+        clutter.replace(space=qc.SE2Space())
     with pytest.raises(ValueError, match=r"SE2Space needs environment bounds for \(x, y, theta\)"):
         qc.SE2Space().check_bounds(np.zeros((2, 2)))
     wide = qc.Environment(np.array([[0.0, 1.0], [0.0, 1.0], [0.0, 7.0]]), np.zeros((0, 2, 3)))
     with pytest.raises(ValueError, match=r"theta bounds \[-pi, pi\]"):
-        qc.RRT(space=qc.SE2Space(), predicate=ShortMoves())
+        qc.Problem.build(wide, [0.5, 0.5, 1.0], [0.7, 0.7, 1.0], 0.1, predicate=ShortMoves(), space=qc.SE2Space())
     with pytest.raises(ValueError, match="dimension mismatch: the space has d = 3"):
-        qc.RRT(space=qc.RealVectorSpace(3))
+        clutter.replace(space=qc.RealVectorSpace(3))
     with pytest.raises(TypeError, match="space must be a StateSpace"):
-        qc.RRT(space="se2")
+        clutter.replace(space="se2")
+    with pytest.raises(TypeError, match="RRT does not take space"):
+        qc.RRT(space=qc.SE2Space())
     with pytest.raises(ValueError, match="angle_weight must be a finite number >= 0.0"):
         qc.SE2Space(angle_weight=-1.0)

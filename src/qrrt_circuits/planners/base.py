@@ -86,10 +86,12 @@ class Planner:
                  **keywords: Any) -> None:
         if options is None:
             options = self.Options.create(self.name, **keywords)
-        elif keywords:
-            raise TypeError(f"give {self.name} its options or keywords, not both (got options and "
-                            f"{', '.join(sorted(keywords))})")
-        check_instance(options, "options", self.Options, f"{self.Options.__name__} (the options of {self.name})")
+        else:  # (a problem or an environment given here belongs to plan)
+            check_instance(options, "options", self.Options,
+                           f"{self.Options.__name__} (the options of {self.name}; the problem is plan's argument)")
+            if keywords:
+                raise TypeError(f"give {self.name} its options or keywords, not both (got options and "
+                                f"{', '.join(sorted(keywords))})")
         if executor is not None and not self.takes_executor:
             raise TypeError(f"{self.name} does not take executor= (its rounds have one task)")
         self.options = self._complete(options)
