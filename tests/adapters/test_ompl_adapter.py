@@ -12,6 +12,7 @@ import pytest
 ob = pytest.importorskip("ompl.base")
 
 import qrrt_circuits as qc  # noqa: E402
+from planner_checks import posed  # noqa: E402
 from qrrt_circuits.adapters.ompl import OMPLMotionPredicate, from_environment  # noqa: E402
 from qrrt_circuits.reachability.predicate import check_predicate  # noqa: E402
 
@@ -35,6 +36,7 @@ def real_vector_si(dim: int, low: float = 0.0, high: float = 1.0) -> "ob.SpaceIn
 
 # ------------------------------------------------------------------------------------ (a) protocol
 def test_satisfies_the_predicate_protocol(clutter):
+    clutter = clutter.env
     predicate = from_environment(clutter)
     assert check_predicate(predicate, clutter.dim) is predicate
     assert isinstance(predicate, qc.ReachabilityPredicate)
@@ -109,19 +111,17 @@ def assert_edges_free_up_to_ompl_resolution(env: qc.Environment, result, segment
 
 
 PLANNERS = {
-    "rrt": lambda env, predicate: qc.RRT(predicate=predicate, seed=0),
-    "qrrt": lambda env, predicate: qc.QRRT(backend=qc.StatevectorBackend(seed=0), num_qubits=6,
-                                          predicate=predicate, seed=0),
-    "pqrrt-shared-aer": lambda env, predicate: qc.PQRRT(backend=qc.AerBackend(seed=0), workers=4,
-                                                       num_qubits=5, shared_database=True,
-                                                       predicate=predicate, seed=0),
+    "rrt": lambda: qc.RRT(seed=0),
+    "qrrt": lambda: qc.QRRT(backend=qc.StatevectorBackend(seed=0), num_qubits=6, seed=0),
+    "pqrrt-shared-aer": lambda: qc.PQRRT(backend=qc.AerBackend(seed=0), workers=4, num_qubits=5,
+                                         shared_database=True, seed=0),
 }
 
 
 @pytest.mark.parametrize("name", list(PLANNERS))
 def test_planners_plan_on_ompl_checks_and_every_edge_rechecks(name, clutter):
-    predicate = from_environment(clutter)
-    result = PLANNERS[name](clutter, predicate).plan(max_nodes=15)
+    predicate = from_environment(clutter.env)
+    result = PLANNERS[name]().plan(clutter.replace(predicate=predicate), max_nodes=15)
     assert str(result.status) in ("reached", "max_nodes")
     assert result.metrics.nodes >= 1
     assert result.settings["predicate"] == predicate.describe()
@@ -129,7 +129,7 @@ def test_planners_plan_on_ompl_checks_and_every_edge_rechecks(name, clutter):
     assert predicate.evaluations > 0
     segment_length = predicate.space.getLongestValidSegmentLength()
     assert segment_length == pytest.approx(predicate.describe()["longest_valid_segment_length"])
-    assert_edges_free_up_to_ompl_resolution(clutter, result, segment_length)
+    assert_edges_free_up_to_ompl_resolution(clutter.env, result, segment_length)
 
 
 # ------------------------------------------------------------------------------------ (c) refusals
@@ -151,8 +151,8 @@ def test_bad_constructions_are_refused_with_clear_messages():
     with pytest.raises(TypeError, match="Environment"):
         from_environment(np.zeros((2, 2)))
     with pytest.raises(ValueError, match="dimension mismatch"):
-        qc.RRT(qc.Environment(np.array([[0.0, 1.0]] * 3), np.zeros((0, 2, 3))),
-               predicate=from_environment(wall_world()))
+        qc.Problem.build(qc.Environment(np.array([[0.0, 1.0]] * 3), np.zeros((0, 2, 3))), [0.5] * 3, [0.6] * 3,
+                         0.05, predicate=from_environment(wall_world()))
 
 
 def test_import_without_ompl_names_the_extra(monkeypatch):
@@ -168,21 +168,22 @@ def test_import_without_ompl_names_the_extra(monkeypatch):
 def test_an_invalid_start_or_goal_under_ompls_validity_check_is_refused():
     """OMPL's own validity checker decides (here: a disc at (2, 2) invalid that the box world does
     not know), as OMPL refuses "no valid initial states"."""
-    env = qc.Problem.build(qc.Environment(np.array([[0.0, 10.0], [0.0, 10.0]]), np.zeros((0, 2, 2))), [2, 2], [9, 9], 0.5)
+    env = qc.Environment(np.array([[0.0, 10.0], [0.0, 10.0]]), np.zeros((0, 2, 2)))
     si = real_vector_si(2, 0.0, 10.0)
     si.setStateValidityChecker(lambda state: (state[0] - 2) ** 2 + (state[1] - 2) ** 2 > 0.25)
     predicate = OMPLMotionPredicate(si)
     assert predicate.is_valid(np.array([[2.0, 2.0], [5.0, 5.0], [11.0, 5.0]])).tolist() == [False, True, False]
     with pytest.raises(ValueError, match=r"start \[2.0, 2.0\] is not a valid state: the ompl check's own validity"):
-        qc.RRT(predicate=predicate, seed=0).plan(env, max_nodes=3)
+        posed(env, start=[2, 2], goal=[9, 9], goal_radius=0.5, predicate=predicate)
     with pytest.raises(ValueError, match=r"goal \[2.0, 2.0\] is not a valid state"):
-        qc.RRT(predicate=predicate, seed=0).plan(posed(env, start=[8, 8], goal=[2, 2]), max_nodes=3)
-    result = qc.RRT(predicate=predicate, seed=0).plan(posed(env, start=[5, 5]), max_nodes=3)
+        posed(env, start=[8, 8], goal=[2, 2], goal_radius=0.5, predicate=predicate)
+    result = qc.RRT(seed=0).plan(posed(env, start=[5, 5], goal=[9, 9], goal_radius=0.5, predicate=predicate),
+                                 max_nodes=3)
     assert result.metrics.nodes >= 3
 
 
 def test_an_environment_wider_than_ompls_space_is_refused():
-    env = qc.Problem.build(qc.Environment(np.array([[0.0, 20.0], [0.0, 20.0]]), np.zeros((0, 2, 2))), [1, 1], [9, 9], 0.5)
+    env = qc.Environment(np.array([[0.0, 20.0], [0.0, 20.0]]), np.zeros((0, 2, 2)))
     predicate = OMPLMotionPredicate(real_vector_si(2, 0.0, 10.0))
     with pytest.raises(ValueError, match=r"outside the ompl check's state space \[\[0.0, 10.0\], \[0.0, 10.0\]\]"):
-        qc.QRRT(predicate=predicate, backend=qc.StatevectorBackend(seed=0), num_qubits=3, seed=0)
+        posed(env, start=[1, 1], goal=[9, 9], goal_radius=0.5, predicate=predicate)

@@ -41,13 +41,13 @@ def gap_setup(goal_threshold: float = 0.5) -> og.SimpleSetup:
 
 def test_a_setup_becomes_a_problem_the_planners_take():
     problem = problem_from_setup(gap_setup())
-    assert problem.env.bounds.tolist() == [[0.0, 10.0], [0.0, 10.0]] and problem.env.start.tolist() == [1.0, 1.0]
+    assert problem.env.bounds.tolist() == [[0.0, 10.0], [0.0, 10.0]] and problem.start.tolist() == [1.0, 1.0]
     assert isinstance(problem.goal, qc.GoalState) and problem.goal.threshold == 0.5
     assert problem.predicate.is_valid(np.array([[5.0, 1.0], [5.0, 5.0]])).tolist() == [False, True]
-    for make in (lambda: qc.RRT(predicate=problem.predicate, goal_bias=0.05, seed=0),
-                 lambda: qc.QRRT(predicate=problem.predicate, backend=qc.StatevectorBackend(seed=0),
-                                 num_qubits=4, goal_bias=0.05, search_policy=qc.Adaptive(), seed=0)):
-        result = make().plan(goal=problem.goal, max_oracle_calls=20000)
+    for make in (lambda: qc.RRT(goal_bias=0.05, seed=0),
+                 lambda: qc.QRRT(backend=qc.StatevectorBackend(seed=0), num_qubits=4, goal_bias=0.05,
+                                 search_policy=qc.Adaptive(), seed=0)):
+        result = make().plan(problem, max_oracle_calls=20000)
         assert result.reached and np.linalg.norm(result.path[-1] - [9, 9]) <= 0.5
         for parent, child in zip(result.path[:-1], result.path[1:], strict=True):  # every path edge, by OMPL
             assert problem.predicate.reachable(parent[None], child[None])[0]
@@ -77,16 +77,13 @@ def test_a_goal_region_is_asked_through_ompl():
     problem = problem_from_setup(setup)
     assert isinstance(problem.goal, OMPLGoalRegion) and not hasattr(problem.goal, "sample")
     assert problem.goal.is_satisfied(np.array([[9.5, 1.0], [8.0, 1.0]])).tolist() == [True, False]
-    result = qc.RRT(predicate=problem.predicate, seed=1).plan(posed(problem.env, goal=problem.goal), max_oracle_calls=20000)
+    result = qc.RRT(seed=1).plan(problem, max_oracle_calls=20000)
     assert result.reached and result.path[-1][0] >= 9.0
 
 
 def test_library_planners_solve_through_simple_setup():
     setup = gap_setup()
-    def make(env, predicate):
-        return qc.RRT(predicate=predicate, goal_bias=0.05, seed=2)
-
-    planner = LibraryPlanner(setup.getSpaceInformation(), make, "RRT-lib")
+    planner = LibraryPlanner(setup.getSpaceInformation(), qc.RRT(goal_bias=0.05, seed=2), "RRT-lib")
     setup.setPlanner(planner)
     assert setup.solve(30.0) and setup.haveExactSolutionPath()
     path = setup.getSolutionPath()
@@ -99,13 +96,13 @@ def test_benchmark_logs_carry_oracle_calls_that_ompls_statistics_read(tmp_path):
 
     setup = gap_setup()
 
-    def library(name, make):
-        return lambda si: LibraryPlanner(si, make, name)
+    def library(name, planner):
+        return lambda si: LibraryPlanner(si, planner, name)
 
     planners = {
         "RRT (OMPL)": og.RRT,
-        "q-RRT": library("q-RRT", lambda env, predicate: qc.QRRT(predicate=predicate, backend=qc.StatevectorBackend(seed=0), num_qubits=4, goal_bias=0.05,
-            search_policy=qc.Adaptive(), seed=0)),
+        "q-RRT": library("q-RRT", qc.QRRT(backend=qc.StatevectorBackend(seed=0), num_qubits=4, goal_bias=0.05,
+                                          search_policy=qc.Adaptive(), seed=0)),
     }
     log = tmp_path / "run.log"
     rows = benchmark_log(setup, planners, runs=2, max_time_s=20.0, path=log)
@@ -133,8 +130,8 @@ def test_bad_benchmark_arguments_are_refused(tmp_path):
 def test_ompls_planners_plan_a_library_problem_on_the_same_checks(clutter):
     from qrrt_circuits.adapters.ompl_planning import setup_from_problem
 
-    check = qc.ExactCheck(clutter)
-    setup = setup_from_problem(clutter, check)
+    check = clutter.predicate
+    setup = setup_from_problem(clutter)
     setup.setPlanner(og.RRTConnect(setup.getSpaceInformation()))
     assert setup.solve(30.0) and setup.haveExactSolutionPath()
     path = setup.getSolutionPath()
@@ -146,11 +143,8 @@ def test_ompls_planners_plan_a_library_problem_on_the_same_checks(clutter):
 def test_benchmark_logs_of_a_library_problem_count_every_planners_motion_checks(clutter, tmp_path):
     from qrrt_circuits.adapters.ompl_planning import setup_from_problem
 
-    setup = setup_from_problem(clutter, qc.ExactCheck(clutter))
-
-    def rrt(env, predicate):
-        return qc.RRT(predicate=predicate, goal_bias=0.05, seed=0, look_ahead=False)
-
+    setup = setup_from_problem(clutter)
+    rrt = qc.RRT(goal_bias=0.05, seed=0, look_ahead=False)
     rows = benchmark_log(setup, {"RRTConnect (OMPL)": og.RRTConnect,
                                  "RRT (library)": lambda si: LibraryPlanner(si, rrt, "RRT (library)")},
                          runs=2, max_time_s=30.0, path=tmp_path / "clutter.log")

@@ -196,6 +196,7 @@ class Problem:
             predicate = ExactCheck(env, dynamics, resolution=resolution)
         elif dynamics is not None:
             raise ValueError("give dynamics= or predicate=, not both (a predicate carries its own motion model)")
+        check_predicate(predicate, env.dim)  # (before the goal point is checked with it)
         if isinstance(goal, Goal):
             if goal_radius is not None:
                 raise ValueError("goal_radius is given with a goal point, not with a Goal object "
