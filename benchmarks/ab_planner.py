@@ -51,9 +51,31 @@ import qrrt_circuits as qc
 from qrrt_circuits.experiments.planners import make_planner
 planner, backend, worlds, nodes = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
 replay, unreachable = sys.argv[5] == "1", sys.argv[6] == "1"
-goal = {"goal_radius": 1e-9} if unreachable else {}
-envs = [qc.paper_clutter(seed=seed) for seed in range(worlds)]
-make_planner(planner, envs[0], 0, backend).plan(max_rounds=5)  # compile and warm up
+# the two checkouts may predate or follow the problem API (a planner's plan(problem, ...)): the child
+# speaks whichever its checkout has
+PROBLEM_API = hasattr(qc, "Problem")
+
+
+def world(seed):
+    return qc.paper_clutter(seed=seed) if PROBLEM_API else qc.scenarios.paper_clutter(seed=seed)
+
+
+def geometry(problem):
+    return problem.env if PROBLEM_API else problem
+
+
+def plan(problem, seed, predicate=None, **limits):
+    if PROBLEM_API:
+        posed = problem if predicate is None else problem.replace(predicate=predicate)
+        posed = posed.with_goal_radius(1e-9) if unreachable else posed
+        return make_planner(planner, seed, backend).plan(posed, **limits)
+    extra = {} if predicate is None else {"predicate": predicate}
+    goal = {"goal_radius": 1e-9} if unreachable else {}
+    return make_planner(planner, problem, seed, backend, **extra).plan(**limits, **goal)
+
+
+problems = [world(seed) for seed in range(worlds)]
+plan(problems[0], 0, max_rounds=5)  # compile and warm up
 
 
 class Recorded:  # the exact predicate of a world, recording its answers (record) or handing them back
@@ -74,18 +96,17 @@ class Recorded:  # the exact predicate of a world, recording its answers (record
 
 if not replay:
     began, total = time.perf_counter(), 0
-    for seed, env in enumerate(envs):
-        total += make_planner(planner, env, seed, backend).plan(max_nodes=nodes, **goal).metrics.nodes
+    for seed, problem in enumerate(problems):
+        total += plan(problem, seed, max_nodes=nodes).metrics.nodes
     elapsed = time.perf_counter() - began
     print(json.dumps({"ms_per_node": elapsed * 1e3 / max(total, 1), "nodes": total, "module": qc.__file__}))
 else:
     wall = rounds = total = 0
-    for seed, env in enumerate(envs):
+    for seed, problem in enumerate(problems):
         answers = []
-        recorded = make_planner(planner, env, seed, backend, predicate=Recorded(env, answers, True)).plan(
-            max_nodes=nodes, **goal)
-        replayer = Recorded(env, answers, False)
-        replayed = make_planner(planner, env, seed, backend, predicate=replayer).plan(max_nodes=nodes, **goal)
+        recorded = plan(problem, seed, Recorded(geometry(problem), answers, True), max_nodes=nodes)
+        replayer = Recorded(geometry(problem), answers, False)
+        replayed = plan(problem, seed, replayer, max_nodes=nodes)
         same = (np.array_equal(replayed.nodes, recorded.nodes) and np.array_equal(replayed.parents, recorded.parents)
                 and replayed.metrics.oracle_calls == recorded.metrics.oracle_calls)
         if not same or replayer.calls != len(answers):
@@ -96,6 +117,7 @@ else:
     print(json.dumps({"us_per_round_replayed": wall * 1e6 / max(rounds, 1), "rounds": rounds, "nodes": total,
                       "module": qc.__file__}))
 """
+
 
 
 def run_child(src: Path, planner: str, backend: str, worlds: int, nodes: int, replay: bool = False,

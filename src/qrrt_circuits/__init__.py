@@ -6,6 +6,7 @@ Lathrop, Boardman and Martinez, "Parallel Quantum Rapidly-Exploring Random Trees
 """
 
 import importlib as _importlib
+from importlib import util as _importlib_util
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -111,6 +112,8 @@ def __getattr__(name: str) -> Any:
         value = _importlib.import_module(where, __name__)
         if where.rpartition(".")[2] != name:
             value = getattr(value, name)
+    elif not name.startswith("_") and _importlib_util.find_spec(f"{__name__}.{name}") is not None:
+        value = _importlib.import_module(f"{__name__}.{name}")  # a subpackage: qc.X is import qrrt_circuits.X
     else:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     globals()[name] = value

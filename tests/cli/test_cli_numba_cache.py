@@ -113,7 +113,7 @@ def _use_cache(folder: str) -> None:
 
 
 def _build_world() -> str:
-    return qrrt_circuits.scenarios.paper_clutter(seed=0).name
+    return qrrt_circuits.paper_clutter(seed=0).name
 
 
 def test_a_worker_process_meeting_a_corrupt_cache_is_recognised(filled_cache, tmp_path):

@@ -4,15 +4,14 @@ import numpy as np
 import pytest
 
 import qrrt_circuits as qc
-from planner_checks import posed
 from qrrt_circuits.reachability.dynamics import LinearTrackingDynamics
 
 ENV = qc.paper_clutter(seed=0)
 
 CASES = {
     "goal_bias": lambda v: qc.RRT(goal_bias=v),
-    "resolution": lambda v: qc.ExactCheck(ENV, resolution=v),
-    "goal_radius": lambda v: qc.RRT(seed=0).plan(posed(ENV, goal_radius=v), max_rounds=1),
+    "resolution": lambda v: qc.ExactCheck(ENV.env, resolution=v),
+    "goal_radius": lambda v: qc.Problem.build(ENV.env, ENV.start, ENV.goal.centre, v),
     "max_time_s": lambda v: qc.RRT(seed=0).plan(ENV, max_time_s=v, max_rounds=1),
     "MaxWallTime": lambda v: qc.MaxWallTime(v),
     "false_positive": lambda v: qc.OracleErrorModel(false_positive=v),
@@ -41,5 +40,5 @@ def test_points_as_strings_or_booleans_are_refused():
     """``is_free`` reads numbers only, as the constructors and ``plan`` do."""
     for bad in (["5", "5"], [True, 1.0]):
         with pytest.raises(ValueError, match="points must hold real numbers"):
-            ENV.is_free(bad)
-    assert ENV.is_free([5, 5]) == ENV.is_free(np.array([5.0, 5.0]))
+            ENV.env.is_free(bad)
+    assert ENV.env.is_free([5, 5]) == ENV.env.is_free(np.array([5.0, 5.0]))

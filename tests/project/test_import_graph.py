@@ -83,6 +83,7 @@ LAYERS = (
     {"_support"},
     {"probability"},
     {"world", "reachability"},
+    {"problems"},
     {"search", "hardware"},
     {"coherent"},
     {"planners"},
@@ -92,12 +93,9 @@ LAYERS = (
 )
 #: imports against the layer order that remain, each named: (importing module, imported module)
 LAYER_EXCEPTIONS = {
-    # the process pools' warm-up compiles the experiments' worlds and the exact check once per worker
+    # the process pools' warm-up builds the experiments' default world (and its exact check) once per worker
     ("qrrt_circuits._support.worker_warmup", "qrrt_circuits.experiments"),
     ("qrrt_circuits._support.worker_warmup", "qrrt_circuits.experiments.worlds"),
-    ("qrrt_circuits._support.worker_warmup", "qrrt_circuits.reachability.exact"),
-    # a problem's goal region is the planners' GoalBall (goals belong with the problem)
-    ("qrrt_circuits.problems.families", "qrrt_circuits.problems.goals"),
     # the OMPL planner adapter reads the package version for OMPL's planner name
     ("qrrt_circuits.adapters.ompl_planning", "qrrt_circuits"),
 }

@@ -27,7 +27,7 @@ def test_importing_the_package_and_planning_on_the_statevector_imports_none_of_t
 
 
 @pytest.mark.parametrize("name, needs", [
-    ("AerBackend", "qiskit_aer"), ("circuits", "qiskit"), ("SamplerBackend", "qiskit"),
+    ("AerBackend", "qiskit_aer"), ("SamplerBackend", "qiskit"),
     ("EstimatedOptimal", "qiskit"),
 ])
 def test_a_lazy_name_imports_what_it_needs_on_first_use(name, needs):

@@ -13,13 +13,6 @@ from planner_checks import posed
 
 ROOT = Path(qc.__file__).resolve().parent
 
-#: names of ``qc.__all__`` that are modules living below a subpackage: ``qc.scenarios`` is
-#: ``qrrt_circuits.problems.scenarios``, imported under that path only (no module file aliases it)
-NAMESPACE_MODULES = {"scenarios": "qrrt_circuits.problems.scenarios",
-                     "termination": "qrrt_circuits.planners.termination",
-                     "circuits": "qrrt_circuits.search.circuits"}
-
-
 @pytest.fixture(scope="module")
 def env():
     return qc.paper_clutter(seed=0)
@@ -32,25 +25,22 @@ def test_every_public_name_resolves():
         value = getattr(qc, name)
         assert value is not None, name
         if isinstance(value, type(qc)):
-            home = NAMESPACE_MODULES.get(name, f"qrrt_circuits.{name}")
-            assert value.__name__ == home and value is importlib.import_module(home), name
+            assert value.__name__ == f"qrrt_circuits.{name}" and value is importlib.import_module(value.__name__)
 
 
-def test_a_module_name_of_the_namespace_is_a_module_file_or_a_listed_subpackage_module():
-    """``import qrrt_circuits.X`` and ``qc.X`` agree for every top-level module file X; the modules
-    of ``NAMESPACE_MODULES`` are attributes of the namespace, not module paths of their own."""
-    top_level = {path.stem for path in ROOT.glob("*.py") if path.stem != "__init__"}
-    for stem in top_level:
-        module = importlib.import_module(f"qrrt_circuits.{stem}")
-        assert module.__name__ == f"qrrt_circuits.{stem}"
-        assert Path(module.__file__).resolve() == ROOT / f"{stem}.py"
-        if stem in qc.__all__:
-            assert getattr(qc, stem) is module
-    modules = {name for name in qc.__all__ if isinstance(getattr(qc, name), type(qc))}
-    assert modules - top_level == set(NAMESPACE_MODULES)
-    for name in NAMESPACE_MODULES:
-        with pytest.raises(ModuleNotFoundError):
-            importlib.import_module(f"qrrt_circuits.{name}")
+@pytest.mark.parametrize("name", sorted({path.stem for path in ROOT.glob("*.py") if path.stem != "__init__"}
+                                        | {path.parent.name for path in ROOT.glob("*/__init__.py")}
+                                        | {"scenarios", "termination", "circuits", "nope"}))
+def test_import_and_attribute_agree_for_every_name(name):
+    """``import qrrt_circuits.X`` and ``qc.X`` give the same module for every module file and
+    subpackage X, and both fail for a name that is neither."""
+    try:
+        module = importlib.import_module(f"qrrt_circuits.{name}")
+    except ModuleNotFoundError:
+        with pytest.raises(AttributeError):
+            getattr(qc, name)
+        return
+    assert getattr(qc, name) is module
 
 
 def _module_level_getattr(tree: ast.Module) -> bool:
@@ -113,18 +103,24 @@ def test_an_old_name_is_gone(module, name):
 
 
 def test_old_arguments_and_attributes_are_gone(env):
-    predicate = qc.ExactCheck(env)
+    predicate = qc.ExactCheck(env.env)
     for make in (lambda: qc.RRT(oracle=predicate), lambda: qc.ParallelRRT(oracle=predicate),
                  lambda: qc.QRRT(backend=qc.StatevectorBackend(), oracle=predicate),
                  lambda: qc.PQRRT(backend=qc.StatevectorBackend(), oracle=predicate),
                  lambda: qc.QRRT(backend=qc.StatevectorBackend(), iterations=qc.FixedIterations(2)),
                  lambda: qc.PQRRT(backend=qc.StatevectorBackend(), iterations=qc.FixedIterations(2)),
-                 lambda: qc.ExactCheck(env, check="time_samples"),
-                 lambda: qc.ExactCheck(env, time_samples=9)):
+                 lambda: qc.RRT(env.env), lambda: qc.QRRT(predicate=predicate)):
+        with pytest.raises(TypeError, match="does not take|options must be"):
+            make()
+    for make in (lambda: qc.ExactCheck(env.env, check="time_samples"),
+                 lambda: qc.ExactCheck(env.env, time_samples=9)):
         with pytest.raises(TypeError, match="unexpected keyword argument"):
             make()
-    planner = qc.PQRRT(backend=qc.StatevectorBackend(), predicate=predicate, seed=0)
-    assert planner.predicate is predicate and not hasattr(planner, "oracle")
+    planner = qc.PQRRT(backend=qc.StatevectorBackend(), seed=0)
+    assert not hasattr(planner, "oracle") and not hasattr(planner, "predicate") and not hasattr(planner, "env")
     assert not hasattr(planner, "iterations_policy") and not hasattr(predicate, "check")
     assert not hasattr(qc.PaperIterations().start(256), "iterations")
     assert not hasattr(qc.RRT(seed=0).plan(posed(env, goal_radius=1e-9), max_rounds=3), "budget_exhausted")
+    assert not hasattr(env.env, "start") and not hasattr(env.env, "goal_radius")
+    with pytest.raises(TypeError):
+        qc.RRT(seed=0).plan(env, None, None, 100)  # the budgets are keyword-only

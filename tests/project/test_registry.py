@@ -13,15 +13,21 @@ EXPECTED_PLANNERS = {"rrt": qc.RRT, "prrt": qc.ParallelRRT, "qrrt": qc.QRRT, "pq
                      "pqrrt-unshared": qc.PQRRT}
 
 
-def _cli_choices(command: str, option: str) -> tuple[str, ...]:
+def _cli_action(command: str, option: str) -> argparse.Action:
     parser = build_parser()
     sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices[command]
-    return tuple(next(a for a in sub._actions if option in a.option_strings).choices)
+    return next(a for a in sub._actions if option in a.option_strings)
+
+
+def _cli_choices(command: str, option: str) -> tuple[str, ...]:
+    return tuple(_cli_action(command, option).choices)
 
 
 def test_every_cli_choice_comes_from_the_registry():
     assert _cli_choices("plan", "--planner") == PLANNERS.names()
-    assert _cli_choices("plan", "--backend") == BACKENDS.names() == _cli_choices("search", "--backend")
+    assert tuple(_cli_action("plan", "--backend").metavar.split("|")) == BACKENDS.names() == \
+        _cli_choices("search", "--backend")
+    assert tuple(_cli_action("plan", "--policy").metavar.split("|")) == POLICIES.labels()
     assert _cli_choices("plan", "--scenario") == SCENARIOS.names()
     help_text = build_parser()._subparsers._group_actions[0].choices["plan"].format_help()
     for label in POLICIES.labels() + PREDICATES.labels():
@@ -31,10 +37,13 @@ def test_every_cli_choice_comes_from_the_registry():
 @pytest.mark.parametrize("name", list(PLANNERS))
 def test_every_planner_name_builds_its_class_and_plans(name, clutter):
     options = {"seed": 1, "workers": 3, "num_qubits": 5, "backend": qc.StatevectorBackend(1)}
-    planner = PLANNERS.create(name, env=clutter, **PLANNERS.applicable(name, options))
+    takes = PLANNERS.resolve(name).options()
+    planner = PLANNERS.create(name, **{key: value for key, value in options.items() if key in takes})
     assert type(planner) is EXPECTED_PLANNERS[name]
     assert getattr(planner, "shared_database", None) == {"qrrt": True, "pqrrt": True, "pqrrt-unshared": False}.get(name)
-    assert planner.plan(max_rounds=2).metrics.rounds == 2
+    assert planner.plan(clutter, max_rounds=2).metrics.rounds == 2
+    assert takes == {spec.name for spec in PLANNERS.resolve(name).specs} | (
+        {"executor"} if EXPECTED_PLANNERS[name].takes_executor else set())
 
 
 @pytest.mark.parametrize("name", list(PLANNERS))
@@ -79,9 +88,9 @@ def test_policies_including_parametric_ones():
 
 
 def test_scenarios_and_predicates(clutter):
-    assert SCENARIOS.create("paper_clutter", seed=0).boxes.tobytes() == clutter.boxes.tobytes()
-    assert isinstance(PREDICATES.create("exact", env=clutter), qc.ExactCheck)
-    sampled = PREDICATES.create("time-samples:20", env=clutter)
+    assert SCENARIOS.create("paper_clutter", seed=0).env.boxes.tobytes() == clutter.env.boxes.tobytes()
+    assert isinstance(PREDICATES.create("exact", env=clutter.env), qc.ExactCheck)
+    sampled = PREDICATES.create("time-samples:20", env=clutter.env)
     assert isinstance(sampled, qc.TimeSampledCheck) and sampled.time_samples == 20
 
 
@@ -97,10 +106,15 @@ def test_unknown_names_list_the_choices(registry, kind):
         registry.resolve(3)
 
 
-def test_options_that_do_not_apply_are_refused(clutter):
+def test_options_that_do_not_apply_are_refused():
     with pytest.raises(ValueError, match=r"option\(s\) \['backend'\] do not apply to planner 'rrt'"):
-        PLANNERS.create("rrt", env=clutter, backend=qc.StatevectorBackend())
-    assert PLANNERS.applicable("qrrt", {"workers": 4, "num_qubits": 5}) == {"num_qubits": 5}
+        PLANNERS.create("rrt", backend=qc.StatevectorBackend())
+    with pytest.raises(ValueError, match=r"option\(s\) \['shared_database'\] do not apply to planner 'pqrrt'"):
+        PLANNERS.create("pqrrt", shared_database=False)  # (the entry fixes it)
+    with pytest.raises(ValueError, match=r"option\(s\) \['executor'\] do not apply to planner 'qrrt'"):
+        PLANNERS.create("qrrt", executor=None)
+    with pytest.raises(TypeError, match="QRRT does not take workers"):
+        qc.QRRT(workers=4)
 
 
 def test_a_name_is_registered_once():

@@ -46,11 +46,11 @@ class Metrics:
             calls.
 
     Example:
-        >>> from qrrt_circuits import QRRT, Environment, PaperIterations, StatevectorBackend
-        >>> env = Environment([[0, 10], [0, 10]], [], start=[1, 1], goal=[9, 9], goal_radius=1.0)
-        >>> planner = QRRT(env, backend=StatevectorBackend(seed=0), num_qubits=3, seed=0,
+        >>> from qrrt_circuits import QRRT, Environment, PaperIterations, Problem, StatevectorBackend
+        >>> problem = Problem.build(Environment([[0, 10], [0, 10]], []), [1, 1], [9, 9], 1.0)
+        >>> planner = QRRT(backend=StatevectorBackend(seed=0), num_qubits=3, seed=0,
         ...                search_policy=PaperIterations())
-        >>> metrics = planner.plan(max_rounds=5).metrics
+        >>> metrics = planner.plan(problem, max_rounds=5).metrics
         >>> metrics.oracle_calls, metrics.quantum_oracle_calls, metrics.verification_calls
         (6, 5, 1)
         >>> metrics["simulation_checks"]  # 2^3 predicate evaluations built the phase oracle
@@ -115,11 +115,11 @@ class PlanResult:
             set), not one of the caller's.
 
     Example:
-        >>> from qrrt_circuits import QRRT, Environment, PaperIterations, StatevectorBackend
-        >>> env = Environment([[0, 10], [0, 10]], [], start=[1, 1], goal=[9, 9], goal_radius=1.0)
-        >>> planner = QRRT(env, backend=StatevectorBackend(seed=0), num_qubits=3, seed=0,
+        >>> from qrrt_circuits import QRRT, Environment, PaperIterations, Problem, StatevectorBackend
+        >>> problem = Problem.build(Environment([[0, 10], [0, 10]], []), [1, 1], [9, 9], 1.0)
+        >>> planner = QRRT(backend=StatevectorBackend(seed=0), num_qubits=3, seed=0,
         ...                search_policy=PaperIterations())
-        >>> result = planner.plan(max_rounds=5)
+        >>> result = planner.plan(problem, max_rounds=5)
         >>> result.status, result.reached
         (<PlanStatus.REACHED: 'reached'>, True)
         >>> result.nodes.shape, result.parents.tolist(), result.goal_node
@@ -151,10 +151,10 @@ class PlanResult:
         changes it.
 
         Example:
-            >>> from qrrt_circuits import RRT, Environment
+            >>> from qrrt_circuits import RRT, Environment, Problem
             >>> ring = [[[4, 4], [6, 4.99]], [[4, 5.01], [6, 6]], [[4, 4.99], [4.99, 5.01]], [[5.01, 4.99], [6, 5.01]]]
-            >>> env = Environment([[0, 10], [0, 10]], ring, start=[5, 5], goal=[9, 9], goal_radius=0.5)
-            >>> result = RRT(env, seed=0).plan(max_nodes=5)  # the start is walled in
+            >>> problem = Problem.build(Environment([[0, 10], [0, 10]], ring), [5, 5], [9, 9], 0.5)
+            >>> result = RRT(seed=0).plan(problem, max_nodes=5)  # the start is walled in
             >>> result.safety_limit, result.status_text[:71]
             (True, 'ended by a safety limit, not one you set: 5000 rounds in a row added no')
         """

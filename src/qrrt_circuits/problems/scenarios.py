@@ -310,7 +310,7 @@ def by_name(name: str, seed: int | None = 0) -> Problem:
         RuntimeError: The scenario could not place its start and goal (see each scenario).
 
     Example:
-        >>> from qrrt_circuits import scenarios
+        >>> from qrrt_circuits.problems import scenarios
         >>> problem = scenarios.by_name("narrow_corridor")
         >>> problem.name, problem.dim, problem.goal.radius
         ('narrow_corridor', 2, 0.75)
