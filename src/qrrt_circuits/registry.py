@@ -157,7 +157,7 @@ class Registry:
             tags: Free labels.
             parameter_optional: Whether the bare name is accepted too (the factory gets None).
             declared: The options the factory takes, where it declares them (else its signature's).
-            specs: Their declarations (a planner's ``OptionSpec``s).
+            specs: Their declarations (a planner's option specifications, ``OptionSpec``).
 
         Returns:
             The new ``Entry``.

@@ -83,7 +83,7 @@ def test_write_json_is_to_dict(make):
     env = qc.paper_clutter(seed=1)
     paths = []
     for max_nodes in (3, 400):
-        result = make(env).plan(max_nodes=max_nodes)
+        result = make(env).plan(env, max_nodes=max_nodes)
         handle = io.StringIO()
         result.write_json(handle)
         assert json.loads(handle.getvalue()) == json.loads(json.dumps(result.to_dict(), indent=1))
@@ -97,7 +97,7 @@ def test_write_json_holds_one_chunk_not_the_tree(tmp_path):
     import dataclasses
     import tracemalloc
 
-    small = qc.RRT(qc.paper_clutter(seed=1), seed=1).plan(max_nodes=3)
+    small = qc.RRT(seed=1).plan(qc.paper_clutter(seed=1), max_nodes=3)
     rows = 50_000
     rng = np.random.default_rng(0)
     big = dataclasses.replace(small, nodes=rng.random((rows, 2)), parents=rng.integers(0, rows, rows))
@@ -131,7 +131,7 @@ def test_string_arrays_holding_the_row_separator_stay_valid():
 def test_to_dict_takes_scalars_with_tolist_as_before():
     import dataclasses
 
-    small = qc.RRT(qc.paper_clutter(seed=1), seed=1).plan(max_nodes=3)
+    small = qc.RRT(seed=1).plan(qc.paper_clutter(seed=1), max_nodes=3)
     odd = dataclasses.replace(small, history={"x": np.int64(3), "y": np.float64(0.5)})
     assert odd.to_dict()["history"] == {"x": 3, "y": 0.5}
     handle = io.StringIO()
