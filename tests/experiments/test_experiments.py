@@ -694,7 +694,7 @@ def test_heatmaps_share_one_colour_scale(tmp_path, monkeypatch):
     images = [image for ax in fig.axes for image in ax.images]
     assert 1 <= len(images) <= 9  # a panel without nodes has no image
     assert len({id(image.norm) for image in images}) == 1
-    env = world(settings["scenario"], settings["world_seed"])
+    env = world(settings["scenario"], settings["world_seed"]).env
     largest = max(float(image.get_array().max()) for image in images)
     assert images[0].norm.vmax == max(largest, 2.0)
     assert images[0].norm.vmin == 1
