@@ -23,9 +23,9 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
 import numpy as np
 from _common import machine, median_time, write_json
+from planner_checks import posed
 
 import qrrt_circuits as qc
-from planner_checks import posed
 from qrrt_circuits.planners.tree import Tree, _brute_block
 
 QUERIES = 256

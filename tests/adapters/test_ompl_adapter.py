@@ -11,8 +11,9 @@ import pytest
 
 ob = pytest.importorskip("ompl.base")
 
-import qrrt_circuits as qc  # noqa: E402
 from planner_checks import posed  # noqa: E402
+
+import qrrt_circuits as qc  # noqa: E402
 from qrrt_circuits.adapters.ompl import OMPLMotionPredicate, from_environment  # noqa: E402
 from qrrt_circuits.reachability.predicate import check_predicate  # noqa: E402
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from conftest import make_backend
+from planner_checks import posed
 
 import qrrt_circuits as qc
-from planner_checks import posed
 from qrrt_circuits.problems.goals import first_satisfying, sample_goal
 
 

@@ -4,11 +4,10 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pytest
 from conftest import BACKENDS, make_backend
-from planner_checks import assert_path_valid, assert_tree_edges_valid
+from planner_checks import assert_path_valid, assert_tree_edges_valid, posed
 from tolerances import binomial_counts, z_bound
 
 import qrrt_circuits as qc
-from planner_checks import posed
 from qrrt_circuits.registry import PLANNERS
 from qrrt_circuits.world.environment import Environment
 

@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 
-from qrrt_circuits.problems.goals import GoalBall, in_ball
 from qrrt_circuits.planners.run_state import RunState
+from qrrt_circuits.problems.goals import GoalBall, in_ball
 
 
 def first_in_ball(points, centre, radius):

@@ -6,9 +6,9 @@ import math
 
 import numpy as np
 import pytest
+from planner_checks import posed
 
 import qrrt_circuits as qc
-from planner_checks import posed
 from qrrt_circuits.planners.termination import (
     DEFAULT_MAX_NODES,
     Progress,
@@ -35,6 +35,16 @@ def boxed_in():
     boxes = [[[4, 4], [6, 5 - gap]], [[4, 5 + gap], [6, 6]], [[4, 5 - gap], [5 - gap, 5 + gap]],
              [[5 + gap, 5 - gap], [6, 5 + gap]]]
     return Environment(np.array([[0, 20], [0, 20]]), np.array(boxes, dtype=float))
+
+
+def _walled_from(walled, start):
+    """The walled world's problem from ``start`` toward the walled-in goal (16, 16)."""
+    return posed(walled, start=start, goal=[16, 16], goal_radius=0.5)
+
+
+def _boxed(boxed_in):
+    """The boxed-in world's problem from (5, 5), inside the pocket."""
+    return posed(boxed_in, start=[5, 5], goal=[15, 15], goal_radius=0.5)
 
 
 def _applicable(name, options):
@@ -69,7 +79,7 @@ def test_wall_time_condition_on_progress_and_on_a_plan(walled):
     assert condition.ended_by(progress(elapsed_s=0.49)) is None
     assert condition.ended_by(progress(elapsed_s=0.5)) == "max_time_s"
     # a limit far below one round's time ends the plan before its first round
-    result = qc.RRT(seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), max_time_s=1e-12)
+    result = qc.RRT(seed=0).plan(_walled_from(walled, [1, 1]), max_time_s=1e-12)
     assert result.status == "max_time_s" and result.metrics.rounds == 0
 
 
@@ -88,7 +98,7 @@ def test_combined_conditions_name_the_first_that_fires():
 def test_oracle_call_budget_on_a_plan(budget, walled):
     for planner in (qc.RRT(seed=0), qc.QRRT(backend=qc.StatevectorBackend(0), seed=0,
                                                      search_policy=qc.FixedIterations(2))):
-        result = planner.plan(posed(walled, start=[2, 2], goal=[16, 16], goal_radius=0.5), max_oracle_calls=budget)
+        result = planner.plan(_walled_from(walled, [2, 2]), max_oracle_calls=budget)
         calls = result.history["oracle_calls"]
         assert result.status == "max_oracle_calls"
         # the plan stops after the first round that reaches the budget, and not before
@@ -100,7 +110,7 @@ def test_critical_path_budget_stops_parallel_workers_on_their_own_time(walled):
     so a critical-path budget of 40 ends the plan after ceil(40 / 3) = 14 rounds."""
     k, p, budget = 2, 8, 40
     result = qc.PQRRT(backend=qc.StatevectorBackend(0), workers=p, search_policy=qc.FixedIterations(k),
-                      seed=1).plan(posed(walled, start=[2, 2], goal=[16, 16], goal_radius=0.5), max_critical_path_calls=budget)
+                      seed=1).plan(_walled_from(walled, [2, 2]), max_critical_path_calls=budget)
     rounds = math.ceil(budget / (k + 1))
     assert result.status == "max_critical_path_calls"
     assert result.metrics.rounds == rounds
@@ -122,7 +132,7 @@ def test_stall_ends_a_plan_that_cannot_add_nodes(planner_name, boxed_in):
 
     options = {"seed": 0, "workers": 3, "num_qubits": 5, "backend": qc.StatevectorBackend(0)}
     planner = PLANNERS.create(planner_name, **_applicable(planner_name, options))
-    result = planner.plan(posed(boxed_in, start=[5, 5], goal=[15, 15], goal_radius=0.5), stall_rounds=9, max_nodes=50)
+    result = planner.plan(_boxed(boxed_in), stall_rounds=9, max_nodes=50)
     assert result.status == qc.PlanStatus.STALLED
     assert result.metrics.nodes == 0 and result.metrics.rounds == 9
 
@@ -135,13 +145,13 @@ def test_stall_counts_consecutive_rounds_only(clutter):
 
 
 def test_termination_argument_combines_with_the_shorthands(walled):
-    result = qc.RRT(seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), termination=qc.MaxRounds(30), max_oracle_calls=12)
+    result = qc.RRT(seed=0).plan(_walled_from(walled, [1, 1]), termination=qc.MaxRounds(30), max_oracle_calls=12)
     assert result.status == "max_oracle_calls" and result.metrics.rounds == 12
     assert result.settings["termination"] == {"max_rounds": 30, "max_oracle_calls": 12,
                                               "max_nodes": DEFAULT_MAX_NODES}  # budgets: no stall limit
     assert not result.safety_limit and "ended by a limit you set" in result.status_text
     with pytest.raises(TypeError, match="termination must be a TerminationCondition"):
-        qc.RRT().plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), termination=30)
+        qc.RRT().plan(_walled_from(walled, [1, 1]), termination=30)
 
 
 def test_a_round_limit_is_always_in_force():
@@ -182,7 +192,7 @@ def test_default_stall_ends_a_plan_given_only_a_node_budget(monkeypatch, boxed_i
     from qrrt_circuits.planners import termination
 
     monkeypatch.setattr(termination, "DEFAULT_STALL_ROUNDS", 25)
-    result = qc.RRT(seed=0).plan(posed(boxed_in, start=[5, 5], goal=[15, 15], goal_radius=0.5), max_nodes=5)
+    result = qc.RRT(seed=0).plan(_boxed(boxed_in), max_nodes=5)
     assert result.status == "stalled" and result.metrics.rounds == 25
     assert result.to_dict()["safety_limit"] is True
     assert with_defaults(qc.Stall(3)) == (qc.Stall(3) | qc.MaxRounds(termination.DEFAULT_MAX_ROUNDS)
@@ -279,10 +289,10 @@ def test_a_node_limit_is_always_in_force(walled, monkeypatch):
     from qrrt_circuits.planners import termination
 
     monkeypatch.setattr(termination, "DEFAULT_MAX_NODES", 40)
-    result = qc.ParallelRRT(workers=8, seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5))
+    result = qc.ParallelRRT(workers=8, seed=0).plan(_walled_from(walled, [1, 1]))
     assert result.status == "max_nodes" and 40 <= result.metrics.nodes < 40 + 8
     assert result.settings["termination"]["max_nodes"] == 40
-    own = qc.ParallelRRT(workers=8, seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), max_nodes=60)
+    own = qc.ParallelRRT(workers=8, seed=0).plan(_walled_from(walled, [1, 1]), max_nodes=60)
     assert own.status == "max_nodes" and 60 <= own.metrics.nodes < 68
     assert own.settings["termination"]["max_nodes"] == 60
 
@@ -306,11 +316,11 @@ def test_limits_whose_tree_or_history_exceed_memory_are_refused_before_any_work(
     monkeypatch.setattr(memory, "available_memory", lambda: (1 << 30, memory.MACHINE_SOURCE))
     planner = qc.RRT(seed=0)
     with pytest.raises(ValueError, match=r"max_rounds = 1000000000: .* the largest max_rounds that fits is about"):
-        planner.plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), max_rounds=10**9,
+        planner.plan(_walled_from(walled, [1, 1]), max_rounds=10**9,
                      stall_rounds=10**9)
     with pytest.raises(ValueError, match=r"max_nodes = 1000000000: .* the largest max_nodes that fits is about"):
-        qc.ParallelRRT(workers=4096, seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), max_nodes=10**9)
-    assert planner.plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), max_rounds=50,
+        qc.ParallelRRT(workers=4096, seed=0).plan(_walled_from(walled, [1, 1]), max_nodes=10**9)
+    assert planner.plan(_walled_from(walled, [1, 1]), max_rounds=50,
                         stall_rounds=50).metrics.rounds == 50
 
 
@@ -382,9 +392,9 @@ class _OwnLimit(_UserCondition):
 ])
 def test_a_user_condition_with_a_bad_node_limit_is_refused(walled, value, error, message):
     with pytest.raises(error, match=message):
-        qc.RRT(seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), termination=_OwnLimit(value), max_rounds=30)
+        qc.RRT(seed=0).plan(_walled_from(walled, [1, 1]), termination=_OwnLimit(value), max_rounds=30)
     with pytest.raises(error, match=message):
-        qc.RRT(seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), termination=_OwnLimit(value) | qc.Stall(5))
+        qc.RRT(seed=0).plan(_walled_from(walled, [1, 1]), termination=_OwnLimit(value) | qc.Stall(5))
 
 
 def test_numpy_limits_are_python_ints_and_the_memory_check_sees_them(walled, monkeypatch):
@@ -398,10 +408,11 @@ def test_numpy_limits_are_python_ints_and_the_memory_check_sees_them(walled, mon
     assert type(limit.limit) is int
     monkeypatch.setattr(memory, "available_memory", lambda: (1 << 30, memory.MACHINE_SOURCE))
     with pytest.raises(ValueError, match="max_rounds = 72057594037927936"):
-        qc.RRT(seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), termination=limit, max_nodes=5)
+        qc.RRT(seed=0).plan(_walled_from(walled, [1, 1]), termination=limit, max_nodes=5)
     with pytest.raises(ValueError, match="max_nodes = 288230376151711744"):
-        qc.ParallelRRT(workers=4096, seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), termination=qc.MaxNodes(np.int64(2**58)))
-    result = qc.RRT(seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), termination=qc.MaxRounds(np.int64(7)))
+        qc.ParallelRRT(workers=4096, seed=0).plan(_walled_from(walled, [1, 1]),
+                                                  termination=qc.MaxNodes(np.int64(2**58)))
+    result = qc.RRT(seed=0).plan(_walled_from(walled, [1, 1]), termination=qc.MaxRounds(np.int64(7)))
     assert result.metrics.rounds == 7 and json.dumps(result.settings["termination"])
 
 
@@ -420,7 +431,8 @@ def test_describe_merges_user_settings_without_comparing_them(walled):
     """Only this module's limits take the smaller value; a user's keys keep the last value (a
     minimum over None or dicts raised after the plan had run)."""
     for first, last in ((None, None), ({"x": 1}, {"x": 2}), ([1], "s")):
-        result = qc.RRT(seed=0).plan(posed(walled, start=[1, 1], goal=[16, 16], goal_radius=0.5), max_rounds=5, termination=_UserCondition(first) | _UserCondition(last))
+        result = qc.RRT(seed=0).plan(_walled_from(walled, [1, 1]), max_rounds=5,
+                                     termination=_UserCondition(first) | _UserCondition(last))
         assert result.settings["termination"]["user_note"] == last
 
 
@@ -528,14 +540,14 @@ def test_a_budget_is_never_cut_by_a_safety_limit(monkeypatch, boxed_in, planner)
     monkeypatch.setattr(termination, "DEFAULT_MAX_ROUNDS", 40)
     make = {"RRT": lambda: qc.RRT(seed=0),
             "QRRT": lambda: qc.QRRT(backend=qc.StatevectorBackend(seed=0), num_qubits=3, seed=0)}[planner]
-    result = make().plan(posed(boxed_in, start=[5, 5], goal=[15, 15], goal_radius=0.5), max_oracle_calls=300)
+    result = make().plan(_boxed(boxed_in), max_oracle_calls=300)
     assert result.status == "max_oracle_calls" and not result.safety_limit
     assert 300 <= result.metrics.oracle_calls and result.metrics.nodes == 0
     assert result.settings["termination"]["max_rounds"] == 301 and "stall_rounds" not in result.settings["termination"]
-    timed = make().plan(posed(boxed_in, start=[5, 5], goal=[15, 15], goal_radius=0.5), max_critical_path_calls=100)
+    timed = make().plan(_boxed(boxed_in), max_critical_path_calls=100)
     assert timed.status == "max_critical_path_calls" and timed.metrics.critical_path_oracle_calls >= 100
     # without a budget the safety limits end it, and say so
-    unbounded = make().plan(posed(boxed_in, start=[5, 5], goal=[15, 15], goal_radius=0.5), max_nodes=3)
+    unbounded = make().plan(_boxed(boxed_in), max_nodes=3)
     assert unbounded.status == "stalled" and unbounded.safety_limit and unbounded.metrics.rounds == 25
 
 

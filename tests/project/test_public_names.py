@@ -7,9 +7,9 @@ import importlib
 from pathlib import Path
 
 import pytest
+from planner_checks import posed
 
 import qrrt_circuits as qc
-from planner_checks import posed
 
 ROOT = Path(qc.__file__).resolve().parent
 

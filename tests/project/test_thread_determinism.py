@@ -5,9 +5,9 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pytest
 from conftest import ALL_BACKENDS, make_backend
+from planner_checks import posed
 
 import qrrt_circuits as qc
-from planner_checks import posed
 
 
 @pytest.mark.parametrize("backend_name", ALL_BACKENDS)

@@ -4,10 +4,10 @@ the built-in ones describe themselves; bad predicates are refused with the reaso
 import numpy as np
 import pytest
 from conftest import BACKENDS, make_backend
+from planner_checks import posed
 from reference import penetration_and_clearance
 
 import qrrt_circuits as qc
-from planner_checks import posed
 from qrrt_circuits.plotting import edge_curves, plan_dynamics
 from qrrt_circuits.reachability.predicate import check_predicate
 from qrrt_circuits.registry import PLANNERS

@@ -13,7 +13,6 @@ import numpy as np
 import pytest
 
 import qrrt_circuits as qc
-from planner_checks import posed
 from qrrt_circuits import cli
 from qrrt_circuits._support import memory
 

@@ -3,10 +3,10 @@ import math
 
 import numpy as np
 import pytest
+from planner_checks import posed
 from tolerances import z_bound
 
 import qrrt_circuits as qc
-from planner_checks import posed
 from qrrt_circuits.problems import scenarios
 from qrrt_circuits.problems.families import box_world, save_box_world
 from qrrt_circuits.world.environment import Environment

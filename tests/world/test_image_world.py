@@ -22,9 +22,9 @@ from fractions import Fraction
 import matplotlib
 import numpy as np
 import pytest
+from planner_checks import posed
 
 import qrrt_circuits as qc
-from planner_checks import posed
 from qrrt_circuits.plotting import plan_dynamics
 from qrrt_circuits.reachability.grid_check import EPSILON
 from qrrt_circuits.world.image import MAX_CELLS
