@@ -49,6 +49,7 @@ if TYPE_CHECKING:
     from .world import scenarios
     from .world.environment import Environment
     from .world.image import OccupancyGrid
+    from .world.nearest import GridNearest, LinearNearest, NearestNeighbors
     from .world.spaces import RealVectorSpace, SE2Space, StateSpace
 
     __version__: str
@@ -66,6 +67,7 @@ _WHERE = {
     **dict.fromkeys(["Candidates", "LatticeCandidates", "NearestParents"], ".planners.candidates"),
     **dict.fromkeys(["Goal", "GoalBall", "GoalState"], ".planners.goals"),
     **dict.fromkeys(["RealVectorSpace", "SE2Space", "StateSpace"], ".world.spaces"),
+    **dict.fromkeys(["GridNearest", "LinearNearest", "NearestNeighbors"], ".world.nearest"),
     "termination": ".planners.termination",
     **dict.fromkeys(["AnyOf", "MaxCriticalPathCalls", "MaxNodes", "MaxOracleCalls", "MaxRounds", "MaxWallTime",
                      "PlanStatus", "Stall", "TerminationCondition"], ".planners.termination"),
@@ -142,6 +144,9 @@ __all__ = [
     "GoalBall",
     "GoalState",
     "GridCheck",
+    "GridNearest",
+    "LinearNearest",
+    "NearestNeighbors",
     "RealVectorSpace",
     "SE2Space",
     "StateSpace",

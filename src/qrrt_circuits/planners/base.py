@@ -64,7 +64,7 @@ __all__ = ["Metrics", "PlanResult", "Planner", "RunState"]
 
 
 #: the members a state space must have (``world.spaces.StateSpace``)
-SPACE_MEMBERS = ("dim", "distance", "interpolate", "nearest", "check_bounds", "describe")
+SPACE_MEMBERS = ("dim", "distance", "interpolate", "nearest_neighbors", "check_bounds", "describe")
 
 
 def check_space(space: Any, env: Environment) -> StateSpace:
@@ -316,7 +316,7 @@ class Planner:
                       safety: frozenset[PlanStatus]) -> PlanResult:
         """The plan after its checks: the run state, the rounds and the result (``safety``: the
         statuses of the safety limits added to the caller's condition)."""
-        state = RunState(start, goal)
+        state = RunState(start, goal, self.space.nearest_neighbors())  # the plan's structure, chosen once
         state.policy_state = self._start_policy()
         state.context = self._context()
         began = time.perf_counter()
@@ -418,7 +418,7 @@ class Planner:
                              max_extension=self.max_extension, space=self.space)
 
     def _view(self, state: RunState, temperature_index: int = 0) -> RoundView:
-        return RoundView(state.tree, state.goal, state.rounds, temperature_index,
+        return RoundView(state.tree, state.neighbors, state.goal, state.rounds, temperature_index,
                          state.policy_state)
 
     # ----------------------------------------------------------------- reporting

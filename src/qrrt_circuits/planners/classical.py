@@ -163,7 +163,7 @@ class ParallelRRT(Planner):
                 keys[:, 2] = int(Stream.CANDIDATES)
                 drawn = np.concatenate((drawn[:kept * workers], self._candidates(state, keys)))
             samples = drawn[:ahead * workers]  # kept raw: a round tested again is steered from its new parents
-            parents = self.space.nearest(state.tree, samples)
+            parents = state.neighbors.nearest(samples)
             children = steer(self.space, state.tree.nodes[parents], samples, self.max_extension)
             truth = self._test(state, state.tree.nodes[parents], children)
             for offset in range(ahead):

@@ -18,7 +18,7 @@ import abc
 import numpy as np
 
 from ..world.environment import Environment
-from ..world.spaces import StateSpace
+from ..world.nearest import NearestNeighbors
 from .goals import Goal, sample_goal
 from .tree import Tree
 
@@ -45,18 +45,21 @@ class Placement(abc.ABC):
     """One reading of Alg. 4, line 7: the candidates (and their nearest nodes) of one database."""
 
     @abc.abstractmethod
-    def candidates(self, tree: Tree, size: int, env: Environment, rng: np.random.Generator, goal: Goal | None,
-                   goal_bias: float, band: tuple[float, float], space: StateSpace) -> tuple[np.ndarray, np.ndarray]:
-        """``size`` candidates placed for the band, and the tree row of each one's parent."""
+    def candidates(self, tree: Tree, neighbors: NearestNeighbors, size: int, env: Environment,
+                   rng: np.random.Generator, goal: Goal | None, goal_bias: float,
+                   band: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+        """``size`` candidates placed for the band, and the tree row of each one's parent (its
+        nearest node, found by ``neighbors``, the tree's structure)."""
 
 
 class _Moved(Placement):
     """Samples paired with their nearest nodes, then moved along P -> t to a distance in the band."""
 
-    def candidates(self, tree: Tree, size: int, env: Environment, rng: np.random.Generator, goal: Goal | None,
-                   goal_bias: float, band: tuple[float, float], space: StateSpace) -> tuple[np.ndarray, np.ndarray]:
+    def candidates(self, tree: Tree, neighbors: NearestNeighbors, size: int, env: Environment,
+                   rng: np.random.Generator, goal: Goal | None, goal_bias: float,
+                   band: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
         samples = uniform_samples(size, env, rng, goal, goal_bias)
-        parents = space.nearest(tree, samples)
+        parents = neighbors.nearest(samples)
         origin = tree.nodes[parents]
         offset = samples - origin
         norm = np.linalg.norm(offset, axis=1)
@@ -106,14 +109,15 @@ class AdmitPlacement(Placement):
         RuntimeError: Fewer than ``size`` admitted in ``ADMIT_DRAWS_PER_ENTRY * size`` samples.
     """
 
-    def candidates(self, tree: Tree, size: int, env: Environment, rng: np.random.Generator, goal: Goal | None,
-                   goal_bias: float, band: tuple[float, float], space: StateSpace) -> tuple[np.ndarray, np.ndarray]:
+    def candidates(self, tree: Tree, neighbors: NearestNeighbors, size: int, env: Environment,
+                   rng: np.random.Generator, goal: Goal | None, goal_bias: float,
+                   band: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
         kept_samples: list[np.ndarray] = []
         kept_parents: list[np.ndarray] = []
         admitted = 0
         for _ in range(ADMIT_DRAWS_PER_ENTRY):
             samples = uniform_samples(size, env, rng, goal, goal_bias)
-            parents = space.nearest(tree, samples)
+            parents = neighbors.nearest(samples)
             distance = np.linalg.norm(samples - tree.nodes[parents], axis=1)
             inside = (distance >= band[0]) & (distance <= band[1])
             kept_samples.append(samples[inside])
