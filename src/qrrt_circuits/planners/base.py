@@ -24,7 +24,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from concurrent.futures import Executor
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -56,9 +56,6 @@ from .termination import (
     safety_limits,
     with_defaults,
 )
-
-if TYPE_CHECKING:
-    from ..search.policies.base import PolicyState
 
 __all__ = ["Metrics", "PlanResult", "Planner", "RunState"]
 
@@ -106,9 +103,10 @@ class Planner:
     """Base class of the planners: checks the problem, runs rounds until the goal or the
     termination condition, and reports.
 
-    Subclasses define one round (``_round``: the paper's Alg. 1-3; ``ParallelRRT`` records its
-    rounds in batches, ``_run``) and their own settings. ``RRT``, ``ParallelRRT``, ``QRRT`` and
-    ``PQRRT`` document only their own arguments; the ones they share are documented here, once.
+    Subclasses define one round (``_round``: the paper's Alg. 1-3), what their rounds carry from
+    one to the next (``_start_rounds``) and their own settings; ``_run`` is the one round loop.
+    ``RRT``, ``ParallelRRT``, ``QRRT`` and ``PQRRT`` document only their own arguments; the ones
+    they share are documented here, once.
 
     Arguments every planner takes (all keyword-only after ``env``):
 
@@ -317,8 +315,8 @@ class Planner:
         """The plan after its checks: the run state, the rounds and the result (``safety``: the
         statuses of the safety limits added to the caller's condition)."""
         state = RunState(start, goal, self.space.nearest_neighbors())  # the plan's structure, chosen once
-        state.policy_state = self._start_policy()
         state.context = self._context()
+        self._start_rounds(state)
         began = time.perf_counter()
         status = self._run(state, condition, began)
         elapsed = time.perf_counter() - began
@@ -406,8 +404,9 @@ class Planner:
         of n, the plan's n); (None, 0) here, a plan without databases."""
         return None, 0
 
-    def _start_policy(self) -> PolicyState | None:
-        return None
+    def _start_rounds(self, state: RunState) -> None:
+        """Set up, once per plan, what the rounds carry from one to the next (the quantum planners'
+        policy state, the classical planners' tests made ahead); nothing here."""
 
     def _round(self, state: RunState) -> None:
         raise NotImplementedError

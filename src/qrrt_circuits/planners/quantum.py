@@ -32,7 +32,7 @@ from ..reachability.oracle_errors import OracleErrorModel
 from ..reachability.predicate import ReachabilityPredicate
 from ..search.backends.base import QuantumSearchBackend
 from ..search.policies.adaptive import Adaptive
-from ..search.policies.base import IterationPolicy, PolicyState
+from ..search.policies.base import IterationPolicy
 from ..search.policies.thompson import ThompsonIterations
 from ..world.environment import Environment
 from ..world.spaces import StateSpace
@@ -192,8 +192,9 @@ class PQRRT(Planner):
         """N = 2^n, the entries of each database."""
         return 1 << self.num_qubits
 
-    def _start_policy(self) -> PolicyState:
-        return self.search_policy.start(self.database_size)
+    def _start_rounds(self, state: RunState) -> None:
+        """The search policy's state of this plan."""
+        state.policy_state = self.search_policy.start(self.database_size)
 
     def _max_new_nodes_per_round(self) -> int:
         """p: each worker adds at most one node a round."""

@@ -14,6 +14,7 @@ from .tree import Tree
 if TYPE_CHECKING:  # annotations only (context imports the search modules)
     from ..search.policies.base import PolicyState
     from ..world.nearest import NearestNeighbors
+    from .classical import LookAhead
     from .context import WorkerContext
 
 HISTORY_KEYS = ("oracle_calls", "critical_path", "nodes", "entries", "reachable")
@@ -51,6 +52,7 @@ class RunState:
         self._nodes_at_round_start = 0
         self.policy_state: PolicyState | None = None  # quantum planners only
         self.context: WorkerContext | None = None  # the plan's WorkerContext, built once
+        self.ahead: LookAhead | None = None  # classical planners only
 
     @property
     def worker_context(self) -> WorkerContext:
@@ -65,6 +67,13 @@ class RunState:
         if self.policy_state is None:
             raise RuntimeError("this plan has no search policy state (a classical planner's)")
         return self.policy_state
+
+    @property
+    def tests_ahead(self) -> LookAhead:
+        """The classical planners' tests made ahead (set when the plan starts)."""
+        if self.ahead is None:
+            raise RuntimeError("this plan tests no extensions ahead (a quantum planner's)")
+        return self.ahead
 
     @property
     def oracle_calls(self) -> int:
