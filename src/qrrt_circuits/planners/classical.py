@@ -32,7 +32,7 @@ from concurrent.futures import Executor
 
 import numpy as np
 
-from .._support.randomness import Stream
+from .._support.randomness import Stream, round_keys
 from .._support.validation import check_bool, check_int
 from ..reachability.dynamics import LinearTrackingDynamics
 from ..reachability.oracle_errors import OracleErrorModel
@@ -145,10 +145,7 @@ class LookAhead:
         drawn = drawn[(first - self.drawn_from) * workers:]  # (the rounds used are dropped)
         kept = min(drawn.shape[0] // workers, ahead)  # a round's candidates depend on its key only
         if kept < ahead:
-            keys = np.empty(((ahead - kept) * workers, 3), dtype=np.int64)
-            keys[:, 0] = np.repeat(np.arange(first + kept, first + ahead), workers)
-            keys[:, 1] = np.tile(np.arange(workers), ahead - kept)
-            keys[:, 2] = int(Stream.CANDIDATES)
+            keys = round_keys(first + kept, ahead - kept, workers, int(Stream.CANDIDATES))
             drawn = np.concatenate((drawn[:kept * workers], self.draw(state, keys)))
         self.drawn, self.drawn_from = drawn, first
         # the raw samples are kept: a round tested again is steered from its new parents
