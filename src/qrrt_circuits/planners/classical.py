@@ -44,6 +44,7 @@ from .context import map_tasks
 from .database import steer
 from .placement import keyed_samples
 from .run_state import RunState
+from .tree import Tree
 from .workers import check_extensions
 
 MAX_WORKERS = 4096
@@ -99,26 +100,27 @@ class LookAhead:
 
     ``round`` hands a round its p (children, parents, truth): from the batch tested last, if that
     batch holds the round and the tree is still the one it was tested against; else from a new
-    batch, the next B rounds' candidates (kept from the draw of a batch before, or drawn now) tested
-    in one call.
+    batch, the next B rounds' candidates (kept from the draw of a batch before, or drawn now)
+    tested in one call.
+
     ``RunState.wasted_checks`` counts the tests made ahead and not used: a batch of B rounds adds
     (B - 1) p, each round served from it takes p away.
 
     Args:
         workers: p, the extensions of one round.
         most: The most rounds one batch tests (``batch_round_limit``, or 1).
-        size: The tree's nodes when the plan starts.
+        tree: The plan's tree as the plan starts (its d and its nodes).
         draw: The candidates of keys (round, worker, stream) (K, 3), (K, d).
         extend: (children, parents, truth) of samples (K, d) against the plan's tree, in order.
     """
 
-    def __init__(self, workers: int, most: int, size: int, draw: Draw, extend: Extend) -> None:
+    def __init__(self, workers: int, most: int, tree: Tree, draw: Draw, extend: Extend) -> None:
         self.workers, self.most, self.draw, self.extend = workers, most, draw, extend
         self.changed = 0  # rounds that added a node, up to the last batch
-        self.drawn: np.ndarray | None = None  # the candidates of rounds drawn_from, drawn_from + 1, ...
+        self.drawn = np.empty((0, tree.dim))  # the candidates of rounds drawn_from, drawn_from + 1, ...
         self.drawn_from = 0
         self.tested_from = self.tested_rounds = 0  # the rounds of the last batch
-        self.tested_size = size  # the tree's nodes when the last batch was tested
+        self.tested_size = tree.size  # the tree's nodes when the last batch was tested
         self.tested = (np.empty(0), np.empty(0, dtype=np.int64), np.empty(0, dtype=bool))
 
     def round(self, state: RunState) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -139,10 +141,7 @@ class LookAhead:
         """Test rounds r .. r + B - 1 (r the current round) against the tree as it is."""
         workers, first = self.workers, state.rounds
         ahead = min(batch_rounds(self.changed, first), self.most)
-        drawn = self.drawn
-        if drawn is None:
-            drawn = np.empty((0, state.tree.dim))
-        drawn = drawn[(first - self.drawn_from) * workers:]  # (the rounds used are dropped)
+        drawn = self.drawn[(first - self.drawn_from) * workers:]  # (the rounds used are dropped)
         kept = min(drawn.shape[0] // workers, ahead)  # a round's candidates depend on its key only
         if kept < ahead:
             keys = round_keys(first + kept, ahead - kept, workers, int(Stream.CANDIDATES))
@@ -210,7 +209,7 @@ class ParallelRRT(Planner):
         """The plan's ``LookAhead``: B at most ``batch_round_limit`` in-process, 1 on an executor or
         without ``look_ahead``."""
         most = batch_round_limit(self.workers, self.env.dim) if self.executor is None and self.look_ahead else 1
-        state.ahead = LookAhead(self.workers, most, state.tree.size, self._draw, self._extend)
+        state.ahead = LookAhead(self.workers, most, state.tree, self._draw, self._extend)
 
     def _round(self, state: RunState) -> None:
         """One round of p extensions: its tests (``LookAhead.round``), then its counters and nodes."""
