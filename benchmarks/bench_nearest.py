@@ -1,10 +1,10 @@
-"""Nearest-node queries: ``Tree.nearest`` (a compiled grid) against the compiled brute force.
+"""Nearest-node queries: ``GridNearest.nearest`` (a compiled grid) against the compiled brute force.
 
     python benchmarks/bench_nearest.py [--quick] [--out FILE]
 
 One quantum round of the planners pairs 2^n = 256 candidates with their nearest tree nodes. This
-times ``Tree.nearest`` (a brute force below ``tree.BRUTE_FORCE_BELOW`` nodes, the grid from there),
-``Tree.grid_nearest`` (the grid at every size) and the tree's brute force alone (``tree._brute_block``
+times ``GridNearest.nearest`` (a brute force below ``nearest.BRUTE_FORCE_BELOW`` nodes, the grid from
+there), ``GridNearest.grid_nearest`` (the grid at every size) and its brute force alone (``nearest._brute_block``
 over every node: one pass over the nodes for all queries, the reference that placed the switch) for
 256 uniform queries on trees of 100 to 3 000 nodes (``--quick``: up to 400): uniform in the 20 x 20
 workspace, and the tree q-RRT grows on paper_clutter (which clusters around the start, so many
@@ -23,10 +23,9 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
 import numpy as np
 from _common import machine, median_time, write_json
-from planner_checks import posed
 
 import qrrt_circuits as qc
-from qrrt_circuits.planners.tree import Tree, _brute_block
+from qrrt_circuits.world.nearest import GridNearest, _brute_block
 
 QUERIES = 256
 SIZES = (100, 200, 300, 400, 500, 1000, 3000)
@@ -44,22 +43,22 @@ def on_new_queries(kernel, query_sets):
     return lambda: kernel(next(sets))
 
 
-def uniform_tree(size: int, rng: np.random.Generator) -> Tree:
-    """A tree of ``size`` nodes uniform in the 20 x 20 workspace."""
-    tree = Tree(rng.random(2) * 20.0)
+def uniform_tree(size: int, rng: np.random.Generator) -> GridNearest:
+    """The structure of a tree of ``size`` nodes uniform in the 20 x 20 workspace, added one by one."""
+    tree = GridNearest(2)
     while tree.size < size:
-        tree.add(rng.random(2) * 20.0, 0)
+        tree.add(rng.random((1, 2)) * 20.0)
     return tree
 
 
-def planner_tree(size: int) -> Tree:
-    """The tree q-RRT (statevector, n = 8) grows on paper_clutter world 0 toward an unreachable
-    goal, to ``size`` nodes: the trees the planners query (clustered around the start)."""
-    env = qc.paper_clutter(seed=0)
-    result = qc.QRRT(backend=qc.StatevectorBackend(), seed=0).plan(posed(env, goal_radius=1e-9), max_nodes=size - 1)
-    tree = Tree(result.nodes[0])
-    for node, parent in zip(result.nodes[1:], result.parents[1:], strict=True):
-        tree.add(node, int(parent))
+def planner_tree(size: int) -> GridNearest:
+    """The structure of the tree q-RRT (statevector, n = 8) grows on paper_clutter world 0 toward an
+    unreachable goal, to ``size`` nodes: the trees the planners query (clustered around the start)."""
+    problem = qc.paper_clutter(seed=0).with_goal_radius(1e-9)
+    result = qc.QRRT(backend=qc.StatevectorBackend(), seed=0).plan(problem, max_nodes=size - 1)
+    tree = GridNearest(2)
+    for node in result.nodes:
+        tree.add(node[None])
     return tree
 
 
@@ -78,7 +77,7 @@ def main() -> None:
             out = np.empty(QUERIES, dtype=np.int64)
 
             def brute(t=tree, q=queries, o=out):
-                brute_force(q, t.nodes, t.size, o)
+                brute_force(q, t.points, t.size, o)
 
             fresh = [rng.random((QUERIES, 2)) * 20.0 for _ in range(repeats + 1)]  # one per call, warm-up too
             times = {"nearest_us": median_time(lambda t=tree, q=queries: t.nearest(q), repeats)[0] * 1e6,
@@ -87,12 +86,12 @@ def main() -> None:
                      "nearest_fresh_us": median_time(on_new_queries(tree.nearest, fresh), repeats)[0] * 1e6,
                      "grid_fresh_us": median_time(on_new_queries(tree.grid_nearest, fresh), repeats)[0] * 1e6,
                      "brute_force_fresh_us": median_time(on_new_queries(
-                         lambda q, t=tree, o=out: brute_force(q, t.nodes, t.size, o), fresh), repeats)[0] * 1e6}
+                         lambda q, t=tree, o=out: brute_force(q, t.points, t.size, o), fresh), repeats)[0] * 1e6}
             brute()
             assert np.array_equal(out, tree.nearest(queries)), "the kernels disagree"
             assert np.array_equal(out, tree.grid_nearest(queries)), "the kernels disagree"
             rows.append({"layout": layout, "nodes": size, "queries": QUERIES, **times})
-            print(f"  {layout:8s} {size:5d} nodes: Tree.nearest {times['nearest_us']:7.1f} us (the grid "
+            print(f"  {layout:8s} {size:5d} nodes: GridNearest.nearest {times['nearest_us']:7.1f} us (the grid "
                   f"{times['grid_us']:7.1f} us), brute force {times['brute_force_us']:8.1f} us; new queries each "
                   f"call: {times['nearest_fresh_us']:7.1f} / {times['grid_fresh_us']:7.1f} / "
                   f"{times['brute_force_fresh_us']:8.1f} us ({QUERIES} queries)")

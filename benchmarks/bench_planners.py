@@ -85,7 +85,7 @@ class TimedPredicate:
 class PartTimer:
     """Times the main parts of a quantum planner's round by wrapping, for the duration of a
     ``with`` block, the functions that do them: the nearest-node query of the candidates
-    (``Tree.nearest``), the candidate draws (``Environment.sample_uniform``) and the backend's
+    (``GridNearest.nearest``), the candidate draws (``Environment.sample_uniform``) and the backend's
     searches (``QuantumSearchBackend.search``). The predicate is timed by ``TimedPredicate``; the rest of the round (the
     policy, verification, bookkeeping, the planner's loop) is the plan's wall time minus these."""
 
@@ -108,11 +108,11 @@ class PartTimer:
         setattr(owner, attribute, timed)
 
     def __enter__(self) -> PartTimer:
-        from qrrt_circuits.planners.tree import Tree
         from qrrt_circuits.search.backends.base import QuantumSearchBackend
         from qrrt_circuits.world.environment import Environment
+        from qrrt_circuits.world.nearest import GridNearest
 
-        self._wrap(Tree, "nearest", "nearest")
+        self._wrap(GridNearest, "nearest", "nearest")
         self._wrap(Environment, "sample_uniform", "candidate_draws")
         self._wrap(QuantumSearchBackend, "search", "search")
         return self

@@ -1,8 +1,8 @@
-"""Batched RRT / ParallelRRT rounds are exactly the sequential rounds (issue 11, item 3).
+"""RRT / ParallelRRT rounds tested ahead in batches are exactly the rounds tested one at a time.
 
-The sequential reference is the same planner with an executor: one task per worker per round, the
-loop of ``Planner._run`` (the code path every plan took before batching). Trees, counters, history
-and status must agree bit for bit; only ``wasted_checks`` (tests made ahead and dropped) differ.
+The reference is the same planner with an executor: one task per worker per round, nothing tested
+ahead (B = 1). Trees, counters, history and status must agree bit for bit; only ``wasted_checks``
+(tests made ahead and dropped) differ. Every planner runs the one round loop of ``Planner._run``.
 """
 
 from __future__ import annotations
@@ -14,7 +14,10 @@ import pytest
 from planner_fingerprints import HISTORY_KEYS, METRIC_KEYS
 
 import qrrt_circuits as qc
+from qrrt_circuits._support.randomness import RandomStreams, Stream
+from qrrt_circuits.planners.base import Planner
 from qrrt_circuits.planners.classical import MAX_BATCH_ROUNDS, batch_rounds
+from qrrt_circuits.planners.placement import keyed_samples, uniform_samples
 
 
 def _sequential(planner, executor):
@@ -113,3 +116,24 @@ def test_without_look_ahead_the_predicate_is_asked_once_per_oracle_call(clutter,
     assert batched.pairs == ahead.metrics.oracle_calls + ahead.metrics.wasted_checks > single.pairs
     with pytest.raises(TypeError, match="look_ahead"):
         qc.RRT(look_ahead="no")
+
+
+def test_every_planner_runs_the_one_round_loop():
+    for planner in (qc.RRT, qc.ParallelRRT, qc.QRRT, qc.PQRRT):
+        assert planner._run is Planner._run, planner.__name__
+
+
+@pytest.mark.parametrize("goal_bias", [0.0, 0.3])
+def test_keyed_samples_are_the_samples_of_each_keys_generator(clutter, goal_bias):
+    """``keyed_samples`` (the classical planners' batched draws) is, key by key, what
+    ``uniform_samples(1, ...)`` (``build_database``'s draws) makes of that key's generator."""
+    streams = RandomStreams.from_seed(12)
+    keys = np.array([(round_index, worker, int(Stream.CANDIDATES)) for round_index in (0, 1, 7, 4000)
+                     for worker in range(5)], dtype=np.int64)
+    goal = qc.GoalBall(np.array([9.0, 9.0]), 1.5)
+    samples = keyed_samples(streams, keys, clutter.env, goal, goal_bias)
+    for key, sample in zip(keys, samples, strict=True):
+        one = uniform_samples(1, clutter.env, streams.generator(*key), goal, goal_bias)
+        assert np.array_equal(sample, one[0]), key
+    if goal_bias:
+        assert np.any(np.linalg.norm(samples - goal.centre, axis=1) <= 1.5)  # (some were drawn in the goal)

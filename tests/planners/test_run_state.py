@@ -8,6 +8,7 @@ import numpy as np
 
 from qrrt_circuits.planners.run_state import RunState
 from qrrt_circuits.problems.goals import GoalBall, in_ball
+from qrrt_circuits.world.nearest import GridNearest
 
 
 def first_in_ball(points, centre, radius):
@@ -35,8 +36,8 @@ def test_add_nodes_in_a_batch_sets_the_goal_node_as_add_node_one_by_one():
     for _ in range(30):
         points = rng.uniform(0, 10, (12, 2))
         parents = rng.integers(0, 3, 12)
-        single = RunState(np.array([1.0, 1.0]), GoalBall(goal, 2.5))
-        batch = RunState(np.array([1.0, 1.0]), GoalBall(goal, 2.5))
+        single = RunState(np.array([1.0, 1.0]), GoalBall(goal, 2.5), GridNearest(2))
+        batch = RunState(np.array([1.0, 1.0]), GoalBall(goal, 2.5), GridNearest(2))
         for point, parent in zip(points, parents, strict=True):
             single.add_node(point, int(parent))
         batch.add_nodes(points[:5], parents[:5])
@@ -46,4 +47,7 @@ def test_add_nodes_in_a_batch_sets_the_goal_node_as_add_node_one_by_one():
         inside = [i + 1 for i, p in enumerate(points) if np.hypot(*(p - goal)) <= 2.5]
         assert single.goal_node == (inside[0] if inside else None)
         assert np.array_equal(single.tree.nodes, batch.tree.nodes)
-    assert RunState(goal + [0.0, 2.5], GoalBall(goal, 2.5)).goal_node == 0  # a root in the ball is the goal node
+        for state in (single, batch):  # the structure holds the tree's nodes, at the same indices
+            assert np.array_equal(state.neighbors.points, state.tree.nodes)
+    root_in_the_ball = RunState(goal + [0.0, 2.5], GoalBall(goal, 2.5), GridNearest(2))
+    assert root_in_the_ball.goal_node == 0  # a root in the ball is the goal node

@@ -1,4 +1,7 @@
-"""Nearest-node queries of the growing tree answer what brute force answers."""
+"""The tree stores nodes and parents: ``add_many`` appends as ``add`` does one node at a time.
+
+Its nearest-node queries belong to the plan's nearest-neighbour structure
+(``tests/world/test_nearest.py``)."""
 
 from __future__ import annotations
 
@@ -8,255 +11,8 @@ import pytest
 from qrrt_circuits.planners.tree import Tree
 
 
-@pytest.mark.parametrize("dim", [1, 2, 3, 5])
-def test_nearest_equals_brute_force_as_the_tree_grows(dim):
-    rng = np.random.default_rng(dim)
-    tree = Tree(rng.random(dim) * 20, capacity=4)
-    for step in range(700):
-        tree.add(rng.random(dim) * 20, int(rng.integers(0, tree.size)))
-        if step % 97 == 0 or step < 6:
-            queries = rng.random((50, dim)) * 24 - 2  # some outside the nodes' span
-            squared = ((queries[:, None, :] - tree.nodes[None]) ** 2).sum(-1)
-            want = np.argmin(squared, axis=1)
-            assert np.array_equal(tree.nearest(queries), want)  # brute force below BRUTE_FORCE_BELOW
-            assert np.array_equal(tree.grid_nearest(queries), want)  # the grid at every size
-    assert tree.parents.shape == (701,) and tree.parents[0] == -1
-
-
-def test_ties_go_to_the_lowest_index_and_clustered_nodes_work():
-    tree = Tree(np.array([1.0, 1.0]))
-    for point in ([1.0, 3.0], [3.0, 1.0], [1.0, 1.0], [5.0, 5.0]):
-        tree.add(np.array(point), 0)
-    for nearest in (tree.nearest, tree.grid_nearest):
-        assert nearest(np.array([[2.0, 2.0], [1.0, 1.0], [9.0, 9.0]])).tolist() == [0, 0, 4]
-        assert nearest(np.array([1.0, 2.0])).tolist() == [0]
-
-
-def test_degenerate_trees_line_and_repeated_points():
-    rng = np.random.default_rng(5)
-    line = Tree(np.array([0.0, 3.0]))
-    same = Tree(np.array([2.0, 2.0, 2.0]))
-    for step in range(300):
-        line.add(np.array([rng.random() * 50, 3.0]), 0)
-        same.add(np.array([2.0, 2.0, 2.0]), step)
-    queries = rng.random((40, 2)) * 60 - 5
-    squared = ((queries[:, None, :] - line.nodes[None]) ** 2).sum(-1)
-    for tree_line, tree_same in ((line.nearest, same.nearest), (line.grid_nearest, same.grid_nearest)):
-        assert np.array_equal(tree_line(queries), np.argmin(squared, axis=1))
-        assert tree_same(rng.random((10, 3))).tolist() == [0] * 10  # all equally near: the lowest index
-
-
-@pytest.mark.parametrize("width", [0.0, 0.7, 1.6])  # one, three and five columns of cells
-@pytest.mark.parametrize("vertical", [True, False])
-def test_strips_one_to_three_cells_wide_on_integer_points(width, vertical):
-    """The first visit's three column runs at the grid's edges (a column outside the grid is an empty
-    run): strips of integer points, so that many queries tie, searched along and across."""
-    rng = np.random.default_rng(int(width * 10) + vertical)
-    along = rng.integers(0, 60, size=500).astype(float)
-    across = np.round(rng.random(500) * width)
-    points = np.column_stack((across, along) if vertical else (along, across))
-    tree = Tree(points[0])
-    tree.add_many(points[1:], np.zeros(499, dtype=np.int64))
-    queries = np.round(rng.random((400, 2)) * np.array([8.0, 70.0] if vertical else [70.0, 8.0]) - 3.0) / 2.0
-    want = np.argmin(((queries[:, None, :] - tree.nodes[None]) ** 2).sum(-1), axis=1)  # ties: lowest index
-    assert np.array_equal(tree.grid_nearest(queries), want)
-    assert np.array_equal(tree.nearest(queries), want)
-
-
-def test_nearest_agrees_with_the_grid_on_both_sides_of_the_brute_force_switch():
-    from qrrt_circuits.planners import tree as tree_module
-
-    rng = np.random.default_rng(8)
-    tree = Tree(rng.random(2) * 20)
-    while tree.size < tree_module.BRUTE_FORCE_BELOW + 50:
-        tree.add(rng.random(2) * 20, 0)
-        if tree.size in (tree_module.BRUTE_FORCE_BELOW - 1, tree_module.BRUTE_FORCE_BELOW):
-            queries = rng.random((256, 2)) * 20
-            want = np.argmin(((queries[:, None, :] - tree.nodes[None]) ** 2).sum(-1), axis=1)
-            assert np.array_equal(tree.nearest(queries), want)  # brute force, then the grid
-            assert np.array_equal(tree.grid_nearest(queries), want)
-
-
-def test_the_grid_built_when_the_tree_reaches_the_switch_answers_as_one_kept_from_the_start():
-    """Small trees keep no grid (built at BRUTE_FORCE_BELOW nodes, or by a first grid query), and a
-    grid is rebuilt once the nodes added since its build reach ``_pending_limit``: both histories
-    answer every query as the brute force does, at every size, rebuilds on both sides."""
-    from qrrt_circuits.planners import tree as tree_module
-
-    switch = tree_module.BRUTE_FORCE_BELOW
-    rebuilds = [switch]  # the sizes at which the lazy tree (re)builds its grid
-    while rebuilds[-1] < 1200:
-        rebuilds.append(rebuilds[-1] + tree_module._pending_limit(rebuilds[-1]))
-    rng = np.random.default_rng(11)
-    points = rng.random((1200, 2)) * 20
-    lazy, early = Tree(points[0]), Tree(points[0])
-    early.grid_nearest(points[:1])  # the grid from the first node on
-    assert lazy._grid_built_at == 0 and early._grid_built_at == 1
-    checked = {switch - 1, 1200} | {size + offset for size in rebuilds[:4] for offset in (-1, 0, 1)}
-    for point in points[1:]:
-        lazy.add(point, 0)
-        early.add(point, 0)
-        assert lazy.size - lazy._grid_built_at < tree_module._pending_limit(lazy._grid_built_at) or \
-            lazy._grid_built_at == 0
-        if lazy.size in checked:
-            queries = rng.random((128, 2)) * 24 - 2
-            want = np.argmin(((queries[:, None, :] - lazy.nodes[None]) ** 2).sum(-1), axis=1)
-            assert np.array_equal(lazy.nearest(queries), want)
-            assert np.array_equal(early.nearest(queries), want)
-            assert np.array_equal(early.grid_nearest(queries), want)
-            if lazy.size >= switch:  # (below, a grid query would build the grid)
-                assert np.array_equal(lazy.grid_nearest(queries), want)
-    assert lazy._grid_built_at == max(size for size in rebuilds if size <= 1200)
-
-
-def test_nodes_added_since_the_grid_was_built_are_found_and_win_no_false_ties():
-    """The nodes the grid does not hold yet are scanned first: the nearest may be one of them, and
-    a grid node exactly as near (a lower index) still wins the tie."""
-    from qrrt_circuits.planners import tree as tree_module
-
-    rng = np.random.default_rng(4)
-    tree = Tree(np.array([10.0, 10.0]))
-    while tree.size < tree_module.BRUTE_FORCE_BELOW:
-        tree.add(rng.random(2) * 20, 0)
-    assert tree._grid_built_at == tree.size
-    query = np.array([[3.25, 17.5]])
-    tree.add(query[0] + [0.0, 1e-9], 0)  # added after the build: the nearest
-    assert tree.nearest(query).tolist() == [tree.size - 1]
-    tree.add(tree.nodes[1].copy(), 0)  # a twin of node 1, added after the build
-    assert tree.nearest(tree.nodes[1][None]).tolist() == [1]  # node 1 and its later twin: the lower index
-    assert tree.size - tree._grid_built_at == 2
-
-
-@pytest.mark.parametrize("xs, query", [
-    # a node a rounding error below a cell edge is filed in the cell above it: the search must
-    # still find it (it is nearer by 2.5e-14) ...
-    ([3.1327023920027237, 49.03221452405565, 20.115521880862303, 40.311307218965595, 37.55733649104241,
-      30.67240967123448], 34.11487308113845),
-    # ... and a tie across such an edge goes to the lower index
-    ([-4.590264760638053, -0.8134658907971861, -3.1928491787969326, -1.5310576760669505, -1.7576656082574031,
-      -1.8520855800034244], -1.8048755941304138),
-])
-def test_the_grid_finds_nodes_filed_across_a_cell_edge_by_rounding(xs, query):
-    tree = Tree(np.array(xs[:1]))
-    for value in xs[1:]:
-        tree.add(np.array([value]), 0)
-    squared = (query - np.array(xs)) ** 2
-    assert tree.grid_nearest(np.array([[query]])).tolist() == [int(np.argmin(squared))]
-    assert tree.nearest(np.array([[query]])).tolist() == [int(np.argmin(squared))]
-
-
-def test_cell_edge_near_ties_in_two_dimensions():
-    """A node a rounding error below a cell edge filed in the cell above, with a rival a hair
-    farther on the query's side: the grid must visit the node's cell before stopping."""
-    rng = np.random.default_rng(3)
-    checked = 0
-    for _ in range(60):
-        base = rng.uniform(0, 20, (128, 2))
-        probe = Tree(base[0])  # the grid of 130 nodes in base's box: base and two nodes inside its box
-        for point in (*base[1:], base[1], base[2]):
-            probe.add(point, 0)
-        probe.grid_nearest(base[:1])  # a small tree builds its grid on the first grid query
-        origin, cell = probe._origin, probe._cell
-        y = float(rng.uniform(2, 18))
-        for k in range(1, int(probe._shape[0])):
-            edge = origin[0] + k * cell
-            x = np.nextafter(edge, -np.inf)
-            if int((x - origin[0]) / cell) < k:
-                continue  # filed below the edge: not the case under test
-            query = edge - 0.001 * cell
-            angle = rng.uniform(np.pi / 2, 3 * np.pi / 2)  # a rival a hair farther, on the query's side
-            radius = (x - query) * (1 + 1e-13)
-            tree = Tree(base[0])
-            for point in (*base[1:], [x, y], [query + radius * np.cos(angle), y + radius * np.sin(angle)]):
-                tree.add(np.asarray(point), 0)
-            tree.grid_nearest(base[:1])  # the grid of these 130 nodes
-            if not (np.array_equal(tree._origin, origin) and tree._cell == cell):
-                continue  # the two nodes moved the box: another grid
-            assert int((x - origin[0]) / cell) == k  # the node is filed above the edge
-            queries = np.array([[query, y]])
-            want = int(np.argmin(((queries[:, None] - tree.nodes[None]) ** 2).sum(-1)[0]))
-            assert tree.grid_nearest(queries).tolist() == [want]
-            assert tree.nearest(queries).tolist() == [want]
-            checked += 1
-    assert checked >= 20  # the construction produced cell-edge cases
-
-
-def test_queries_of_the_wrong_shape_or_not_finite_are_refused():
-    tree = Tree(np.array([1.0, 2.0]))
-    tree.add(np.array([3.0, 4.0]), 0)
-    for bad in (np.array([[1.0, 2.0, 3.0]]), np.array([[1.0]]), np.array([[np.nan, 1.0]]), np.array([np.inf, 0.0])):
-        for nearest in (tree.nearest, tree.grid_nearest):
-            with pytest.raises(ValueError, match="points"):
-                nearest(bad)
-
-
-def test_queries_whose_squared_distances_overflow_still_end():
-    """Every squared distance inf: the lowest index, from the brute force, from the grid, and from
-    the grid with nodes added since its build (whose inf ties the grid's lower indices must win)."""
-    from qrrt_circuits.planners import tree as tree_module
-
-    rng = np.random.default_rng(1)
-    tree = Tree(rng.random(2))
-    far = np.array([[1e200, 1.0], [-1e300, -1e300]])
-    while tree.size < tree_module.BRUTE_FORCE_BELOW + 10:
-        tree.add(rng.random(2), 0)
-        if tree.size in (300, tree_module.BRUTE_FORCE_BELOW + 10):
-            assert tree.nearest(far).tolist() == [0, 0] and tree.grid_nearest(far).tolist() == [0, 0]
-    assert tree.size > tree._grid_built_at > 0  # the last check had nodes the grid does not hold
-
-
-@pytest.mark.parametrize("dim", [1, 2, 3])
-def test_a_tree_growing_outward_past_its_grid_box(dim):
-    """Planner trees grow outward: the nodes added since the grid's build lie outside the box of
-    the nodes it holds, and queries near them, beyond the box and on exact nodes agree with the
-    brute force."""
-    rng = np.random.default_rng(20 + dim)
-    tree = Tree(np.zeros(dim))
-    for step in range(1, 1500):
-        radius = 0.02 * step  # each node a little farther out than the last
-        direction = rng.normal(size=dim)
-        tree.add(direction / np.linalg.norm(direction) * radius * rng.uniform(0.9, 1.0), int(rng.integers(0, step)))
-        if step % 61 == 0 or step in (399, 400, 401):
-            newest = tree.nodes[-5:]
-            queries = np.concatenate([newest, newest * 1.05, rng.normal(size=(30, dim)) * radius * 1.5])
-            want = np.argmin(((queries[:, None, :] - tree.nodes[None]) ** 2).sum(-1), axis=1)
-            assert np.array_equal(tree.nearest(queries), want)
-            assert np.array_equal(tree.grid_nearest(queries), want)
-
-
-def test_first_grid_queries_from_several_threads_agree_with_the_brute_force():
-    """A small tree builds its grid on the first grid query: threads asking at once must not read a
-    half-built grid (before the lock, about 1.5 % of such trials answered wrongly)."""
-    import threading
-
-    rng = np.random.default_rng(1)
-    queries = rng.random((400, 2)) * 20
-    for _ in range(150):
-        points = rng.random((159, 2)) * 20
-        tree = Tree(points[0])
-        for point in points[1:]:
-            tree.add(point, 0)
-        want = np.argmin(((queries[:, None, :] - tree.nodes[None]) ** 2).sum(-1), axis=1)
-        results = [None] * 4
-        barrier = threading.Barrier(4)
-
-        def work(i, tree=tree, barrier=barrier, results=results):
-            barrier.wait()
-            results[i] = tree.grid_nearest(queries)
-
-        threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
-        for thread in threads:
-            thread.start()
-        for thread in threads:
-            thread.join()
-        assert all(np.array_equal(result, want) for result in results)
-
-
 def test_add_many_builds_the_tree_add_builds_one_node_at_a_time():
-    """``add_many`` appends as ``add`` does (indices, positions, parents, buffers grown), with
-    the grid rebuilt once at most, and queries answer as the brute force does on both trees."""
-    from qrrt_circuits.planners import tree as tree_module
-
+    """``add_many`` appends as ``add`` does (indices, positions, parents, buffers grown)."""
     rng = np.random.default_rng(9)
     points = rng.random((1500, 2)) * 20
     parents = rng.integers(0, 10, 1500)
@@ -264,18 +20,13 @@ def test_add_many_builds_the_tree_add_builds_one_node_at_a_time():
     for index in range(1, 1500):
         assert one.add(points[index], int(parents[index])) == index
     position = 1
-    for count in (0, 1, 3, 250, 7, 1, 500):  # batches across the switch, rebuilds and buffer growth
+    for count in (0, 1, 3, 250, 7, 1, 500):  # batches of every size, and buffer growth
         assert many.add_many(points[position:position + count], parents[position:position + count]) == position
         position += count
-        built = many._grid_built_at
         assert many.size == position
-        assert (built == 0 and position < tree_module.BRUTE_FORCE_BELOW) or \
-            position - built < tree_module._pending_limit(built)  # a batch that reaches the limit rebuilds
     assert many.add_many(points[position:], parents[position:]) == position
-    assert np.array_equal(one.nodes, many.nodes) and np.array_equal(one.parents[1:], many.parents[1:])
-    queries = rng.random((300, 2)) * 24 - 2
-    want = np.argmin(((queries[:, None, :] - one.nodes[None]) ** 2).sum(-1), axis=1)
-    assert np.array_equal(one.nearest(queries), want) and np.array_equal(many.nearest(queries), want)
+    assert np.array_equal(one.nodes, many.nodes) and np.array_equal(one.nodes, points)
+    assert np.array_equal(one.parents[1:], many.parents[1:]) and one.parents[0] == many.parents[0] == -1
 
 
 def test_add_many_refuses_positions_that_do_not_match_the_parents():
@@ -286,43 +37,3 @@ def test_add_many_refuses_positions_that_do_not_match_the_parents():
         with pytest.raises(ValueError, match="positions must have shape"):
             tree.add_many(positions, parents)
     assert tree.size == 1
-
-
-@pytest.mark.parametrize("dim", [20, 63, 64, 100])
-def test_high_dimensional_trees_past_the_switch(dim):
-    """In high d every axis of the grid got 2 cells: 2^64 cells wrapped to 0 in int64 and the grid was
-    filed out of bounds (a segmentation fault at d >= 64, a numpy error at d = 63), and at d = 20 a
-    query visited all 2^20 cells. Where a query's first block (3^d cells) would exceed the node
-    count the grid is one cell: answers as brute force, in bounded work."""
-    rng = np.random.default_rng(dim)
-    tree = Tree(rng.uniform(0, 20, dim))
-    for point in rng.uniform(0, 20, (450, dim)):
-        tree.add(point, 0)
-    assert tree.size == 451 and tree._grid_built_at >= 400 and tree._shape.tolist() == [1] * dim
-    assert not tree._several_cells  # one cell: searched by the (vectorized) brute-force block
-    queries = rng.uniform(0, 20, (64, dim))
-    brute = np.argmin(((queries[:, None, :] - tree.nodes[None, :, :]) ** 2).sum(axis=2), axis=1)
-    assert np.array_equal(tree.nearest(queries), brute)
-    assert np.array_equal(tree.grid_nearest(queries), brute)
-
-
-def test_a_six_dimensional_grid_has_cells_once_the_nodes_outnumber_a_query_block():
-    """3^6 = 729: one cell below 729 nodes, a real grid above (the same answers either way)."""
-    rng = np.random.default_rng(6)
-    tree = Tree(rng.uniform(0, 20, 6))
-    tree.add_many(rng.uniform(0, 20, (500, 6)), np.zeros(500, dtype=np.int64))
-    assert tree._shape.tolist() == [1] * 6
-    tree.add_many(rng.uniform(0, 20, (1500, 6)), np.zeros(1500, dtype=np.int64))
-    assert int(np.prod(tree._shape)) > 1
-    queries = rng.uniform(0, 20, (64, 6))
-    brute = np.argmin(((queries[:, None, :] - tree.nodes[None, :, :]) ** 2).sum(axis=2), axis=1)
-    assert np.array_equal(tree.nearest(queries), brute)
-
-
-def test_a_planar_tree_past_the_switch_is_searched_through_its_grid():
-    """The grid is used wherever it has several cells:
-    a planner's 2-D tree past BRUTE_FORCE_BELOW is not scanned by brute force."""
-    rng = np.random.default_rng(2)
-    tree = Tree(rng.uniform(0, 20, 2))
-    tree.add_many(rng.uniform(0, 20, (999, 2)), np.zeros(999, dtype=np.int64))
-    assert tree._several_cells and tree._grid_built_at >= 400 and int(np.prod(tree._shape)) > 1

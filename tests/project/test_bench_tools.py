@@ -122,6 +122,7 @@ def test_compare_reads_runs_from_git_revisions_and_prints_ratios_per_benchmark(t
     (["--baseline-src", "/no/such/checkout/src"], "must be a checkout's src directory"),
     (["--baseline-src", str(BENCHMARKS.parent / "src"), "--pairs", "0"], "--pairs must be >= 1"),
     (["--baseline-src", str(BENCHMARKS.parent / "src"), "--nodes", "-3"], "--nodes must be >= 1"),
+    (["--baseline-src", str(BENCHMARKS.parent / "src"), "--replay", "--cpu-time"], "does not combine with --replay"),
 ])
 def test_ab_planner_refuses_bad_arguments_before_running_anything(argv, message, capsys, monkeypatch):
     monkeypatch.setattr(ab_planner, "run_child", lambda *args: pytest.fail("a child was started"))

@@ -59,3 +59,27 @@ def test_uniform_draws_equal_the_generators_doubles():
     for row, key in enumerate(keys):
         expected = np.random.default_rng(np.random.SeedSequence(streams.entropy, spawn_key=tuple(key))).random(5)
         assert np.array_equal(draws[row], expected)
+
+
+@pytest.mark.parametrize("seed", [0, 4, 2**70 + 3, None])
+def test_compiled_pcg64_doubles_equal_numpys_on_many_keys(seed):
+    """``uniform_draws`` runs PCG64 compiled (128-bit steps in 64-bit words, carries included):
+    2 000 random keys, up to 2^40, and 9 doubles each, against ``Generator.random``."""
+    from qrrt_circuits._support.randomness import uniform_draws
+
+    streams = RandomStreams.from_seed(seed)
+    rng = np.random.default_rng(17)
+    keys = np.column_stack([rng.integers(0, 2**40, 2000), rng.integers(0, 5000, 2000), rng.choice([1, 2, 3, 7], 2000)])
+    draws = uniform_draws(streams, keys, 9)
+    assert draws.shape == (2000, 9) and uniform_draws(streams, keys[:0], 9).shape == (0, 9)
+    for key, row in zip(keys, draws, strict=True):
+        expected = np.random.default_rng(np.random.SeedSequence(streams.entropy, spawn_key=tuple(int(k) for k in key)))
+        assert np.array_equal(row, expected.random(9)), key
+
+
+def test_round_keys_list_each_rounds_workers_in_turn():
+    from qrrt_circuits._support.randomness import round_keys
+
+    keys = round_keys(7, 3, 4, int(Stream.ORACLE_ERRORS))
+    assert keys.dtype == np.int64 and keys.tolist() == [[r, w, 2] for r in (7, 8, 9) for w in range(4)]
+    assert round_keys(7, 0, 4, 1).shape == (0, 3)

@@ -1,5 +1,5 @@
 """State spaces: R^d (the paper's) and SE(2); the planners' nearest nodes and steps follow the
-space's metric."""
+space's metric (its nearest-neighbour structure: ``tests/world/test_nearest.py``)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,6 @@ import pytest
 
 import qrrt_circuits as qc
 from qrrt_circuits.planners.database import steer
-from qrrt_circuits.planners.tree import Tree
 from qrrt_circuits.world.spaces import wrap_angle
 
 PI = math.pi
@@ -31,22 +30,6 @@ def test_se2_interpolation_turns_along_the_shorter_arc():
     middle = space.interpolate(a, b, np.array([0.5]))[0]
     assert middle[:2].tolist() == [1.0, 0.0] and abs(abs(middle[2]) - PI) < 1e-12
     assert np.allclose(space.interpolate(a, b, np.array([1.0])), [[2.0, 0.0, -PI + 0.1]])
-
-
-def test_se2_nearest_is_the_brute_force_under_its_metric():
-    rng = np.random.default_rng(0)
-    space = qc.SE2Space()
-    nodes = np.column_stack([rng.uniform(0, 10, 500), rng.uniform(0, 10, 500), rng.uniform(-PI, PI, 500)])
-    tree = Tree(nodes[0])
-    tree.add_many(nodes[1:], np.zeros(499, dtype=np.int64))
-    queries = np.column_stack([rng.uniform(0, 10, 300), rng.uniform(0, 10, 300), rng.uniform(-PI, PI, 300)])
-    expected = [int(np.argmin(space.distance(nodes, q))) for q in queries]
-    assert space.nearest(tree, queries).tolist() == expected
-    # the Euclidean search differs where the angle wraps: a node at theta = pi - 0.05 is near -pi + 0.05
-    near_wrap = Tree(np.array([5.0, 5.0, 0.0]))
-    near_wrap.add(np.array([5.0, 5.3, PI - 0.05]), 0)
-    query = np.array([[5.0, 5.3, -PI + 0.05]])
-    assert space.nearest(near_wrap, query).tolist() == [1] and near_wrap.nearest(query).tolist() == [0]
 
 
 def test_steering_in_se2_caps_the_metric_step():

@@ -60,7 +60,7 @@ DATABASE_BYTES_PER_COORDINATE = 16
 #: 46 + 38 d bytes per entry (calibrated in the same way)
 ANNEALING_BYTES_PER_ENTRY = 46
 ANNEALING_BYTES_PER_COORDINATE = 38
-#: fixed allowance: the nearest-node grid of the tree (``tree.Tree``) and allocator slack
+#: fixed allowance: the nearest-node grid of the tree (``world.nearest.GridNearest``) and allocator slack
 SCRATCH_BYTES = 64 * MIB
 
 
@@ -590,7 +590,8 @@ def out_of_memory(error: MemoryError, estimate_for: Callable[[int], MemoryEstima
 #: 96 + 48 d, a calibrated upper bound, with a margin, of the measured peak of a parallel-RRT plan
 #: whose goal is walled in
 TREE_BYTES_PER_NODE = 96
-#: a plan's tree, bytes per node and coordinate (positions in the tree, the grid and the result)
+#: a plan's tree, bytes per node and coordinate (positions in the tree, its nearest-neighbour
+#: structure, the grid and the result)
 TREE_BYTES_PER_COORDINATE = 48
 #: a plan's round history (``RunState.end_round``: five Python integers a round in lists, and the
 #: result's copies), bytes per round: a calibrated upper bound of the measured peak of long RRT

@@ -12,6 +12,14 @@ mixing, then ``generate_state(4, uint64)``, as numpy's ``bit_generator.pyx``), f
 one call, and hands them to ``PCG64`` through a fixed-words seed sequence (``_SeedWords``). The
 generators are therefore bit for bit the ones ``np.random.default_rng(SeedSequence(entropy,
 spawn_key=key))`` gives (tested against numpy on many keys).
+
+Where only a key's first few doubles are wanted (``uniform_draws``: one classical extension per
+key), building a ``Generator`` per key is again the larger cost. ``_pcg64_doubles`` runs numpy's
+``PCG64`` itself, compiled: the 128-bit state s and increment c from the four seed words (w0 w1 and
+w2 w3, high word first; c = 2 (w2 w3) + 1, s = 0, one step, s += w0 w1, one step, as numpy's
+``pcg64_set_seed``), each draw a step s = s a + c mod 2^128 (a = numpy's 128-bit multiplier) and
+the output XSL-RR: the 64-bit xor of the halves of s rotated right by the top 6 bits of s; a
+double is (output >> 11) 2^-53, numpy's ``next_double``. Tested equal to ``Generator.random``.
 """
 
 from __future__ import annotations
@@ -127,6 +135,63 @@ def _seed_words(run_entropy: np.ndarray, keys: np.ndarray) -> np.ndarray:
             state[i_dst] = value ^ (value >> np.uint64(16))
         for word in range(4):
             out[row, word] = state[2 * word] | (state[2 * word + 1] << np.uint64(32))
+    return out
+
+
+#: numpy's PCG64 multiplier (``PCG_DEFAULT_MULTIPLIER_128``), high and low 64-bit words
+_PCG_MULTIPLIER_HIGH = 2549297995355413924
+_PCG_MULTIPLIER_LOW = 4865540595714422341
+#: 2^-53: the double of an output's top 53 bits (numpy's ``next_double``)
+_DOUBLE_UNIT = 1.0 / 9007199254740992.0
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _multiply_64(a: np.uint64, b: np.uint64) -> tuple[np.uint64, np.uint64]:
+    """The 128-bit product of two 64-bit words: (high, low)."""
+    mask = np.uint64(_MASK)
+    thirty_two = np.uint64(32)
+    a_low, a_high = a & mask, a >> thirty_two
+    b_low, b_high = b & mask, b >> thirty_two
+    low_low = a_low * b_low
+    low_high = a_low * b_high
+    high_low = a_high * b_low
+    middle = (low_low >> thirty_two) + (low_high & mask) + (high_low & mask)
+    low = (low_low & mask) | (middle << thirty_two)
+    high = a_high * b_high + (low_high >> thirty_two) + (high_low >> thirty_two) + (middle >> thirty_two)
+    return high, low
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _pcg_step(high: np.uint64, low: np.uint64, inc_high: np.uint64,
+              inc_low: np.uint64) -> tuple[np.uint64, np.uint64]:
+    """One PCG64 step of the 128-bit state (high, low): state * multiplier + increment mod 2^128."""
+    multiplier_high, multiplier_low = np.uint64(_PCG_MULTIPLIER_HIGH), np.uint64(_PCG_MULTIPLIER_LOW)
+    product_high, product_low = _multiply_64(low, multiplier_low)
+    product_high += high * multiplier_low + low * multiplier_high
+    new_low = product_low + inc_low
+    carry = np.uint64(1) if new_low < product_low else np.uint64(0)
+    return product_high + inc_high + carry, new_low
+
+
+@njit(cache=True, nogil=True)
+def _pcg64_doubles(words: np.ndarray, count: int) -> np.ndarray:
+    """For each row of ``words`` (K, 4) uint64 seed words: the first ``count`` doubles of
+    ``Generator(PCG64)`` seeded with them (module docstring), (K, count)."""
+    out = np.empty((words.shape[0], count))
+    one, sixty_three = np.uint64(1), np.uint64(63)
+    for row in range(words.shape[0]):
+        inc_high = (words[row, 2] << one) | (words[row, 3] >> sixty_three)
+        inc_low = (words[row, 3] << one) | one
+        high, low = _pcg_step(np.uint64(0), np.uint64(0), inc_high, inc_low)
+        low_sum = low + words[row, 1]
+        carry = np.uint64(1) if low_sum < low else np.uint64(0)
+        high, low = _pcg_step(high + words[row, 0] + carry, low_sum, inc_high, inc_low)
+        for column in range(count):
+            high, low = _pcg_step(high, low, inc_high, inc_low)
+            folded = high ^ low
+            rotation = high >> np.uint64(58)
+            output = (folded >> rotation) | (folded << ((np.uint64(64) - rotation) & sixty_three))
+            out[row, column] = np.float64(output >> np.uint64(11)) * _DOUBLE_UNIT
     return out
 
 
@@ -263,6 +328,27 @@ class RandomStreams:
         return int(self.generator(round_index, worker, stream).integers(0, 2**62))
 
 
+@njit(cache=True, nogil=True)
+def round_keys(first: int, rounds: int, workers: int, stream: int) -> np.ndarray:
+    """The keys (round, worker, stream) of rounds ``first .. first + rounds - 1``, each round's
+    workers ``0 .. workers - 1`` in turn: int64 (rounds * workers, 3).
+
+    Example:
+        >>> from qrrt_circuits._support.randomness import round_keys
+        >>> round_keys(5, 2, 2, 1).tolist()
+        [[5, 0, 1], [5, 1, 1], [6, 0, 1], [6, 1, 1]]
+    """
+    keys = np.empty((max(rounds, 0) * workers, 3), dtype=np.int64)
+    row = 0
+    for round_index in range(first, first + rounds):
+        for worker in range(workers):
+            keys[row, 0] = round_index
+            keys[row, 1] = worker
+            keys[row, 2] = stream
+            row += 1
+    return keys
+
+
 def uniform_draws(streams: RandomStreams, keys: np.ndarray, count: int) -> np.ndarray:
     """(K, count): the first ``count`` doubles ``generator(*key).random()`` returns, for each key
     (round, worker, stream) of ``keys`` (K, 3).
@@ -278,9 +364,4 @@ def uniform_draws(streams: RandomStreams, keys: np.ndarray, count: int) -> np.nd
     Raises:
         ValueError: A negative key.
     """
-    count = int(count)
-    words = streams.seed_words(keys)
-    if not words.shape[0]:
-        return np.empty((0, count))
-    return np.array([np.random.Generator(np.random.PCG64(_SeedWords(row))).random(count)  # type: ignore[arg-type]
-                     for row in words])
+    return _pcg64_doubles(streams.seed_words(keys), int(count))

@@ -24,7 +24,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from concurrent.futures import Executor
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -47,9 +47,6 @@ from .termination import (
     with_defaults,
 )
 
-if TYPE_CHECKING:
-    from ..search.policies.base import PolicyState
-
 __all__ = ["Metrics", "PlanResult", "Planner", "RunState"]
 
 
@@ -57,8 +54,9 @@ class Planner:
     """Base class of the planners: an algorithm with its settings (``options``) that plans any
     ``Problem`` in rounds until the goal or the termination condition, and reports.
 
-    Subclasses define one round (``_round``: the paper's Alg. 1-3) and their options class
-    (``Options``: every setting declared once, with its check and help; ``planners.options``).
+    Subclasses define one round (``_round``: the paper's Alg. 1-3), what their rounds carry from
+    one to the next (``_start_rounds``) and their options class (``Options``: every setting
+    declared once, with its check and help; ``planners.options``); ``_run`` is the one round loop.
 
     Args:
         options: The planner's ``Options``, whole; or None (default) to build them from
@@ -219,9 +217,9 @@ class Planner:
                       safety: frozenset[PlanStatus]) -> PlanResult:
         """The plan after its checks: the run state, the rounds and the result (``safety``: the
         statuses of the safety limits added to the caller's condition)."""
-        state = RunState(problem.start, problem.goal)
-        state.policy_state = self._start_policy()
+        state = RunState(problem.start, problem.goal, problem.space.nearest_neighbors())  # chosen once a plan
         state.context = self._context(problem)
+        self._start_rounds(state)
         began = time.perf_counter()
         status = self._run(state, condition, began)
         elapsed = time.perf_counter() - began
@@ -252,8 +250,9 @@ class Planner:
         databases."""
         return None, 0
 
-    def _start_policy(self) -> PolicyState | None:
-        return None
+    def _start_rounds(self, state: RunState) -> None:
+        """Set up, once per plan, what the rounds carry from one to the next (the quantum planners'
+        policy state, the classical planners' tests made ahead); nothing here."""
 
     def _round(self, state: RunState) -> None:
         raise NotImplementedError
@@ -264,7 +263,7 @@ class Planner:
                              self.options.oracle_errors, max_extension=self.options.max_extension)
 
     def _view(self, state: RunState, temperature_index: int = 0) -> RoundView:
-        return RoundView(state.tree, state.goal, state.rounds, temperature_index,
+        return RoundView(state.tree, state.neighbors, state.goal, state.rounds, temperature_index,
                          state.policy_state)
 
     # ----------------------------------------------------------------- reporting

@@ -69,7 +69,7 @@ class NearestParents(Candidates):
     def build(self, context: WorkerContext, view: RoundView, worker: int) -> Database:
         return stream_database(view.tree, context.database_size, context.env, context.streams, view.round_index,
                                worker, view.goal, context.goal_bias, context.annealing,
-                               view.temperature_index, context.max_extension, context.space)
+                               view.temperature_index, context.max_extension, context.space, view.neighbors)
 
     def describe(self) -> dict:
         return {"kind": "nearest-parents"}

@@ -7,38 +7,40 @@ of one candidate); a round's critical path is 1 call. With an ``OracleErrorModel
 is noisy and a positive answer is verified with the true predicate (one more call) before the node
 is added, as the quantum planners' finalizer does.
 
-Rounds in batches. A round's candidates depend only on its random streams (keyed by round and
-worker), and the tree cannot change until a round adds a node, so the planners draw the candidates
-of the next B rounds at once (``randomness.uniform_draws``), find their nearest nodes in one query
-and test all B x p pairs together. The rounds are then recorded one by one (the termination
-condition checked before each, counters, history, error flips), up to and including the first round
-that adds a node. The later rounds' tests were made against the tree without that node, so they
-are counted in ``Metrics.wasted_checks``, never as oracle calls, and those rounds are tested again
-in the next batch (the same candidates, kept from their draw, with their nearest nodes in the new
+Rounds tested ahead. The planners run the one round loop of ``Planner._run`` (the termination
+condition checked before each round). A round's candidates depend only on its random streams
+(keyed by round and worker: ``placement.keyed_samples``, the samples ``build_database(tree, 1,
+...)`` draws), and the tree cannot change until a round adds a node, so a round that finds no
+tests made ahead for it draws the candidates of the next B rounds at once, finds their nearest
+nodes in one query and tests all B x p pairs in one call (``LookAhead``); the following rounds
+take their tests from that batch while the tree is the one it was tested against. A round that
+adds a node makes the batch's later tests stale: they are counted in ``Metrics.wasted_checks``
+(tests made ahead and never used), never as oracle calls, and their rounds are tested again in
+the next batch (the same candidates, kept from their draw, with their nearest nodes in the new
 tree). The tree, the counters and the status are those of one round at a time. B is the expected
 number of rounds up to the next success, ceil(1 / rate) with the Laplace estimate
 rate = (rounds that added + 1) / (rounds recorded + 2), at most ``MAX_BATCH_ROUNDS`` and at most
 ``batch_round_limit(workers, d)`` (a batch's candidates take at most ``MAX_BATCH_BYTES``). On an
-``executor`` B = 1 and each worker's test is one task.
+``executor``, or with ``look_ahead=False``, B = 1 (on an executor each worker's test is one task).
 """
 
 from __future__ import annotations
 
 import math
-import time
+from collections.abc import Callable
 from typing import ClassVar
 
 import numpy as np
 
-from .._support.randomness import Stream, uniform_draws
-from ..problems.goals import sample_goal
+from .._support.randomness import Stream, round_keys
 from ..reachability.predicate import check_answers
 from .base import Planner
 from .context import map_tasks
 from .database import steer
 from .options import ParallelOptions, PlannerOptions, RRTOptions
+from .placement import keyed_samples
 from .run_state import RunState
-from .termination import PlanStatus, TerminationCondition
+from .tree import Tree
 from .workers import check_extensions
 
 #: the most rounds one batch tests ahead
@@ -82,6 +84,70 @@ def batch_rounds(changed_rounds: int, recorded_rounds: int) -> int:
     return max(1, min(MAX_BATCH_ROUNDS, math.ceil(1.0 / rate)))
 
 
+#: what ``LookAhead`` draws and tests with: the candidates of keys (K, 3), and (children, parents,
+#: truth) of samples (K, d) against the plan's tree
+Draw = Callable[[RunState, np.ndarray], np.ndarray]
+Extend = Callable[[RunState, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]
+
+
+class LookAhead:
+    """One plan's classical extensions, tested ahead of the rounds that use them (module docstring).
+
+    ``round`` hands a round its p (children, parents, truth): from the batch tested last, if that
+    batch holds the round and the tree is still the one it was tested against; else from a new
+    batch, the next B rounds' candidates (kept from the draw of a batch before, or drawn now)
+    tested in one call.
+
+    ``RunState.wasted_checks`` counts the tests made ahead and not used: a batch of B rounds adds
+    (B - 1) p, each round served from it takes p away.
+
+    Args:
+        workers: p, the extensions of one round.
+        most: The most rounds one batch tests (``batch_round_limit``, or 1).
+        tree: The plan's tree as the plan starts (its d and its nodes).
+        draw: The candidates of keys (round, worker, stream) (K, 3), (K, d).
+        extend: (children, parents, truth) of samples (K, d) against the plan's tree, in order.
+    """
+
+    def __init__(self, workers: int, most: int, tree: Tree, draw: Draw, extend: Extend) -> None:
+        self.workers, self.most, self.draw, self.extend = workers, most, draw, extend
+        self.changed = 0  # rounds that added a node, up to the last batch
+        self.drawn = np.empty((0, tree.dim))  # the candidates of rounds drawn_from, drawn_from + 1, ...
+        self.drawn_from = 0
+        self.tested_from = self.tested_rounds = 0  # the rounds of the last batch
+        self.tested_size = tree.size  # the tree's nodes when the last batch was tested
+        self.tested = (np.empty(0), np.empty(0, dtype=np.int64), np.empty(0, dtype=bool))
+
+    def round(self, state: RunState) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The current round's (children (p, d), parents (p,), truth (p,))."""
+        workers = self.workers
+        offset = state.rounds - self.tested_from
+        if state.tree.size == self.tested_size and offset < self.tested_rounds:
+            state.wasted_checks -= workers  # a test made ahead, used
+        else:
+            self.changed += state.tree.size != self.tested_size  # (the round before added)
+            self._test_ahead(state)
+            offset = 0
+        children, parents, truth = self.tested
+        rows = slice(offset * workers, (offset + 1) * workers)
+        return children[rows], parents[rows], truth[rows]
+
+    def _test_ahead(self, state: RunState) -> None:
+        """Test rounds r .. r + B - 1 (r the current round) against the tree as it is."""
+        workers, first = self.workers, state.rounds
+        ahead = min(batch_rounds(self.changed, first), self.most)
+        drawn = self.drawn[(first - self.drawn_from) * workers:]  # (the rounds used are dropped)
+        kept = min(drawn.shape[0] // workers, ahead)  # a round's candidates depend on its key only
+        if kept < ahead:
+            keys = round_keys(first + kept, ahead - kept, workers, int(Stream.CANDIDATES))
+            drawn = np.concatenate((drawn[:kept * workers], self.draw(state, keys)))
+        self.drawn, self.drawn_from = drawn, first
+        # the raw samples are kept: a round tested again is steered from its new parents
+        self.tested = self.extend(state, drawn[:ahead * workers])
+        self.tested_from, self.tested_rounds, self.tested_size = first, ahead, state.tree.size
+        state.wasted_checks += (ahead - 1) * workers
+
+
 class ParallelRRT(Planner):
     """Manager-worker parallel RRT (paper §V, Devaurs et al. 2013): the classical counterpart of Pq-RRT.
 
@@ -92,7 +158,7 @@ class ParallelRRT(Planner):
     ``oracle_errors``). ``RRT`` is the case p = 1.
 
     Its options are ``ParallelOptions`` (``workers``, ``look_ahead`` and what every planner takes);
-    it takes an ``executor`` (``Planner``). Without an ``executor`` the rounds are tested in
+    it takes an ``executor`` (``Planner``). Without an ``executor`` the rounds are tested ahead in
     batches (module docstring); with one, each worker's test is one task.
     """
 
@@ -105,51 +171,31 @@ class ParallelRRT(Planner):
         """p, the workers of a round."""
         return int(self.options.workers)
 
-    def _run(self, state: RunState, condition: TerminationCondition, began: float) -> PlanStatus:
-        """Rounds in batches: the candidates of the next B rounds drawn and tested together, then
-        recorded round by round (the condition checked before each) up to the first round that adds
-        a node; the later rounds' tests are ``wasted_checks`` and those rounds are tested again, with
-        the candidates already drawn (a round's candidates depend on its (round, worker) keys only).
-        B is ``batch_rounds`` (at most ``batch_round_limit``) in-process, 1 on an executor."""
-        workers = self.workers
-        changed = recorded = 0
+    def _start_rounds(self, state: RunState) -> None:
+        """The plan's ``LookAhead``: B at most ``batch_round_limit`` in-process, 1 on an executor or
+        without ``look_ahead``."""
+        look_ahead = self.executor is None and self.options.look_ahead
+        most = batch_round_limit(self.workers, state.tree.dim) if look_ahead else 1
+        state.ahead = LookAhead(self.workers, most, state.tree, self._draw, self._extend)
+
+    def _round(self, state: RunState) -> None:
+        """One round of p extensions: its tests (``LookAhead.round``), then its counters and nodes."""
+        children, parents, truth = state.tests_ahead.round(state)
+        self._record(state, state.rounds, children, parents, truth)
+
+    def _draw(self, state: RunState, keys: np.ndarray) -> np.ndarray:
+        """The candidates of the keys (round, worker, ``Stream.CANDIDATES``) (K, 3): the samples
+        ``build_database(tree, 1, ...)`` draws from each key's generator (``keyed_samples``)."""
+        return keyed_samples(self.streams, keys, state.worker_context.env, state.goal, self.options.goal_bias)
+
+    def _extend(self, state: RunState, samples: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Each sample's nearest node, the sample steered toward it, and the predicate's answer on
+        the pair: (children, parents, truth)."""
+        parents = state.neighbors.nearest(samples)
+        origins = state.tree.nodes[parents]
         context = state.worker_context
-        most = batch_round_limit(workers, context.env.dim) if self.executor is None and self.options.look_ahead else 1
-        drawn = np.empty((0, context.env.dim))  # candidates drawn for rounds first, first + 1, ... not yet recorded
-        while state.goal_node is None:
-            ended = condition.ended_by(state.progress(time.perf_counter() - began))
-            if ended is not None:
-                return ended
-            ahead = min(batch_rounds(changed, recorded), most)
-            first = state.rounds
-            kept = min(drawn.shape[0] // workers, ahead)  # a round's candidates depend on its key only
-            if kept < ahead:
-                keys = np.empty(((ahead - kept) * workers, 3), dtype=np.int64)
-                keys[:, 0] = np.repeat(np.arange(first + kept, first + ahead), workers)
-                keys[:, 1] = np.tile(np.arange(workers), ahead - kept)
-                keys[:, 2] = int(Stream.CANDIDATES)
-                drawn = np.concatenate((drawn[:kept * workers], self._candidates(state, keys)))
-            samples = drawn[:ahead * workers]  # kept raw: a round tested again is steered from its new parents
-            parents = context.space.nearest(state.tree, samples)
-            children = steer(context.space, state.tree.nodes[parents], samples, context.max_extension)
-            truth = self._test(state, state.tree.nodes[parents], children)
-            for offset in range(ahead):
-                if offset:  # (the first round's check came before the draws)
-                    ended = condition.ended_by(state.progress(time.perf_counter() - began))
-                    if ended is not None:
-                        state.wasted_checks += (ahead - offset) * workers
-                        return ended
-                nodes_before = state.nodes
-                rows = slice(offset * workers, (offset + 1) * workers)
-                self._record(state, first + offset, children[rows], parents[rows], truth[rows])
-                state.end_round()
-                recorded += 1
-                if state.nodes != nodes_before:  # the tree changed: later tests are stale, their candidates not
-                    changed += 1
-                    state.wasted_checks += (ahead - offset - 1) * workers
-                    break
-            drawn = drawn[(offset + 1) * workers:]
-        return PlanStatus.REACHED
+        children = steer(context.space, origins, samples, context.max_extension)
+        return children, parents, self._test(state, origins, children)
 
     def _test(self, state: RunState, origins: np.ndarray, children: np.ndarray) -> np.ndarray:
         """The predicate on every (parent position, child) pair: one call in-process, one task per
@@ -162,26 +208,9 @@ class ParallelRRT(Planner):
         answers = map_tasks(self.executor, check_extensions, state.worker_context, self._view(state), pairs)
         return np.concatenate([check_answers(answer, 1, name) for answer in answers])
 
-    def _candidates(self, state: RunState, keys: np.ndarray) -> np.ndarray:
-        """The samples ``build_database(tree, 1, ...)`` draws from each key's generator: uniform
-        in the workspace (``Environment.sample_uniform``: low + (high - low) * u), and with goal
-        bias the next double decides, a biased one redrawn in the goal ball by the generator."""
-        env, goal_bias = state.worker_context.env, self.options.goal_bias
-        dim = env.dim
-        biased = goal_bias > 0
-        draws = uniform_draws(self.streams, keys, dim + int(biased))
-        low, high = env.bounds[:, 0], env.bounds[:, 1]
-        children = low + (high - low) * draws[:, :dim]
-        if biased:
-            for row in np.flatnonzero(draws[:, dim] < goal_bias):
-                rng = self.streams.generator(*keys[row])
-                rng.random(dim + 1)  # the doubles used above
-                children[row] = sample_goal(state.goal, 1, rng)[0]
-        return children
-
     def _record(self, state: RunState, round_index: int, children: np.ndarray, parents: np.ndarray,
                 truth: np.ndarray) -> None:
-        """One round's counters and nodes from its workers' tests, as ``_round`` records them."""
+        """One round's counters and nodes from its workers' tests (p of them)."""
         longest = 1
         errors = self.options.oracle_errors
         for worker in range(children.shape[0]):

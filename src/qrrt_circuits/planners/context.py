@@ -29,6 +29,7 @@ from ..reachability.predicate import ReachabilityPredicate
 from ..search.backends.base import QuantumSearchBackend
 from ..search.policies.base import PolicyState
 from ..world.environment import Environment
+from ..world.nearest import NearestNeighbors
 from ..world.spaces import StateSpace
 from .database import AnnealingSchedule
 from .tree import Tree
@@ -87,9 +88,11 @@ def _restore_context(token: str, payload: bytes) -> WorkerContext:
 
 @dataclass(frozen=True, eq=False)
 class RoundView:
-    """The round's part of a worker's task (the tree is a snapshot: workers never change it)."""
+    """The round's part of a worker's task (the tree and its nearest-neighbour structure are a
+    snapshot: workers never change them)."""
 
     tree: Tree
+    neighbors: NearestNeighbors
     goal: Goal
     round_index: int
     temperature_index: int = 0

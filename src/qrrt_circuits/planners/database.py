@@ -20,6 +20,7 @@ from .._support.randomness import RandomStreams, Stream
 from .._support.validation import check_choice, check_float, check_int
 from ..problems.goals import Goal
 from ..world.environment import Environment
+from ..world.nearest import NearestNeighbors
 from ..world.spaces import RealVectorSpace, StateSpace
 from .placement import PLACEMENTS, uniform_samples
 from .tree import Tree
@@ -191,6 +192,7 @@ def build_database(
     temperature_index: int = 0,
     max_extension: float | None = None,
     space: StateSpace | None = None,
+    neighbors: NearestNeighbors | None = None,
 ) -> Database:
     """Build one database: ``size`` samples, each paired with its nearest tree node.
 
@@ -207,21 +209,26 @@ def build_database(
         temperature_index: Alg. 4's h, which picks the annealing band.
         max_extension: The longest step from a parent (``steer``), or None (default: the raw
             samples, as the paper's Alg. 1 takes them).
-        space: The ``StateSpace`` whose metric picks the nearest parents and steers; None for
-            ``RealVectorSpace`` (Euclidean, the paper's).
+        space: The ``StateSpace`` whose metric steers (and whose nearest-neighbour structure picks
+            the parents without ``neighbors``); None for ``RealVectorSpace`` (Euclidean, the paper's).
+        neighbors: The tree's nearest-neighbour structure (``world.nearest``: the tree's nodes,
+            at the same indices), or None for a new one of ``space`` filled with them.
 
     Returns:
         The ``Database`` of candidates and their nearest parents.
     """
     space = RealVectorSpace(tree.dim) if space is None else space
+    if neighbors is None:
+        neighbors = space.nearest_neighbors()
+        neighbors.add(tree.nodes)
     band = None
     if annealing is None:
         samples = uniform_samples(size, env, rng, goal, goal_bias)
-        parents = space.nearest(tree, samples)
+        parents = neighbors.nearest(samples)
     else:  # Alg. 4, line 7, under the schedule's reading (``placement.PLACEMENTS``)
         band = annealing.band(temperature_index)
-        samples, parents = PLACEMENTS[annealing.placement].candidates(tree, size, env, rng, goal, goal_bias, band,
-                                                                      space)
+        samples, parents = PLACEMENTS[annealing.placement].candidates(tree, neighbors, size, env, rng, goal,
+                                                                      goal_bias, band)
     return Database(steer(space, tree.nodes[parents], samples, max_extension), parents, band)
 
 
@@ -258,6 +265,7 @@ def stream_database(
     temperature_index: int = 0,
     max_extension: float | None = None,
     space: StateSpace | None = None,
+    neighbors: NearestNeighbors | None = None,
 ) -> Database:
     """``build_database`` with the generator of (round, worker, ``Stream.CANDIDATES``).
 
@@ -274,9 +282,10 @@ def stream_database(
         temperature_index: Alg. 4's h.
         max_extension: The longest step from a parent (``steer``), or None.
         space: The ``StateSpace`` (None: ``RealVectorSpace``).
+        neighbors: The tree's nearest-neighbour structure, or None (``build_database``).
 
     Returns:
         The ``Database``.
     """
     return build_database(tree, size, env, streams.generator(round_index, worker, Stream.CANDIDATES), goal,
-                          goal_bias, annealing, temperature_index, max_extension, space)
+                          goal_bias, annealing, temperature_index, max_extension, space, neighbors)

@@ -17,12 +17,13 @@ import abc
 
 import numpy as np
 
+from .._support.randomness import RandomStreams, uniform_draws
 from ..problems.goals import Goal, sample_goal
 from ..world.environment import Environment
-from ..world.spaces import StateSpace
+from ..world.nearest import NearestNeighbors
 from .tree import Tree
 
-__all__ = ["ADMIT_DRAWS_PER_ENTRY", "PLACEMENTS", "Placement", "uniform_samples"]
+__all__ = ["ADMIT_DRAWS_PER_ENTRY", "PLACEMENTS", "Placement", "keyed_samples", "uniform_samples"]
 
 #: ``AdmitPlacement``: the most samples drawn per database entry before the band is declared empty
 ADMIT_DRAWS_PER_ENTRY = 10_000
@@ -41,22 +42,59 @@ def uniform_samples(size: int, env: Environment, rng: np.random.Generator, goal:
     return samples
 
 
+def keyed_samples(streams: RandomStreams, keys: np.ndarray, env: Environment, goal: Goal | None,
+                  goal_bias: float) -> np.ndarray:
+    """One sample per key, as ``uniform_samples(1, env, streams.generator(*key), goal, goal_bias)``
+    draws it, for many keys at once (the classical planners' candidates, one per (round, worker)).
+
+    That call takes the key's first d doubles u for the point low + (high - low) u
+    (``Environment.sample_uniform``), then, with goal bias, one more double b, and where
+    b < ``goal_bias`` it draws the point in the goal with the same generator. Here the first d + 1
+    doubles of every key come from one call (``randomness.uniform_draws``), and only the biased
+    keys' generators are built again, their d + 1 doubles skipped, for the goal draws.
+
+    Args:
+        streams: The plan's ``RandomStreams``.
+        keys: Int (K, 3), the keys (round, worker, stream).
+        env: The ``Environment`` whose workspace is sampled.
+        goal: The ``Goal`` of the goal-biased samples, or None.
+        goal_bias: Fraction in [0, 1) of samples drawn in the goal.
+
+    Returns:
+        Float (K, d), row k the sample of key k.
+    """
+    dim = env.dim
+    biased = goal if goal_bias > 0 else None
+    draws = uniform_draws(streams, keys, dim + (biased is not None))
+    low, high = env.bounds[:, 0], env.bounds[:, 1]
+    samples = low + (high - low) * draws[:, :dim]
+    if biased is not None:
+        for row in np.flatnonzero(draws[:, dim] < goal_bias):
+            rng = streams.generator(*keys[row])
+            rng.random(dim + 1)  # the doubles used above
+            samples[row] = sample_goal(biased, 1, rng)[0]
+    return samples
+
+
 class Placement(abc.ABC):
     """One reading of Alg. 4, line 7: the candidates (and their nearest nodes) of one database."""
 
     @abc.abstractmethod
-    def candidates(self, tree: Tree, size: int, env: Environment, rng: np.random.Generator, goal: Goal | None,
-                   goal_bias: float, band: tuple[float, float], space: StateSpace) -> tuple[np.ndarray, np.ndarray]:
-        """``size`` candidates placed for the band, and the tree row of each one's parent."""
+    def candidates(self, tree: Tree, neighbors: NearestNeighbors, size: int, env: Environment,
+                   rng: np.random.Generator, goal: Goal | None, goal_bias: float,
+                   band: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+        """``size`` candidates placed for the band, and the tree row of each one's parent (its
+        nearest node, found by ``neighbors``, the tree's structure)."""
 
 
 class _Moved(Placement):
     """Samples paired with their nearest nodes, then moved along P -> t to a distance in the band."""
 
-    def candidates(self, tree: Tree, size: int, env: Environment, rng: np.random.Generator, goal: Goal | None,
-                   goal_bias: float, band: tuple[float, float], space: StateSpace) -> tuple[np.ndarray, np.ndarray]:
+    def candidates(self, tree: Tree, neighbors: NearestNeighbors, size: int, env: Environment,
+                   rng: np.random.Generator, goal: Goal | None, goal_bias: float,
+                   band: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
         samples = uniform_samples(size, env, rng, goal, goal_bias)
-        parents = space.nearest(tree, samples)
+        parents = neighbors.nearest(samples)
         origin = tree.nodes[parents]
         offset = samples - origin
         norm = np.linalg.norm(offset, axis=1)
@@ -106,14 +144,15 @@ class AdmitPlacement(Placement):
         RuntimeError: Fewer than ``size`` admitted in ``ADMIT_DRAWS_PER_ENTRY * size`` samples.
     """
 
-    def candidates(self, tree: Tree, size: int, env: Environment, rng: np.random.Generator, goal: Goal | None,
-                   goal_bias: float, band: tuple[float, float], space: StateSpace) -> tuple[np.ndarray, np.ndarray]:
+    def candidates(self, tree: Tree, neighbors: NearestNeighbors, size: int, env: Environment,
+                   rng: np.random.Generator, goal: Goal | None, goal_bias: float,
+                   band: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
         kept_samples: list[np.ndarray] = []
         kept_parents: list[np.ndarray] = []
         admitted = 0
         for _ in range(ADMIT_DRAWS_PER_ENTRY):
             samples = uniform_samples(size, env, rng, goal, goal_bias)
-            parents = space.nearest(tree, samples)
+            parents = neighbors.nearest(samples)
             distance = np.linalg.norm(samples - tree.nodes[parents], axis=1)
             inside = (distance >= band[0]) & (distance <= band[1])
             kept_samples.append(samples[inside])

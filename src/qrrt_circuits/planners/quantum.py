@@ -30,7 +30,7 @@ from .._support.memory import MemoryEstimate, database_bytes, database_resident_
 from ..problems.problem import Problem
 from ..search.backends.base import QuantumSearchBackend
 from ..search.policies.adaptive import Adaptive
-from ..search.policies.base import IterationPolicy, PolicyState
+from ..search.policies.base import IterationPolicy
 from ..search.policies.thompson import ThompsonIterations
 from .base import Planner
 from .candidates import Candidates, NearestParents
@@ -168,8 +168,9 @@ class PQRRT(Planner):
         """N = 2^n, the entries of each database."""
         return 1 << self.num_qubits
 
-    def _start_policy(self) -> PolicyState:
-        return self.search_policy.start(self.database_size)
+    def _start_rounds(self, state: RunState) -> None:
+        """The search policy's state of this plan."""
+        state.policy_state = self.search_policy.start(self.database_size)
 
     def _max_new_nodes_per_round(self) -> int:
         """p: each worker adds at most one node a round."""

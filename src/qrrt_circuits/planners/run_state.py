@@ -1,4 +1,5 @@
-"""The mutable bookkeeping of one ``plan`` call: the tree, the counters and the round history."""
+"""The mutable bookkeeping of one ``plan`` call: the tree and its nearest-neighbour structure, the
+counters and the round history."""
 
 from __future__ import annotations
 
@@ -12,16 +13,27 @@ from .tree import Tree
 
 if TYPE_CHECKING:  # annotations only (context imports the search modules)
     from ..search.policies.base import PolicyState
+    from ..world.nearest import NearestNeighbors
+    from .classical import LookAhead
     from .context import WorkerContext
 
 HISTORY_KEYS = ("oracle_calls", "critical_path", "nodes", "entries", "reachable")
 
 
 class RunState:
-    """Counters of DESIGN §2 as a plan accumulates them; ``end_round`` appends the history."""
+    """Counters of DESIGN §2 as a plan accumulates them; ``end_round`` appends the history.
 
-    def __init__(self, root: np.ndarray, goal: Goal) -> None:
+    Args:
+        root: Float (d,), the tree's root.
+        goal: The plan's ``Goal``.
+        neighbors: The plan's nearest-neighbour structure (``StateSpace.nearest_neighbors``),
+            empty: it gets the root and every node the tree gets, at the same index.
+    """
+
+    def __init__(self, root: np.ndarray, goal: Goal, neighbors: NearestNeighbors) -> None:
         self.tree = Tree(root)
+        neighbors.add(self.tree.nodes)
+        self.neighbors = neighbors
         self.goal = goal
         self.goal_node: int | None = 0 if first_satisfying(goal, root.reshape(1, -1)) == 0 else None
         self.rounds = 0
@@ -40,6 +52,7 @@ class RunState:
         self._nodes_at_round_start = 0
         self.policy_state: PolicyState | None = None  # quantum planners only
         self.context: WorkerContext | None = None  # the plan's WorkerContext, built once
+        self.ahead: LookAhead | None = None  # classical planners only
 
     @property
     def worker_context(self) -> WorkerContext:
@@ -56,6 +69,13 @@ class RunState:
         return self.policy_state
 
     @property
+    def tests_ahead(self) -> LookAhead:
+        """The classical planners' tests made ahead (set when the plan starts)."""
+        if self.ahead is None:
+            raise RuntimeError("this plan tests no extensions ahead (a quantum planner's)")
+        return self.ahead
+
+    @property
     def oracle_calls(self) -> int:
         return self.quantum_calls + self.verification_calls
 
@@ -65,8 +85,10 @@ class RunState:
         return self.tree.size - 1
 
     def add_node(self, position: np.ndarray, parent: int) -> int:
-        """Add one node (``Tree.add``); the first node that satisfies the goal becomes ``goal_node``."""
+        """Add one node (``Tree.add``, and to the nearest-neighbour structure); the first node that
+        satisfies the goal becomes ``goal_node``."""
         index = self.tree.add(position, parent)
+        self.neighbors.add(position.reshape(1, -1))
         if self.goal_node is None and first_satisfying(self.goal, position.reshape(1, -1)) == 0:
             self.goal_node = index
         return index
@@ -76,6 +98,7 @@ class RunState:
         if parents.shape[0] == 0:
             return
         first = self.tree.add_many(positions, parents)
+        self.neighbors.add(positions)
         if self.goal_node is None:
             hit = first_satisfying(self.goal, positions)
             if hit >= 0:

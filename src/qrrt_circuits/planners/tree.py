@@ -1,58 +1,19 @@
-"""The growing tree: node positions, parent indices and nearest-node queries.
+"""The growing tree: node positions and parent indices.
 
-Node 0 is the root. Nearest-node queries are exact (Euclidean; among equally near nodes the
-lowest index) and compiled. Trees of fewer than ``BRUTE_FORCE_BELOW`` nodes are searched by brute
-force (every query against every node, one pass over the nodes for all the queries at once, so the
-inner loop over the queries vectorizes). From there the tree keeps a uniform bucket grid over the
-bounding box of the nodes it held at the grid's last build, about one node per cell, in compressed
-form: the nodes sorted by cell with their coordinates copied in that order, and the offset of each
-cell's first node (a cell's nodes, and a run of cells along the last axis, are one contiguous
-slice). A query first scans, by the same brute force, the nodes added since the build (fewer than
-``_pending_limit(built)``: max(32, sqrt(built))), then visits the grid's cells ring by ring
-(Chebyshev rings around its own cell, the first visit the block of 3^d cells around it; a
-nearer node replaces the best by selects, not branches) and stops once the distance from the query to the part of
-the grid not yet visited exceeds the best distance found (the cell technique of Bentley, Weide and
-Yao 1980). When the nodes added since the build reach that limit the grid is rebuilt (O(N), so
-O(sqrt N) amortized per node). A query therefore costs about the nodes of a few cells plus the
-recent nodes, however large the tree. It answers what a brute-force search does, ties and
-rounding-level near-ties included: the stopping bound allows for the rounding of a node's cell
-(tested on adversarial cell-edge cases). ``BRUTE_FORCE_BELOW`` is calibrated: the tree size from
-which the grid search costs less than brute force.
+Node 0 is the root. The tree stores nodes only; which node is nearest to a sample is the question
+of the plan's nearest-neighbour structure (``world.nearest``, chosen once per plan by the state
+space), which ``RunState`` keeps beside the tree and gives every node the tree gets.
 """
 
 from __future__ import annotations
 
-import math
-import threading
-
 import numpy as np
-from numba import njit
-
-#: cells per node when the grid is (re)built, and the most cells one grid has
-_CELLS_PER_NODE = 1.0
-_MAX_CELLS = 1 << 22
-#: trees with fewer nodes answer nearest-node queries by brute force (see the module docstring)
-BRUTE_FORCE_BELOW = 400
-#: the fewest nodes added since the grid's build that trigger a rebuild (see ``_pending_limit``)
-_PENDING_MIN = 32
-#: relative rounding allowance of the grid's stopping bound (a few units in the last place)
-_EDGE_SLACK = 16 * float(np.finfo(float).eps)
-_NOT_FINITE = "points must be finite (no NaN or infinity)"
-#: serializes the lazy grid builds of ``grid_nearest`` (queries may come from several threads)
-_FIRST_GRID = threading.Lock()
-
-
-def _pending_limit(built: int) -> int:
-    """Nodes added since a grid of ``built`` nodes was built at which it is rebuilt: max(32,
-    isqrt(built)) (queries scan those nodes by brute force; a rebuild costs O(built))."""
-    return max(_PENDING_MIN, math.isqrt(built))
 
 
 class Tree:
     """Growable arrays of node positions and parent indices; node 0 is the root.
 
-    The tree T of the paper's Alg. 1-4, with the exact nearest-node query of Alg. 1 line 6 (see the
-    module docstring for the grid).
+    The tree T of the paper's Alg. 1-4.
 
     Args:
         root: Float (d,), the root's position.
@@ -64,8 +25,8 @@ class Tree:
         >>> tree = Tree(np.array([0.0, 0.0]))
         >>> tree.add(np.array([2.0, 0.0]), parent=0), tree.add(np.array([2.0, 2.0]), parent=1)
         (1, 2)
-        >>> tree.nearest(np.array([[1.9, 1.5], [0.2, -0.1]])).tolist(), tree.parents.tolist()
-        ([2, 0], [-1, 0, 1])
+        >>> tree.nodes.tolist(), tree.parents.tolist()
+        ([[0.0, 0.0], [2.0, 0.0], [2.0, 2.0]], [-1, 0, 1])
     """
 
     def __init__(self, root: np.ndarray, capacity: int = 256) -> None:
@@ -76,18 +37,6 @@ class Tree:
         self._nodes[0] = root
         self._parents[0] = -1
         self.size = 1
-        # the grid (built once the tree reaches BRUTE_FORCE_BELOW nodes, see ``add``, or by a first
-        # ``grid_nearest`` call); until then empty arrays of the grid's types, and _grid_built_at = 0
-        # (the nodes it holds)
-        self._grid_built_at = 0
-        self._rebuild_at = BRUTE_FORCE_BELOW  # the size at which ``add`` (re)builds the grid
-        self._origin, self._low, self._high = np.zeros(self.dim), np.zeros(self.dim), np.zeros(self.dim)
-        self._cell = 1.0
-        self._shape = np.ones(self.dim, dtype=np.int64)
-        self._several_cells = False  # whether the grid has more than one cell (read by nearest)
-        self._start = np.zeros(2, dtype=np.int64)  # offset of each cell's first node in _order, and the end
-        self._order = np.empty(0, dtype=np.int64)  # the grid's node indices sorted by cell
-        self._sorted = np.empty((0, self.dim))  # their positions, in that order
 
     @property
     def nodes(self) -> np.ndarray:
@@ -100,7 +49,7 @@ class Tree:
         return self._parents[: self.size]
 
     def add(self, position: np.ndarray, parent: int) -> int:
-        """Append a node (amortized O(sqrt N): the grid is rebuilt after ``_pending_limit`` additions).
+        """Append a node (amortized O(1)).
 
         Args:
             position: Float (d,), the new node.
@@ -115,13 +64,10 @@ class Tree:
         self._nodes[index] = position
         self._parents[index] = parent
         self.size += 1
-        if self.size >= self._rebuild_at:  # BRUTE_FORCE_BELOW reached, or too many nodes since the build
-            self._build_grid()
         return index
 
     def add_many(self, positions: np.ndarray, parents: np.ndarray) -> int:
-        """Append nodes in order, as ``add`` one by one would (the same indices and arrays; the grid
-        is rebuilt at most once, after the last).
+        """Append nodes in order, as ``add`` one by one would (the same indices and arrays).
 
         Args:
             positions: Float (m, d), the new nodes.
@@ -144,8 +90,6 @@ class Tree:
         self._nodes[first:first + count] = positions
         self._parents[first:first + count] = parents
         self.size += count
-        if self.size >= self._rebuild_at:
-            self._build_grid()
         return first
 
     def _grow(self, needed: int) -> None:
@@ -156,291 +100,3 @@ class Tree:
         nodes, parents = np.empty((capacity, self.dim)), np.empty(capacity, dtype=np.int64)
         nodes[:self.size], parents[:self.size] = self._nodes[:self.size], self._parents[:self.size]
         self._nodes, self._parents = nodes, parents
-
-    def nearest(self, points: np.ndarray) -> np.ndarray:
-        """Index of the nearest node (Euclidean) to each of ``points`` (M, d).
-
-        Exact; among equally near nodes the lowest index.
-
-        Args:
-            points: Float (M, d) or (d,).
-
-        Returns:
-            Int array (M,) of node indices.
-
-        Raises:
-            ValueError: ``points`` not of shape (M, d) or (d,) for the tree's d, or not finite.
-        """
-        points = self._queries(points)
-        out = np.empty(points.shape[0], dtype=np.int64)
-        # a one-cell grid (high d, see _build_grid) is searched by the brute-force block instead,
-        # which scans the same nodes (vectorized over the queries)
-        nearest_into(points, *self._search_arrays(self.size >= BRUTE_FORCE_BELOW and self._several_cells), out)
-        return out
-
-    def _search_arrays(self, grid: bool) -> tuple[np.ndarray, int, int, np.ndarray, np.ndarray, np.ndarray,
-                                                   np.ndarray, float, np.ndarray, np.ndarray, np.ndarray]:
-        return (self._nodes, self.size, self._grid_built_at if grid else 0, self._start, self._order, self._sorted,
-                self._origin, self._cell, self._shape, self._low, self._high)
-
-    def grid_nearest(self, points: np.ndarray) -> np.ndarray:
-        """``nearest`` through the grid whatever the tree's size (for tests, and for comparing the
-        two searches): the same argument (float points, (M, d) or (d,)), result (int (M,) node
-        indices) and errors."""
-        points = self._queries(points)
-        if not self._grid_built_at:  # a small tree's first grid query builds the grid, once
-            with _FIRST_GRID:
-                if not self._grid_built_at:  # (_build_grid sets it last: a built grid is complete)
-                    self._build_grid()
-        out = np.empty(points.shape[0], dtype=np.int64)
-        nearest_into(points, *self._search_arrays(True), out)
-        return out
-
-    def _queries(self, points: np.ndarray) -> np.ndarray:
-        points = np.ascontiguousarray(np.atleast_2d(points), dtype=float)
-        if points.ndim != 2 or points.shape[1] != self.dim:
-            raise ValueError(f"points must have shape (M, {self.dim}) (the tree's d), got {points.shape}")
-        return points  # the kernels refuse points that are not finite
-
-    def _build_grid(self) -> None:
-        nodes = self.nodes
-        low, high = _bounding_box(nodes)  # (one compiled pass for both, not numpy's min and max)
-        extent = np.maximum(high - low, 1e-9)
-        cells = min(max(1.0, _CELLS_PER_NODE * self.size), _MAX_CELLS)
-        cell = float(np.prod(extent) / cells) ** (1.0 / self.dim)
-        cell = max(cell, float(extent.max()) / _MAX_CELLS ** (1.0 / self.dim), 1e-12)
-        shape = np.minimum(np.floor(extent / cell).astype(np.int64) + 1, 1 << 20)
-        # the most cells: _MAX_CELLS; or one cell (a scan of every node, as brute force) where a
-        # query's first visit, the block of 3^d cells around its own, would exceed the node count
-        # (high d: at d = 20, 2 cells per axis would make a query visit all 2^20). Products in
-        # Python integers: in int64, 2^64 wraps to 0 and the grid would be filed out of bounds.
-        most = 1 if 3 ** self.dim > self.size else _MAX_CELLS
-        while math.prod(int(count) for count in shape) > most:  # a very flat box, or high d: coarser cells
-            cell *= 2.0
-            shape = np.minimum(np.floor(extent / cell).astype(np.int64) + 1, 1 << 20)
-        start = np.zeros(math.prod(int(count) for count in shape) + 1, dtype=np.int64)
-        order = np.empty(self.size, dtype=np.int64)
-        ordered = np.empty_like(nodes)
-        _file_by_cell(nodes, low, cell, shape, start, order, ordered)
-        self._origin, self._cell, self._shape = low.copy(), cell, shape
-        self._several_cells = math.prod(int(count) for count in shape) > 1
-        self._low, self._high = low, high
-        self._start, self._order, self._sorted = start, order, ordered
-        self._rebuild_at = self.size + _pending_limit(self.size)
-        self._grid_built_at = self.size
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _cell_of(point: np.ndarray, origin: np.ndarray, cell: float, shape: np.ndarray, out: np.ndarray) -> int:
-    """The (clamped) integer cell coordinates of ``point`` into ``out``; returns the flat index."""
-    flat = 0
-    for axis in range(point.shape[0]):
-        value = (point[axis] - origin[axis]) / cell
-        if value < 0.0:
-            coordinate = 0
-        elif value >= shape[axis]:
-            coordinate = shape[axis] - 1
-        else:
-            coordinate = min(int(value), shape[axis] - 1)
-        out[axis] = coordinate
-        flat = flat * shape[axis] + coordinate
-    return flat
-
-
-@njit(cache=True, nogil=True)
-def _file_by_cell(nodes: np.ndarray, origin: np.ndarray, cell: float, shape: np.ndarray, start: np.ndarray,
-                  order: np.ndarray, ordered: np.ndarray) -> None:
-    """A counting sort of the nodes by cell: ``order`` the node indices by cell (ascending within a
-    cell), ``ordered`` their positions in that order (``nodes[order]``), ``start[c]`` the position
-    in ``order`` of cell c's first node (``start`` has one entry per cell plus the end, zero on
-    entry)."""
-    size = nodes.shape[0]
-    coordinates = np.empty(shape.shape[0], dtype=np.int64)
-    cells = np.empty(size, dtype=np.int64)
-    for index in range(size):
-        cells[index] = _cell_of(nodes[index], origin, cell, shape, coordinates)
-        start[cells[index] + 1] += 1
-    for flat in range(start.shape[0] - 1):
-        start[flat + 1] += start[flat]
-    filled = start[:-1].copy()
-    for index in range(size):
-        slot = filled[cells[index]]
-        order[slot] = index
-        for axis in range(nodes.shape[1]):
-            ordered[slot, axis] = nodes[index, axis]
-        filled[cells[index]] += 1
-
-
-@njit(cache=True, nogil=True)
-def _bounding_box(nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The smallest and largest coordinate of the (M >= 1, d) ``nodes`` along each axis (what
-    ``nodes.min(axis=0)`` and ``nodes.max(axis=0)`` give, for finite coordinates) in one pass."""
-    low = nodes[0].copy()
-    high = nodes[0].copy()
-    for axis in range(nodes.shape[1]):
-        smallest = largest = nodes[0, axis]
-        for index in range(1, nodes.shape[0]):
-            value = nodes[index, axis]
-            smallest = value if value < smallest else smallest
-            largest = value if value > largest else largest
-        low[axis], high[axis] = smallest, largest
-    return low, high
-
-
-@njit(cache=True, nogil=True)
-def _brute_block(points: np.ndarray, nodes: np.ndarray, first: int, stop: int, best: np.ndarray,
-                 out: np.ndarray) -> None:
-    """For each point, the nearest of nodes ``first .. stop - 1`` (the smallest squared distance,
-    summed over the axes in order; among equals the lowest index) into ``best`` (squared distance)
-    and ``out`` (index); ``inf`` and ``first`` where there are no such nodes or every squared
-    distance overflows. One pass over the nodes for all points (the loop over the points is the
-    inner one, without branches, so it vectorizes)."""
-    count, dim = points.shape
-    for row in range(count):
-        best[row] = np.inf
-        out[row] = first
-    if dim == 2:  # the planners' case, unrolled (the same sum: 0.0 + dx^2 == dx^2 exactly)
-        xs = points[:, 0].copy()
-        ys = points[:, 1].copy()
-        for node in range(first, stop):
-            x, y = nodes[node, 0], nodes[node, 1]
-            for row in range(count):
-                dx = xs[row] - x
-                dy = ys[row] - y
-                squared = dx * dx + dy * dy
-                nearer = squared < best[row]
-                best[row] = squared if nearer else best[row]
-                out[row] = node if nearer else out[row]
-        return
-    coordinates = points.T.copy()
-    squared = np.empty(count)
-    for node in range(first, stop):
-        squared[:] = 0.0
-        for axis in range(dim):
-            value = nodes[node, axis]
-            for row in range(count):
-                delta = coordinates[axis, row] - value
-                squared[row] += delta * delta
-        for row in range(count):
-            nearer = squared[row] < best[row]
-            best[row] = squared[row] if nearer else best[row]
-            out[row] = node if nearer else out[row]
-
-
-@njit(cache=True, nogil=True)
-def _grid_search(points: np.ndarray, start: np.ndarray, order: np.ndarray, ordered: np.ndarray, origin: np.ndarray,
-                 cell: float, shape: np.ndarray, low: np.ndarray, high: np.ndarray, best: np.ndarray,
-                 out: np.ndarray) -> None:
-    """Ring search of the grid, from the nearest (``best``, ``out``) found so far: for each point,
-    the node with the smallest (squared distance, index)."""
-    dim = points.shape[1]
-    last = dim - 1
-    centre = np.empty(dim, dtype=np.int64)
-    current = np.empty(dim, dtype=np.int64)
-    lower = np.empty(dim, dtype=np.int64)
-    upper = np.empty(dim, dtype=np.int64)
-    outside = np.empty(dim)  # the point's distance to the grid nodes' bounding box along each axis
-    slack = np.empty(dim)  # the rounding allowance of the cell edges along each axis (see below)
-    for row in range(points.shape[0]):
-        point = points[row]
-        _cell_of(point, origin, cell, shape, centre)
-        outside_total = 0.0
-        for axis in range(dim):
-            below = low[axis] - point[axis]
-            above = point[axis] - high[axis]
-            outside[axis] = max(below, above, 0.0)
-            outside_total += outside[axis] * outside[axis]
-            slack[axis] = _EDGE_SLACK * (abs(point[axis]) + abs(origin[axis]) + shape[axis] * cell)
-        nearest = best[row]
-        nearest_index = out[row]
-        ring = 1  # the first visit covers rings 0 and 1 (the block of 3^d cells around the centre)
-        while True:
-            # visit the cells at Chebyshev distance ``ring`` from the centre (clipped to the grid),
-            # on the first visit every cell of the block: an odometer over the first d - 1 axes;
-            # along the last axis the whole run of cells (one slice of the sorted nodes) where the
-            # prefix is on the ring (or on the first visit), else its two ends
-            for axis in range(dim):
-                lower[axis] = max(centre[axis] - ring, 0)
-                upper[axis] = min(centre[axis] + ring, shape[axis] - 1)
-                current[axis] = lower[axis]
-            while True:
-                on_ring = ring == 1
-                prefix = 0
-                for axis in range(last):
-                    if abs(current[axis] - centre[axis]) == ring:
-                        on_ring = True
-                    prefix = prefix * shape[axis] + current[axis]
-                prefix *= shape[last]
-                for end in range(2):  # on the ring: the run [lower, upper] once; else its two end cells
-                    if on_ring:
-                        if end:
-                            break
-                        first, stop = start[prefix + lower[last]], start[prefix + upper[last] + 1]
-                    else:
-                        cell_last = centre[last] - ring if end == 0 else centre[last] + ring
-                        if cell_last < 0 or cell_last > shape[last] - 1:
-                            continue
-                        first, stop = start[prefix + cell_last], start[prefix + cell_last + 1]
-                    for slot in range(first, stop):  # the scan written out (an inlined helper is slower)
-                        squared = 0.0
-                        for axis in range(dim):
-                            delta = point[axis] - ordered[slot, axis]
-                            squared += delta * delta
-                        candidate = order[slot]  # the update without branches
-                        nearer = (squared < nearest) | ((squared == nearest) & (candidate < nearest_index))
-                        nearest = squared if nearer else nearest
-                        nearest_index = candidate if nearer else nearest_index
-                axis = last - 1  # odometer step over the prefix
-                while axis >= 0:
-                    current[axis] += 1
-                    if current[axis] <= upper[axis]:
-                        break
-                    current[axis] = lower[axis]
-                    axis -= 1
-                if axis < 0:
-                    break
-            # a lower bound on the squared distance from the point to any cell outside the visited
-            # block: beyond one side of one axis, the gap to that side plus, along the other axes,
-            # the point's distance to the grid nodes' bounding box.
-            # Each gap is shortened by a few units in the last place of the coordinates involved:
-            # a node is filed by int((x - origin) / cell), which can put a node lying a rounding
-            # error below a computed edge origin + k * cell into cell k, and the search must not
-            # stop before reaching it (a node as near as the best, or a tie with a lower index).
-            bound = np.inf
-            covers = True
-            for axis in range(dim):
-                others = outside_total - outside[axis] * outside[axis]
-                if centre[axis] - ring - 1 >= 0:
-                    covers = False
-                    gap = max(point[axis] - (origin[axis] + (centre[axis] - ring) * cell) - slack[axis], 0.0)
-                    bound = min(bound, gap * gap + others)
-                if centre[axis] + ring + 1 <= shape[axis] - 1:
-                    covers = False
-                    gap = max(origin[axis] + (centre[axis] + ring + 1) * cell - point[axis] - slack[axis], 0.0)
-                    bound = min(bound, gap * gap + others)
-            if covers or bound > nearest * (1.0 + _EDGE_SLACK):  # every cell visited, or none left nearer
-                break
-            ring += 1
-        best[row] = nearest
-        out[row] = nearest_index
-
-
-@njit(cache=True, nogil=True)
-def nearest_into(points: np.ndarray, nodes: np.ndarray, size: int, built: int, start: np.ndarray, order: np.ndarray,
-                 ordered: np.ndarray, origin: np.ndarray, cell: float, shape: np.ndarray, low: np.ndarray,
-                 high: np.ndarray, out: np.ndarray) -> None:
-    """``Tree.nearest`` compiled (the arguments after ``points`` are ``Tree._search_arrays``): the
-    brute force over the nodes the grid does not hold (all of them without a grid), then the
-    grid's ring search from that best; writes the node indices into ``out``.
-
-    Raises:
-        ValueError: A point that is not finite.
-    """
-    for row in range(points.shape[0]):
-        for axis in range(points.shape[1]):
-            if not np.isfinite(points[row, axis]):
-                raise ValueError(_NOT_FINITE)
-    best = np.empty(points.shape[0])
-    _brute_block(points, nodes, built, size, best, out)
-    if built:
-        _grid_search(points, start, order, ordered, origin, cell, shape, low, high, best, out)

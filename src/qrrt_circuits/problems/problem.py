@@ -40,7 +40,7 @@ from .goals import Goal, GoalBall, ball_of, check_goal, first_satisfying
 __all__ = ["SPACE_MEMBERS", "Problem", "check_space"]
 
 #: the members a state space must have (``world.spaces.StateSpace``)
-SPACE_MEMBERS = ("dim", "distance", "interpolate", "nearest", "check_bounds", "describe")
+SPACE_MEMBERS = ("dim", "distance", "interpolate", "nearest_neighbors", "check_bounds", "describe")
 
 
 def check_space(space: Any, env: Environment) -> StateSpace:

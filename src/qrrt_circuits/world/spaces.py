@@ -1,34 +1,35 @@
-"""State spaces: the distance, interpolation and nearest-node search of a planning problem
+"""State spaces: the distance, interpolation and nearest-neighbour structure of a planning problem
 (OMPL's ``StateSpace``), chosen once per planner.
 
 A planner samples states uniformly in its environment's bounds (paper Alg. 1, line 4), pairs each
-with its nearest tree node under the space's distance (line 6), and moves a candidate farther than
-``max_extension`` toward its parent along the space's interpolation. Two spaces are built in:
+with its nearest tree node under the space's distance (line 6), found by the nearest-neighbour
+structure the space chooses once per plan (``nearest_neighbors``, ``world.nearest``), and moves a
+candidate farther than ``max_extension`` toward its parent along the space's interpolation. Two
+spaces are built in:
 
-- ``RealVectorSpace(d)``: Euclidean distance, straight interpolation, and the tree's compiled
-  exact grid search (``Tree.nearest``); the paper's space and the default.
+- ``RealVectorSpace(d)``: Euclidean distance, straight interpolation, and the compiled exact grid
+  search (``GridNearest``); the paper's space and the default.
 - ``SE2Space()``: a rigid body in the plane, states (x, y, theta) with theta in [-pi, pi);
   OMPL's ``SE2StateSpace`` metric ``||(dx, dy)|| + w * abs(dtheta)`` (dtheta wrapped to the shorter
-  way round, w = 0.5 as in OMPL), interpolation along the shorter arc, and an exact brute-force
-  nearest search under that metric.
+  way round, w = 0.5 as in OMPL), interpolation along the shorter arc, and an exact scan under
+  that metric (``LinearNearest``).
 
-Any object with ``dim``, ``distance``, ``interpolate``, ``nearest``, ``check_bounds`` and
-``describe`` is a space. Goal balls (``GoalBall``) measure Euclidean distance in the coordinates
-whatever the space; a goal of your own can use the space's metric.
+Any object with ``dim``, ``distance``, ``interpolate``, ``nearest_neighbors``, ``check_bounds`` and
+``describe`` is a space; its ``nearest_neighbors`` can return ``LinearNearest(self)``, exact under
+any ``distance``. Goal balls (``GoalBall``) measure Euclidean distance in the coordinates whatever
+the space; a goal of your own can use the space's metric.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Protocol, runtime_checkable
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 
 from .._support.validation import check_float, check_int
-
-if TYPE_CHECKING:
-    from ..planners.tree import Tree
+from .nearest import GridNearest, LinearNearest, NearestNeighbors
 
 __all__ = ["RealVectorSpace", "SE2Space", "StateSpace", "wrap_angle"]
 
@@ -50,8 +51,9 @@ class StateSpace(Protocol):
         """Float (M, d): the states a ``fraction`` (M,) of the way from each origin to its target."""
         ...
 
-    def nearest(self, tree: Tree, points: np.ndarray) -> np.ndarray:
-        """Int (M,): the index of each point's nearest tree node (ties: the lowest index)."""
+    def nearest_neighbors(self) -> NearestNeighbors:
+        """A new, empty nearest-neighbour structure exact under ``distance`` (ties: the lowest
+        index; ``world.nearest``), one per plan: ``LinearNearest(self)`` suits any metric."""
         ...
 
     def check_bounds(self, bounds: np.ndarray) -> None:
@@ -82,9 +84,9 @@ class RealVectorSpace:
     def interpolate(self, origins: np.ndarray, targets: np.ndarray, fraction: np.ndarray) -> np.ndarray:
         return origins + (targets - origins) * np.asarray(fraction)[:, None]
 
-    def nearest(self, tree: Tree, points: np.ndarray) -> np.ndarray:
-        """``tree.nearest`` (the compiled exact grid search)."""
-        return tree.nearest(points)
+    def nearest_neighbors(self) -> GridNearest:
+        """A ``GridNearest`` (the compiled exact Euclidean grid search)."""
+        return GridNearest(self.dim)
 
     def check_bounds(self, bounds: np.ndarray) -> None:
         if bounds.shape != (self.dim, 2):
@@ -105,10 +107,6 @@ def wrap_angle(angle: np.ndarray) -> np.ndarray:
         The same shape, each ``(angle + pi) mod 2 pi - pi``.
     """
     return np.mod(np.asarray(angle, dtype=float) + math.pi, 2 * math.pi) - math.pi
-
-
-#: queries times nodes per chunk of SE2Space's brute-force search (bounds its scratch memory)
-_CHUNK = 1 << 20
 
 
 @dataclass(frozen=True)
@@ -144,19 +142,10 @@ class SE2Space:
         out[:, 2] = wrap_angle(origins[:, 2] + wrap_angle(targets[:, 2] - origins[:, 2]) * fraction[:, 0])
         return out
 
-    def nearest(self, tree: Tree, points: np.ndarray) -> np.ndarray:
-        """Exact brute force under the SE(2) metric (the first of equally near nodes)."""
-        points = np.atleast_2d(np.asarray(points, dtype=float))
-        nodes = tree.nodes
-        out = np.empty(points.shape[0], dtype=np.int64)
-        step = max(1, _CHUNK // max(1, nodes.shape[0]))
-        for first in range(0, points.shape[0], step):
-            block = points[first:first + step]
-            offset = nodes[None, :, :] - block[:, None, :]
-            turn = np.abs(wrap_angle(offset[..., 2]))
-            distance = np.hypot(offset[..., 0], offset[..., 1]) + self.angle_weight * turn
-            out[first:first + step] = np.argmin(distance, axis=1)
-        return out
+    def nearest_neighbors(self) -> LinearNearest:
+        """A ``LinearNearest`` under the SE(2) metric (an exact scan; the first of equally near
+        nodes)."""
+        return LinearNearest(self)
 
     def check_bounds(self, bounds: np.ndarray) -> None:
         if bounds.shape != (3, 2):
