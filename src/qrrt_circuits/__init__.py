@@ -38,6 +38,7 @@ if TYPE_CHECKING:
     from .search.backends.sampler import SamplerBackend
     from .search.backends.statevector import StatevectorBackend
     from .search.iterate_sequence import IterateSequence
+    from .search.oracles import CircuitOracle, LookupOracle, SearchOracle
     from .search.policies.adaptive import Adaptive
     from .search.policies.base import IterationPolicy
     from .search.policies.bbht import BBHT
@@ -81,6 +82,7 @@ _WHERE = {
     **dict.fromkeys(["AerBackend", "EstimatedOptimal", "FixedPointAmplification", "IterateSequence",
                      "SamplerBackend", "StatevectorBackend"], ".search"),
     "circuits": ".search.circuits",
+    **dict.fromkeys(["CircuitOracle", "LookupOracle", "SearchOracle"], ".search.oracles"),
     "IterationPolicy": ".search.policies.base",
     **dict.fromkeys(["FixedIterations", "KnownOptimal", "PaperIterations"], ".search.policies.schedules"),
     "BBHT": ".search.policies.bbht",
@@ -135,6 +137,7 @@ __all__ = [
     "AuthorsCheck",
     "DatabaseSearch",
     "Environment",
+    "CircuitOracle",
     "EstimatedOptimal",
     "FixedIterations",
     "FixedPointAmplification",
@@ -150,6 +153,7 @@ __all__ = [
     "IterateSequence",
     "LatticeCandidates",
     "LinearTrackingDynamics",
+    "LookupOracle",
     "MaxCriticalPathCalls",
     "MaxNodes",
     "MaxOracleCalls",
@@ -167,6 +171,7 @@ __all__ = [
     "ExactCheck",
     "ReachabilityPredicate",
     "SamplerBackend",
+    "SearchOracle",
     "SearchOutcome",
     "SearchRequest",
     "SearchResult",

@@ -165,7 +165,8 @@ class PQRRT(Planner):
         Counts the databases alive at once (one shared database, or one per worker when the
         databases are unshared: a round builds every worker's database before it searches them, on
         an executor or not), each with its backend search at the policy's largest iteration count
-        (``IterationPolicy.search_peak_bytes``), plus the policy's state.
+        (``QuantumSearchBackend.peak_bytes`` of ``IterationPolicy.iterations_bound``), plus the
+        policy's state.
 
         Args:
             num_qubits: Qubits n to estimate for (databases of 2^n entries); default the planner's
@@ -178,7 +179,8 @@ class PQRRT(Planner):
         size = 1 << n
         concurrent = 1 if self.shared_database else self.workers
         shots = self.workers if self.shared_database else 1
-        search = self.search_policy.search_peak_bytes(self.backend, n, shots)
+        policy = self.search_policy
+        search = self.backend.peak_bytes(n, shots, policy.iterations_bound(size), sequence=policy.runs_sequences)
         return MemoryEstimate(
             n,
             database_bytes=concurrent * database_bytes(n, self.env.dim, self.annealing is not None),
