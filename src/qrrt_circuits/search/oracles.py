@@ -30,7 +30,7 @@ from __future__ import annotations
 import abc
 import enum
 import functools
-import itertools
+import uuid
 from collections.abc import Hashable, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -222,10 +222,6 @@ class LookupOracle(SearchOracle):
         return f"lookup oracle of {self.marked_count()} marked entries among 2^{self.num_qubits}"
 
 
-#: distinguishes circuit oracles in cache keys (an object's id can be reused once it is freed)
-_SERIALS = itertools.count()
-
-
 class CircuitOracle(SearchOracle):
     """A phase-oracle circuit: (-1)^f(i) on |i>, its ancillas starting and ending in |0> (module
     docstring).
@@ -289,7 +285,7 @@ class CircuitOracle(SearchOracle):
                                  f"got {checked.shape[0]}")
             self.marks = checked.copy()
             self.marks.setflags(write=False)
-        self._serial = next(_SERIALS)
+        self._token = uuid.uuid4().hex  # (an object's id can be reused once it is freed)
         self._built: dict[int, QuantumCircuit] = {}  # transpiled, per iteration count
 
     @property
@@ -355,8 +351,9 @@ class CircuitOracle(SearchOracle):
                          "Grover iterations (search), or search a LookupOracle")
 
     def cache_key(self) -> Hashable:
-        """This oracle's own serial number (two circuit oracles are never taken for each other)."""
-        return ("circuit", self._serial)
+        """This oracle's own random token, kept through pickling (two circuit oracles are never taken
+        for each other, in any process)."""
+        return ("circuit", self._token)
 
     def describe(self) -> str:
         return f"circuit oracle of {self.width} qubits, {self.num_qubits} of them the index"
