@@ -3,7 +3,11 @@
 from __future__ import annotations
 
 import json
+import os
+import subprocess
+import sys
 import time
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -35,3 +39,22 @@ def write_json(name: str, payload: dict, out: str | None = None) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(payload, indent=1))
     return path
+
+
+def rows_in_subprocesses(script: str, cases: Sequence[Sequence[object]], header: str,
+                         line: Callable[[dict], str]) -> list[dict]:
+    """Each case run as ``python script --case *case`` in a fresh process (one OpenMP thread), whose
+    last line of output is its row as JSON; ``header``, then ``line(row)`` for each row as it comes.
+
+    Returns:
+        The rows, in the order of ``cases``.
+    """
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    print(header)
+    rows = []
+    for case in cases:
+        done = subprocess.run([sys.executable, script, "--case", *map(str, case)], capture_output=True, text=True,
+                              check=True, env=env)
+        rows.append(json.loads(done.stdout.strip().splitlines()[-1]))
+        print(line(rows[-1]), flush=True)
+    return rows

@@ -107,7 +107,7 @@ def _marks(n: int, marked: int, rng: np.random.Generator) -> np.ndarray:
 def _timed(backend: qc.AerBackend, marks: np.ndarray, seed: int, shots: int = SHOTS,
            iterations: int = ITERATIONS) -> tuple[float, np.ndarray]:
     start = time.perf_counter()
-    result = backend.search(marks, iterations, shots=shots, seed=seed)
+    result = backend.search(qc.LookupOracle(marks), iterations, shots=shots, seed=seed)
     return time.perf_counter() - start, result.indices
 
 
@@ -218,10 +218,10 @@ def main() -> None:
     gpu = None if args.cpu_only else qc.AerBackend(seed=1, device="GPU")
     if gpu is not None:
         start = time.perf_counter()
-        gpu.search(_marks(8, MARKED, np.random.default_rng(9)), ITERATIONS, shots=SHOTS, seed=0)
+        gpu.search(qc.LookupOracle(_marks(8, MARKED, np.random.default_rng(9))), ITERATIONS, shots=SHOTS, seed=0)
         payload["gpu_first_search_s"] = time.perf_counter() - start
         print(f"GPU first search (CUDA context, kernels): {payload['gpu_first_search_s']:.2f} s", flush=True)
-    cpu.search(_marks(8, MARKED, np.random.default_rng(9)), ITERATIONS, shots=SHOTS, seed=0)  # warm-up
+    cpu.search(qc.LookupOracle(_marks(8, MARKED, np.random.default_rng(9))), ITERATIONS, shots=SHOTS, seed=0)  # warm-up
     for name, backend in (("GPU", gpu), ("CPU", cpu)):
         if backend is not None and not args.dense and not args.blocking:
             payload["checks"].append({"device": name, **_attempt(lambda d=name: distribution_check(d))})

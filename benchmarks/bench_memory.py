@@ -22,7 +22,7 @@ Cases:
   --json`` does, against ``json.dump`` and ``json.dumps`` of ``to_dict()``);
 - ``--mcz``: one ``AerBackend.search`` (8 shots) whose oracle takes the ``mcz`` form: 12 marked
   entries at n = 20, 22 (k = 1, 12) and 24 (k = 1), and 100 marked entries at n = 16 with k = 1 and
-  400 (80 200 instructions); the estimate is ``AerBackend.memory_estimate(n, 8, k, marked)`` (the
+  400 (80 200 instructions); the estimate is ``AerBackend.peak_bytes(n, 8, k, marked)`` (the
   constants ``AER_MCZ_BYTES_PER_ENTRY`` and ``AER_BYTES_PER_MCZ_INSTRUCTION`` come from these).
 
     python benchmarks/bench_memory.py            # n = 16, 18, 20, 22 on both backends (a few minutes)
@@ -36,13 +36,10 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import subprocess
-import sys
 import time
 from pathlib import Path
 
-from _common import RESULTS, machine
+from _common import RESULTS, machine, rows_in_subprocesses
 
 MIB = 1 << 20
 
@@ -70,7 +67,7 @@ def run_plan_case(backend_name: str, n: int, k: int | None) -> dict:
     qc.QRRT(backend=backend, num_qubits=4, seed=0, search_policy=policy).plan(env, max_rounds=2)  # warm up
     base = _rss()
     planner = qc.QRRT(backend=backend, num_qubits=n, seed=0, search_policy=policy)
-    estimate = planner.memory_estimate()
+    estimate = planner.memory_estimate(dim=2)
     planner.plan(env, max_rounds=1)
     return {"case": "plan", "backend": backend_name, "num_qubits": n,
             "iterations": policy.iterations_bound(1 << n), "measured_bytes": _peak() - base,
@@ -252,21 +249,21 @@ def run_mcz_search_case(n: int, marked: int, k: int) -> dict:
     marks[np.random.default_rng(0).choice(1 << n, marked, replace=False)] = True
     warm = np.zeros(1 << 14, dtype=bool)
     warm[:marked] = True
-    backend.search(warm, 1, shots=8)  # warm up (a 14-qubit run: Aer's fusion and threads)
+    backend.search(qc.LookupOracle(warm), 1, shots=8)  # warm up (a 14-qubit run: Aer's fusion and threads)
     base = _rss()
-    backend.search(marks, k, shots=8)
-    estimate = backend.memory_estimate(n, 8, k, marked)
+    backend.search(qc.LookupOracle(marks), k, shots=8)
+    estimate = backend.peak_bytes(n, 8, k, marked)
     return {"case": "search-mcz", "backend": "aer", "num_qubits": n, "marked": marked, "iterations": k,
             "synthesis": simulation_synthesis(marks), "measured_bytes": _peak() - base,
-            "estimated_bytes": estimate.total_bytes,
+            "estimated_bytes": estimate,
             "measured_bytes_per_entry": (_peak() - base) / (1 << n)}
 
 
-def in_subprocess(*args: str) -> dict:
-    env = dict(os.environ, OMP_NUM_THREADS="1")
-    out = subprocess.run([sys.executable, __file__, "--case", *args], capture_output=True, text=True,
-                         check=True, env=env)
-    return json.loads(out.stdout.strip().splitlines()[-1])
+def _line(row: dict) -> str:
+    ratio = row["estimated_bytes"] / max(row["measured_bytes"], 1)
+    return (f"{row['case']:9s} {row.get('backend', '-'):12s} {row['num_qubits']:3d} {row.get('dim', 2):2d} "
+            f"{row.get('iterations', '-')!s:>3s} {row['estimated_bytes'] / MIB:14.1f} "
+            f"{row['measured_bytes'] / MIB:13.1f} {ratio:9.2f}")
 
 
 def main() -> None:
@@ -316,16 +313,9 @@ def main() -> None:
         cases = mcz
     else:
         cases += (limits if args.plan_limits else []) + (mcz if args.mcz else [])
-    rows = []
-    print(f"{'case':9s} {'backend':12s} {'n':>3s} {'d':>2s} {'k':>3s} {'estimated MiB':>14s} "
-          f"{'measured MiB':>13s} {'est/meas':>9s}")
-    for case in cases:
-        row = in_subprocess(*case)
-        rows.append(row)
-        ratio = row["estimated_bytes"] / max(row["measured_bytes"], 1)
-        print(f"{row['case']:9s} {row.get('backend', '-'):12s} {row['num_qubits']:3d} {row.get('dim', 2):2d} "
-              f"{row.get('iterations', '-')!s:>3s} {row['estimated_bytes'] / MIB:14.1f} "
-              f"{row['measured_bytes'] / MIB:13.1f} {ratio:9.2f}", flush=True)
+    header = (f"{'case':9s} {'backend':12s} {'n':>3s} {'d':>2s} {'k':>3s} {'estimated MiB':>14s} "
+              f"{'measured MiB':>13s} {'est/meas':>9s}")
+    rows = rows_in_subprocesses(__file__, cases, header, _line)
     RESULTS.mkdir(exist_ok=True)
     path = Path(args.out) if args.out else RESULTS / "bench_memory.json"
     path.write_text(json.dumps({"machine": machine(), "rows": rows,

@@ -3,7 +3,7 @@
 Makes a cgroup (v2, or v1's memory controller) with a 600 MiB limit, which needs root and a
 writable cgroup file system, and runs in it, in fresh processes: a q-RRT construction and one
 round at n = 22, 23 and 24 with the guard as it is (the room of the group,
-``memory.cgroup_available_bytes``), and n = 24 with the group ignored (the guard before it read the
+``available_memory.cgroup_available_bytes``), and n = 24 with the group ignored (the guard before it read the
 group: the machine's ``MemAvailable`` only). Records for each: refused (the message), ran, or
 killed (exit status, the group's failure count).
 
@@ -33,11 +33,12 @@ LIMIT = 600 << 20
 
 CHILD = """
 import sys
+from qrrt_circuits._support import available_memory as probe
 import qrrt_circuits as qc
 from qrrt_circuits._support import memory
 n, guarded = int(sys.argv[1]), sys.argv[2] == "guarded"
 if not guarded:
-    memory.cgroup_available_bytes = lambda: None
+    probe.cgroup_available_bytes = lambda: None
 env = qc.paper_clutter(seed=0)
 planner = qc.QRRT(backend=qc.StatevectorBackend(0, max_qubits=24), num_qubits=n, seed=0)
 try:
@@ -128,7 +129,9 @@ def main() -> None:
         print(f"n = {row['num_qubits']} {row['guard']:9s} {row['outcome']:8s} rc {row['returncode']}  "
               f"{row['message'][:110]}")
     RESULTS.mkdir(exist_ok=True)
-    from qrrt_circuits._support.memory import _machine_available_bytes  # the machine's figure, outside any group
+    from qrrt_circuits._support.available_memory import (
+        _machine_available_bytes,  # the machine's figure, outside any group
+    )
 
     path.write_text(json.dumps({"machine": machine(), "machine_available_bytes": _machine_available_bytes(),
                                 "limit_bytes": LIMIT, "rows": rows,

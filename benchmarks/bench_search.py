@@ -83,7 +83,7 @@ def _floor_runs(marks: np.ndarray) -> dict:
     floor.measure(0, 0)
     ours = qc.AerBackend(seed=1, max_parallel_threads=1)
     return {"floor": lambda: simulator.run(floor, shots=8, seed_simulator=1, memory=True).result(),
-            "ours": lambda: ours.search(marks, 12, shots=8)}
+            "ours": lambda: ours.search(qc.LookupOracle(marks), 12, shots=8)}
 
 
 def _contenders(n: int, marks: np.ndarray) -> dict:
@@ -122,7 +122,7 @@ def _contenders(n: int, marks: np.ndarray) -> dict:
     if n in (8, 12):
         for form in ("diagonal", "mcz"):
             backend = qc.AerBackend(seed=1, max_parallel_threads=1, synthesis=form)
-            runs[f"ours_{form}"] = lambda b=backend: b.search(marks, 12, shots=8)
+            runs[f"ours_{form}"] = lambda b=backend: b.search(qc.LookupOracle(marks), 12, shots=8)
     if n <= 12:
         runs["qiskit_algorithms"] = _qiskit_algorithms_grover(n, marks)
     return runs
@@ -238,7 +238,7 @@ def bench_one_job(quick: bool) -> dict:
     def one_run() -> None:  # the circuits of the round built and run in one AerSimulator.run
         words([circuits.aer_grover_circuit(mk, k, synthesis=synthesis) for mk in marks], 1, seeds[0])
 
-    requests = [qc.SearchRequest(mk, k, 1, seed) for mk, seed in zip(marks, seeds, strict=True)]
+    requests = [qc.SearchRequest(qc.LookupOracle(mk), k, 1, seed) for mk, seed in zip(marks, seeds, strict=True)]
     runs = {"search_many": lambda: backend.search_many(requests), "one_run": one_run}
     for run in runs.values():
         run()
@@ -278,11 +278,11 @@ def bench_round_search(quick: bool) -> dict:
                                max_parallel_threads=1).result()
         cpp_us[iterations].append(result.results[0].time_taken * 1e6)
 
-    runs = {"search": lambda: backend.search(marks, k, 1, seed=1),
+    runs = {"search": lambda: backend.search(qc.LookupOracle(marks), k, 1, seed=1),
             "build_circuit": lambda: circuits.aer_grover_circuit(marks, k),
             "run_prebuilt": lambda: run_prebuilt(k),
             "run_prebuilt_k0": lambda: run_prebuilt(0),
-            "statevector_search": lambda: statevector.search(marks, k, 1, seed=1)}
+            "statevector_search": lambda: statevector.search(qc.LookupOracle(marks), k, 1, seed=1)}
     for run in runs.values():
         run()
     for samples in cpp_us.values():  # drop the warm-up's
@@ -312,8 +312,8 @@ def bench_search(quick: bool) -> list[dict]:
             marks = np.zeros(2**n, dtype=bool)
             marks[rng.choice(2**n, m, replace=False)] = True
             repeats = 5 if quick else (10 if n >= 15 else 30)
-            med, lo, hi = median_time(lambda b=backend, mk=marks, sd=seed: b.search(mk, 12, shots=8, seed=sd),
-                                      repeats)
+            oracle = qc.LookupOracle(marks)
+            med, lo, hi = median_time(lambda b=backend, o=oracle, sd=seed: b.search(o, 12, shots=8, seed=sd), repeats)
             rows.append({"backend": name, "qubits": n, "marked": m, "iterations": 12, "shots": 8,
                          "median_s": med, "min_s": lo, "max_s": hi, "repeats": repeats})
             print(f"  {name:20s} n={n:2d}  {med * 1e3:9.3f} ms  (min {lo * 1e3:.3f}, max {hi * 1e3:.3f})")
@@ -338,11 +338,11 @@ def bench_synthesis(quick: bool) -> dict:
             marks[rng.choice(2**n, m, replace=False)] = True
             times: dict[str, list[float]] = {form: [] for form in forms}
             for backend in forms.values():
-                backend.search(marks, 12, shots=8, seed=0)
+                backend.search(qc.LookupOracle(marks), 12, shots=8, seed=0)
             for repeat in range(repeats):
                 for form, backend in forms.items():
                     start = time.perf_counter()
-                    backend.search(marks, 12, shots=8, seed=repeat)
+                    backend.search(qc.LookupOracle(marks), 12, shots=8, seed=repeat)
                     times[form].append(time.perf_counter() - start)
             medians = {form: float(np.median(values)) for form, values in times.items()}
             choice = simulation_synthesis(marks)

@@ -62,7 +62,7 @@ def stream_cost(policy: qc.IterationPolicy, lam: float, workers: int, budget: in
     while spent < budget:
         marks = np.zeros(num_items, dtype=bool)
         marks[rng.choice(num_items, min(int(rng.poisson(lam)), num_items), replace=False)] = True
-        problem = qc.DatabaseSearch(marks, marks, backend, streams, index)
+        problem = qc.DatabaseSearch(qc.LookupOracle(marks), marks, backend, streams, index)
         outcomes = state.run(problem, workers, tree_nodes=index)
         state.learn([outcomes])
         spent += sum(o.oracle_calls for o in outcomes)

@@ -24,6 +24,8 @@ def clutter_world(clutter):
 def make_backend(name: str, seed: int):
     if name == "aer":
         return qc.AerBackend(seed=seed)
+    if name == "aer-mps":
+        return qc.AerBackend(seed=seed, method="matrix_product_state")
     if name == "statevector":
         return qc.StatevectorBackend(seed=seed)
     if name == "statevector-iterated":
@@ -34,7 +36,7 @@ def make_backend(name: str, seed: int):
 
 
 BACKENDS = ["aer", "statevector"]
-ALL_BACKENDS = ["aer", "statevector", "statevector-iterated", "sampler"]
+ALL_BACKENDS = ["aer", "aer-mps", "statevector", "statevector-iterated", "sampler"]
 
 
 def random_marks(rng: np.random.Generator, num_qubits: int, num_marked: int) -> np.ndarray:

@@ -48,6 +48,7 @@ if TYPE_CHECKING:
     from .search.backends.sampler import SamplerBackend
     from .search.backends.statevector import StatevectorBackend
     from .search.iterate_sequence import IterateSequence
+    from .search.oracles import CircuitOracle, LookupOracle, SearchOracle
     from .search.policies.adaptive import Adaptive
     from .search.policies.base import IterationPolicy
     from .search.policies.bbht import BBHT
@@ -95,6 +96,7 @@ _WHERE = {
     # (these import Qiskit: the circuits, Aer, the sampler, amplitude estimation, or its circuit types)
     **dict.fromkeys(["AerBackend", "EstimatedOptimal", "FixedPointAmplification", "IterateSequence",
                      "SamplerBackend", "StatevectorBackend"], ".search"),
+    **dict.fromkeys(["CircuitOracle", "LookupOracle", "SearchOracle"], ".search.oracles"),
     "IterationPolicy": ".search.policies.base",
     **dict.fromkeys(["FixedIterations", "KnownOptimal", "PaperIterations"], ".search.policies.schedules"),
     "BBHT": ".search.policies.bbht",
@@ -150,6 +152,7 @@ __all__ = [
     "AuthorsCheck",
     "DatabaseSearch",
     "Environment",
+    "CircuitOracle",
     "EstimatedOptimal",
     "FixedIterations",
     "FixedPointAmplification",
@@ -168,6 +171,7 @@ __all__ = [
     "IterateSequence",
     "LatticeCandidates",
     "LinearTrackingDynamics",
+    "LookupOracle",
     "MaxCriticalPathCalls",
     "MaxNodes",
     "MaxOracleCalls",
@@ -199,6 +203,7 @@ __all__ = [
     "ExactCheck",
     "ReachabilityPredicate",
     "SamplerBackend",
+    "SearchOracle",
     "SearchOutcome",
     "SearchRequest",
     "SearchResult",

@@ -9,6 +9,7 @@ from qiskit import QuantumCircuit
 from qiskit.quantum_info import Statevector
 from tolerances import binomial_counts, within_binomial
 
+from qrrt_circuits import LookupOracle
 from qrrt_circuits.hardware import noise
 from qrrt_circuits.probability import good_probability, prob_true_solution
 from qrrt_circuits.search.backends.noisy import depolarizing_backend
@@ -25,7 +26,7 @@ def _marks(n, marked, seed=0):
 def test_zero_noise_gives_the_ideal_success_rate(method):
     marks, k, shots = _marks(4, 2), 2, 2000
     backend = depolarizing_backend(0.0, 0.0, method=method)
-    result = backend.search(marks, k, shots=shots, seed=11)
+    result = backend.search(LookupOracle(marks), k, shots=shots, seed=11)
     hits = int(marks[result.indices].sum())
     assert within_binomial(hits, shots, good_probability(16, 2, k))
     assert result.oracle_calls == k * shots
@@ -50,7 +51,7 @@ def test_noisy_shots_agree_with_the_density_matrix(n, method):
     expected = float(exact[marks].sum())
     ideal = good_probability(1 << n, 1, k)
     assert expected < ideal - 0.05  # the noise is large enough to matter
-    result = depolarizing_backend(p1, p2, method=method).search(marks, k, shots=shots, seed=5)
+    result = depolarizing_backend(p1, p2, method=method).search(LookupOracle(marks), k, shots=shots, seed=5)
     hits = int(marks[result.indices].sum())
     assert within_binomial(hits, shots, expected)
 
@@ -128,8 +129,8 @@ def test_fake_device_backend_searches_on_the_device():
 
     backend = fake_device_backend()
     marks, shots = _marks(3, 1, seed=1), 200
-    result = backend.search(marks, 1, shots=shots, seed=3)
-    compiled = backend.compiled(marks, 1)
+    result = backend.search(LookupOracle(marks), 1, shots=shots, seed=3)
+    compiled = backend.compiled(LookupOracle(marks), 1)
     assert set(compiled.count_ops()) <= set(noise.fake_device().operation_names) | {"barrier"}
     hits = int(marks[result.indices].sum())
     # the calibrated noise may lower the ideal sin^2(3 theta) = 0.78, not raise it, and a 3-qubit

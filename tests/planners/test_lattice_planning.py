@@ -1,6 +1,6 @@
 """Planning on the lattice database (``LatticeCandidates``), searched by lookup or by the coherent
-circuit on Aer: every plan reaches its goal within an oracle-call budget and every edge is
-re-checked by the planner's own predicate."""
+circuit on Aer's matrix-product-state method: every plan reaches its goal within an oracle-call
+budget and every edge is re-checked by the planner's own predicate."""
 
 from __future__ import annotations
 
@@ -27,7 +27,8 @@ def _on_lattice(points: np.ndarray, bits: int, cell_bits: int) -> bool:
 def test_lattice_plans_reach_the_goal_with_checked_edges(coherent):
     reached = 0
     for seed in range(4):
-        planner = qc.QRRT(backend=qc.StatevectorBackend(seed=0), num_qubits=7, seed=seed,
+        backend = qc.AerBackend(seed=0, method="matrix_product_state") if coherent else qc.StatevectorBackend(seed=0)
+        planner = qc.QRRT(backend=backend, num_qubits=7, seed=seed,
                           database=qc.LatticeCandidates(3, bits=6, coherent=coherent))
         result = planner.plan(CORRIDOR, max_oracle_calls=400)
         reached += result.reached
@@ -37,25 +38,6 @@ def test_lattice_plans_reach_the_goal_with_checked_edges(coherent):
                                                "time_samples": 4, "fraction_bits": 6}
         assert any("coherent oracle" in label for label in result.labels) == coherent
     assert reached == 4
-
-
-def test_the_coherent_backend_measures_what_its_circuit_marks():
-    from qrrt_circuits.coherent import LatticeDatabase, SampledMotion, build_coherent_oracle, reachable_reference
-    from qrrt_circuits.coherent.backend import CoherentOracleBackend
-    from qrrt_circuits.probability import optimal_iterations
-
-    database = LatticeDatabase(FixedPointFormat.covering(CORRIDOR.env, 6), 3, np.array([[3.0, 10.0], [17.0, 10.0]]))
-    motion = SampledMotion.from_dynamics(qc.LinearTrackingDynamics.paper(), 4, 6)
-    marks = reachable_reference(CORRIDOR.env, database, motion)
-    backend = CoherentOracleBackend(build_coherent_oracle(CORRIDOR.env, database, motion).circuit, 7)
-    k = optimal_iterations(marks.size, int(marks.sum()))
-    shots = 200
-    result = backend.search(marks, k, shots, seed=3)
-    theta = np.arcsin(np.sqrt(marks.mean()))
-    expected = np.sin((2 * k + 1) * theta) ** 2
-    sd = np.sqrt(max(expected * (1 - expected), 1e-12) / shots)
-    assert abs(marks[result.indices].mean() - expected) <= 4 * sd + 1e-12
-    assert result.oracle_calls == k * shots
 
 
 @pytest.mark.parametrize(("options", "message"), [

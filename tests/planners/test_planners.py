@@ -166,14 +166,14 @@ def test_bbht_terminates_with_no_solution_and_respects_its_bound():
     rng = np.random.default_rng(0)
     size = 256
     none = np.zeros(size, dtype=bool)
-    out = policy.run(lambda j: int(backend.search(none, j, 1).indices[0]), lambda i: False, size, rng)
+    out = policy.run(lambda j: int(backend.search(qc.LookupOracle(none), j, 1).indices[0]), lambda i: False, size, rng)
     assert out.index is None and out.iterations <= policy.cap(size)
     for m in (1, 4, 16):
         marks = np.zeros(size, dtype=bool)
         marks[rng.choice(size, m, replace=False)] = True
         costs = []
         for _ in range(300):
-            out = policy.run(lambda j, mk=marks: int(backend.search(mk, j, 1).indices[0]),
+            out = policy.run(lambda j, mk=marks: int(backend.search(qc.LookupOracle(mk), j, 1).indices[0]),
                              lambda i, mk=marks: bool(mk[i]), size, rng)
             costs.append(out.iterations)
         costs = np.array(costs)

@@ -9,6 +9,7 @@ import pytest
 from planner_checks import posed
 
 import qrrt_circuits as qc
+from qrrt_circuits._support import available_memory as probe
 from qrrt_circuits.planners.termination import (
     DEFAULT_MAX_NODES,
     Progress,
@@ -311,9 +312,8 @@ def test_limits_whose_tree_or_history_exceed_memory_are_refused_before_any_work(
     """A round limit of 10^9 would let a plan that cannot grow keep about 240 GiB of round history
     (RRT's rounds take microseconds, so it would get there); a node limit of 10^9 the same of tree.
     Both are refused before the first round, naming the limit and the largest value that fits."""
-    from qrrt_circuits._support import memory
 
-    monkeypatch.setattr(memory, "available_memory", lambda: (1 << 30, memory.MACHINE_SOURCE))
+    monkeypatch.setattr(probe, "available_memory", lambda: (1 << 30, probe.MACHINE_SOURCE))
     planner = qc.RRT(seed=0)
     with pytest.raises(ValueError, match=r"max_rounds = 1000000000: .* the largest max_rounds that fits is about"):
         planner.plan(_walled_from(walled, [1, 1]), max_rounds=10**9,
@@ -402,11 +402,10 @@ def test_numpy_limits_are_python_ints_and_the_memory_check_sees_them(walled, mon
     settings could not be written as JSON."""
     import json
 
-    from qrrt_circuits._support import memory
 
     limit = qc.MaxRounds(np.int64(2**56))
     assert type(limit.limit) is int
-    monkeypatch.setattr(memory, "available_memory", lambda: (1 << 30, memory.MACHINE_SOURCE))
+    monkeypatch.setattr(probe, "available_memory", lambda: (1 << 30, probe.MACHINE_SOURCE))
     with pytest.raises(ValueError, match="max_rounds = 72057594037927936"):
         qc.RRT(seed=0).plan(_walled_from(walled, [1, 1]), termination=limit, max_nodes=5)
     with pytest.raises(ValueError, match="max_nodes = 288230376151711744"):

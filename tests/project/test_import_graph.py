@@ -121,10 +121,7 @@ def test_imports_look_one_way():
 
 
 #: private names a module of one layer takes from another layer, each named: (module, name)
-PRIVATE_EXCEPTIONS = {
-    # `qrrt search` asks the backend for a search its plan-level memory check already covered
-    ("qrrt_circuits.cli.commands.search", "_search_covered"),
-}
+PRIVATE_EXCEPTIONS: set[tuple[str, str]] = set()
 
 
 def test_no_private_name_crosses_a_layer():

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from conftest import BACKENDS, make_backend, random_marks
 
-from qrrt_circuits import OracleErrorModel
+from qrrt_circuits import LookupOracle, OracleErrorModel
 from qrrt_circuits import probability as pr
 
 
@@ -19,7 +19,7 @@ def test_success_probability_and_optimal_iterations():
 
 
 def _groups(backend, marks, k, workers, repeats):
-    indices = backend.search(marks, k, shots=workers * repeats).indices.reshape(repeats, workers)
+    indices = backend.search(LookupOracle(marks), k, shots=workers * repeats).indices.reshape(repeats, workers)
     good = marks[indices].all(axis=1)
     same = good & (indices == indices[:, :1]).all(axis=1)
     distinct = good & np.array([len(set(row)) == workers for row in indices])
@@ -74,7 +74,7 @@ def test_lemmas_4_and_5_with_oracle_errors(backend_name):
     p_good = pr.success_probability(2**n, m, k)
     backend = make_backend(backend_name, seed=11)
     repeats = 4000
-    indices = backend.search(marks, k, shots=workers * repeats).indices.reshape(repeats, workers)
+    indices = backend.search(LookupOracle(marks), k, shots=workers * repeats).indices.reshape(repeats, workers)
     true_hit = truth[indices[:, 0]].mean()
     assert _within(true_hit, pr.prob_true_solution(2**n, m, m1, m2, p_good), repeats)
     same_true = (truth[indices].all(axis=1) & (indices == indices[:, :1]).all(axis=1)).mean()

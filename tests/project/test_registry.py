@@ -72,7 +72,7 @@ def test_every_backend_name_searches(name):
     backend = BACKENDS.create(name, seed=3)
     assert isinstance(backend, qc.QuantumSearchBackend)
     marks = [False] * 15 + [True]
-    assert backend.search(marks, 2, shots=4, seed=5).indices.shape == (4,)
+    assert backend.search(qc.LookupOracle(marks), 2, shots=4, seed=5).indices.shape == (4,)
 
 
 def test_policies_including_parametric_ones():

@@ -32,7 +32,8 @@ def test_sampler_searches_on_threads_measure_what_serial_searches_measure():
     backend = make_backend("sampler", 5)
     rng = np.random.default_rng(0)
     requests = [(rng.random(16) < 0.3, int(k), 8, seed) for seed, k in enumerate(rng.integers(0, 3, 48))]
-    serial = [backend.search(marks, k, shots, seed=seed).indices for marks, k, shots, seed in requests]
+    serial = [backend.search(qc.LookupOracle(marks), k, shots, seed=seed).indices for marks, k, shots, seed in requests]
     with ThreadPoolExecutor(8) as pool:
-        threaded = list(pool.map(lambda r: backend.search(r[0], r[1], r[2], seed=r[3]).indices, requests))
+        threaded = list(pool.map(lambda r: backend.search(qc.LookupOracle(r[0]), r[1], r[2], seed=r[3]).indices,
+                                 requests))
     assert all(np.array_equal(a, b) for a, b in zip(serial, threaded, strict=True))

@@ -115,7 +115,7 @@ def test_policy_inside_the_planners_counts_the_estimation(workers, shared, clutt
 
 def test_policy_state_run_identities():
     marks = random_marks(np.random.default_rng(3), 6, 9)
-    problem = qc.DatabaseSearch(marks, marks, qc.StatevectorBackend(), RandomStreams.from_seed(1), 0)
+    problem = qc.DatabaseSearch(qc.LookupOracle(marks), marks, qc.StatevectorBackend(), RandomStreams.from_seed(1), 0)
     state = qc.EstimatedOptimal(shots=8).start(64)
     outcomes = state.run(problem, 4, 10)
     (estimate, k), = state.history

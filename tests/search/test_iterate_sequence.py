@@ -114,7 +114,7 @@ def test_sampled_success_within_binomial_bounds(backend_name, delta, num_marked)
     marks = random_marks(np.random.default_rng(num_marked), 5, num_marked)
     policy = qc.FixedPointAmplification(delta=delta, min_fraction=1 / 16)
     shots = 3000
-    result = make_backend(backend_name, 11).search_sequence(marks, policy.sequence(), shots, seed=5)
+    result = make_backend(backend_name, 11).search_sequence(qc.LookupOracle(marks), policy.sequence(), shots, seed=5)
     successes = int(np.count_nonzero(marks[result.indices]))
     exact = policy.success_probability(num_marked / 32)
     assert exact >= 1 - delta**2
@@ -127,12 +127,12 @@ def test_search_sequence_is_reproducible_and_checks_its_input():
     marks = random_marks(np.random.default_rng(0), 4, 3)
     sequence = IterateSequence.fixed_point(0.4, 2)
     backend = qc.AerBackend()
-    first = backend.search_sequence(marks, sequence, 50, seed=3).indices
-    assert np.array_equal(first, backend.search_sequence(marks, sequence, 50, seed=3).indices)
+    first = backend.search_sequence(qc.LookupOracle(marks), sequence, 50, seed=3).indices
+    assert np.array_equal(first, backend.search_sequence(qc.LookupOracle(marks), sequence, 50, seed=3).indices)
     with pytest.raises(TypeError, match="sequence must be an IterateSequence"):
-        backend.search_sequence(marks, [0.1, 0.2], 5)
+        backend.search_sequence(qc.LookupOracle(marks), [0.1, 0.2], 5)
     with pytest.raises(ValueError, match="shots must be an integer"):
-        backend.search_sequence(marks, sequence, 0)
+        backend.search_sequence(qc.LookupOracle(marks), sequence, 0)
     with pytest.raises(ValueError, match="same length"):
         IterateSequence([1.0, 2.0], [1.0])
 

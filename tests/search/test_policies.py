@@ -19,7 +19,7 @@ POLICY_NAMES = ["paper", "fixed:2", "optimal", "bbht", "adaptive", "thompson"]
 
 def problem(marks, backend, round_index=0, first_worker=0, truth=None):
     truth = marks if truth is None else truth
-    return qc.DatabaseSearch(np.asarray(marks), np.asarray(truth), backend, RandomStreams.from_seed(7),
+    return qc.DatabaseSearch(qc.LookupOracle(np.asarray(marks)), np.asarray(truth), backend, RandomStreams.from_seed(7),
                              round_index, first_worker)
 
 

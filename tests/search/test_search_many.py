@@ -12,7 +12,8 @@ import qrrt_circuits as qc
 
 def requests_for(rng: np.random.Generator, seeded: bool) -> list[qc.SearchRequest]:
     shapes = [(3, 1, 0, 1), (5, 3, 2, 4), (4, 16, 3, 2), (6, 5, 1, 8), (5, 0, 4, 1), (2, 1, 1, 3)]
-    return [qc.SearchRequest(random_marks(rng, n, m), k, shots, int(rng.integers(2**31)) if seeded else None)
+    return [qc.SearchRequest(qc.LookupOracle(random_marks(rng, n, m)), k, shots,
+                             int(rng.integers(2**31)) if seeded else None)
             for n, m, k, shots in shapes]
 
 
@@ -24,7 +25,7 @@ def test_search_many_equals_one_by_one(backend_name, seed):
     alone = make_backend(backend_name, seed)
     assert len(together) == len(requests)
     for request, result in zip(requests, together, strict=True):
-        expected = alone.search(request.marks, request.iterations, request.shots, seed=request.seed)
+        expected = alone.search(request.oracle, request.iterations, request.shots, seed=request.seed)
         assert np.array_equal(result.indices, expected.indices)
         assert (result.iterations, result.shots, result.oracle_calls) == (
             expected.iterations, expected.shots, expected.oracle_calls)
@@ -36,18 +37,18 @@ def test_search_many_without_seeds_draws_the_backends_stream_in_order(backend_na
     together = make_backend(backend_name, 11).search_many(requests)
     alone = make_backend(backend_name, 11)
     for request, result in zip(requests, together, strict=True):
-        assert np.array_equal(result.indices, alone.search(request.marks, request.iterations, request.shots).indices)
+        assert np.array_equal(result.indices, alone.search(request.oracle, request.iterations, request.shots).indices)
 
 
 def test_search_many_checks_every_request_before_searching():
     backend = qc.StatevectorBackend(seed=0)
-    good = qc.SearchRequest(np.array([True, False, False, False]), 1, 2, 3)
+    good = qc.SearchRequest(qc.LookupOracle(np.array([True, False, False, False])), 1, 2, 3)
     with pytest.raises(TypeError, match="SearchRequest"):
-        backend.search_many([good, (good.marks, 1)])
+        backend.search_many([good, (good.oracle, 1)])
     with pytest.raises(ValueError, match="shots"):
-        backend.search_many([good, qc.SearchRequest(good.marks, 1, 0)])
+        backend.search_many([good, qc.SearchRequest(good.oracle, 1, 0)])
     with pytest.raises(ValueError, match="iterations"):
-        backend.search_many([qc.SearchRequest(good.marks, -1)])
+        backend.search_many([qc.SearchRequest(good.oracle, -1)])
     assert backend.search_many([]) == ()
 
 

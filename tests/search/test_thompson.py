@@ -26,7 +26,7 @@ def _stream(policy: qc.IterationPolicy, backend: qc.QuantumSearchBackend, mean_m
     for index in range(databases):
         marks = np.zeros(256, dtype=bool)
         marks[rng.choice(256, min(int(rng.poisson(mean_marked)), 256), replace=False)] = True
-        outcomes = state.run(qc.DatabaseSearch(marks, marks, backend, streams, index), workers, index)
+        outcomes = state.run(qc.DatabaseSearch(qc.LookupOracle(marks), marks, backend, streams, index), workers, index)
         chosen.append(outcomes[0].quantum_calls)
         spent += sum(o.oracle_calls for o in outcomes)
         found += len({o.index for o in outcomes if o.index is not None})

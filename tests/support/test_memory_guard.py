@@ -14,6 +14,7 @@ import pytest
 
 import qrrt_circuits as qc
 from qrrt_circuits import cli
+from qrrt_circuits._support import available_memory as probe
 from qrrt_circuits._support import memory
 
 MIB = 1 << 20
@@ -27,7 +28,7 @@ def env():
 @pytest.fixture
 def small_memory(monkeypatch):
     """The machine reports 300 MiB available (machine-independent refusals)."""
-    monkeypatch.setattr(memory, "available_memory", lambda: (300 * MIB, memory.MACHINE_SOURCE))
+    monkeypatch.setattr(probe, "available_memory", lambda: (300 * MIB, probe.MACHINE_SOURCE))
     return 300 * MIB
 
 
@@ -63,17 +64,18 @@ def test_plan_refused_before_its_first_allocation_with_the_largest_fitting_n(env
 def test_the_estimate_grows_with_what_the_run_holds(env):
     sv = qc.StatevectorBackend(0)
     paper = qc.PaperIterations()  # at most 5 iterations: fewer than the 20 below
-    base = qc.QRRT(backend=sv, num_qubits=10, seed=0, search_policy=paper).memory_estimate(24)
+    base = qc.QRRT(backend=sv, num_qubits=10, seed=0, search_policy=paper).memory_estimate(24, dim=2)
     annealed = qc.QRRT(backend=sv, num_qubits=10, seed=0, search_policy=paper,
-                       annealing=qc.AnnealingSchedule.paper()).memory_estimate(24)
-    aer = qc.QRRT(backend=qc.AerBackend(0), num_qubits=10, seed=0, search_policy=paper).memory_estimate(24)
+                       annealing=qc.AnnealingSchedule.paper()).memory_estimate(24, dim=2)
+    aer = qc.QRRT(backend=qc.AerBackend(0), num_qubits=10, seed=0, search_policy=paper).memory_estimate(24, dim=2)
     aer_more_k = qc.QRRT(backend=qc.AerBackend(0), num_qubits=10, seed=0,
-                         search_policy=qc.FixedIterations(20)).memory_estimate(24)
+                         search_policy=qc.FixedIterations(20)).memory_estimate(24, dim=2)
     assert base.total_bytes < annealed.total_bytes
     assert base.total_bytes < aer.total_bytes < aer_more_k.total_bytes
     # the per-entry part doubles with one more qubit; shots add a per-shot part
     shot = sv.peak_bytes(20, 2) - sv.peak_bytes(20, 1)
-    assert shot > 0 and sv.peak_bytes(21, 1) - shot == 2 * (sv.peak_bytes(20, 1) - shot)
+    fixed = sv.FIXED_BYTES
+    assert shot > 0 and sv.peak_bytes(21, 1) - shot - fixed == 2 * (sv.peak_bytes(20, 1) - shot - fixed)
     assert qc.Adaptive(grid_size=100_000, max_iterations=1_000_000).state_bytes(1 << 10) > 1 << 40
 
 
@@ -123,7 +125,7 @@ def planner(n, workers):
                     search_policy=qc.FixedIterations(1), seed=0, predicate=Nowhere())
 planner(8, 2).plan(max_rounds=1)  # compiled code loaded before the measurement
 big = planner(20, int(sys.argv[1]))
-print(added_peak(lambda: big.plan(max_rounds=1)), big.memory_estimate().total_bytes)
+print(added_peak(lambda: big.plan(max_rounds=1)), big.memory_estimate(dim=2).total_bytes)
 """
 
 
@@ -135,7 +137,7 @@ def test_unshared_databases_are_counted_once_per_worker_without_an_executor(env)
     (the peak reset just before the round)."""
     def estimate(workers):
         return qc.PQRRT(backend=qc.StatevectorBackend(0), num_qubits=16, workers=workers,
-                        shared_database=False, seed=0).memory_estimate()
+                        shared_database=False, seed=0).memory_estimate(dim=2)
 
     one, eight = estimate(1), estimate(8)
     assert eight.database_bytes == 8 * one.database_bytes and eight.search_bytes == 8 * one.search_bytes
@@ -161,7 +163,7 @@ def test_direct_search_refused(small_memory, make_backend):
     marks[::3] = True
     with pytest.raises(ValueError, match=r"num_qubits = 24: this .* search \(1 shots, 5 iterations\) needs "
                                          r"about .*the largest num_qubits that fits is \d+"):
-        backend.search(marks, 5)
+        backend.search(qc.LookupOracle(marks), 5)
 
 
 def test_an_aer_search_with_the_mcz_oracle_is_held_to_its_own_footprint(small_memory):
@@ -173,14 +175,44 @@ def test_an_aer_search_with_the_mcz_oracle_is_held_to_its_own_footprint(small_me
     sparse = np.zeros(1 << 20, dtype=bool)
     sparse[np.random.default_rng(0).choice(1 << 20, 12, replace=False)] = True
     assert backend.oracle_form(20, 12) == "mcz"
-    assert backend.peak_bytes(20, 8, 1, marked=12) < 64 * MIB
-    result = backend.search(sparse, 1, shots=8)
+    assert backend.peak_bytes(20, 8, 1, marked=12) < 64 * MIB + backend.FIXED_BYTES
+    result = backend.search(qc.LookupOracle(sparse), 1, shots=8)
     assert result.indices.shape == (8,)
     dense = np.zeros(1 << 20, dtype=bool)
     dense[::3] = True
     with pytest.raises(ValueError, match=r"num_qubits = 20: this aer search \(8 shots, 1 iterations\) needs about"):
-        backend.search(dense, 1, shots=8)
+        backend.search(qc.LookupOracle(dense), 1, shots=8)
     assert qc.AerBackend(0, synthesis="diagonal").peak_bytes(20, 8, 1, marked=12) == backend.peak_bytes(20, 8, 1)
+
+
+def _every_backend():
+    from qiskit_aer.noise import NoiseModel
+    from qiskit_aer.primitives import SamplerV2
+
+    yield "statevector", qc.StatevectorBackend(0)
+    yield "statevector-iterated", qc.StatevectorBackend(0, closed_form=False)
+    for synthesis in ("auto", "diagonal", "mcz"):
+        yield f"aer-{synthesis}", qc.AerBackend(0, synthesis=synthesis)
+        yield f"aer-mps-{synthesis}", qc.AerBackend(0, method="matrix_product_state", synthesis=synthesis)
+        yield f"aer-noise-{synthesis}", qc.AerBackend(0, synthesis=synthesis, noise_model=NoiseModel())
+        yield f"sampler-{synthesis}", qc.SamplerBackend(SamplerV2(), synthesis=synthesis, seed=0)
+
+
+@pytest.mark.parametrize("sequence", [False, True])
+def test_every_backends_estimate_grows_and_holds_at_least_the_state(sequence):
+    """``peak_bytes`` is a bound of the measured peak (``benchmarks/memory_peaks.py``); as a formula
+    it grows with n, with k, with the shots and, without a count, bounds every m; and it is never
+    below the 2^n complex128 amplitudes of the index register's state."""
+    for name, backend in _every_backend():
+        for n in range(1, 31):
+            for k in (0, 1, 5, 50):
+                peak = backend.peak_bytes(n, 8, k, sequence=sequence)
+                assert peak >= 16 << n, (name, n, k)
+                assert backend.peak_bytes(n + 1, 8, k, sequence=sequence) >= peak, (name, n, k)
+                assert backend.peak_bytes(n, 8, k + 1, sequence=sequence) >= peak, (name, n, k)
+                assert backend.peak_bytes(n, 9, k, sequence=sequence) > peak, (name, n, k)
+                for m in {0, 1, min(3, 1 << n), (1 << n) // 3, 1 << n}:
+                    assert backend.peak_bytes(n, 8, k, m, sequence=sequence) <= peak, (name, n, k, m)
 
 
 @pytest.mark.parametrize("num_qubits", [4, 10, 16, 24, 30])
@@ -222,8 +254,8 @@ def test_issue_reproductions_on_this_machine(env, argv_backend, qubits, planner)
     """The issue's two runs, with this machine's real available memory: refused when their estimate
     exceeds it (skipped on a machine that has the memory: they then run, as they should)."""
     backend = qc.StatevectorBackend(0) if argv_backend == "statevector" else qc.AerBackend(0)
-    estimate = planner(env, backend=backend, num_qubits=12, seed=0).memory_estimate(qubits)
-    available = memory.available_memory_bytes()
+    estimate = planner(env, backend=backend, num_qubits=12, seed=0).memory_estimate(qubits, dim=2)
+    available = probe.available_memory_bytes()
     if available is None or estimate.total_bytes <= available:
         pytest.skip(f"this machine has {available} bytes available, enough for the estimated "
                     f"{estimate.total_bytes}")
@@ -232,7 +264,7 @@ def test_issue_reproductions_on_this_machine(env, argv_backend, qubits, planner)
 
 
 def test_available_memory_reads_meminfo():
-    available = memory.available_memory_bytes()
+    available = probe.available_memory_bytes()
     assert available is not None and available > 0
     with open("/proc/meminfo") as meminfo:
         total = next(int(line.split()[1]) * 1024 for line in meminfo if line.startswith("MemTotal:"))
@@ -245,8 +277,9 @@ import qrrt_circuits as qc
 backend = qc.registry.BACKENDS.create("sampler", seed=0)
 marks = np.zeros(256, dtype=bool)
 marks[::7] = True
-backend.search(marks, 1, shots=10)
-print(added_peak(lambda: backend.search(marks, 1, shots=1_000_000)), backend.peak_bytes(8, 1_000_000, 1))
+oracle = qc.LookupOracle(marks)
+backend.search(oracle, 1, shots=10)
+print(added_peak(lambda: backend.search(oracle, 1, shots=1_000_000)), backend.peak_bytes(8, 1_000_000, 1))
 """
 
 
@@ -301,7 +334,6 @@ def test_the_tree_estimate_covers_a_tree_grown_to_its_node_limit(dim):
 def _cgroup(tmp_path, monkeypatch, limit: str, usage: int, stat: str, version: int = 2, parent_limit=None):
     """Fake control-group files of ``version`` for a process in group ``/box`` (parent: the root),
     and point ``memory`` at them."""
-    from qrrt_circuits._support import memory
 
     root = tmp_path / "cgroup"
     names = ("memory.max", "memory.current", "memory.stat") if version == 2 else (
@@ -314,45 +346,42 @@ def _cgroup(tmp_path, monkeypatch, limit: str, usage: int, stat: str, version: i
         (folder / names[2]).write_text(stat)
     proc = tmp_path / "cgroup.txt"
     proc.write_text("0::/box\n" if version == 2 else "5:cpu,cpuacct:/box\n4:memory:/box\n0::/\n")
-    monkeypatch.setattr(memory, "CGROUP_ROOT", str(root))
-    monkeypatch.setattr(memory, "PROC_CGROUP", str(proc))
-    memory._smallest_limit_cached.cache_clear()  # (read once per process)
+    monkeypatch.setattr(probe, "CGROUP_ROOT", str(root))
+    monkeypatch.setattr(probe, "PROC_CGROUP", str(proc))
+    probe._smallest_limit_cached.cache_clear()  # (read once per process)
 
 
 @pytest.mark.parametrize("version", [2, 1])
 def test_a_control_group_limit_bounds_the_available_memory(tmp_path, monkeypatch, version):
     """In a container the kernel kills the process at its group's limit, whatever the machine has
     free: the room is the limit less the usage, the inactive page cache not counted as used."""
-    from qrrt_circuits._support import memory
 
     prefix = "" if version == 2 else "total_"
     stat = f"{prefix}active_file {50 * MIB}\n{prefix}inactive_file {100 * MIB}\nanon 7\n"
     _cgroup(tmp_path, monkeypatch, str(1024 * MIB), 450 * MIB, stat, version)
-    assert memory.cgroup_available_bytes() == (1024 - 300) * MIB  # the page cache (150 MiB) is not used memory
-    monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 20 * 1024 * MIB)
-    assert memory.available_memory_bytes() == 724 * MIB
-    monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 500 * MIB)
-    assert memory.available_memory_bytes() == 500 * MIB
-    monkeypatch.setattr(memory, "_machine_available_bytes", lambda: None)
-    assert memory.available_memory_bytes() == 724 * MIB
+    assert probe.cgroup_available_bytes() == (1024 - 300) * MIB  # the page cache (150 MiB) is not used memory
+    monkeypatch.setattr(probe, "_machine_available_bytes", lambda: 20 * 1024 * MIB)
+    assert probe.available_memory_bytes() == 724 * MIB
+    monkeypatch.setattr(probe, "_machine_available_bytes", lambda: 500 * MIB)
+    assert probe.available_memory_bytes() == 500 * MIB
+    monkeypatch.setattr(probe, "_machine_available_bytes", lambda: None)
+    assert probe.available_memory_bytes() == 724 * MIB
 
 
 @pytest.mark.parametrize("limit, version", [("max", 2), (str(9223372036854771712), 1), ("garbage", 2)])
 def test_no_control_group_limit_leaves_the_machine_figure(tmp_path, monkeypatch, limit, version):
-    from qrrt_circuits._support import memory
 
     _cgroup(tmp_path, monkeypatch, limit, 400 * MIB, "", version)
-    assert memory.cgroup_available_bytes() is None
-    monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 3 * MIB)
-    assert memory.available_memory_bytes() == 3 * MIB
+    assert probe.cgroup_available_bytes() is None
+    monkeypatch.setattr(probe, "_machine_available_bytes", lambda: 3 * MIB)
+    assert probe.available_memory_bytes() == 3 * MIB
 
 
 def test_a_plan_in_a_small_control_group_is_refused(tmp_path, monkeypatch, env):
     """q-RRT at n = 24 needs over a GiB: refused in a 512 MiB group on a machine with 20 GiB free."""
-    from qrrt_circuits._support import memory
 
     _cgroup(tmp_path, monkeypatch, str(512 * MIB), 100 * MIB, "")
-    monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 20 * 1024 * MIB)
+    monkeypatch.setattr(probe, "_machine_available_bytes", lambda: 20 * 1024 * MIB)
     planner = qc.QRRT(backend=qc.StatevectorBackend(0, max_qubits=24), num_qubits=24, seed=0)
     with pytest.raises(ValueError, match=r"num_qubits = 24: .* more than the 412 MiB of memory available "
                                          r"\(the memory control group's room\)"):
@@ -362,46 +391,42 @@ def test_a_plan_in_a_small_control_group_is_refused(tmp_path, monkeypatch, env):
 @pytest.mark.parametrize("version", [2, 1])
 def test_an_ancestor_group_with_less_room_bounds_the_available_memory(tmp_path, monkeypatch, version):
     """A group without a limit inside a parent with one (or a tighter parent): the smallest room."""
-    from qrrt_circuits._support import memory
 
     _cgroup(tmp_path, monkeypatch, str(1024 * MIB), 100 * MIB, "", version, parent_limit=str(300 * MIB))
-    assert memory.cgroup_available_bytes() == 200 * MIB
+    assert probe.cgroup_available_bytes() == 200 * MIB
     _cgroup(tmp_path, monkeypatch, "max" if version == 2 else "9223372036854771712", 100 * MIB, "", version,
             parent_limit=str(300 * MIB))
-    assert memory.cgroup_available_bytes() == 200 * MIB
+    assert probe.cgroup_available_bytes() == 200 * MIB
 
 
 def test_without_control_group_files_the_machine_figure_stands(tmp_path, monkeypatch):
-    from qrrt_circuits._support import memory
 
-    monkeypatch.setattr(memory, "PROC_CGROUP", str(tmp_path / "absent"))
-    assert memory.cgroup_available_bytes() is None
-    monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 5 * MIB)
-    assert memory.available_memory_bytes() == 5 * MIB
+    monkeypatch.setattr(probe, "PROC_CGROUP", str(tmp_path / "absent"))
+    assert probe.cgroup_available_bytes() is None
+    monkeypatch.setattr(probe, "_machine_available_bytes", lambda: 5 * MIB)
+    assert probe.available_memory_bytes() == 5 * MIB
 
 
 @pytest.fixture(autouse=True)
 def _fresh_group_limit():
     """The smallest group limit is read once per process: each test starts and ends without it."""
-    from qrrt_circuits._support import memory
 
-    memory._smallest_limit_cached.cache_clear()
+    probe._smallest_limit_cached.cache_clear()
     yield
-    memory._smallest_limit_cached.cache_clear()
+    probe._smallest_limit_cached.cache_clear()
 
 
 def test_v1_hidden_ancestor_and_swap_limits_bound_the_room(tmp_path, monkeypatch):
     """A container's v1 mount hides its parent's limit except as ``hierarchical_memory_limit``; with
     swap accounting the kernel kills at the memory + swap limit."""
-    from qrrt_circuits._support import memory
 
     _cgroup(tmp_path, monkeypatch, "9223372036854771712", 100 * MIB, f"hierarchical_memory_limit {600 * MIB}\n", 1)
-    assert memory.cgroup_available_bytes() == 500 * MIB
+    assert probe.cgroup_available_bytes() == 500 * MIB
     box = tmp_path / "cgroup" / "memory" / "box"
     (box / "memory.limit_in_bytes").write_text(f"{600 * MIB}\n")
     (box / "memory.memsw.limit_in_bytes").write_text(f"{600 * MIB}\n")
     (box / "memory.memsw.usage_in_bytes").write_text(f"{550 * MIB}\n")  # 450 MiB of it in swap
-    assert memory.cgroup_available_bytes() == 50 * MIB
+    assert probe.cgroup_available_bytes() == 50 * MIB
 
 
 def test_a_small_group_lowers_the_size_accepted_unchecked(tmp_path, monkeypatch):
@@ -410,19 +435,18 @@ def test_a_small_group_lowers_the_size_accepted_unchecked(tmp_path, monkeypatch)
     from qrrt_circuits._support import memory
 
     _cgroup(tmp_path, monkeypatch, str(130 * 10**6), 50 * MIB, "")
-    assert memory.always_fits_bytes() == 130 * 10**6 // 8
+    assert probe.always_fits_bytes() == 130 * 10**6 // 8
     estimate = memory.MemoryEstimate(21, database_bytes=180 * MIB)
     with pytest.raises(ValueError, match="num_qubits = 21"):
         memory.check_fits(lambda n: estimate, 21, "this plan")
 
 
 def test_a_group_name_that_is_not_utf8_is_read(tmp_path, monkeypatch):
-    from qrrt_circuits._support import memory
 
     _cgroup(tmp_path, monkeypatch, str(1024 * MIB), 100 * MIB, "")
-    proc = Path(memory.PROC_CGROUP)
+    proc = Path(probe.PROC_CGROUP)
     proc.write_bytes(b"0::/box\xff\n")
-    assert memory.cgroup_available_bytes() is None  # no such folder: no limit read, and no error
+    assert probe.cgroup_available_bytes() is None  # no such folder: no limit read, and no error
 
 
 def test_on_the_gpu_auto_takes_the_mcz_form_above_14_qubits_and_the_bound_covers_it():
@@ -455,8 +479,8 @@ import qrrt_circuits as qc
 backend = qc.AerBackend(0, synthesis="mcz", noise_model=NoiseModel())  # a noise model: the gate-by-gate circuit
 marks = np.zeros(1 << 10, dtype=bool)
 marks[np.random.default_rng(0).choice(1 << 10, 400, replace=False)] = True
-backend.search(marks, 1, shots=1)
-added = added_peak(lambda: backend.search(marks, 8, shots=1))
+backend.search(qc.LookupOracle(marks), 1, shots=1)
+added = added_peak(lambda: backend.search(qc.LookupOracle(marks), 8, shots=1))
 print(added, backend.peak_bytes(10, 1, 8, 400), backend.peak_bytes(10, 1, 8))
 """
 
@@ -478,11 +502,11 @@ def test_a_sequence_is_held_to_its_own_circuits_footprint(small_memory):
     from qrrt_circuits.search.iterate_sequence import IterateSequence
 
     backend = qc.AerBackend(0)
-    assert backend.sequence_peak_bytes(20, 8, 1) > small_memory
-    assert backend.sequence_peak_bytes(20, 8, 1, 12) < 64 * MIB
+    assert backend.peak_bytes(20, 8, 1, sequence=True) > small_memory
+    assert backend.peak_bytes(20, 8, 1, 12, sequence=True) < 64 * MIB + backend.FIXED_BYTES
     sparse = np.zeros(1 << 20, dtype=bool)
     sparse[np.random.default_rng(0).choice(1 << 20, 12, replace=False)] = True
-    assert backend.search_sequence(sparse, IterateSequence.grover(1), shots=8).indices.shape == (8,)
+    assert backend.search_sequence(qc.LookupOracle(sparse), IterateSequence.grover(1), shots=8).indices.shape == (8,)
 
 
 def test_the_marked_count_is_checked_and_the_largest_fitting_width_is_found_past_a_form_change(small_memory):
@@ -493,8 +517,10 @@ def test_the_marked_count_is_checked_and_the_largest_fitting_width_is_found_past
     # k = 2000, 12 marked: the diagonal form (n <= 12) needs 160 KB per entry, the mcz form (n >= 13)
     # about 48 B per entry plus its instructions, so n = 11 does not fit where n = 20 does
     assert backend.peak_bytes(11, 8, 2000, 12) > small_memory > backend.peak_bytes(20, 8, 2000, 12)
-    with pytest.raises(ValueError) as info:
-        backend.check_memory(24, 8, 2000, marked=12)
+    size = memory.SearchSize(lambda n, m: backend.peak_bytes(n, 8, 2000, m), 24, backend.name, 8, 2000, lambda: 12)
+    refusal = r"num_qubits = 24: this aer search \(8 shots, 2000 iterations, 12 marked\)"
+    with pytest.raises(ValueError, match=refusal) as info:
+        memory.check_searches([size])
     assert _largest(str(info.value)) >= 20
 
 
@@ -502,7 +528,7 @@ def test_a_refusal_that_the_marked_count_cannot_change_names_no_count(small_memo
     marks = np.zeros(1 << 24, dtype=bool)
     marks[:12] = True
     with pytest.raises(ValueError, match=r"search \(1 shots, 1 iterations\) needs"):
-        qc.StatevectorBackend(0, max_qubits=24).search(marks, 1)
+        qc.StatevectorBackend(0, max_qubits=24).search(qc.LookupOracle(marks), 1)
 
 
 # ------------------------------------------------------------------ one check per plan, and per direct search
@@ -511,14 +537,14 @@ def counted_reads(monkeypatch):
     """Every size is checked (nothing is accepted unread), and each read of the available memory is
     counted."""
     reads = []
-    real = memory.available_memory
+    real = probe.available_memory
 
     def counting():
         reads.append(1)
         return real()
 
-    monkeypatch.setattr(memory, "ALWAYS_FITS_BYTES", 0)
-    monkeypatch.setattr(memory, "available_memory", counting)
+    monkeypatch.setattr(probe, "ALWAYS_FITS_BYTES", 0)
+    monkeypatch.setattr(probe, "available_memory", counting)
     return reads
 
 
@@ -540,13 +566,13 @@ def test_a_direct_search_checks_once_per_call(counted_reads):
     backend = qc.StatevectorBackend(0)
     marks = np.zeros(1 << 10, dtype=bool)
     marks[::7] = True
-    backend.search(marks, 2, shots=4)
+    backend.search(qc.LookupOracle(marks), 2, shots=4)
     assert len(counted_reads) == 1
-    backend.search_many([qc.SearchRequest(marks, k, 2, seed=k) for k in range(5)])
+    backend.search_many([qc.SearchRequest(qc.LookupOracle(marks), k, 2, seed=k) for k in range(5)])
     assert len(counted_reads) == 2
     from qrrt_circuits.search.iterate_sequence import IterateSequence
 
-    backend.search_sequence(marks, IterateSequence.grover(2), shots=3)
+    backend.search_sequence(qc.LookupOracle(marks), IterateSequence.grover(2), shots=3)
     assert len(counted_reads) == 3
 
 
@@ -570,7 +596,7 @@ def test_the_fixed_point_policy_is_sized_by_its_sequence_circuit(env):
     planner = qc.QRRT(backend=qc.AerBackend(0), num_qubits=16, seed=0,
                       search_policy=qc.FixedPointAmplification())
     policy = planner.search_policy
-    assert planner.memory_estimate().search_bytes == planner.backend.sequence_peak_bytes(16, 1, policy.iterates)
+    assert planner.memory_estimate(dim=2).search_bytes == planner.backend.peak_bytes(16, 1, policy.iterates, sequence=True)
 
 
 # ------------------------------------------------------------------ what is available: RLIMIT_AS
@@ -582,21 +608,21 @@ def test_the_address_space_left_under_rlimit_as_bounds_the_available_memory(tmp_
     page = os.sysconf("SC_PAGE_SIZE")
     statm = tmp_path / "statm"
     statm.write_text(f"{(700 * MIB) // page} 1 2 3 4 5 6\n")
-    monkeypatch.setattr(memory, "PROC_STATM", str(statm))
-    monkeypatch.setattr(memory, "address_space_limit", lambda: 1024 * MIB)
-    monkeypatch.setattr(memory, "cgroup_available_bytes", lambda: None)
-    monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 20 * 1024 * MIB)
-    assert memory.virtual_memory_bytes() == (700 * MIB) // page * page
-    room = 1024 * MIB - memory.virtual_memory_bytes()
-    assert memory.address_space_available_bytes() == room
-    assert memory.available_memory() == (room, memory.ADDRESS_SPACE_SOURCE)
-    assert memory.always_fits_bytes() == min(memory.ALWAYS_FITS_BYTES, room)
-    monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 100 * MIB)
-    assert memory.available_memory() == (100 * MIB, memory.MACHINE_SOURCE)
-    monkeypatch.setattr(memory, "PROC_STATM", str(tmp_path / "absent"))
-    assert memory.address_space_available_bytes() is None  # no virtual size: the limit is not taken
-    monkeypatch.setattr(memory, "address_space_limit", lambda: None)
-    assert memory.address_space_available_bytes() is None
+    monkeypatch.setattr(probe, "PROC_STATM", str(statm))
+    monkeypatch.setattr(probe, "address_space_limit", lambda: 1024 * MIB)
+    monkeypatch.setattr(probe, "cgroup_available_bytes", lambda: None)
+    monkeypatch.setattr(probe, "_machine_available_bytes", lambda: 20 * 1024 * MIB)
+    assert probe.virtual_memory_bytes() == (700 * MIB) // page * page
+    room = 1024 * MIB - probe.virtual_memory_bytes()
+    assert probe.address_space_available_bytes() == room
+    assert probe.available_memory() == (room, probe.ADDRESS_SPACE_SOURCE)
+    assert probe.always_fits_bytes() == min(probe.ALWAYS_FITS_BYTES, room)
+    monkeypatch.setattr(probe, "_machine_available_bytes", lambda: 100 * MIB)
+    assert probe.available_memory() == (100 * MIB, probe.MACHINE_SOURCE)
+    monkeypatch.setattr(probe, "PROC_STATM", str(tmp_path / "absent"))
+    assert probe.address_space_available_bytes() is None  # no virtual size: the limit is not taken
+    monkeypatch.setattr(probe, "address_space_limit", lambda: None)
+    assert probe.address_space_available_bytes() is None
 
 
 def test_without_a_limit_the_address_space_is_not_a_figure():
@@ -604,7 +630,7 @@ def test_without_a_limit_the_address_space_is_not_a_figure():
 
     if resource.getrlimit(resource.RLIMIT_AS)[0] != resource.RLIM_INFINITY:
         pytest.skip("this process runs under a RLIMIT_AS")
-    assert memory.address_space_limit() is None and memory.address_space_available_bytes() is None
+    assert probe.address_space_limit() is None and probe.address_space_available_bytes() is None
 
 
 # ------------------------------------------------------------------ the refusals on the command line: one line each
@@ -616,7 +642,7 @@ def test_cli_plan_refused_under_a_control_group_limit_in_one_line(tmp_path, monk
     """A 512 MiB group on a machine with 20 GiB free: ``qrrt plan`` at n = 24 is refused in one line
     naming the group's room and the largest n that fits, and writes nothing."""
     _cgroup(tmp_path, monkeypatch, str(512 * MIB), 100 * MIB, "")
-    monkeypatch.setattr(memory, "_machine_available_bytes", lambda: 20 * 1024 * MIB)
+    monkeypatch.setattr(probe, "_machine_available_bytes", lambda: 20 * 1024 * MIB)
     out = tmp_path / "plan.json"
     with pytest.raises(SystemExit) as info:
         cli.main(["plan", "--planner", "qrrt", "--backend", "statevector", "--qubits", "24", "--max-rounds", "1",
@@ -646,7 +672,7 @@ def test_cli_plan_refused_under_ulimit_v_in_one_line(tmp_path):
     """``ulimit -v`` of 2 GiB on a machine with more free: q-RRT at n = 28 (about 14.6 GiB) is
     refused in one line naming the address space left and the largest n that fits, exit status 2,
     no traceback, no output file."""
-    available = memory.available_memory_bytes()
+    available = probe.available_memory_bytes()
     if available is not None and available < 3 << 30:
         pytest.skip("the machine has less than 3 GiB available: RLIMIT_AS would not be the smallest figure")
     out = tmp_path / "plan.json"
@@ -664,7 +690,7 @@ def test_cli_plan_refused_under_ulimit_v_in_one_line(tmp_path):
 
 @_LINUX_RLIMIT
 def test_cli_search_refused_under_ulimit_v_in_one_line():
-    available = memory.available_memory_bytes()
+    available = probe.available_memory_bytes()
     if available is not None and available < 3 << 30:
         pytest.skip("the machine has less than 3 GiB available: RLIMIT_AS would not be the smallest figure")
     run = subprocess.run([sys.executable, "-m", "qrrt_circuits.cli", "search", "--backend", "statevector",
@@ -715,9 +741,9 @@ def test_a_memory_error_in_a_direct_search_is_one_out_of_memory_line(monkeypatch
     marks[3] = True
     with pytest.raises(memory.OutOfMemory, match=r"^num_qubits = 12: this statevector search \(5 shots, 2 iterations\) "
                                                  r"ran out of memory \(Unable to allocate .*\).* is 11$"):
-        backend.search(marks, 2, shots=5)
+        backend.search(qc.LookupOracle(marks), 2, shots=5)
     with pytest.raises(memory.OutOfMemory, match=r"^num_qubits = 12: this statevector search \(1 shots, 4 "):
-        backend.search_many([qc.SearchRequest(marks, 4)])
+        backend.search_many([qc.SearchRequest(qc.LookupOracle(marks), 4)])
 
 
 @pytest.mark.parametrize("argv", [

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+from qrrt_circuits._support import available_memory as probe
 from qrrt_circuits._support import output_files
 from qrrt_circuits._support.output_files import check_output_file, same_file, write_replacing
 
@@ -203,10 +204,9 @@ def test_a_file_of_another_group_in_a_set_group_id_folder_is_replaced_whole(tmp_
 def test_the_to_dict_output_can_be_counted_before_a_plan(monkeypatch):
     """``to_dict``'s lists take about as much memory as the tree: a caller that writes them can
     have them counted (``output_bytes_per_node``), and a plan that fits alone is then refused."""
-    from qrrt_circuits._support import memory
     from qrrt_circuits._support.memory import JSON_BYTES_PER_COORDINATE, JSON_BYTES_PER_NODE, check_plan_fits
 
-    monkeypatch.setattr(memory, "available_memory", lambda: (300 << 20, memory.MACHINE_SOURCE))
+    monkeypatch.setattr(probe, "available_memory", lambda: (300 << 20, probe.MACHINE_SOURCE))
     check_plan_fits(10**6, 4096, 20000, 2)  # the plan alone: about 188 MiB
     with pytest.raises(ValueError, match="its JSON output"):
         check_plan_fits(10**6, 4096, 20000, 2,
@@ -217,10 +217,9 @@ def test_a_plan_too_large_for_memory_is_refused_before_it_runs_and_json_adds_not
     """``qrrt plan --json``: the plan's own check refuses limits whose tree could exceed the
     available memory, before the plan and before any output file exists; the streamed JSON is not
     charged per node (``PlanResult.write_json``)."""
-    from qrrt_circuits._support import memory
     from qrrt_circuits.cli import main
 
-    monkeypatch.setattr(memory, "available_memory", lambda: (300 << 20, memory.MACHINE_SOURCE))
+    monkeypatch.setattr(probe, "available_memory", lambda: (300 << 20, probe.MACHINE_SOURCE))
     with pytest.raises(SystemExit) as exited:  # a tree of about 380 MiB (above always_fits_bytes)
         main(["plan", "--planner", "prrt", "--workers", "4096", "--max-nodes", "2000000",
               "--json", str(tmp_path / "out.json")])

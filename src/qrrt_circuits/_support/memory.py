@@ -1,53 +1,44 @@
-"""The memory guard: a plan or a search is sized once, before anything large is allocated, and
-refused (``ValueError``) if it would not fit; one that runs out of memory all the same ends with one
-``OutOfMemory``.
+"""The memory guard: a plan or a direct search is sized once, before anything large is allocated,
+and refused (``ValueError``) if it would not fit; one that runs out of memory all the same ends with
+one ``OutOfMemory``.
 
 What is sized, in bytes *added* to the running process (the interpreter and the imported libraries
-are already resident, so they are already missing from the available memory):
+are already resident, so they are already missing from the available memory), from sizes the
+parts expose as plain numbers:
 
-- a plan (``check_plan_fits``, called by ``Planner.plan`` before the plan allocates anything): its
+- a plan (``PlanSize``, checked once by ``Planner.plan`` before the plan allocates anything): its
   tree and round history up to the node and round limits in force (``plan_bytes``) and, for a
   quantum planner, one round at its peak (``MemoryEstimate``): the databases of 2^n candidates
   alive at once (samples, nearest parents, the predicate's answers, the oracle's marks and the
   scratch arrays that build them), the backend's search of them at the policy's largest iteration
-  count (``IterationPolicy.search_peak_bytes``: each backend reports its own footprint,
-  ``QuantumSearchBackend.peak_bytes``) and the search policy's state
-  (``IterationPolicy.state_bytes``). The plan's searches make no check of their own.
-- a direct search (``QuantumSearchBackend.search``, ``search_many``, ``search_sequence``): the
-  backend's footprint, checked once per call (``check_fits``).
+  count (``QuantumSearchBackend.peak_bytes`` of ``IterationPolicy.iterations_bound``) and the
+  search policy's state (``IterationPolicy.state_bytes``). The plan's searches make no check of
+  their own (``QuantumSearchBackend.run``).
+- a direct search (``QuantumSearchBackend.search``, ``search_many``, ``search_sequence``;
+  ``SearchSize``): the backend's ``peak_bytes``, all the searches of one call checked at once.
 
-What is available (``available_memory``): the smallest of
-
-- ``MemAvailable`` from ``/proc/meminfo`` (Linux: free memory plus the page cache and slabs the
-  kernel can reclaim, i.e. what can be allocated without swapping); elsewhere
-  ``os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")`` (free pages only, a lower figure);
-- the room left in the process's memory control groups (``cgroup_available_bytes``: inside a
-  container the kernel kills the process at its group's limit, whatever the machine has free);
-- the address space left under ``RLIMIT_AS`` (``ulimit -v``; ``address_space_available_bytes``):
-  the soft limit less the process's virtual size, the first field of ``/proc/self/statm`` times
-  the page size (not taken where that file cannot be read).
-
-A figure that cannot be read is left out; where none can, no check refuses. The estimates count
-resident bytes: address space that a library reserves without touching it (thread stacks,
-allocator arenas) is not in them, so a run sized close to the ``RLIMIT_AS`` room can still fail.
+What is available is probed in ``available_memory`` (the smallest of ``MemAvailable``, the memory
+control groups' room and the address space left under ``RLIMIT_AS``). The estimates count resident
+bytes: address space that a library reserves without touching it (thread stacks, allocator arenas)
+is not in them, so a run sized close to the ``RLIMIT_AS`` room can still fail.
 
 A ``MemoryError`` raised while a plan or a direct search runs (numpy's ``_ArrayMemoryError`` is
 one) is raised again as an ``OutOfMemory`` whose message is one line: the size that did not fit
 (``num_qubits``, or the node or round limit), what the allocator reported, the estimate, and the
 largest smaller size whose estimate fits in the memory available after the failure.
 
-``psutil`` is not a runtime dependency, so it is not used. The per-entry constants are calibrated,
-not derived: upper bounds of the measured peak resident set of real runs, rounded up.
+The per-entry constants are calibrated, not derived: upper bounds of the measured peak resident set
+of real runs, rounded up.
 """
 
 from __future__ import annotations
 
-import functools
 import gc
-import os
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
-from pathlib import Path
+from typing import TypeVar
+
+from . import available_memory as probe
 
 MIB = 1 << 20
 
@@ -62,235 +53,6 @@ ANNEALING_BYTES_PER_ENTRY = 46
 ANNEALING_BYTES_PER_COORDINATE = 38
 #: fixed allowance: the nearest-node grid of the tree (``world.nearest.GridNearest``) and allocator slack
 SCRATCH_BYTES = 64 * MIB
-
-
-#: where each figure of ``available_memory`` comes from, as its messages name it
-MACHINE_SOURCE = "MemAvailable"
-CGROUP_SOURCE = "the memory control group's room"
-ADDRESS_SPACE_SOURCE = "the address space left under RLIMIT_AS, ulimit -v"
-
-
-def available_memory() -> tuple[int, str] | None:
-    """The memory a run can still take, in bytes, and which figure bounds it.
-
-    Returns:
-        ``(bytes, source)``: the smallest of the figures that can be read (the module docstring):
-        the machine's (``MemAvailable``, or free pages where there is no ``/proc/meminfo``;
-        ``MACHINE_SOURCE``), the room of the memory control groups (``cgroup_available_bytes``;
-        ``CGROUP_SOURCE``) and the address space left under ``RLIMIT_AS``
-        (``address_space_available_bytes``; ``ADDRESS_SPACE_SOURCE``); None if none can.
-    """
-    figures = [(figure, source) for figure, source in ((_machine_available_bytes(), MACHINE_SOURCE),
-                                                       (cgroup_available_bytes(), CGROUP_SOURCE),
-                                                       (address_space_available_bytes(), ADDRESS_SPACE_SOURCE))
-               if figure is not None]
-    return min(figures, key=lambda figure: figure[0]) if figures else None
-
-
-def available_memory_bytes() -> int | None:
-    """The bytes of ``available_memory`` (None if no figure can be read).
-
-    Returns:
-        The smallest of ``MemAvailable`` (or free pages), the control groups' room and the address
-        space left under ``RLIMIT_AS``, whichever are known; None if none is.
-    """
-    found = available_memory()
-    return None if found is None else found[0]
-
-
-#: the process's sizes in pages: total virtual size first (Linux)
-PROC_STATM = "/proc/self/statm"
-
-
-def virtual_memory_bytes() -> int | None:
-    """The process's virtual size (what ``RLIMIT_AS`` limits), in bytes; None where it cannot be
-    read.
-
-    Returns:
-        The first field of ``/proc/self/statm`` times the page size, or None (no such file).
-    """
-    try:
-        with open(PROC_STATM, encoding="ascii") as statm:
-            pages = int(statm.read().split()[0])
-        return pages * int(os.sysconf("SC_PAGE_SIZE"))
-    except (OSError, ValueError, IndexError, AttributeError):
-        return None
-
-
-def address_space_limit() -> int | None:
-    """The soft ``RLIMIT_AS`` (``ulimit -v``) in bytes; None where there is none (unlimited, or no
-    ``resource`` module).
-
-    Returns:
-        The limit, or None.
-    """
-    try:
-        import resource
-    except ImportError:  # not POSIX
-        return None
-    soft = resource.getrlimit(resource.RLIMIT_AS)[0]
-    return None if soft == resource.RLIM_INFINITY or soft < 0 else int(soft)
-
-
-def address_space_available_bytes() -> int | None:
-    """The address space the process can still map under ``RLIMIT_AS``: the soft limit less the
-    process's virtual size (``virtual_memory_bytes``), at least 0.
-
-    Returns:
-        The bytes; None without a limit, or where the virtual size cannot be read.
-    """
-    limit = address_space_limit()
-    if limit is None:
-        return None
-    size = virtual_memory_bytes()
-    return None if size is None else max(limit - size, 0)
-
-
-def _machine_available_bytes() -> int | None:
-    try:
-        with open("/proc/meminfo", encoding="ascii") as meminfo:
-            for line in meminfo:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        pass
-    try:
-        return int(os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
-    except (ValueError, OSError, AttributeError):
-        return None
-
-
-#: the process's control groups (``hierarchy:controllers:path`` lines) and where their file systems
-#: are mounted (cgroup v2 at the root, or at ``unified`` beside v1's ``memory``)
-PROC_CGROUP = "/proc/self/cgroup"
-CGROUP_ROOT = "/sys/fs/cgroup"
-#: per version: the limit, the usage, the statistics, the statistics of the page cache (which the
-#: kernel reclaims before it kills), and the limit and usage of memory + swap (v1 only)
-_V2_FILES = ("memory.max", "memory.current", "memory.stat", ("active_file", "inactive_file"), None)
-_V1_FILES = ("memory.limit_in_bytes", "memory.usage_in_bytes", "memory.stat",
-             ("total_active_file", "total_inactive_file"),
-             ("memory.memsw.limit_in_bytes", "memory.memsw.usage_in_bytes"))
-#: a cgroup v1 limit at or above this is "no limit" (the kernel writes about 2^63)
-_UNLIMITED = 1 << 60
-
-_GroupFiles = tuple[str, str, str, tuple[str, str], "tuple[str, str] | None"]
-
-
-def cgroup_available_bytes() -> int | None:
-    """The room left in the process's memory control group and its ancestors: for each group with
-    a limit, its limit less its usage, the usage counted without the page cache (active and
-    inactive file pages, which the kernel reclaims before it would kill); in v1 also the limit of
-    memory and swap less their usage, and the ``hierarchical_memory_limit`` of ancestors the
-    process cannot see (a container's mount). The smallest, in bytes; None without any limit
-    (``max`` in v2, about 2^63 in v1) or where the groups cannot be read (not Linux, no memory
-    controller).
-
-    The groups are found from ``/proc/self/cgroup`` (in a container with its own cgroup
-    namespace, the container's group is the mount's root).
-
-    Returns:
-        The smallest room, or None.
-    """
-    rooms = [room for folder, files in _memory_groups() if (room := _room(folder, files)) is not None]
-    return min(rooms) if rooms else None
-
-
-def smallest_cgroup_limit() -> int | None:
-    """The smallest memory limit among the process's groups and their ancestors (None without
-    one), read once per process: it decides how large an estimate is accepted without reading the
-    available memory (``always_fits_bytes``)."""
-    return _smallest_limit_cached()
-
-
-@functools.lru_cache(maxsize=1)
-def _smallest_limit_cached() -> int | None:
-    limits = [limit for folder, files in _memory_groups() if (limit := _limit(folder, files)) is not None]
-    return min(limits) if limits else None
-
-
-def always_fits_bytes() -> int:
-    """Estimates up to this are accepted without reading the machine's or the control groups'
-    figures: ``ALWAYS_FITS_BYTES``, or an eighth of the smallest control-group limit where that is
-    less, and never more than the address space left under ``RLIMIT_AS`` where there is such a
-    limit (read on every call: the limit is a system call, the virtual size one small file)."""
-    limit = smallest_cgroup_limit()
-    fits = ALWAYS_FITS_BYTES if limit is None else min(ALWAYS_FITS_BYTES, limit // 8)
-    room = address_space_available_bytes()
-    return fits if room is None else min(fits, room)
-
-
-def _memory_groups() -> list[tuple[Path, _GroupFiles]]:
-    """(folder, file names) of the process's memory groups, from its own up to the mount's root."""
-    try:
-        with open(PROC_CGROUP, encoding="utf-8", errors="surrogateescape") as handle:  # any group name
-            lines = handle.read().splitlines()
-    except OSError:
-        return []
-    groups: list[tuple[Path, _GroupFiles]] = []
-    for line in lines:
-        parts = line.split(":", 2)
-        if len(parts) != 3:
-            continue
-        controllers, path = parts[1], parts[2].lstrip("/")
-        mounts: list[tuple[Path, _GroupFiles]]
-        if controllers == "":  # the v2 hierarchy
-            mounts = [(Path(CGROUP_ROOT), _V2_FILES), (Path(CGROUP_ROOT) / "unified", _V2_FILES)]
-        elif "memory" in controllers.split(","):
-            mounts = [(Path(CGROUP_ROOT) / "memory", _V1_FILES)]
-        else:
-            continue
-        for root, files in mounts:
-            folder = root / path
-            while True:
-                groups.append((folder, files))
-                if folder == root or root not in folder.parents:
-                    break
-                folder = folder.parent
-    return groups
-
-
-def _read_int(path: Path) -> int | None:
-    try:
-        return int(path.read_text(encoding="ascii").split()[0])
-    except (OSError, ValueError, IndexError):  # absent, or "max" (v2: no limit)
-        return None
-
-
-def _statistics(folder: Path, files: _GroupFiles) -> dict[str, int]:
-    values: dict[str, int] = {}
-    try:
-        for line in (folder / files[2]).read_text(encoding="ascii").splitlines():
-            key, _, value = line.partition(" ")
-            if value.strip().isdigit():
-                values[key] = int(value)
-    except (OSError, UnicodeDecodeError):
-        pass
-    return values
-
-
-def _limit(folder: Path, files: _GroupFiles) -> int | None:
-    """One group's memory limit (v1: also its ``hierarchical_memory_limit``), or None."""
-    limits = [_read_int(folder / files[0])]
-    if files[4] is not None:
-        limits.append(_statistics(folder, files).get("hierarchical_memory_limit"))
-    present = [limit for limit in limits if limit is not None and limit < _UNLIMITED]
-    return min(present) if present else None
-
-
-def _room(folder: Path, files: _GroupFiles) -> int | None:
-    """One group's room (``cgroup_available_bytes``), or None (no limit, or unreadable)."""
-    limit = _limit(folder, files)
-    usage = _read_int(folder / files[1])
-    if limit is None or usage is None:
-        return None
-    statistics = _statistics(folder, files)
-    cache = sum(statistics.get(key, 0) for key in files[3])
-    room = max(limit - max(usage - cache, 0), 0)
-    if files[4] is not None:  # v1 with swap accounting: memory + swap have their own limit
-        swap_limit, swap_usage = _read_int(folder / files[4][0]), _read_int(folder / files[4][1])
-        if swap_limit is not None and swap_usage is not None and swap_limit < _UNLIMITED:
-            room = min(room, max(swap_limit - max(swap_usage - cache, 0), 0))
-    return room
 
 
 def database_bytes(num_qubits: int, dim: int, annealing: bool = False) -> int:
@@ -428,10 +190,6 @@ def _size(value: float) -> str:
     return f"{int(value)} bytes"
 
 
-#: estimates up to this size are not checked (reading /proc/meminfo and the control groups for
-#: every small search would cost as much as the search)
-ALWAYS_FITS_BYTES = 256 * MIB
-
 #: n is never tried beyond this when looking for the largest n that fits (2^64 entries)
 _LARGEST_TRIED = 64
 
@@ -487,7 +245,7 @@ def check_fits(estimate_for: Callable[[int], MemoryEstimate], num_qubits: int, w
     n that fits. ``what`` names the run ("this aer search (8 shots, 5 iterations)"). Returns the
     estimate when it fits. The available memory is read at most once.
 
-    Estimates up to ``always_fits_bytes()`` (256 MiB, less in a small container or under a small
+    Estimates up to ``available_memory.always_fits_bytes()`` (256 MiB, less in a small container or under a small
     ``RLIMIT_AS``) are accepted without reading the available memory; so is any estimate when the
     available memory is unknown.
 
@@ -495,7 +253,7 @@ def check_fits(estimate_for: Callable[[int], MemoryEstimate], num_qubits: int, w
         estimate_for: The run's ``MemoryEstimate`` as a function of n.
         num_qubits: The n asked for.
         what: The run's name for the message.
-        available: The available bytes; None (default) for ``available_memory()``.
+        available: The available bytes; None (default) for ``available_memory.available_memory()``.
         source: Which figure ``available`` is, for the message (``available_memory``'s second
             item; default none named).
 
@@ -518,9 +276,9 @@ def check_fits(estimate_for: Callable[[int], MemoryEstimate], num_qubits: int, w
         ValueError: num_qubits = 26: this plan needs about 3.7 GiB ...; the largest num_qubits that fits is 24
     """
     estimate = estimate_for(num_qubits)
-    if estimate.total_bytes <= always_fits_bytes():
+    if estimate.total_bytes <= probe.always_fits_bytes():
         return estimate
-    measured = available_memory() if available is None else (available, source)
+    measured = probe.available_memory() if available is None else (available, source)
     if measured is None or estimate.total_bytes <= measured[0]:
         return estimate
     largest = largest_fitting(estimate_for, measured[0], num_qubits)
@@ -549,7 +307,7 @@ def _out_of_memory(error: MemoryError, name: str, value: int, what: str, estimat
             f"{_size(estimate.total_bytes)} ({estimate.breakdown()})")
     when = " when it started"
     if measured is None:
-        measured, when = available_memory(), " now"
+        measured, when = probe.available_memory(), " now"
     if measured is None:
         return OutOfMemory(f"{head}; the memory available cannot be read: try a smaller {name}")
     largest = largest_below(measured[0])
@@ -571,7 +329,7 @@ def out_of_memory(error: MemoryError, estimate_for: Callable[[int], MemoryEstima
         estimate_for: The run's ``MemoryEstimate`` as a function of n.
         num_qubits: The n that ran out of memory.
         what: The run's name for the message.
-        measured: The memory available when the run started, as ``available_memory()`` gave it
+        measured: The memory available when the run started, as ``available_memory.available_memory()`` gave it
             (what a new run would find; memory that a failed run leaves behind, such as arrays
             that compiled code keeps after an exception, is not in it), or None (default) to read
             it now.
@@ -583,6 +341,123 @@ def out_of_memory(error: MemoryError, estimate_for: Callable[[int], MemoryEstima
     """
     return _out_of_memory(error, "num_qubits", num_qubits, what, estimate_for(num_qubits),
                           lambda available: largest_fitting(estimate_for, available, num_qubits), measured)
+
+
+@dataclass(frozen=True)
+class SearchSize:
+    """What a direct search's memory check sizes: one search of 2^n entries, by the peak its backend
+    reports (``QuantumSearchBackend.peak_bytes`` at the search's shots and iterations).
+
+    Args:
+        peak: The search's peak bytes as a function of (n, m), m the marked entries or None for
+            the bound over every m.
+        num_qubits: n.
+        backend: The backend's name, for the messages.
+        shots: The search's shots, for the messages.
+        iterations: Its iterations (or generalized iterates), for the messages.
+        marked: m where it is known, else None; called only where the bound over every m does not
+            fit (counting the marks is a pass over them).
+
+    Example:
+        >>> from qrrt_circuits._support.memory import SearchSize, check_searches
+        >>> size = SearchSize(lambda n, m: 16 << n, 30, "statevector", 8, 5, lambda: None)
+        >>> check_searches([size], available=2**30)  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        ValueError: num_qubits = 30: this statevector search (8 shots, 5 iterations) needs about 16.0 GiB ...
+    """
+
+    peak: Callable[[int, int | None], int]
+    num_qubits: int
+    backend: str
+    shots: int
+    iterations: int
+    marked: Callable[[], int | None]
+
+    def estimate_for(self, marked: int | None) -> Callable[[int], MemoryEstimate]:
+        """The search's ``MemoryEstimate`` as a function of n, for m = ``marked`` (None: every m)."""
+        def estimate(width: int) -> MemoryEstimate:
+            return MemoryEstimate(width, search_bytes=self.peak(width, marked), scratch_bytes=0)
+
+        return estimate
+
+    def what(self, marked: int | None = None) -> str:
+        """``"this aer search (8 shots, 5 iterations, 12 marked)"``: the search in words."""
+        count = "" if marked is None else f", {marked} marked"
+        return f"this {self.backend} search ({self.shots} shots, {self.iterations} iterations{count})"
+
+    def check(self, measured: tuple[int, str]) -> None:
+        """Refuse (``ValueError``, ``check_fits``) the search if its bound over every m exceeds
+        ``measured`` (the available bytes and their source) and the estimate for its known m, where
+        that is smaller, does too (the message names m only where m lowered the estimate)."""
+        bound = self.peak(self.num_qubits, None)
+        if bound <= measured[0]:
+            return
+        marked = self.marked()
+        if marked is not None and self.peak(self.num_qubits, marked) >= bound:
+            marked = None  # the count cannot lower the estimate: the message names none
+        check_fits(self.estimate_for(marked), self.num_qubits, self.what(marked), *measured)
+
+    def out_of_memory(self, error: MemoryError, measured: tuple[int, str] | None) -> OutOfMemory:
+        """The one-line ``OutOfMemory`` of this search (``out_of_memory``, the bound over every m)."""
+        return out_of_memory(error, self.estimate_for(None), self.num_qubits, self.what(), measured)
+
+
+def check_searches(sizes: Sequence[SearchSize], available: int | None = None) -> tuple[int, str] | None:
+    """A direct search's one memory check, for the searches of one call run one after the other:
+    each refused (``ValueError``) as ``SearchSize.check`` says. The available memory is read at most
+    once, and not at all where every bound is at most ``available_memory.always_fits_bytes()``.
+
+    Args:
+        sizes: The searches' ``SearchSize``.
+        available: The available bytes; None (default) for ``available_memory.available_memory()``.
+
+    Returns:
+        What was read (``available_memory()``'s ``(bytes, source)``), or None where nothing was.
+
+    Raises:
+        ValueError: A search whose estimate exceeds the available memory.
+    """
+    bounds = [size.peak(size.num_qubits, None) for size in sizes]
+    if available is None and (not bounds or max(bounds) <= probe.always_fits_bytes()):
+        return None
+    measured = probe.available_memory() if available is None else (available, "")
+    if measured is not None:
+        for size in sizes:
+            size.check(measured)
+    return measured
+
+
+_Result = TypeVar("_Result")
+
+
+def run_checked(sizes: Sequence[SearchSize], runs: Sequence[Callable[[], _Result]]) -> tuple[_Result, ...]:
+    """Direct searches: ``check_searches(sizes)`` once, then ``runs`` one after the other, a
+    ``MemoryError`` raised by run i raised again as the one-line ``OutOfMemory`` of ``sizes[i]``
+    (naming n, what the allocator reported and the largest smaller n whose bound fits in the memory
+    the check read, or in what is available then where it read none).
+
+    Args:
+        sizes: One ``SearchSize`` per search.
+        runs: One callable per search, in the same order.
+
+    Returns:
+        The runs' results, in order.
+
+    Raises:
+        ValueError: A search refused by the check (before any runs).
+        OutOfMemory: A ``MemoryError`` while a search ran.
+    """
+    measured = check_searches(sizes)
+    results = []
+    for size, run in zip(sizes, runs, strict=True):
+        try:
+            results.append(run())
+        except OutOfMemory:
+            raise
+        except MemoryError as error:  # (its frames, and the search's arrays, are released before the message)
+            raise size.out_of_memory(error, measured) from error
+    return tuple(results)
 
 
 #: a plan's tree, bytes per node besides its coordinates (parents in the tree and the result, the
@@ -687,7 +562,7 @@ class PlanSize:
         output_bytes_per_node: What writing the result adds per node (``plan_bytes``).
 
     Attributes:
-        measured: The memory available as the last ``check`` read it (``available_memory()``'s
+        measured: The memory available as the last ``check`` read it (``available_memory.available_memory()``'s
             ``(bytes, source)``), or None where it read none.
 
     Example:
@@ -741,11 +616,11 @@ class PlanSize:
         available memory (and which figure bounds it) and the largest value of that size that
         fits. The available memory is read at most once.
 
-        Estimates up to ``always_fits_bytes()`` are accepted without reading the available memory;
+        Estimates up to ``available_memory.always_fits_bytes()`` are accepted without reading the available memory;
         so is any estimate when the available memory is unknown.
 
         Args:
-            available: The available bytes; None (default) for ``available_memory()``.
+            available: The available bytes; None (default) for ``available_memory.available_memory()``.
 
         Returns:
             The plan's ``estimate()`` when it fits.
@@ -755,9 +630,9 @@ class PlanSize:
         """
         self.measured = None
         estimate = self.estimate()
-        if estimate.total_bytes <= always_fits_bytes():
+        if estimate.total_bytes <= probe.always_fits_bytes():
             return estimate
-        measured = self.measured = (available, "") if available is not None else available_memory()
+        measured = self.measured = (available, "") if available is not None else probe.available_memory()
         if measured is None or estimate.total_bytes <= measured[0]:
             return estimate
         name, value, given = self._size_to_lower(estimate, measured[0])
@@ -790,7 +665,7 @@ class PlanSize:
         """
         estimate = self.estimate()
         _released(error)
-        figure = self.measured if self.measured is not None else available_memory()
+        figure = self.measured if self.measured is not None else probe.available_memory()
         name, value, given = self._size_to_lower(estimate, None if figure is None else figure[0])
         return _out_of_memory(error, name, value, "this plan", estimate,
                               lambda available: self._largest_below(name, estimate, available, value),
@@ -833,7 +708,7 @@ def check_plan_fits(max_nodes: int, nodes_per_round: int, max_rounds: int | None
     that limit is the default one, the estimate, the available memory and the largest value of that
     size that fits.
 
-    Estimates up to ``always_fits_bytes()`` are accepted without reading the available memory; so is
+    Estimates up to ``available_memory.always_fits_bytes()`` are accepted without reading the available memory; so is
     any estimate when the available memory is unknown.
 
     Args:
@@ -841,7 +716,7 @@ def check_plan_fits(max_nodes: int, nodes_per_round: int, max_rounds: int | None
         nodes_per_round: The most nodes one round adds.
         max_rounds: The round limit in force (None: not counted, see ``plan_bytes``).
         dim: The workspace dimension d.
-        available: The available bytes; None (default) for ``available_memory()``.
+        available: The available bytes; None (default) for ``available_memory.available_memory()``.
         default_nodes: Whether ``max_nodes`` is the default limit (the caller gave none).
         default_rounds: Whether ``max_rounds`` is the default limit.
         output_bytes_per_node: What writing the result adds per node (``plan_bytes``).

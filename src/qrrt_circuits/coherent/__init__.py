@@ -8,7 +8,7 @@ Entry points: ``coherent_phase_oracle(env, database, motion)`` (the circuit) and
 """
 
 from .costs import LookupCost, OracleCost, lookup_costs, oracle_costs
-from .grover import coherent_grover_circuit
+from .grover import coherent_grover_circuit, coherent_search_oracle
 from .lattice import DatabaseEntries, LatticeDatabase
 from .motion import SampledMotion
 from .number_format import FixedPointFormat
@@ -36,6 +36,7 @@ __all__ = [
     "build_coherent_oracle",
     "coherent_grover_circuit",
     "coherent_phase_oracle",
+    "coherent_search_oracle",
     "compare_with_time_sampled",
     "lookup_costs",
     "oracle_costs",

@@ -43,13 +43,16 @@ import json
 import math
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save
 from .intervals import binomial_interval, bootstrap_interval, rounded_interval
+
+if TYPE_CHECKING:
+    from ..search.backends.base import QuantumSearchBackend
 
 VERIFY_BITS = (8, 12, 16)
 GROVER_BITS = (5, 9, 13)
@@ -303,7 +306,13 @@ def _plan(config: str, seed: int, budget: int) -> Record:
     problem = Problem.build(world, [2.0, 10.0], [18.0, 10.0], 2.5)
     database = {"paper database": NearestParents(), "lattice, lookup": LatticeCandidates(3, bits=6),
                 "lattice, coherent": LatticeCandidates(3, bits=6, coherent=True)}[config]
-    planner = QRRT(backend=StatevectorBackend(seed=seed), num_qubits=7, database=database, seed=seed)
+    if database.describe().get("coherent"):  # a circuit oracle, simulated gate by gate
+        from ..search.backends.aer import AerBackend
+
+        backend: QuantumSearchBackend = AerBackend(seed=seed, method="matrix_product_state")
+    else:  # a lookup, in closed form
+        backend = StatevectorBackend(seed=seed)
+    planner = QRRT(backend=backend, num_qubits=7, database=database, seed=seed)
     result = planner.plan(problem, max_oracle_calls=budget)
     edges = problem.predicate.reachable(result.nodes[result.parents[1:]], result.nodes[1:])
     if not bool(np.all(edges)):

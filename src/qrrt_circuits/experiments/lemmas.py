@@ -20,6 +20,7 @@ import numpy as np
 
 from .. import probability as pr
 from ..reachability.oracle_errors import OracleErrorModel
+from ..search.oracles import LookupOracle
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
 from .figures import new_figure, save, with_intervals
 from .intervals import binomial_interval, rounded_interval
@@ -144,7 +145,7 @@ class Lemmas(Experiment):
         p_good = pr.success_probability(size, m_oracle, k)
         repeats = settings["repeats"]
         backend = make_backend(settings["backend"])
-        indices = backend.search(marks, k, shots=p * repeats, seed=int(rng.integers(2**62))).indices
+        indices = backend.search(LookupOracle(marks), k, shots=p * repeats, seed=int(rng.integers(2**62))).indices
         groups = indices.reshape(repeats, p)
         good = marks[groups].all(axis=1)
         same = good & (groups == groups[:, :1]).all(axis=1)

@@ -30,6 +30,7 @@ from ..hardware import noise
 from ..probability import good_probability
 from ..registry import PLANNERS
 from ..search.backends.noisy import depolarizing_backend, fake_device_backend
+from ..search.oracles import LookupOracle
 from ..search.policies.adaptive import Adaptive
 from ..search.policies.schedules import KnownOptimal
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
@@ -171,7 +172,7 @@ class Noise(Experiment):
                           collision=noise.wrong_answer_collision(distribution, marks))
         else:
             backend = depolarizing_backend(p1, p2, method="statevector")
-            result = backend.search(marks, k, shots=settings["shots"], seed=trial.seed)
+            result = backend.search(LookupOracle(marks), k, shots=settings["shots"], seed=trial.seed)
             hits = int(np.count_nonzero(marks[result.indices]))
             low, high = binomial_interval(hits, settings["shots"])
             record.update(method="statevector trajectories (shots)", shots=settings["shots"], successes=hits,
@@ -187,10 +188,11 @@ class Noise(Experiment):
         n, k = trial.params["n"], trial.params["k"]
         marks = sweep_marks(n, trial.seed)
         backend = fake_device_backend(settings["device"])
-        result = backend.search(marks, k, shots=settings["device_shots"], seed=trial.seed)
+        oracle = LookupOracle(marks)
+        result = backend.search(oracle, k, shots=settings["device_shots"], seed=trial.seed)
         hits = int(np.count_nonzero(marks[result.indices]))
         low, high = binomial_interval(hits, settings["device_shots"])
-        compiled = backend.compiled(marks, k)
+        compiled = backend.compiled(oracle, k)
         two = sum(count for gate, count in compiled.count_ops().items() if gate in ("ecr", "cz", "cx"))
         return {"m": int(marks.sum()), "ideal": good_probability(1 << n, int(marks.sum()), k),
                 "shots": settings["device_shots"], "successes": hits, "success": hits / settings["device_shots"],

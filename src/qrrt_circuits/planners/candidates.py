@@ -9,10 +9,11 @@ strategy object chosen once, when the planner is made (``database=``).
   uniformly from the tree (with replacement while the tree is smaller), so every pairing of a cell
   with a drawn node is an entry: a sample is on the lattice, not uniform, and its parent any drawn
   node, not the nearest. With ``coherent=True`` the workers search the reversible circuit of the
-  motion check (``coherent.build_coherent_oracle``) on Aer's matrix-product-state method instead
-  of a lookup: its marks are the fixed-point reference's (``coherent.reachable_reference``, the
-  circuit checked equal to it entry for entry), and each measured entry is verified by the
-  planner's own predicate, as every candidate is.
+  motion check (``coherent.build_coherent_oracle``, a ``CircuitOracle``) on the planner's backend
+  instead of a lookup (``AerBackend(method="matrix_product_state")`` suits its many ancillas; the
+  statevector backend's closed form cannot run a circuit): its marks are the fixed-point
+  reference's (``coherent.reachable_reference``, the circuit checked equal to it entry for entry),
+  and each measured entry is verified by the planner's own predicate, as every candidate is.
 """
 
 from __future__ import annotations
@@ -25,10 +26,10 @@ import numpy as np
 from .._support.randomness import Stream
 from .._support.validation import check_bool, check_instance, check_int
 from ..reachability.dynamics import LinearTrackingDynamics
+from ..search.oracles import LookupOracle, SearchOracle
 from .database import Database, stream_database
 
 if TYPE_CHECKING:
-    from ..search.backends.base import QuantumSearchBackend
     from ..world.environment import Environment
     from .context import RoundView, WorkerContext
 
@@ -50,9 +51,10 @@ class Candidates(abc.ABC):
         """The phase oracle's marks given the predicate's answers (default: the lookup of them)."""
         return truth
 
-    def search_backend(self, context: WorkerContext, db: Database) -> QuantumSearchBackend:
-        """The backend that searches ``db`` (default: the planner's)."""
-        return context.search_backend
+    def search_oracle(self, context: WorkerContext, db: Database, marks: np.ndarray) -> SearchOracle:
+        """The phase oracle the workers search ``db`` with, given its (possibly erroneous) marks
+        (default: their lookup, ``LookupOracle``)."""
+        return LookupOracle(marks)
 
     @abc.abstractmethod
     def describe(self) -> dict:
@@ -83,8 +85,9 @@ class LatticeCandidates(Candidates):
         cell_bits: a, 1 .. ``bits``: 2^a cells per axis; the planner's n must exceed d a (the
             parent field has m = n - d a bits).
         bits: b, the fixed-point coordinates' bits (1 .. 24; default 8).
-        coherent: Search the reversible circuit on Aer (True) or the lookup on the planner's
-            backend (False, default).
+        coherent: Search the reversible circuit (True; a ``CircuitOracle``, on a backend that runs
+            circuits: ``AerBackend(method="matrix_product_state")``) or the lookup (False, default),
+            on the planner's backend either way.
         time_samples: K of the coherent circuit's sampled motion (default 4).
         fraction_bits: f, the circuit's coefficient bits (default ``bits``).
         dynamics: The closed loop the circuit samples (default the paper's); give the dynamics of
@@ -142,14 +145,13 @@ class LatticeCandidates(Candidates):
 
         return reachable_reference(context.env, db.lattice, self.motion)
 
-    def search_backend(self, context: WorkerContext, db: Database) -> QuantumSearchBackend:
+    def search_oracle(self, context: WorkerContext, db: Database, marks: np.ndarray) -> SearchOracle:
         if not self.coherent:
-            return context.search_backend
-        from ..coherent import build_coherent_oracle
-        from ..coherent.backend import CoherentOracleBackend
+            return LookupOracle(marks)
+        from ..coherent import build_coherent_oracle, coherent_search_oracle
 
-        oracle = build_coherent_oracle(context.env, db.lattice, self.motion)
-        return CoherentOracleBackend(oracle.circuit, db.lattice.num_index_bits)
+        built = build_coherent_oracle(context.env, db.lattice, self.motion)
+        return coherent_search_oracle(built.circuit, db.lattice.num_index_bits, marks=marks)
 
     def describe(self) -> dict:
         return {"kind": "lattice", "cell_bits": self.cell_bits, "bits": self.bits, "coherent": self.coherent,
@@ -157,6 +159,6 @@ class LatticeCandidates(Candidates):
 
     def labels(self) -> tuple[str, ...]:
         if self.coherent:
-            return ("coherent oracle: the workers search the reversible circuit of the motion check on Aer's "
-                    "matrix_product_state method; its marks are the fixed-point reference's",)
+            return ("coherent oracle: the workers search the reversible circuit of the motion check (a "
+                    "CircuitOracle) on the planner's backend; its marks are the fixed-point reference's",)
         return ()

@@ -133,19 +133,20 @@ class PQRRT(Planner):
         """Refuse a database this problem cannot hold (``Candidates.check``)."""
         self.candidates.check(problem.env, self.num_qubits, self.options.oracle_errors is not None)
 
-    def memory_estimate(self, dim: int, num_qubits: int | None = None) -> MemoryEstimate:
+    def memory_estimate(self, num_qubits: int | None = None, *, dim: int) -> MemoryEstimate:
         """Estimated peak memory of one round (``qrrt_circuits._support.memory``); ``plan`` checks it, with
         the tree and the round history, once before the plan allocates anything.
 
         Counts the databases alive at once (one shared database, or one per worker when the
         databases are unshared: a round builds every worker's database before it searches them, on
         an executor or not), each with its backend search at the policy's largest iteration count
-        (``IterationPolicy.search_peak_bytes``), plus the policy's state.
+        (``QuantumSearchBackend.peak_bytes`` of ``IterationPolicy.iterations_bound``), plus the
+        policy's state.
 
         Args:
-            dim: The problem's dimension d.
             num_qubits: Qubits n to estimate for (databases of 2^n entries); default the planner's
                 own ``num_qubits``.
+            dim: The problem's dimension d (a database entry holds a sample and its parent).
 
         Returns:
             A ``MemoryEstimate`` with the database, resident, search and policy bytes.
@@ -154,7 +155,8 @@ class PQRRT(Planner):
         size = 1 << n
         concurrent = 1 if self.shared_database else self.workers
         shots = self.workers if self.shared_database else 1
-        search = self.search_policy.search_peak_bytes(self.backend, n, shots)
+        policy = self.search_policy
+        search = self.backend.peak_bytes(n, shots, policy.iterations_bound(size), sequence=policy.runs_sequences)
         return MemoryEstimate(
             n,
             database_bytes=concurrent * database_bytes(n, dim, self.annealing is not None),
@@ -178,7 +180,7 @@ class PQRRT(Planner):
 
     def _round_memory(self, dim: int) -> tuple[Callable[[int], MemoryEstimate] | None, int]:
         """One round's ``memory_estimate`` in dimension ``dim`` as a function of n, and the plan's n."""
-        return functools.partial(self.memory_estimate, dim), self.num_qubits
+        return functools.partial(self.memory_estimate, dim=dim), self.num_qubits
 
     def _context(self, problem: Problem) -> WorkerContext:
         options = self.options

@@ -106,7 +106,7 @@ def search_database(context: WorkerContext, view: RoundView, group: tuple[int, i
     """Workers ``first, ..., first + count - 1`` search one database built by worker ``first``."""
     first, count = group
     db, truth, marks = make_database(context, view, first)
-    problem = DatabaseSearch(marks, truth, context.candidates.search_backend(context, db), context.streams,
-                             view.round_index, first, memory_checked=True)  # covered by the plan's one memory check
+    problem = DatabaseSearch(context.candidates.search_oracle(context, db, marks), truth, context.search_backend,
+                             context.streams, view.round_index, first)
     return database_outcome(db.children, db.parents, truth, view.search_policy_state.run(problem, count,
                                                                                         view.tree_nodes))

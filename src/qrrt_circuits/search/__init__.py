@@ -16,6 +16,7 @@ if TYPE_CHECKING:
     from .backends.sampler import SamplerBackend
     from .backends.statevector import StatevectorBackend
     from .iterate_sequence import IterateSequence
+    from .oracles import CircuitOracle, LookupOracle, SearchOracle
     from .policies.estimated import EstimatedOptimal
     from .policies.fixed_point_amplification import FixedPointAmplification
     from .problem import DatabaseSearch, SearchOutcome
@@ -24,6 +25,9 @@ if TYPE_CHECKING:
 #: public name -> the submodule that defines it ("" for a submodule itself)
 _WHERE = {
     "AerBackend": ".backends.aer",
+    "CircuitOracle": ".oracles",
+    "LookupOracle": ".oracles",
+    "SearchOracle": ".oracles",
     "DatabaseSearch": ".problem",
     "EstimatedOptimal": ".policies.estimated",
     "FixedPointAmplification": ".policies.fixed_point_amplification",
@@ -40,13 +44,16 @@ _WHERE = {
 
 __all__ = [
     "AerBackend",
+    "CircuitOracle",
     "DatabaseSearch",
     "EstimatedOptimal",
     "FixedPointAmplification",
     "IterateSequence",
+    "LookupOracle",
     "OracleSynthesis",
     "QuantumSearchBackend",
     "SamplerBackend",
+    "SearchOracle",
     "SearchOutcome",
     "SearchRequest",
     "SearchResult",

@@ -1,13 +1,17 @@
 """One database as a search policy sees it, and what one worker's search of it produced.
 
 A ``DatabaseSearch`` gives a policy three things and nothing else: ``search(iterations, shots,
-seed)`` (prepare the uniform superposition, apply Grover iterations, measure ``shots`` times: each
-shot one worker's independent preparation; ``search_sequence(sequence, shots, seed)`` applies
-generalized iterates instead, for fixed-point amplification), ``verify(index)`` (the classical finalizer: the true
-predicate on one entry, 1 oracle call), and the database size. ``marked_count()`` is simulation
-knowledge a quantum device does not have (only ``KnownOptimal`` uses it, and it is labelled).
-Seeds come from the plan's random streams, keyed by round and worker, so a search never depends on
-the executor or the order of workers.
+seed)`` (prepare the uniform superposition, apply Grover iterations with the database's oracle,
+measure ``shots`` times: each shot one worker's independent preparation; ``search_sequence(sequence,
+shots, seed)`` applies generalized iterates instead, for fixed-point amplification),
+``verify(index)`` (the classical finalizer: the true predicate on one entry, 1 oracle call), and the
+database size. ``marked_count()`` is simulation knowledge a quantum device does not have (only
+``KnownOptimal`` uses it, and it is labelled). Seeds come from the plan's random streams, keyed by
+round and worker, so a search never depends on the executor or the order of workers.
+
+A database is a part of a plan, whose one memory check (``memory.PlanSize``) covers its searches:
+they run without a check of their own (``QuantumSearchBackend.run``), and a ``MemoryError`` is left
+to the plan, which words it.
 
 A ``SearchOutcome`` is what one worker's search of one database returns to the planner: the
 verified index (or None), the quantum oracle calls and verifications it spent (DESIGN §2), and
@@ -23,6 +27,7 @@ import numpy as np
 
 from .._support.randomness import RandomStreams, Stream
 from .backends.base import QuantumSearchBackend
+from .oracles import SearchOracle
 
 if TYPE_CHECKING:
     from .iterate_sequence import IterateSequence
@@ -73,50 +78,46 @@ class SearchOutcome:
 
 @dataclass(frozen=True, eq=False)
 class DatabaseSearch:
-    """A database of ``len(marks)`` entries searched by workers ``first_worker, first_worker + 1, ...``
-    in round ``round_index``. ``marks`` are the phase oracle's (possibly erroneous) marks;
-    ``truth`` the true predicate used by ``verify``.
+    """A database of 2^n entries searched by workers ``first_worker, first_worker + 1, ...`` in round
+    ``round_index``. ``oracle`` is its phase oracle (a ``LookupOracle`` of the possibly erroneous
+    marks, or a ``CircuitOracle``); ``truth`` the true predicate used by ``verify``.
 
     What a search policy sees of one database of Alg. 2 / 3: Grover search (``search``),
     generalized iterates (``search_sequence``), the classical finalizer (``verify``, 1 oracle call)
-    and the size N. ``marked_count`` is simulation knowledge (``KnownOptimal`` only, labelled).
+    and the size N. ``marked_count`` is simulation knowledge (``KnownOptimal`` only, labelled). Its
+    searches make no memory check of their own (module docstring).
 
     Args:
-        marks: Boolean array of length N = 2^n, the phase oracle's marks.
-        truth: Boolean array of length N, the true reachability used by ``verify``.
+        oracle: The database's phase oracle (``SearchOracle``) on n index qubits.
+        truth: Boolean array of length N = 2^n, the true reachability used by ``verify``.
         backend: The ``QuantumSearchBackend`` that runs the searches.
         streams: The plan's ``RandomStreams`` (seeds keyed by round and worker).
         round_index: The planner's round.
         first_worker: The first worker searching this database (default 0).
-        memory_checked: True where a plan's memory check covered this database's searches
-            (``memory.PlanSize``): they then make no check of their own and leave a
-            ``MemoryError`` to the plan. False (default): each search checks itself, as a direct
-            ``backend.search`` does.
 
     Example:
         >>> import numpy as np
-        >>> from qrrt_circuits import DatabaseSearch, StatevectorBackend
+        >>> from qrrt_circuits import DatabaseSearch, LookupOracle, StatevectorBackend
         >>> from qrrt_circuits._support.randomness import RandomStreams
         >>> marks = np.zeros(8, dtype=bool)
         >>> marks[5] = True
-        >>> problem = DatabaseSearch(marks, marks, StatevectorBackend(seed=0), RandomStreams(0),
+        >>> problem = DatabaseSearch(LookupOracle(marks), marks, StatevectorBackend(seed=0), RandomStreams(0),
         ...                          round_index=0)
         >>> problem.num_items, problem.marked_count(), problem.verify(5), problem.verify(0)
         (8, 1, True, False)
     """
 
-    marks: np.ndarray
+    oracle: SearchOracle
     truth: np.ndarray
     backend: QuantumSearchBackend
     streams: RandomStreams
     round_index: int
     first_worker: int = 0
-    memory_checked: bool = False
 
     @property
     def num_items(self) -> int:
         """N, the database's entries."""
-        return int(self.marks.shape[0])
+        return 1 << self.oracle.num_qubits
 
     def search(self, iterations: int, shots: int, seed: int) -> np.ndarray:
         """Measured indices (one per shot) after ``iterations`` Grover iterations.
@@ -130,12 +131,10 @@ class DatabaseSearch:
             Int array of ``shots`` measured indices.
 
         Raises:
-            ValueError: k or ``shots`` out of the backend's range.
+            ValueError: k or ``shots`` out of the backend's range, or an oracle the backend cannot run.
             TypeError: A non-integer k or ``shots``.
         """
-        if self.memory_checked:
-            return self.backend._search_covered(self.marks, iterations, shots, seed=seed).indices
-        return self.backend.search(self.marks, iterations, shots, seed=seed).indices
+        return self.backend.run(self.oracle, iterations, shots, seed=seed).indices
 
     def search_sequence(self, sequence: IterateSequence, shots: int, seed: int) -> np.ndarray:
         """Measured indices (one per shot) after the generalized iterates of ``sequence`` (an
@@ -149,9 +148,7 @@ class DatabaseSearch:
         Returns:
             Int array of ``shots`` measured indices.
         """
-        if self.memory_checked:
-            return self.backend._search_sequence_covered(self.marks, sequence, shots, seed=seed).indices
-        return self.backend.search_sequence(self.marks, sequence, shots, seed=seed).indices
+        return self.backend.run_sequence(self.oracle, sequence, shots, seed=seed).indices
 
     def verify(self, index: int) -> bool:
         """The classical finalizer: is entry ``index`` truly reachable? (1 oracle call.)
@@ -165,8 +162,16 @@ class DatabaseSearch:
         return bool(self.truth[index])
 
     def marked_count(self) -> int:
-        """The number of marked entries: simulation knowledge (KnownOptimal only, labelled)."""
-        return int(np.count_nonzero(self.marks))
+        """The number of marked entries: simulation knowledge (KnownOptimal only, labelled).
+
+        Raises:
+            ValueError: A circuit oracle given without its marks (its count is unknown).
+        """
+        count = self.oracle.marked_count()
+        if count is None:
+            raise ValueError("the marked count of this database's oracle is unknown (a CircuitOracle given "
+                             "without its marks): a policy that reads the true m cannot search it")
+        return count
 
     def shared_seed(self) -> int:
         """The seed of one search serving all the workers of this database.

@@ -1,6 +1,6 @@
 """What a Grover search is asked and what it returns, and the checks of its arguments.
 
-A ``SearchRequest`` is one search (marks, k, shots, seed); a ``SearchResult`` its measured indices
+A ``SearchRequest`` is one search (oracle, k, shots, seed); a ``SearchResult`` its measured indices
 and oracle calls (DESIGN §2: one call per Grover iteration per preparation). ``validate_marks``,
 ``validate_iterations`` and ``validate_shots`` refuse bad arguments before any work; every backend
 and circuit builder uses them.
@@ -9,10 +9,14 @@ and circuit builder uses them.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .._support.validation import check_int, check_seed
+
+if TYPE_CHECKING:
+    from .oracles import SearchOracle
 
 
 @dataclass(frozen=True)
@@ -42,13 +46,13 @@ class SearchRequest:
     """One search of ``QuantumSearchBackend.search_many``: the arguments of one ``search`` call.
 
     Args:
-        marks: Boolean array of length 2^n, the phase oracle's marks.
+        oracle: The phase oracle (``LookupOracle(marks)`` or a ``CircuitOracle``; ``search/oracles.py``).
         iterations: k, 0 .. ``MAX_ITERATIONS``.
         shots: Preparations, 1 .. ``MAX_SHOTS`` (default 1).
         seed: This search's seed, or None (default) for the backend's own stream.
     """
 
-    marks: np.ndarray
+    oracle: SearchOracle
     iterations: int
     shots: int = 1
     seed: int | None = None

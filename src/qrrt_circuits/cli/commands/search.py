@@ -52,7 +52,9 @@ def _run_search(args: argparse.Namespace, backend: QuantumSearchBackend, num_ite
     rng = np.random.default_rng(args.seed)
     marks = np.zeros(num_items, dtype=bool)
     marks[rng.choice(num_items, args.marked, replace=False)] = True
-    return marks, backend._search_covered(marks, iterations, shots=args.shots)
+    from ...search.oracles import LookupOracle
+
+    return marks, backend.run(LookupOracle(marks), iterations, shots=args.shots)
 
 
 #: the marks (1 byte per entry) and numpy's draw of the marked entries (a permutation, 8 bytes)
@@ -61,12 +63,13 @@ SEARCH_MARKS_BYTES_PER_ENTRY = 9
 
 def _search_estimate(backend: QuantumSearchBackend, shots: int, iterations: int,
                      marked: int) -> Callable[[int], MemoryEstimate]:
-    """``qrrt search``'s peak as a function of n: the marks and the search of ``marked`` entries."""
-    from dataclasses import replace
+    """``qrrt search``'s peak as a function of n: the marks and the search of ``marked`` entries
+    (the backend's ``peak_bytes``)."""
+    from ..._support.memory import MemoryEstimate
 
     def estimate(n: int) -> MemoryEstimate:
-        search = backend.memory_estimate(n, shots, iterations, marked)
-        return replace(search, resident_bytes=SEARCH_MARKS_BYTES_PER_ENTRY << n)
+        return MemoryEstimate(n, resident_bytes=SEARCH_MARKS_BYTES_PER_ENTRY << n,
+                              search_bytes=backend.peak_bytes(n, shots, iterations, marked), scratch_bytes=0)
 
     return estimate
 

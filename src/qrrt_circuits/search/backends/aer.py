@@ -1,13 +1,16 @@
 """Gate-level Grover search: real Qiskit circuits executed by qiskit-aer's ``AerSimulator``.
 
-Each search builds its circuit once and hands it to ``AerSimulator.run`` with ``shots``,
-``seed_simulator``, ``memory=True`` (the measured word of every shot, in order) and
-``max_parallel_threads``; nothing else of qiskit-aer is used. The circuit
-(``aer_grover_circuit``: Walsh-Hadamard blocks, the oracle as one ``diagonal`` or as ``pauli`` +
-``mcphase`` pairs, one ``mcphase`` per diffuser) uses only instructions Aer executes natively, so
-it is run without a transpile; with a ``noise_model`` the gate-by-gate circuit
+Each search asks its oracle (``search/oracles.py``) for its Grover circuit once and hands it to
+``AerSimulator.run`` with ``shots``, ``seed_simulator``, ``memory=True`` (the measured word of every
+shot, in order) and ``max_parallel_threads``; nothing else of qiskit-aer is used. A lookup oracle's
+circuit (``aer_grover_circuit``: Walsh-Hadamard blocks, the oracle as one ``diagonal`` or as
+``pauli`` + ``mcphase`` pairs, one ``mcphase`` per diffuser) uses only instructions Aer executes
+natively, so it is run without a transpile; with a ``noise_model`` the gate-by-gate circuit
 (``aer_literal_grover_circuit``: h, x, mcphase) is run instead, so per-gate noise acts on the
-paper's gates. Each shot is an independent preparation, k Grover iterations and a measurement.
+paper's gates. With ``method="matrix_product_state"``, which has no multi-controlled gates, the
+gate-by-gate circuit is transpiled to ``AER_BASIC_GATES``. A circuit oracle's Grover circuit is
+transpiled to those gates once per iteration count, whatever the method. Each shot is an
+independent preparation, k Grover iterations and a measurement.
 
 Independent searches (``search_many``) run one after the other: in a multi-circuit run Aer seeds
 circuit i with ``seed_simulator + 2113 i``, so one run cannot give each database its own seed.
@@ -26,8 +29,8 @@ from qiskit_aer import AerSimulator
 
 from ..._support.validation import check_int
 from ..aer_circuits import simulation_synthesis_for
-from ..circuits import aer_grover_circuit, aer_literal_grover_circuit, oracle_cx_estimate
-from ..iterate_sequence import generalized_grover_circuit
+from ..circuits import grover_cx_bound, oracle_cx_estimate
+from ..oracles import CircuitForm
 from ..synthesis import OracleSynthesis
 from .base import QuantumSearchBackend, seed_stream
 
@@ -36,8 +39,9 @@ if TYPE_CHECKING:
     from qiskit_aer.noise import NoiseModel
 
     from ..iterate_sequence import IterateSequence
+    from ..oracles import SearchOracle
 
-METHODS = ("statevector", "automatic")
+METHODS = ("statevector", "automatic", "matrix_product_state")
 #: circuits on fewer qubits run single-threaded (Aer's default statevector_parallel_threshold)
 SERIAL_BELOW_QUBITS = 14
 #: On the GPU, Aer sizes its matrix buffer for a dense matrix on the widest instruction's qubits
@@ -50,15 +54,16 @@ GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS = 14
 UNSUPPORTED_METHODS = {
     "density_matrix": "its instruction set lacks the mcphase gate of aer_grover_circuit (and it "
                       "doubles the qubits); use method='statevector' with a noise_model",
-    "matrix_product_state": "its instruction set lacks the mcphase gate of aer_grover_circuit",
 }
 
 
 class AerBackend(QuantumSearchBackend):
     """Gate-level Grover search (paper Algorithm 2, lines 4-8) on ``AerSimulator(method=...)``.
 
-    Each search builds the Grover circuit of the marks once (``aer_grover_circuit``; with a
-    noise model given here, the gate-by-gate ``aer_literal_grover_circuit``) and runs it through
+    Each search builds the Grover circuit of its oracle once (for a ``LookupOracle``
+    ``aer_grover_circuit``; with a noise model given here, the gate-by-gate
+    ``aer_literal_grover_circuit``; for ``matrix_product_state`` that one transpiled; for a
+    ``CircuitOracle`` its own, transpiled) and runs it through
     ``AerSimulator.run`` with ``shots`` shots and ``memory=True``; a marked index is measured with
     probability sin^2((2k+1) theta), sin^2 theta = m / 2^n (paper Eq. 1, Lemma 1). Every call
     draws a ``seed_simulator`` from its stream, so a plan depends on the planner's seed only.
@@ -67,9 +72,9 @@ class AerBackend(QuantumSearchBackend):
     Args:
         seed: The backend's own stream for ``search`` calls without a seed: a non-negative
             integer, a ``numpy.random.Generator`` (used as is) or None (fresh entropy).
-        method: ``"statevector"`` (default) or ``"automatic"`` (``METHODS``). ``"density_matrix"``
-            and ``"matrix_product_state"`` are refused (``UNSUPPORTED_METHODS``: their
-            instruction sets lack the ``mcphase`` gate of the circuit).
+        method: ``"statevector"`` (default), ``"automatic"`` or ``"matrix_product_state"``
+            (``METHODS``; the last for a circuit oracle with many ancillas, such as the coherent
+            reachability check). ``"density_matrix"`` is refused (``UNSUPPORTED_METHODS``).
         synthesis: The oracle's form: ``"auto"`` (``simulation_synthesis``, or with a noise model
             the CX-based ``choose_synthesis``), ``"diagonal"`` or ``"mcz"`` (``OracleSynthesis``).
         noise_model: A ``qiskit_aer.noise.NoiseModel`` passed to the simulator as is, or None.
@@ -129,7 +134,13 @@ class AerBackend(QuantumSearchBackend):
         )
         self.device = device
         self.max_parallel_threads = int(max_parallel_threads)
-        self._build = aer_grover_circuit if noise_model is None else aer_literal_grover_circuit
+        self._literal = noise_model is not None
+        if method == "matrix_product_state":  # no multi-controlled gates: the circuits are transpiled
+            self._circuit_form = self._sequence_form = CircuitForm.AER_BASIC
+            self._literal = False
+        else:
+            self._circuit_form = CircuitForm.AER_GATES if self._literal else CircuitForm.AER
+            self._sequence_form = CircuitForm.AER_GATES
 
     @property
     def max_qubits(self) -> int:
@@ -153,6 +164,13 @@ class AerBackend(QuantumSearchBackend):
     #: iteration): the circuit's instruction and Aer's operation, with a margin. Below the diagonal
     #: form's bound whenever ``simulation_synthesis`` picks ``mcz`` (f < 2^n / 600)
     AER_BYTES_PER_MCZ_INSTRUCTION = 4096
+    #: what an Aer search adds whatever its size: its result, Aer's thread and simulator buffers
+    FIXED_BYTES = 16 << 20
+    #: ``matrix_product_state`` runs the gate-by-gate circuit transpiled to ``AER_BASIC_GATES``: per CX
+    #: of it (``grover_cx_bound``: the circuit, its transpile and Aer's copy, with the single-qubit
+    #: gates around each CX), and per entry the method's tensors (at most the state's amplitudes twice)
+    MPS_BYTES_PER_CX = 8 << 10
+    MPS_BYTES_PER_ENTRY = 32
 
     def synthesis_for(self, num_qubits: int) -> OracleSynthesis:
         """The ``synthesis`` a circuit on ``num_qubits`` qubits is built with: the constructor's,
@@ -163,11 +181,6 @@ class AerBackend(QuantumSearchBackend):
         if self.synthesis is OracleSynthesis.AUTO and on_gpu and num_qubits > GPU_DIAGONAL_CHOSEN_UP_TO_QUBITS:
             return OracleSynthesis.MCZ
         return self.synthesis
-
-    @property
-    def _literal(self) -> bool:
-        """Whether searches build the gate-by-gate circuit (a noise model at construction)."""
-        return self._build is aer_literal_grover_circuit
 
     def oracle_form(self, num_qubits: int, marked: int) -> OracleSynthesis:
         """The oracle form a search of m = ``marked`` entries among 2^n is built with:
@@ -184,15 +197,18 @@ class AerBackend(QuantumSearchBackend):
         """
         return self._form(num_qubits, marked, self._literal)
 
-    def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1, marked: int | None = None) -> int:
-        """Upper bound of one search's peak memory.
+    def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1, marked: int | None = None, *,
+                   sequence: bool = False) -> int:
+        """Upper bound of one search's peak memory (``QuantumSearchBackend.peak_bytes``).
 
         Args:
             num_qubits: n, the index register's width.
             shots: Measurements of the search.
             iterations: k, the Grover iterations (Aer copies the diagonal oracle's phases once per
-                iteration).
+                iteration), or the generalized iterates of a sequence.
             marked: m (0 .. 2^n), or None (default) for a bound over every m.
+            sequence: Whether the search runs generalized iterates (``search_sequence``: its circuit,
+                ``generalized_grover_circuit``, is built gate by gate, whatever the noise model).
 
         Returns:
             The diagonal form: ``(AER_BYTES_PER_ENTRY + AER_BYTES_PER_ENTRY_PER_ITERATION * k) *
@@ -205,28 +221,22 @@ class AerBackend(QuantumSearchBackend):
             form only where it is the smaller, the CX-based one in the gate-by-gate circuit). Without m,
             the largest estimate over every m (for the gate-by-gate ``"auto"``, the larger of the
             diagonal form's and the mcz form's with m < 2^n / (n - 1): an n-qubit MCZ needs at least
-            n - 1 CX, so the CX-based choice takes the mcz form for no larger m).
+            n - 1 CX, so the CX-based choice takes the mcz form for no larger m). With
+            ``matrix_product_state``: ``MPS_BYTES_PER_ENTRY * 2^n + MPS_BYTES_PER_CX *
+            grover_cx_bound(n, k, m, synthesis_for(n))`` (the gate-by-gate circuit, transpiled). Plus
+            ``FIXED_BYTES``.
 
         Raises:
             ValueError: ``marked`` outside [0, 2^n].
         """
-        return self._peak(num_qubits, shots, iterations, marked, self._literal)
-
-    def sequence_peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1,
-                            marked: int | None = None) -> int:
-        """``peak_bytes`` of a ``search_sequence``: its circuit (``generalized_grover_circuit``) is
-        built gate by gate, whatever the noise model.
-
-        Args:
-            num_qubits: n.
-            shots: Measurements.
-            iterations: The sequence's length.
-            marked: m (0 .. 2^n), or None (default) for a bound over every m.
-
-        Returns:
-            Bytes (see ``peak_bytes``).
-        """
-        return self._peak(num_qubits, shots, iterations, marked, True)
+        if self._circuit_form is CircuitForm.AER_BASIC:
+            if marked is not None:
+                check_int(marked, "marked", 0, 1 << num_qubits)
+            cx = grover_cx_bound(num_qubits, iterations, marked, self.synthesis_for(num_qubits))
+            body = (self.MPS_BYTES_PER_ENTRY << num_qubits) + self.MPS_BYTES_PER_CX * cx + self.BYTES_PER_SHOT * shots
+        else:
+            body = self._peak(num_qubits, shots, iterations, marked, sequence or self._literal)
+        return self.FIXED_BYTES + body
 
     def _peak(self, num_qubits: int, shots: int, iterations: int, marked: int | None, literal: bool) -> int:
         """``peak_bytes`` of the compact (``literal`` False) or the gate-by-gate circuit."""
@@ -304,22 +314,25 @@ class AerBackend(QuantumSearchBackend):
             raise RuntimeError(f"AerSimulator failed: {result.status}")
         return _indices(result.results[0].data.memory)
 
-    def _sample_seeded(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
+    def _sample_seeded(self, oracle: SearchOracle, num_qubits: int, iterations: int, shots: int,
                        seed: int | np.random.Generator | None) -> np.ndarray:
-        """Build the Grover circuit and run it; the simulator seed is the first
+        """The oracle's Grover circuit in this backend's form (``CircuitForm``: Aer-native, gate by
+        gate with a noise model, or transpiled to the gates every method runs for
+        ``matrix_product_state``), run once; the simulator seed is the first
         ``integers(0, 2**31 - 1)`` of the search's generator."""
         seed_simulator = self._first_integer(seed, 2**31 - 1)
-        circuit = self._build(marks, iterations, measure=True, synthesis=self.synthesis_for(num_qubits))
+        circuit = oracle.grover_circuit(iterations, self._circuit_form, self.synthesis_for(num_qubits))
         return self._run(circuit, num_qubits, shots, seed_simulator)
 
-    def _sample(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
+    def _sample(self, oracle: SearchOracle, num_qubits: int, iterations: int, shots: int,
                 rng: np.random.Generator) -> np.ndarray:
-        return self._sample_seeded(marks, num_qubits, iterations, shots, rng)
+        return self._sample_seeded(oracle, num_qubits, iterations, shots, rng)
 
-    def _sample_sequence(self, marks: np.ndarray, num_qubits: int, sequence: IterateSequence, shots: int,
+    def _sample_sequence(self, oracle: SearchOracle, num_qubits: int, sequence: IterateSequence, shots: int,
                          rng: np.random.Generator) -> np.ndarray:
-        """Fixed-point amplification: the generalized iterates of ``sequence`` as one circuit."""
-        circuit = generalized_grover_circuit(marks, sequence, measure=True, synthesis=self.synthesis_for(num_qubits))
+        """Fixed-point amplification: the generalized iterates of ``sequence`` as one circuit
+        (gate by gate; transpiled for ``matrix_product_state``)."""
+        circuit = oracle.sequence_circuit(sequence, self._sequence_form, self.synthesis_for(num_qubits))
         return self._run(circuit, num_qubits, shots, int(rng.integers(0, 2**31 - 1)))
 
 

@@ -6,9 +6,11 @@ plan depends on the planner's seed only. Any other sampler (or an Aer sampler wi
 which then repeats the same draws on every call) seeds itself: ``labels()`` says so, and the
 planners copy that label into their results.
 
-The logical circuit is ``grover_circuit`` (built with ``grover_operator``). It is transpiled by one
-pass manager made once per backend object (``generate_preset_pass_manager``), and each transpiled
-circuit is cached by its shape (marks, iterations), so a repeated search transpiles nothing.
+The logical circuit is the oracle's Grover circuit (``CircuitForm.LOGICAL``: ``grover_circuit`` of a
+lookup oracle's marks, built with ``grover_operator``, or a circuit oracle's). It is transpiled by
+one pass manager made once per backend object (``generate_preset_pass_manager``), and each
+transpiled circuit is cached by its shape (the oracle's ``cache_key``, iterations), so a repeated
+search transpiles nothing.
 """
 
 from __future__ import annotations
@@ -21,8 +23,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from qiskit.transpiler import generate_preset_pass_manager
 
-from ..circuits import BASIS_GATES, grover_circuit
-from ..iterate_sequence import generalized_grover_circuit
+from ..._support.validation import check_int
+from ..circuits import BASIS_GATES, grover_cx_bound
+from ..oracles import CircuitForm
 from ..synthesis import OracleSynthesis
 from .base import QuantumSearchBackend, seed_stream
 
@@ -32,6 +35,7 @@ if TYPE_CHECKING:
     from qiskit.providers import BackendV2
 
     from ..iterate_sequence import IterateSequence
+    from ..oracles import SearchOracle
 
 
 #: held from setting a per-call seed on a sampler to its run's result (samplers may be shared)
@@ -41,7 +45,8 @@ _SEEDED_RUN = threading.Lock()
 class SamplerBackend(QuantumSearchBackend):
     """Grover search (paper Algorithm 2, lines 4-8) through any Qiskit ``BaseSamplerV2``.
 
-    The logical circuit is ``grover_circuit(marks, k)``; it is transpiled once per shape (marks,
+    The logical circuit is the oracle's Grover circuit (``grover_circuit(marks, k)`` for a
+    ``LookupOracle``; a ``CircuitOracle``'s own); it is transpiled once per shape (oracle,
     iterations) by one preset pass manager and cached (least recently used first out).
 
     Seeding: for qiskit-aer's ``SamplerV2`` built without a seed, each search sets the sampler's
@@ -77,11 +82,11 @@ class SamplerBackend(QuantumSearchBackend):
     Example:
         >>> import numpy as np
         >>> from qiskit_aer.primitives import SamplerV2
-        >>> from qrrt_circuits import SamplerBackend
+        >>> from qrrt_circuits import LookupOracle, SamplerBackend
         >>> backend = SamplerBackend(SamplerV2(), seed=0)
         >>> marks = np.zeros(8, dtype=bool)
         >>> marks[5] = True
-        >>> result = backend.search(marks, iterations=2, shots=100, seed=1)
+        >>> result = backend.search(LookupOracle(marks), iterations=2, shots=100, seed=1)
         >>> result.oracle_calls, backend.transpile_count, backend.labels()
         (200, 1, ())
     """
@@ -91,6 +96,12 @@ class SamplerBackend(QuantumSearchBackend):
     #: indices; a calibrated upper bound of the measured peak per shot of qiskit-aer's ``SamplerV2``
     #: (the generic ``QuantumSearchBackend.BYTES_PER_SHOT`` falls far short of it)
     BYTES_PER_SHOT = 400
+    #: per CX of the transpiled circuit (``grover_cx_bound``): the logical circuit, the pass manager's
+    #: DAGs and the transpiled circuit, with the single-qubit gates around each CX (a calibrated
+    #: upper bound: ``benchmarks/memory_peaks.py`` measures 6.5 - 8.5 KiB)
+    BYTES_PER_CX = 10 << 10
+    #: what a search adds whatever its size: the pass manager's passes and the sampler's result
+    FIXED_BYTES = 32 << 20
 
     def __init__(self, sampler: BaseSamplerV2, backend: BackendV2 | None = None, optimization_level: int = 1,
                  synthesis: str | OracleSynthesis = "auto", cache_size: int = 128, max_qubits: int | None = None,
@@ -123,32 +134,59 @@ class SamplerBackend(QuantumSearchBackend):
         """The largest n: the target's qubits (24 without a backend), capped by ``max_qubits``."""
         return self._max_qubits
 
-    def compiled(self, marks: np.ndarray, iterations: int) -> QuantumCircuit:
-        """The transpiled ``grover_circuit(marks, iterations)``, from the cache when present.
+    def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1, marked: int | None = None, *,
+                   sequence: bool = False) -> int:
+        """A bound of one search's peak memory (``QuantumSearchBackend.peak_bytes``): the transpile of
+        its circuit dominates, k oracles of up to 2^n - 2 CX each (a diagonal's).
 
         Args:
-            marks: Validated boolean marks of length 2^n.
+            num_qubits: n, the index register's width.
+            shots: Measurements of the search.
+            iterations: k, or the generalized iterates of a sequence (the same circuit's shape).
+            marked: m, or None (default) for a bound over every m.
+            sequence: Whether the search runs generalized iterates (the same bound).
+
+        Returns:
+            ``FIXED_BYTES + 16 * 2^n + BYTES_PER_CX * grover_cx_bound(n, k, m, synthesis) +
+            BYTES_PER_SHOT * shots`` bytes: the sampler's state, the circuit's CX on an all-to-all
+            device (a device's routing adds swaps this does not count).
+
+        Raises:
+            ValueError: ``marked`` outside [0, 2^n].
+        """
+        if marked is not None:
+            check_int(marked, "marked", 0, 1 << num_qubits)
+        cx = grover_cx_bound(num_qubits, iterations, marked, self.synthesis)
+        return self.FIXED_BYTES + (16 << num_qubits) + self.BYTES_PER_CX * cx + self.BYTES_PER_SHOT * shots
+
+    def compiled(self, oracle: SearchOracle, iterations: int) -> QuantumCircuit:
+        """The oracle's transpiled Grover circuit of ``iterations`` iterations, from the cache when
+        present.
+
+        Args:
+            oracle: The ``SearchOracle``.
             iterations: k, the Grover iterations.
 
         Returns:
             The transpiled, measured ``QuantumCircuit``.
         """
-        key = (marks.shape[0], np.packbits(marks).tobytes(), iterations)
-        return self._cached_transpile(key, lambda: grover_circuit(marks, iterations, synthesis=self.synthesis))
+        key = (oracle.cache_key(), iterations)
+        return self._cached_transpile(
+            key, lambda: oracle.grover_circuit(iterations, CircuitForm.LOGICAL, self.synthesis))
 
-    def compiled_sequence(self, marks: np.ndarray, sequence: IterateSequence) -> QuantumCircuit:
-        """The transpiled ``generalized_grover_circuit`` (cached by marks and phases).
+    def compiled_sequence(self, oracle: SearchOracle, sequence: IterateSequence) -> QuantumCircuit:
+        """The oracle's transpiled generalized Grover circuit (cached by oracle and phases).
 
         Args:
-            marks: Validated boolean marks of length 2^n.
+            oracle: The ``SearchOracle``.
             sequence: The ``IterateSequence``.
 
         Returns:
             The transpiled, measured ``QuantumCircuit``.
         """
-        key = (marks.shape[0], np.packbits(marks).tobytes(), "sequence", sequence.key())
+        key = (oracle.cache_key(), "sequence", sequence.key())
         return self._cached_transpile(
-            key, lambda: generalized_grover_circuit(marks, sequence, synthesis=self.synthesis))
+            key, lambda: oracle.sequence_circuit(sequence, CircuitForm.LOGICAL, self.synthesis))
 
     def _cached_transpile(self, key: tuple[Any, ...], build: Callable[[], QuantumCircuit]) -> QuantumCircuit:
         """The transpiled circuit for ``key`` from the LRU cache, built and transpiled once."""
@@ -175,13 +213,13 @@ class SamplerBackend(QuantumSearchBackend):
         return (f"randomness: the sampler ({type(self.sampler).__name__}) seeds itself, so results "
                 "depend on it and not only on the planner's seed",)
 
-    def _sample(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
+    def _sample(self, oracle: SearchOracle, num_qubits: int, iterations: int, shots: int,
                 rng: np.random.Generator) -> np.ndarray:
-        return self._execute(self.compiled(marks, iterations), shots, rng)
+        return self._execute(self.compiled(oracle, iterations), shots, rng)
 
-    def _sample_sequence(self, marks: np.ndarray, num_qubits: int, sequence: IterateSequence, shots: int,
+    def _sample_sequence(self, oracle: SearchOracle, num_qubits: int, sequence: IterateSequence, shots: int,
                          rng: np.random.Generator) -> np.ndarray:
-        return self._execute(self.compiled_sequence(marks, sequence), shots, rng)
+        return self._execute(self.compiled_sequence(oracle, sequence), shots, rng)
 
     def _execute(self, circuit: QuantumCircuit, shots: int, rng: np.random.Generator) -> np.ndarray:
         if self.per_call_seed:

@@ -4,7 +4,9 @@ Starting from the uniform state, k Grover iterations leave every marked index wi
 sin((2k+1)theta)/sqrt(m) and every unmarked one with cos((2k+1)theta)/sqrt(N-m), where
 sin^2 theta = m/N (Boyer, Brassard, Hoyer, Tapp 1998). Sampling uses this closed form (fast path,
 O(N) only to list the marked indices); ``amplitudes`` runs the O(N)-per-iteration statevector
-update, which the tests check against the closed form.
+update, which the tests check against the closed form. Both need the oracle's marks: the backend
+searches a ``LookupOracle`` and refuses a ``CircuitOracle`` (its circuit must be simulated gate by
+gate, by Aer or a sampler).
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from .base import QuantumSearchBackend
 
 if TYPE_CHECKING:
     from ..iterate_sequence import IterateSequence
+    from ..oracles import SearchOracle
 
 BYTES_PER_ENTRY = 32  # amplitudes (8) + probabilities (8) + index lists (8) + marks, with slack
 
@@ -81,25 +84,34 @@ class StatevectorBackend(QuantumSearchBackend):
 
     #: per shot: the uniform draws, the good/unmarked split, the ranks and the measured indices
     BYTES_PER_SHOT = 64
+    #: generalized iterates on the iterated vector: the complex128 state, its update temporaries
+    #: and the probabilities with their cumulative sum
+    SEQUENCE_BYTES_PER_ENTRY = 80
 
-    def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1, marked: int | None = None) -> int:
-        """Upper bound of one search's peak memory.
+    def peak_bytes(self, num_qubits: int, shots: int = 1, iterations: int = 1, marked: int | None = None, *,
+                   sequence: bool = False) -> int:
+        """Upper bound of one search's peak memory (``QuantumSearchBackend.peak_bytes``).
 
         Closed form: the marked indices and their rank table (at most 8 + 16 bytes per entry
         when every entry is marked). ``closed_form=False``: the state, its update temporaries,
-        the probabilities and their cumulative sum (5 float64 arrays).
+        the probabilities and their cumulative sum (5 float64 arrays); for generalized iterates the
+        state is complex (``SEQUENCE_BYTES_PER_ENTRY``).
 
         Args:
             num_qubits: n, the index register's width.
             shots: Measurements of the search.
             iterations: k (unused: the footprint does not grow with k).
             marked: m (unused: the bound holds for every m).
+            sequence: Whether the search runs generalized iterates.
 
         Returns:
-            ``(24 or 40) * 2^n + BYTES_PER_SHOT * shots`` bytes.
+            ``FIXED_BYTES + (24, 40 or SEQUENCE_BYTES_PER_ENTRY) * 2^n + BYTES_PER_SHOT * shots`` bytes.
         """
-        per_entry = 24 if self.closed_form else 40
-        return (per_entry << num_qubits) + self.BYTES_PER_SHOT * shots
+        if self.closed_form:
+            per_entry = 24
+        else:
+            per_entry = self.SEQUENCE_BYTES_PER_ENTRY if sequence else 40
+        return self.FIXED_BYTES + (per_entry << num_qubits) + self.BYTES_PER_SHOT * shots
 
     @staticmethod
     def amplitudes(marks: np.ndarray, iterations: int) -> np.ndarray:
@@ -127,17 +139,21 @@ class StatevectorBackend(QuantumSearchBackend):
             state = 2.0 * state.mean() - state
         return state
 
-    def _sample(self, marks: np.ndarray, num_qubits: int, iterations: int, shots: int,
+    def _sample(self, oracle: SearchOracle, num_qubits: int, iterations: int, shots: int,
                 rng: np.random.Generator) -> np.ndarray:
+        """The lookup oracle's marks, sampled in closed form or from the iterated vector (a circuit
+        oracle is refused: ``SearchOracle.lookup_marks``)."""
+        marks = oracle.lookup_marks(f"the {self.name} backend")
         if not self.closed_form:
             return _draw(self.amplitudes(marks, iterations) ** 2, shots, rng)
         p_good = good_probability(marks.shape[0], int(np.count_nonzero(marks)), iterations)
         return _draw_two_level(marks, p_good, shots, rng)
 
-    def _sample_sequence(self, marks: np.ndarray, num_qubits: int, sequence: IterateSequence, shots: int,
+    def _sample_sequence(self, oracle: SearchOracle, num_qubits: int, sequence: IterateSequence, shots: int,
                          rng: np.random.Generator) -> np.ndarray:
         """Generalized iterates: the exact 2-dimensional evolution (closed form; every marked index
         keeps the same amplitude) or, with ``closed_form=False``, the full iterated vector."""
+        marks = oracle.lookup_marks(f"the {self.name} backend")
         if not self.closed_form:
             return _draw(np.abs(statevector_after(marks, sequence)) ** 2, shots, rng)
         num_marked = int(np.count_nonzero(marks))

@@ -31,7 +31,6 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 
 from ...probability import optimal_iterations
-from ..backends.base import QuantumSearchBackend
 from ..problem import DatabaseSearch, SearchOutcome
 from ..requests import validate_iterations
 
@@ -48,15 +47,17 @@ class IterationPolicy:
 
     The class attribute ``uses_true_m`` is True if the policy reads the database's true marked
     count m (simulation knowledge a quantum device does not have, labelled in every output that
-    depends on it); ``name`` is the policy's short name.
+    depends on it); ``name`` is the policy's short name. A plan's memory check sizes the policy by
+    numbers it reports: its largest search (``iterations_bound``, ``runs_sequences``) and its
+    state (``state_bytes``).
 
     Example:
         >>> import numpy as np
-        >>> from qrrt_circuits import DatabaseSearch, KnownOptimal, PaperIterations, StatevectorBackend
+        >>> from qrrt_circuits import DatabaseSearch, KnownOptimal, LookupOracle, PaperIterations, StatevectorBackend
         >>> from qrrt_circuits._support.randomness import RandomStreams
         >>> marks = np.zeros(64, dtype=bool)
         >>> marks[:2] = True
-        >>> problem = DatabaseSearch(marks, marks, StatevectorBackend(seed=0), RandomStreams(0), 0)
+        >>> problem = DatabaseSearch(LookupOracle(marks), marks, StatevectorBackend(seed=0), RandomStreams(0), 0)
         >>> PaperIterations().iterations_for(problem, 0), PaperIterations().iterations_for(problem, 11)
         (5, 3)
         >>> KnownOptimal().iterations_for(problem, 0)  # floor(pi / (4 asin(sqrt(2/64))))
@@ -65,6 +66,9 @@ class IterationPolicy:
 
     uses_true_m: bool = False
     name: str = "policy"
+    #: whether the policy's searches run generalized iterates (``search_sequence``) rather than Grover
+    #: iterations: a plan sizes its largest search as such a sequence of ``iterations_bound(N)`` iterates
+    runs_sequences: bool = False
 
     def start(self, num_items: int) -> PolicyState:
         """The mutable per-plan state of this policy.
@@ -98,7 +102,8 @@ class IterationPolicy:
         return self._iterations(problem.num_items, tree_nodes, None)
 
     def iterations_bound(self, num_items: int) -> int:
-        """The most Grover iterations one search (one circuit) of this policy can run.
+        """The most Grover iterations (or generalized iterates, ``runs_sequences``) one search (one
+        circuit) of this policy can run.
 
         The memory guard sizes a search by it.
 
@@ -120,21 +125,6 @@ class IterationPolicy:
             The bytes (0 by default).
         """
         return 0
-
-    def search_peak_bytes(self, backend: QuantumSearchBackend, num_qubits: int, shots: int) -> int:
-        """The backend's peak for the largest search of one database this policy runs (a plan's
-        memory check counts it; the plan's searches make no check of their own).
-
-        Args:
-            backend: The plan's ``QuantumSearchBackend``.
-            num_qubits: n, the database's qubits.
-            shots: The shots of one search (p workers on a shared database).
-
-        Returns:
-            By default ``backend.peak_bytes(n, shots, iterations_bound(2^n))``, a bound over every
-            marked count.
-        """
-        return backend.peak_bytes(num_qubits, shots, self.iterations_bound(1 << num_qubits))
 
     def _iterations(self, num_items: int, tree_nodes: int, num_marked: int | None) -> int:
         raise NotImplementedError

@@ -54,11 +54,11 @@ class EstimatedOptimal(IterationPolicy):
 
     Example:
         >>> import numpy as np
-        >>> from qrrt_circuits import DatabaseSearch, EstimatedOptimal, StatevectorBackend
+        >>> from qrrt_circuits import DatabaseSearch, EstimatedOptimal, LookupOracle, StatevectorBackend
         >>> from qrrt_circuits._support.randomness import RandomStreams
         >>> marks = np.zeros(16, dtype=bool)
         >>> marks[[1, 5, 9, 13]] = True
-        >>> problem = DatabaseSearch(marks, marks, StatevectorBackend(seed=0), RandomStreams(0), 0)
+        >>> problem = DatabaseSearch(LookupOracle(marks), marks, StatevectorBackend(seed=0), RandomStreams(0), 0)
         >>> estimate = EstimatedOptimal(shots=64).estimate(problem)
         >>> estimate.powers, estimate.oracle_calls  # 64 shots x (1 + 2 + 3 + 5) calls
         ((0, 1, 2, 4), 704)
@@ -91,16 +91,18 @@ class EstimatedOptimal(IterationPolicy):
         Seeded from the policy stream of the database's first worker.
 
         Args:
-            problem: The database search (its marks define the good states).
+            problem: The database search (its lookup oracle's marks define the good states).
 
         Returns:
             The ``AmplitudeEstimate`` (estimate, interval and the quantum oracle calls it cost).
 
         Raises:
+            ValueError: A database whose oracle is not a lookup (a ``CircuitOracle``).
             RuntimeError: IAE running more than ``MAX_IAE_ROUNDS`` circuits, or an oracle-query
                 count that disagrees with qiskit-algorithms' (``estimate_marked_fraction``).
         """
-        return estimate_marked_fraction(problem.marks, alpha=self.alpha, shots=self.shots,
+        marks = problem.oracle.lookup_marks("EstimatedOptimal's amplitude estimation")
+        return estimate_marked_fraction(marks, alpha=self.alpha, shots=self.shots,
                                         rng=problem.worker_generator(0), method=self.method,
                                         schedule=self.schedule, epsilon=self.epsilon)
 

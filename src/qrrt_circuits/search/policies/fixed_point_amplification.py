@@ -17,7 +17,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..backends.base import QuantumSearchBackend
 from ..iterate_sequence import (
     LENGTH_RULES,
     IterateSequence,
@@ -68,6 +67,7 @@ class FixedPointAmplification(IterationPolicy):
     min_fraction: float = 0.05
     length_rule: str = "paper"
     name = "fixed-point"
+    runs_sequences = True
 
     def __post_init__(self) -> None:
         check_delta(self.delta)
@@ -109,19 +109,9 @@ class FixedPointAmplification(IterationPolicy):
     def _iterations(self, num_items: int, tree_nodes: int, num_marked: int | None) -> int:
         return self.iterates
 
-    def search_peak_bytes(self, backend: QuantumSearchBackend, num_qubits: int, shots: int) -> int:
-        """The backend's peak for one ``search_sequence`` of the l iterates
-        (``backend.sequence_peak_bytes``, a bound over every marked count).
-
-        Args:
-            backend: The plan's ``QuantumSearchBackend``.
-            num_qubits: n, the database's qubits.
-            shots: The shots of one search.
-
-        Returns:
-            Bytes.
-        """
-        return backend.sequence_peak_bytes(num_qubits, shots, self.iterates)
+    def iterations_bound(self, num_items: int) -> int:
+        """l, the generalized iterates of every search (``runs_sequences``)."""
+        return self.iterates
 
     def start(self, num_items: int) -> FixedPointState:
         return FixedPointState(self, num_items)
