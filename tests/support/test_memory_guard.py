@@ -3,6 +3,7 @@ refused by one check before anything large is allocated, naming the size, the es
 available memory (the smallest of MemAvailable, the control groups' room and the address space
 left under RLIMIT_AS) and the largest size that fits; a MemoryError while one runs is one line."""
 
+import functools
 import re
 import resource
 import subprocess
@@ -34,8 +35,7 @@ def small_memory(monkeypatch):
 
 def _plan_total(planner, num_qubits, max_rounds=1):
     """The plan's estimate (its round and its tree and history) at ``max_rounds`` and n."""
-    return memory.PlanSize(10**6, planner._max_new_nodes_per_round(),
-                           max_rounds, planner.env.dim, planner.memory_estimate,
+    return memory.PlanSize(10**6, planner.workers, max_rounds, 2, functools.partial(planner.memory_estimate, dim=2),
                            num_qubits).estimate().total_bytes
 
 
@@ -120,12 +120,13 @@ class Nowhere:  # a predicate that costs nothing: the round's memory is its data
         return np.zeros(len(children), dtype=bool)
 
 env = qc.paper_clutter(seed=0)
+problem = env.replace(predicate=Nowhere())
 def planner(n, workers):
     return qc.PQRRT(backend=qc.StatevectorBackend(0), num_qubits=n, workers=workers, shared_database=False,
-                    search_policy=qc.FixedIterations(1), seed=0, predicate=Nowhere())
-planner(8, 2).plan(max_rounds=1)  # compiled code loaded before the measurement
+                    search_policy=qc.FixedIterations(1), seed=0)
+planner(8, 2).plan(problem, max_rounds=1)  # compiled code loaded before the measurement
 big = planner(20, int(sys.argv[1]))
-print(added_peak(lambda: big.plan(max_rounds=1)), big.memory_estimate(dim=2).total_bytes)
+print(added_peak(lambda: big.plan(problem, max_rounds=1)), big.memory_estimate(dim=2).total_bytes)
 """
 
 
@@ -254,13 +255,13 @@ def test_issue_reproductions_on_this_machine(env, argv_backend, qubits, planner)
     """The issue's two runs, with this machine's real available memory: refused when their estimate
     exceeds it (skipped on a machine that has the memory: they then run, as they should)."""
     backend = qc.StatevectorBackend(0) if argv_backend == "statevector" else qc.AerBackend(0)
-    estimate = planner(env, backend=backend, num_qubits=12, seed=0).memory_estimate(qubits, dim=2)
+    estimate = planner(backend=backend, num_qubits=12, seed=0).memory_estimate(qubits, dim=2)
     available = probe.available_memory_bytes()
     if available is None or estimate.total_bytes <= available:
         pytest.skip(f"this machine has {available} bytes available, enough for the estimated "
                     f"{estimate.total_bytes}")
     with pytest.raises(ValueError, match=f"num_qubits = {qubits}: this plan could need about"):
-        planner(env, backend=backend, num_qubits=qubits, seed=0).plan(max_rounds=1)
+        planner(backend=backend, num_qubits=qubits, seed=0).plan(env, max_rounds=1)
 
 
 def test_available_memory_reads_meminfo():
@@ -307,7 +308,8 @@ for axis in range(dim):  # a wall around the corner cube [16, 20]^d: the goal (1
 env = qc.Environment(np.array([[0.0, 20.0]] * dim), np.array(boxes))
 dynamics = None if dim == 2 else qc.LinearTrackingDynamics(-np.eye(dim), np.eye(dim), np.eye(dim))
 def plan(workers, **limits):
-    return qc.ParallelRRT(workers=workers, seed=0, dynamics=dynamics).plan(posed(env, start=np.full(dim, 2.0), goal=np.full(dim, 18.0), goal_radius=0.5), **limits)
+    problem = qc.Problem.build(env, np.full(dim, 2.0), np.full(dim, 18.0), 0.5, dynamics=dynamics)
+    return qc.ParallelRRT(workers=workers, seed=0).plan(problem, **limits)
 plan(8, max_rounds=3)  # compiled code loaded before the measurement,
 plan(64, max_nodes=1000)  # the nearest-node grid's too (from 400 nodes): compiled inside it on a cold cache
 results = []
@@ -558,7 +560,7 @@ def counted_reads(monkeypatch):
     lambda env: qc.RRT(seed=0),
 ], ids=["qrrt", "pqrrt-unshared-aer", "bbht", "fixed-point-aer", "rrt"])
 def test_a_plan_reads_the_available_memory_once_whatever_its_rounds(env, counted_reads, make_planner):
-    result = make_planner(env).plan(max_rounds=12)
+    result = make_planner(env).plan(env, max_rounds=12)
     assert result.metrics.rounds >= 1 and len(counted_reads) == 1
 
 
@@ -580,14 +582,14 @@ def test_the_plan_check_counts_the_round_the_tree_and_the_history_together(env):
     """Each part alone fits where the sum does not: the plan's one check refuses the sum, naming the
     larger part (here the tree's node limit)."""
     planner = qc.PQRRT(backend=qc.StatevectorBackend(0), num_qubits=20, workers=8, seed=0)
-    size = memory.PlanSize(2_000_000, 8, 10**6, 2, planner.memory_estimate, 20)
+    size = memory.PlanSize(2_000_000, 8, 10**6, 2, functools.partial(planner.memory_estimate, dim=2), 20)
     estimate = size.estimate()
     available = estimate.total_bytes - 1
     assert estimate.round_bytes < available and estimate.limits_bytes < available
     with pytest.raises(ValueError, match=r"max_nodes = 2000000: this plan could need about .*database build .*tree "
                                          r".*round history .*; the largest max_nodes that fits is about \d+"):
         size.check(available)
-    small_round = memory.PlanSize(1000, 8, 20000, 2, planner.memory_estimate, 26)
+    small_round = memory.PlanSize(1000, 8, 20000, 2, functools.partial(planner.memory_estimate, dim=2), 26)
     with pytest.raises(ValueError, match=r"num_qubits = 26: .*the largest num_qubits that fits is 2[0-5]"):
         small_round.check(1 << 30)
 
@@ -596,7 +598,8 @@ def test_the_fixed_point_policy_is_sized_by_its_sequence_circuit(env):
     planner = qc.QRRT(backend=qc.AerBackend(0), num_qubits=16, seed=0,
                       search_policy=qc.FixedPointAmplification())
     policy = planner.search_policy
-    assert planner.memory_estimate(dim=2).search_bytes == planner.backend.peak_bytes(16, 1, policy.iterates, sequence=True)
+    expected = planner.backend.peak_bytes(16, 1, policy.iterates, sequence=True)
+    assert planner.memory_estimate(dim=2).search_bytes == expected
 
 
 # ------------------------------------------------------------------ what is available: RLIMIT_AS
@@ -792,7 +795,7 @@ import qrrt_circuits as qc
 from qrrt_circuits import cli
 from qrrt_circuits._support import memory
 
-def short(self, num_qubits=None):  # an estimate that falls short: 16 bytes an entry
+def short(self, num_qubits=None, *, dim):  # an estimate that falls short: 16 bytes an entry
     n = self.num_qubits if num_qubits is None else num_qubits
     return memory.MemoryEstimate(n, database_bytes=16 << n)
 
