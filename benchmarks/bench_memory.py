@@ -124,22 +124,25 @@ def run_plan_limits_case(kind: str, dim: int, limit: int) -> dict:
 
     env, walled_in, outside = _walled_world(dim, 18.0)
     dynamics = None if dim == 2 else qc.LinearTrackingDynamics(-np.eye(dim), np.eye(dim), np.eye(dim))
+    from qrrt_circuits.planners.termination import DEFAULT_MAX_NODES
+
+    toward_wall = qc.Problem.build(env, outside, walled_in, 0.5, dynamics=dynamics)
+    from_wall = qc.Problem.build(env, walled_in, outside, 0.5, dynamics=dynamics)
     if kind == "tree":  # 4 096 workers fill the world outside the wall; the goal is unreachable
-        planner = qc.ParallelRRT(workers=4096, seed=0, dynamics=dynamics)
-        qc.ParallelRRT(workers=8, seed=0, dynamics=dynamics).plan(env, outside, walled_in, 0.5, max_rounds=3)
+        planner = qc.ParallelRRT(workers=4096, seed=0)
+        qc.ParallelRRT(workers=8, seed=0).plan(toward_wall, max_rounds=3)
         base = _rss()
         began = time.perf_counter()
-        result = planner.plan(env, outside, walled_in, 0.5, max_nodes=limit)
+        result = planner.plan(toward_wall, max_nodes=limit)
         nodes_per_round, rounds = 4096, result.metrics.rounds
     else:  # RRT rounds from a walled-in start: nodes only inside the small walled cube, the history grows
-        planner = qc.RRT(seed=0, dynamics=dynamics)
-        planner.plan(env, walled_in, outside, 0.5, max_rounds=3)  # warm up
+        planner = qc.RRT(seed=0)
+        planner.plan(from_wall, max_rounds=3)  # warm up
         base = _rss()
         began = time.perf_counter()
-        result = planner.plan(env, walled_in, outside, 0.5, max_rounds=limit, stall_rounds=limit)
+        result = planner.plan(from_wall, max_rounds=limit, stall_rounds=limit)
         nodes_per_round, rounds = 1, limit
-    tree, history = plan_bytes(limit if kind == "tree" else qc.termination.DEFAULT_MAX_NODES, nodes_per_round,
-                               rounds, dim)
+    tree, history = plan_bytes(limit if kind == "tree" else DEFAULT_MAX_NODES, nodes_per_round, rounds, dim)
     seconds = time.perf_counter() - began
     measured = _peak() - base
     return {"case": f"plan-{kind}", "seconds": round(seconds, 2), "dim": dim, "num_qubits": 0, "limit": limit,
@@ -179,17 +182,16 @@ def run_plan_batch_case(check: str, dim: int, rounds: int) -> dict:
     from qrrt_circuits.planners import classical
 
     if check == "nowhere":
-        env, start, goal = qc.Environment(np.array([[0.0, 20.0]] * dim), np.zeros((0, 2, dim))), None, None
-        options: dict = {"predicate": _Nowhere(dim)}
-        start, goal = np.full(dim, 2.0), np.full(dim, 18.0)
+        env = qc.Environment(np.array([[0.0, 20.0]] * dim), np.zeros((0, 2, dim)))
+        problem = qc.Problem.build(env, np.full(dim, 2.0), np.full(dim, 18.0), 0.5, predicate=_Nowhere(dim))
     else:
         env, start, goal = _walled_world(dim, 18.0)
-        options = {"dynamics": None if dim == 2 else qc.LinearTrackingDynamics(-np.eye(dim), np.eye(dim), np.eye(dim))}
-    qc.ParallelRRT(workers=8, seed=0, **options).plan(env, start, goal, 0.5, max_rounds=3)
+        dynamics = None if dim == 2 else qc.LinearTrackingDynamics(-np.eye(dim), np.eye(dim), np.eye(dim))
+        problem = qc.Problem.build(env, start, goal, 0.5, dynamics=dynamics)
+    qc.ParallelRRT(workers=8, seed=0).plan(problem, max_rounds=3)
     base = _rss()
     began = time.perf_counter()
-    result = qc.ParallelRRT(workers=4096, seed=0, **options).plan(env, start, goal, 0.5, max_rounds=rounds,
-                                                                      stall_rounds=rounds)
+    result = qc.ParallelRRT(workers=4096, seed=0).plan(problem, max_rounds=rounds, stall_rounds=rounds)
     seconds = time.perf_counter() - began
     measured = _peak() - base
     candidates = classical.batch_round_limit(4096, dim) * 4096
@@ -213,7 +215,7 @@ def run_output_case(how: str, nodes: int) -> dict:
     import qrrt_circuits as qc
 
     env, walled_in, outside = _walled_world(2, 18.0)
-    result = qc.ParallelRRT(workers=4096, seed=0).plan(env, outside, walled_in, 0.5, max_nodes=nodes)
+    result = qc.ParallelRRT(workers=4096, seed=0).plan(qc.Problem.build(env, outside, walled_in, 0.5), max_nodes=nodes)
     with open("/proc/self/clear_refs", "w") as handle:  # the peak from here on (Linux)
         handle.write("5")
     base = _rss()

@@ -123,13 +123,20 @@ class PartTimer:
         self._patched.clear()
 
 
+def _timed(problem, big: bool):
+    """The problem with a timed exact check (and, for the big trees, an unreachable goal)."""
+    predicate = TimedPredicate(qc.ExactCheck(problem.env))
+    posed = problem.replace(predicate=predicate)
+    return (posed.with_goal_radius(1e-9) if big else posed), predicate
+
+
 def breakdown(make, env, seed: int, nodes: int, big: bool) -> dict:
     """Microseconds per round in the predicate, the nearest-node queries, the candidate draws, the
     backend search and the rest, for one plan (the wrappers add about a microsecond per call)."""
-    predicate = TimedPredicate(qc.ExactCheck(env))
-    planner = make(env, seed, predicate)
+    problem, predicate = _timed(env, big)
+    planner = make(seed)
     with PartTimer() as parts:
-        result = planner.plan(max_nodes=nodes, goal_radius=1e-9) if big else planner.plan(max_nodes=nodes)
+        result = planner.plan(problem, max_nodes=nodes)
     rounds = max(result.metrics.rounds, 1)
     wall = result.metrics.wall_time_s
     per_round = {"predicate": predicate.seconds, **parts.seconds}
@@ -149,13 +156,12 @@ BREAKDOWN = tuple((label, label, big, {})
 
 
 def configurations(**options):
-    """label -> planner factory (env, seed, predicate), every planner built through the registry
-    (``options`` go to the quantum planners)."""
+    """label -> planner factory (seed), every planner built through the registry (``options`` go
+    to the quantum planners)."""
     from qrrt_circuits.experiments.planners import make_planner
 
     def factory(planner, backend, policy, extra):
-        return lambda env, seed, predicate: make_planner(planner, env, seed, backend or "statevector",
-                                                         search_policy=policy, predicate=predicate, **extra)
+        return lambda seed: make_planner(planner, seed, backend or "statevector", search_policy=policy, **extra)
 
     return {label: factory(planner, backend, policy, options if backend else {})
             for label, planner, backend, policy in CONFIGURATIONS}
@@ -168,9 +174,8 @@ def summarize(values: list[float]) -> dict:
 
 
 def run_one(make, env, seed: int, nodes: int, big: bool) -> dict:
-    predicate = TimedPredicate(qc.ExactCheck(env))
-    planner = make(env, seed, predicate)
-    result = planner.plan(max_nodes=nodes, goal_radius=1e-9) if big else planner.plan(max_nodes=nodes)
+    problem, predicate = _timed(env, big)
+    result = make(seed).plan(problem, max_nodes=nodes)
     m = result.metrics
     count = max(m.nodes, 1)
     other_s = max(m.wall_time_s - predicate.seconds, 0.0)
@@ -275,7 +280,7 @@ def main() -> None:
               f"{t['median']:7.3f} [{t['p10']:5.2f},{t['p90']:6.2f}] {row['oracle_share']['median']:7.2f} "
               f"{row['other_us_per_round']['median']:12.1f} {row['reached_fraction']:8.2f}")
         if name == "RRT" and with_ompl:  # side by side, right after ours
-            ompl_runs = [run_ompl_rrt(env, env.start, env.goal, env.goal_radius, nodes, seed)
+            ompl_runs = [run_ompl_rrt(env.env, env.start, env.goal.centre, env.goal.radius, nodes, seed)
                          for seed, env in enumerate(worlds)]
             ompl_rows = {"runs": ompl_runs, "ms_per_node": summarize([r["ms_per_node"] for r in ompl_runs])}
             t = ompl_rows["ms_per_node"]

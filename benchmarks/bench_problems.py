@@ -62,13 +62,12 @@ def run_library(family: str, planner: str, seed: int) -> dict[str, float]:
     problem = build_problem(family, 0)
     spent = timed(problem)
     if planner == "rrt":
-        plan = qc.RRT(goal_bias=0.05, max_extension=ompl_range(problem), look_ahead=False, seed=seed,
-                      **problem.planner_options())
+        plan = qc.RRT(goal_bias=0.05, max_extension=ompl_range(problem), look_ahead=False, seed=seed)
     else:
         plan = qc.QRRT(backend=qc.StatevectorBackend(seed=seed), search_policy=qc.Adaptive(),
-                       goal_bias=0.05, seed=seed, **problem.planner_options())
+                       goal_bias=0.05, seed=seed)
     began = time.perf_counter()
-    result = plan.plan(problem.env, goal=problem.goal, max_oracle_calls=BUDGET)
+    result = plan.plan(problem, max_oracle_calls=BUDGET)
     wall = time.perf_counter() - began
     return {"wall_s": wall, "check_s": spent[0], "checks": result.metrics.oracle_calls,
             "nodes": result.metrics.nodes, "reached": float(result.reached)}

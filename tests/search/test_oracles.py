@@ -19,8 +19,9 @@ from qrrt_circuits.probability import optimal_iterations, success_probability
 from qrrt_circuits.search.iterate_sequence import IterateSequence
 
 BOXES = np.array([[[0.0, 0.0], [20.0, 7.0]], [[0.0, 13.0], [20.0, 20.0]], [[9.0, 9.0], [11.0, 11.0]]])
-CORRIDOR = qc.Environment(np.array([[0.0, 20.0], [0.0, 20.0]]), BOXES, start=[2.0, 10.0], goal=[18.0, 10.0],
-                          goal_radius=2.5)
+CORRIDOR_PROBLEM = qc.Problem.build(qc.Environment(np.array([[0.0, 20.0], [0.0, 20.0]]), BOXES), [2.0, 10.0],
+                                    [18.0, 10.0], 2.5)
+CORRIDOR = CORRIDOR_PROBLEM.env
 
 
 def phase_flip_circuit(marks: np.ndarray, ancillas: int = 0):
@@ -189,11 +190,11 @@ def test_lattice_plans_search_the_coherent_oracle_on_the_planners_backend():
     matrix-product-state method it plans, and on the statevector backend the first search is
     refused with the message that names what runs it."""
     database = qc.LatticeCandidates(3, bits=6, coherent=True)
-    planner = qc.QRRT(CORRIDOR, backend=qc.AerBackend(seed=0, method="matrix_product_state"), num_qubits=7, seed=1,
+    planner = qc.QRRT(backend=qc.AerBackend(seed=0, method="matrix_product_state"), num_qubits=7, seed=1,
                       database=database)
-    result = planner.plan(max_oracle_calls=60)
+    result = planner.plan(CORRIDOR_PROBLEM, max_oracle_calls=60)
     assert result.metrics.quantum_oracle_calls > 0
     assert "method=matrix_product_state" in result.settings["backend"]
-    refused = qc.QRRT(CORRIDOR, backend=qc.StatevectorBackend(seed=0), num_qubits=7, seed=1, database=database)
+    refused = qc.QRRT(backend=qc.StatevectorBackend(seed=0), num_qubits=7, seed=1, database=database)
     with pytest.raises(ValueError, match="cannot simulate a circuit oracle"):
-        refused.plan(max_oracle_calls=60)
+        refused.plan(CORRIDOR_PROBLEM, max_oracle_calls=60)
