@@ -1,7 +1,7 @@
 """What a Grover search searches: its phase oracle, a part of the search problem, not of the backend.
 
-A backend's ``search(oracle, iterations, shots, seed)`` prepares W|0> = H^n|0> on the oracle's n
-index qubits, applies k Grover iterations Q = (2|s><s| - I) O, O the oracle, and measures the
+A backend's ``search(oracle, iterations, shots, seed)`` prepares ``W|0> = H^n|0>`` on the
+oracle's n index qubits, applies k Grover iterations Q = (``2|s><s|`` - I) O, O the oracle, and measures the
 index register; a marked index comes out with probability sin^2((2k+1) theta), sin^2 theta = m / 2^n
 (paper Eq. 1, Lemma 1), whichever oracle it is:
 
@@ -9,8 +9,8 @@ index register; a marked index comes out with probability sin^2((2k+1) theta), s
   2^n marks. This is the paper's simulation shortcut: the marks come from evaluating the predicate
   on every entry (a plan reports that work as ``simulation_checks`` and labels its results).
   Every backend searches it: the statevector backend in closed form, Aer and a sampler as circuits.
-- ``CircuitOracle(circuit, index_qubits)``: a phase-oracle circuit: on |i>|0...0> it gives
-  (-1)^f(i) |i>|0...0>, its ancillas starting and ending in |0> (the coherent reversible
+- ``CircuitOracle(circuit, index_qubits)``: a phase-oracle circuit: on ``|i>|0...0>`` it gives
+  (-1)^f(i) ``|i>|0...0>``, its ancillas starting and ending in ``|0>`` (the coherent reversible
   reachability check of ``qrrt_circuits.coherent``, or a user's circuit). The backends that run
   circuits search it: Aer (``matrix_product_state`` for an oracle with many ancillas, or any other
   method) and a sampler. The statevector backend's closed form needs the marks; it refuses one.
@@ -99,7 +99,7 @@ class SearchOracle(abc.ABC):
     @abc.abstractmethod
     def grover_circuit(self, iterations: int, form: CircuitForm,
                        synthesis: OracleSynthesis = OracleSynthesis.AUTO) -> QuantumCircuit:
-        """W|0>, k Grover iterations with this oracle and the measurement of the index, in ``form``.
+        """``W|0>``, k Grover iterations with this oracle and the measurement of the index, in ``form``.
 
         Args:
             iterations: k (validated by the caller).
@@ -113,7 +113,7 @@ class SearchOracle(abc.ABC):
     @abc.abstractmethod
     def sequence_circuit(self, sequence: IterateSequence, form: CircuitForm,
                          synthesis: OracleSynthesis = OracleSynthesis.AUTO) -> QuantumCircuit:
-        """W|0>, the generalized iterates of ``sequence`` and the measurement of the index.
+        """``W|0>``, the generalized iterates of ``sequence`` and the measurement of the index.
 
         Raises:
             ValueError: An oracle that cannot give the phase e^{i beta} its iterates need.
@@ -152,7 +152,7 @@ class LookupOracle(SearchOracle):
     simulation shortcut; module docstring).
 
     Args:
-        marks: Boolean (or 0/1) array of length 2^n, n >= 1; entry i marks basis state |i>.
+        marks: Boolean (or 0/1) array of length 2^n, n >= 1; entry i marks basis state ``|i>``.
 
     Attributes:
         marks: The marks as a bool array (the caller's own where it was one: not copied, so not to be
@@ -223,16 +223,16 @@ class LookupOracle(SearchOracle):
 
 
 class CircuitOracle(SearchOracle):
-    """A phase-oracle circuit: (-1)^f(i) on |i>, its ancillas starting and ending in |0> (module
+    """A phase-oracle circuit: (-1)^f(i) on ``|i>``, its ancillas starting and ending in ``|0>`` (module
     docstring).
 
     Its Grover circuit is W = H^n on the index qubits, then k times the oracle followed by the
-    reflection about W|0> on the index qubits only (``grover_operator`` with ``reflection_qubits``),
+    reflection about ``W|0>`` on the index qubits only (``grover_operator`` with ``reflection_qubits``),
     then the index measured into ``meas``; the ancillas are never touched between oracle calls. For
     Aer it is transpiled to ``AER_BASIC_GATES`` once per iteration count and kept.
 
     Args:
-        circuit: A ``QuantumCircuit`` without classical bits acting on |i>|0...0> as the phase oracle.
+        circuit: A ``QuantumCircuit`` without classical bits acting on ``|i>|0...0>`` as the phase oracle.
         index_qubits: The index register: n (the circuit's first n qubits, qubit j index bit j), or
             the n distinct qubit positions of index bits 0, 1, ..., n - 1.
         marks: The 2^n marks the circuit computes, where known (simulation knowledge: ``KnownOptimal``
