@@ -321,8 +321,8 @@ def _planners() -> Registry:
 
 
 # ----------------------------------------------------------------------------------------- backends
-def _aer(seed: int | np.random.Generator | None = None, max_parallel_threads: int = 0, method: str = "statevector",
-         noise_model: NoiseModel | None = None, device: str = "CPU") -> AerBackend:
+def _aer(seed: int | np.random.Generator | None = None, max_parallel_threads: int | None = None,
+         method: str = "statevector", noise_model: NoiseModel | None = None, device: str = "CPU") -> AerBackend:
     from .search import AerBackend
 
     return AerBackend(seed=seed, method=method, noise_model=noise_model, device=device,

@@ -215,7 +215,7 @@ def test_aer_search_measures_what_aersimulator_run_measures_on_its_circuit(num_q
     parallel threshold (14 qubits)."""
     from qrrt_circuits.search.circuits import aer_grover_circuit
 
-    backend = qc.AerBackend(seed=3, synthesis=synthesis)
+    backend = qc.AerBackend(seed=3, synthesis=synthesis, max_parallel_threads=0)  # (all cores from 14 qubits)
     rng = np.random.default_rng(num_qubits)
     fraction = 0.3 if synthesis != "mcz" or num_qubits < 6 else 4 / (1 << num_qubits)  # mcz: few marked
     for case in range(4 if num_qubits < 10 else 2):
@@ -358,3 +358,29 @@ def test_a_process_forked_after_aer_searches_searches_too():
     with multiprocessing.get_context("fork").Pool(2) as pool:
         children = pool.starmap_async(_aer_search_words, [(marks, 11)] * 2).get(timeout=120)
     assert children == [parent, parent]
+
+
+def test_aer_threads_follow_the_free_cores_from_14_qubits(monkeypatch):
+    """By default a circuit of 14 qubits or more runs on the cores other work leaves free (usable
+    cores less the load beyond this process's own thread, at least 1); below 14 qubits on one
+    thread; an explicit limit (0: all cores) is kept whatever the load."""
+    import os
+
+    from qrrt_circuits._support import free_cores
+
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: set(range(8)))
+    auto, all_cores, two = qc.AerBackend(seed=0), qc.AerBackend(max_parallel_threads=0), qc.AerBackend(
+        max_parallel_threads=2)
+    for load, expected in ((0.3, 8), (1.0, 8), (3.5, 5), (7.2, 1), (40.0, 1)):
+        monkeypatch.setattr(os, "getloadavg", lambda load=load: (load, load, load))
+        assert free_cores.free_cores() == expected
+        assert auto.threads_for(16) == expected and auto.threads_for(13) == 1
+        assert all_cores.threads_for(16) == 0 and two.threads_for(16) == 2 and two.threads_for(8) == 1
+    marks = np.zeros(1 << 14, dtype=bool)
+    marks[[3, 999]] = True
+    from qrrt_circuits.probability import optimal_iterations, success_probability
+
+    k = optimal_iterations(marks.size, 2)
+    found = auto.search(qc.LookupOracle(marks), k, shots=64, seed=1).indices  # one thread under this load
+    p = success_probability(marks.size, 2, k)
+    assert np.isin(found, [3, 999]).mean() >= p - 4 * np.sqrt(p * (1 - p) / 64) - 1e-9

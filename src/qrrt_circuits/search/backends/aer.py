@@ -18,6 +18,9 @@ circuit i with ``seed_simulator + 2113 i``, so one run cannot give each database
 Threads: Aer parallelises a state update only from ``statevector_parallel_threshold`` (14) qubits
 on; below it, extra OpenMP threads only cost their start-up and synchronisation, so circuits
 narrower than ``SERIAL_BELOW_QUBITS`` run on one thread whatever ``max_parallel_threads`` says.
+From 14 qubits on, the default (``max_parallel_threads=None``) runs each search on the cores free
+when it starts (``_support.free_cores``: the usable cores less the load of other work, at least
+one), so a search on a busy machine does not wait on threads that have no core.
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from qiskit_aer import AerSimulator
 
+from ..._support.free_cores import free_cores
 from ..._support.validation import check_int
 from ..aer_circuits import simulation_synthesis_for
 from ..circuits import grover_cx_bound, oracle_cx_estimate
@@ -81,21 +85,24 @@ class AerBackend(QuantumSearchBackend):
             With one, the gate-by-gate circuit runs, so per-gate noise acts on the paper's gates.
         device: One of ``AerSimulator().available_devices()`` for this qiskit-aer build:
             ``"CPU"`` (default) or ``"GPU"`` (needs qiskit-aer-gpu and an NVIDIA GPU).
-        max_parallel_threads: Aer's thread limit, 0 .. 4096; 0 lets Aer use all cores. Circuits
-            on fewer than ``SERIAL_BELOW_QUBITS`` (14) qubits always run on one thread.
+        max_parallel_threads: Aer's thread limit for circuits of 14 or more qubits: None (default)
+            for the cores free when each search starts (``free_cores``), 0 for all cores, or a
+            limit in 1 .. 4096. Circuits on fewer than ``SERIAL_BELOW_QUBITS`` (14) qubits always
+            run on one thread.
 
     Attributes:
         method: The Aer simulation method.
         synthesis: The oracle synthesis requested.
         simulator: The ``AerSimulator`` the circuits run on.
         device: ``"CPU"`` or ``"GPU"``.
-        max_parallel_threads: The thread limit for circuits of 14 or more qubits.
+        max_parallel_threads: The thread limit for circuits of 14 or more qubits (None: the free
+            cores, per search).
 
     Raises:
         TypeError: ``method``, ``synthesis`` or ``device`` is not a string, or
             ``max_parallel_threads`` / ``seed`` is not an integer.
         ValueError: An unsupported or unknown ``method``, a ``device`` this build does not offer,
-            an unknown ``synthesis``, ``max_parallel_threads`` outside [0, 4096] or a negative
+            an unknown ``synthesis``, ``max_parallel_threads`` outside [0, 4096] (or None) or a negative
             ``seed``.
     """
 
@@ -108,7 +115,7 @@ class AerBackend(QuantumSearchBackend):
         synthesis: str | OracleSynthesis = "auto",
         noise_model: NoiseModel | None = None,
         device: str = "CPU",
-        max_parallel_threads: int = 0,
+        max_parallel_threads: int | None = None,
     ) -> None:
         for name, value in (("method", method), ("synthesis", synthesis), ("device", device)):
             if not isinstance(value, str):
@@ -122,7 +129,8 @@ class AerBackend(QuantumSearchBackend):
             raise ValueError(f"device must be one of {tuple(available)} for this qiskit-aer build, got {device!r} "
                              "(device='GPU' needs qiskit-aer-gpu and an NVIDIA GPU)")
         synthesis = OracleSynthesis.parse(synthesis)
-        check_int(max_parallel_threads, "max_parallel_threads", 0, 4096)
+        if max_parallel_threads is not None:
+            check_int(max_parallel_threads, "max_parallel_threads", 0, 4096)
         self._rng = seed_stream(seed)
         self.method = method
         self.synthesis = synthesis
@@ -130,10 +138,10 @@ class AerBackend(QuantumSearchBackend):
             method=method,
             device=device,
             noise_model=noise_model,
-            max_parallel_threads=int(max_parallel_threads),
+            max_parallel_threads=0 if max_parallel_threads is None else int(max_parallel_threads),
         )
         self.device = device
-        self.max_parallel_threads = int(max_parallel_threads)
+        self.max_parallel_threads = None if max_parallel_threads is None else int(max_parallel_threads)
         self._literal = noise_model is not None
         if method == "matrix_product_state":  # no multi-controlled gates: the circuits are transpiled
             self._circuit_form = self._sequence_form = CircuitForm.AER_BASIC
@@ -285,9 +293,12 @@ class AerBackend(QuantumSearchBackend):
             num_qubits: n, the circuit's width.
 
         Returns:
-            1 below ``SERIAL_BELOW_QUBITS`` qubits, else the constructor's ``max_parallel_threads``.
+            1 below ``SERIAL_BELOW_QUBITS`` qubits; else the constructor's ``max_parallel_threads``,
+            or with None the cores free now (``free_cores()``).
         """
-        return 1 if num_qubits < SERIAL_BELOW_QUBITS else self.max_parallel_threads
+        if num_qubits < SERIAL_BELOW_QUBITS:
+            return 1
+        return free_cores() if self.max_parallel_threads is None else self.max_parallel_threads
 
     def describe(self) -> str:
         """The backend's settings in words: ``"aer (method=..., device=..., synthesis=...)"``, the
