@@ -6,7 +6,7 @@ backend chooses by default (the cores free when the search starts, ``_support.fr
 On a machine shared with other work, a state update spread over more threads than there are idle
 cores waits on the busy ones. This times ``AerBackend.search`` (k = 12, 8 shots, 4 marked entries)
 at n = 14 and 16 (``--quick``: 14) with ``max_parallel_threads`` 1, 0 (all cores) and None (the
-default), in that order, alternating over the repeats, and records the load average, the usable
+default), in that order, alternating over the repeats, and records the one-minute system load, the usable
 cores and the thread count the default chose at each size. Medians of wall time per search.
 Prints a table and writes JSON.
 """

@@ -1,10 +1,10 @@
 """The processor cores a simulation may take without crowding the machine: the cores this process
 may run on less what the other work on the machine already keeps busy.
 
-A state update parallelised over more threads than there are idle cores waits on the busy ones:
-on a 2-core machine running other work, one n = 16 Grover search with every core took more than
-ten times its one-thread time. ``free_cores()`` reads the one-minute load average (the runnable
-threads, this process's own included) once per call.
+A state update parallelised over more threads than there are idle cores waits on the busy ones
+(``benchmarks/bench_aer_threads.py`` times a search on one thread, on every core and on the free
+cores). ``free_cores()`` reads the one-minute system load
+(``os.getloadavg``: the runnable threads, this process's own included) once per call.
 """
 
 from __future__ import annotations
@@ -26,8 +26,8 @@ def usable_cores() -> int:
 
 def free_cores() -> int:
     """The usable cores that other work does not keep busy: ``usable_cores()`` less the one-minute
-    load average beyond this process's own running thread (load - 1), rounded down, at least 1;
-    ``usable_cores()`` where the platform has no load average.
+    system load beyond this process's own running thread (load - 1), rounded down, at least 1;
+    ``usable_cores()`` where the platform has no system load.
 
     Example:
         >>> from qrrt_circuits._support.free_cores import free_cores, usable_cores
@@ -37,7 +37,7 @@ def free_cores() -> int:
     usable = usable_cores()
     try:
         load = os.getloadavg()[0]
-    except (AttributeError, OSError):  # (no load average on this platform)
+    except (AttributeError, OSError):  # (no system load on this platform)
         return usable
     others = max(0.0, load - 1.0)
     return max(1, min(usable, math.floor(usable - others)))
