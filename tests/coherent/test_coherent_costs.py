@@ -112,7 +112,7 @@ def test_an_oracle_too_large_to_build_is_refused_before_building_naming_the_larg
     env = Environment(env.bounds, boxes)
     full = oracle_costs(env, database, motion).gates
     limit = full - 1
-    with pytest.raises(ValueError, match=r"gates, more than \d+: env.boxes has 8 boxes, at most (\d) fit") as error:
+    with pytest.raises(ValueError, match=r"more than \d+ gates: env.boxes has 8 boxes, at most (\d) fit") as error:
         build_coherent_oracle(env, database, motion, max_gates=limit)
     fits = int(error.value.args[0].split("at most ")[1].split()[0])
     smaller = Environment(env.bounds, env.boxes[:fits])
@@ -123,3 +123,39 @@ def test_an_oracle_too_large_to_build_is_refused_before_building_naming_the_larg
     big = LatticeDatabase(database.fmt, 4, np.array([[2.0, 2.0]]))
     with pytest.raises(ValueError, match="env.boxes has 8 boxes"):
         build_coherent_oracle(env, big, SampledMotion.straight_line(2, 9, 3), max_gates=5000)
+
+
+@pytest.mark.parametrize("boxes_fitting", range(8))
+def test_the_largest_box_count_named_is_the_largest_that_fits(boxes_fitting):
+    """The gallop-and-bisect over box counts names exactly the largest prefix whose gates fit."""
+    env, database, motion = wall_instance()
+    boxes = [[[1.0 + i, 10.0], [1.5 + i, 11.0]] for i in range(8)]
+    gates = [oracle_costs(Environment(env.bounds, boxes[:count]), database, motion).gates for count in range(9)]
+    limit = gates[boxes_fitting]
+    expected = max(count for count in range(9) if gates[count] <= limit)
+    if expected == 8:
+        return
+    with pytest.raises(ValueError, match=rf"at most {expected} fit"):
+        build_coherent_oracle(Environment(env.bounds, boxes), database, motion, max_gates=limit)
+
+
+def test_a_plan_too_large_is_refused_from_its_size_before_planning():
+    """points x boxes above MAX_PLANNED_TESTS: refused at once, naming env.boxes and K."""
+    from qrrt_circuits.coherent.plan import MAX_PLANNED_TESTS
+
+    env, database, motion = scaling_instance(10, 2000, time_samples=1024)
+    start = time.perf_counter()
+    refusal = r"env.boxes has 2000 boxes and motion.time_samples = 1024 .* at most \d+ boxes fit"
+    with pytest.raises(ValueError, match=refusal):
+        oracle_costs(env, database, motion)
+    assert time.perf_counter() - start < 1
+    assert len(motion.tested) * 2000 > MAX_PLANNED_TESTS
+
+
+def test_an_oracle_far_too_large_is_refused_in_seconds():
+    """525 boxes at K = 256 (51.8 M gates): the count stops at the limit."""
+    env, database, motion = scaling_instance(10, 525, time_samples=256)
+    start = time.perf_counter()
+    with pytest.raises(ValueError, match="env.boxes has 525 boxes, at most 11 fit"):
+        build_coherent_oracle(env, database, motion)
+    assert time.perf_counter() - start < 30

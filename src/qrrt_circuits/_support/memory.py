@@ -239,7 +239,7 @@ def _memory_text(measured: tuple[int, str], when: str = "") -> str:
 
 
 def check_fits(estimate_for: Callable[[int], MemoryEstimate], num_qubits: int, what: str,
-               available: int | None = None, source: str = "") -> MemoryEstimate:
+               available: int | None = None, source: str = "", name: str = "num_qubits") -> MemoryEstimate:
     """Refuse (``ValueError``) a run whose estimated peak exceeds the available memory, naming
     ``num_qubits``, the estimate, the available memory (and which figure bounds it) and the largest
     n that fits. ``what`` names the run ("this aer search (8 shots, 5 iterations)"). Returns the
@@ -256,6 +256,7 @@ def check_fits(estimate_for: Callable[[int], MemoryEstimate], num_qubits: int, w
         available: The available bytes; None (default) for ``available_memory.available_memory()``.
         source: Which figure ``available`` is, for the message (``available_memory``'s second
             item; default none named).
+        name: The argument n is, for the message (default ``"num_qubits"``).
 
     Returns:
         ``estimate_for(num_qubits)``.
@@ -283,8 +284,8 @@ def check_fits(estimate_for: Callable[[int], MemoryEstimate], num_qubits: int, w
         return estimate
     largest = largest_fitting(estimate_for, measured[0], num_qubits)
     raise ValueError(
-        f"num_qubits = {num_qubits}: {what} needs about {_size(estimate.total_bytes)} at its peak "
-        f"({estimate.breakdown()}), more than {_memory_text(measured)}; the largest num_qubits that fits is "
+        f"{name} = {num_qubits}: {what} needs about {_size(estimate.total_bytes)} at its peak "
+        f"({estimate.breakdown()}), more than {_memory_text(measured)}; the largest {name} that fits is "
         f"{largest}{' (none does)' if largest == 0 else ''}")
 
 

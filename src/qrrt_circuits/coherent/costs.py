@@ -15,7 +15,10 @@ n (``hardware.resources``: unary-iteration QROM over the 2^n marks, load and unl
 select-swap where Qualtran is installed), counted the same way (ANDs only).
 
 ``check_buildable`` refuses before building an oracle of more than ``oracle.MAX_BUILD_GATES``
-gates, naming the argument to lower and the largest value that fits.
+gates, naming the argument to lower and the largest value that fits. It counts with a
+``BoundedCountEmitter``, which stops as soon as the gates counted so far pass the limit (the count
+only grows as the walk goes on), so a refusal costs at most the walk of a limit's worth of gates for
+each box count it tries, whatever the oracle's full size.
 """
 
 from __future__ import annotations
@@ -28,7 +31,7 @@ import numpy as np
 
 from ..world.environment import Environment
 from .arithmetic import QUBIT, add_into, bit_kinds, chain_steps, controlled_increment
-from .emitter import CountEmitter
+from .emitter import Block, CountEmitter
 from .lattice import LatticeDatabase
 from .motion import SampledMotion
 from .plan import OracleOptions, OraclePlan, oracle_plan
@@ -90,6 +93,58 @@ class FastCountEmitter(CountEmitter):
         tally, extra = qrom_tally(len(index), data)
         self.bump(extra)
         self.tally.add(tally)
+
+
+class _PastLimit(Exception):
+    """The gates counted so far passed a ``BoundedCountEmitter``'s limit."""
+
+
+class BoundedCountEmitter(FastCountEmitter):
+    """A ``FastCountEmitter`` that raises ``_PastLimit`` once its gate count passes ``limit``,
+    checked after each block and each lookup (module text)."""
+
+    def __init__(self, limit: int) -> None:
+        super().__init__()
+        self.limit = limit
+
+    def _check(self) -> None:
+        if self.tally.gates > self.limit:
+            raise _PastLimit
+
+    def end(self, block: Block) -> None:
+        """Close the block, then stop past the limit."""
+        super().end(block)
+        self._check()
+
+    def mirror(self, block: Block) -> None:
+        """Mirror the block, then stop past the limit."""
+        super().mirror(block)
+        self._check()
+
+    def qrom(self, index: Sequence[int], data: Sequence[int], outputs: Sequence[int]) -> None:
+        """Count the lookup, then stop past the limit."""
+        super().qrom(index, data, outputs)
+        self._check()
+
+
+def gates_up_to(database: LatticeDatabase, plan: OraclePlan, limit: int) -> int:
+    """The oracle's gate count where it is at most ``limit``, else ``limit + 1`` (counting stops
+    there: module text).
+
+    Args:
+        database: The ``LatticeDatabase``.
+        plan: Its ``OraclePlan``.
+        limit: The largest count wanted exactly.
+
+    Returns:
+        min(gates, limit + 1).
+    """
+    em = BoundedCountEmitter(limit)
+    try:
+        emit_oracle(em, database, plan)
+    except _PastLimit:
+        return limit + 1
+    return min(em.tally.gates, limit + 1)
 
 
 @dataclass(frozen=True)
@@ -173,28 +228,33 @@ def check_buildable(env: Environment, database: LatticeDatabase, motion: Sampled
         ValueError: Too many gates; the message gives the count, and the largest number of the
             world's boxes (``env.boxes``) that fits, or, where none fits, the lookup's and points' share.
     """
-    cost = plan_costs(database, plan)
-    if cost.gates <= max_gates:
+    if gates_up_to(database, plan, max_gates) <= max_gates:
         return
     boxes = env.num_boxes
 
     def gates_with(count: int) -> int:
         subset = Environment(env.bounds, env.boxes[:count])
-        return plan_costs(database, oracle_plan(subset, database, motion, plan.options)).gates
+        return gates_up_to(database, oracle_plan(subset, database, motion, plan.options), max_gates)
 
     low, high = 0, boxes
     if gates_with(0) > max_gates:
         raise ValueError(
-            f"the oracle would have {cost.gates} gates, more than {max_gates}, and {gates_with(0)} even without "
-            f"boxes: lower database.parent_bits (m = {database.parent_bits}: a lookup over 2^m nodes), "
-            f"motion.time_samples (K = {motion.time_samples}) or the fixed-point bits (b = {database.fmt.bits})")
+            f"the oracle would have more than {max_gates} gates even without boxes: lower database.parent_bits "
+            f"(m = {database.parent_bits}: a lookup over 2^m nodes), motion.time_samples "
+            f"(K = {motion.time_samples}) or the fixed-point bits (b = {database.fmt.bits})")
+    step = 1
+    while low + step < high:  # gallop up from 0 (small counts are cheap), then bisect
+        if gates_with(low + step) > max_gates:
+            high = low + step - 1
+            break
+        low, step = low + step, 2 * step
     while low < high:  # the most boxes (a prefix of env.boxes) that fit
         middle = (low + high + 1) // 2
         if gates_with(middle) <= max_gates:
             low = middle
         else:
             high = middle - 1
-    raise ValueError(f"the oracle would have {cost.gates} gates, more than {max_gates}: env.boxes has {boxes} boxes, "
+    raise ValueError(f"the oracle would have more than {max_gates} gates: env.boxes has {boxes} boxes, "
                      f"at most {low} fit with these sizes (or lower motion.time_samples, K = {motion.time_samples})")
 
 
@@ -373,6 +433,6 @@ def scaling_instance(index_bits: int, boxes: int, parent_bits: int = 6, bits: in
     return env, database, motion
 
 
-__all__ = ["ComparisonCost", "FastCountEmitter", "LookupCost", "OracleCost", "check_buildable", "comparison_costs",
-           "lookup_costs", "mirror_tally", "oracle_costs", "plan_costs", "qiskit_comparator_toffolis",
-           "scaling_instance", "toffoli_depth"]
+__all__ = ["BoundedCountEmitter", "ComparisonCost", "FastCountEmitter", "LookupCost", "OracleCost",
+           "check_buildable", "comparison_costs", "gates_up_to", "lookup_costs", "mirror_tally", "oracle_costs",
+           "plan_costs", "qiskit_comparator_toffolis", "scaling_instance", "toffoli_depth"]

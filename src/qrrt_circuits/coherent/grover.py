@@ -82,7 +82,8 @@ def coherent_grover_circuit(oracle: QuantumCircuit, num_index_bits: int, iterati
     Args:
         oracle: A coherent oracle (``coherent_phase_oracle``): index qubits first, ancillas in |0>.
         num_index_bits: n, 1 .. the oracle's qubits.
-        iterations: k, 0 .. 10 000.
+        iterations: k, 0 .. 10 000, and k x (the oracle's gates + 4 n + 1) at most
+            ``search.oracles.MAX_GROVER_GATES``.
         measure: Measure the index qubits (default True); bit j of the result is index bit j.
         index_in_middle: Put the index register in the middle of the qubits, half of the ancillas
             before it (module text); default False: the oracle's order, index first.
@@ -92,7 +93,9 @@ def coherent_grover_circuit(oracle: QuantumCircuit, num_index_bits: int, iterati
 
     Raises:
         TypeError: A non-integer n or k.
-        ValueError: n or k out of range.
+        ValueError: n or k out of range, or a circuit of more than ``MAX_GROVER_GATES`` gates
+            (refused before it is built, naming ``iterations``, the oracle's size and the most
+            iterations that fit).
     """
     iterations = check_int(iterations, "iterations", 0, 10_000)
     searched = coherent_search_oracle(oracle, num_index_bits, index_in_middle=index_in_middle)

@@ -52,6 +52,11 @@ DIGITS = ("naf", "binary")
 
 CELL, PARENT = "cell", "parent"
 
+#: the most (tested point, box) pairs ``oracle_plan`` plans: points x boxes, known before planning;
+#: a plan keeps about 430 bytes a pair and costs take about 50 microseconds a pair to count, so this
+#: many is about 0.2 GB and half a minute. Larger sizes are refused before any work.
+MAX_PLANNED_TESTS = 500_000
+
 
 @dataclass(frozen=True)
 class OracleOptions:
@@ -309,6 +314,25 @@ def _form(database: LatticeDatabase, motion: SampledMotion, matrix: np.ndarray, 
     return LinearForm(tuple(terms), offset - initial, initial, initial + largest, initial + low, initial + high)
 
 
+def check_planned_tests(points: int, boxes: int, time_samples: int) -> None:
+    """Refuse (``ValueError``) a plan of more than ``MAX_PLANNED_TESTS`` (point, box) pairs.
+
+    Args:
+        points: The motion's tested points (at most K + 1).
+        boxes: The world's boxes.
+        time_samples: K, for the message.
+
+    Raises:
+        ValueError: points x boxes above the limit; the message names ``env.boxes``,
+            ``motion.time_samples`` and the most boxes that fit at these points.
+    """
+    if points * boxes > MAX_PLANNED_TESTS:
+        raise ValueError(
+            f"env.boxes has {boxes} boxes and motion.time_samples = {time_samples} tests {points} points: "
+            f"{points * boxes} (point, box) pairs, more than {MAX_PLANNED_TESTS} the oracle is planned for; "
+            f"at most {MAX_PLANNED_TESTS // max(points, 1)} boxes fit at these points (or lower motion.time_samples)")
+
+
 def oracle_plan(env: Environment, database: LatticeDatabase, motion: SampledMotion,
                 options: OracleOptions | None = None) -> OraclePlan:
     """The integer plan (module text) of the oracle for a world, database and motion.
@@ -323,12 +347,15 @@ def oracle_plan(env: Environment, database: LatticeDatabase, motion: SampledMoti
         The ``OraclePlan``.
 
     Raises:
-        ValueError: Mismatched dimensions or a world outside the format.
+        ValueError: Mismatched dimensions, a world outside the format, or more than
+            ``MAX_PLANNED_TESTS`` (tested point, box) pairs (refused before planning, naming
+            ``env.boxes`` and ``motion.time_samples`` and the most boxes that fit).
     """
     options = OracleOptions() if options is None else options
     prune = options.prune
     if motion.dim != database.dim:
         raise ValueError(f"motion has d = {motion.dim}, the database d = {database.dim}")
+    check_planned_tests(len(motion.tested), env.num_boxes, motion.time_samples)
     bounds, boxes = grid_limits(env, database)
     f = motion.fraction_bits
     parent_range = (database.node_grid.min(axis=0), database.node_grid.max(axis=0))

@@ -20,13 +20,15 @@ parent and the sample's grid point) disagree.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
+from .._support.memory import MemoryEstimate, check_fits
 from ..reachability.time_sampled import TimeSampledCheck
 from ..world.environment import Environment
-from .lattice import DatabaseEntries, LatticeDatabase
+from .lattice import MAX_ENUMERATED_BITS, DatabaseEntries, LatticeDatabase
 from .motion import SampledMotion
 
 #: entries per chunk of the vectorized evaluation (bounded memory whatever 2^n)
@@ -76,6 +78,46 @@ def tested_points(entries: DatabaseEntries, motion: SampledMotion) -> np.ndarray
     return np.floor_divide(accumulated, 1 << f)
 
 
+def reference_bytes(num_index_bits: int, points: int, dim: int) -> int:
+    """Peak bytes ``reachable_reference`` adds over all 2^n entries: the indices and the marks
+    (8 + 1 bytes an entry) and one chunk's scratch (its decoded entries, 16 d + 48 bytes a row, and
+    its tested points with their comparisons, 40 d bytes a row and point).
+
+    Args:
+        num_index_bits: n.
+        points: P, the motion's tested points.
+        dim: d.
+
+    Returns:
+        The bytes.
+    """
+    rows = min(1 << num_index_bits, CHUNK_ENTRIES)
+    return (9 << num_index_bits) + rows * (16 * dim + 48 + 40 * dim * max(points, 1))
+
+
+def check_reference_fits(database: LatticeDatabase, motion: SampledMotion, extra: Callable[[int], int] | None = None,
+                         what: str = "reachable_reference over all 2^n entries") -> None:
+    """Refuse (``ValueError``, before any work) an evaluation over all 2^n entries whose estimate
+    (``reference_bytes``, plus ``extra(n)``) exceeds the available memory, naming
+    ``database.num_index_bits`` and the largest n that fits (``memory.check_fits``).
+
+    Args:
+        database: The ``LatticeDatabase``.
+        motion: The ``SampledMotion``.
+        extra: More bytes as a function of n (a caller's own arrays), or None.
+        what: The run, for the message.
+
+    Raises:
+        ValueError: The estimate exceeds the available memory.
+    """
+    points, dim = len(motion.tested), database.dim
+
+    def estimate_for(n: int) -> MemoryEstimate:
+        return MemoryEstimate(n, database_bytes=reference_bytes(n, points, dim) + (extra(n) if extra else 0))
+
+    check_fits(estimate_for, database.num_index_bits, what, name="database.num_index_bits")
+
+
 def reachable_reference(env: Environment, database: LatticeDatabase, motion: SampledMotion,
                         indices: np.ndarray | None = None) -> np.ndarray:
     """The marks of the coherent oracle: is entry i reachable, in the circuit's integer semantics?
@@ -91,7 +133,9 @@ def reachable_reference(env: Environment, database: LatticeDatabase, motion: Sam
         bounds and in no box.
 
     Raises:
-        ValueError: Mismatched dimensions, a world outside the format, or too many entries.
+        ValueError: Mismatched dimensions, a world outside the format, too many entries, or all
+            2^n entries asked for where their estimate (``reference_bytes``) exceeds the available
+            memory (refused before any work, naming ``database.num_index_bits``).
 
     Example:
         >>> import numpy as np
@@ -108,8 +152,12 @@ def reachable_reference(env: Environment, database: LatticeDatabase, motion: Sam
         raise ValueError(f"motion has d = {motion.dim}, the database d = {database.dim}")
     bounds, boxes = grid_limits(env, database)
     if indices is None:
-        entries_all = database.entries()
-        indices = entries_all.indices
+        n = database.num_index_bits
+        if n > MAX_ENUMERATED_BITS:
+            raise ValueError(f"reachable_reference enumerates 2^n entries: database.num_index_bits must be "
+                             f"<= {MAX_ENUMERATED_BITS}, got {n} (or pass indices)")
+        check_reference_fits(database, motion)
+        indices = np.arange(1 << n, dtype=np.int64)
     indices = np.asarray(indices, dtype=np.int64).reshape(-1)
     out = np.zeros(indices.shape[0], dtype=bool)
     for first in range(0, indices.shape[0], CHUNK_ENTRIES):

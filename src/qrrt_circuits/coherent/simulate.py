@@ -28,6 +28,23 @@ CCX = 5
 MAX_SIMULATION_BYTES = 2 << 30
 
 
+def simulation_bytes(num_index: int, num_qubits: int) -> int:
+    """Peak bytes ``simulate`` adds: the qubit vectors, the index's initial bits and the phase
+    ((qubits + n + 3) 2^n / 8) and the index bits' construction and the phases unpacked (26 bytes
+    an index state).
+
+    Args:
+        num_index: n.
+        num_qubits: All qubits.
+
+    Returns:
+        The bytes.
+    """
+    states = 1 << num_index
+    words = max(1, (states + 63) // 64)
+    return (num_qubits + num_index + 3) * words * 8 + 26 * words * 64
+
+
 @dataclass(frozen=True)
 class PermutationResult:
     """The oracle on every |i>|0> (module text).

@@ -18,8 +18,8 @@ from .lattice import LatticeDatabase
 from .motion import SampledMotion
 from .oracle import build_coherent_oracle
 from .plan import OracleOptions
-from .reference import reachable_reference
-from .simulate import CCX, circuit_gates, simulate
+from .reference import check_reference_fits, reachable_reference
+from .simulate import CCX, circuit_gates, simulate, simulation_bytes
 
 
 @dataclass(frozen=True)
@@ -71,9 +71,14 @@ def verify_oracle(env: Environment, database: LatticeDatabase, motion: SampledMo
         The ``VerificationResult``.
 
     Raises:
-        ValueError: As ``build_coherent_oracle``, or an n too large to enumerate.
+        ValueError: As ``build_coherent_oracle``, an n too large to enumerate, or an estimate of
+            the reference marks and the simulation above the available memory (refused before
+            either runs, naming ``database.num_index_bits``).
     """
     oracle = build_coherent_oracle(env, database, motion, options)
+    qubits = oracle.layout.num_qubits
+    check_reference_fits(database, motion, lambda n: simulation_bytes(n, qubits + n - database.num_index_bits),
+                         "verify_oracle (the reference marks and the simulation of every index state)")
     marks = reachable_reference(env, database, motion)
     tagged = oracle.gates
     read = circuit_gates(oracle.circuit)

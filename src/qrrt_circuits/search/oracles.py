@@ -47,6 +47,11 @@ if TYPE_CHECKING:
 
 __all__ = ["AER_BASIC_GATES", "CircuitForm", "CircuitOracle", "LookupOracle", "SearchOracle", "check_oracle"]
 
+#: the most gates a circuit oracle's Grover circuit holds (k iterations of the oracle and the
+#: reflection; about the size ``coherent.oracle.MAX_BUILD_GATES`` bounds for one oracle): larger
+#: ones are refused before they are built
+MAX_GROVER_GATES = 2_000_000
+
 #: gates every Aer method runs, ``matrix_product_state`` included (it has no multi-controlled
 #: gates): the instruction set of ``CircuitForm.AER_BASIC``, which a circuit oracle's Grover circuit
 #: is transpiled to for Aer
@@ -314,13 +319,43 @@ class CircuitOracle(SearchOracle):
         """The Grover circuit of the class text: as built for ``LOGICAL`` (a new circuit each call),
         transpiled to ``AER_BASIC_GATES`` for every Aer form (built once per k and kept: not to be
         changed); ``synthesis`` does not apply (the circuit is the oracle's own)."""
-        iterations = validate_iterations(iterations)
+        iterations = self.check_grover_size(iterations)
         if form is CircuitForm.LOGICAL:
             return self._grover(iterations)
         built = self._built.get(iterations)
         if built is None:
             built = self._built[iterations] = _basic(self._grover(iterations))
         return built
+
+    def iteration_gates(self) -> int:
+        """Gates of one Grover iteration: the oracle's and the reflection's (H, X on each index
+        qubit before and after one multi-controlled Z: 4 n + 1)."""
+        return int(self.circuit.size()) + 4 * self.num_qubits + 1
+
+    def check_grover_size(self, iterations: int) -> int:
+        """k, validated, and refused (``ValueError``) before anything is built where k iterations
+        of this oracle would hold more than ``MAX_GROVER_GATES`` gates.
+
+        Args:
+            iterations: k.
+
+        Returns:
+            k as a Python ``int``.
+
+        Raises:
+            TypeError: A non-integer k.
+            ValueError: k out of range, or k x ``iteration_gates()`` above ``MAX_GROVER_GATES``; the
+                message names ``iterations``, the oracle's size and the most iterations that fit.
+        """
+        iterations = validate_iterations(iterations)
+        per_iteration = self.iteration_gates()
+        if iterations * per_iteration > MAX_GROVER_GATES:
+            raise ValueError(
+                f"iterations = {iterations} of an oracle of {self.circuit.size()} gates on {self.width} qubits "
+                f"({per_iteration} gates an iteration with the reflection) would build a circuit of "
+                f"{iterations * per_iteration} gates, more than {MAX_GROVER_GATES}: at most "
+                f"{MAX_GROVER_GATES // per_iteration} iterations of this oracle fit (or build a smaller oracle)")
+        return iterations
 
     def _grover(self, iterations: int) -> QuantumCircuit:
         from qiskit import ClassicalRegister, QuantumCircuit
