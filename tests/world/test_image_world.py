@@ -491,7 +491,7 @@ def test_bad_files_are_refused_naming_the_path_and_the_formats(tmp_path):
     cases = {
         "missing.png": "does not exist",
         ".": "is not a file",
-        "notes.txt": r"is not a readable image \(unknown format, the file starts with b'hello'\)",
+        "notes.txt": r"is not a readable image \(unknown format: neither a PNG signature nor",
         "short.pgm": r"is not a readable image \(truncated: 7 of 9 raster bytes\)",
         "maxval.pgm": r"maxval 0 outside \[1, 65535\]",
         "above.pgm": "a sample above maxval 15",
@@ -505,6 +505,32 @@ def test_bad_files_are_refused_naming_the_path_and_the_formats(tmp_path):
             qc.OccupancyGrid.from_image(tmp_path / name, 1.0)
     with pytest.raises(ValueError, match="path must be a file path"):
         qc.OccupancyGrid.from_image(3, 1.0)
+    with pytest.raises(ValueError) as error:
+        qc.OccupancyGrid.from_image(tmp_path / "notes.txt", 1.0)
+    assert "hello" not in str(error.value)  # a file's content is never echoed
+
+
+def test_a_pnm_reads_only_its_declared_raster_and_refuses_a_far_larger_file(tmp_path):
+    """A 40 x 40 map with a 2 GiB tail (sparse): refused from its size before its raster is read,
+    with little memory; a small tail is read and ignored; a 5 000-digit width is refused by name."""
+    import tracemalloc
+
+    raster = b"P5 40 40 255\n" + bytes([255]) * 1600
+    tail = tmp_path / "tail.pgm"
+    with open(tail, "wb") as handle:
+        handle.write(raster)
+        handle.truncate(2 << 30)
+    tracemalloc.start()
+    with pytest.raises(ValueError, match=r"2147483648 bytes, far more than the 1613 its header declares"):
+        qc.OccupancyGrid.from_image(tail, 1.0)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert peak < 8 << 20
+    (tmp_path / "small_tail.pgm").write_bytes(raster + b"\0" * 1000)
+    assert qc.OccupancyGrid.from_image(tmp_path / "small_tail.pgm", 1.0).free.all()
+    (tmp_path / "wide.pgm").write_bytes(b"P5 " + b"4" * 5000 + b" 4 255\n" + bytes(16))
+    with pytest.raises(ValueError, match="a PGM / PPM header width of 5000 digits, more than 9"):
+        qc.OccupancyGrid.from_image(tmp_path / "wide.pgm", 1.0)
 
 
 def test_images_beyond_the_cell_limit_are_refused_from_their_header(tmp_path):

@@ -98,7 +98,7 @@ def test_unreadable_problem_files_are_refused(tmp_path):
         load_problem(tmp_path / "missing.json")
     bad = tmp_path / "bad.json"
     bad.write_text("{not json")
-    with pytest.raises(ValueError, match="not a JSON problem file"):
+    with pytest.raises(ValueError, match="is not valid JSON"):
         load_problem(bad)
     other = tmp_path / "other.json"
     other.write_text(json.dumps({"format": "qrrt-environment"}))
@@ -283,3 +283,84 @@ def test_the_winding_band_is_solved_by_q_rrt_within_a_budget():
 def test_bad_winding_band_arguments_are_refused_by_name(arguments, message):
     with pytest.raises((TypeError, ValueError), match=message):
         winding_band(**arguments)
+
+
+def _problem_folder(tmp_path, name, **fields):
+    folder = tmp_path / name
+    folder.mkdir()
+    return folder, _write(folder, **fields)
+
+
+def _scenario(start=(1, 1)):
+    return json.dumps({"format": "qrrt-environment", "version": 1, "bounds": [[0, 20], [0, 20]],
+                       "boxes": [[[0, 0], [5, 5]]], "start": list(start), "goal": [19, 19], "goal_radius": 0.75})
+
+
+def _bad_problem_files(tmp_path):
+    """(case, problem file, extra flags, what the one line must say) for files an adversarial user
+    would write."""
+    import os
+
+    cases = []
+    deep = tmp_path / "deep.json"
+    deep.write_text("[" * 100_000 + "]" * 100_000)
+    cases.append(("nested", deep, [], "nested too deeply"))
+    folder, path = _problem_folder(tmp_path, "bigint", family="image", image="map.pgm", pixel_size=1.0,
+                                   start=[1, 1], goal=[3, 3], goal_radius=0.5)
+    (folder / "map.pgm").write_bytes(b"P5 4 4 255\n" + bytes([255]) * 16)
+    path.write_text(path.read_text().replace("[1, 1]", "[" + "9" * 401 + ", 1]"))
+    cases.append(("401 digits", path, [], "start must be numeric"))
+    cases.append(("family list", _problem_folder(tmp_path, "list", family=["maze"])[1], [], '"family" must be one of'))
+    cases.append(("version true", _problem_folder(tmp_path, "true", family="open-space", version=True)[1], [],
+                  '"version" must be 1, got True'))
+    cases.append(("missing scenario", _problem_folder(tmp_path, "missing", family="boxes", scenario="no.json")[1], [],
+                  '"scenario": scenario file: no such file'))
+    folder, path = _problem_folder(tmp_path, "collide", family="boxes", scenario="world.json")
+    (folder / "world.json").write_text(_scenario())
+    cases.append(("start in collision", path, [], "world.json: start [1.0, 1.0] is in collision"))
+    cases.append(("absolute", _problem_folder(tmp_path, "zero", family="boxes", scenario="/dev/zero")[1], [],
+                  '"scenario" must name a file inside the problem file\'s folder'))
+    cases.append(("device allowed", tmp_path / "zero" / "problem.json", ["--allow-outside-files"],
+                  "'/dev/zero' is not a regular file"))
+    folder, path = _problem_folder(tmp_path, "fifo", family="boxes", scenario="pipe.json")
+    os.mkfifo(folder / "pipe.json")
+    cases.append(("FIFO", path, [], "pipe.json' is not a regular file"))
+    cases.append(("dot dot", _problem_folder(tmp_path, "up", family="boxes", scenario="../collide/world.json")[1], [],
+                  '"scenario" leads outside the problem file\'s folder'))
+    folder, path = _problem_folder(tmp_path, "link", family="boxes", scenario="world.json")
+    (folder / "world.json").symlink_to(tmp_path / "collide" / "world.json")
+    cases.append(("symbolic link out", path, [], '"scenario" leads outside'))
+    secret = tmp_path / "secret.txt"
+    secret.write_text("root:*:0:0:secret")
+    folder, path = _problem_folder(tmp_path, "secret", family="image", image=str(secret), pixel_size=1.0,
+                                   start=[1, 1], goal=[3, 3], goal_radius=0.5)
+    cases.append(("content never echoed", path, ["--allow-outside-files"], "unknown format"))
+    return cases
+
+
+def test_bad_problem_files_exit_2_with_one_line_naming_the_file_and_the_field(tmp_path, capsys):
+    """Every bad problem file: exit 2 and one line that names the problem file and the field, never
+    a traceback, never the content of a file it reads."""
+    from qrrt_circuits.cli import main
+
+    for case, path, flags, message in _bad_problem_files(tmp_path):
+        with pytest.raises(SystemExit) as exit_info:
+            main(["plan", "--problem", str(path), "--planner", "rrt", "--max-nodes", "5", *flags])
+        err = capsys.readouterr().err.strip().splitlines()
+        assert exit_info.value.code == 2, case
+        assert len(err) == 1 and str(path) in err[0] and message in err[0], (case, err)
+        assert "root:*" not in err[0] and "Traceback" not in err[0], case
+
+
+def test_files_a_problem_names_inside_its_folder_are_read():
+    """A scenario in a subfolder of the problem file's folder is inside it."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as name:
+        from pathlib import Path
+
+        root = Path(name)
+        (root / "worlds").mkdir()
+        (root / "worlds" / "world.json").write_text(_scenario(start=(10, 10)))
+        problem = load_problem(_write(root, family="boxes", scenario="worlds/world.json"))
+        assert problem.start.tolist() == [10.0, 10.0]

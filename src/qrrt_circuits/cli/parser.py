@@ -80,6 +80,9 @@ def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
     plan.add_argument("--problem", default=None,
                       help="a problem JSON file instead (qrrt-problem: open-space, narrow-passage, se2-gap, boxes "
                            "or image); it fixes the world, the motion check, the state space and the goal")
+    plan.add_argument("--allow-outside-files", action="store_true",
+                      help="let a --problem file name a scenario or image outside its own folder (an absolute "
+                           "path or ..); by default such names are refused")
     plan.add_argument("--scenario-seed", type=_nonnegative_int, default=0,
                       help="seed of the scenario's random world")
     plan.add_argument("--planner", type=_registered(PLANNERS), choices=PLANNERS.names(), default="pqrrt",

@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from .._support.input_files import check_regular_file, inside_folder, read_json_file
 from .._support.validation import check_float, check_int
 from ..reachability.dynamics import LinearTrackingDynamics
 from ..reachability.exact import ExactCheck
@@ -253,19 +254,22 @@ def box_world(path: str | Path) -> Problem:
         The problem.
 
     Raises:
-        ValueError: What ``Environment.load`` refuses, or a file without ``start``, ``goal`` and
-            ``goal_radius`` or with values ``Problem.build`` refuses; the message starts with the
-            path.
+        ValueError: What ``Environment.load`` refuses (a missing file, one that is not a regular
+            file, malformed JSON), or a file without ``start``, ``goal`` and ``goal_radius`` or
+            with values ``Problem.build`` refuses; the message starts with the path.
     """
-    env = Environment.load(path)
-    data = json.loads(Path(path).read_text(encoding="utf-8"))
+    data = read_json_file(path, "scenario file")
+    try:
+        env = Environment.from_dict(data)
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise ValueError(f"{path}: {exc}") from exc
     missing = [key for key in ("start", "goal", "goal_radius") if data.get(key) is None]
     if missing:
         raise ValueError(f"{path}: a problem's scenario needs start, goal and goal_radius "
                          f"(missing {', '.join(missing)})")
     try:
         return Problem.build(env, data["start"], data["goal"], data["goal_radius"])
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OverflowError) as exc:
         raise ValueError(f"{path}: {exc}") from exc
 
 
@@ -328,52 +332,69 @@ FAMILIES: dict[str, tuple[Any, dict[str, Any]]] = {
 }
 
 
-def load_problem(path: str | Path) -> Problem:
+def load_problem(path: str | Path, allow_outside: bool = False) -> Problem:
     """Read a problem file: ``{"format": "qrrt-problem", "version": 1, "family": NAME, ARGS...}``
     for a family of ``FAMILIES``, or ``{"format": "qrrt-problem", "version": 1, "family": "boxes",
-    "scenario": FILE}`` for a scenario file (relative to the problem file).
+    "scenario": FILE}`` for a scenario file.
+
+    A file the problem names (``"scenario"``, ``"image"``) is resolved against the problem file's
+    folder and must lie inside it (``_support.input_files.inside_folder``) unless ``allow_outside``;
+    every file read must be a regular file (a device or a FIFO is refused unread), and no message
+    quotes a file's content.
 
     Args:
         path: The file.
+        allow_outside: Accept absolute names and names outside the problem file's folder (default
+            False; ``qrrt plan --allow-outside-files``).
 
     Returns:
         The problem.
 
     Raises:
-        ValueError: A missing, unreadable or malformed file, naming the field and what is accepted.
+        ValueError: A missing, unreadable or malformed file, naming the file and the field and what
+            is accepted.
     """
     path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"--problem: no such file {str(path)!r}")
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
-        raise ValueError(f"{path}: not a JSON problem file ({exc})") from exc
+    data = read_json_file(path, "--problem")
     if not isinstance(data, dict) or data.get("format") != PROBLEM_FORMAT:
         raise ValueError(f'{path}: "format" must be "{PROBLEM_FORMAT}"')
-    if data.get("version") != PROBLEM_VERSION:
-        raise ValueError(f'{path}: "version" must be {PROBLEM_VERSION}, got {data.get("version")!r}')
+    version = data.get("version")
+    if isinstance(version, bool) or version != PROBLEM_VERSION:
+        raise ValueError(f'{path}: "version" must be {PROBLEM_VERSION}, got {_shown(version)}')
     family = data.get("family")
+    families = sorted([*FAMILIES, "boxes"])
+    if not isinstance(family, str) or family not in families:
+        raise ValueError(f'{path}: "family" must be one of {families}, got {_shown(family)}')
     arguments = {key: value for key, value in data.items() if key not in ("format", "version", "family")}
     if family == "boxes":
         if set(arguments) != {"scenario"} or not isinstance(arguments["scenario"], str):
             raise ValueError(f'{path}: family "boxes" takes one field, "scenario" (a scenario file name)')
-        return box_world(path.parent / arguments["scenario"])
+        scenario = inside_folder(path.parent, arguments["scenario"], "scenario", path, allow_outside)
+        try:
+            return box_world(scenario)
+        except ValueError as exc:
+            raise ValueError(f'{path}: "scenario": {exc}') from exc
     if family == "image":  # the file's "image", relative to the problem file, is the builder's path
         if not isinstance(arguments.get("image"), str) or "path" in arguments:
             raise ValueError(f'{path}: family "image" needs "image", the file name of a PNG, PGM or PPM image')
         missing = sorted({"pixel_size", "start", "goal", "goal_radius"} - set(arguments))
         if missing:
             raise ValueError(f'{path}: family "image" needs {missing}')
-        arguments["path"] = str(path.parent / arguments.pop("image"))
-    if family not in FAMILIES:
-        raise ValueError(f'{path}: "family" must be one of {sorted([*FAMILIES, "boxes"])}, got {family!r}')
+        image = inside_folder(path.parent, arguments.pop("image"), "image", path, allow_outside)
+        check_regular_file(image, f'{path}: "image"')
+        arguments["path"] = str(image)
     builder, accepted = FAMILIES[family]
     unknown = sorted(set(arguments) - set(accepted))
     if unknown:
         raise ValueError(f'{path}: family "{family}" takes {sorted(accepted) or "no fields"}, not {unknown}')
     try:
         problem: Problem = builder(**arguments)
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OverflowError) as exc:
         raise ValueError(f"{path}: {exc}") from exc
     return problem
+
+
+def _shown(value: Any) -> str:
+    """A JSON value for a message, cut to 40 characters."""
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."

@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from .._support.validation import check_instance
+from .._support.validation import check_instance, check_real_array
 from ..world.environment import Environment
 from ..world.image import OccupancyGrid
 from .predicate import as_pairs
@@ -281,7 +281,7 @@ def check_map_point(check: GridCheck, name: str, point: Any) -> None:
     Raises:
         ValueError: A point outside the bounds or in or on an occupied cell, naming the pixel.
     """
-    point = np.asarray(point, dtype=float).reshape(-1)
+    point = check_real_array(point, name).reshape(-1)
     if point.shape == (2,) and np.all(np.isfinite(point)) and not check.is_valid(point)[0]:
         raise ValueError(f"{name} {point.tolist()} is not a free point of the map: {_why_invalid(check.grid, point)}; "
                          f"accepted: a point inside a free cell, within the bounds {check.grid.bounds().tolist()}")

@@ -355,19 +355,14 @@ class Environment:
             The ``Environment`` (validated as by the constructor).
 
         Raises:
-            ValueError: Not UTF-8, not valid JSON, a wrong format or version, a missing
-                ``bounds`` / ``boxes``, or any value the constructor refuses; the message starts
-                with the path.
-            OSError: The file cannot be read.
+            ValueError: Missing, not a regular file, larger than ``MAX_INPUT_BYTES``, not UTF-8,
+                not valid JSON, a wrong format or version, a missing ``bounds`` / ``boxes``, or any
+                value the constructor refuses; the message names the path and never quotes the
+                file (``_support.input_files``).
         """
-        try:
-            data = json.loads(Path(path).read_text(encoding="utf-8"))
-        except UnicodeDecodeError as exc:
-            raise ValueError(f"{path}: not a UTF-8 text file ({exc.reason} at byte {exc.start})") from exc
-        except (json.JSONDecodeError, ValueError) as exc:
-            raise ValueError(f"{path}: not valid JSON ({exc})") from exc
-        except RecursionError as exc:  # nesting deeper than the parser's recursion limit
-            raise ValueError(f"{path}: not a scenario file (JSON nested too deeply)") from exc
+        from .._support.input_files import read_json_file
+
+        data = read_json_file(path, "scenario file")
         try:
             return cls.from_dict(data)
         except (ValueError, TypeError) as exc:

@@ -57,6 +57,12 @@ ACCEPTED = "a PNG file, or a PGM / PPM file (binary P5 / P6 or ASCII P2 / P3)"
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 _PNM_CHANNELS = {b"P2": 1, b"P3": 3, b"P5": 1, b"P6": 3}
 _PNM_HEADER_BYTES = 1 << 20  # a PGM / PPM header (comments included) longer than this is refused
+_PNM_NUMBER_DIGITS = 9  # a width, height or maxval of more digits is refused (no number fits in fewer)
+#: bytes an ASCII (P2 / P3) sample may take with its whitespace: a file whose raster is longer than
+#: this per declared sample, plus ``_PNM_SLACK_BYTES``, is refused
+_ASCII_SAMPLE_BYTES = 16
+#: bytes a PGM / PPM file may hold beyond what its header declares before it is refused
+_PNM_SLACK_BYTES = 1 << 16
 
 
 @dataclass(frozen=True, eq=False)
@@ -272,7 +278,7 @@ def _header(path: Path) -> tuple[str, int, int]:
     if head[:2] in _PNM_CHANNELS:
         magic, width, height, _, _ = _pnm_header(path, head)
         return magic, width, height
-    raise _unreadable(path, f"unknown format, the file starts with {head[:8]!r}")
+    raise _unreadable(path, "unknown format: neither a PNG signature nor a P2 / P3 / P5 / P6 magic number")
 
 
 def _pnm_header(path: Path, data: bytes) -> tuple[str, int, int, int, int]:
@@ -293,6 +299,10 @@ def _pnm_header(path: Path, data: bytes) -> tuple[str, int, int, int, int]:
             position += 1
         if position == start:
             raise _unreadable(path, "a PGM / PPM header without its width, height and maxval")
+        if position - start > _PNM_NUMBER_DIGITS:
+            name = ("width", "height", "maxval")[len(values)]
+            raise _unreadable(path, f"a PGM / PPM header {name} of {position - start} digits, more than "
+                                    f"{_PNM_NUMBER_DIGITS}")
         values.append(int(data[start:position]))
     if position >= len(data) or not data[position:position + 1].isspace():
         raise _unreadable(path, "a PGM / PPM header not followed by whitespace")
@@ -303,19 +313,30 @@ def _pnm_header(path: Path, data: bytes) -> tuple[str, int, int, int, int]:
 
 
 def _read_pnm(path: Path, magic: str) -> tuple[np.ndarray, int]:
-    """The samples (height, width, channels) and maxval of a PGM / PPM file."""
-    data = path.read_bytes()
-    _, width, height, maxval, offset = _pnm_header(path, data)
-    channels = _PNM_CHANNELS[magic.encode()]
-    count = width * height * channels
-    if magic in ("P5", "P6"):
+    """The samples (height, width, channels) and maxval of a PGM / PPM file, reading only the raster
+    its header declares; a file far longer than that (``_PNM_SLACK_BYTES`` beyond it) is refused
+    before its raster is read."""
+    import os
+
+    with path.open("rb") as handle:
+        data = handle.read(_PNM_HEADER_BYTES)
+        _, width, height, maxval, offset = _pnm_header(path, data)
+        channels = _PNM_CHANNELS[magic.encode()]
+        count = width * height * channels
+        binary = magic in ("P5", "P6")
         size = 1 if maxval < 256 else 2
-        raster = data[offset:offset + count * size]
+        declared = count * size if binary else count * _ASCII_SAMPLE_BYTES
+        length = os.fstat(handle.fileno()).st_size
+        if length > offset + declared + _PNM_SLACK_BYTES:
+            raise _unreadable(path, f"{length} bytes, far more than the {offset + declared} its header declares "
+                                    f"({width} x {height} x {channels} samples)")
+        handle.seek(offset)
+        raster = handle.read(count * size if binary else length - offset)
+    if binary:
         if len(raster) < count * size:
             raise _unreadable(path, f"truncated: {len(raster)} of {count * size} raster bytes")
         samples = np.frombuffer(raster, dtype=np.uint8 if size == 1 else ">u2").astype(np.int64)
     else:
-        raster = data[offset:]
         if raster.translate(None, b"0123456789 \t\n\v\f\r"):  # anything but digits and whitespace
             raise _unreadable(path, "an ASCII sample that is not a non-negative integer")
         # (numpy's text parser: no Python object per sample, unlike bytes.split)

@@ -31,7 +31,9 @@ def _load_problem(args: argparse.Namespace) -> Problem:
             raise ValueError(f"--problem: {args.problem!r} is a folder, not a problem file")
         from ...problems.families import load_problem
 
-        return load_problem(args.problem)
+        return load_problem(args.problem, allow_outside=args.allow_outside_files)
+    if args.allow_outside_files:
+        raise ValueError("--allow-outside-files applies to a --problem file: give one, or leave it out")
     from ...registry import PREDICATES
 
     if args.scenario_file:
