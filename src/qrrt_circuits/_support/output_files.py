@@ -26,6 +26,7 @@ refused before the work: the two would overwrite each other.
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
 import re
@@ -155,6 +156,25 @@ def write_replacing(path: Path, write: Callable[[IO[Any]], None], binary: bool =
     except BaseException:
         Path(temporary).unlink(missing_ok=True)
         raise
+
+
+def remove_stale_temporaries(folder: Path) -> list[Path]:
+    """Remove the temporary files (``.qrrt-*.tmp``) that ``write_replacing`` left in ``folder`` when
+    its process was killed between creating one and renaming it. Only a process that holds the
+    folder's lock (``folder_lock``), so that no other writer's file is in flight, may call it.
+
+    Args:
+        folder: The folder.
+
+    Returns:
+        The files removed.
+    """
+    removed = []
+    for stale in Path(folder).glob(".qrrt-*.tmp"):
+        with contextlib.suppress(OSError):
+            stale.unlink()
+            removed.append(stale)
+    return removed
 
 
 def write_result_file(path: Path, write: Callable[[IO[Any]], None], binary: bool = False) -> None:

@@ -1,6 +1,6 @@
 """records.csv: one row per finished trial, appended and flushed (fsync) as trials finish.
 
-The file is only ever appended to. Reading it never changes it:
+Reading the file never changes it:
 
 - a line counts only once it ends with a line break, so a torn last line (the writer was killed
   mid-write, or the disk filled) is not a record; a torn first line is a torn header: the file
@@ -13,6 +13,10 @@ The file is only ever appended to. Reading it never changes it:
   (file, line, column, value) in one ``RecordsWarning``; its trial runs again;
 - a second valid row of a trial (a file concatenated by hand) is reported and excluded: each trial
   counts once, by its first valid row.
+
+A run (which holds its folder's lock) compacts the file before it appends (``compact_records``):
+excluded rows are moved to ``records.csv.excluded`` beside it and the file is rewritten whole
+without them, so each is reported once.
 
 Before appending, ``RecordWriter`` moves a torn last line out of the way: its bytes are appended to
 ``records.csv.torn`` beside it, then the file is cut back to its last line break. Only bytes that
@@ -28,12 +32,13 @@ import warnings
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 from .base import Trial
 from .columns import ColumnKind, column_kind
 
-__all__ = ["RecordSchema", "RecordWriter", "RecordsError", "RecordsWarning", "check_records_header", "read_records"]
+__all__ = ["RecordSchema", "RecordWriter", "RecordsError", "RecordsWarning", "check_records_header", "compact_records",
+           "read_records"]
 
 #: the columns every record starts with
 _KEYS = ("trial_id", "seed")
@@ -158,6 +163,44 @@ def _lines(path: Path) -> list[str]:
     return text.split("\n")[:-1]
 
 
+def _read(path: Path, schema: RecordSchema | None) -> tuple[list[dict[str, Any]], list[str], list[str], list[str]]:
+    """(records, the valid lines with the header first, the excluded lines, why each was excluded)."""
+    lines = _lines(path) if path.exists() else []
+    if not lines:
+        return [], [], [], []
+    header = next(csv.reader([lines[0]]))
+    if schema is not None:
+        _check_header(path, header, schema)
+    excluded: list[str] = []
+    why: list[str] = []
+    kept = [lines[0]]
+    first_line: dict[str, int] = {}
+    records: list[dict[str, Any]] = []
+    for number, line in enumerate(lines[1:], start=2):
+        cells = next(csv.reader([line]), [])
+        if len(cells) != len(header):
+            excluded.append(line)
+            why.append(f"line {number}: {len(cells)} cells, the header has {len(header)}")
+            continue
+        row = dict(zip(header, cells, strict=True))
+        problem = schema.row_problem(row) if schema is not None else None
+        if problem is None and "trial_id" in row and row["trial_id"] in first_line:
+            problem = f"a second record of trial {row['trial_id']!r} (line {first_line[row['trial_id']]} counts)"
+        if problem is not None:
+            excluded.append(line)
+            why.append(f"line {number}: {problem}")
+            continue
+        if "trial_id" in row:
+            first_line[row["trial_id"]] = number
+        kept.append(line)
+        records.append({name: _value(name, cell) for name, cell in row.items()})
+    return records, kept, excluded, why
+
+
+def _listed(why: list[str]) -> str:
+    return "; ".join(why[:_LISTED]) + (f"; and {len(why) - _LISTED} more" if len(why) > _LISTED else "")
+
+
 def read_records(path: Path, schema: RecordSchema | None = None) -> list[dict[str, Any]]:
     """The valid records of a records.csv (see the module docstring); the file is not changed.
 
@@ -176,37 +219,50 @@ def read_records(path: Path, schema: RecordSchema | None = None) -> list[dict[st
     Warns:
         RecordsWarning: Once, listing the rows excluded.
     """
-    if not path.exists():
-        return []
-    lines = _lines(path)
-    if not lines:
-        return []
-    header = next(csv.reader([lines[0]]))
-    if schema is not None:
-        _check_header(path, header, schema)
-    excluded: list[str] = []
-    first_line: dict[str, int] = {}
-    records: list[dict[str, Any]] = []
-    for number, line in enumerate(lines[1:], start=2):
-        cells = next(csv.reader([line]), [])
-        if len(cells) != len(header):
-            excluded.append(f"line {number}: {len(cells)} cells, the header has {len(header)}")
-            continue
-        row = dict(zip(header, cells, strict=True))
-        problem = schema.row_problem(row) if schema is not None else None
-        if problem is None and "trial_id" in row and row["trial_id"] in first_line:
-            problem = f"a second record of trial {row['trial_id']!r} (line {first_line[row['trial_id']]} counts)"
-        if problem is not None:
-            excluded.append(f"line {number}: {problem}")
-            continue
-        if "trial_id" in row:
-            first_line[row["trial_id"]] = number
-        records.append({name: _value(name, cell) for name, cell in row.items()})
-    if excluded:
-        listed = "; ".join(excluded[:_LISTED]) + (f"; and {len(excluded) - _LISTED} more" if len(excluded) > _LISTED
-                                                  else "")
-        warnings.warn(f"{path}: {len(excluded)} row(s) excluded, never counted (their trials run again): {listed}",
+    records, _, _, why = _read(path, schema)
+    if why:
+        warnings.warn(f"{path}: {len(why)} row(s) excluded, never counted (their trials run again): {_listed(why)}",
                       RecordsWarning, stacklevel=2)
+    return records
+
+
+def compact_records(path: Path, schema: RecordSchema) -> list[dict[str, Any]]:
+    """``read_records``, and where rows were excluded, the file rewritten without them: the
+    excluded lines are appended to ``records.csv.excluded`` beside it (flushed to disk) first, then
+    the header and the valid rows replace the file whole (``output_files.write_replacing``). Only
+    the writer holding the folder's lock (``_support.folder_lock``) may call it.
+
+    Args:
+        path: The ``records.csv`` file (need not exist).
+        schema: The run's schema.
+
+    Returns:
+        The valid records, as ``read_records`` returns them.
+
+    Raises:
+        RecordsError: The header does not fit ``schema``.
+
+    Warns:
+        RecordsWarning: Once, listing the rows moved aside (a later read finds none).
+    """
+    from .._support.output_files import write_replacing
+
+    records, kept, excluded, why = _read(path, schema)
+    if not excluded:
+        return records
+    aside = path.with_name(path.name + ".excluded")
+    with aside.open("a", encoding="utf-8") as handle:
+        handle.write("".join(line + "\n" for line in excluded))
+        handle.flush()
+        os.fsync(handle.fileno())
+    text = "".join(line + "\n" for line in kept)
+
+    def write(handle: IO[Any]) -> None:
+        handle.write(text)
+
+    write_replacing(path, write)
+    warnings.warn(f"{path}: {len(why)} row(s) excluded, never counted (their trials run again), and moved to "
+                  f"{aside.name}: {_listed(why)}", RecordsWarning, stacklevel=2)
     return records
 
 

@@ -5,7 +5,11 @@ finishes. Re-running with the same ``--out`` reads the file, skips finished tria
 rest; an interrupted run loses at most the trials in flight (a torn last line is set aside). The
 settings are stored in ``settings.json``; resuming with different settings is refused. Each row is
 checked against its trial on resume (``records.RecordSchema``): a row that fails is reported and
-excluded, never counted, and its trial runs again; the file is never rewritten.
+excluded, never counted, and its trial runs again; such rows are moved to
+``records.csv.excluded`` (``records.compact_records``). One run writes a folder at a time: a run
+takes the folder's lock (``_support.folder_lock``) before it reads or writes anything there, and a
+second run into it is refused at once, naming the first one's PID; holding it, the run removes
+temporary files (``.qrrt-*.tmp``) that a killed run left.
 ``summary.json`` = {"experiment", "settings", "ours", "paper", ..., "provenance"} and the figures
 are rewritten from all records at the end; ``provenance`` (commit, versions, machine, date) is the
 only part that differs between two runs with the same settings. Both JSON files are strict JSON
@@ -29,12 +33,14 @@ from typing import TYPE_CHECKING, Any, cast
 import numpy as np
 from tqdm.auto import tqdm
 
+from .._support.folder_lock import FolderLock
 from .._support.json_files import dumps, write_json
+from .._support.output_files import remove_stale_temporaries
 from .._support.provenance import provenance
 from .._support.validation import check_int, check_optional_int
 from ..world.environment import Environment
 from .base import Experiment, Record, Settings, Summary, Trial
-from .records import RecordSchema, RecordWriter, check_records_header, read_records
+from .records import RecordSchema, RecordWriter, check_records_header, compact_records, read_records
 
 if TYPE_CHECKING:
     from ..execution import WorkerPool
@@ -379,6 +385,8 @@ def run_experiment(
     Raises:
         ValueError: If an argument is refused, or ``out/name`` holds results for other settings.
         RuntimeError: If the experiment produced duplicate trial ids.
+        FolderInUse: Another run holds ``out/name`` (an ``OSError`` naming its PID): one run writes
+            a folder at a time (``_support.folder_lock``).
     """
     from .catalog import EXPERIMENTS
 
@@ -388,9 +396,29 @@ def run_experiment(
     schema = _schema(name, settings)
     all_trials = list(schema.trials.values())
     directory = Path(out) / name
+    _check_directory(directory, settings, schema)
+    directory.mkdir(parents=True, exist_ok=True)
+    lock = FolderLock(directory).acquire()
+    try:
+        return _run_locked(experiment, name, directory, settings, schema, all_trials, kind, executor, jobs,
+                           scheduler, progress, stop_after, on_record, max_restarts, on_restart, defer_summary, lock)
+    except BaseException:
+        lock.release()
+        raise
+
+
+def _run_locked(experiment: Experiment, name: str, directory: Path, settings: Settings, schema: RecordSchema,
+                all_trials: list[Trial], kind: str | None, executor: str | Executor | WorkerPool | None,
+                jobs: int | None, scheduler: str | None, progress: bool, stop_after: int | None,
+                on_record: Callable[[Record], None] | None, max_restarts: int,
+                on_restart: Callable[[int], None] | None,
+                defer_summary: Callable[[Callable[[], Summary]], None] | None, lock: FolderLock) -> Summary:
+    """``run_experiment`` once it holds the folder's lock, which it releases when the summary is
+    made (by ``defer_summary``'s function, where given)."""
+    remove_stale_temporaries(directory)
     _claim_directory(directory, settings, schema)
     records_path = directory / RECORDS
-    done = {record["trial_id"] for record in read_records(records_path, schema)}
+    done = {record["trial_id"] for record in compact_records(records_path, schema)}
     todo = [trial for trial in all_trials if trial.id not in done]
     if stop_after is not None:
         todo = todo[:stop_after]
@@ -408,10 +436,18 @@ def run_experiment(
                  max_restarts, on_restart)
     finally:
         bar.close()
+    summarize = partial(_summarize, experiment, name, directory, settings, all_trials, schema)
+
+    def summarize_and_release() -> Summary:
+        try:
+            return summarize()
+        finally:
+            lock.release()
+
     if defer_summary is not None:
-        defer_summary(partial(_summarize, experiment, name, directory, settings, all_trials, schema))
+        defer_summary(summarize_and_release)
         return {"experiment": name, "deferred": True}
-    return _summarize(experiment, name, directory, settings, all_trials, schema)
+    return summarize_and_release()
 
 
 def run_experiments(names: list[str], pool: WorkerPool, on_summary: Callable[[str, Summary], None],
