@@ -17,6 +17,17 @@ server is a fresh single-threaded interpreter that never runs a simulator, so no
 threads or OpenMP state. It is started with the single-thread environment below and stopped when
 the executor is shut down. Where the platform has no fork server, workers are spawned (cold).
 
+**Interrupts.** Workers never see Ctrl-C (a Ctrl-C from a terminal goes to the whole process
+group, and a worker interrupted mid-trial would print its traceback): the fork server is started
+with SIGINT blocked in the starting thread and ignores it from the first module it preloads
+(``_support.ignore_interrupts``), so every worker it forks ignores it too, and a spawned pool
+worker ignores it from its initializer. The command's own process gets it and shuts
+the workers down as it leaves (``WorkerPool``'s ``with`` block); while a local Dask cluster shuts
+down, Dask's and Tornado's loggers are silenced (its nannies and heartbeats would report the
+closing connections). Scratch folders are named with the owner's PID (``qrrt-pymp-PID-*`` for
+multiprocessing's, ``qrrt-dask-PID-*`` for Dask's): a run killed with SIGKILL leaves its own, and
+the next pool started removes those whose process is gone (``remove_stale_scratch``).
+
 Workers build their own backends with one thread each (``max_parallel_threads=1`` for Aer), so
 ``jobs`` processes use ``jobs`` cores. :class:`WorkerPool` keeps one executor for several sweeps
 (``qrrt reproduce all`` starts one pool or cluster, not one per experiment) and starts a new one
@@ -35,7 +46,7 @@ from typing import Any
 
 from ._support.validation import check_optional_int
 
-__all__ = ["EXECUTORS", "WORKER_PRELOAD", "WorkerPool", "check_executor_args", "get_executor"]
+__all__ = ["EXECUTORS", "WORKER_PRELOAD", "WorkerPool", "check_executor_args", "get_executor", "remove_stale_scratch"]
 
 #: the executor kinds ``get_executor`` and ``WorkerPool`` build
 EXECUTORS = ("serial", "process", "dask")
@@ -56,6 +67,11 @@ LOCAL_DASK_CONFIG = {"distributed.worker.profile.enabled": False, "distributed.a
 
 #: modules the fork server imports before forking any worker (the warm-up is the import)
 WORKER_PRELOAD = ("qrrt_circuits._support.worker_warmup",)
+#: what a local Dask cluster's fork server imports besides: Dask, and its workers' shutdown warnings
+#: left out (``_support.quiet_dask_workers``)
+DASK_PRELOAD = ("distributed", "qrrt_circuits._support.quiet_dask_workers")
+#: imported by the fork server before anything else: SIGINT ignored (module text, "Interrupts")
+INTERRUPTS_IGNORED = "qrrt_circuits._support.ignore_interrupts"
 
 #: how often a pool worker checks that its client is alive (seconds)
 PARENT_POLL_S = 0.5
@@ -84,12 +100,14 @@ def _exit_when_orphaned(client: int, parent: int) -> None:
 
 
 def _worker_init(client: int | None = None) -> None:
-    """Pool worker start-up: one thread per native library, and a watch on ``client`` (the pid of
-    the process that made the pool, passed in: a spawned worker still importing when its client
-    dies would otherwise take its new parent for the real one, and a forked one's parent is the
-    fork server)."""
+    """Pool worker start-up: SIGINT ignored (the client shuts the pool down: module text), one
+    thread per native library, and a watch on ``client`` (the pid of the process that made the
+    pool, passed in: a spawned worker still importing when its client dies would otherwise take its
+    new parent for the real one, and a forked one's parent is the fork server)."""
+    import signal
     import threading
 
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     os.environ.update(SINGLE_THREAD_ENV)
     parent = os.getppid()
     client = parent if client is None else client
@@ -132,14 +150,76 @@ def _warm_fork_server(extra_preload: tuple[str, ...] = ()) -> Iterator[str]:
     server = forkserver._forkserver  # the standard library's one per process
     started_here = server._forkserver_pid is None  # type: ignore[attr-defined]  # private, see docstring
     if started_here:
-        multiprocessing.get_context("forkserver").set_forkserver_preload([*extra_preload, *WORKER_PRELOAD])
-        with _single_thread_environment():
+        multiprocessing.get_context("forkserver").set_forkserver_preload([INTERRUPTS_IGNORED, *extra_preload,
+                                                                          *WORKER_PRELOAD])
+        _own_scratch_folder()
+        with _single_thread_environment(), _interrupts_blocked():
             forkserver.ensure_running()
     try:
         yield "forkserver"
     finally:
         if started_here:
             _stop_fork_server(server)
+
+
+@contextlib.contextmanager
+def _interrupts_blocked() -> Iterator[None]:
+    """SIGINT blocked in this thread while the block runs (a process started meanwhile inherits the
+    mask, module text); one that arrives meanwhile is delivered when the block ends."""
+    import signal
+
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
+#: the temporary folders of this package's pools, named with the owner's PID: PREFIX-PID-random
+SCRATCH_PREFIXES = ("qrrt-pymp", "qrrt-dask")
+
+
+def remove_stale_scratch(folder: str | None = None) -> list[str]:
+    """Remove the scratch folders (``SCRATCH_PREFIXES``) in the temporary folder whose owner
+    process is gone (killed before it could remove them), owned by this user.
+
+    Args:
+        folder: Where to look (default ``tempfile.gettempdir()``).
+
+    Returns:
+        The folders removed.
+    """
+    import glob
+    import shutil
+    import tempfile
+
+    removed = []
+    for prefix in SCRATCH_PREFIXES:
+        for path in glob.glob(os.path.join(folder or tempfile.gettempdir(), f"{prefix}-*-*")):
+            pid = os.path.basename(path)[len(prefix) + 1:].split("-", 1)[0]
+            try:
+                owned = os.stat(path).st_uid == os.getuid()
+            except OSError:
+                continue
+            if pid.isdigit() and owned and not _alive(int(pid)):
+                shutil.rmtree(path, ignore_errors=True)
+                removed.append(path)
+    return removed
+
+
+def _own_scratch_folder() -> None:
+    """Give multiprocessing a temporary folder named with this PID (``qrrt-pymp-PID-*``: where the
+    fork server's socket lives) unless it has one, removed at exit as its own would be."""
+    import shutil
+    import tempfile
+    from multiprocessing import process, util
+
+    config = process.current_process()._config  # type: ignore[attr-defined]  # util.get_temp_dir's
+    if config.get("tempdir") is None:
+        remove_stale_scratch()
+        tempdir = tempfile.mkdtemp(prefix=f"qrrt-pymp-{os.getpid()}-")
+        util.Finalize(None, shutil.rmtree, args=(tempdir,), kwargs={"ignore_errors": True}, exitpriority=-100)
+        config["tempdir"] = tempdir
 
 
 def _stop_fork_server(server: Any, wait_s: float = 5.0) -> None:  # a multiprocessing.forkserver.ForkServer
@@ -226,6 +306,7 @@ def check_executor_args(kind: str, jobs: int | None, scheduler: str | None) -> i
 def _process_pool(jobs: int) -> Iterator[Executor]:
     import multiprocessing
 
+    remove_stale_scratch()
     with _warm_fork_server() as method, \
             ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context(method),
                                 initializer=_worker_init, initargs=(os.getpid(),)) as pool:
@@ -241,23 +322,57 @@ def _local_dask(jobs: int, retries: int, local_directory: str | None) -> Iterato
 
     # Dask leaves lock files in its scratch directory: give it one of ours and remove it after (the
     # workers get it as local_directory, the scheduler through "temporary-directory")
-    scratch = None if local_directory is not None else tempfile.TemporaryDirectory(prefix="qrrt-dask-")
+    if local_directory is None:
+        remove_stale_scratch()
+    scratch = (None if local_directory is not None else
+               tempfile.TemporaryDirectory(prefix=f"qrrt-dask-{os.getpid()}-"))
     local_directory = local_directory if scratch is None else scratch.name
     try:
         # workers forked from the fork server inherit its single-thread environment (set when it
         # started); only spawned ones need it in ours (a change of os.environ while another thread
         # runs trials would race with C code reading the environment)
-        with _warm_fork_server(("distributed",)) as method, \
+        with _warm_fork_server(DASK_PRELOAD) as method, \
                 dask.config.set({**LOCAL_DASK_CONFIG, "distributed.worker.multiprocessing-method": method,
                                  "temporary-directory": local_directory}), \
                 (_single_thread_environment() if method == "spawn" else contextlib.nullcontext()), \
+                _dask_logs_restored(), \
                 LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, host="127.0.0.1",
                              dashboard_address=NO_DASHBOARD, local_directory=local_directory) as cluster, \
-                Client(cluster) as client:
+                Client(cluster) as client, \
+                _dask_logs_silenced_on_exit():
             yield client.get_executor(retries=retries, pure=False)
     finally:
         if scratch is not None:
             scratch.cleanup()
+
+
+#: the loggers a local Dask cluster's shutdown writes to (closing connections, missed heartbeats)
+DASK_LOGGERS = ("distributed", "tornado", "asyncio")
+
+
+@contextlib.contextmanager
+def _dask_logs_restored() -> Iterator[None]:
+    """The levels of ``DASK_LOGGERS`` as they were, once the block (the cluster's life) ends."""
+    import logging
+
+    saved = {name: logging.getLogger(name).level for name in DASK_LOGGERS}
+    try:
+        yield
+    finally:
+        for name, level in saved.items():
+            logging.getLogger(name).setLevel(level)
+
+
+@contextlib.contextmanager
+def _dask_logs_silenced_on_exit() -> Iterator[None]:
+    """``DASK_LOGGERS`` silenced as the block ends, however it ends (the cluster then shuts down)."""
+    import logging
+
+    try:
+        yield
+    finally:
+        for name in DASK_LOGGERS:
+            logging.getLogger(name).setLevel(logging.CRITICAL + 1)
 
 
 @contextlib.contextmanager
@@ -421,7 +536,7 @@ class WorkerPool:
         if server._forkserver_pid is not None:  # type: ignore[attr-defined]  # one runs: not ours to stop
             return
         stack = contextlib.ExitStack()
-        stack.enter_context(_warm_fork_server(("distributed",) if self.kind == "dask" else ()))
+        stack.enter_context(_warm_fork_server(DASK_PRELOAD if self.kind == "dask" else ()))
         self._fork_server = (stack, server)
 
     def _stop_prestarted_fork_server(self) -> None:

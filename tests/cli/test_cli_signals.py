@@ -197,3 +197,45 @@ def test_the_exit_statuses_are_documented_where_the_command_line_is():
     for status in cli.EXIT_STATUSES:
         if status:
             assert f"exit {status}" in readme, status
+
+
+@pytest.mark.parametrize("executor", ["process", "dask"])
+def test_ctrl_c_to_the_process_group_is_one_line_and_the_workers_are_shut_down(executor, tmp_path):
+    """Ctrl-C from a terminal reaches the whole process group, workers and fork server included:
+    they ignore it, the command prints its one line, exits 130 and shuts them down, and the run
+    resumes. Sent once the first records are written (the workers mid-trial) and, on a second
+    run, while the fork server is still importing its preload."""
+    if executor == "dask":
+        pytest.importorskip("distributed")
+    out = tmp_path / "results"
+    argv = _reproduce("heatmaps", out, "--executor", executor, "--jobs", "2", "--trials", "100")
+    for ready in (lambda: _records(out) >= 2, lambda: True):
+        process = _start(argv, tmp_path, start_new_session=True)
+        _wait_for(ready, process, "the moment to interrupt", timeout_s=120)
+        if ready() is True:
+            time.sleep(1.0)  # the fork server is importing
+        helpers = psutil.Process(process.pid).children(recursive=True)
+        os.killpg(process.pid, signal.SIGINT)
+        out_text, err = process.communicate(timeout=120)
+        assert process.returncode == 130, (process.returncode, err)
+        assert _error_lines(out_text + err) == [
+            f"qrrt reproduce: interrupted; finished trials are kept in {out / 'heatmaps' / 'records.csv'}; run the "
+            "same command again to resume"], err
+        gone, alive = psutil.wait_procs(helpers, timeout=10)
+        assert not alive, f"left running: {alive}"
+
+
+def test_stale_scratch_folders_of_dead_runs_are_removed_on_the_next_start(tmp_path):
+    """A run killed with SIGKILL leaves its qrrt-pymp-PID-* / qrrt-dask-PID-* folders; the next
+    pool removes those whose PID is gone, and keeps a live process's."""
+    from qrrt_circuits.execution import remove_stale_scratch
+
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    stale = [tmp_path / f"qrrt-pymp-{dead.pid}-abc", tmp_path / f"qrrt-dask-{dead.pid}-def"]
+    live = tmp_path / f"qrrt-dask-{os.getpid()}-ghi"
+    for folder in (*stale, live):
+        folder.mkdir()
+        (folder / "lock").write_text("")
+    assert sorted(remove_stale_scratch(str(tmp_path))) == sorted(map(str, stale))
+    assert live.exists() and not any(folder.exists() for folder in stale)

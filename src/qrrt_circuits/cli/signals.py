@@ -13,9 +13,10 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-#: C libraries that call back into Python where an exception is printed and dropped (llvmlite's
-#: object-cache notification while numba compiles): a signal handled inside one is delivered again
-FOREIGN_CALLBACKS = (os.path.join("llvmlite", "binding"),)
+#: code called back where an exception is printed and dropped (llvmlite's object-cache notification
+#: while numba compiles; Dask's garbage-collection callback, which the interpreter calls): a signal
+#: handled inside one is delivered again
+FOREIGN_CALLBACKS = (os.path.join("llvmlite", "binding"), os.path.join("distributed", "gc.py"))
 #: the delay before a signal that landed in a foreign callback is delivered again
 REDELIVERY_S = 0.01
 
