@@ -364,3 +364,52 @@ def test_files_a_problem_names_inside_its_folder_are_read():
         (root / "worlds" / "world.json").write_text(_scenario(start=(10, 10)))
         problem = load_problem(_write(root, family="boxes", scenario="worlds/world.json"))
         assert problem.start.tolist() == [10.0, 10.0]
+
+
+def _broken(member, value):
+    """The paper's problem with one protocol member replaced by one that returns ``value``."""
+    problem = qc.paper_clutter(seed=0)
+    owner = {"predicate": problem.predicate, "space": problem.space, "goal": problem.goal}[member.split(".")[0]]
+    name = member.split(".")[1]
+
+    class Broken:
+        def __getattr__(self, attribute):
+            return getattr(owner, attribute)
+
+    broken = Broken()
+    if name == "dim":
+        broken.dim = value
+    else:
+        setattr(broken, name, lambda *args, **kwargs: value)
+    return problem, member.split(".")[0], broken
+
+
+@pytest.mark.parametrize(("member", "value", "message"), [
+    ("predicate.describe", "a string", r"predicate.describe\(\) must return a dict"),
+    ("predicate.describe", {"k": object()}, r"predicate.describe\(\) must return JSON-able values"),
+    ("predicate.dim", 2.0, "predicate.dim must be an int"),
+    ("space.describe", {"k": {1, 2}}, r"space.describe\(\) must return JSON-able values"),
+    ("space.distance", [[0.0]], r"space.distance\(states, others\) must return one finite distance"),
+    ("space.distance", np.array([-1.0]), r"space.distance\(states, others\) must return one finite distance"),
+    ("space.interpolate", np.array([np.nan, 0.0]), r"space.interpolate\(origins, targets, fraction\) must return"),
+    ("space.nearest_neighbors", [], r"space.nearest_neighbors\(\) must return a NearestNeighbors structure"),
+    ("space.dim", True, "space.dim must be an int"),
+    ("goal.describe", None, r"goal.describe\(\) must return a dict"),
+    ("goal.is_satisfied", np.array([0.5]), "the goal's is_satisfied must return booleans"),
+])
+def test_every_protocol_member_is_probed_with_its_return_type_before_planning(member, value, message):
+    """A predicate, space or goal whose member returns the wrong kind of value is refused when the
+    problem is built, naming the member, not after a plan (where a result could not be built)."""
+    problem, part, broken = _broken(member, value)
+    with pytest.raises((TypeError, ValueError), match=message):
+        problem.replace(**{part: broken})
+
+
+def test_a_predicate_that_describes_itself_in_words_fails_before_any_round():
+    """The issue's case: describe() returning a string used to plan to the end and then fail."""
+    problem, part, broken = _broken("predicate.describe", "straight lines")
+    calls = []
+    broken.reachable = lambda parents, children: calls.append(len(children)) or np.ones(len(children), bool)
+    with pytest.raises(TypeError, match="predicate.describe"):
+        qc.RRT(seed=0).plan(problem.replace(**{part: broken}), max_nodes=50)
+    assert calls == []

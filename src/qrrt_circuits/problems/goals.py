@@ -275,6 +275,8 @@ def first_satisfying(goal: Goal, points: np.ndarray) -> int:
     if answers.shape != (points.shape[0],):
         raise ValueError(f"the goal's is_satisfied must return {points.shape[0]} booleans for {points.shape[0]} "
                          f"points, got shape {answers.shape}")
+    if answers.dtype != np.bool_ and (answers.dtype.kind not in "iuf" or not np.isin(answers, (0, 1)).all()):
+        raise ValueError(f"the goal's is_satisfied must return booleans (or 0 / 1), got {answers!r:.60}")
     hits = np.flatnonzero(answers.astype(bool))
     return int(hits[0]) if hits.size else -1
 

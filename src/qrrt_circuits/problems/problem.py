@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from .._support.json_files import dumps
 from .._support.validation import check_float, check_instance, check_real_array
 from ..reachability.dynamics import LinearTrackingDynamics
 from ..reachability.exact import ExactCheck
@@ -61,12 +62,51 @@ def check_space(space: Any, env: Environment) -> StateSpace:
 
 
 def _check_description(owner: str, description: Any) -> dict:
-    """``description`` if it is a dict with string keys (what ``describe()`` must return: results
-    record it as JSON)."""
+    """``description`` if it is a dict with string keys that JSON can write (what ``describe()``
+    must return: results record it as JSON)."""
     if not isinstance(description, dict) or not all(isinstance(key, str) for key in description):
         raise TypeError(f"{owner}.describe() must return a dict with string keys (it is recorded in every "
                         f"result), got {type(description).__name__}: {description!r:.80}")
+    try:
+        dumps(description)
+    except (TypeError, ValueError, RecursionError) as exc:
+        raise TypeError(f"{owner}.describe() must return JSON-able values (it is recorded in every result): "
+                        f"{exc}") from None
     return description
+
+
+def _check_dim(owner: str, dim: Any) -> None:
+    """``dim`` must be an int (not a bool)."""
+    if isinstance(dim, bool) or not isinstance(dim, int | np.integer):
+        raise TypeError(f"{owner}.dim must be an int, got {type(dim).__name__}: {dim!r:.40}")
+
+
+def _probe_space(space: StateSpace, start: np.ndarray) -> None:
+    """Call every member of the space on the start (a zero-length motion) and check what each
+    returns, so that a space that returns the wrong kind of value fails here and not after rounds
+    of planning: ``distance`` one finite distance >= 0 per pair, ``interpolate`` one finite state
+    per pair, ``nearest_neighbors()`` a structure with ``size``, ``add`` and ``nearest`` that
+    finds the one point it holds."""
+    pair = start[None]
+    distance = np.asarray(space.distance(pair, pair))
+    numeric = distance.dtype.kind in "iuf"
+    if distance.shape != (1,) or not numeric or not (np.isfinite(distance) & (distance >= 0)).all():
+        raise TypeError(f"space.distance(states, others) must return one finite distance >= 0 per pair (float (M,)), "
+                        f"got {distance!r:.80} for one pair")
+    middle = np.asarray(space.interpolate(pair, pair, np.array([0.5])))
+    if middle.shape != pair.shape or middle.dtype.kind not in "iuf" or not np.isfinite(middle).all():
+        raise TypeError(f"space.interpolate(origins, targets, fraction) must return one finite state per pair "
+                        f"(float (M, {start.shape[0]})), got {middle!r:.80} for one pair")
+    structure = space.nearest_neighbors()
+    missing = [member for member in ("size", "add", "nearest") if not hasattr(structure, member)]
+    if missing:
+        raise TypeError(f"space.nearest_neighbors() must return a NearestNeighbors structure (size, add(points), "
+                        f"nearest(queries)); {type(structure).__name__} lacks {', '.join(missing)}")
+    structure.add(pair)
+    found = np.asarray(structure.nearest(pair))
+    if found.shape != (1,) or found.dtype.kind not in "iu" or int(found[0]) != 0 or structure.size != 1:
+        raise TypeError(f"space.nearest_neighbors(): after add(one point), nearest(that point) must return the "
+                        f"int array [0] and size 1, got {found!r:.60} and size {structure.size!r:.20}")
 
 
 def _checked_point(name: str, point: Any, env: Environment, predicate: ReachabilityPredicate) -> np.ndarray:
@@ -111,9 +151,18 @@ class Problem:
         space: The ``StateSpace`` (its ``dim`` is d and it accepts the bounds).
         name: The problem's name (default: the environment's).
 
+    Every member of the space, goal and predicate protocols is checked here with the type of what
+    it returns, on a probe at the start (``dim`` an int; ``describe()`` a JSON-able dict; the
+    space's ``distance``, ``interpolate`` and ``nearest_neighbors`` on a zero-length motion; the
+    goal's ``is_satisfied`` and the predicate's ``is_valid`` and ``can_leave`` at the start), so a
+    wrong one fails before any planning. The predicate's ``reachable`` is not called here (every
+    call is an oracle call, DESIGN §2): its answers are checked on every batch from the first
+    round's (``predicate.check_answers``).
+
     Raises:
         TypeError: ``env`` not an ``Environment``, a predicate, space or goal that lacks a member
-            of its protocol or whose ``describe()`` returns no dict.
+            of its protocol, whose ``dim`` is not an int, whose ``describe()`` returns no
+            JSON-able dict, or a space member that returns the wrong kind of value on the probe.
         ValueError: A dimension mismatch; a start or a ball goal's centre that is not d finite
             numbers, out of bounds, inside a box or rejected by the predicate's validity check;
             a start on the workspace boundary that the predicate can never leave (unless it already
@@ -129,6 +178,9 @@ class Problem:
 
     def __post_init__(self) -> None:
         env = check_instance(self.env, "env", Environment, "an Environment")
+        for owner, member in (("predicate", self.predicate), ("space", self.space), ("goal", self.goal)):
+            if hasattr(member, "dim"):
+                _check_dim(owner, member.dim)
         predicate = check_predicate(self.predicate, env.dim)
         check_within_space(predicate, env.bounds)
         if not isinstance(predicate.name, str):
@@ -137,6 +189,7 @@ class Problem:
         space = check_space(self.space, env)
         _check_description("space", space.describe())
         start = _checked_point("start", self.start, env, predicate)
+        _probe_space(space, start)
         goal = check_goal(self.goal, env.dim)  # the protocol; whether a planner can end in it is its own check
         _check_description("goal", goal.describe())
         ball = ball_of(goal)
