@@ -22,6 +22,9 @@ SIDE_RANGE = (0.25, 0.85)
 GOAL_RADIUS = 0.75
 #: the most clutter boxes ``narrow_corridor`` accepts
 MAX_CORRIDOR_CLUTTER = 10_000
+#: the most boxes a random world (``paper_clutter``, ``annealing_field``) draws: its boxes and the
+#: collision checks' structures over them stay within tens of megabytes
+MAX_WORLD_BOXES = 1_000_000
 #: random draws per box ``narrow_corridor`` tries before it gives up placing its clutter
 PLACEMENT_TRIES = 1_000
 
@@ -84,13 +87,13 @@ def paper_clutter(seed: int | None = 0, num_boxes: int = CLUTTER_BOXES,
         The ``Problem``: its world (``metadata`` set), start, goal ball and exact check.
 
     Raises:
-        ValueError: A negative ``seed`` or ``num_boxes``, or ``size`` <= 1.7.
+        ValueError: A negative ``seed``, ``num_boxes`` outside [0, ``MAX_WORLD_BOXES``], or
+            ``size`` <= 1.7.
         TypeError: A non-integer ``seed``.
         RuntimeError: No start and goal could be placed (an overfull world).
     """
     _check_seed(seed)
-    if num_boxes < 0:
-        raise ValueError(f"num_boxes must be >= 0, got {num_boxes}")
+    num_boxes = check_int(num_boxes, "num_boxes", 0, MAX_WORLD_BOXES)
     if size <= 2 * SIDE_RANGE[1]:
         raise ValueError(f"size must be > {2 * SIDE_RANGE[1]}, got {size}")
     rng = _world_rng("paper_clutter", seed)
@@ -202,13 +205,13 @@ def annealing_field(seed: int | None = 0, num_boxes: int = 6025, side: float | N
         The ``Problem``: its world (``metadata`` set), start, goal ball and exact check.
 
     Raises:
-        ValueError: A negative ``seed`` or ``num_boxes``, or ``side`` <= 1.7 or not finite.
+        ValueError: A negative ``seed``, ``num_boxes`` outside [0, ``MAX_WORLD_BOXES``], or
+            ``side`` <= 1.7 or not finite.
         TypeError: A non-integer ``seed``, or a non-real ``side``.
         RuntimeError: No start and goal could be placed.
     """
     _check_seed(seed)
-    if num_boxes < 0:
-        raise ValueError(f"num_boxes must be >= 0, got {num_boxes}")
+    num_boxes = check_int(num_boxes, "num_boxes", 0, MAX_WORLD_BOXES)
     if side is None:
         size = CLUTTER_SIZE * math.sqrt(num_boxes / CLUTTER_BOXES)
     else:
