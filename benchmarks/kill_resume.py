@@ -24,8 +24,9 @@ that each way of tearing is tried).
    there is a file to tear), so kills land in the interpreter's start, the trials and the summary
    and figures (the references print when their first and last records were written; on a loaded
    machine a run may finish before its moment: shown as SIGNAL>seconds). The signal is drawn from
-   SIGKILL, SIGINT, SIGTERM, SIGHUP: SIGKILL goes to the whole process group (workers die too, as
-   in a crash), the others to the main process only (as ``kill PID``). Every
+   SIGKILL, SIGINT, SIGTERM, SIGHUP and SIGINT-group: SIGKILL goes to the whole process group
+   (workers die too, as in a crash), SIGINT-group too (Ctrl-C from a terminal), the others to the
+   main process only (as ``kill PID``). Every
    ``--second-kill-every``-th run is killed a second time, the same way, during its first resume;
    every ``--tear-every``-th run has its records.csv truncated after the kill, in turn at a drawn
    offset inside the header line (0 included: an empty file), just before the header line's
@@ -79,7 +80,18 @@ from run import machine_description
 HERE = Path(__file__).resolve().parent
 SRC = HERE.parent / "src"
 EXECUTORS = ("serial", "process", "dask")
-SIGNALS = (signal.SIGKILL, signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
+class GroupSignal:
+    """A signal sent to the command's whole process group, as a terminal sends Ctrl-C (SIGINT to
+    the foreground group: the workers and the fork server get it too)."""
+
+    def __init__(self, signum: signal.Signals) -> None:
+        self.signum = signum
+        self.name = f"{signum.name}-group"
+
+
+SIGNALS = (signal.SIGKILL, signal.SIGINT, signal.SIGTERM, signal.SIGHUP, GroupSignal(signal.SIGINT))
 #: the kill moment, as fractions of the executor's uninterrupted duration (tear runs: the later range)
 KILL_RANGE = (0.02, 0.9)
 TEAR_KILL_RANGE = (0.4, 0.9)
@@ -134,6 +146,8 @@ def run_phase(command: list[str], env: dict[str, str], logs: Path, name: str, ti
             sent_s = time.monotonic() - start  # (not reaped yet, so the pid is still this process)
             if signum == signal.SIGKILL:
                 _kill_group(pgid)
+            elif isinstance(signum, GroupSignal):
+                os.killpg(pgid, signum.signum)
             else:
                 os.kill(process.pid, signum)
     hung, lines, first_s, last_s = False, 0, None, None
@@ -164,7 +178,9 @@ def run_phase(command: list[str], env: dict[str, str], logs: Path, name: str, ti
         while group_members(pgid) and time.monotonic() < stop:
             time.sleep(0.1)
     stderr = (logs / f"{name}.stderr").read_text(errors="replace")
+    stdout = (logs / f"{name}.stdout").read_text(errors="replace")
     lines_seen = [line.strip() for line in stderr.splitlines() if line.strip()]
+    printed = len(lines_seen) + sum(1 for line in stdout.splitlines() if line.strip())
     leaked = [line for line in lines_seen if "leaked semaphore" in line]
     return {"rc": rc, "wall_s": round(wall, 2), "signal": signum.name if signum is not None else None,
             "kill_at_s": round(kill_at, 2) if kill_at is not None else None,
@@ -172,6 +188,9 @@ def run_phase(command: list[str], env: dict[str, str], logs: Path, name: str, ti
             **({"records_s": [first_s, last_s]} if watch else {}),
             "orphans": [f"{pid}:{comm}" for pid, comm in orphans],
             "traceback": "Traceback" in stderr, "leaked_semaphore": "leaked semaphore" in stderr,
+            # an interrupted command prints one line (stdout and stderr together)
+            "interrupted": rc in (128 + signal.SIGINT, 128 + signal.SIGTERM, 128 + signal.SIGHUP),
+            "lines_printed": printed,
             # the resource tracker's warning if there is one, else the last line (an error, an exception)
             "stderr_line": leaked[0] if leaked else (lines_seen[-1][:400] if lines_seen else None)}
 
@@ -332,6 +351,7 @@ def run_one(args: argparse.Namespace, env: dict[str, str], work: Path, entry: di
            "records_after_tear": after_tear if torn else None,
            "second_kill": entry["second_kill"], "resume_rcs": [p["rc"] for p in phases[1:]], "resumed": resumed,
            "traceback": any(p["traceback"] for p in phases),
+           "beyond_one_line": any(p["interrupted"] and p["lines_printed"] > 1 for p in phases),
            "leaked_semaphore": any(p["leaked_semaphore"] for p in phases),
            "orphans": sum(len(p["orphans"]) for p in phases), "hung": any(p["hung"] for p in phases),
            # (by the resume that exited 0: a run that finished before its kill already wrote one)
@@ -432,6 +452,8 @@ def main() -> int:
     totals = {"runs": len(rows), "byte_identical_summaries": sum(r["summary_identical"] for r in rows),
               "runs_double_counted": sum(r["double_counted"] > 0 for r in rows),
               "runs_lost": sum(r["lost"] > 0 for r in rows), "runs_traceback": sum(r["traceback"] for r in rows),
+              "runs_group_sigint": sum(any(name.endswith("-group") for name in r["signals"]) for r in rows),
+              "runs_beyond_one_line": sum(r["beyond_one_line"] for r in rows),
               "trials_double_counted": sum(r["double_counted"] for r in rows),
               "trials_lost": sum(r["lost"] for r in rows),
               "runs_leaked_semaphore": sum(r["leaked_semaphore"] for r in rows),
@@ -440,7 +462,8 @@ def main() -> int:
               "wall_s": round(time.monotonic() - started, 1)}
     print(f"{totals['runs']} runs: {totals['byte_identical_summaries']} byte-identical summaries, "
           f"{totals['runs_double_counted']} double-counted, {totals['runs_lost']} lost, "
-          f"{totals['runs_traceback']} tracebacks")
+          f"{totals['runs_traceback']} tracebacks; {totals['runs_beyond_one_line']} interrupted runs printed more "
+          f"than one line ({totals['runs_group_sigint']} runs had a group SIGINT)")
     print(f"  (trials: {totals['trials_lost']} lost, {totals['trials_double_counted']} double-counted; runs: "
           f"{totals['runs_leaked_semaphore']} leaked semaphores, {totals['runs_orphans']} with orphans, "
           f"{totals['runs_not_resumed']} not resumed, {totals['runs_failed']} failed; {totals['wall_s']} s)")
