@@ -39,11 +39,13 @@ that each way of tearing is tried).
    records.csv that end with a newline and have the header's width); whether any phase's stderr
    holds "Traceback" or "leaked semaphore"; processes of a phase's group still alive ``--grace``
    seconds after its main process ended (orphans; killed then, before the next phase); whether a
-   resume exited 0; whether the summary.json then is byte-identical to the reference (only after
-   a resume exited 0: a run that finished before its kill already wrote one); and, read raw (not
-   through the package, whose reader repairs the file), whether the final records.csv has the
-   reference header, every reference trial exactly once (lost: missing; double-counted: extra rows
-   of one trial), no unknown trial, no invalid line and each row equal to the reference row.
+   phase stopped by a signal (exit 129, 130 or 143) printed more than its one line (stdout and
+   stderr together); whether a resume exited 0; whether the summary.json then is byte-identical
+   to the reference (only after a resume exited 0: a run that finished before its kill already
+   wrote one); and, read raw (not through the package, whose reader repairs the file), whether
+   the final records.csv has the reference header, every reference trial exactly once (lost:
+   missing; double-counted: extra rows of one trial), no unknown trial, no invalid line and each
+   row equal to the reference row.
 
 A run fails if no resume exits 0, its summary differs, a trial is lost or double-counted, or its
 records.csv is otherwise not the reference's (unknown trials, rows differing, invalid lines).
