@@ -10,6 +10,7 @@ while a second one still holds the old). Where ``fcntl`` is missing (Windows) no
 
 from __future__ import annotations
 
+import contextlib
 import os
 from pathlib import Path
 from types import TracebackType
@@ -52,8 +53,9 @@ class FolderLock:
             os.close(descriptor)
             raise FolderInUse(f"{self.what} {self.path.parent} is in use by another qrrt run (PID {holder}); "
                               f"wait for it to finish, or use another {self.what}") from None
-        os.ftruncate(descriptor, 0)
-        os.write(descriptor, f"{os.getpid()}\n".encode())
+        with contextlib.suppress(OSError):  # (a full disk: the lock holds, its PID is left unnamed)
+            os.ftruncate(descriptor, 0)
+            os.write(descriptor, f"{os.getpid()}\n".encode())
         self._descriptor = descriptor
         return self
 
