@@ -119,6 +119,14 @@ def group_members(pgid: int) -> list[tuple[int, str]]:
     return members
 
 
+def _default_signals() -> None:
+    """In the command's process, before it starts: the default dispositions of the signals sent.
+    A campaign started in the background (``cmd &``, ``nohup``) inherits SIGINT or SIGHUP ignored,
+    and a program keeps an ignored signal ignored, so its SIGINT runs would test nothing."""
+    for signum in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(signum, signal.SIG_DFL)
+
+
 def _kill_group(pgid: int) -> None:
     try:
         os.killpg(pgid, signal.SIGKILL)
@@ -138,7 +146,7 @@ def run_phase(command: list[str], env: dict[str, str], logs: Path, name: str, ti
     with open(logs / f"{name}.stdout", "wb") as out, open(logs / f"{name}.stderr", "wb") as err:
         start = time.monotonic()
         process = subprocess.Popen(command, env=env, stdout=out, stderr=err, stdin=subprocess.DEVNULL,
-                                   start_new_session=True)
+                                   start_new_session=True, preexec_fn=_default_signals)
     pgid = process.pid
     sent_s = None
     if kill_at is not None and signum is not None:
