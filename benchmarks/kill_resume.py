@@ -306,8 +306,10 @@ def make_references(args: argparse.Namespace, env: dict[str, str], work: Path) -
     return references
 
 
-def draw_plan(rng: np.random.Generator, runs: int, tear_every: int, second_every: int) -> list[dict]:
-    """Every run's executor, kill moments (as fractions), signals and tear, drawn up front."""
+def draw_plan(rng: np.random.Generator, runs: int, tear_every: int, second_every: int,
+              signals: tuple = SIGNALS) -> list[dict]:
+    """Every run's executor, kill moments (as fractions), signals (from ``signals``) and tear, drawn
+    up front."""
     plan, tears = [], 0
     for index in range(runs):
         number = index + 1
@@ -315,9 +317,9 @@ def draw_plan(rng: np.random.Generator, runs: int, tear_every: int, second_every
         kill_range = TEAR_KILL_RANGE if is_tear else KILL_RANGE
         entry = {"run": number, "executor": EXECUTORS[index % len(EXECUTORS)],
                  "kill_fraction": float(rng.uniform(*kill_range)),
-                 "signal": SIGNALS[int(rng.integers(len(SIGNALS)))],
+                 "signal": signals[int(rng.integers(len(signals)))],
                  "second_fraction": float(rng.uniform(*KILL_RANGE)),
-                 "second_signal": SIGNALS[int(rng.integers(len(SIGNALS)))],
+                 "second_signal": signals[int(rng.integers(len(signals)))],
                  "tear_fraction": float(rng.uniform()),
                  "second_kill": second_every > 0 and number % second_every == 0,
                  "tear": None}
@@ -421,6 +423,9 @@ def main() -> int:
     parser.add_argument("--attempts", type=int, default=3, help="resumes tried before a run counts as failed")
     parser.add_argument("--grace", type=float, default=10.0,
                         help="seconds a phase's workers may outlive its main process before they are killed")
+    parser.add_argument("--signals", nargs="+", default=[item.name for item in SIGNALS],
+                        choices=[item.name for item in SIGNALS],
+                        help="the signals drawn from (default all: SIGKILL SIGINT SIGTERM SIGHUP SIGINT-group)")
     parser.add_argument("--strict", action="store_true", help="tracebacks, leaked semaphores, orphans also fail")
     parser.add_argument("--keep-all", action="store_true", help="keep every run's folder, not only failed ones")
     parser.add_argument("--work", default=None, help="campaign folder (default: a fresh /tmp/kill_resume_*)")
@@ -447,7 +452,8 @@ def main() -> int:
     column = serial["header"].index("trial_id")
     reference = {"summary": serial["summary"], "header": serial["header"],
                  "by_id": {row[column]: row for row in serial["rows"]}}
-    plan = draw_plan(np.random.default_rng(args.seed), args.runs, args.tear_every, args.second_kill_every)
+    chosen = tuple(SIGNALS[[item.name for item in SIGNALS].index(name)] for name in args.signals)
+    plan = draw_plan(np.random.default_rng(args.seed), args.runs, args.tear_every, args.second_kill_every, chosen)
     print_header()
     rows = []
     for entry in plan:
@@ -493,6 +499,7 @@ def main() -> int:
     payload = {"machine": machine_description(), "experiment": args.experiment, "quick": args.quick,
                "seed": args.seed, "jobs": args.jobs, "tear_every": args.tear_every,
                "second_kill_every": args.second_kill_every, "attempts": args.attempts, "grace_s": args.grace,
+               "signals": list(args.signals),
                "strict": args.strict, "src": str(SRC), "work": str(work),
                "compared": "summary.json bytes without its provenance",
                "references": {executor: {"wall_s": ref["wall_s"], "records": len(ref["rows"]),
