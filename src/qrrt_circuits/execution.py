@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import logging
 import os
 import threading
 from collections.abc import Iterator
@@ -67,7 +68,7 @@ LOCAL_DASK_CONFIG = {"distributed.worker.profile.enabled": False, "distributed.a
 
 #: modules the fork server imports before forking any worker (the warm-up is the import)
 WORKER_PRELOAD = ("qrrt_circuits._support.worker_warmup",)
-#: what a local Dask cluster's fork server imports besides: Dask, and its workers' shutdown warnings
+#: what a local Dask cluster's fork server imports besides: Dask, and its workers' shutdown reports
 #: left out (``_support.quiet_dask_workers``)
 DASK_PRELOAD = ("distributed", "qrrt_circuits._support.quiet_dask_workers")
 #: imported by the fork server before anything else: SIGINT ignored (module text, "Interrupts")
@@ -346,33 +347,46 @@ def _local_dask(jobs: int, retries: int, local_directory: str | None) -> Iterato
             scratch.cleanup()
 
 
-#: the loggers a local Dask cluster's shutdown writes to (closing connections, missed heartbeats)
+#: the loggers a local Dask cluster's shutdown writes to (closing connections, missed heartbeats),
+#: with every logger under them
 DASK_LOGGERS = ("distributed", "tornado", "asyncio")
+
+
+def _dask_loggers() -> list[logging.Logger]:
+    """``DASK_LOGGERS`` and every logger created under them (Dask sets some of their levels)."""
+    names = [name for name in list(logging.root.manager.loggerDict)
+             if any(name == root or name.startswith(root + ".") for root in DASK_LOGGERS)]
+    return [logging.getLogger(name) for name in {*DASK_LOGGERS, *names}]
 
 
 @contextlib.contextmanager
 def _dask_logs_restored() -> Iterator[None]:
-    """The levels of ``DASK_LOGGERS`` as they were, once the block (the cluster's life) ends."""
-    import logging
+    """The levels of the Dask loggers (``_dask_loggers``) as they were once the block (the
+    cluster's life) ends; from the block's start, the client's reports of cancelled tasks and
+    closed connections are left out (``dask_noise.SHUTDOWN_NOISE`` on ``tornado.application`` and
+    ``distributed``, kept for the rest of the process: its event loop may report a task cancelled
+    by an interrupt after the cluster has closed)."""
+    from ._support.dask_noise import SHUTDOWN_NOISE
 
-    saved = {name: logging.getLogger(name).level for name in DASK_LOGGERS}
+    for name in ("tornado.application", "distributed"):
+        logging.getLogger(name).addFilter(SHUTDOWN_NOISE)  # (once: a filter already set is not added again)
+    saved = {logger: logger.level for logger in _dask_loggers()}
     try:
         yield
     finally:
-        for name, level in saved.items():
-            logging.getLogger(name).setLevel(level)
+        for logger in _dask_loggers():
+            logger.setLevel(saved.get(logger, logging.NOTSET))
 
 
 @contextlib.contextmanager
 def _dask_logs_silenced_on_exit() -> Iterator[None]:
-    """``DASK_LOGGERS`` silenced as the block ends, however it ends (the cluster then shuts down)."""
-    import logging
-
+    """The Dask loggers (``_dask_loggers``) silenced as the block ends, however it ends (the
+    cluster then shuts down)."""
     try:
         yield
     finally:
-        for name in DASK_LOGGERS:
-            logging.getLogger(name).setLevel(logging.CRITICAL + 1)
+        for logger in _dask_loggers():
+            logger.setLevel(logging.CRITICAL + 1)
 
 
 @contextlib.contextmanager

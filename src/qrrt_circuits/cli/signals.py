@@ -113,9 +113,15 @@ def _stop_signals() -> Iterator[_Received]:
 
 
 def _in_foreign_callback(frame: Any) -> bool:
-    """Whether the handler interrupted Python code that a C library called (``FOREIGN_CALLBACKS``):
-    an exception raised there would be printed as "Exception ignored" and lost."""
-    return frame is not None and any(part in frame.f_code.co_filename for part in FOREIGN_CALLBACKS)
+    """Whether the handler interrupted Python code that a C library called (``FOREIGN_CALLBACKS``)
+    or a finalizer (``__del__``) runs, at any depth: an exception raised there would be printed as
+    "Exception ignored" and lost."""
+    while frame is not None:
+        code = frame.f_code
+        if code.co_name == "__del__" or any(part in code.co_filename for part in FOREIGN_CALLBACKS):
+            return True
+        frame = frame.f_back
+    return False
 
 
 def _deliver_again(signum: int, received: _Received) -> None:
