@@ -5,8 +5,11 @@ q-RRT's time per oracle call, on the problem families of ``qrrt reproduce proble
 
 Per family, ``RUNS`` seeds of each planner plan until the goal or ``BUDGET`` motion checks:
 
-- ``rrt``: the library's RRT with OMPL's range (0.2 of the bounds' diagonal), goal bias 0.05 and no
-  look-ahead, the algorithm of OMPL's RRT;
+- ``rrt``: the library's RRT with OMPL's range (0.2 of the bounds' diagonal) and goal bias 0.05, the
+  algorithm of OMPL's RRT (the same tree whether rounds are tested ahead or not), with its default
+  look-ahead (rounds tested ahead in batches; the tests thrown away are in the wall time and in
+  ``wasted_per_check``);
+- ``rrt_one_by_one``: the same with ``look_ahead=False`` (one predicate call per oracle call);
 - ``ompl_rrt``: OMPL's ``geometric::RRT`` with its defaults (the same range and goal bias), the same
   predicate as its motion validator (``experiments.ompl_runs``), when the ``ompl`` extra is
   installed;
@@ -17,7 +20,9 @@ splits into the time inside the check and the planner's own time. Figures, per f
 ``us_per_check`` (wall time over motion checks or oracle calls), ``check_us_per_check`` (inside the
 predicate), ``own_us_per_check`` (the rest: sampling, nearest neighbours, tree, for q-RRT the
 database and the search), ``us_per_node``; and the ratios ``rrt_over_ompl_wall`` and
-``rrt_over_ompl_own`` (one run, same machine). Prints a table and writes JSON.
+``rrt_over_ompl_own`` (pooled: total time over total checks), and ``rrt_over_ompl_per_run`` (the
+ratio of the medians of each run's wall time per check, with a 95 % bootstrap interval), all in one
+run on one machine. Prints a table and writes JSON.
 """
 
 from __future__ import annotations
@@ -39,6 +44,8 @@ from qrrt_circuits.experiments.problems import build_problem, ompl_range  # noqa
 from qrrt_circuits.problems.families import Problem  # noqa: E402
 
 BUDGET = 5000
+#: the library's planners of the benchmark
+LIBRARY = ("rrt", "rrt_one_by_one", "qrrt")
 
 
 def timed(problem: Problem) -> list[float]:
@@ -61,8 +68,8 @@ def run_library(family: str, planner: str, seed: int) -> dict[str, float]:
     """One run of the library's ``rrt`` or ``qrrt`` on a fresh problem."""
     problem = build_problem(family, 0)
     spent = timed(problem)
-    if planner == "rrt":
-        plan = qc.RRT(goal_bias=0.05, max_extension=ompl_range(problem), look_ahead=False, seed=seed)
+    if planner in ("rrt", "rrt_one_by_one"):
+        plan = qc.RRT(goal_bias=0.05, max_extension=ompl_range(problem), look_ahead=planner == "rrt", seed=seed)
     else:
         plan = qc.QRRT(backend=qc.StatevectorBackend(seed=seed), search_policy=qc.Adaptive(),
                        goal_bias=0.05, seed=seed)
@@ -70,7 +77,8 @@ def run_library(family: str, planner: str, seed: int) -> dict[str, float]:
     result = plan.plan(problem, max_oracle_calls=BUDGET)
     wall = time.perf_counter() - began
     return {"wall_s": wall, "check_s": spent[0], "checks": result.metrics.oracle_calls,
-            "nodes": result.metrics.nodes, "reached": float(result.reached)}
+            "nodes": result.metrics.nodes, "reached": float(result.reached),
+            "wasted": result.metrics.wasted_checks}
 
 
 def run_ompl(family: str, seed: int) -> dict[str, float]:
@@ -81,7 +89,21 @@ def run_ompl(family: str, seed: int) -> dict[str, float]:
     spent = timed(problem)
     run = ompl_run(problem, "OMPL RRT", BUDGET, seed + 1, 0.05)
     return {"wall_s": run.wall_time_s, "check_s": spent[0], "checks": run.motion_checks, "nodes": float("nan"),
-            "reached": float(run.reached)}
+            "reached": float(run.reached), "wasted": 0}
+
+
+def per_run(runs: list[dict[str, float]]) -> np.ndarray:
+    """Each run's wall time per motion check, in microseconds."""
+    return np.array([1e6 * r["wall_s"] / max(r["checks"], 1) for r in runs])
+
+
+def ratio_of_medians(mine: np.ndarray, peer: np.ndarray, seed: int = 0) -> dict[str, float]:
+    """median(mine) / median(peer) (wall time per check, one run each seed) with a 95 % percentile
+    bootstrap interval (runs resampled within each planner, 2 000 resamples)."""
+    rng = np.random.default_rng(seed)
+    draws = [np.median(rng.choice(mine, mine.size)) / np.median(rng.choice(peer, peer.size)) for _ in range(2000)]
+    low, high = np.percentile(draws, [2.5, 97.5])
+    return {"median": float(np.median(mine) / np.median(peer)), "low": float(low), "high": float(high)}
 
 
 def figures(runs: list[dict[str, float]]) -> dict[str, float]:
@@ -93,7 +115,8 @@ def figures(runs: list[dict[str, float]]) -> dict[str, float]:
     return {"us_per_check": 1e6 * wall / checks, "check_us_per_check": 1e6 * check / checks,
             "own_us_per_check": 1e6 * (wall - check) / checks,
             "us_per_node": 1e6 * wall / nodes if np.isfinite(nodes) and nodes else float("nan"),
-            "checks": float(checks), "success_rate": float(np.mean([r["reached"] for r in runs]))}
+            "checks": float(checks), "wasted_per_check": sum(r["wasted"] for r in runs) / checks,
+            "success_rate": float(np.mean([r["reached"] for r in runs]))}
 
 
 def main() -> None:
@@ -107,22 +130,28 @@ def main() -> None:
     have_ompl = importlib.util.find_spec("ompl") is not None
     out: dict[str, Any] = {"machine": machine(), "budget": BUDGET, "runs": runs, "ompl": have_ompl, "figures": {}}
     header = ("family", "planner", "us/check", "in check", "own", "us/node", "success")
-    print(f"{header[0]:20s} {header[1]:9s} " + " ".join(f"{h:>9s}" for h in header[2:]))
+    print(f"{header[0]:20s} {header[1]:14s} " + " ".join(f"{h:>9s}" for h in header[2:]))
     for family in families:
-        for planner in ("rrt", "qrrt"):
+        for planner in LIBRARY:
             run_library(family, planner, 10_000)  # warm-up: numba compilation, caches
-        rows = {planner: figures([run_library(family, planner, seed) for seed in range(runs)])
-                for planner in ("rrt", "qrrt")}
+        raw = {planner: [run_library(family, planner, seed) for seed in range(runs)] for planner in LIBRARY}
         if have_ompl:
             run_ompl(family, 10_000)
-            rows["ompl_rrt"] = figures([run_ompl(family, seed) for seed in range(runs)])
+            raw["ompl_rrt"] = [run_ompl(family, seed) for seed in range(runs)]
+        rows: dict[str, Any] = {planner: figures(value) for planner, value in raw.items()}
+        if have_ompl:
             rows["ratios"] = {"rrt_over_ompl_wall": rows["rrt"]["us_per_check"] / rows["ompl_rrt"]["us_per_check"],
                               "rrt_over_ompl_own": rows["rrt"]["own_us_per_check"]
-                              / rows["ompl_rrt"]["own_us_per_check"]}
+                              / rows["ompl_rrt"]["own_us_per_check"],
+                              "rrt_one_by_one_over_ompl_wall": rows["rrt_one_by_one"]["us_per_check"]
+                              / rows["ompl_rrt"]["us_per_check"],
+                              "rrt_over_ompl_per_run": ratio_of_medians(per_run(raw["rrt"]), per_run(raw["ompl_rrt"])),
+                              "rrt_one_by_one_over_ompl_per_run": ratio_of_medians(
+                                  per_run(raw["rrt_one_by_one"]), per_run(raw["ompl_rrt"]))}
         out["figures"][family] = rows
         for planner, row in rows.items():
             if planner != "ratios":
-                print(f"{family:20s} {planner:9s} {row['us_per_check']:9.1f} {row['check_us_per_check']:9.1f} "
+                print(f"{family:20s} {planner:14s} {row['us_per_check']:9.1f} {row['check_us_per_check']:9.1f} "
                       f"{row['own_us_per_check']:9.1f} {row['us_per_node']:9.1f} {row['success_rate']:8.2f}")
         if "ratios" in rows:
             print(f"{family:20s} RRT / OMPL RRT: wall per check {rows['ratios']['rrt_over_ompl_wall']:.2f}x, "

@@ -382,3 +382,21 @@ def test_each_space_chooses_its_structure_once_empty():
     assert isinstance(grid, GridNearest) and grid.dim == 2 and grid.size == 0
     assert isinstance(scan, LinearNearest) and scan.space == qc.SE2Space() and scan.size == 0
     assert qc.RealVectorSpace(2).nearest_neighbors() is not grid  # a new structure per call (per plan)
+
+
+@pytest.mark.parametrize("make", [lambda: GridNearest(3), lambda: LinearNearest(qc.SE2Space()),
+                                  lambda: LinearNearest(qc.RealVectorSpace(3))], ids=["grid", "se2", "euclidean"])
+@pytest.mark.parametrize("count", [5, 700])  # (700: past the grid's brute-force switch)
+def test_the_distance_to_the_points_added_since_an_index_is_the_brute_force(make, count):
+    """``nearest_distance_from(queries, first)``: the smallest distance, under the structure's
+    metric, to the points of index ``first`` on; ``inf`` where there are none."""
+    rng = np.random.default_rng(count)
+    near = make()
+    space = near.space if isinstance(near, LinearNearest) else qc.RealVectorSpace(3)
+    points = _se2_points(rng, count)
+    near.add(points)
+    queries = _se2_points(rng, 9)
+    for first in (0, 1, count // 2, count - 1, count):
+        want = [min((float(space.distance(points[index], query)[0]) for index in range(first, count)),
+                    default=math.inf) for query in queries]
+        np.testing.assert_allclose(near.nearest_distance_from(queries, first), want, rtol=1e-12)

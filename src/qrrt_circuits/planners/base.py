@@ -40,6 +40,7 @@ from .result import Metrics, PlanResult
 from .run_state import RunState
 from .termination import (
     PlanStatus,
+    Progress,
     TerminationCondition,
     from_budgets,
     limits_in_force,
@@ -229,12 +230,19 @@ class Planner:
         """The round loop: check the condition before every round, run the round, record it; until
         the goal or the end."""
         while state.goal_node is None:
-            ended = condition.ended_by(state.progress(time.perf_counter() - began))
+            progress = state.progress(time.perf_counter() - began)
+            ended = condition.ended_by(progress)
             if ended is not None:
                 return ended
-            self._round(state)
-            state.end_round()
+            self._rounds(state, condition, progress)
         return PlanStatus.REACHED
+
+    def _rounds(self, state: RunState, condition: TerminationCondition, progress: Progress) -> None:
+        """Run and record (``RunState.end_round``) one round or more, all but the last adding no
+        node, each one that ``condition`` lets start (``termination.rounds_that_start`` from
+        ``progress``, the counters now, which it let start); here one ``_round``."""
+        self._round(state)
+        state.end_round()
 
     def _check_serves(self, problem: Problem) -> None:
         """Refuse, before any work, a problem this planner's settings cannot serve (none here)."""

@@ -84,13 +84,17 @@ class RunState:
         """Nodes in the tree, root excluded."""
         return self.tree.size - 1
 
-    def add_node(self, position: np.ndarray, parent: int) -> int:
+    def add_node(self, position: np.ndarray, parent: int, in_goal: bool | None = None) -> int:
         """Add one node (``Tree.add``, and to the nearest-neighbour structure); the first node that
-        satisfies the goal becomes ``goal_node``."""
+        satisfies the goal becomes ``goal_node``. ``in_goal``: whether it does, where the caller
+        has asked the goal already (None: asked here)."""
         index = self.tree.add(position, parent)
         self.neighbors.add(position.reshape(1, -1))
-        if self.goal_node is None and first_satisfying(self.goal, position.reshape(1, -1)) == 0:
-            self.goal_node = index
+        if self.goal_node is None:
+            if in_goal is None:
+                in_goal = first_satisfying(self.goal, position.reshape(1, -1)) == 0
+            if in_goal:
+                self.goal_node = index
         return index
 
     def add_nodes(self, positions: np.ndarray, parents: np.ndarray) -> None:
@@ -107,6 +111,24 @@ class RunState:
     def progress(self, elapsed_s: float) -> Progress:
         return Progress(self.oracle_calls, self.critical_path, self.nodes, self.rounds,
                         self.rounds_without_new_node, elapsed_s)
+
+    def end_idle_rounds(self, count: int, calls: int) -> None:
+        """Record ``count`` rounds that each tested ``calls`` candidates classically (``calls``
+        verification calls, critical path 1), found none reachable and added no node: the counters
+        and history ``count`` calls of ``end_round`` after such rounds would leave."""
+        if count <= 0:
+            return
+        history, nodes = self.history, self.tree.size - 1
+        calls_before = self.quantum_calls + self.verification_calls
+        history["oracle_calls"].extend(range(calls_before + calls, calls_before + (count + 1) * calls, calls))
+        history["critical_path"].extend(range(self.critical_path + 1, self.critical_path + count + 1))
+        history["nodes"].extend([nodes] * count)
+        history["entries"].extend([calls] * count)
+        history["reachable"].extend([0] * count)
+        self.verification_calls += count * calls
+        self.critical_path += count
+        self.rounds += count
+        self.rounds_without_new_node += count
 
     def end_round(self) -> None:
         self.rounds += 1

@@ -257,8 +257,29 @@ def ball_of(goal: Goal) -> tuple[np.ndarray, float] | None:
     return np.asarray(centre, dtype=float).reshape(-1), float(radius)
 
 
+def satisfying(goal: Goal, points: np.ndarray) -> np.ndarray:
+    """Bool (M,): which rows of ``points`` satisfy ``goal`` (its ``is_satisfied``, checked).
+
+    Args:
+        goal: Any ``Goal``.
+        points: Float (M, d) or (d,).
+
+    Returns:
+        Bool (M,).
+
+    Raises:
+        ValueError: An ``is_satisfied`` whose answer is not M booleans.
+    """
+    points = np.atleast_2d(points)
+    answers = np.asarray(goal.is_satisfied(points))
+    if answers.shape != (points.shape[0],):
+        raise ValueError(f"the goal's is_satisfied must return {points.shape[0]} booleans for {points.shape[0]} "
+                         f"points, got shape {answers.shape}")
+    return answers.astype(bool)
+
+
 def first_satisfying(goal: Goal, points: np.ndarray) -> int:
-    """The first row of ``points`` that satisfies ``goal``, or -1.
+    """The first row of ``points`` that satisfies ``goal`` (``satisfying``), or -1.
 
     Args:
         goal: Any ``Goal``.
@@ -270,12 +291,7 @@ def first_satisfying(goal: Goal, points: np.ndarray) -> int:
     Raises:
         ValueError: An ``is_satisfied`` whose answer is not M booleans.
     """
-    points = np.atleast_2d(points)
-    answers = np.asarray(goal.is_satisfied(points))
-    if answers.shape != (points.shape[0],):
-        raise ValueError(f"the goal's is_satisfied must return {points.shape[0]} booleans for {points.shape[0]} "
-                         f"points, got shape {answers.shape}")
-    hits = np.flatnonzero(answers.astype(bool))
+    hits = np.flatnonzero(satisfying(goal, points))
     return int(hits[0]) if hits.size else -1
 
 

@@ -88,6 +88,12 @@ class NearestNeighbors(Protocol):
         """Int (M,): the index of the point nearest to each row of ``queries`` ((M, d) or (d,))."""
         ...
 
+    def nearest_distance_from(self, queries: np.ndarray, first: int) -> np.ndarray:
+        """Float (M,): the distance from each row of ``queries`` to the nearest of the points of
+        index ``first`` on (``inf`` where there are none): whether a point added since index
+        ``first`` may have taken a query's nearest."""
+        ...
+
 
 class _Points:
     """A growable (size, d) buffer of points, the storage every structure keeps of what it holds."""
@@ -181,6 +187,20 @@ class LinearNearest(_Points):
             out[first:first + block.shape[0]] = np.argmin(distance.reshape(block.shape[0], count), axis=1)
         return out
 
+    def nearest_distance_from(self, queries: np.ndarray, first: int) -> np.ndarray:
+        """Float (M,): the distance, under the space's metric, from each of ``queries`` to the
+        nearest of the points of index ``first`` on (``inf`` where there are none)."""
+        queries = self.queries(queries)
+        points = self.points[max(0, first):]
+        count = points.shape[0]
+        out = np.full(queries.shape[0], np.inf)
+        step = max(1, _CHUNK // max(count, 1))
+        for start in range(0, queries.shape[0] if count else 0, step):
+            block = queries[start:start + step]
+            distance = self.space.distance(np.repeat(block, count, axis=0), np.tile(points, (block.shape[0], 1)))
+            out[start:start + block.shape[0]] = distance.reshape(block.shape[0], count).min(axis=1)
+        return out
+
 
 class GridNearest(_Points):
     """Exact Euclidean nearest points, compiled: brute force for small structures, a bucket grid
@@ -238,6 +258,18 @@ class GridNearest(_Points):
         # which scans the same points (vectorized over the queries)
         nearest_into(queries, *self._search_arrays(self.size >= BRUTE_FORCE_BELOW and self._several_cells), out)
         return out
+
+    def nearest_distance_from(self, queries: np.ndarray, first: int) -> np.ndarray:
+        """Float (M,): the Euclidean distance from each of ``queries`` to the nearest of the points
+        of index ``first`` on (``inf`` where there are none), by the brute-force block.
+
+        Raises:
+            ValueError: ``queries`` not of shape (M, d) or (d,) for the structure's d.
+        """
+        queries = self.queries(queries)
+        best = np.empty(queries.shape[0])
+        _brute_block(queries, self._buffer, max(0, first), self.size, best, np.empty(queries.shape[0], np.int64))
+        return np.sqrt(best)
 
     def grid_nearest(self, queries: np.ndarray) -> np.ndarray:
         """``nearest`` through the grid whatever the structure's size (for tests, and for comparing
