@@ -22,16 +22,20 @@ predicate), ``own_us_per_check`` (the rest: sampling, nearest neighbours, tree, 
 database and the search), ``us_per_node``; and the ratios ``rrt_over_ompl_wall`` and
 ``rrt_over_ompl_own`` (pooled: total time over total checks), and ``rrt_over_ompl_per_run`` (the
 ratio of the medians of each run's wall time per check, with a 95 % bootstrap interval), all in one
-run on one machine. Prints a table and writes JSON.
+run on one machine. ``profile``: where one plan's time goes on the maze family, per planner
+(``cProfile``, the functions with the most own time, microseconds per round). Prints a table and
+writes JSON.
 """
 
 from __future__ import annotations
 
 import argparse
+import functools
 import importlib.util
 import os
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
@@ -64,15 +68,18 @@ def timed(problem: Problem) -> list[float]:
     return spent
 
 
+def make(planner: str, problem: Problem, seed: int) -> qc.Planner:
+    """The library's ``rrt``, ``rrt_one_by_one`` or ``qrrt`` of the benchmark."""
+    if planner in ("rrt", "rrt_one_by_one"):
+        return qc.RRT(goal_bias=0.05, max_extension=ompl_range(problem), look_ahead=planner == "rrt", seed=seed)
+    return qc.QRRT(backend=qc.StatevectorBackend(seed=seed), search_policy=qc.Adaptive(), goal_bias=0.05, seed=seed)
+
+
 def run_library(family: str, planner: str, seed: int) -> dict[str, float]:
     """One run of the library's ``rrt`` or ``qrrt`` on a fresh problem."""
     problem = build_problem(family, 0)
     spent = timed(problem)
-    if planner in ("rrt", "rrt_one_by_one"):
-        plan = qc.RRT(goal_bias=0.05, max_extension=ompl_range(problem), look_ahead=planner == "rrt", seed=seed)
-    else:
-        plan = qc.QRRT(backend=qc.StatevectorBackend(seed=seed), search_policy=qc.Adaptive(),
-                       goal_bias=0.05, seed=seed)
+    plan = make(planner, problem, seed)
     began = time.perf_counter()
     result = plan.plan(problem, max_oracle_calls=BUDGET)
     wall = time.perf_counter() - began
@@ -119,6 +126,29 @@ def figures(runs: list[dict[str, float]]) -> dict[str, float]:
             "success_rate": float(np.mean([r["reached"] for r in runs]))}
 
 
+def round_profile(family: str, planner: str, seed: int = 0, top: int = 15) -> dict[str, Any]:
+    """Where one plan's time goes: ``cProfile`` of ``run_library(family, planner, seed)``, the
+    ``top`` functions by their own time, in microseconds per round (profiling slows every call, so
+    the shares matter, not the totals)."""
+    import cProfile
+    import pstats
+
+    profiler = cProfile.Profile()
+    problem = build_problem(family, 0)
+    plan = make(planner, problem, seed)
+    profiler.enable()
+    result = plan.plan(problem, max_oracle_calls=BUDGET)
+    profiler.disable()
+    rounds = max(result.metrics.rounds, 1)
+    stats = pstats.Stats(profiler).stats  # type: ignore[attr-defined]
+    total = sum(entry[2] for entry in stats.values())
+    rows = sorted(stats.items(), key=lambda item: -item[1][2])[:top]
+    return {"rounds": rounds, "total_us_per_round": 1e6 * total / rounds,
+            "functions": [{"function": f"{Path(key[0]).name}:{key[1]}({key[2]})", "calls_per_round": entry[1] / rounds,
+                           "own_us_per_round": 1e6 * entry[2] / rounds, "share": entry[2] / total}
+                          for key, entry in rows]}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true")
@@ -132,12 +162,16 @@ def main() -> None:
     header = ("family", "planner", "us/check", "in check", "own", "us/node", "success")
     print(f"{header[0]:20s} {header[1]:14s} " + " ".join(f"{h:>9s}" for h in header[2:]))
     for family in families:
-        for planner in LIBRARY:
-            run_library(family, planner, 10_000)  # warm-up: numba compilation, caches
-        raw = {planner: [run_library(family, planner, seed) for seed in range(runs)] for planner in LIBRARY}
+        planners: dict[str, Callable[[int], dict[str, float]]] = {
+            name: functools.partial(run_library, family, name) for name in LIBRARY}
         if have_ompl:
-            run_ompl(family, 10_000)
-            raw["ompl_rrt"] = [run_ompl(family, seed) for seed in range(runs)]
+            planners["ompl_rrt"] = functools.partial(run_ompl, family)
+        raw: dict[str, list[dict[str, float]]] = {name: [] for name in planners}
+        for run in planners.values():
+            run(10_000)  # warm-up: numba compilation, caches
+        for seed in range(runs):  # interleaved: a burst of load on the machine falls on every planner
+            for name, run in planners.items():
+                raw[name].append(run(seed))
         rows: dict[str, Any] = {planner: figures(value) for planner, value in raw.items()}
         if have_ompl:
             rows["ratios"] = {"rrt_over_ompl_wall": rows["rrt"]["us_per_check"] / rows["ompl_rrt"]["us_per_check"],
@@ -156,6 +190,7 @@ def main() -> None:
         if "ratios" in rows:
             print(f"{family:20s} RRT / OMPL RRT: wall per check {rows['ratios']['rrt_over_ompl_wall']:.2f}x, "
                   f"own time per check {rows['ratios']['rrt_over_ompl_own']:.2f}x")
+    out["profile"] = {planner: round_profile("maze", planner) for planner in LIBRARY}
     if not have_ompl:
         print("OMPL is not installed (pip install 'qrrt-circuits[ompl]'): the OMPL figures were skipped")
     print(f"wrote {write_json('bench_problems', out, args.out)}")
