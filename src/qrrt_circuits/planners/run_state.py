@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._support.memory import HISTORY_ROUNDS_CHECKED_UP_FRONT, check_history_growth
 from ..problems.goals import Goal, first_satisfying
 from .termination import Progress
 from .tree import Tree
@@ -21,7 +22,9 @@ HISTORY_KEYS = ("oracle_calls", "critical_path", "nodes", "entries", "reachable"
 
 
 class RunState:
-    """Counters of DESIGN §2 as a plan accumulates them; ``end_round`` appends the history.
+    """Counters of DESIGN §2 as a plan accumulates them; ``end_round`` appends the history (and,
+    from ``HISTORY_ROUNDS_CHECKED_UP_FRONT`` rounds on, checks at each doubling that the memory
+    holds it: ``memory.check_history_growth``).
 
     Args:
         root: Float (d,), the tree's root.
@@ -50,6 +53,7 @@ class RunState:
         self.round_entries = 0
         self.round_reachable = 0
         self._nodes_at_round_start = 0
+        self._check_history_at = HISTORY_ROUNDS_CHECKED_UP_FRONT  # (memory.check_history_growth)
         self.policy_state: PolicyState | None = None  # quantum planners only
         self.context: WorkerContext | None = None  # the plan's WorkerContext, built once
         self.ahead: LookAhead | None = None  # classical planners only
@@ -129,6 +133,8 @@ class RunState:
         self.critical_path += count
         self.rounds += count
         self.rounds_without_new_node += count
+        while self.rounds >= self._check_history_at:
+            self._check_history_at = check_history_growth(self._check_history_at)
 
     def end_round(self) -> None:
         self.rounds += 1
@@ -142,3 +148,5 @@ class RunState:
         history["entries"].append(self.round_entries)
         history["reachable"].append(self.round_reachable)
         self.round_entries = self.round_reachable = 0
+        if self.rounds >= self._check_history_at:
+            self._check_history_at = check_history_growth(self._check_history_at)
