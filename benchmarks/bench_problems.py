@@ -13,7 +13,11 @@ Per family, ``RUNS`` seeds of each planner plan until the goal or ``BUDGET`` mot
 - ``ompl_rrt``: OMPL's ``geometric::RRT`` with its defaults (the same range and goal bias), the same
   predicate as its motion validator (``experiments.ompl_runs``), when the ``ompl`` extra is
   installed;
-- ``qrrt``: q-RRT with ``Adaptive()``, 2^8 databases on the exact statevector.
+- ``qrrt``: q-RRT with ``Adaptive()``, 2^8 databases on the exact statevector;
+- ``*_python_check`` (with OMPL): ``rrt``, ``rrt_one_by_one`` and ``ompl_rrt`` with the predicate
+  asked one pair at a time from a Python loop, each pair also paying ``PYTHON_WORK`` Python
+  additions (``PairByPair``): a checker whose cost is Python's and dominates, the same on both
+  sides.
 
 Every planner's predicate is timed (its ``reachable`` wrapped by a timer), so a run's wall time
 splits into the time inside the check and the planner's own time. Figures, per family and planner:
@@ -68,6 +72,41 @@ def timed(problem: Problem) -> list[float]:
     return spent
 
 
+#: Python additions ``PairByPair`` makes per pair besides the check (a user's own Python work)
+PYTHON_WORK = 2000
+
+
+class PairByPair:
+    """The problem's predicate asked one pair at a time from a Python loop, each pair also paying
+    ``PYTHON_WORK`` Python additions: a checker whose cost is Python's and dominates the planner's,
+    the same answers on both sides."""
+
+    def __init__(self, inner: Any) -> None:
+        self.inner, self.dim, self.name = inner, inner.dim, f"{inner.name}, pair by pair"
+
+    def reachable(self, parents: np.ndarray, children: np.ndarray) -> np.ndarray:
+        parents, children = np.atleast_2d(parents), np.atleast_2d(children)
+        answers = np.empty(children.shape[0], dtype=bool)
+        for row in range(children.shape[0]):
+            total = 0
+            for step in range(PYTHON_WORK):
+                total += step
+            answers[row] = bool(self.inner.reachable(parents[row:row + 1], children[row:row + 1])[0]) and total >= 0
+        return answers
+
+    def describe(self) -> dict:
+        return self.inner.describe() | {"pair_by_pair": True}
+
+    def __getattr__(self, name: str) -> Any:  # (is_valid, can_leave, ... of the inner check)
+        return getattr(self.inner, name)
+
+
+def posed(family: str, python_check: bool) -> Problem:
+    """The family's world 0, its predicate asked pair by pair with ``python_check``."""
+    problem = build_problem(family, 0)
+    return problem.replace(predicate=PairByPair(problem.predicate)) if python_check else problem
+
+
 def make(planner: str, problem: Problem, seed: int) -> qc.Planner:
     """The library's ``rrt``, ``rrt_one_by_one`` or ``qrrt`` of the benchmark."""
     if planner in ("rrt", "rrt_one_by_one"):
@@ -75,9 +114,9 @@ def make(planner: str, problem: Problem, seed: int) -> qc.Planner:
     return qc.QRRT(backend=qc.StatevectorBackend(seed=seed), search_policy=qc.Adaptive(), goal_bias=0.05, seed=seed)
 
 
-def run_library(family: str, planner: str, seed: int) -> dict[str, float]:
-    """One run of the library's ``rrt`` or ``qrrt`` on a fresh problem."""
-    problem = build_problem(family, 0)
+def run_library(family: str, planner: str, seed: int, python_check: bool = False) -> dict[str, float]:
+    """One run of the library's ``rrt``, ``rrt_one_by_one`` or ``qrrt`` on a fresh problem."""
+    problem = posed(family, python_check)
     spent = timed(problem)
     plan = make(planner, problem, seed)
     began = time.perf_counter()
@@ -88,11 +127,11 @@ def run_library(family: str, planner: str, seed: int) -> dict[str, float]:
             "wasted": result.metrics.wasted_checks}
 
 
-def run_ompl(family: str, seed: int) -> dict[str, float]:
+def run_ompl(family: str, seed: int, python_check: bool = False) -> dict[str, float]:
     """One run of OMPL's RRT on a fresh problem (its node count is not read back: NaN)."""
     from qrrt_circuits.experiments.ompl_runs import ompl_run
 
-    problem = build_problem(family, 0)
+    problem = posed(family, python_check)
     spent = timed(problem)
     run = ompl_run(problem, "OMPL RRT", BUDGET, seed + 1, 0.05)
     return {"wall_s": run.wall_time_s, "check_s": spent[0], "checks": run.motion_checks, "nodes": float("nan"),
@@ -166,6 +205,9 @@ def main() -> None:
             name: functools.partial(run_library, family, name) for name in LIBRARY}
         if have_ompl:
             planners["ompl_rrt"] = functools.partial(run_ompl, family)
+            for name in ("rrt", "rrt_one_by_one"):
+                planners[f"{name}_python_check"] = functools.partial(run_library, family, name, python_check=True)
+            planners["ompl_rrt_python_check"] = functools.partial(run_ompl, family, python_check=True)
         raw: dict[str, list[dict[str, float]]] = {name: [] for name in planners}
         for run in planners.values():
             run(10_000)  # warm-up: numba compilation, caches
@@ -181,7 +223,11 @@ def main() -> None:
                               / rows["ompl_rrt"]["us_per_check"],
                               "rrt_over_ompl_per_run": ratio_of_medians(per_run(raw["rrt"]), per_run(raw["ompl_rrt"])),
                               "rrt_one_by_one_over_ompl_per_run": ratio_of_medians(
-                                  per_run(raw["rrt_one_by_one"]), per_run(raw["ompl_rrt"]))}
+                                  per_run(raw["rrt_one_by_one"]), per_run(raw["ompl_rrt"])),
+                              "python_check_rrt_over_ompl_per_run": ratio_of_medians(
+                                  per_run(raw["rrt_python_check"]), per_run(raw["ompl_rrt_python_check"])),
+                              "python_check_rrt_one_by_one_over_ompl_per_run": ratio_of_medians(
+                                  per_run(raw["rrt_one_by_one_python_check"]), per_run(raw["ompl_rrt_python_check"]))}
         out["figures"][family] = rows
         for planner, row in rows.items():
             if planner != "ratios":
