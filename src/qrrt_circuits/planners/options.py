@@ -18,6 +18,7 @@ refused by name.
 from __future__ import annotations
 
 import dataclasses
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass, field, fields
 from typing import Any, TypeVar
@@ -72,8 +73,9 @@ def declare(default: Any, check: Callable[[Any, str], Any], help: str, flag: str
     return field(default=default, metadata=metadata)
 
 
+@functools.cache
 def option_specs(options_type: type[PlannerOptions]) -> tuple[OptionSpec, ...]:
-    """The declared options of an options class, in declaration order.
+    """The declared options of an options class, in declaration order (read once per class).
 
     Args:
         options_type: ``PlannerOptions`` or a subclass.
