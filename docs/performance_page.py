@@ -453,9 +453,9 @@ def _other_results(root: Path) -> list[str]:
     files = sorted(path.name for path in (root / RESULTS).iterdir()
                    if path.name not in (RUN.name, BASELINE.name) and not path.name.startswith("."))
     return ["## Other results kept", "",
-            f"`{RESULTS.as_posix()}/` also keeps {len(files)} results of measurements `benchmarks/run.py` does not "
-            "make (other modes of a script, the GPU, comparisons of two checkouts, a reliability campaign); each "
-            "names the script that wrote it and carries its provenance inside.", ""]
+            f"`{RESULTS.as_posix()}/` also keeps the results of measurements `benchmarks/run.py` does not make "
+            f"(other modes of a script, the GPU, comparisons of two checkouts, a reliability campaign; files: "
+            f"{len(files)}); each names the script that wrote it and carries its provenance inside.", ""]
 
 
 # ------------------------------------------------------------------------------------------ the page

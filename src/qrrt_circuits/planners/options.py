@@ -18,7 +18,6 @@ refused by name.
 from __future__ import annotations
 
 import dataclasses
-import functools
 from collections.abc import Callable
 from dataclasses import dataclass, field, fields
 from typing import Any, TypeVar
@@ -73,7 +72,10 @@ def declare(default: Any, check: Callable[[Any, str], Any], help: str, flag: str
     return field(default=default, metadata=metadata)
 
 
-@functools.cache
+#: ``option_specs`` of each options class, read once
+_SPECS: dict[type, tuple[OptionSpec, ...]] = {}
+
+
 def option_specs(options_type: type[PlannerOptions]) -> tuple[OptionSpec, ...]:
     """The declared options of an options class, in declaration order (read once per class).
 
@@ -83,10 +85,13 @@ def option_specs(options_type: type[PlannerOptions]) -> tuple[OptionSpec, ...]:
     Returns:
         One ``OptionSpec`` per field.
     """
-    return tuple(OptionSpec(item.name, item.default, item.metadata["check"], item.metadata["help"],
-                            item.metadata["flag"], item.metadata["text"],
-                            item.metadata.get("describe", lambda value: value))
-                 for item in fields(options_type))
+    specs = _SPECS.get(options_type)
+    if specs is None:
+        specs = _SPECS[options_type] = tuple(
+            OptionSpec(item.name, item.default, item.metadata["check"], item.metadata["help"], item.metadata["flag"],
+                       item.metadata["text"], item.metadata.get("describe", lambda value: value))
+            for item in fields(options_type))
+    return specs
 
 
 def _goal_bias(value: Any, name: str) -> float:
