@@ -107,6 +107,8 @@ def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
     plan.add_argument("--no-compare", action="store_true",
                       help="do not plan with the quantum planner's classical peer (RRT for q-RRT, parallel RRT "
                            "for Pq-RRT) in the same world to print the two side by side")
+    plan.add_argument("--no-progress", action="store_true",
+                      help="hide the progress bar (shown only when stdout and stderr are terminals)")
     plan.set_defaults(func=cmd_plan)
 
 
