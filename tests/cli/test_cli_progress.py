@@ -35,7 +35,7 @@ def test_on_round_sees_every_round_and_the_final_counts():
     assert len(seen) == result.metrics.rounds
     assert [p.rounds for p in seen] == list(range(1, result.metrics.rounds + 1))
     assert seen[-1].nodes == result.metrics.nodes and seen[-1].oracle_calls == result.metrics.oracle_calls
-    assert all(a.oracle_calls <= b.oracle_calls and a.nodes <= b.nodes for a, b in zip(seen, seen[1:]))
+    assert all(a.oracle_calls <= b.oracle_calls and a.nodes <= b.nodes for a, b in zip(seen, seen[1:], strict=False))
 
 
 def test_on_round_does_not_change_the_plan():
