@@ -124,6 +124,10 @@ class OMPLGoalRegion:
             out[row] = self.coordinates.read(state)
         return out
 
+    def __repr__(self) -> str:
+        fields = ", ".join(f"{key}={value}" for key, value in self.describe().items() if key != "kind")
+        return f"OMPLGoalRegion({fields})"
+
     def describe(self) -> dict:
         described: dict[str, Any] = {"kind": "ompl", "type": type(self.goal).__name__}
         if self.goal.hasType(ob.GoalType.GOAL_REGION):
