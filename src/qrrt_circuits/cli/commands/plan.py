@@ -106,8 +106,8 @@ def _print_notes(result: PlanResult, planner: Planner) -> None:
         print(f"note: most oracle calls were classical verifications ({verifications} of {metrics.oracle_calls}; "
               f"{quantum} quantum): the searches ran {quantum / verifications:.2f} Grover iterations per "
               "measurement on average, and a measurement after 0 iterations is a uniform draw from the database, "
-              "checked classically as RRT checks its samples; so most of this plan's calls are classical, and its "
-              "calls per node say little about quantum search.")
+              "checked classically as RRT checks its samples: the fewer the iterations, the closer this plan's calls "
+              "are to classical sampling's.")
     if verifications and metrics.rejected / verifications > OVER_ROTATION_SHARE:
         entries = int(result.history["entries"].sum())
         share = int(result.history["reachable"].sum()) / entries if entries else 0.0
