@@ -42,7 +42,8 @@ def gap_setup(goal_threshold: float = 0.5) -> og.SimpleSetup:
 def test_a_setup_becomes_a_problem_the_planners_take():
     problem = problem_from_setup(gap_setup())
     assert problem.env.bounds.tolist() == [[0.0, 10.0], [0.0, 10.0]] and problem.start.tolist() == [1.0, 1.0]
-    assert isinstance(problem.goal, qc.GoalState) and problem.goal.threshold == 0.5
+    assert isinstance(problem.goal, OMPLGoalRegion) and problem.goal.describe()["threshold"] == 0.5
+    assert problem.goal.describe()["state"] == [9.0, 9.0] and not problem.goal.has_volume
     assert problem.predicate.is_valid(np.array([[5.0, 1.0], [5.0, 5.0]])).tolist() == [False, True]
     for make in (lambda: qc.RRT(goal_bias=0.05, seed=0),
                  lambda: qc.QRRT(backend=qc.StatevectorBackend(seed=0), num_qubits=4, goal_bias=0.05,

@@ -140,6 +140,7 @@ class Planner:
         max_time_s: float | None = None,
         max_critical_path_calls: int | None = None,
         stall_rounds: int | None = None,
+        on_round: Callable[[Progress], None] | None = None,
     ) -> PlanResult:
         """Grow a tree from the problem's start until a node satisfies its goal (a node in the goal
         ball, as in the paper) or the termination condition ends the plan (OMPL's ``solve(ptc)``).
@@ -170,6 +171,10 @@ class Planner:
             max_critical_path_calls: End after this many critical-path oracle calls (per round the
                 largest of any worker: the time of p parallel quantum devices).
             stall_rounds: End after this many consecutive rounds without a new node.
+            on_round: Called after every round (after every block of rounds a planner runs at
+                once: RRT's rounds tested ahead) with the plan's counters (``Progress``): an
+                observer for a progress display (``qrrt plan`` passes one); it cannot change the
+                plan, and None (default) calls nothing.
 
         Returns:
             A frozen ``PlanResult``: ``status`` (``PlanStatus``: ``"reached"`` or the condition that
@@ -208,33 +213,37 @@ class Planner:
                         default_rounds=limits.default_rounds)
         size.check()  # the plan's one memory check, before its first allocation
         try:
-            return self._plan_checked(problem, condition, safety)
+            return self._plan_checked(problem, condition, safety, on_round)
         except OutOfMemory:
             raise
         except MemoryError as error:  # (its frames, and the plan's arrays, are released before the message)
             raise size.out_of_memory(error) from error
 
     def _plan_checked(self, problem: Problem, condition: TerminationCondition,
-                      safety: frozenset[PlanStatus]) -> PlanResult:
+                      safety: frozenset[PlanStatus], on_round: Callable[[Progress], None] | None = None) -> PlanResult:
         """The plan after its checks: the run state, the rounds and the result (``safety``: the
-        statuses of the safety limits added to the caller's condition)."""
+        statuses of the safety limits added to the caller's condition; ``on_round``: the observer
+        called after every round)."""
         state = RunState(problem.start, problem.goal, problem.space.nearest_neighbors())  # chosen once a plan
         state.context = self._context(problem)
         self._start_rounds(state)
         began = time.perf_counter()
-        status = self._run(state, condition, began)
+        status = self._run(state, condition, began, on_round)
         elapsed = time.perf_counter() - began
         return self._result(state, status, elapsed, problem, condition, status in safety)
 
-    def _run(self, state: RunState, condition: TerminationCondition, began: float) -> PlanStatus:
-        """The round loop: check the condition before every round, run the round, record it; until
-        the goal or the end."""
+    def _run(self, state: RunState, condition: TerminationCondition, began: float,
+             on_round: Callable[[Progress], None] | None = None) -> PlanStatus:
+        """The round loop: check the condition before every round, run the round, record it (and
+        show it to ``on_round``); until the goal or the end."""
         while state.goal_node is None:
             progress = state.progress(time.perf_counter() - began)
             ended = condition.ended_by(progress)
             if ended is not None:
                 return ended
             self._rounds(state, condition, progress)
+            if on_round is not None:
+                on_round(state.progress(time.perf_counter() - began))
         return PlanStatus.REACHED
 
     def _rounds(self, state: RunState, condition: TerminationCondition, progress: Progress) -> None:
@@ -279,6 +288,12 @@ class Planner:
         """Everything of the planner's that fixes its answers: its name and options (JSON-able;
         recorded in every result beside the problem's parts)."""
         return {"planner": self.name} | self.options.describe()
+
+    def miss_reason(self) -> str:
+        """Why a candidate this planner tests can fail its check, in one clause (``qrrt plan``
+        prints it when most candidates failed): here, a random sample's motion from its nearest
+        node is blocked."""
+        return "a random sample's motion from its nearest node is blocked"
 
     def labels(self) -> tuple[str, ...]:
         """Every simulation shortcut this planner's numbers depend on (copied into each result).

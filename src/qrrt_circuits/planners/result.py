@@ -168,7 +168,7 @@ class PlanResult:
                 PlanStatus.MAX_NODES: f"the tree reached {limit} nodes",
                 PlanStatus.MAX_ORACLE_CALLS: f"{limit} oracle calls were spent",
                 PlanStatus.MAX_CRITICAL_PATH_CALLS: f"{limit} critical-path oracle calls were spent",
-                PlanStatus.MAX_TIME: f"{limit} s passed"}.get(self.status, str(self.status))
+                PlanStatus.MAX_TIME: "the time limit passed"}.get(self.status, str(self.status))
         if not self.safety_limit:
             return f"ended by a limit you set: {what} ({key}={limit})"
         return (f"ended by a safety limit, not one you set: {what} ({key}={limit}; pass {key}, or a budget "

@@ -328,6 +328,13 @@ FAMILIES: dict[str, tuple[Any, dict[str, Any]]] = {
 }
 
 
+def _check_named_file(path: Path, key: str, named: Path) -> None:
+    """Refuse a file named by the problem file's ``key`` that is not a file, naming the key."""
+    if not named.is_file():
+        raise ValueError(f'{path}: "{key}" names {str(named)!r}, which is not a file (the name is read relative '
+                         "to the problem file's folder)")
+
+
 def load_problem(path: str | Path) -> Problem:
     """Read a problem file: ``{"format": "qrrt-problem", "version": 1, "family": NAME, ARGS...}``
     for a family of ``FAMILIES``, or ``{"format": "qrrt-problem", "version": 1, "family": "boxes",
@@ -358,6 +365,7 @@ def load_problem(path: str | Path) -> Problem:
     if family == "boxes":
         if set(arguments) != {"scenario"} or not isinstance(arguments["scenario"], str):
             raise ValueError(f'{path}: family "boxes" takes one field, "scenario" (a scenario file name)')
+        _check_named_file(path, "scenario", path.parent / arguments["scenario"])
         return box_world(path.parent / arguments["scenario"])
     if family == "image":  # the file's "image", relative to the problem file, is the builder's path
         if not isinstance(arguments.get("image"), str) or "path" in arguments:
@@ -365,6 +373,7 @@ def load_problem(path: str | Path) -> Problem:
         missing = sorted({"pixel_size", "start", "goal", "goal_radius"} - set(arguments))
         if missing:
             raise ValueError(f'{path}: family "image" needs {missing}')
+        _check_named_file(path, "image", path.parent / arguments["image"])
         arguments["path"] = str(path.parent / arguments.pop("image"))
     if family not in FAMILIES:
         raise ValueError(f'{path}: "family" must be one of {sorted([*FAMILIES, "boxes"])}, got {family!r}')

@@ -75,6 +75,10 @@ class Adaptive(IterationPolicy):
         """
         return 3 * 8 * (self.iterations_bound(num_items) + 1) * int(self.grid_size)
 
+    def miss_reason(self) -> str:
+        return ("the posterior over m/N learns from misses, and where m/N is large the k with the most successes "
+                "per call is 0: a uniform draw, which misses with probability 1 - m/N")
+
     def describe(self) -> str:
         return "adaptive (estimates m/N from verified outcomes; no access to the true m)"
 
