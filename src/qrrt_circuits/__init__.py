@@ -59,7 +59,7 @@ if TYPE_CHECKING:
     from .search.problem import DatabaseSearch, SearchOutcome
     from .world.environment import Environment
     from .world.image import OccupancyGrid
-    from .world.nearest import GridNearest, LinearNearest, NearestNeighbors
+    from .world.nearest import GridNearest, LinearNearest, NearestNeighbors, SE2Nearest
     from .world.spaces import RealVectorSpace, SE2Space, StateSpace
 
     __version__: str
@@ -82,7 +82,7 @@ _WHERE = {
     **dict.fromkeys(["Candidates", "LatticeCandidates", "NearestParents"], ".planners.candidates"),
     **dict.fromkeys(["Goal", "GoalBall", "GoalState"], ".problems.goals"),
     **dict.fromkeys(["RealVectorSpace", "SE2Space", "StateSpace"], ".world.spaces"),
-    **dict.fromkeys(["GridNearest", "LinearNearest", "NearestNeighbors"], ".world.nearest"),
+    **dict.fromkeys(["GridNearest", "LinearNearest", "NearestNeighbors", "SE2Nearest"], ".world.nearest"),
     **dict.fromkeys(["AnyOf", "MaxCriticalPathCalls", "MaxNodes", "MaxOracleCalls", "MaxRounds", "MaxWallTime",
                      "PlanStatus", "Stall", "TerminationCondition"], ".planners.termination"),
     "AuthorsCheck": ".reachability.authors_check",
@@ -162,6 +162,7 @@ __all__ = [
     "GridCheck",
     "GridNearest",
     "LinearNearest",
+    "SE2Nearest",
     "NearestNeighbors",
     "RealVectorSpace",
     "SE2Space",
