@@ -304,7 +304,7 @@ def register_planner(registry: Registry, name: str, planner: type[Planner], help
 
 
 def _planners() -> Registry:
-    from .planners import PQRRT, QRRT, RRT, ParallelRRT
+    from .planners import PQRRT, QRRT, RRT, ParallelRRT, QRRTConnect, QRRTStar
 
     registry = Registry("planner")
     register_planner(registry, "rrt", RRT, "classical RRT, 1 reachability test a round", aliases=("RRT",),
@@ -317,6 +317,12 @@ def _planners() -> Registry:
                      fixed={"shared_database": True}, aliases=("PQRRT", "pqrrt-shared"), tags=("quantum", "parallel"))
     register_planner(registry, "pqrrt-unshared", PQRRT, "Pq-RRT: each worker builds and searches its own database",
                      fixed={"shared_database": False}, aliases=("PQRRT-unshared",), tags=("quantum", "parallel"))
+    register_planner(registry, "qrrt-connect", QRRTConnect,
+                     "q-RRT-Connect: two trees, q-RRT extensions, a Grover-searched connection",
+                     aliases=("QRRTConnect",), tags=("quantum", "bidirectional"))
+    register_planner(registry, "qrrt-star", QRRTStar,
+                     "q-RRT*: q-RRT extensions, Durr-Hoyer choice of parent, searched rewires (anytime)",
+                     aliases=("QRRTStar",), tags=("quantum", "optimizing"))
     return registry
 
 

@@ -37,7 +37,7 @@ from . import termination as _termination
 from .context import RoundView, WorkerContext
 from .options import PlannerOptions
 from .result import Metrics, PlanResult
-from .run_state import RunState
+from .run_state import FLOAT_HISTORY_KEYS, RunState
 from .termination import (
     PlanStatus,
     TerminationCondition,
@@ -228,13 +228,23 @@ class Planner:
     def _run(self, state: RunState, condition: TerminationCondition, began: float) -> PlanStatus:
         """The round loop: check the condition before every round, run the round, record it; until
         the goal or the end."""
-        while state.goal_node is None:
+        while not self._finished(state):
             ended = condition.ended_by(state.progress(time.perf_counter() - began))
             if ended is not None:
-                return ended
+                return self._status(state, ended)
             self._round(state)
             state.end_round()
         return PlanStatus.REACHED
+
+    def _finished(self, state: RunState) -> bool:
+        """Whether the plan is done before its condition ends it: here once a node satisfies the
+        goal (an anytime planner, q-RRT*, runs until its condition)."""
+        return state.goal_node is not None
+
+    def _status(self, state: RunState, ended: PlanStatus) -> PlanStatus:
+        """The status of a plan its condition ended (``ended``, here; an anytime planner that holds
+        a solution reports it reached)."""
+        return ended
 
     def _check_serves(self, problem: Problem) -> None:
         """Refuse, before any work, a problem this planner's settings cannot serve (none here)."""
@@ -307,7 +317,8 @@ class Planner:
         settings = self.settings() | problem.describe() | {
             "space": problem.space.describe(), "predicate": predicate, "dynamics": predicate.get("dynamics"),
             "termination": condition.describe()}
-        history = {key: np.asarray(value, dtype=np.int64) for key, value in state.history.items()}
+        history = {key: np.asarray(value, dtype=np.float64 if key in FLOAT_HISTORY_KEYS else np.int64)
+                   for key, value in state.history.items()}
         return PlanResult(
             status=status,
             nodes=tree.nodes.copy(),
@@ -320,5 +331,10 @@ class Planner:
             history=history,
             goal_node=state.goal_node,
             safety_limit=safety_limit,
+            second_tree=self._second_tree(state),
         )
+
+    def _second_tree(self, state: RunState) -> tuple[np.ndarray, np.ndarray] | None:
+        """A bidirectional planner's second tree (its nodes and parents), or None (here)."""
+        return None
 
