@@ -123,7 +123,7 @@ class Registry:
     Example:
         >>> from qrrt_circuits.registry import PLANNERS, POLICIES
         >>> PLANNERS.names()
-        ('rrt', 'prrt', 'qrrt', 'pqrrt', 'pqrrt-unshared')
+        ('rrt', 'prrt', 'qrrt', 'pqrrt', 'pqrrt-unshared', 'qrrt-connect', 'qrrt-star')
         >>> PLANNERS.canonical("PQRRT"), "qrrt" in PLANNERS, "astar" in PLANNERS
         ('pqrrt', True, False)
         >>> POLICIES.labels()
@@ -133,7 +133,7 @@ class Registry:
         >>> PLANNERS.resolve("astar")
         Traceback (most recent call last):
         ...
-        ValueError: unknown planner 'astar'; choose one of rrt, prrt, qrrt, pqrrt, pqrrt-unshared
+        ValueError: unknown planner 'astar'; choose one of rrt, prrt, qrrt, pqrrt, pqrrt-unshared, qrrt-connect, ...
     """
 
     def __init__(self, kind: str) -> None:

@@ -46,7 +46,8 @@ def _trees(backend, connecting: int, candidates: int):
     space = qc.RealVectorSpace(2)
     context = WorkerContext(env, Hop(1.0), space, RandomStreams(0), backend=backend, database_size=candidates)
     angles = np.linspace(0.0, 2 * np.pi, candidates, endpoint=False)
-    radii = np.where(np.arange(candidates) < connecting, 0.5 + 0.01 * np.arange(candidates), 3.0 + 0.01 * np.arange(candidates))
+    offsets = 0.01 * np.arange(candidates)
+    radii = np.where(np.arange(candidates) < connecting, 0.5 + offsets, 3.0 + offsets)
     other_tree = Tree(np.array([9.0, 9.0]))
     other_tree.add_many(np.column_stack([radii * np.cos(angles), radii * np.sin(angles)]),
                         np.zeros(candidates, dtype=np.int64))

@@ -40,7 +40,6 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from .._support.randomness import Stream
 from ..problems.goals import Goal, GoalState, ball_of
 from ..problems.problem import Problem
 from ..reachability.predicate import ReachabilityPredicate, check_answers, valid_states

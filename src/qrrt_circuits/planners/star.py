@@ -175,8 +175,8 @@ class QRRTStar(SearchPlanner):
         count = near.shape[0]
         size = padded_size(count)
         feasible = np.zeros(size, dtype=bool)
-        feasible[:count] = check_answers(context.predicate.reachable(tree.nodes[near], np.repeat(point[None], count, 0)),
-                                         count, f"the predicate {context.predicate.name!r}")
+        answers = context.predicate.reachable(tree.nodes[near], np.repeat(point[None], count, 0))
+        feasible[:count] = check_answers(answers, count, f"the predicate {context.predicate.name!r}")
         values = np.full(size, math.inf)
         steps = context.space.distance(tree.nodes[near], point)
         values[:count] = np.asarray(star.costs, dtype=float)[near] + steps
@@ -214,7 +214,7 @@ class QRRTStar(SearchPlanner):
         for index in outcome.indices:
             neighbour = int(near[index])
             cost = star.costs[node] + float(context.space.distance(tree.nodes[neighbour][None], point)[0])
-            if cost < star.costs[neighbour]:  # (an earlier rewire this round may have lowered it)
+            if cost < star.costs[neighbour]:  # (a rewire found before it in this round may have lowered it)
                 star.reparent(state, neighbour, node, cost)
 
     @staticmethod

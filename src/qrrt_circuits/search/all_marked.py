@@ -82,12 +82,13 @@ def find_all_marked(marks: np.ndarray, backend: QuantumSearchBackend, rng: np.ra
     found: list[int] = []
     quantum = verifications = 0
     while True:
-        oracle = LookupOracle(remaining.copy())
+        left = remaining.copy()
+        oracle = LookupOracle(left)
 
         def run(j: int, oracle: LookupOracle = oracle) -> int:
             return int(backend.run(oracle, j, 1, seed=int(rng.integers(2**62))).indices[0])
 
-        def verify(i: int, left: np.ndarray = remaining.copy()) -> bool:
+        def verify(i: int, left: np.ndarray = left) -> bool:
             return bool(left[i])
 
         outcome = search.run(run, verify, size, rng)
