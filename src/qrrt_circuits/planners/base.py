@@ -190,7 +190,7 @@ class Planner:
         """
         check_instance(problem, "problem", Problem, "a Problem (qrrt_circuits.Problem.build(env, start, goal, "
                                                     "goal_radius), a scenario or a problem family)")
-        check_reachable_by(problem.goal, self.options.goal_bias)
+        self._check_goal(problem)
         condition = from_budgets(max_oracle_calls, max_nodes, max_rounds, max_time_s,
                                  max_critical_path_calls, stall_rounds)
         if termination is not None:
@@ -245,6 +245,11 @@ class Planner:
         """The status of a plan its condition ended (``ended``, here; an anytime planner that holds
         a solution reports it reached)."""
         return ended
+
+    def _check_goal(self, problem: Problem) -> None:
+        """Refuse a goal this planner cannot end in (``check_reachable_by``: one with ``sample``
+        where ``goal_bias > 0``, and one with volume where ``goal_bias == 0``)."""
+        check_reachable_by(problem.goal, self.options.goal_bias)
 
     def _check_serves(self, problem: Problem) -> None:
         """Refuse, before any work, a problem this planner's settings cannot serve (none here)."""

@@ -40,7 +40,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ..problems.goals import Goal, GoalState, ball_of
+from ..problems.goals import Goal, GoalState, ball_of, check_reachable_by
 from ..problems.problem import Problem
 from ..reachability.predicate import ReachabilityPredicate, check_answers, valid_states
 from ..search.oracles import LookupOracle
@@ -175,6 +175,12 @@ class QRRTConnect(SearchPlanner):
         """q: a connection database holds at most 2^q candidates."""
         value = self.options.connect_qubits
         return self.num_qubits if value is None else int(value)
+
+    def _check_goal(self, problem: Problem) -> None:
+        """A goal without volume serves (the goal tree is rooted in it); one drawn from where
+        ``goal_bias > 0`` must have ``sample`` (``check_reachable_by``)."""
+        if self.options.goal_bias > 0:
+            check_reachable_by(problem.goal, self.options.goal_bias)
 
     def _check_serves(self, problem: Problem) -> None:
         """Refuse a goal without a goal state (``_goal_root``), before any work."""
