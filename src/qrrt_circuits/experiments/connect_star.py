@@ -25,10 +25,12 @@ from .base import Record
 from .family_runs import Units
 from .intervals import percentile_interval, rounded_interval
 
-__all__ = ["BUDGET_SHARES", "anytime_columns", "connect_summary", "cost_at_shares", "star_summary"]
+__all__ = ["BUDGET_SHARES", "NO_ANYTIME", "anytime_columns", "connect_summary", "cost_at_shares", "star_summary"]
 
 #: the shares of the budget (percent) at which an anytime planner's best cost is recorded
 BUDGET_SHARES = (5, 10, 25, 50, 75, 100)
+#: the anytime columns of a planner that is not anytime (every record of a run has the same columns)
+NO_ANYTIME: Record = {**{f"cost_at_{share}": math.nan for share in BUDGET_SHARES}, "first_solution_calls": math.nan}
 
 
 def cost_at_shares(calls: ArrayLike, costs: ArrayLike, budget: int) -> dict[str, float]:

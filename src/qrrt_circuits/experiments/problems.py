@@ -64,7 +64,7 @@ from ..planners.paths import path_length, shortcut
 from ..problems.families import Problem, maze, narrow_passage, open_space, se2_gap, winding_band
 from ..registry import POLICIES
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
-from .connect_star import anytime_columns, connect_summary, star_summary
+from .connect_star import NO_ANYTIME, anytime_columns, connect_summary, star_summary
 from .default_policy import POLICY_CANDIDATES, TIE_MARGIN, default_policies
 from .family_runs import family_counts, family_units, paired_ratio, resampled, statistic
 from .figures import dodge, new_figure, save, with_intervals
@@ -199,8 +199,9 @@ class Problems(Experiment):
                   "critical_path_calls": m.critical_path_oracle_calls, "simulation_checks": m.simulation_checks,
                   "classical_checks": _evaluations(problem), "nodes": m.nodes,
                   "wall_time_s": m.wall_time_s}
-        if config in STAR_PAIR:  # an anytime planner: its best cost against its calls
-            record |= anytime_columns(result.history["oracle_calls"], result.history["path_cost"], settings["budget"])
+        # an anytime planner's best cost against its calls (NaN columns for the others: one header for all rows)
+        record |= anytime_columns(result.history["oracle_calls"], result.history["path_cost"], settings["budget"]) \
+            if config in STAR_PAIR else NO_ANYTIME
         return record | self._paths(problem, result.path)
 
     @staticmethod
@@ -212,9 +213,9 @@ class Problems(Experiment):
                   "oracle_calls": run.motion_checks, "critical_path_calls": run.motion_checks,
                   "simulation_checks": 0, "classical_checks": _evaluations(problem),
                   "nodes": math.nan, "wall_time_s": run.wall_time_s}
-        if config in STAR_PAIR:
-            record |= anytime_columns([0, *(calls for calls, _ in run.anytime)],
-                                      [math.nan, *(cost for _, cost in run.anytime)], settings["budget"])
+        record |= anytime_columns([0, *(calls for calls, _ in run.anytime)],
+                                  [math.nan, *(cost for _, cost in run.anytime)], settings["budget"]) \
+            if config in STAR_PAIR else NO_ANYTIME
         return record | Problems._paths(problem, run.path)
 
     @staticmethod
