@@ -8,10 +8,12 @@ Per run (one root seed and replicate, both planners' records of it):
   calls until the first solution or the whole budget for a run that failed; reported as the median
   over the family's runs with a 95 % interval from the two-level bootstrap of ``family_runs`` (worlds,
   then the runs in each).
-- **star cost ratio**: q-RRT*'s best path cost at the budget over OMPL RRT*'s (runs where both hold a
-  path), median and interval as above; and the **share of the budget** q-RRT* needs to reach
-  OMPL RRT*'s cost at the full budget: the least of ``BUDGET_SHARES`` at which its best cost is at
-  most that, inf where it never is (a run OMPL RRT* did not solve is left out).
+- **star cost ratio**: q-RRT*'s path length at the budget over OMPL RRT*'s (both under the problem's
+  metric, ``path_length``; inf where q-RRT* holds no path, a run OMPL RRT* did not solve left out),
+  median and interval as above; and the **share of the budget** q-RRT* needs to reach OMPL RRT*'s
+  path length at the full budget: the least of ``BUDGET_SHARES`` at which its best cost is at most
+  that, inf where it never is. The mean costs at each share are each planner's own (OMPL's
+  ``bestCost()`` is under its real-vector metric, which differs from the problem's in SE(2)).
 """
 
 from __future__ import annotations
@@ -110,13 +112,13 @@ def star_summary(units: Units, counts: np.ndarray, config: str, reference: str) 
     ratios, shares = [], []
     for _, unit in units:
         ours, theirs = unit.get(config), unit.get(reference)
-        target = math.nan if ours is None or theirs is None else float(theirs["cost_at_100"])
+        target = math.nan if ours is None or theirs is None else float(theirs["path_length"])
         if not math.isfinite(target):
             ratios.append(math.nan)
             shares.append(math.nan)
             continue
         assert ours is not None
-        ratios.append(float(ours["cost_at_100"]) / target if math.isfinite(float(ours["cost_at_100"])) else math.inf)
+        ratios.append(float(ours["path_length"]) / target if math.isfinite(float(ours["path_length"])) else math.inf)
         reached = [share for share in BUDGET_SHARES if float(ours[f"cost_at_{share}"]) <= target]
         shares.append(float(reached[0]) if reached else math.inf)
     ratio, ratio_interval = _median_with_interval(np.asarray(ratios), counts)
