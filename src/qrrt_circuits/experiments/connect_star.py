@@ -7,7 +7,7 @@ Per run (one root seed and replicate, both planners' records of it):
 - **connect ratio**: q-RRT-Connect's oracle calls over OMPL RRTConnect's motion checks, each the
   calls until the first solution or the whole budget for a run that failed; reported as the median
   over the family's runs with a 95 % interval from the two-level bootstrap of ``family_runs`` (worlds,
-  then the runs in each).
+  then the runs in each; its 2.5 % and 97.5 % quantiles, inf where the resampled median is inf).
 - **star cost ratio**: q-RRT*'s path length at the budget over OMPL RRT*'s (both under the problem's
   metric, ``path_length``; inf where q-RRT* holds no path, a run OMPL RRT* did not solve left out),
   median and interval as above; and the **share of the budget** q-RRT* needs to reach OMPL RRT*'s
@@ -25,7 +25,6 @@ from numpy.typing import ArrayLike
 
 from .base import Record
 from .family_runs import Units
-from .intervals import percentile_interval, rounded_interval
 
 __all__ = ["BUDGET_SHARES", "NO_ANYTIME", "anytime_columns", "connect_summary", "cost_at_shares", "star_summary"]
 
@@ -65,8 +64,9 @@ def anytime_columns(calls: ArrayLike, costs: ArrayLike, budget: int) -> Record:
 
 
 def _median_with_interval(values: np.ndarray, counts: np.ndarray) -> tuple[float, list[float]]:
-    """The median of the finite per-run ``values`` (inf counts as large), and its percentile interval
-    over the resampled runs of ``counts`` (resamples x runs)."""
+    """The median of the per-run ``values`` that are not NaN (inf counts as larger than any), and the
+    2.5 % and 97.5 % quantiles of the medians over the resampled runs of ``counts`` (resamples x runs),
+    inf included."""
     keep = ~np.isnan(values)
     if not keep.any():
         return math.nan, [math.nan, math.nan]
@@ -76,8 +76,13 @@ def _median_with_interval(values: np.ndarray, counts: np.ndarray) -> tuple[float
         if drawn.size:
             medians.append(float(np.median(drawn)))
     value = float(np.median(values[keep]))
-    return (round(value, 4) if math.isfinite(value) else value), rounded_interval(
-        percentile_interval(np.asarray(medians)), 4)
+    low, high = (float(q) for q in np.quantile(np.asarray(medians), [0.025, 0.975], method="inverted_cdf"))
+    return _rounded(value), [_rounded(low), _rounded(high)]
+
+
+def _rounded(value: float) -> float:
+    """4 decimals, inf kept (a median over runs that never reach the reference is inf)."""
+    return round(value, 4) if math.isfinite(value) else value
 
 
 def connect_summary(units: Units, counts: np.ndarray, config: str, reference: str) -> dict:
