@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from . import probability, registry
-    from .planners import PQRRT, QRRT, RRT, Metrics, ParallelRRT, Planner, PlanResult
+    from .planners import PQRRT, QRRT, RRT, Metrics, ParallelRRT, Planner, PlanResult, QRRTConnect, QRRTStar
     from .planners.candidates import Candidates, LatticeCandidates, NearestParents
     from .planners.database import AnnealingSchedule
     from .planners.options import (
@@ -72,7 +72,8 @@ if TYPE_CHECKING:
 _WHERE = {
     "probability": ".probability",
     "registry": ".registry",
-    **dict.fromkeys(["PQRRT", "QRRT", "RRT", "Metrics", "ParallelRRT", "PlanResult", "Planner"], ".planners"),
+    **dict.fromkeys(["PQRRT", "QRRT", "RRT", "Metrics", "ParallelRRT", "PlanResult", "Planner", "QRRTConnect",
+                     "QRRTStar"], ".planners"),
     **dict.fromkeys(["ParallelOptions", "ParallelQuantumOptions", "PlannerOptions", "QuantumOptions", "RRTOptions"],
                     ".planners.options"),
     "Problem": ".problems.problem",
@@ -142,6 +143,8 @@ __all__ = [
     "BBHT",
     "PQRRT",
     "QRRT",
+    "QRRTConnect",
+    "QRRTStar",
     "RRT",
     "Adaptive",
     "ThompsonIterations",

@@ -40,6 +40,7 @@ NOTEBOOKS = [
     "06_would_it_pay_off.ipynb",
     "07_plan_your_ompl_problem.ipynb",
     "08_coherent_oracle.ipynb",
+    "09_connect_and_star.ipynb",
 ]
 INTERPRETER_MARK = "kernel interpreter: "
 

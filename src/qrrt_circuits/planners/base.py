@@ -37,7 +37,7 @@ from . import termination as _termination
 from .context import RoundView, WorkerContext
 from .options import PlannerOptions
 from .result import Metrics, PlanResult
-from .run_state import RunState
+from .run_state import FLOAT_HISTORY_KEYS, RunState
 from .termination import (
     PlanStatus,
     Progress,
@@ -196,7 +196,7 @@ class Planner:
         """
         check_instance(problem, "problem", Problem, "a Problem (qrrt_circuits.Problem.build(env, start, goal, "
                                                     "goal_radius), a scenario or a problem family)")
-        check_reachable_by(problem.goal, self.options.goal_bias)
+        self._check_goal(problem)
         condition = from_budgets(max_oracle_calls, max_nodes, max_rounds, max_time_s,
                                  max_critical_path_calls, stall_rounds)
         if termination is not None:
@@ -235,12 +235,12 @@ class Planner:
     def _run(self, state: RunState, condition: TerminationCondition, began: float,
              on_round: Callable[[Progress], None] | None = None) -> PlanStatus:
         """The round loop: check the condition before every round, run the round, record it (and
-        show it to ``on_round``); until the goal or the end."""
-        while state.goal_node is None:
+        show it to ``on_round``); until the plan is finished or its condition ends it."""
+        while not self._finished(state):
             progress = state.progress(time.perf_counter() - began)
             ended = condition.ended_by(progress)
             if ended is not None:
-                return ended
+                return self._status(state, ended)
             self._rounds(state, condition, progress)
             if on_round is not None:
                 on_round(state.progress(time.perf_counter() - began))
@@ -252,6 +252,21 @@ class Planner:
         ``progress``, the counters now, which it let start); here one ``_round``."""
         self._round(state)
         state.end_round()
+
+    def _finished(self, state: RunState) -> bool:
+        """Whether the plan is done before its condition ends it: here once a node satisfies the
+        goal (an anytime planner, q-RRT*, runs until its condition)."""
+        return state.goal_node is not None
+
+    def _status(self, state: RunState, ended: PlanStatus) -> PlanStatus:
+        """The status of a plan its condition ended (``ended``, here; an anytime planner that holds
+        a solution reports it reached)."""
+        return ended
+
+    def _check_goal(self, problem: Problem) -> None:
+        """Refuse a goal this planner cannot end in (``check_reachable_by``: one with ``sample``
+        where ``goal_bias > 0``, and one with volume where ``goal_bias == 0``)."""
+        check_reachable_by(problem.goal, self.options.goal_bias)
 
     def _check_serves(self, problem: Problem) -> None:
         """Refuse, before any work, a problem this planner's settings cannot serve (none here)."""
@@ -330,7 +345,8 @@ class Planner:
         settings = self.settings() | problem.describe() | {
             "space": problem.space.describe(), "predicate": predicate, "dynamics": predicate.get("dynamics"),
             "termination": condition.describe()}
-        history = {key: np.asarray(value, dtype=np.int64) for key, value in state.history.items()}
+        history = {key: np.asarray(value, dtype=np.float64 if key in FLOAT_HISTORY_KEYS else np.int64)
+                   for key, value in state.history.items()}
         return PlanResult(
             status=status,
             nodes=tree.nodes.copy(),
@@ -343,5 +359,10 @@ class Planner:
             history=history,
             goal_node=state.goal_node,
             safety_limit=safety_limit,
+            second_tree=self._second_tree(state),
         )
+
+    def _second_tree(self, state: RunState) -> tuple[np.ndarray, np.ndarray] | None:
+        """A bidirectional planner's second tree (its nodes and parents), or None (here)."""
+        return None
 

@@ -3,7 +3,7 @@ counters and the round history."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -19,6 +19,8 @@ if TYPE_CHECKING:  # annotations only (context imports the search modules)
     from .context import WorkerContext
 
 HISTORY_KEYS = ("oracle_calls", "critical_path", "nodes", "entries", "reachable")
+#: history keys a planner may add whose values are floats (q-RRT*'s best path cost after each round)
+FLOAT_HISTORY_KEYS = ("path_cost",)
 
 
 class RunState:
@@ -57,6 +59,7 @@ class RunState:
         self.policy_state: PolicyState | None = None  # quantum planners only
         self.context: WorkerContext | None = None  # the plan's WorkerContext, built once
         self.ahead: LookAhead | None = None  # classical planners only
+        self.extra: Any = None  # what a planner's own rounds carry (q-RRT-Connect's second tree, q-RRT*'s costs)
 
     @property
     def worker_context(self) -> WorkerContext:
