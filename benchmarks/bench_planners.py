@@ -259,12 +259,14 @@ def main() -> None:
     ompl_rows = None
     print(f"{'planner':40s} {'calls/node':>18s} {'critical/node':>14s} {'ms/node':>18s} {'oracle':>7s} "
           f"{'other us/rnd':>12s} {'reached':>8s}")
+    settings = {label: {"planner": planner, "backend": backend, "search_policy": policy}
+                for label, planner, backend, policy in CONFIGURATIONS}
     for name, make in configurations().items():
         big = name in BIG
         runs = [run_one(make, env, seed, big_nodes if big else nodes, big)
                 for seed, env in enumerate(worlds[:big_seeds] if big else worlds)]
         pooled = sum(r["oracle_calls"] for r in runs) / max(sum(r["nodes"] for r in runs), 1)
-        row = {"runs": runs, "max_nodes": big_nodes if big else nodes,
+        row = {"runs": runs, "max_nodes": big_nodes if big else nodes, "settings": settings[name],
                "goal": "unreachable (goal radius 1e-9)" if big else "the world's",
                "calls_per_node": summarize([r["calls_per_node"] for r in runs]),
                "critical_per_node": summarize([r["critical_per_node"] for r in runs]),

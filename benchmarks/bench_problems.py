@@ -5,28 +5,41 @@ q-RRT's time per oracle call, on the problem families of ``qrrt reproduce proble
 
 Per family, ``RUNS`` seeds of each planner plan until the goal or ``BUDGET`` motion checks:
 
-- ``rrt``: the library's RRT with OMPL's range (0.2 of the bounds' diagonal), goal bias 0.05 and no
-  look-ahead, the algorithm of OMPL's RRT;
+- ``rrt``: the library's RRT with OMPL's range (0.2 of the bounds' diagonal) and goal bias 0.05, the
+  algorithm of OMPL's RRT (the same tree whether rounds are tested ahead or not), with its default
+  look-ahead (rounds tested ahead in batches; the tests thrown away are in the wall time and in
+  ``wasted_per_check``);
+- ``rrt_one_by_one``: the same with ``look_ahead=False`` (one predicate call per oracle call);
 - ``ompl_rrt``: OMPL's ``geometric::RRT`` with its defaults (the same range and goal bias), the same
   predicate as its motion validator (``experiments.ompl_runs``), when the ``ompl`` extra is
   installed;
-- ``qrrt``: q-RRT with ``Adaptive()``, 2^8 databases on the exact statevector.
+- ``qrrt``: q-RRT with ``Adaptive()``, 2^8 databases on the exact statevector;
+- ``*_python_check`` (with OMPL): ``rrt``, ``rrt_one_by_one`` and ``ompl_rrt`` with the predicate
+  asked one pair at a time from a Python loop, each pair also paying ``PYTHON_WORK`` Python
+  additions (``PairByPair``): a checker whose cost is Python's and dominates, the same on both
+  sides.
 
 Every planner's predicate is timed (its ``reachable`` wrapped by a timer), so a run's wall time
 splits into the time inside the check and the planner's own time. Figures, per family and planner:
 ``us_per_check`` (wall time over motion checks or oracle calls), ``check_us_per_check`` (inside the
 predicate), ``own_us_per_check`` (the rest: sampling, nearest neighbours, tree, for q-RRT the
 database and the search), ``us_per_node``; and the ratios ``rrt_over_ompl_wall`` and
-``rrt_over_ompl_own`` (one run, same machine). Prints a table and writes JSON.
+``rrt_over_ompl_own`` (pooled: total time over total checks), and ``rrt_over_ompl_per_run`` (the
+ratio of the medians of each run's wall time per check, with a 95 % bootstrap interval), all in one
+run on one machine. ``profile``: where one plan's time goes on the maze family, per planner
+(``cProfile``, the functions with the most own time, microseconds per round). Prints a table and
+writes JSON.
 """
 
 from __future__ import annotations
 
 import argparse
+import functools
 import importlib.util
 import os
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
@@ -39,6 +52,8 @@ from qrrt_circuits.experiments.problems import build_problem, ompl_range  # noqa
 from qrrt_circuits.problems.families import Problem  # noqa: E402
 
 BUDGET = 5000
+#: the library's planners of the benchmark
+LIBRARY = ("rrt", "rrt_one_by_one", "qrrt")
 
 
 def timed(problem: Problem) -> list[float]:
@@ -57,31 +72,84 @@ def timed(problem: Problem) -> list[float]:
     return spent
 
 
-def run_library(family: str, planner: str, seed: int) -> dict[str, float]:
-    """One run of the library's ``rrt`` or ``qrrt`` on a fresh problem."""
+#: Python additions ``PairByPair`` makes per pair besides the check (a user's own Python work)
+PYTHON_WORK = 2000
+
+
+class PairByPair:
+    """The problem's predicate asked one pair at a time from a Python loop, each pair also paying
+    ``PYTHON_WORK`` Python additions: a checker whose cost is Python's and dominates the planner's,
+    the same answers on both sides."""
+
+    def __init__(self, inner: Any) -> None:
+        self.inner, self.dim, self.name = inner, inner.dim, f"{inner.name}, pair by pair"
+
+    def reachable(self, parents: np.ndarray, children: np.ndarray) -> np.ndarray:
+        parents, children = np.atleast_2d(parents), np.atleast_2d(children)
+        answers = np.empty(children.shape[0], dtype=bool)
+        for row in range(children.shape[0]):
+            total = 0
+            for step in range(PYTHON_WORK):
+                total += step
+            answers[row] = bool(self.inner.reachable(parents[row:row + 1], children[row:row + 1])[0]) and total >= 0
+        return answers
+
+    def describe(self) -> dict:
+        return self.inner.describe() | {"pair_by_pair": True}
+
+    def __getattr__(self, name: str) -> Any:  # (is_valid, can_leave, ... of the inner check)
+        return getattr(self.inner, name)
+
+
+def posed(family: str, python_check: bool) -> Problem:
+    """The family's world 0, its predicate asked pair by pair with ``python_check``."""
     problem = build_problem(family, 0)
+    return problem.replace(predicate=PairByPair(problem.predicate)) if python_check else problem
+
+
+def make(planner: str, problem: Problem, seed: int) -> qc.Planner:
+    """The library's ``rrt``, ``rrt_one_by_one`` or ``qrrt`` of the benchmark."""
+    if planner in ("rrt", "rrt_one_by_one"):
+        return qc.RRT(goal_bias=0.05, max_extension=ompl_range(problem), look_ahead=planner == "rrt", seed=seed)
+    return qc.QRRT(backend=qc.StatevectorBackend(seed=seed), search_policy=qc.Adaptive(), goal_bias=0.05, seed=seed)
+
+
+def run_library(family: str, planner: str, seed: int, python_check: bool = False) -> dict[str, float]:
+    """One run of the library's ``rrt``, ``rrt_one_by_one`` or ``qrrt`` on a fresh problem."""
+    problem = posed(family, python_check)
     spent = timed(problem)
-    if planner == "rrt":
-        plan = qc.RRT(goal_bias=0.05, max_extension=ompl_range(problem), look_ahead=False, seed=seed)
-    else:
-        plan = qc.QRRT(backend=qc.StatevectorBackend(seed=seed), search_policy=qc.Adaptive(),
-                       goal_bias=0.05, seed=seed)
+    plan = make(planner, problem, seed)
     began = time.perf_counter()
     result = plan.plan(problem, max_oracle_calls=BUDGET)
     wall = time.perf_counter() - began
     return {"wall_s": wall, "check_s": spent[0], "checks": result.metrics.oracle_calls,
-            "nodes": result.metrics.nodes, "reached": float(result.reached)}
+            "nodes": result.metrics.nodes, "reached": float(result.reached),
+            "wasted": result.metrics.wasted_checks}
 
 
-def run_ompl(family: str, seed: int) -> dict[str, float]:
+def run_ompl(family: str, seed: int, python_check: bool = False) -> dict[str, float]:
     """One run of OMPL's RRT on a fresh problem (its node count is not read back: NaN)."""
     from qrrt_circuits.experiments.ompl_runs import ompl_run
 
-    problem = build_problem(family, 0)
+    problem = posed(family, python_check)
     spent = timed(problem)
     run = ompl_run(problem, "OMPL RRT", BUDGET, seed + 1, 0.05)
     return {"wall_s": run.wall_time_s, "check_s": spent[0], "checks": run.motion_checks, "nodes": float("nan"),
-            "reached": float(run.reached)}
+            "reached": float(run.reached), "wasted": 0}
+
+
+def per_run(runs: list[dict[str, float]]) -> np.ndarray:
+    """Each run's wall time per motion check, in microseconds."""
+    return np.array([1e6 * r["wall_s"] / max(r["checks"], 1) for r in runs])
+
+
+def ratio_of_medians(mine: np.ndarray, peer: np.ndarray, seed: int = 0) -> dict[str, float]:
+    """median(mine) / median(peer) (wall time per check, one run each seed) with a 95 % percentile
+    bootstrap interval (runs resampled within each planner, 2 000 resamples)."""
+    rng = np.random.default_rng(seed)
+    draws = [np.median(rng.choice(mine, mine.size)) / np.median(rng.choice(peer, peer.size)) for _ in range(2000)]
+    low, high = np.percentile(draws, [2.5, 97.5])
+    return {"median": float(np.median(mine) / np.median(peer)), "low": float(low), "high": float(high)}
 
 
 def figures(runs: list[dict[str, float]]) -> dict[str, float]:
@@ -93,7 +161,31 @@ def figures(runs: list[dict[str, float]]) -> dict[str, float]:
     return {"us_per_check": 1e6 * wall / checks, "check_us_per_check": 1e6 * check / checks,
             "own_us_per_check": 1e6 * (wall - check) / checks,
             "us_per_node": 1e6 * wall / nodes if np.isfinite(nodes) and nodes else float("nan"),
-            "checks": float(checks), "success_rate": float(np.mean([r["reached"] for r in runs]))}
+            "checks": float(checks), "wasted_per_check": sum(r["wasted"] for r in runs) / checks,
+            "success_rate": float(np.mean([r["reached"] for r in runs]))}
+
+
+def round_profile(family: str, planner: str, seed: int = 0, top: int = 15) -> dict[str, Any]:
+    """Where one plan's time goes: ``cProfile`` of ``run_library(family, planner, seed)``, the
+    ``top`` functions by their own time, in microseconds per round (profiling slows every call, so
+    the shares matter, not the totals)."""
+    import cProfile
+    import pstats
+
+    profiler = cProfile.Profile()
+    problem = build_problem(family, 0)
+    plan = make(planner, problem, seed)
+    profiler.enable()
+    result = plan.plan(problem, max_oracle_calls=BUDGET)
+    profiler.disable()
+    rounds = max(result.metrics.rounds, 1)
+    stats = pstats.Stats(profiler).stats  # type: ignore[attr-defined]
+    total = sum(entry[2] for entry in stats.values())
+    rows = sorted(stats.items(), key=lambda item: -item[1][2])[:top]
+    return {"rounds": rounds, "total_us_per_round": 1e6 * total / rounds,
+            "functions": [{"function": f"{Path(key[0]).name}:{key[1]}({key[2]})", "calls_per_round": entry[1] / rounds,
+                           "own_us_per_round": 1e6 * entry[2] / rounds, "share": entry[2] / total}
+                          for key, entry in rows]}
 
 
 def main() -> None:
@@ -107,26 +199,44 @@ def main() -> None:
     have_ompl = importlib.util.find_spec("ompl") is not None
     out: dict[str, Any] = {"machine": machine(), "budget": BUDGET, "runs": runs, "ompl": have_ompl, "figures": {}}
     header = ("family", "planner", "us/check", "in check", "own", "us/node", "success")
-    print(f"{header[0]:20s} {header[1]:9s} " + " ".join(f"{h:>9s}" for h in header[2:]))
+    print(f"{header[0]:20s} {header[1]:14s} " + " ".join(f"{h:>9s}" for h in header[2:]))
     for family in families:
-        for planner in ("rrt", "qrrt"):
-            run_library(family, planner, 10_000)  # warm-up: numba compilation, caches
-        rows = {planner: figures([run_library(family, planner, seed) for seed in range(runs)])
-                for planner in ("rrt", "qrrt")}
+        planners: dict[str, Callable[[int], dict[str, float]]] = {
+            name: functools.partial(run_library, family, name) for name in LIBRARY}
         if have_ompl:
-            run_ompl(family, 10_000)
-            rows["ompl_rrt"] = figures([run_ompl(family, seed) for seed in range(runs)])
+            planners["ompl_rrt"] = functools.partial(run_ompl, family)
+            for name in ("rrt", "rrt_one_by_one"):
+                planners[f"{name}_python_check"] = functools.partial(run_library, family, name, python_check=True)
+            planners["ompl_rrt_python_check"] = functools.partial(run_ompl, family, python_check=True)
+        raw: dict[str, list[dict[str, float]]] = {name: [] for name in planners}
+        for run in planners.values():
+            run(10_000)  # warm-up: numba compilation, caches
+        for seed in range(runs):  # interleaved: a burst of load on the machine falls on every planner
+            for name, run in planners.items():
+                raw[name].append(run(seed))
+        rows: dict[str, Any] = {planner: figures(value) for planner, value in raw.items()}
+        if have_ompl:
             rows["ratios"] = {"rrt_over_ompl_wall": rows["rrt"]["us_per_check"] / rows["ompl_rrt"]["us_per_check"],
                               "rrt_over_ompl_own": rows["rrt"]["own_us_per_check"]
-                              / rows["ompl_rrt"]["own_us_per_check"]}
+                              / rows["ompl_rrt"]["own_us_per_check"],
+                              "rrt_one_by_one_over_ompl_wall": rows["rrt_one_by_one"]["us_per_check"]
+                              / rows["ompl_rrt"]["us_per_check"],
+                              "rrt_over_ompl_per_run": ratio_of_medians(per_run(raw["rrt"]), per_run(raw["ompl_rrt"])),
+                              "rrt_one_by_one_over_ompl_per_run": ratio_of_medians(
+                                  per_run(raw["rrt_one_by_one"]), per_run(raw["ompl_rrt"])),
+                              "python_check_rrt_over_ompl_per_run": ratio_of_medians(
+                                  per_run(raw["rrt_python_check"]), per_run(raw["ompl_rrt_python_check"])),
+                              "python_check_rrt_one_by_one_over_ompl_per_run": ratio_of_medians(
+                                  per_run(raw["rrt_one_by_one_python_check"]), per_run(raw["ompl_rrt_python_check"]))}
         out["figures"][family] = rows
         for planner, row in rows.items():
             if planner != "ratios":
-                print(f"{family:20s} {planner:9s} {row['us_per_check']:9.1f} {row['check_us_per_check']:9.1f} "
+                print(f"{family:20s} {planner:14s} {row['us_per_check']:9.1f} {row['check_us_per_check']:9.1f} "
                       f"{row['own_us_per_check']:9.1f} {row['us_per_node']:9.1f} {row['success_rate']:8.2f}")
         if "ratios" in rows:
             print(f"{family:20s} RRT / OMPL RRT: wall per check {rows['ratios']['rrt_over_ompl_wall']:.2f}x, "
                   f"own time per check {rows['ratios']['rrt_over_ompl_own']:.2f}x")
+    out["profile"] = {planner: round_profile("maze", planner) for planner in LIBRARY}
     if not have_ompl:
         print("OMPL is not installed (pip install 'qrrt-circuits[ompl]'): the OMPL figures were skipped")
     print(f"wrote {write_json('bench_problems', out, args.out)}")

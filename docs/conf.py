@@ -5,7 +5,7 @@ Build (from the repository root, after ``pip install ".[docs]"``)::
     python -m sphinx -W -b html docs docs/_build/html
 
 Four things are generated at build time, so nothing here has to be edited when the code,
-the tutorials or the results change (all four land in git-ignored places under ``docs/``):
+the tutorials or the results change (under ``docs/``; all but the results tables git-ignored):
 
 * ``docs/api/_generated/reference.rst`` -- the API reference, written from
   ``qrrt_circuits.__all__`` (and each public submodule's own public names) by ``write_api_pages``;
@@ -16,15 +16,19 @@ the tutorials or the results change (all four land in git-ignored places under `
 * ``docs/results/_gallery.md`` -- every figure under ``docs/results`` (referenced in place, not
   copied).
 * ``docs/results/_generated/EXPERIMENT.md`` -- each results page's table of numbers, from the
-  committed ``summary.json`` files (``results_tables.py``).
+  committed ``summary.json`` files (``results_tables.py``). These are committed too, so that a
+  repository browser shows them (each page links its own); ``tests/project/test_results_pages.py``
+  fails where they differ from what the summaries give (``python docs/results_tables.py``).
 * ``docs/_generated/performance.md`` -- the Performance page, written by ``performance_page.py``
   from ``benchmarks/results/run.json`` and ``baseline.json``: every figure on it is read from them.
 """
 
 from __future__ import annotations
 
+import importlib.util
 import inspect
 import os
+import re
 import shutil
 import sys
 import types
@@ -58,6 +62,7 @@ extensions = [
     "sphinx.ext.autosummary",
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
+    "sphinx-mathjax-offline",  # MathJax copied into the built site: formulas render without a network
     "sphinx.ext.viewcode",
     "myst_nb",  # Markdown pages (MyST) and executed notebooks
     "qiskit_sphinx_theme",  # registers the "qiskit-ecosystem" HTML theme
@@ -94,6 +99,11 @@ nb_execution_timeout = 120  # seconds per cell; each tutorial runs in well under
 nb_execution_raise_on_error = True  # a failing tutorial fails the build
 nb_execution_show_tb = True
 nb_merge_streams = True
+#: pages that need an optional extra to run: (docname, the module it needs); where the module is not
+#: installed the page is shown without running, and says so at its top (``note_unrun_pages``)
+NEEDS_EXTRA = {"howto/ompl": "ompl"}
+UNRUN = {page for page, module in NEEDS_EXTRA.items() if importlib.util.find_spec(module) is None}
+nb_execution_excludepatterns = [f"{page}.md" for page in UNRUN]
 
 suppress_warnings = [
     "myst.header",  # README/DESIGN fragments start below level 1
@@ -244,8 +254,32 @@ def check_notebook_kernel() -> None:
                            f"interpreter ({sys.executable}); the tutorials would run without qrrt_circuits")
 
 
+def note_unrun_pages(app, docname: str, source: list[str]) -> None:
+    """Under the title of a page of ``UNRUN``, a note that its code is shown without running."""
+    if docname not in UNRUN:
+        return
+    lines = source[0].splitlines(keepends=True)
+    title = next(index for index, line in enumerate(lines) if line.startswith("# "))
+    note = (f"\n:::{{note}}\nThe `{NEEDS_EXTRA[docname]}` extra is not installed where this site was built, so the "
+            "code on this page is shown without its output.\n:::\n")
+    source[0] = "".join([*lines[:title + 1], note, *lines[title + 1:]])
+
+
+#: a results page's link to its committed table, for a repository browser; the site shows the table
+#: itself (``{include}``), so the build drops the link
+BROWSER_LINK = re.compile(r" \(\[as a file\]\(_generated/[\w-]+\.md\), for a repository browser\)")
+
+
+def drop_browser_links(app, docname: str, source: list[str]) -> None:
+    """Drop the results pages' links to their committed tables (``BROWSER_LINK``)."""
+    if docname.startswith("results/"):
+        source[0] = BROWSER_LINK.sub("", source[0])
+
+
 def setup(app) -> None:
     app.connect("autodoc-process-docstring", drop_builtin_docstrings)
+    app.connect("source-read", note_unrun_pages)
+    app.connect("source-read", drop_browser_links)
 
 
 check_notebook_kernel()

@@ -190,20 +190,54 @@ def _staleness(root: Path, run: dict) -> list[str]:
 
 
 def _benchmarks_table(root: Path, run: dict) -> list[str]:
-    rows = []
+    """One sentence: the benchmarks the run holds, and any that failed or were skipped (their
+    commands and wall times are in the run's JSON)."""
     raw = run.get("raw") or {}
+    names, notes = [], []
     for name, entry in (run.get("benchmarks") or {}).items():
-        status = entry.get("returncode")
+        names.append(f"`{name}`")
         payload = raw.get(name)
         if isinstance(payload, dict) and payload.get("skipped"):
-            outcome = "skipped: " + str(payload["skipped"]).split(";")[0]
-        else:
-            outcome = "ran" if status == 0 else f"failed (exit status {status})"
-        rows.append([f"`{name}`", _script_summary(root, name), outcome, _number(entry.get("wall_s"))])
-    if not rows:
+            notes.append(f"`{name}` skipped ({str(payload['skipped']).split(';')[0]})")
+        elif entry.get("returncode") != 0:
+            notes.append(f"`{name}` failed (exit status {entry.get('returncode')})")
+    if not names:
         return ["The run holds no benchmark.", ""]
-    return _table(["benchmark", "what it measures (its script's summary)", "outcome", "wall time (s)"], rows,
-                  "lllr")
+    outcome = "; ".join(notes) if notes else "every one ran"
+    return [f"The run holds {len(names)} benchmarks ({', '.join(names)}; each script's docstring says what it "
+            f"measures): {outcome}. Their commands and wall times are in the run's JSON.", ""]
+
+
+def _families_section(run: dict) -> list[str]:
+    problems = (run.get("raw") or {}).get("problems") or {}
+    figures = problems.get("figures")
+    lines = ["### OMPL's RRT on the problem families", ""]
+    if not isinstance(figures, dict) or not figures:
+        return lines + ["This run holds no problem-family figures (`bench_problems.py`).", ""]
+    lines += [f"Each family of `qrrt reproduce problems` (its world 0), {problems.get('runs', '—')} seeds per planner, "
+              f"interleaved seed by seed, each plan until the goal or {_number(problems.get('budget'))} motion checks. "
+              "`RRT` has OMPL's range and goal bias and tests rounds ahead (its wall time includes the tests "
+              "thrown away); `RRT, one by one` asks the predicate once per oracle call; OMPL's `RRT` uses the same "
+              "predicate as its motion validator. Wall time per motion check in microseconds (pooled over the "
+              "seeds), and the ratio of the medians of each seed's time per check, ours over OMPL's, with its "
+              "95 % bootstrap interval over the seeds.", ""]
+    rows = []
+    for family, row in figures.items():
+        ratios = row.get("ratios") or {}
+        per_run = ratios.get("rrt_over_ompl_per_run") or {}
+        one_by_one = ratios.get("rrt_one_by_one_over_ompl_per_run") or {}
+
+        def interval(ratio: dict) -> str:
+            return (f"{_number(ratio.get('median'))} [{_number(ratio.get('low'))}, {_number(ratio.get('high'))}]"
+                    if ratio else "—")
+
+        rows.append([family, _number((row.get("rrt") or {}).get("us_per_check")),
+                     _number((row.get("rrt") or {}).get("own_us_per_check")),
+                     _number((row.get("ompl_rrt") or {}).get("us_per_check")), interval(per_run),
+                     interval(one_by_one)])
+    lines += _table(["family", "RRT µs / check", "its own µs", "OMPL µs / check", "RRT / OMPL",
+                     "one by one / OMPL"], rows, "lrrrrr")
+    return lines
 
 
 def _planners_section(run: dict) -> list[str]:
@@ -214,15 +248,20 @@ def _planners_section(run: dict) -> list[str]:
              f"{planners.get('max_nodes', '—')} nodes; the rows at {planners.get('big_nodes', '—')} nodes: "
              f"{planners.get('big_seeds', '—')} seeds, the goal made unreachable so that the tree reaches its size). "
              "Medians over the worlds, with the 10th and 90th percentiles in brackets. An oracle call is one "
-             "question to the reachability oracle (classical planners) or one Grover search (quantum planners); "
-             "the oracle share is the fraction of the plan's wall time spent inside the predicate.", ""]
+             "application of the reachability predicate as the algorithm sees it (DESIGN §2): one classical test, "
+             "one Grover iteration of one preparation, or one classical verification of a measured candidate; "
+             "the oracle share is the fraction of the plan's wall time spent inside the predicate. The search "
+             "policy is the registry's name (`paper`: the paper's iteration schedule, not the planners' defaults: "
+             "`thompson` for q-RRT, `adaptive` for Pq-RRT).", ""]
     rows = []
     for name, row in planners["planners"].items():
-        rows.append([name, _number(row.get("max_nodes")), str(len(row.get("runs") or [])),
+        settings = row.get("settings") or {}
+        rows.append([name, f"`{settings.get('search_policy')}`" if settings.get("search_policy") else "—",
+                     _number(row.get("max_nodes")), str(len(row.get("runs") or [])),
                      _spread(row.get("ms_per_node")), _spread(row.get("ms_per_call")),
                      _number(_median(row.get("calls_per_node"))), _percent(_median(row.get("oracle_share")))])
-    lines += _table(["planner", "nodes", "worlds", "ms per node", "ms per oracle call", "oracle calls per node",
-                     "oracle share"], rows, "lrrrrrr")
+    lines += _table(["planner", "policy", "nodes", "worlds", "ms / node", "ms / call", "calls / node",
+                     "in oracle"], rows, "llrrrrrr")
     if planners.get("note"):
         lines += [f"Settings, as the benchmark records them: {planners['note']}.", ""]
     return lines
@@ -411,22 +450,12 @@ def _recorded(payload: dict) -> str:
 
 
 def _other_results(root: Path) -> list[str]:
-    lines = ["## Other results kept", "",
-             f"Besides the run and the baseline, `{RESULTS.as_posix()}/` keeps the latest result of measurements "
-             "that `benchmarks/run.py` does not make (other modes of a script, the GPU, comparisons of two "
-             "checkouts, a reliability campaign). Each file records its provenance inside, some more of it than "
-             "others; where a file lacks the commit or the date, git's history of the file gives them.", ""]
-    rows = []
-    for path in sorted((root / RESULTS).iterdir()):
-        if path.name in (RUN.name, BASELINE.name) or path.name.startswith("."):
-            continue
-        recorded = "—"
-        if path.suffix == ".json":
-            payload, _ = _load(path)
-            if isinstance(payload, dict):
-                recorded = _recorded(payload)
-        rows.append([f"`{path.name}`", f"`{_script_of(root, path.stem)}`", recorded])
-    return lines + _table(["file", "written by", "provenance recorded in it"], rows, "lll")
+    files = sorted(path.name for path in (root / RESULTS).iterdir()
+                   if path.name not in (RUN.name, BASELINE.name) and not path.name.startswith("."))
+    return ["## Other results kept", "",
+            f"`{RESULTS.as_posix()}/` also keeps the results of measurements `benchmarks/run.py` does not make "
+            f"(other modes of a script, the GPU, comparisons of two checkouts, a reliability campaign; files: "
+            f"{len(files)}); each names the script that wrote it and carries its provenance inside.", ""]
 
 
 # ------------------------------------------------------------------------------------------ the page
@@ -452,6 +481,7 @@ def performance_page(root: Path) -> str:
     lines += _planners_section(run)
     lines += ["## Against peers measured in the same run", ""]
     lines += _ompl_section(run)
+    lines += _families_section(run)
     lines += _floor_section(run)
     lines += _interleaved_section(run)
     baseline, why = _load(root / BASELINE)

@@ -131,3 +131,9 @@ def write_tables(results: Path, target: Path) -> list[Path]:
             path.write_text(text)
         written.append(path)
     return written
+
+
+if __name__ == "__main__":  # python docs/results_tables.py: the committed tables, written afresh
+    here = Path(__file__).resolve().parent
+    for fragment in write_tables(here / "results", here / "results" / "_generated"):
+        print(f"wrote {fragment.relative_to(here.parent)}")

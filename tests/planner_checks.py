@@ -11,7 +11,11 @@ def assert_tree_edges_valid(env, dynamics, result, resolution=0.01, spacing=0.00
     obstacle (or leave the workspace) by more than the resolution."""
     nodes, parents = result.nodes, result.parents
     assert parents[0] == -1
-    assert np.all(parents[1:] >= 0) and np.all(parents[1:] < np.arange(1, len(parents)))
+    assert np.all(parents[1:] >= 0) and np.all(parents[1:] < len(parents))
+    ancestors = np.where(np.arange(len(parents)) == 0, 0, parents)  # a tree rooted at 0: every chain ends
+    for _ in range(int(np.ceil(np.log2(len(parents) + 1))) + 1):  # there (pointer doubling; a rewired
+        ancestors = ancestors[ancestors]  # q-RRT* node may have a parent of a higher index)
+    assert np.all(ancestors == 0), "a node whose chain of parents never reaches the root (a cycle)"
     assert env.is_free(nodes).all()
     closed = dynamics.closed_loop
     if np.allclose(closed, np.diag(np.diag(closed))):

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from . import probability, registry
-    from .planners import PQRRT, QRRT, RRT, Metrics, ParallelRRT, Planner, PlanResult
+    from .planners import PQRRT, QRRT, RRT, Metrics, ParallelRRT, Planner, PlanResult, QRRTConnect, QRRTStar
     from .planners.candidates import Candidates, LatticeCandidates, NearestParents
     from .planners.database import AnnealingSchedule
     from .planners.options import (
@@ -59,7 +59,7 @@ if TYPE_CHECKING:
     from .search.problem import DatabaseSearch, SearchOutcome
     from .world.environment import Environment
     from .world.image import OccupancyGrid
-    from .world.nearest import GridNearest, LinearNearest, NearestNeighbors
+    from .world.nearest import GridNearest, LinearNearest, NearestNeighbors, SE2Nearest
     from .world.spaces import RealVectorSpace, SE2Space, StateSpace
 
     __version__: str
@@ -72,7 +72,8 @@ if TYPE_CHECKING:
 _WHERE = {
     "probability": ".probability",
     "registry": ".registry",
-    **dict.fromkeys(["PQRRT", "QRRT", "RRT", "Metrics", "ParallelRRT", "PlanResult", "Planner"], ".planners"),
+    **dict.fromkeys(["PQRRT", "QRRT", "RRT", "Metrics", "ParallelRRT", "PlanResult", "Planner", "QRRTConnect",
+                     "QRRTStar"], ".planners"),
     **dict.fromkeys(["ParallelOptions", "ParallelQuantumOptions", "PlannerOptions", "QuantumOptions", "RRTOptions"],
                     ".planners.options"),
     "Problem": ".problems.problem",
@@ -82,7 +83,7 @@ _WHERE = {
     **dict.fromkeys(["Candidates", "LatticeCandidates", "NearestParents"], ".planners.candidates"),
     **dict.fromkeys(["Goal", "GoalBall", "GoalState"], ".problems.goals"),
     **dict.fromkeys(["RealVectorSpace", "SE2Space", "StateSpace"], ".world.spaces"),
-    **dict.fromkeys(["GridNearest", "LinearNearest", "NearestNeighbors"], ".world.nearest"),
+    **dict.fromkeys(["GridNearest", "LinearNearest", "NearestNeighbors", "SE2Nearest"], ".world.nearest"),
     **dict.fromkeys(["AnyOf", "MaxCriticalPathCalls", "MaxNodes", "MaxOracleCalls", "MaxRounds", "MaxWallTime",
                      "PlanStatus", "Stall", "TerminationCondition"], ".planners.termination"),
     "AuthorsCheck": ".reachability.authors_check",
@@ -142,6 +143,8 @@ __all__ = [
     "BBHT",
     "PQRRT",
     "QRRT",
+    "QRRTConnect",
+    "QRRTStar",
     "RRT",
     "Adaptive",
     "ThompsonIterations",
@@ -162,6 +165,7 @@ __all__ = [
     "GridCheck",
     "GridNearest",
     "LinearNearest",
+    "SE2Nearest",
     "NearestNeighbors",
     "RealVectorSpace",
     "SE2Space",

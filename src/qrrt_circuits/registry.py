@@ -123,7 +123,7 @@ class Registry:
     Example:
         >>> from qrrt_circuits.registry import PLANNERS, POLICIES
         >>> PLANNERS.names()
-        ('rrt', 'prrt', 'qrrt', 'pqrrt', 'pqrrt-unshared')
+        ('rrt', 'prrt', 'qrrt', 'pqrrt', 'pqrrt-unshared', 'qrrt-connect', 'qrrt-star')
         >>> PLANNERS.canonical("PQRRT"), "qrrt" in PLANNERS, "astar" in PLANNERS
         ('pqrrt', True, False)
         >>> POLICIES.labels()
@@ -133,7 +133,7 @@ class Registry:
         >>> PLANNERS.resolve("astar")
         Traceback (most recent call last):
         ...
-        ValueError: unknown planner 'astar'; choose one of rrt, prrt, qrrt, pqrrt, pqrrt-unshared
+        ValueError: unknown planner 'astar'; choose one of rrt, prrt, qrrt, pqrrt, pqrrt-unshared, qrrt-connect, ...
     """
 
     def __init__(self, kind: str) -> None:
@@ -304,7 +304,7 @@ def register_planner(registry: Registry, name: str, planner: type[Planner], help
 
 
 def _planners() -> Registry:
-    from .planners import PQRRT, QRRT, RRT, ParallelRRT
+    from .planners import PQRRT, QRRT, RRT, ParallelRRT, QRRTConnect, QRRTStar
 
     registry = Registry("planner")
     register_planner(registry, "rrt", RRT, "classical RRT, 1 reachability test a round", aliases=("RRT",),
@@ -317,6 +317,12 @@ def _planners() -> Registry:
                      fixed={"shared_database": True}, aliases=("PQRRT", "pqrrt-shared"), tags=("quantum", "parallel"))
     register_planner(registry, "pqrrt-unshared", PQRRT, "Pq-RRT: each worker builds and searches its own database",
                      fixed={"shared_database": False}, aliases=("PQRRT-unshared",), tags=("quantum", "parallel"))
+    register_planner(registry, "qrrt-connect", QRRTConnect,
+                     "q-RRT-Connect: two trees, q-RRT extensions, a Grover-searched connection",
+                     aliases=("QRRTConnect",), tags=("quantum", "bidirectional"))
+    register_planner(registry, "qrrt-star", QRRTStar,
+                     "q-RRT*: q-RRT extensions, Durr-Hoyer choice of parent, searched rewires (anytime)",
+                     aliases=("QRRTStar",), tags=("quantum", "optimizing"))
     return registry
 
 

@@ -42,7 +42,8 @@ def gap_setup(goal_threshold: float = 0.5) -> og.SimpleSetup:
 def test_a_setup_becomes_a_problem_the_planners_take():
     problem = problem_from_setup(gap_setup())
     assert problem.env.bounds.tolist() == [[0.0, 10.0], [0.0, 10.0]] and problem.start.tolist() == [1.0, 1.0]
-    assert isinstance(problem.goal, qc.GoalState) and problem.goal.threshold == 0.5
+    assert isinstance(problem.goal, OMPLGoalRegion) and problem.goal.describe()["threshold"] == 0.5
+    assert problem.goal.describe()["state"] == [9.0, 9.0] and not problem.goal.has_volume
     assert problem.predicate.is_valid(np.array([[5.0, 1.0], [5.0, 5.0]])).tolist() == [False, True]
     for make in (lambda: qc.RRT(goal_bias=0.05, seed=0),
                  lambda: qc.QRRT(backend=qc.StatevectorBackend(seed=0), num_qubits=4, goal_bias=0.05,
@@ -153,3 +154,20 @@ def test_benchmark_logs_of_a_library_problem_count_every_planners_motion_checks(
             assert row["solved BOOLEAN"] == 1 and row["motion checks INTEGER"] >= 1, name
     for row in rows["RRT (library)"]:  # without look-ahead, one motion check per oracle call
         assert row["motion checks INTEGER"] == row["oracle calls INTEGER"]
+
+
+@pytest.mark.parametrize("planner", [
+    qc.QRRTConnect(backend=qc.StatevectorBackend(seed=0), num_qubits=4, seed=1),
+    qc.QRRTStar(backend=qc.StatevectorBackend(seed=0), num_qubits=4, goal_bias=0.05, seed=1),
+], ids=["qrrt-connect", "qrrt-star"])
+def test_quantum_connect_and_star_solve_inside_ompl(planner):
+    """q-RRT-Connect (its goal tree rooted at OMPL's goal state) and q-RRT* (anytime: it plans until
+    OMPL's condition ends it and returns its best path) as ``ompl.base.Planner`` objects."""
+    setup = gap_setup()
+    library = LibraryPlanner(setup.getSpaceInformation(), planner, planner.name)
+    setup.setPlanner(library)
+    assert setup.solve(ob.plannerOrTerminationCondition(ob.timedPlannerTerminationCondition(20.0),
+                                                        ob.exactSolnPlannerTerminationCondition(
+                                                            setup.getProblemDefinition()))
+                       if planner.name == "QRRTConnect" else ob.timedPlannerTerminationCondition(3.0))
+    assert setup.haveExactSolutionPath() and setup.getSolutionPath().check() and library.last_result.reached

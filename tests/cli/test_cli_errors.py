@@ -46,8 +46,8 @@ CASES = [
     (["plan", "--planner", "rrt", "--backend", "statevector"], "--backend does not apply to --planner rrt"),
     (["plan", "--planner", "prrt", "--policy", "bbht"], "--policy does not apply to --planner prrt"),
     (["plan", "--planner", "qrrt", "--workers", "4"], "--workers does not apply to --planner qrrt"),
-    (["plan", "--planner", "rrt", "--max-rounds", "10000000000000", "--stall-rounds", "10000000000000"],
-     "max_rounds = 10000000000000: this plan could need about"),
+    (["plan", "--planner", "rrt", "--max-rounds", "10000000000000", "--max-nodes", "10000000000000"],
+     "max_nodes = 10000000000000: this plan could need about"),
 ]
 
 

@@ -360,6 +360,7 @@ def _check_search_policies(summary, records):
 
 
 def _check_problems(summary, records):
+    from qrrt_circuits.experiments.connect_star import BUDGET_SHARES
     from qrrt_circuits.experiments.default_policy import POLICY_CANDIDATES, TIE_MARGIN
 
     settings = summary["settings"]
@@ -370,10 +371,21 @@ def _check_problems(summary, records):
             assert r["status"] == "max_oracle_calls" and r["oracle_calls"] >= settings["budget"]
         assert r["critical_path_calls"] <= r["oracle_calls"]
         assert r["classical_checks"] >= r["simulation_checks"]
-        if r["config"].startswith("QRRT") or r["config"].startswith("PQRRT"):
+        if r["config"] in ("QRRTConnect", "QRRTStar"):  # extension databases of 2^n, and smaller ones
+            assert r["simulation_checks"] >= 1 << settings["num_qubits"]
+        elif r["config"].startswith("QRRT") or r["config"].startswith("PQRRT"):
             assert r["simulation_checks"] > 0 and r["simulation_checks"] % (1 << settings["num_qubits"]) == 0
         elif r["config"] == "RRT range" or r["config"].startswith("OMPL"):  # no check thrown away
             assert r["classical_checks"] == r["oracle_calls"]
+        costs = [r[f"cost_at_{share}"] for share in BUDGET_SHARES]
+        if r["config"] in ("QRRTStar", "OMPL RRTstar"):  # an anytime planner's best cost never rises
+            held = [cost for cost in costs if math.isfinite(cost)]
+            assert held == sorted(held, reverse=True) and bool(held) == bool(r["reached"])
+            if r["config"] == "QRRTStar":  # (its cost is the problem's metric; OMPL's is its own; the last
+                # round may pass the budget and shorten the path further)
+                assert not held or held[-1] >= r["path_length"] * (1 - 1e-9)
+        else:
+            assert all(math.isnan(cost) for cost in costs)
     for family, planners in summary["ours"].items():
         for config, row in planners.items():
             runs = [r for r in records if r["family"] == family and r["config"] == config]
@@ -383,6 +395,10 @@ def _check_problems(summary, records):
                 assert row["calls_per_solution"] == round(sum(r["oracle_calls"] for r in runs) / solved, 4)
         _assert_intervals_hold(planners, summary["interval_95"][family])
         _assert_intervals_hold(summary["details"][family], summary["details_interval_95"][family])
+    for family in settings["families"]:
+        assert set(summary["connect_vs_ompl"][family]) == {"median", "interval_95", "runs", "both_solved"}
+        star = summary["star_vs_ompl"][family]
+        assert set(star["mean_cost"]) == {"QRRTStar", "OMPL RRTstar"}
     for rule in summary["default_policy"].values():
         assert rule["chosen"] in POLICY_CANDIDATES and rule["chosen_by_root_seed"]
         worst = {c: math.inf if v is None else v for c, v in rule["worst"].items()}  # JSON's null is inf

@@ -137,3 +137,27 @@ def test_keyed_samples_are_the_samples_of_each_keys_generator(clutter, goal_bias
         assert np.array_equal(sample, one[0]), key
     if goal_bias:
         assert np.any(np.linalg.norm(samples - goal.centre, axis=1) <= 1.5)  # (some were drawn in the goal)
+
+
+@pytest.mark.parametrize("family", ["se2-gap", "narrow-passage-4d", "open-space", "maze"])
+def test_batched_rrt_equals_sequential_on_the_problem_families(family, executor):
+    """Tests made ahead stay in use while no node added since is as near to their sample as their
+    parent (SE(2)'s scan and the Euclidean grid): the same plan as testing each round on its own."""
+    from qrrt_circuits.experiments.problems import build_problem
+
+    problem = build_problem(family, 1)
+    batched = qc.RRT(seed=5, goal_bias=0.05).plan(problem, max_oracle_calls=600)
+    sequential = _sequential(qc.RRT(seed=5, goal_bias=0.05), executor).plan(problem, max_oracle_calls=600)
+    _same(batched, sequential)
+    assert batched.metrics.wasted_checks < batched.metrics.oracle_calls  # most tests made ahead were used
+
+
+def test_rounds_ready_stop_where_a_check_before_each_round_would():
+    from qrrt_circuits.planners.termination import MaxOracleCalls, MaxRounds, Progress, Stall, rounds_that_start
+
+    now = Progress(10, 4, 3, 6, 2, 0.0)
+    growth = Progress(3, 1, 0, 1, 1, 0.0)
+    assert rounds_that_start(MaxOracleCalls(20), now, growth, 10) == 4  # rounds from 10, 13, 16, 19 calls
+    assert rounds_that_start(MaxRounds(8) | Stall(100), now, growth, 10) == 2
+    assert rounds_that_start(Stall(5), now, growth, 10) == 3
+    assert rounds_that_start(MaxOracleCalls(10**6), now, growth, 7) == 7

@@ -435,11 +435,15 @@ def test_describe_merges_user_settings_without_comparing_them(walled):
         assert result.settings["termination"]["user_note"] == last
 
 
-def test_a_limit_too_large_for_a_float_is_refused_in_words():
+def test_a_round_limit_too_large_for_a_float_is_sized_by_the_history_checked_up_front():
+    """The history of at most ``HISTORY_ROUNDS_CHECKED_UP_FRONT`` rounds is counted whatever the
+    round limit (10^400 here): refused in GiB where that and the tree do not fit, accepted where
+    they do."""
     from qrrt_circuits._support.memory import check_plan_fits
 
-    with pytest.raises(ValueError, match=r"max_rounds = 1000+: .* about 10\^40[0-9] bytes"):
+    with pytest.raises(ValueError, match=r"max_rounds = 1000+: this plan could need about 1\.2 GiB"):
         check_plan_fits(10**6, 1, 10**400, 2, available=1 << 30)
+    check_plan_fits(10**6, 1, 10**400, 2, available=1 << 32)
 
 
 class _DescribesMaxNodes(_UserCondition):
@@ -556,3 +560,27 @@ def test_a_wall_clock_budget_alone_adds_no_round_or_stall_limit():
     assert with_defaults(qc.MaxWallTime(1.0)) == qc.MaxWallTime(1.0) | qc.MaxNodes(termination.DEFAULT_MAX_NODES)
     assert with_defaults(qc.MaxOracleCalls(10) | qc.MaxWallTime(1.0)).round_limit == termination.DEFAULT_MAX_ROUNDS
     assert with_defaults(qc.MaxOracleCalls(10 ** 6)).round_limit == 10 ** 6 + 1
+
+
+def test_a_large_budget_is_not_refused_for_history_it_may_never_need(clutter):
+    """An oracle-call budget of 10^8 lets 10^8 rounds run, but the plan's check counts the history
+    of at most ``HISTORY_ROUNDS_CHECKED_UP_FRONT`` of them; the plan reaches the goal in a few
+    hundred calls."""
+    result = qc.RRT(seed=0).plan(clutter, max_oracle_calls=10**8)
+    assert result.reached and result.metrics.oracle_calls < 10**4
+
+
+def test_history_beyond_the_rounds_checked_up_front_is_checked_as_it_grows(walled, monkeypatch):
+    """Past the checkpoint, a history whose doubling does not fit ends the plan with one line naming
+    the rounds run and the limits to lower (not the whole plan's worst case refused up front)."""
+    from qrrt_circuits._support.memory import OutOfMemory
+    from qrrt_circuits.planners import run_state
+
+    monkeypatch.setattr(run_state, "HISTORY_ROUNDS_CHECKED_UP_FRONT", 64)
+    monkeypatch.setattr(probe, "available_memory", lambda: (10_000, probe.MACHINE_SOURCE))
+    with pytest.raises(OutOfMemory, match=r"the plan has run 64 rounds and its round history would need about "
+                                          r"16 KiB more .*max_rounds or oracle-call budget"):
+        qc.RRT(seed=0).plan(_walled_from(walled, [1, 1]), max_rounds=1000, stall_rounds=1000)
+    monkeypatch.setattr(probe, "available_memory", lambda: (1 << 30, probe.MACHINE_SOURCE))
+    assert qc.RRT(seed=0).plan(_walled_from(walled, [1, 1]), max_rounds=1000,
+                               stall_rounds=1000).metrics.rounds == 1000

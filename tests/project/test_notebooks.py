@@ -14,7 +14,9 @@ the docs just before the suite), the test checks the cached outputs instead of r
 notebook a second time; otherwise it executes the notebook itself.
 """
 
+import difflib
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -38,6 +40,7 @@ NOTEBOOKS = [
     "06_would_it_pay_off.ipynb",
     "07_plan_your_ompl_problem.ipynb",
     "08_coherent_oracle.ipynb",
+    "09_connect_and_star.ipynb",
 ]
 INTERPRETER_MARK = "kernel interpreter: "
 
@@ -80,6 +83,7 @@ def executed_by_docs_build(nb):
 def test_notebook_executes(name):
     nb = nbformat.read(NOTEBOOKS_DIR / name, as_version=4)
     check_stored(name, nb)
+    stored = nbformat.read(NOTEBOOKS_DIR / name, as_version=4)
     for cell in nb.cells:  # executed afresh below (or by the docs build), from the code alone
         if cell.cell_type == "code":
             cell.outputs, cell.execution_count = [], None
@@ -89,6 +93,7 @@ def test_notebook_executes(name):
                       and not c.get("execution_count")]
         assert not unexecuted, f"the docs build's copy of {name} has unexecuted cells: {unexecuted}"
         check_outputs(name, cached)
+        check_stored_outputs_match(name, stored, cached)
         return
     nb.cells.append(nbformat.v4.new_code_cell(f"import sys; print({INTERPRETER_MARK!r} + sys.prefix)"))
 
@@ -104,7 +109,57 @@ def test_notebook_executes(name):
     reported = _stream_text(nb.cells[-1]).strip()
     assert reported.startswith(INTERPRETER_MARK), reported
     assert Path(reported.removeprefix(INTERPRETER_MARK)) == Path(sys.prefix), "kernel runs another Python"
+    nb.cells.pop()  # (the interpreter check, not part of the tutorial)
     check_outputs(name, nb)
+    check_stored_outputs_match(name, stored, nb)
+
+
+#: what may differ between two runs of the same code, replaced before stored and fresh outputs are
+#: compared: durations and rates (a number with a unit of time), object addresses, and which
+#: counter gave the fault-tolerant counts (Qualtran where the ``ft`` extra is installed, else the
+#: library's formulas: the counts agree, ``tests/hardware/test_resources.py``)
+VOLATILE = [
+    (re.compile(r"\d[\d,.]*(?:e[-+]?\d+)?\s*(?:ms|µs|us|ns|s|sec|seconds?|minutes?|min|h)\b"), "<time>"),
+    (re.compile(r"(?:ms|s|seconds?) (?:per|a) (?:node|call|oracle call|round|plan)[^\n]*"), "<time per>"),
+    (re.compile(r"0x[0-9a-f]+"), "<address>"),
+    (re.compile(r"\((?:qualtran [\w.]+|formula)\)"), "(<fault-tolerant counter>)"),
+    (re.compile(r"[^\n]*\d+it/s[^\n]*|[^\n]*\|[#█▏▎▍▌▋▊▉ ]*\|[^\n]*"), "<progress>"),
+]
+
+
+def _texts(nb) -> list[str]:
+    """The text each code cell printed or returned (streams and text/plain), volatile parts masked."""
+    texts = []
+    for cell in nb.cells:
+        if cell.cell_type != "code":
+            continue
+        parts = [out.get("text", "") if out.output_type == "stream" else out.get("data", {}).get("text/plain", "")
+                 for out in cell.get("outputs", []) if out.output_type in ("stream", "execute_result")]
+        text = "".join(parts)
+        for pattern, mask in VOLATILE:
+            text = pattern.sub(mask, text)
+        texts.append(text)
+    return texts
+
+
+#: notebooks whose outputs depend on an optional extra (stored with it installed): compared only
+#: where it is installed
+NEEDS_EXTRA = {"07_plan_your_ompl_problem.ipynb": "ompl"}
+
+
+def check_stored_outputs_match(name, stored, fresh):
+    """The outputs the repository stores are those a fresh run prints, up to ``VOLATILE`` parts:
+    a stored tutorial whose code or library has changed since it was executed fails here."""
+    import importlib.util
+
+    if name in NEEDS_EXTRA and importlib.util.find_spec(NEEDS_EXTRA[name]) is None:
+        return  # (its stored outputs are those with the extra; this run has none)
+    for index, (kept, made) in enumerate(zip(_texts(stored), _texts(fresh), strict=True)):
+        if kept != made:
+            diff = "\n".join(difflib.unified_diff(kept.splitlines(), made.splitlines(), "stored", "fresh", lineterm="",
+                                                  n=1))
+            pytest.fail(f"{name}: code cell {index + 1}'s stored output differs from a fresh run (run python "
+                        f"docs/execute_notebooks.py {name}):\n{diff[:3000]}")
 
 
 def check_stored(name, nb):
@@ -184,3 +239,16 @@ def test_notebook_06_without_the_results_says_how_to_make_them_and_reads_results
     run = _run_results_script(elsewhere, package.parent)
     assert run.returncode == 0, run.stderr
     assert all(text in run.stdout for text in RESULTS_READ) and "skipped" not in run.stdout, run.stdout
+
+
+def test_a_stale_stored_output_is_caught_and_timings_are_not():
+    """The comparison fails on a changed count and passes on changed timings and addresses."""
+    def notebook(text):
+        cell = nbformat.v4.new_code_cell("print(...)")
+        cell.outputs = [nbformat.v4.new_output("stream", name="stdout", text=text)]
+        return nbformat.v4.new_notebook(cells=[cell])
+
+    stored = notebook("196 oracle calls in 1.52 s at 0x7f00aa (qualtran 0.7.0)\n")
+    check_stored_outputs_match("x", stored, notebook("196 oracle calls in 0.9 s at 0x7f11bb (formula)\n"))
+    with pytest.raises(pytest.fail.Exception, match="196 oracle calls"):
+        check_stored_outputs_match("x", stored, notebook("60 oracle calls in 1.52 s at 0x7f00aa (formula)\n"))

@@ -17,7 +17,7 @@ def _run(commit: str, ms_per_node: float, cpu: str = "Test CPU") -> dict:
     machine = {"git_commit": commit, "git_dirty": False, "date": "DATE-OF-" + commit, "cpu": cpu, "cores": 2,
                "packages": {"qiskit": "9.9", "ompl": None}, "python": "3.x", "load_average": [0.5, 0.25, 0.125]}
     planners = {"seeds": 3, "max_nodes": 10, "big_nodes": 30, "big_seeds": 1, "note": "NOTE",
-                "planners": {"RRT": {"max_nodes": 10, "runs": [{}, {}, {}],
+                "planners": {"RRT": {"max_nodes": 10, "runs": [{}, {}, {}], "settings": {"search_policy": None},
                                      "ms_per_node": {"median": ms_per_node, "p10": 0.1, "p90": 0.9},
                                      "ms_per_call": {"median": 0.0123}, "calls_per_node": {"median": 4.5},
                                      "oracle_share": {"median": 0.25}}},
@@ -25,9 +25,14 @@ def _run(commit: str, ms_per_node: float, cpu: str = "Test CPU") -> dict:
     search = {"against_floor": [{"qubits": 8, "marked": 12, "iterations": 12, "shots": 8, "repeats": 5,
                                  "median_ms": {"floor": 0.5, "ours": 1.0, "qiskit_algorithms": 20.0},
                                  "ratio_to_floor": {"floor": 1.0, "ours": 2.0, "qiskit_algorithms": 40.0}}]}
-    return {"machine": machine, "quick": True, "benchmarks": {"planners": {"returncode": 0, "wall_s": 1.5}},
-            "figures": {"planners.RRT.ms_per_node.median": ms_per_node}, "raw": {"planners": planners,
-                                                                                  "search": search}}
+    ratio = {"median": 1.25, "low": 1.0, "high": 1.5}
+    problems = {"runs": 4, "budget": 5000, "figures": {"maze": {
+        "rrt": {"us_per_check": 8.0, "own_us_per_check": 6.0}, "ompl_rrt": {"us_per_check": 6.4},
+        "ratios": {"rrt_over_ompl_per_run": ratio, "rrt_one_by_one_over_ompl_per_run": ratio}}}}
+    return {"machine": machine, "quick": True, "benchmarks": {"planners": {"returncode": 0, "wall_s": 1.5},
+                                                            "problems": {"returncode": 3, "wall_s": 2.0}},
+            "figures": {"planners.RRT.ms_per_node.median": ms_per_node},
+            "raw": {"planners": planners, "search": search, "problems": problems}}
 
 
 @pytest.fixture
@@ -48,15 +53,16 @@ def test_the_page_shows_the_runs_figures_provenance_and_peers(root):
     assert page.startswith("# Performance")
     assert "`aaaa`" in page and "DATE-OF-aaaa" in page and "Test CPU, 2 cores" in page
     assert "quick run" in page and "qiskit 9.9" in page and "not installed: ompl" in page
-    assert "Planner figures, in words." in page
-    assert "| RRT | 10 | 3 | 0.25 (0.1–0.9) | 0.0123 | 4.5 | 25 % |" in page
+    assert "The run holds 2 benchmarks (`planners`, `problems`" in page and "`problems` failed (exit status 3)" in page
+    assert "| RRT | — | 10 | 3 | 0.25 (0.1–0.9) | 0.0123 | 4.5 | 25 % |" in page
+    assert "| maze | 8 | 6 | 6.4 | 1.25 [1, 1.5] | 1.25 [1, 1.5] |" in page  # RRT against OMPL on a family
     assert "ours over OMPL's: **0.5×**" in page
     assert "| 8 | 12 | 12 | 8 | 5 | 0.5 | 1 | 2× | 20 | 40× |" in page
     assert "20× at n = 8" in page  # qiskit-algorithms over ours
     assert "`bbbb`" in page and "different machines" in page
     assert "| RRT | 0.5 | 0.25 | 0.5× |" in page  # baseline, this run, ratio
     assert "| `planners` | 1 | 0.5 |" in page  # compare.py's per-benchmark line
-    assert "`extra.json`" in page and "no commit or date" in page
+    assert "a reliability campaign; files: 1)" in page
     assert "not in this checkout's history" in page or "cannot be checked" in page  # tmp_path: no such commit
 
 

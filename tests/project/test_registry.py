@@ -10,7 +10,7 @@ from qrrt_circuits.cli import build_parser, main
 from qrrt_circuits.registry import BACKENDS, PLANNERS, POLICIES, PREDICATES, SCENARIOS, Registry
 
 EXPECTED_PLANNERS = {"rrt": qc.RRT, "prrt": qc.ParallelRRT, "qrrt": qc.QRRT, "pqrrt": qc.PQRRT,
-                     "pqrrt-unshared": qc.PQRRT}
+                     "pqrrt-unshared": qc.PQRRT, "qrrt-connect": qc.QRRTConnect, "qrrt-star": qc.QRRTStar}
 
 
 def _cli_action(command: str, option: str) -> argparse.Action:

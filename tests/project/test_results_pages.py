@@ -54,3 +54,21 @@ def test_the_fragments_are_written_for_both_checks(tmp_path):
     corridor = (tmp_path / "corridor.md").read_text()
     assert "our exact check" in corridor and "the authors' check" in corridor
     assert re.search(r"\| QRRT \| 3 \| \[0, 6\] \| 47 \| yes \|", corridor)
+
+
+def test_the_committed_tables_are_the_ones_the_summaries_give(tmp_path):
+    """``docs/results/_generated/`` is committed, so a repository browser shows each page's table
+    (the pages link it); it must be what ``results_tables.py`` writes from the summaries now."""
+    written = write_tables(RESULTS, tmp_path)
+    committed = RESULTS / "_generated"
+    for path in written:
+        assert (committed / path.name).read_text() == path.read_text(), (
+            f"docs/results/_generated/{path.name} is stale: run python docs/results_tables.py")
+    assert sorted(p.name for p in committed.glob("*.md")) == sorted(p.name for p in written)
+
+
+def test_every_page_links_its_tables_for_a_repository_browser():
+    for page in RESULTS.glob("*.md"):
+        text = page.read_text()
+        for name in re.findall(r"\{include\} _generated/([\w-]+)\.md", text):
+            assert f"([as a file](_generated/{name}.md), for a repository browser)" in text, (page.name, name)

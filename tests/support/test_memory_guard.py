@@ -806,14 +806,14 @@ sys.exit(cli.main(sys.argv[1:]))
 
 @_LINUX_RLIMIT
 def test_a_real_memory_error_under_ulimit_v_is_one_line(tmp_path):
-    """An estimate that falls short passes the check under ``ulimit -v`` of 2.5 GiB and the round
+    """An estimate that falls short passes the check under ``ulimit -v`` of 3 GiB and the round
     really runs out of address space: one line naming n, what the allocator reported and the
     largest smaller n whose estimate fits in what was available when the plan started; exit status
     1, no traceback, no output file."""
     out = tmp_path / "plan.json"
     run = subprocess.run([sys.executable, "-c", _SHORT_ESTIMATE, "plan", "--planner", "qrrt", "--backend",
                           "statevector", "--qubits", "26", "--max-rounds", "1", "--json", str(out)],
-                         capture_output=True, text=True, timeout=300, preexec_fn=_limited(5 << 29))
+                         capture_output=True, text=True, timeout=300, preexec_fn=_limited(6 << 29))
     assert run.returncode == 1 and "Traceback" not in run.stderr, run.stderr
     lines = _error_lines(run.stderr)
     assert len(lines) == 1, run.stderr

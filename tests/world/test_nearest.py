@@ -1,6 +1,7 @@
 """Nearest-neighbour structures answer what brute force answers under their metric, ties to the
 lowest index: the compiled Euclidean grid (``GridNearest``) as it grows, and the scan under a
-space's distance (``LinearNearest``, Euclidean and SE(2))."""
+space's distance (``LinearNearest``, Euclidean and SE(2)), and its compiled SE(2) form
+(``SE2Nearest``)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ import numpy as np
 import pytest
 
 import qrrt_circuits as qc
-from qrrt_circuits.world.nearest import GridNearest, LinearNearest, NearestNeighbors
+from qrrt_circuits.world.nearest import GridNearest, LinearNearest, NearestNeighbors, SE2Nearest
 
 
 def _grid(first: np.ndarray, capacity: int = 256) -> GridNearest:
@@ -380,5 +381,44 @@ def test_the_linear_scan_breaks_ties_to_the_lowest_index_and_wraps_the_angle():
 def test_each_space_chooses_its_structure_once_empty():
     grid, scan = qc.RealVectorSpace(2).nearest_neighbors(), qc.SE2Space().nearest_neighbors()
     assert isinstance(grid, GridNearest) and grid.dim == 2 and grid.size == 0
-    assert isinstance(scan, LinearNearest) and scan.space == qc.SE2Space() and scan.size == 0
+    assert isinstance(scan, SE2Nearest) and scan.angle_weight == 0.5 and scan.size == 0
     assert qc.RealVectorSpace(2).nearest_neighbors() is not grid  # a new structure per call (per plan)
+
+
+@pytest.mark.parametrize(("make", "space"), [(lambda: GridNearest(3), qc.RealVectorSpace(3)),
+                                             (lambda: LinearNearest(qc.SE2Space()), qc.SE2Space()),
+                                             (lambda: SE2Nearest(0.5), qc.SE2Space()),
+                                             (lambda: LinearNearest(qc.RealVectorSpace(3)), qc.RealVectorSpace(3))],
+                         ids=["grid", "se2-scan", "se2-compiled", "euclidean"])
+@pytest.mark.parametrize("count", [5, 700])  # (700: past the grid's brute-force switch)
+def test_the_distance_to_the_points_added_since_an_index_is_the_brute_force(make, space, count):
+    """``nearest_distance_from(queries, first)``: the smallest distance, under the structure's
+    metric, to the points of index ``first`` on; ``inf`` where there are none."""
+    rng = np.random.default_rng(count)
+    near = make()
+    points = _se2_points(rng, count)
+    near.add(points)
+    queries = _se2_points(rng, 9)
+    for first in (0, 1, count // 2, count - 1, count):
+        want = [min((float(space.distance(points[index], query)[0]) for index in range(first, count)),
+                    default=math.inf) for query in queries]
+        np.testing.assert_allclose(near.nearest_distance_from(queries, first), want, rtol=1e-12)
+
+
+@pytest.mark.parametrize("weight", [0.5, 2.0, 0.0])
+def test_the_compiled_se2_scan_is_the_space_metric_scan_bit_for_bit(weight):
+    """``SE2Nearest`` answers ``LinearNearest(SE2Space(w))``'s indices and distances exactly, ties
+    (positions on a 0.1 grid) and wrapped angles included."""
+    rng = np.random.default_rng(int(weight * 10))
+    for trial in range(30):
+        scan, compiled = LinearNearest(qc.SE2Space(weight)), SE2Nearest(weight)
+        count = int(rng.integers(1, 300))
+        points, queries = _se2_points(rng, count), _se2_points(rng, 40)
+        if trial % 3 == 0:
+            points[:, :2], queries[:, :2] = np.round(points[:, :2], 1), np.round(queries[:, :2], 1)
+        scan.add(points)
+        compiled.add(points)
+        assert np.array_equal(scan.nearest(queries), compiled.nearest(queries))
+        first = int(rng.integers(0, count + 1))
+        assert np.array_equal(scan.nearest_distance_from(queries, first),
+                              compiled.nearest_distance_from(queries, first))

@@ -473,6 +473,34 @@ TREE_BYTES_PER_COORDINATE = 48
 #: result's copies), bytes per round: a calibrated upper bound of the measured peak of long RRT
 #: plans from a walled-in start, rounded up
 HISTORY_BYTES_PER_ROUND = 256
+#: the rounds of history a plan's check before its first round counts at most (1 GiB at
+#: ``HISTORY_BYTES_PER_ROUND``): a budget allows far more rounds than most plans run, so the history
+#: beyond them is checked as it grows (``check_history_growth``), not refused up front
+HISTORY_ROUNDS_CHECKED_UP_FRONT = 1 << 22
+
+
+def check_history_growth(rounds: int) -> int:
+    """Check, when a plan's history reaches ``rounds`` rounds, that the memory available holds as
+    many more; returns the round count at which to check again (twice ``rounds``).
+
+    Args:
+        rounds: The rounds recorded (a checkpoint: ``HISTORY_ROUNDS_CHECKED_UP_FRONT`` and its
+            doublings).
+
+    Returns:
+        2 ``rounds``.
+
+    Raises:
+        OutOfMemory: The memory available (``available_memory``) holds less than ``rounds``
+            more rounds of history, naming the rounds run and the limits to lower.
+    """
+    needed = rounds * HISTORY_BYTES_PER_ROUND
+    reading = probe.available_memory()
+    if reading is not None and reading[0] < needed:
+        raise OutOfMemory(f"the plan has run {rounds} rounds and its round history would need about "
+                          f"{_size(needed)} more to double, more than {_memory_text(reading)}: give a smaller "
+                          "max_rounds or oracle-call budget, or a stall_rounds limit")
+    return 2 * rounds
 
 
 #: writing a plan's result as ``json.dump(result.to_dict(), ...)`` (the Python lists of ``to_dict``),
@@ -487,7 +515,9 @@ JSON_BYTES_PER_COORDINATE = 48
 
 def plan_bytes(max_nodes: int, nodes_per_round: int, max_rounds: int | None, dim: int,
                output_bytes_per_node: int = 0) -> tuple[int, int]:
-    """The most a plan's tree and its round history can hold, in bytes: (tree, history).
+    """The most a plan's tree and its round history can hold, in bytes: (tree, history); the history
+    up to ``HISTORY_ROUNDS_CHECKED_UP_FRONT`` rounds (beyond, ``check_history_growth`` checks it as the
+    plan runs).
 
     A round adds at most ``nodes_per_round`` nodes (1, or p workers) and the node limit is checked
     before each round, so the tree ends with at most min(``max_nodes + nodes_per_round - 1``,
@@ -515,7 +545,7 @@ def plan_bytes(max_nodes: int, nodes_per_round: int, max_rounds: int | None, dim
     """
     nodes = _tree_nodes(max_nodes, nodes_per_round, max_rounds)
     tree = nodes * (TREE_BYTES_PER_NODE + TREE_BYTES_PER_COORDINATE * dim + output_bytes_per_node)
-    history = 0 if max_rounds is None else max_rounds * HISTORY_BYTES_PER_ROUND
+    history = 0 if max_rounds is None else min(max_rounds, HISTORY_ROUNDS_CHECKED_UP_FRONT) * HISTORY_BYTES_PER_ROUND
     return tree, history
 
 
@@ -738,7 +768,7 @@ def check_plan_fits(max_nodes: int, nodes_per_round: int, max_rounds: int | None
         >>> check_plan_fits(10**6, 1, 10**9, 2, available=2**30)  # doctest: +ELLIPSIS
         Traceback (most recent call last):
         ...
-        ValueError: max_rounds = 1000000000: this plan could need about 238.6 GiB ...
+        ValueError: max_rounds = 1000000000: this plan could need about 1.2 GiB ...
     """
     return PlanSize(max_nodes, nodes_per_round, max_rounds, dim, round_estimate, num_qubits, default_nodes,
                     default_rounds, output_bytes_per_node).check(available)

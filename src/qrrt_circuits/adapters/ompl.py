@@ -1,6 +1,7 @@
 """OMPL's motion validation as a reachability predicate (needs the ``ompl`` extra, OMPL >= 2.0).
 
-``OMPLMotionPredicate`` wraps an OMPL ``SpaceInformation`` on a ``RealVectorStateSpace``:
+``OMPLMotionPredicate`` wraps an OMPL ``SpaceInformation`` on a ``RealVectorStateSpace``, an
+``SE2StateSpace`` or a compound of real-vector spaces (``ompl_states``: states as coordinates):
 ``reachable(parents, children)`` answers, for each pair, ``si.checkMotion(parent, child)``, that
 is whatever motion validator the ``SpaceInformation`` holds (OMPL's default, the
 ``DiscreteMotionValidator``, tests the child state and then the straight segment at interpolated
@@ -45,6 +46,8 @@ except ImportError as exc:  # pragma: no cover - exercised by a test that hides 
         "qrrt_circuits.adapters.ompl needs the OMPL Python bindings (OMPL >= 2.0); install them with "
         f"{INSTALL_HINT}") from exc
 
+from .ompl_states import coordinates_for  # noqa: E402  (after the hint for a missing OMPL)
+
 __all__ = ["INSTALL_HINT", "OMPLMotionPredicate", "from_environment"]
 
 #: OMPL's default motion validator for a real-vector space, a C++ class OMPL 2.0 does not bind:
@@ -55,19 +58,21 @@ DEFAULT_VALIDATOR = "DiscreteMotionValidator"
 class OMPLMotionPredicate:
     """Reachability predicate answering ``si.checkMotion(parent, child)`` for each pair.
 
-    ``space_information`` must be an ``ompl.base.SpaceInformation`` whose state space is an
-    ``ompl.base.RealVectorStateSpace`` (its dimension is ``dim``). It is set up here if it is not
+    ``space_information`` must be an ``ompl.base.SpaceInformation`` whose state space
+    ``ompl_states.coordinates_for`` maps (a ``RealVectorStateSpace``, an ``SE2StateSpace`` or a
+    compound of real-vector spaces; ``dim`` coordinates per state, ``coordinates`` reads them).
+    It is set up here if it is not
     yet (``si.setup()``, as OMPL's planners do); its validity checker and motion validator are used
     as they are. ``evaluations`` counts the pairs checked through this object.
 
     Args:
-        space_information: An ``ompl.base.SpaceInformation`` on a ``RealVectorStateSpace``.
+        space_information: An ``ompl.base.SpaceInformation`` on a space ``coordinates_for`` maps.
         name: A non-empty short name recorded in every result (default ``"ompl"``).
 
     Raises:
         TypeError: ``space_information`` not a ``SpaceInformation``, or an empty or non-string
             ``name``.
-        ValueError: A state space that is not a ``RealVectorStateSpace``, or one OMPL cannot set up
+        ValueError: A state space ``coordinates_for`` does not map, or one OMPL cannot set up
             (its bounds unset).
     """
 
@@ -78,11 +83,7 @@ class OMPLMotionPredicate:
         if not isinstance(name, str) or not name:
             raise TypeError(f"name must be a non-empty string, got {name!r}")
         space = space_information.getStateSpace()
-        if not isinstance(space, ob.RealVectorStateSpace):
-            raise ValueError(
-                "OMPLMotionPredicate needs a SpaceInformation on an ompl.base.RealVectorStateSpace (states "
-                f"are d real coordinates, as the planners' (M, d) arrays are); got a {type(space).__name__} "
-                f"({space.getName()!r})")
+        self.coordinates = coordinates_for(space)
         if not space_information.isSetup():
             try:
                 space_information.setup()
@@ -94,7 +95,7 @@ class OMPLMotionPredicate:
         self.name = name
         self.environment: Environment | None = None  # set by from_environment, for describe()
         self.evaluations = 0
-        self._dim = int(space.getDimension())
+        self._dim = self.coordinates.dim
 
     @property
     def dim(self) -> int:
@@ -102,9 +103,8 @@ class OMPLMotionPredicate:
         return self._dim
 
     def bounds(self) -> np.ndarray:
-        """(d, 2) array of the state space's [low, high] per axis."""
-        bounds = self.space.getBounds()
-        return np.column_stack([np.asarray(bounds.low, dtype=float), np.asarray(bounds.high, dtype=float)])
+        """(d, 2) array of the state space's [low, high] per coordinate."""
+        return self.coordinates.bounds()
 
     def is_valid(self, points: np.ndarray) -> np.ndarray:
         """Bool (M,): ``si.isValid(state)`` for each point (the space's bounds and the state
@@ -122,8 +122,7 @@ class OMPLMotionPredicate:
         state = self.si.allocState()
         out = np.empty(points.shape[0], dtype=np.bool_)
         for m, point in enumerate(points.tolist()):
-            for axis in range(self._dim):
-                state[axis] = point[axis]
+            self.coordinates.write(state, point)
             out[m] = self.si.isValid(state) and self.si.satisfiesBounds(state)
         return out
 
@@ -170,13 +169,12 @@ class OMPLMotionPredicate:
             ValueError: Shapes other than (M, d), different M, or non-finite coordinates.
         """
         parents, children = as_pairs(parents, children, self._dim)
-        si, axes = self.si, range(self._dim)
+        si, write = self.si, self.coordinates.write
         parent_state, child_state = si.allocState(), si.allocState()  # owned by Python: no freeState
         out = np.empty(parents.shape[0], dtype=np.bool_)
         for m, (parent, child) in enumerate(zip(parents.tolist(), children.tolist(), strict=True)):
-            for axis in axes:
-                parent_state[axis] = parent[axis]
-                child_state[axis] = child[axis]
+            write(parent_state, parent)
+            write(child_state, child)
             out[m] = si.checkMotion(parent_state, child_state)
         self.evaluations += int(parents.shape[0])
         return out

@@ -6,7 +6,8 @@ from ``qrrt_circuits.registry``, so the command line and the library mean the sa
 Every failure is one line on stderr, and the exit status says what happened (``EXIT_STATUSES``):
 0 done, 1 the environment failed (a file that cannot be read or written, an unreachable Dask
 scheduler, out of memory, an unreadable or corrupt numba cache), 2 bad input, 130 interrupted
-(Ctrl-C, SIGINT), 143 and 129 terminated (SIGTERM, SIGHUP): 128 + the signal's number.
+(Ctrl-C, SIGINT), 143 and 129 terminated (SIGTERM, SIGHUP): 128 + the signal's number; 141 the
+output's reader closed it early (a pipe into ``head``), without a line.
 
 Importing it imports only the standard library; the package's heavy dependencies (numpy, numba,
 scipy, Qiskit) are imported inside ``main`` once its signal handlers are installed, so an
@@ -22,7 +23,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .failures import EXIT_STATUSES, _command_in, _exit
+from .failures import EXIT_STATUSES, _closed_output, _command_in, _exit
 from .failures import _numba_cache_failure as _numba_cache_failure  # (the tests read it here)
 from .parser import build_parser
 from .signals import STOP_SIGNALS, Terminated, _interrupt_in, _stop_signals, _stopped
@@ -50,6 +51,8 @@ def main(argv: list[str] | None = None) -> int:
             return status
         except KeyboardInterrupt as stop:
             return _stopped(stop, args.command if args is not None else _command_in(words), args)
+        except BrokenPipeError:  # the reader of the output closed it (a pipe into head)
+            return _closed_output()
         except Exception as exc:
             command = args.command if args is not None else _command_in(words)
             stop_in_chain = _interrupt_in(exc) or received.stop()  # (an error a signal caused)

@@ -14,7 +14,10 @@ if TYPE_CHECKING:
 
 from .signals import _chain
 
-#: ``qrrt``'s exit statuses (every one but 0 comes with one line on stderr)
+#: the exit status of a command whose output was closed under it: 128 + SIGPIPE, as a shell reports it
+CLOSED_OUTPUT = 128 + getattr(signal, "SIGPIPE", 13)
+
+#: ``qrrt``'s exit statuses (every one but 0 and a closed output comes with one line on stderr)
 EXIT_STATUSES = {
     0: "done",
     1: "the environment failed: a file that cannot be read or written, an unreachable Dask scheduler, "
@@ -23,6 +26,7 @@ EXIT_STATUSES = {
     128 + signal.SIGINT: "interrupted (Ctrl-C, SIGINT)",
     128 + signal.SIGTERM: "terminated (SIGTERM)",
     **({128 + signal.SIGHUP: "terminated (SIGHUP: the terminal closed)"} if hasattr(signal, "SIGHUP") else {}),
+    CLOSED_OUTPUT: "the output's reader closed it early (a pipe into head); nothing more is printed",
 }
 
 
@@ -80,6 +84,15 @@ def _numba_cache_text(error: BaseException, folder: str | None) -> str:
             f"*.nbi and *.nbc files (or set NUMBA_CACHE_DIR to an empty folder) and run again")
 
 
+
+
+def _closed_output() -> int:
+    """A closed standard output (``qrrt plan | head``): point stdout at the null device, so that the
+    interpreter's flush at exit raises nothing more, and return ``CLOSED_OUTPUT`` quietly."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.stdout.fileno())
+    os.close(devnull)
+    return CLOSED_OUTPUT
 
 
 def _exit(command: str | None, exc: Exception) -> None:

@@ -15,8 +15,21 @@ from .commands.plan import PLOT_FORMATS, cmd_plan
 from .commands.reproduce import cmd_compare_checks, cmd_reproduce
 from .commands.search import cmd_search
 
-#: the first line of ``qrrt --help`` (the package docstring's first line)
-DESCRIPTION = "The ``qrrt`` command line: ``search``, ``plan`` and ``reproduce``."
+#: the first line of ``qrrt --help``
+DESCRIPTION = ("Motion planning with quantum search: Grover-search a database (search), plan a path (plan), "
+               "reproduce the paper's figures (reproduce), compare collision checks (compare-checks).")
+
+
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """Help with each default said once: an option's help that names its default already (or an
+    option whose default is None or a flag's False) gets no "(default: ...)" appended; the
+    description and epilog keep their own lines (the list of experiments)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        text = action.help or ""
+        if "default" in text or action.default in (None, False, argparse.SUPPRESS) or not action.option_strings:
+            return text
+        return f"{text} (default: %(default)s)"
 
 def _positive_int(text: str) -> int:
     value = int(text)
@@ -69,6 +82,7 @@ def _add_search_parser(sub: _Subparsers, formatter: _Formatter) -> None:
 
 
 def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
+    from ..problems.families import FAMILIES
     from ..registry import PLANNERS, PREDICATES, SCENARIOS
     from .planner_flags import add_planner_flags
 
@@ -78,8 +92,8 @@ def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
                       default="paper_clutter", help=SCENARIOS.help_text())
     plan.add_argument("--scenario-file", default=None, help="an environment JSON file instead")
     plan.add_argument("--problem", default=None,
-                      help="a problem JSON file instead (qrrt-problem: open-space, narrow-passage, se2-gap, boxes "
-                           "or image); it fixes the world, the motion check, the state space and the goal")
+                      help=f"a problem JSON file instead (qrrt-problem: {', '.join([*FAMILIES, 'boxes'])}); it fixes "
+                           "the world, the motion check, the state space and the goal")
     plan.add_argument("--allow-outside-files", action="store_true",
                       help="let a --problem file name a scenario or image outside its own folder (an absolute "
                            "path or ..); by default such names are refused")
@@ -110,23 +124,32 @@ def _add_plan_parser(sub: _Subparsers, formatter: _Formatter) -> None:
     plan.add_argument("--no-compare", action="store_true",
                       help="do not plan with the quantum planner's classical peer (RRT for q-RRT, parallel RRT "
                            "for Pq-RRT) in the same world to print the two side by side")
+    plan.add_argument("--no-progress", action="store_true",
+                      help="hide the progress bar (shown only when stdout and stderr are terminals)")
     plan.set_defaults(func=cmd_plan)
 
 
 def _add_reproduce_parser(sub: _Subparsers, formatter: _Formatter) -> None:
+    from ..experiments import EXPERIMENTS
     from ..registry import PREDICATES
 
+    width = max(len(name) for name in EXPERIMENTS)
+    listing = "\n".join(f"  {name:{width}s}  {experiment.title}" for name, experiment in EXPERIMENTS.items())
     reproduce = sub.add_parser("reproduce", help="reproduce the paper's figures and tables",
-                               formatter_class=formatter)
-    reproduce.add_argument("experiment", help="an experiment name or 'all'")
+                               formatter_class=formatter, epilog=f"experiments:\n{listing}")
+    reproduce.add_argument("experiment", metavar="EXPERIMENT",
+                           help="an experiment's name (listed below) or 'all'")
     reproduce.add_argument("--quick", action="store_true", help="small settings (each < 2 min)")
-    reproduce.add_argument("--trials", type=_positive_int, default=None, help="override the trial count")
-    reproduce.add_argument("--out", default="results", help="output directory (default results/)")
-    reproduce.add_argument("--seed", type=_nonnegative_int, default=0)
+    reproduce.add_argument("--trials", type=_positive_int, default=None,
+                           help="the trial count (default: the experiment's own)")
+    reproduce.add_argument("--out", default="results", help="output directory")
+    reproduce.add_argument("--seed", type=_nonnegative_int, default=0,
+                           help="root seed: every trial's seed is derived from it and the trial's key")
     reproduce.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     reproduce.add_argument("--executor", choices=["serial", "process", "dask"], default="serial",
                            help="where trials run (dask needs the [dask] extra)")
-    reproduce.add_argument("--jobs", type=_positive_int, default=None, help="worker processes (default: cores)")
+    reproduce.add_argument("--jobs", type=_positive_int, default=None,
+                           help="worker processes (default: one per core, os.cpu_count())")
     reproduce.add_argument("--scheduler", default=None,
                            help="address of an existing Dask scheduler (with --executor dask)")
     reproduce.add_argument("--predicate", type=_registered(PREDICATES), default="exact",
@@ -151,7 +174,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="qrrt", description=DESCRIPTION)
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
-    formatter = argparse.ArgumentDefaultsHelpFormatter
+    formatter = HelpFormatter
     _add_search_parser(sub, formatter)
     _add_plan_parser(sub, formatter)
     _add_reproduce_parser(sub, formatter)

@@ -62,7 +62,7 @@ _NAMED: dict[str, ColumnKind] = {
         "invalid_edges", "invalid_edges_fine", "in_channel", "through_channel", "start_distance", "wall_time_s",
         "free_fraction",
         # problem families
-        "reached", "classical_checks", "path_length", "path_length_simplified",
+        "reached", "classical_checks", "path_length", "path_length_simplified", "first_solution_calls",
         # coherent oracle
         "qubits", "gates", "entries", "marked", "mismatches", "ancillas_clean", "index_preserved", "rounding_compared",
         "rounding_differs", "hits", "expected", "search_s", "toffolis", "lookup_qrom_ands",
@@ -82,6 +82,7 @@ _NAMED: dict[str, ColumnKind] = {
 #: measurement columns by pattern (families whose names carry a setting)
 _PATTERNS: tuple[tuple[re.Pattern[str], ColumnKind], ...] = (
     (re.compile(r"(nodes|calls)_at_\d+(_total)?"), ColumnKind.NUMBER),  # a growth curve cut at a call budget
+    (re.compile(r"cost_at_\d+"), ColumnKind.NUMBER),  # an anytime planner's best path cost at a share of its budget
     (re.compile(r"lemma\d+_(observed|theory|stderr)"), ColumnKind.NUMBER),
     (re.compile(r"mean_parent_distance_\d+"), ColumnKind.NUMBER),
     (re.compile(r"[a-z_]+_json"), ColumnKind.JSON),

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 
@@ -10,8 +11,10 @@ import numpy as np
 
 from ..problems.families import Problem
 
-#: OMPL planners by the experiment's label: (``ompl.geometric`` class, whether it takes a goal bias)
-OMPL_PLANNERS = {"OMPL RRT": ("RRT", True), "OMPL RRTConnect": ("RRTConnect", False)}
+#: OMPL planners by the experiment's label: (``ompl.geometric`` class, whether it takes a goal bias, whether
+#: it is anytime: it plans until the budget and reports its best cost as it goes, ``bestCost()``)
+OMPL_PLANNERS = {"OMPL RRT": ("RRT", True, False), "OMPL RRTConnect": ("RRTConnect", False, False),
+                 "OMPL RRTstar": ("RRTstar", True, True)}
 
 
 @dataclass(frozen=True)
@@ -24,6 +27,8 @@ class OMPLRun:
         path: Float (L, d), the solution path's states, or None.
         wall_time_s: Seconds in ``SimpleSetup.solve``.
         range: The planner's ``range`` (OMPL's default: 0.2 of the space's largest extent).
+        anytime: An anytime planner's (motion checks, best path cost) each time its best cost fell
+            (read from ``bestCost()`` as the termination condition is polled); empty for the others.
     """
 
     reached: bool
@@ -31,6 +36,7 @@ class OMPLRun:
     path: np.ndarray | None
     wall_time_s: float
     range: float
+    anytime: tuple[tuple[int, float], ...] = ()
 
 
 def ompl_run(problem: Problem, label: str, budget: int, seed: int, goal_bias: float) -> OMPLRun:
@@ -66,13 +72,22 @@ def ompl_run(problem: Problem, label: str, budget: int, seed: int, goal_bias: fl
     setup = setup_from_problem(problem)
     si = setup.getSpaceInformation()
     validator = si.getMotionValidator()
-    name, takes_goal_bias = OMPL_PLANNERS[label]
+    name, takes_goal_bias, anytime = OMPL_PLANNERS[label]
     planner = getattr(og, name)(si)
     if takes_goal_bias:
         planner.setGoalBias(goal_bias)
     setup.setPlanner(planner)
     setup.setup()
-    condition = ob.PlannerTerminationCondition(lambda: validator.checks >= budget)
+    trace: list[tuple[int, float]] = []
+
+    def ended() -> bool:
+        if anytime:
+            cost = float(planner.bestCost().value())
+            if math.isfinite(cost) and (not trace or cost < trace[-1][1]):
+                trace.append((int(validator.checks), cost))
+        return bool(validator.checks >= budget)
+
+    condition = ob.PlannerTerminationCondition(ended)
     began = time.perf_counter()
     setup.solve(condition)
     elapsed = time.perf_counter() - began
@@ -81,4 +96,4 @@ def ompl_run(problem: Problem, label: str, budget: int, seed: int, goal_bias: fl
         states = setup.getSolutionPath().getStates()
         path = np.array([[state[axis] for axis in range(problem.env.dim)] for state in states])
     ou.setLogLevel(previous)
-    return OMPLRun(path is not None, int(validator.checks), path, elapsed, float(planner.getRange()))
+    return OMPLRun(path is not None, int(validator.checks), path, elapsed, float(planner.getRange()), tuple(trace))

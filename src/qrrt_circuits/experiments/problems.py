@@ -64,6 +64,7 @@ from ..planners.paths import path_length, shortcut
 from ..problems.families import Problem, maze, narrow_passage, open_space, se2_gap, winding_band
 from ..registry import POLICIES
 from .base import Experiment, Record, Settings, Summary, Trial, TrialStream, replicate_seed
+from .connect_star import NO_ANYTIME, anytime_columns, connect_summary, star_summary
 from .default_policy import POLICY_CANDIDATES, TIE_MARGIN, default_policies
 from .family_runs import family_counts, family_units, paired_ratio, resampled, statistic
 from .figures import dodge, new_figure, save, with_intervals
@@ -90,8 +91,14 @@ LIBRARY_CONFIGS: dict[str, tuple[str, str | None, Callable[[Problem], dict[str, 
     "PQRRT adaptive": ("pqrrt", "adaptive", lambda problem: {}),
     "PQRRT bbht": ("pqrrt", "bbht", lambda problem: {}),
     "PQRRT thompson": ("pqrrt", "thompson", lambda problem: {}),
+    "QRRTConnect": ("qrrt-connect", "thompson", lambda problem: {"goal_bias": 0.0,
+                                                                 "max_extension": ompl_range(problem)}),
+    "QRRTStar": ("qrrt-star", "thompson", lambda problem: {"max_extension": ompl_range(problem)}),
 }
-OMPL_CONFIGS = ("OMPL RRT", "OMPL RRTConnect")
+OMPL_CONFIGS = ("OMPL RRT", "OMPL RRTConnect", "OMPL RRTstar")
+#: the quantum RRT-Connect and RRT* beside their OMPL peers (``experiments.connect_star``)
+CONNECT_PAIR = ("QRRTConnect", "OMPL RRTConnect")
+STAR_PAIR = ("QRRTStar", "OMPL RRTstar")
 GOAL_BIAS = 0.05
 #: the narrow passage's hole: its share of the wall's cross-section, in every dimension
 HOLE_SHARE = 0.01
@@ -184,14 +191,17 @@ class Problems(Experiment):
             return self._ompl_trial(problem, config, trial.seed, settings)
         kind, policy, options = LIBRARY_CONFIGS[config]
         planner = make_planner(kind, trial.seed, settings["backend"], settings["workers"],
-                               settings["num_qubits"], search_policy=policy, goal_bias=settings["goal_bias"],
-                               **options(problem))
+                               settings["num_qubits"], search_policy=policy,
+                               **({"goal_bias": settings["goal_bias"]} | options(problem)))
         result = planner.plan(problem, max_oracle_calls=settings["budget"])
         m = result.metrics
         record = {"status": str(result.status), "reached": int(result.reached), "oracle_calls": m.oracle_calls,
                   "critical_path_calls": m.critical_path_oracle_calls, "simulation_checks": m.simulation_checks,
                   "classical_checks": _evaluations(problem), "nodes": m.nodes,
                   "wall_time_s": m.wall_time_s}
+        # an anytime planner's best cost against its calls (NaN columns for the others: one header for all rows)
+        record |= anytime_columns(result.history["oracle_calls"], result.history["path_cost"], settings["budget"]) \
+            if config in STAR_PAIR else NO_ANYTIME
         return record | self._paths(problem, result.path)
 
     @staticmethod
@@ -203,6 +213,9 @@ class Problems(Experiment):
                   "oracle_calls": run.motion_checks, "critical_path_calls": run.motion_checks,
                   "simulation_checks": 0, "classical_checks": _evaluations(problem),
                   "nodes": math.nan, "wall_time_s": run.wall_time_s}
+        record |= anytime_columns([0, *(calls for calls, _ in run.anytime)],
+                                  [math.nan, *(cost for _, cost in run.anytime)], settings["budget"]) \
+            if config in STAR_PAIR else NO_ANYTIME
         return record | Problems._paths(problem, run.path)
 
     @staticmethod
@@ -251,7 +264,17 @@ class Problems(Experiment):
                         value, span = paired_ratio(units, counts, config, reference, quantity)
                         ratios[family].setdefault(config, {})[key] = value
                         ratio_intervals[family].setdefault(config, {})[key] = span
+        connect: dict[str, dict] = {}
+        star: dict[str, dict] = {}
+        for index, family in enumerate(settings["families"]):
+            units = family_units(records, family)
+            counts = family_counts(units, seed, index)
+            if all(config in settings["configs"] for config in CONNECT_PAIR):
+                connect[family] = connect_summary(units, counts, *CONNECT_PAIR)
+            if all(config in settings["configs"] for config in STAR_PAIR):
+                star[family] = star_summary(units, counts, *STAR_PAIR)
         return {"ours": ours, "paper": self.paper, "interval_95": intervals, "details": details,
+                "connect_vs_ompl": connect, "star_vs_ompl": star,
                 "details_interval_95": detail_intervals, "ratios": ratios,
                 "ratios_interval_95": ratio_intervals, "worlds": worlds,
                 "default_policy": default_policies(records, settings),

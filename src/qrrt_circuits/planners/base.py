@@ -37,9 +37,10 @@ from . import termination as _termination
 from .context import RoundView, WorkerContext
 from .options import PlannerOptions
 from .result import Metrics, PlanResult
-from .run_state import RunState
+from .run_state import FLOAT_HISTORY_KEYS, RunState
 from .termination import (
     PlanStatus,
+    Progress,
     TerminationCondition,
     from_budgets,
     limits_in_force,
@@ -139,6 +140,7 @@ class Planner:
         max_time_s: float | None = None,
         max_critical_path_calls: int | None = None,
         stall_rounds: int | None = None,
+        on_round: Callable[[Progress], None] | None = None,
     ) -> PlanResult:
         """Grow a tree from the problem's start until a node satisfies its goal (a node in the goal
         ball, as in the paper) or the termination condition ends the plan (OMPL's ``solve(ptc)``).
@@ -169,6 +171,10 @@ class Planner:
             max_critical_path_calls: End after this many critical-path oracle calls (per round the
                 largest of any worker: the time of p parallel quantum devices).
             stall_rounds: End after this many consecutive rounds without a new node.
+            on_round: Called after every round (after every block of rounds a planner runs at
+                once: RRT's rounds tested ahead) with the plan's counters (``Progress``): an
+                observer for a progress display (``qrrt plan`` passes one); it cannot change the
+                plan, and None (default) calls nothing.
 
         Returns:
             A frozen ``PlanResult``: ``status`` (``PlanStatus``: ``"reached"`` or the condition that
@@ -190,7 +196,7 @@ class Planner:
         """
         check_instance(problem, "problem", Problem, "a Problem (qrrt_circuits.Problem.build(env, start, goal, "
                                                     "goal_radius), a scenario or a problem family)")
-        check_reachable_by(problem.goal, self.options.goal_bias)
+        self._check_goal(problem)
         condition = from_budgets(max_oracle_calls, max_nodes, max_rounds, max_time_s,
                                  max_critical_path_calls, stall_rounds)
         if termination is not None:
@@ -207,34 +213,60 @@ class Planner:
                         default_rounds=limits.default_rounds)
         size.check()  # the plan's one memory check, before its first allocation
         try:
-            return self._plan_checked(problem, condition, safety)
+            return self._plan_checked(problem, condition, safety, on_round)
         except OutOfMemory:
             raise
         except MemoryError as error:  # (its frames, and the plan's arrays, are released before the message)
             raise size.out_of_memory(error) from error
 
     def _plan_checked(self, problem: Problem, condition: TerminationCondition,
-                      safety: frozenset[PlanStatus]) -> PlanResult:
+                      safety: frozenset[PlanStatus], on_round: Callable[[Progress], None] | None = None) -> PlanResult:
         """The plan after its checks: the run state, the rounds and the result (``safety``: the
-        statuses of the safety limits added to the caller's condition)."""
+        statuses of the safety limits added to the caller's condition; ``on_round``: the observer
+        called after every round)."""
         state = RunState(problem.start, problem.goal, problem.space.nearest_neighbors())  # chosen once a plan
         state.context = self._context(problem)
         self._start_rounds(state)
         began = time.perf_counter()
-        status = self._run(state, condition, began)
+        status = self._run(state, condition, began, on_round)
         elapsed = time.perf_counter() - began
         return self._result(state, status, elapsed, problem, condition, status in safety)
 
-    def _run(self, state: RunState, condition: TerminationCondition, began: float) -> PlanStatus:
-        """The round loop: check the condition before every round, run the round, record it; until
-        the goal or the end."""
-        while state.goal_node is None:
-            ended = condition.ended_by(state.progress(time.perf_counter() - began))
+    def _run(self, state: RunState, condition: TerminationCondition, began: float,
+             on_round: Callable[[Progress], None] | None = None) -> PlanStatus:
+        """The round loop: check the condition before every round, run the round, record it (and
+        show it to ``on_round``); until the plan is finished or its condition ends it."""
+        while not self._finished(state):
+            progress = state.progress(time.perf_counter() - began)
+            ended = condition.ended_by(progress)
             if ended is not None:
-                return ended
-            self._round(state)
-            state.end_round()
+                return self._status(state, ended)
+            self._rounds(state, condition, progress)
+            if on_round is not None:
+                on_round(state.progress(time.perf_counter() - began))
         return PlanStatus.REACHED
+
+    def _rounds(self, state: RunState, condition: TerminationCondition, progress: Progress) -> None:
+        """Run and record (``RunState.end_round``) one round or more, all but the last adding no
+        node, each one that ``condition`` lets start (``termination.rounds_that_start`` from
+        ``progress``, the counters now, which it let start); here one ``_round``."""
+        self._round(state)
+        state.end_round()
+
+    def _finished(self, state: RunState) -> bool:
+        """Whether the plan is done before its condition ends it: here once a node satisfies the
+        goal (an anytime planner, q-RRT*, runs until its condition)."""
+        return state.goal_node is not None
+
+    def _status(self, state: RunState, ended: PlanStatus) -> PlanStatus:
+        """The status of a plan its condition ended (``ended``, here; an anytime planner that holds
+        a solution reports it reached)."""
+        return ended
+
+    def _check_goal(self, problem: Problem) -> None:
+        """Refuse a goal this planner cannot end in (``check_reachable_by``: one with ``sample``
+        where ``goal_bias > 0``, and one with volume where ``goal_bias == 0``)."""
+        check_reachable_by(problem.goal, self.options.goal_bias)
 
     def _check_serves(self, problem: Problem) -> None:
         """Refuse, before any work, a problem this planner's settings cannot serve (none here)."""
@@ -272,6 +304,12 @@ class Planner:
         recorded in every result beside the problem's parts)."""
         return {"planner": self.name} | self.options.describe()
 
+    def miss_reason(self) -> str:
+        """Why a candidate this planner tests can fail its check, in one clause (``qrrt plan``
+        prints it when most candidates failed): here, a random sample's motion from its nearest
+        node is blocked."""
+        return "a random sample's motion from its nearest node is blocked"
+
     def labels(self) -> tuple[str, ...]:
         """Every simulation shortcut this planner's numbers depend on (copied into each result).
 
@@ -307,7 +345,8 @@ class Planner:
         settings = self.settings() | problem.describe() | {
             "space": problem.space.describe(), "predicate": predicate, "dynamics": predicate.get("dynamics"),
             "termination": condition.describe()}
-        history = {key: np.asarray(value, dtype=np.int64) for key, value in state.history.items()}
+        history = {key: np.asarray(value, dtype=np.float64 if key in FLOAT_HISTORY_KEYS else np.int64)
+                   for key, value in state.history.items()}
         return PlanResult(
             status=status,
             nodes=tree.nodes.copy(),
@@ -320,5 +359,10 @@ class Planner:
             history=history,
             goal_node=state.goal_node,
             safety_limit=safety_limit,
+            second_tree=self._second_tree(state),
         )
+
+    def _second_tree(self, state: RunState) -> tuple[np.ndarray, np.ndarray] | None:
+        """A bidirectional planner's second tree (its nodes and parents), or None (here)."""
+        return None
 

@@ -10,29 +10,34 @@ is added, as the quantum planners' finalizer does.
 Rounds tested ahead. The planners run the one round loop of ``Planner._run`` (the termination
 condition checked before each round). A round's candidates depend only on its random streams
 (keyed by round and worker: ``placement.keyed_samples``, the samples ``build_database(tree, 1,
-...)`` draws), and the tree cannot change until a round adds a node, so a round that finds no
-tests made ahead for it draws the candidates of the next B rounds at once, finds their nearest
-nodes in one query and tests all B x p pairs in one call (``LookAhead``); the following rounds
-take their tests from that batch while the tree is the one it was tested against. A round that
-adds a node makes the batch's later tests stale: they are counted in ``Metrics.wasted_checks``
-(tests made ahead and never used), never as oracle calls, and their rounds are tested again in
-the next batch (the same candidates, kept from their draw, with their nearest nodes in the new
-tree). The tree, the counters and the status are those of one round at a time. B is the expected
-number of rounds up to the next success, ceil(1 / rate) with the Laplace estimate
-rate = (rounds that added + 1) / (rounds recorded + 2), at most ``MAX_BATCH_ROUNDS`` and at most
-``batch_round_limit(workers, d)`` (a batch's candidates take at most ``MAX_BATCH_BYTES``). On an
-``executor``, or with ``look_ahead=False``, B = 1 (on an executor each worker's test is one task).
+...)`` draws), so a round that finds no tests made ahead for it draws the candidates of the next B
+rounds at once, finds their nearest nodes in one query and tests all B x p pairs in one call
+(``LookAhead``). A test made ahead holds as long as the candidate's nearest node is the one it was
+tested with: a node added since takes that place only if it is at least as near to the raw sample
+as the parent (ties go to the lower index, the older node), which one query of the
+nearest-neighbour structure tells (``nearest_distance_from``). A round whose test no longer holds
+is stale: it and the rest of the batch are tested again, the same candidates with their nearest
+nodes in the new tree. The rounds ready before the first that finds a reachable candidate run as
+one block: they add no node, so their counters and history are written at once, as many as the
+termination condition lets start (``termination.rounds_that_start``). The tree, the counters, the
+history and the status are those of testing each round on its own; tests made ahead and never used
+are counted in ``Metrics.wasted_checks``, never as oracle calls. B is the expected number of rounds
+up to the next stale one, ceil(1 / rate) with the Laplace estimate rate = (stale rounds + 1) /
+(rounds recorded + 2), at most ``MAX_BATCH_ROUNDS`` and at most ``batch_round_limit(workers, d)``
+(a batch's candidates take at most ``MAX_BATCH_BYTES``). On an ``executor``, or with
+``look_ahead=False``, B = 1 (on an executor each worker's test is one task).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import ClassVar
+from typing import ClassVar, NamedTuple
 
 import numpy as np
 
 from .._support.randomness import Stream, round_keys
+from ..problems.goals import satisfying
 from ..reachability.predicate import check_answers
 from .base import Planner
 from .context import map_tasks
@@ -40,6 +45,7 @@ from .database import steer
 from .options import ParallelOptions, PlannerOptions, RRTOptions
 from .placement import keyed_samples
 from .run_state import RunState
+from .termination import Progress, TerminationCondition, rounds_that_start
 from .tree import Tree
 from .workers import check_extensions
 
@@ -69,73 +75,123 @@ def batch_round_limit(workers: int, dim: int) -> int:
     return max(1, min(MAX_BATCH_ROUNDS, MAX_BATCH_BYTES // per_round))
 
 
-def batch_rounds(changed_rounds: int, recorded_rounds: int) -> int:
-    """Rounds to test ahead in one batch: the expected number of rounds up to the next that adds a node.
+def batch_rounds(stale_rounds: int, recorded_rounds: int) -> int:
+    """Rounds to test ahead in one batch: the expected number of rounds up to the next whose test
+    a new node made stale.
 
     Args:
-        changed_rounds: Rounds recorded so far that added a node (>= 0).
-        recorded_rounds: Rounds recorded so far (>= ``changed_rounds``).
+        stale_rounds: Rounds so far whose test made ahead was stale when they came (>= 0).
+        recorded_rounds: Rounds recorded so far (>= ``stale_rounds``).
 
     Returns:
-        ceil(1 / rate) with rate = (changed + 1) / (recorded + 2) (a Laplace estimate of the rate at
-        which rounds add a node), clipped to [1, ``MAX_BATCH_ROUNDS``].
+        ceil(1 / rate) with rate = (stale + 1) / (recorded + 2) (a Laplace estimate of the rate at
+        which rounds find their test stale), clipped to [1, ``MAX_BATCH_ROUNDS``].
     """
-    rate = (changed_rounds + 1) / (recorded_rounds + 2)
+    rate = (stale_rounds + 1) / (recorded_rounds + 2)
     return max(1, min(MAX_BATCH_ROUNDS, math.ceil(1.0 / rate)))
 
 
 #: what ``LookAhead`` draws and tests with: the candidates of keys (K, 3), and (children, parents,
-#: truth) of samples (K, d) against the plan's tree
+#: truth, reach) of samples (K, d) against the plan's tree
 Draw = Callable[[RunState, np.ndarray], np.ndarray]
-Extend = Callable[[RunState, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]
+Extend = Callable[[RunState, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
+#: a node counts as possibly nearer than a candidate's parent within this relative margin (the
+#: structures round distances their own way; a false alarm only tests a round again)
+NEARER_MARGIN = 1e-9
+
+
+class RoundGate(NamedTuple):
+    """Which of the rounds ready may start: ``termination.rounds_that_start`` of the plan's
+    condition from the counters now, each round adding ``growth``."""
+
+    condition: TerminationCondition
+    progress: Progress
+    growth: Progress
+
+    def rounds(self, ready: int) -> int:
+        """How many of ``ready`` rounds start (1 .. ready)."""
+        return rounds_that_start(self.condition, self.progress, self.growth, ready)
 
 
 class LookAhead:
     """One plan's classical extensions, tested ahead of the rounds that use them (module docstring).
 
-    ``round`` hands a round its p (children, parents, truth): from the batch tested last, if that
-    batch holds the round and the tree is still the one it was tested against; else from a new
-    batch, the next B rounds' candidates (kept from the draw of a batch before, or drawn now)
-    tested in one call.
+    ``block`` hands the loop the next rounds' p (children, parents, truth) each: from the batch
+    tested last while their tests still hold, else from a new batch, the next B rounds'
+    candidates (kept from the draw of a batch before, or drawn now) tested in one call.
+
+    A test holds while the candidate's nearest node is the one it was tested with: a node added
+    since can only take that place by being at least as near to the raw sample as the parent was
+    (``reach``); rounds with such a candidate are stale and are tested again, with the rest of the
+    batch, against the tree as it is. A block is the rounds from the current one up to the first
+    that finds a reachable candidate or the first stale one, at most the rounds the caller allows.
 
     ``RunState.wasted_checks`` counts the tests made ahead and not used: a batch of B rounds adds
-    (B - 1) p, each round served from it takes p away.
+    B p, each round served from it takes p away.
 
     Args:
         workers: p, the extensions of one round.
         most: The most rounds one batch tests (``batch_round_limit``, or 1).
         tree: The plan's tree as the plan starts (its d and its nodes).
         draw: The candidates of keys (round, worker, stream) (K, 3), (K, d).
-        extend: (children, parents, truth) of samples (K, d) against the plan's tree, in order.
+        extend: (children, parents, truth, reach) of samples (K, d) against the plan's tree, in
+            order; ``reach`` the distance from each parent to its raw sample.
     """
 
     def __init__(self, workers: int, most: int, tree: Tree, draw: Draw, extend: Extend) -> None:
         self.workers, self.most, self.draw, self.extend = workers, most, draw, extend
-        self.changed = 0  # rounds that added a node, up to the last batch
+        self.stale_rounds = 0  # rounds found stale (each tested again in a new batch)
         self.drawn = np.empty((0, tree.dim))  # the candidates of rounds drawn_from, drawn_from + 1, ...
         self.drawn_from = 0
         self.tested_from = self.tested_rounds = 0  # the rounds of the last batch
-        self.tested_size = tree.size  # the tree's nodes when the last batch was tested
-        self.tested = (np.empty(0), np.empty(0, dtype=np.int64), np.empty(0, dtype=bool))
+        self.checked_size = tree.size  # the tree's nodes the batch's candidates were compared with
+        empty = np.empty(0, dtype=bool)
+        self.tested = (np.empty((0, tree.dim)), np.empty(0, dtype=np.int64), empty, empty)
+        self.reach = np.empty(0)
+        self.hits = self.stale = empty  # per round of the batch: a reachable candidate; a stale test
 
-    def round(self, state: RunState) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The current round's (children (p, d), parents (p,), truth (p,))."""
-        workers = self.workers
+    def block(self, state: RunState, gate: RoundGate | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The next k rounds' (children (k p, d), parents (k p,), truth (k p,), in_goal (k p,)): the
+        rounds ready (up to the first that finds a reachable candidate, before the first stale one)
+        that ``gate`` lets start, or k = 1 without a gate. Rounds 0 .. k - 2 find nothing
+        reachable, so only the last can add nodes; ``in_goal`` says which reachable children
+        satisfy the goal."""
         offset = state.rounds - self.tested_from
-        if state.tree.size == self.tested_size and offset < self.tested_rounds:
-            state.wasted_checks -= workers  # a test made ahead, used
-        else:
-            self.changed += state.tree.size != self.tested_size  # (the round before added)
+        if offset < self.tested_rounds and state.tree.size > self.checked_size:
+            self._mark_stale(state, offset)
+        if offset >= self.tested_rounds or self.stale[offset]:
+            self.stale_rounds += offset < self.tested_rounds
             self._test_ahead(state)
             offset = 0
-        children, parents, truth = self.tested
-        rows = slice(offset * workers, (offset + 1) * workers)
-        return children[rows], parents[rows], truth[rows]
+        stop = offset + 1
+        if gate is not None:
+            stop = self.tested_rounds
+            stale = np.flatnonzero(self.stale[offset + 1:stop])
+            if stale.size:
+                stop = offset + 1 + int(stale[0])
+            hits = np.flatnonzero(self.hits[offset:stop])
+            if hits.size:
+                stop = offset + int(hits[0]) + 1
+            stop = offset + gate.rounds(stop - offset)
+        state.wasted_checks -= (stop - offset) * self.workers
+        rows = slice(offset * self.workers, stop * self.workers)
+        children, parents, truth, in_goal = self.tested
+        return children[rows], parents[rows], truth[rows], in_goal[rows]
+
+    def _mark_stale(self, state: RunState, offset: int) -> None:
+        """Mark the batch's rounds from ``offset`` on whose candidates a node added since may be
+        nearer to than their parents."""
+        first = offset * self.workers
+        samples = self.drawn[first:self.tested_rounds * self.workers]
+        nearer = state.neighbors.nearest_distance_from(samples, self.checked_size) <= self.reach[first:] * (
+            1.0 + NEARER_MARGIN)
+        self.stale[offset:] |= nearer.reshape(-1, self.workers).any(axis=1)
+        self.checked_size = state.tree.size
 
     def _test_ahead(self, state: RunState) -> None:
         """Test rounds r .. r + B - 1 (r the current round) against the tree as it is."""
         workers, first = self.workers, state.rounds
-        ahead = min(batch_rounds(self.changed, first), self.most)
+        ahead = min(batch_rounds(self.stale_rounds, first), self.most)
         drawn = self.drawn[(first - self.drawn_from) * workers:]  # (the rounds used are dropped)
         kept = min(drawn.shape[0] // workers, ahead)  # a round's candidates depend on its key only
         if kept < ahead:
@@ -143,9 +199,16 @@ class LookAhead:
             drawn = np.concatenate((drawn[:kept * workers], self.draw(state, keys)))
         self.drawn, self.drawn_from = drawn, first
         # the raw samples are kept: a round tested again is steered from its new parents
-        self.tested = self.extend(state, drawn[:ahead * workers])
-        self.tested_from, self.tested_rounds, self.tested_size = first, ahead, state.tree.size
-        state.wasted_checks += (ahead - 1) * workers
+        children, parents, truth, self.reach = self.extend(state, drawn[:ahead * workers])
+        in_goal = np.zeros(truth.shape[0], dtype=bool)
+        reachable = np.flatnonzero(truth)
+        if reachable.size:
+            in_goal[reachable] = satisfying(state.goal, children[reachable])
+        self.tested = children, parents, truth, in_goal
+        self.hits = np.asarray(truth.reshape(ahead, workers).any(axis=1))
+        self.stale = np.zeros(ahead, dtype=bool)
+        self.tested_from, self.tested_rounds, self.checked_size = first, ahead, state.tree.size
+        state.wasted_checks += ahead * workers
 
 
 class ParallelRRT(Planner):
@@ -178,24 +241,39 @@ class ParallelRRT(Planner):
         most = batch_round_limit(self.workers, state.tree.dim) if look_ahead else 1
         state.ahead = LookAhead(self.workers, most, state.tree, self._draw, self._extend)
 
-    def _round(self, state: RunState) -> None:
-        """One round of p extensions: its tests (``LookAhead.round``), then its counters and nodes."""
-        children, parents, truth = state.tests_ahead.round(state)
-        self._record(state, state.rounds, children, parents, truth)
+    def _rounds(self, state: RunState, condition: TerminationCondition, progress: Progress) -> None:
+        """A block of rounds from the tests made ahead (``LookAhead.block``): the rounds before the
+        last found nothing reachable (p calls, critical path 1, no node each) and are recorded at
+        once, the last worker by worker. With ``oracle_errors`` (answers drawn round by round) one
+        round."""
+        workers = self.workers
+        gate = None if self.options.oracle_errors else RoundGate(condition, progress, self._idle_growth)
+        children, parents, truth, in_goal = state.tests_ahead.block(state, gate)
+        last = children.shape[0] - workers
+        state.end_idle_rounds(last // workers, workers)
+        self._round_from(state, children[last:], parents[last:], truth[last:], in_goal[last:])
+        state.end_round()
+
+    @property
+    def _idle_growth(self) -> Progress:
+        """What a round that finds nothing reachable adds: p calls, one critical-path call, one round."""
+        return Progress(self.workers, 1, 0, 1, 1, 0.0)
 
     def _draw(self, state: RunState, keys: np.ndarray) -> np.ndarray:
         """The candidates of the keys (round, worker, ``Stream.CANDIDATES``) (K, 3): the samples
         ``build_database(tree, 1, ...)`` draws from each key's generator (``keyed_samples``)."""
         return keyed_samples(self.streams, keys, state.worker_context.env, state.goal, self.options.goal_bias)
 
-    def _extend(self, state: RunState, samples: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Each sample's nearest node, the sample steered toward it, and the predicate's answer on
-        the pair: (children, parents, truth)."""
+    def _extend(self, state: RunState,
+                samples: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Each sample's nearest node, the sample steered toward it, the predicate's answer on the
+        pair and the distance from the node to the sample: (children, parents, truth, reach)."""
         parents = state.neighbors.nearest(samples)
         origins = state.tree.nodes[parents]
         context = state.worker_context
-        children = steer(context.space, origins, samples, context.max_extension)
-        return children, parents, self._test(state, origins, children)
+        reach = context.space.distance(origins, samples)
+        children = steer(context.space, origins, samples, context.max_extension, reach)
+        return children, parents, self._test(state, origins, children), reach
 
     def _test(self, state: RunState, origins: np.ndarray, children: np.ndarray) -> np.ndarray:
         """The predicate on every (parent position, child) pair: one call in-process, one task per
@@ -208,9 +286,10 @@ class ParallelRRT(Planner):
         answers = map_tasks(self.executor, check_extensions, state.worker_context, self._view(state), pairs)
         return np.concatenate([check_answers(answer, 1, name) for answer in answers])
 
-    def _record(self, state: RunState, round_index: int, children: np.ndarray, parents: np.ndarray,
-                truth: np.ndarray) -> None:
-        """One round's counters and nodes from its workers' tests (p of them)."""
+    def _round_from(self, state: RunState, children: np.ndarray, parents: np.ndarray, truth: np.ndarray,
+                    in_goal: np.ndarray) -> None:
+        """The current round's counters and nodes from its workers' tests (p of them)."""
+        round_index = state.rounds
         longest = 1
         errors = self.options.oracle_errors
         for worker in range(children.shape[0]):
@@ -230,7 +309,7 @@ class ParallelRRT(Planner):
                 if not true:
                     state.rejected += 1
                     continue
-            state.add_node(children[worker], int(parents[worker]))
+            state.add_node(children[worker], int(parents[worker]), bool(in_goal[worker]))
         state.critical_path += longest
 
     def settings(self) -> dict:

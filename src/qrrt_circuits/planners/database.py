@@ -232,7 +232,12 @@ def build_database(
     return Database(steer(space, tree.nodes[parents], samples, max_extension), parents, band)
 
 
-def steer(space: StateSpace, origins: np.ndarray, samples: np.ndarray, max_extension: float | None) -> np.ndarray:
+#: the smallest positive normal double (a sample on its origin moves nowhere)
+_TINY = float(np.finfo(float).tiny)
+
+
+def steer(space: StateSpace, origins: np.ndarray, samples: np.ndarray, max_extension: float | None,
+          length: np.ndarray | None = None) -> np.ndarray:
     """Each sample moved toward its origin until it lies at most ``max_extension`` from it under
     the space's metric (OMPL's RRT ``range``; the step bound of the authors' ``drawrandin``):
     x = interpolate(o, s, min(1, r / distance(o, s))); in R^d, o + (s - o) min(1, r / |s - o|).
@@ -242,14 +247,16 @@ def steer(space: StateSpace, origins: np.ndarray, samples: np.ndarray, max_exten
         origins: Float (M, d), each candidate's parent position.
         samples: Float (M, d), the raw samples.
         max_extension: r > 0, or None for the samples unchanged.
+        length: ``space.distance(origins, samples)`` where the caller has it, else None.
 
     Returns:
         ``samples`` itself for None, else a new (M, d) array.
     """
     if max_extension is None:
         return samples
-    length = space.distance(origins, samples)
-    fraction = np.minimum(1.0, max_extension / np.maximum(length, np.finfo(float).tiny))
+    if length is None:
+        length = space.distance(origins, samples)
+    fraction = np.minimum(1.0, max_extension / np.maximum(length, _TINY))
     return space.interpolate(origins, samples, fraction)
 
 def stream_database(

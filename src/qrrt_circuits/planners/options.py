@@ -29,8 +29,8 @@ from ..search.policies.base import IterationPolicy
 from .candidates import Candidates
 from .database import AnnealingSchedule
 
-__all__ = ["MAX_WORKERS", "OptionSpec", "ParallelOptions", "ParallelQuantumOptions", "PlannerOptions",
-           "QuantumOptions", "RRTOptions", "option_specs"]
+__all__ = ["MAX_WORKERS", "ConnectOptions", "OptionSpec", "ParallelOptions", "ParallelQuantumOptions", "PlannerOptions",
+           "QuantumOptions", "RRTOptions", "StarOptions", "option_specs"]
 
 #: the most workers a parallel planner takes
 MAX_WORKERS = 4096
@@ -72,8 +72,12 @@ def declare(default: Any, check: Callable[[Any, str], Any], help: str, flag: str
     return field(default=default, metadata=metadata)
 
 
+#: ``option_specs`` of each options class, read once
+_SPECS: dict[type, tuple[OptionSpec, ...]] = {}
+
+
 def option_specs(options_type: type[PlannerOptions]) -> tuple[OptionSpec, ...]:
-    """The declared options of an options class, in declaration order.
+    """The declared options of an options class, in declaration order (read once per class).
 
     Args:
         options_type: ``PlannerOptions`` or a subclass.
@@ -81,10 +85,13 @@ def option_specs(options_type: type[PlannerOptions]) -> tuple[OptionSpec, ...]:
     Returns:
         One ``OptionSpec`` per field.
     """
-    return tuple(OptionSpec(item.name, item.default, item.metadata["check"], item.metadata["help"],
-                            item.metadata["flag"], item.metadata["text"],
-                            item.metadata.get("describe", lambda value: value))
-                 for item in fields(options_type))
+    specs = _SPECS.get(options_type)
+    if specs is None:
+        specs = _SPECS[options_type] = tuple(
+            OptionSpec(item.name, item.default, item.metadata["check"], item.metadata["help"], item.metadata["flag"],
+                       item.metadata["text"], item.metadata.get("describe", lambda value: value))
+            for item in fields(options_type))
+    return specs
 
 
 def _goal_bias(value: Any, name: str) -> float:
@@ -113,6 +120,25 @@ def _workers() -> Any:
 
 def _describe(value: Any) -> Any:
     return None if value is None else value.describe()
+
+
+def _backend() -> Any:
+    """The ``backend`` option of the quantum planners."""
+    return declare(None, _optional(_instance(QuantumSearchBackend, "a QuantumSearchBackend")),
+                   "the search backend", "--backend", describe=_describe)
+
+
+def _num_qubits() -> Any:
+    """The ``num_qubits`` option of the quantum planners."""
+    return declare(8, lambda value, name: check_int(value, name, 1), "database of 2^qubits entries", "--qubits", int)
+
+
+def _search_policy() -> Any:
+    """The ``search_policy`` option of the quantum planners."""
+    return declare(None, _optional(_instance(IterationPolicy, "a search policy (PaperIterations(), FixedIterations(k), "
+                                                              "KnownOptimal(), BBHT(), Adaptive(), "
+                                                              "ThompsonIterations())")),
+                   "search policy", "--policy", describe=_describe)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -245,16 +271,9 @@ class QuantumOptions(PlannerOptions):
             ``database``.
     """
 
-    backend: QuantumSearchBackend | None = declare(
-        None, _optional(_instance(QuantumSearchBackend, "a QuantumSearchBackend")),
-        "the search backend", "--backend", describe=_describe)
-    num_qubits: int = declare(8, lambda value, name: check_int(value, name, 1), "database of 2^qubits entries",
-                              "--qubits", int)
-    search_policy: IterationPolicy | None = declare(
-        None, _optional(_instance(IterationPolicy, "a search policy (PaperIterations(), FixedIterations(k), "
-                                                   "KnownOptimal(), BBHT(), Adaptive(), ThompsonIterations())")),
-        "search policy", "--policy",
-        describe=_describe)
+    backend: QuantumSearchBackend | None = _backend()
+    num_qubits: int = _num_qubits()
+    search_policy: IterationPolicy | None = _search_policy()
     annealing: AnnealingSchedule | None = declare(
         None, _optional(_instance(AnnealingSchedule, "an AnnealingSchedule or None")),
         "Quantum Database Annealing's schedule (default: uniform databases)", describe=_describe)
@@ -284,3 +303,73 @@ class ParallelQuantumOptions(QuantumOptions):
 
     workers: int = _workers()
     shared_database: bool = declare(True, check_bool, "whether the workers search one shared database")
+
+
+def _rewire_factor(value: Any, name: str) -> float:
+    return check_float(value, name, 1.0, 10.0)
+
+
+@dataclass(frozen=True, kw_only=True)
+class ConnectOptions(PlannerOptions):
+    """q-RRT-Connect's options: ``PlannerOptions``, the search of q-RRT and the connection database.
+
+    Args:
+        backend: The ``QuantumSearchBackend`` of every search (``QuantumOptions``), or None (default)
+            for a new ``AerBackend()``.
+        num_qubits: Qubits n of each extension database (2^n samples with their nearest node of the
+            tree that grows); an integer >= 1 and at most the backend's ``max_qubits``. Default 8.
+        search_policy: The ``IterationPolicy`` of the extension and connection searches, or None
+            (default) for the planner's ``default_search_policy()``.
+        connect_qubits: The connection database holds the 2^q nodes of the other tree nearest to the
+            new node (all of them while that tree is smaller, padded with unmarked entries to the
+            next power of two); an integer >= 1 and at most the backend's ``max_qubits``, or None
+            (default) for ``num_qubits``.
+
+    Raises:
+        ValueError: ``num_qubits`` or ``connect_qubits`` above the backend's ``max_qubits``.
+    """
+
+    backend: QuantumSearchBackend | None = _backend()
+    num_qubits: int = _num_qubits()
+    search_policy: IterationPolicy | None = _search_policy()
+    connect_qubits: int | None = declare(
+        None, _optional(lambda value, name: check_int(value, name, 1)),
+        "connection database of the 2^q nearest nodes of the other tree (default: --qubits)", "--connect-qubits",
+        int)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.backend is not None:
+            self.backend.check_qubits(self.num_qubits)
+            if self.connect_qubits is not None:
+                self.backend.check_qubits(self.connect_qubits)
+
+
+@dataclass(frozen=True, kw_only=True)
+class StarOptions(PlannerOptions):
+    """q-RRT*'s options: ``PlannerOptions``, the search of q-RRT and the near set of RRT*.
+
+    Args:
+        backend: The ``QuantumSearchBackend`` of every search, or None (default) for a new
+            ``AerBackend()``.
+        num_qubits: Qubits n of each extension database; an integer >= 1 and at most the backend's
+            ``max_qubits``. Default 8.
+        search_policy: The ``IterationPolicy`` of the extension search, or None (default) for the
+            planner's ``default_search_policy()``.
+        rewire_factor: OMPL's ``rewire_factor`` r in [1, 10] (default 1.1, OMPL's): the near set is
+            the k = ceil(r e (1 + 1/d) ln(n + 1)) nearest nodes (OMPL's k-nearest RRT*, its default).
+
+    Raises:
+        ValueError: ``num_qubits`` above the backend's ``max_qubits``.
+    """
+
+    backend: QuantumSearchBackend | None = _backend()
+    num_qubits: int = _num_qubits()
+    search_policy: IterationPolicy | None = _search_policy()
+    rewire_factor: float = declare(1.1, _rewire_factor, "RRT*'s rewire factor (k-nearest near set), in [1, 10]",
+                                   "--rewire-factor", float)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.backend is not None:
+            self.backend.check_qubits(self.num_qubits)

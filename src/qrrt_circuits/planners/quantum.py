@@ -229,6 +229,11 @@ class PQRRT(Planner):
     def settings(self) -> dict:
         return super().settings() | {"workers": self.workers, "shared_database": self.shared_database}
 
+    def miss_reason(self) -> str:
+        """Why a measured candidate fails verification: its search policy's reason
+        (``IterationPolicy.miss_reason``)."""
+        return self.search_policy.miss_reason()
+
     def labels(self) -> tuple[str, ...]:
         """The simulation shortcuts of this planner: the classical lookup behind the phase oracle,
         the one search standing for p workers of a shared database (p > 1), and the search

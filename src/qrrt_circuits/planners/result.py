@@ -113,6 +113,8 @@ class PlanResult:
         safety_limit: Whether the condition that ended the plan is a safety limit the library
             added (``termination.safety_limits``: a round, stall or node limit the caller did not
             set), not one of the caller's.
+        second_tree: A bidirectional planner's second tree (q-RRT-Connect's, rooted in the goal):
+            (nodes (M, d), parents (M,)), each edge a motion from the child to its parent; or None.
 
     Example:
         >>> from qrrt_circuits import QRRT, Environment, PaperIterations, Problem, StatevectorBackend
@@ -139,6 +141,7 @@ class PlanResult:
     history: dict[str, np.ndarray] = field(repr=False)
     goal_node: int | None = None
     safety_limit: bool = False
+    second_tree: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
 
     @property
     def reached(self) -> bool:
@@ -168,7 +171,7 @@ class PlanResult:
                 PlanStatus.MAX_NODES: f"the tree reached {limit} nodes",
                 PlanStatus.MAX_ORACLE_CALLS: f"{limit} oracle calls were spent",
                 PlanStatus.MAX_CRITICAL_PATH_CALLS: f"{limit} critical-path oracle calls were spent",
-                PlanStatus.MAX_TIME: f"{limit} s passed"}.get(self.status, str(self.status))
+                PlanStatus.MAX_TIME: "the time limit passed"}.get(self.status, str(self.status))
         if not self.safety_limit:
             return f"ended by a limit you set: {what} ({key}={limit})"
         return (f"ended by a safety limit, not one you set: {what} ({key}={limit}; pass {key}, or a budget "
@@ -226,4 +229,5 @@ class PlanResult:
             "goal_node": self.goal_node,
             "safety_limit": self.safety_limit,
             "history": {key: arrays(value) for key, value in self.history.items()},
-        }
+        } | ({} if self.second_tree is None else {"second_tree": {"nodes": arrays(self.second_tree[0]),
+                                                                  "parents": arrays(self.second_tree[1])}})

@@ -3,10 +3,11 @@ counters and the round history."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._support.memory import HISTORY_ROUNDS_CHECKED_UP_FRONT, check_history_growth
 from ..problems.goals import Goal, first_satisfying
 from .termination import Progress
 from .tree import Tree
@@ -18,10 +19,14 @@ if TYPE_CHECKING:  # annotations only (context imports the search modules)
     from .context import WorkerContext
 
 HISTORY_KEYS = ("oracle_calls", "critical_path", "nodes", "entries", "reachable")
+#: history keys a planner may add whose values are floats (q-RRT*'s best path cost after each round)
+FLOAT_HISTORY_KEYS = ("path_cost",)
 
 
 class RunState:
-    """Counters of DESIGN §2 as a plan accumulates them; ``end_round`` appends the history.
+    """Counters of DESIGN §2 as a plan accumulates them; ``end_round`` appends the history (and,
+    from ``HISTORY_ROUNDS_CHECKED_UP_FRONT`` rounds on, checks at each doubling that the memory
+    holds it: ``memory.check_history_growth``).
 
     Args:
         root: Float (d,), the tree's root.
@@ -50,9 +55,11 @@ class RunState:
         self.round_entries = 0
         self.round_reachable = 0
         self._nodes_at_round_start = 0
+        self._check_history_at = HISTORY_ROUNDS_CHECKED_UP_FRONT  # (memory.check_history_growth)
         self.policy_state: PolicyState | None = None  # quantum planners only
         self.context: WorkerContext | None = None  # the plan's WorkerContext, built once
         self.ahead: LookAhead | None = None  # classical planners only
+        self.extra: Any = None  # what a planner's own rounds carry (q-RRT-Connect's second tree, q-RRT*'s costs)
 
     @property
     def worker_context(self) -> WorkerContext:
@@ -84,13 +91,17 @@ class RunState:
         """Nodes in the tree, root excluded."""
         return self.tree.size - 1
 
-    def add_node(self, position: np.ndarray, parent: int) -> int:
+    def add_node(self, position: np.ndarray, parent: int, in_goal: bool | None = None) -> int:
         """Add one node (``Tree.add``, and to the nearest-neighbour structure); the first node that
-        satisfies the goal becomes ``goal_node``."""
+        satisfies the goal becomes ``goal_node``. ``in_goal``: whether it does, where the caller
+        has asked the goal already (None: asked here)."""
         index = self.tree.add(position, parent)
         self.neighbors.add(position.reshape(1, -1))
-        if self.goal_node is None and first_satisfying(self.goal, position.reshape(1, -1)) == 0:
-            self.goal_node = index
+        if self.goal_node is None:
+            if in_goal is None:
+                in_goal = first_satisfying(self.goal, position.reshape(1, -1)) == 0
+            if in_goal:
+                self.goal_node = index
         return index
 
     def add_nodes(self, positions: np.ndarray, parents: np.ndarray) -> None:
@@ -108,6 +119,26 @@ class RunState:
         return Progress(self.oracle_calls, self.critical_path, self.nodes, self.rounds,
                         self.rounds_without_new_node, elapsed_s)
 
+    def end_idle_rounds(self, count: int, calls: int) -> None:
+        """Record ``count`` rounds that each tested ``calls`` candidates classically (``calls``
+        verification calls, critical path 1), found none reachable and added no node: the counters
+        and history ``count`` calls of ``end_round`` after such rounds would leave."""
+        if count <= 0:
+            return
+        history, nodes = self.history, self.tree.size - 1
+        calls_before = self.quantum_calls + self.verification_calls
+        history["oracle_calls"].extend(range(calls_before + calls, calls_before + (count + 1) * calls, calls))
+        history["critical_path"].extend(range(self.critical_path + 1, self.critical_path + count + 1))
+        history["nodes"].extend([nodes] * count)
+        history["entries"].extend([calls] * count)
+        history["reachable"].extend([0] * count)
+        self.verification_calls += count * calls
+        self.critical_path += count
+        self.rounds += count
+        self.rounds_without_new_node += count
+        while self.rounds >= self._check_history_at:
+            self._check_history_at = check_history_growth(self._check_history_at)
+
     def end_round(self) -> None:
         self.rounds += 1
         nodes = self.tree.size - 1
@@ -120,3 +151,5 @@ class RunState:
         history["entries"].append(self.round_entries)
         history["reachable"].append(self.round_reachable)
         self.round_entries = self.round_reachable = 0
+        if self.rounds >= self._check_history_at:
+            self._check_history_at = check_history_growth(self._check_history_at)

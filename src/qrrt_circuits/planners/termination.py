@@ -7,7 +7,9 @@ itself; ``a | b`` ends the plan when either ends it, and the status says which o
 Conditions are checked *before* each round, so the last round may overshoot an oracle-call budget
 by less than one round's cost and a node budget by fewer than ``workers`` nodes (the paper's
 cut-offs behave the same way). The planner checks its condition before every round, as OMPL does;
-a condition whose test is costly caches inside itself.
+a condition whose test is costly caches inside itself. Rounds a planner has ready (classical tests
+made ahead) are checked on the counters they will start from (``rounds_that_start``), all at once,
+so a wall-time limit is checked again before the next round that does work.
 
 Every plan terminates: ``Planner.plan`` adds the ``safety_limits`` the caller's condition lacks.
 Without a budget (oracle calls, critical-path calls, rounds or wall time: ``is_budget``) those are
@@ -686,3 +688,38 @@ def with_round_limit(condition: TerminationCondition | None,
     if condition.limits_rounds:
         return condition
     return condition | MaxRounds(default_max_rounds)
+
+
+def rounds_that_start(condition: TerminationCondition, progress: Progress, growth: Progress, ready: int) -> int:
+    """How many of ``ready`` rounds start before ``condition`` ends the plan, when each round but
+    the last adds no node and grows the counters by ``growth`` (``nodes`` unchanged, ``elapsed_s``
+    unused): the rounds checking the condition before each would run.
+
+    The first always starts (the caller checked ``progress``); round k + 1 starts if
+    ``condition.ended_by`` lets it start from the counters after k rounds.
+
+    Args:
+        condition: The plan's condition.
+        progress: The counters before the first of the rounds.
+        growth: What one of the rounds adds to each counter.
+        ready: Rounds ready to run (>= 1).
+
+    Returns:
+        An integer in [1, ready].
+
+    Example:
+        >>> from qrrt_circuits.planners.termination import MaxOracleCalls, Progress, rounds_that_start
+        >>> now = Progress(oracle_calls=10, critical_path_oracle_calls=10, nodes=3, rounds=10,
+        ...                rounds_without_new_node=2, elapsed_s=0.0)
+        >>> growth = Progress(1, 1, 0, 1, 1, 0.0)
+        >>> rounds_that_start(MaxOracleCalls(13), now, growth, 8)  # rounds from 10, 11, 12 calls
+        3
+    """
+    calls, critical, nodes, rounds, idle, elapsed = progress
+    for started in range(1, ready):
+        after = Progress(calls + started * growth.oracle_calls,
+                         critical + started * growth.critical_path_oracle_calls, nodes,
+                         rounds + started * growth.rounds, idle + started * growth.rounds_without_new_node, elapsed)
+        if condition.ended_by(after) is not None:
+            return started
+    return ready

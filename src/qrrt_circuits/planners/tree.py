@@ -100,3 +100,12 @@ class Tree:
         nodes, parents = np.empty((capacity, self.dim)), np.empty(capacity, dtype=np.int64)
         nodes[:self.size], parents[:self.size] = self._nodes[:self.size], self._parents[:self.size]
         self._nodes, self._parents = nodes, parents
+
+    def reparent(self, node: int, parent: int) -> None:
+        """Give ``node`` a new parent (RRT*'s rewire; unvalidated: the caller keeps the tree acyclic).
+
+        Args:
+            node: A node index >= 1.
+            parent: Its new parent's index.
+        """
+        self._parents[node] = parent

@@ -257,15 +257,15 @@ def ball_of(goal: Goal) -> tuple[np.ndarray, float] | None:
     return np.asarray(centre, dtype=float).reshape(-1), float(radius)
 
 
-def first_satisfying(goal: Goal, points: np.ndarray) -> int:
-    """The first row of ``points`` that satisfies ``goal``, or -1.
+def satisfying(goal: Goal, points: np.ndarray) -> np.ndarray:
+    """Bool (M,): which rows of ``points`` satisfy ``goal`` (its ``is_satisfied``, checked).
 
     Args:
         goal: Any ``Goal``.
-        points: Float (M, d).
+        points: Float (M, d) or (d,).
 
     Returns:
-        The row, or -1.
+        Bool (M,).
 
     Raises:
         ValueError: An ``is_satisfied`` whose answer is not M booleans.
@@ -277,7 +277,23 @@ def first_satisfying(goal: Goal, points: np.ndarray) -> int:
                          f"points, got shape {answers.shape}")
     if answers.dtype != np.bool_ and (answers.dtype.kind not in "iuf" or not np.isin(answers, (0, 1)).all()):
         raise ValueError(f"the goal's is_satisfied must return booleans (or 0 / 1), got {answers!r:.60}")
-    hits = np.flatnonzero(answers.astype(bool))
+    return answers.astype(bool)
+
+
+def first_satisfying(goal: Goal, points: np.ndarray) -> int:
+    """The first row of ``points`` that satisfies ``goal`` (``satisfying``), or -1.
+
+    Args:
+        goal: Any ``Goal``.
+        points: Float (M, d).
+
+    Returns:
+        The row, or -1.
+
+    Raises:
+        ValueError: An ``is_satisfied`` whose answer is not M booleans.
+    """
+    hits = np.flatnonzero(satisfying(goal, points))
     return int(hits[0]) if hits.size else -1
 
 

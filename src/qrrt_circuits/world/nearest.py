@@ -40,7 +40,7 @@ from numba import njit
 if TYPE_CHECKING:
     from .spaces import StateSpace
 
-__all__ = ["BRUTE_FORCE_BELOW", "GridNearest", "LinearNearest", "NearestNeighbors"]
+__all__ = ["BRUTE_FORCE_BELOW", "GridNearest", "LinearNearest", "NearestNeighbors", "SE2Nearest"]
 
 #: cells per point when the grid is (re)built, and the most cells one grid has
 _CELLS_PER_NODE = 1.0
@@ -86,6 +86,12 @@ class NearestNeighbors(Protocol):
 
     def nearest(self, queries: np.ndarray) -> np.ndarray:
         """Int (M,): the index of the point nearest to each row of ``queries`` ((M, d) or (d,))."""
+        ...
+
+    def nearest_distance_from(self, queries: np.ndarray, first: int) -> np.ndarray:
+        """Float (M,): the distance from each row of ``queries`` to the nearest of the points of
+        index ``first`` on (``inf`` where there are none): whether a point added since index
+        ``first`` may have taken a query's nearest."""
         ...
 
 
@@ -181,6 +187,82 @@ class LinearNearest(_Points):
             out[first:first + block.shape[0]] = np.argmin(distance.reshape(block.shape[0], count), axis=1)
         return out
 
+    def nearest_distance_from(self, queries: np.ndarray, first: int) -> np.ndarray:
+        """Float (M,): the distance, under the space's metric, from each of ``queries`` to the
+        nearest of the points of index ``first`` on (``inf`` where there are none)."""
+        queries = self.queries(queries)
+        points = self.points[max(0, first):]
+        count = points.shape[0]
+        out = np.full(queries.shape[0], np.inf)
+        step = max(1, _CHUNK // max(count, 1))
+        for start in range(0, queries.shape[0] if count else 0, step):
+            block = queries[start:start + step]
+            distance = self.space.distance(np.repeat(block, count, axis=0), np.tile(points, (block.shape[0], 1)))
+            out[start:start + block.shape[0]] = distance.reshape(block.shape[0], count).min(axis=1)
+        return out
+
+
+@njit(cache=True, nogil=True)
+def _se2_scan(queries: np.ndarray, points: np.ndarray, first: int, stop: int, weight: float, best: np.ndarray,
+              out: np.ndarray) -> None:
+    """For each query, the nearest of points ``first .. stop - 1`` under the SE(2) metric into
+    ``best`` (distance) and ``out`` (index; the lowest among equals): the operations of
+    ``SE2Space.distance`` (offset = point - query, ``hypot`` of the position, the angle wrapped to
+    [-pi, pi) by ``mod`` and taken absolute, times ``weight``), in that order, so the same bits."""
+    two_pi = 2 * math.pi
+    for row in range(queries.shape[0]):
+        x, y, theta = queries[row, 0], queries[row, 1], queries[row, 2]
+        nearest, index = np.inf, first
+        for point in range(first, stop):
+            turn = np.mod(points[point, 2] - theta + math.pi, two_pi) - math.pi
+            distance = math.hypot(points[point, 0] - x, points[point, 1] - y) + weight * abs(turn)
+            if distance < nearest:
+                nearest, index = distance, point
+        best[row] = nearest
+        out[row] = index
+
+
+class SE2Nearest(_Points):
+    """Exact nearest points under an ``SE2Space``'s metric, compiled: every query scans every point
+    (OMPL's ``NearestNeighborsLinear``), with the space's own operations, so it answers what
+    ``LinearNearest(space)`` answers, bit for bit, ties to the lowest index.
+
+    Args:
+        angle_weight: w of the metric ``||(dx, dy)|| + w |wrap(dtheta)|`` (``SE2Space.angle_weight``).
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits.world.nearest import SE2Nearest
+        >>> near = SE2Nearest(0.5)
+        >>> near.add(np.array([[0.0, 0.0, 0.0], [0.0, 0.3, 3.1]]))
+        >>> near.nearest(np.array([[0.0, 0.3, -3.1], [1.0, 0.0, 0.0]])).tolist()  # theta wraps
+        [1, 0]
+    """
+
+    def __init__(self, angle_weight: float) -> None:
+        super().__init__(3)
+        self.angle_weight = float(angle_weight)
+
+    def _scan(self, queries: np.ndarray, first: int) -> tuple[np.ndarray, np.ndarray]:
+        best = np.empty(queries.shape[0])
+        out = np.empty(queries.shape[0], dtype=np.int64)
+        _se2_scan(queries, self._buffer, max(0, first), self.size, self.angle_weight, best, out)
+        return best, out
+
+    def nearest(self, queries: np.ndarray) -> np.ndarray:
+        """Int (M,): the index of the point nearest to each of ``queries`` ((M, 3) or (3,)) under
+        the SE(2) metric; among equally near points the lowest index.
+
+        Raises:
+            ValueError: ``queries`` of the wrong shape, or no point added yet.
+        """
+        return self._scan(self.queries(queries), 0)[1]
+
+    def nearest_distance_from(self, queries: np.ndarray, first: int) -> np.ndarray:
+        """Float (M,): the SE(2) distance from each of ``queries`` to the nearest of the points of
+        index ``first`` on (``inf`` where there are none)."""
+        return self._scan(self.queries(queries), first)[0]
+
 
 class GridNearest(_Points):
     """Exact Euclidean nearest points, compiled: brute force for small structures, a bucket grid
@@ -238,6 +320,18 @@ class GridNearest(_Points):
         # which scans the same points (vectorized over the queries)
         nearest_into(queries, *self._search_arrays(self.size >= BRUTE_FORCE_BELOW and self._several_cells), out)
         return out
+
+    def nearest_distance_from(self, queries: np.ndarray, first: int) -> np.ndarray:
+        """Float (M,): the Euclidean distance from each of ``queries`` to the nearest of the points
+        of index ``first`` on (``inf`` where there are none), by the brute-force block.
+
+        Raises:
+            ValueError: ``queries`` not of shape (M, d) or (d,) for the structure's d.
+        """
+        queries = self.queries(queries)
+        best = np.empty(queries.shape[0])
+        _brute_block(queries, self._buffer, max(0, first), self.size, best, np.empty(queries.shape[0], np.int64))
+        return np.sqrt(best)
 
     def grid_nearest(self, queries: np.ndarray) -> np.ndarray:
         """``nearest`` through the grid whatever the structure's size (for tests, and for comparing

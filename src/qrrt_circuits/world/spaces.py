@@ -12,7 +12,7 @@ spaces are built in:
 - ``SE2Space()``: a rigid body in the plane, states (x, y, theta) with theta in [-pi, pi);
   OMPL's ``SE2StateSpace`` metric ``||(dx, dy)|| + w * abs(dtheta)`` (dtheta wrapped to the shorter
   way round, w = 0.5 as in OMPL), interpolation along the shorter arc, and an exact scan under
-  that metric (``LinearNearest``).
+  that metric (``SE2Nearest``, compiled).
 
 Any object with ``dim``, ``distance``, ``interpolate``, ``nearest_neighbors``, ``check_bounds`` and
 ``describe`` is a space; its ``nearest_neighbors`` can return ``LinearNearest(self)``, exact under
@@ -29,7 +29,7 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 
 from .._support.validation import check_float, check_int
-from .nearest import GridNearest, LinearNearest, NearestNeighbors
+from .nearest import GridNearest, NearestNeighbors, SE2Nearest
 
 __all__ = ["RealVectorSpace", "SE2Space", "StateSpace", "wrap_angle"]
 
@@ -142,10 +142,10 @@ class SE2Space:
         out[:, 2] = wrap_angle(origins[:, 2] + wrap_angle(targets[:, 2] - origins[:, 2]) * fraction[:, 0])
         return out
 
-    def nearest_neighbors(self) -> LinearNearest:
-        """A ``LinearNearest`` under the SE(2) metric (an exact scan; the first of equally near
+    def nearest_neighbors(self) -> SE2Nearest:
+        """An ``SE2Nearest`` (the compiled exact scan under this metric; the first of equally near
         nodes)."""
-        return LinearNearest(self)
+        return SE2Nearest(self.angle_weight)
 
     def check_bounds(self, bounds: np.ndarray) -> None:
         if bounds.shape != (3, 2):

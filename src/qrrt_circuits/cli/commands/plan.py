@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    import numpy as np
 
     from ...planners.base import Planner
     from ...planners.result import PlanResult
@@ -69,13 +70,19 @@ def build_planner(args: argparse.Namespace, name: str | None = None) -> Planner:
 #: the classical planner each quantum planner is compared with: the same round structure without
 #: quantum search (one worker for q-RRT, p workers on one tree snapshot for Pq-RRT)
 CLASSICAL_PEERS = {"qrrt": "rrt", "pqrrt": "prrt", "pqrrt-unshared": "prrt"}
-#: the share of verified measurements above which the output says the iterations over-rotate
+#: the share of verified measurements above which the output says why measurements failed
 OVER_ROTATION_SHARE = 0.5
+#: settings the default view leaves out (``--json`` writes every one): the headline's, the
+#: arrays, and the internals of the goal region and the motion check
+HIDDEN_SETTINGS = frozenset({"planner", "start", "goal", "termination", "oracle_errors", "dynamics", "centre",
+                             "false_rejection_bound"})
+#: seed of the bootstrap behind the verdict's intervals
+VERDICT_SEED = 0
 
 
 def _print_comparison(result: PlanResult, peer: PlanResult) -> None:
     """The quantum plan beside its classical peer's, in the same world and with the same seed,
-    predicate and limits; the critical path named; a note where most measurements failed."""
+    predicate and limits; the critical path named."""
     rows: list[tuple[str, Callable[[PlanResult], str]]] = [
         ("status", lambda r: f"{r.status}{' (safety limit)' if r.safety_limit else ''}"),
         ("nodes", lambda r: str(r.metrics.nodes)),
@@ -90,34 +97,85 @@ def _print_comparison(result: PlanResult, peer: PlanResult) -> None:
     for label, value in rows:
         print(f"  {label:30s} {value(result):>14s} {value(peer):>14s}")
     print("  (critical-path calls: per round, the most calls any one worker made: the time of parallel devices)")
+
+
+def _print_notes(result: PlanResult, planner: Planner) -> None:
+    """What the quantum plan's counts mean where they mislead: most calls classical verifications,
+    or most measurements failed (with the reason of the policy that ran)."""
     metrics = result.metrics
-    if metrics.verification_calls and metrics.rejected / metrics.verification_calls > OVER_ROTATION_SHARE:
+    quantum, verifications = metrics.quantum_oracle_calls, metrics.verification_calls
+    if verifications > quantum:
+        print(f"note: most oracle calls were classical verifications ({verifications} of {metrics.oracle_calls}; "
+              f"{quantum} quantum): the searches ran {quantum / verifications:.2f} Grover iterations per "
+              "measurement on average, and a measurement after 0 iterations is a uniform draw from the database, "
+              "checked classically as RRT checks its samples: the fewer the iterations, the closer this plan's calls "
+              "are to classical sampling's.")
+    if verifications and metrics.rejected / verifications > OVER_ROTATION_SHARE:
         entries = int(result.history["entries"].sum())
         share = int(result.history["reachable"].sum()) / entries if entries else 0.0
-        print(f"note: {metrics.rejected / metrics.verification_calls:.0%} of the measured candidates failed "
-              f"verification. {share:.0%} of the databases' entries were reachable on average; a fixed "
-              "iteration count tuned for a small share over-rotates past the peak of sin^2((2k+1)theta) "
-              "as the share grows, and BBHT's random counts miss often by design. --policy thompson or adaptive "
-              "learn the iteration count from verified outcomes.")
+        print(f"note: {metrics.rejected / verifications:.0%} of the measured candidates failed verification "
+              f"({share:.0%} of the databases' entries were reachable on average): {planner.miss_reason()}.")
+
+
+def _per_round(history: np.ndarray) -> list[int]:
+    """A cumulative per-round count as the count of each round."""
+    import numpy as np
+
+    return [int(count) for count in np.diff(history, prepend=0)]
+
+
+def _calls_per_node(result: PlanResult) -> tuple[float, tuple[float, float]]:
+    """Oracle calls per node and its 95 % bootstrap interval over the plan's rounds."""
+    from ...experiments.intervals import bootstrap_ratio_interval
+
+    calls = _per_round(result.history["oracle_calls"])
+    nodes = _per_round(result.history["nodes"])
+    low, high = bootstrap_ratio_interval(calls, nodes, VERDICT_SEED)
+    return result.metrics.oracle_calls / result.metrics.nodes, (low, high)
+
+
+def _verdict(result: PlanResult, peer: PlanResult) -> str:
+    """One line: which plan needed fewer oracle calls per node (DESIGN §2), and whether the
+    difference is larger than its spread (the two 95 % bootstrap intervals over rounds apart)."""
+    if not (result.metrics.nodes and peer.metrics.nodes):
+        return "verdict: none: a plan added no node, so neither has calls per node"
+    (value, (low, high)), (other, (other_low, other_high)) = _calls_per_node(result), _calls_per_node(peer)
+    fewer, more = (result.planner, peer.planner) if value < other else (peer.planner, result.planner)
+    apart = high < other_low or other_high < low
+    spread = ("larger than its spread (the intervals are apart)" if apart
+              else "within its spread (the intervals overlap)")
+    return (f"verdict: {fewer} needed fewer oracle calls per node than {more}: {result.planner} "
+            f"{value:.2f} [{low:.2f}, {high:.2f}], {peer.planner} {other:.2f} [{other_low:.2f}, {other_high:.2f}] "
+            "(95 % bootstrap intervals over each plan's rounds); the difference is "
+            f"{spread}; one plan each, in this world and at this tree size.")
 
 
 def _per_node(value: float, result: PlanResult) -> str:
     return f"{value / result.metrics.nodes:.2f}" if result.metrics.nodes else "-"
 
 
-def _print_plan(result: PlanResult, problem: Problem, seed: int) -> None:
+def _shown_setting(value: object) -> str | None:
+    """A setting as the default view shows it, None for one it leaves out (None, or internal)."""
+    if isinstance(value, dict):  # the predicate's and the goal region's settings
+        parts = [f"{key}={part}" for key, part in value.items() if key not in HIDDEN_SETTINGS and part is not None]
+        return ", ".join(parts) or None
+    return None if value is None else str(value)
+
+
+def _print_plan(result: PlanResult, problem: Problem, seed: int, compile_s: float) -> None:
     metrics = result.metrics
     print(f"{result.planner} on {problem.name} (seed {seed}): {result.status}: {result.status_text}")
+    print("settings (--json writes every setting):")
     for key, value in result.settings.items():
-        if key in ("start", "goal", "termination", "oracle_errors", "dynamics"):
-            continue
-        if isinstance(value, dict):  # the predicate: its settings without the dynamics matrices
-            value = ", ".join(f"{k}={v}" for k, v in value.items() if k != "dynamics")
-        print(f"  {key:24s} {value}")
+        shown = None if key in HIDDEN_SETTINGS else _shown_setting(value)
+        if shown is not None:
+            print(f"  {key:24s} {shown}")
     print("metrics:")
     for key, value in metrics.as_dict().items():
         shown = f"{value:.3f}" if isinstance(value, float) else str(value)
-        print(f"  {key:28s} {shown:>12s}")
+        compiled = (f"  (numba compiled for {compile_s:.1f} s during this plan: a first run only)"
+                    if key == "wall_time_s" and compile_s >= COMPILE_SHOWN_S else "")
+        print(f"  {key:28s} {shown:>12s}{compiled}")
     if metrics.nodes:
         print(f"  {'oracle_calls per node':28s} {metrics.oracle_calls / metrics.nodes:12.2f}")
         print(f"  {'wall ms per node':28s} {metrics.wall_time_s * 1e3 / metrics.nodes:12.2f}")
@@ -125,6 +183,10 @@ def _print_plan(result: PlanResult, problem: Problem, seed: int) -> None:
         print(f"path: {len(result.path)} nodes")
     for label in result.labels:
         print(f"note: {label}")
+
+
+#: compile seconds below which the output does not mention compiling (a cached kernel loads in less)
+COMPILE_SHOWN_S = 0.05
 
 
 def _write_plan_outputs(args: argparse.Namespace, result: PlanResult, problem: Problem) -> None:
@@ -173,22 +235,47 @@ def _write_failure(exc: OSError | MemoryError) -> str:
 def cmd_plan(args: argparse.Namespace) -> int:
     from ..._support.output_files import check_output_file, same_file
     from ...registry import PLANNERS
+    from ..progress import CompileClock, PlanDisplay, shown
 
     check_output_file(args.json, "--json")
     check_output_file(args.plot, "--plot", PLOT_FORMATS)
     if args.json and args.plot and same_file(args.json, args.plot):
         raise ValueError(f"--json and --plot name the same file {args.plot!r} (the plot would overwrite the JSON)")
-    problem = _load_problem(args)
-    planner = build_planner(args)
+    clock = CompileClock()
+    display = PlanDisplay(clock, enabled=shown() and not args.no_progress)
     # (the plan makes its one memory check before it allocates anything, and words a MemoryError as
     # one OutOfMemory line; --json adds no memory per node: PlanResult.write_json streams the arrays
     # chunk by chunk; the outputs are written only once the plan has finished)
     limits = {"max_nodes": args.max_nodes, "max_oracle_calls": args.max_oracle_calls, "max_rounds": args.max_rounds,
               "max_critical_path_calls": args.max_critical_path_calls, "stall_rounds": args.stall_rounds}
-    result = planner.plan(problem, **limits)
-    _print_plan(result, problem, args.seed)
-    peer = CLASSICAL_PEERS.get(PLANNERS.canonical(args.planner))
-    if peer is not None and not args.no_compare:
-        _print_comparison(result, build_planner(args, peer).plan(problem, **limits))
+    peer: PlanResult | None = None
+    try:
+        with clock.running():
+            display.stage("building the world", counted=False)
+            problem = _load_problem(args)
+            planner = build_planner(args)
+            display.stage(planner.name, total=args.max_nodes)
+            before = clock.seconds
+            result = planner.plan(problem, **limits, on_round=display.on_round)
+            compiled = clock.seconds - before
+            display.close()
+            _print_plan(result, problem, args.seed, compiled)
+            peer_name = CLASSICAL_PEERS.get(PLANNERS.canonical(args.planner))
+            if peer_name is not None and not args.no_compare:
+                peer_planner = build_planner(args, peer_name)
+                display.stage(peer_planner.name, total=args.max_nodes)
+                peer = peer_planner.plan(problem, **limits, on_round=display.on_round)
+                display.close()
+    finally:
+        display.close()
+    if peer is not None:
+        _print_comparison(result, peer)
+        _print_notes(result, planner)
+    if clock.seconds >= COMPILE_SHOWN_S:
+        print(f"note: numba compiled the package's kernels for {clock.seconds:.1f} s of this run ({compiled:.1f} s "
+              f"during the {result.planner} plan, in its wall time): a first run only; later runs load them from "
+              "numba's cache.")
     _write_plan_outputs(args, result, problem)
+    if peer is not None:
+        print(_verdict(result, peer))
     return 0

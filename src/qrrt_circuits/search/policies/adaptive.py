@@ -64,16 +64,21 @@ class Adaptive(IterationPolicy):
         return optimal_iterations(num_items, 1) if self.max_iterations is None else int(self.max_iterations)
 
     def state_bytes(self, num_items: int) -> int:
-        """The success table sin^2((2k+1) theta(f)), (k_max + 1) x grid_size float64, and the
-        temporaries that build it (3 tables).
+        """The success table sin^2((2k+1) theta(f)), (k_max + 1) x grid_size float64, the log
+        likelihoods of a success and of a miss (2 more tables), and the temporaries that build them
+        (3 tables).
 
         Args:
             num_items: N, the database size.
 
         Returns:
-            3 x 8 x (k_max + 1) x ``grid_size`` bytes.
+            6 x 8 x (k_max + 1) x ``grid_size`` bytes.
         """
-        return 3 * 8 * (self.iterations_bound(num_items) + 1) * int(self.grid_size)
+        return 6 * 8 * (self.iterations_bound(num_items) + 1) * int(self.grid_size)
+
+    def miss_reason(self) -> str:
+        return ("the posterior over m/N learns from misses, and where m/N is large the k with the most successes "
+                "per call is 0: a uniform draw, which misses with probability 1 - m/N")
 
     def describe(self) -> str:
         return "adaptive (estimates m/N from verified outcomes; no access to the true m)"
@@ -105,6 +110,9 @@ class AdaptiveState(PolicyState):
         theta = np.arcsin(np.sqrt(self.fractions))
         # success[k, f] = sin^2((2k+1) theta(f))
         self.success = np.sin(np.outer(2 * self.candidates + 1, theta)) ** 2
+        # the log likelihood of a success and of a miss at each candidate k (``observe``)
+        clipped = np.clip(self.success, 1e-9, 1 - 1e-9)
+        self.log_success, self.log_miss = np.log(clipped), np.log(1 - clipped)
 
     @property
     def log_posterior(self) -> np.ndarray:
@@ -132,10 +140,17 @@ class AdaptiveState(PolicyState):
         return self.choose_iterations(tree_nodes)
 
     def observe(self, iterations: int, success: bool) -> None:
-        theta = np.arcsin(np.sqrt(self.fractions))
-        p = np.clip(np.sin((2 * iterations + 1) * theta) ** 2, 1e-9, 1 - 1e-9)
+        """Discount the log likelihood by ``forgetting`` and add log sin^2((2k+1) theta(f)) (a
+        success) or log of its complement (a miss), clipped to [1e-9, 1 - 1e-9] (the candidates'
+        rows are computed once, when the plan starts)."""
+        if 0 <= iterations < self.candidates.shape[0]:
+            row = (self.log_success if success else self.log_miss)[iterations]
+        else:
+            theta = np.arcsin(np.sqrt(self.fractions))
+            p = np.clip(np.sin((2 * iterations + 1) * theta) ** 2, 1e-9, 1 - 1e-9)
+            row = np.log(p if success else 1 - p)
         self.log_likelihood *= self.policy.forgetting
-        self.log_likelihood += np.log(p if success else 1 - p)
+        self.log_likelihood += row
 
     def estimate(self) -> float:
         """Posterior mean of the marked fraction."""

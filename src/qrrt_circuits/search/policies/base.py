@@ -89,6 +89,17 @@ class IterationPolicy:
         """Caveats every result planned with this policy must carry (none by default)."""
         return ()
 
+    def miss_reason(self) -> str:
+        """Why a measurement of this policy can fail verification, in one clause (``qrrt plan``
+        prints it when most measured candidates failed).
+
+        Returns:
+            By default: a measurement after k iterations is marked only with probability
+            sin^2((2k+1) theta), sin^2 theta = m/N (the success probability behind Eq. 1).
+        """
+        return ("a measurement after k Grover iterations is a reachable entry only with probability "
+                "sin^2((2k+1) theta), sin^2 theta = m/N (Eq. 1)")
+
     def iterations_for(self, problem: DatabaseSearch, tree_nodes: int) -> int:
         """The Grover iteration count k for one database (policies that pick k before measuring).
 

@@ -128,6 +128,10 @@ class BBHT(IterationPolicy):
                 # (N = 2: M never reaches 2, every j is 0 and spends nothing; stop after cap attempts)
                 return BBHTOutcome(None, spent, len(attempts), tuple(attempts))
 
+    def miss_reason(self) -> str:
+        return ("BBHT draws a random k below a bound that each miss raises, so misses are part of its schedule "
+                "(Boyer et al., Thm. 3)")
+
     def describe(self) -> str:
         return f"bbht (unknown m, cap {self.cap_factor} sqrt(N) iterations)"
 

@@ -106,6 +106,10 @@ class EstimatedOptimal(IterationPolicy):
                                         rng=problem.worker_generator(0), method=self.method,
                                         schedule=self.schedule, epsilon=self.epsilon)
 
+    def miss_reason(self) -> str:
+        return ("the optimal k for an estimated m misses more where the estimate is off, and a database with no "
+                "reachable entry always misses")
+
     def describe(self) -> str:
         top = 2 ** (self.schedule - 1) if self.schedule else 0
         how = (f"maximum-likelihood amplitude estimation, powers 0..{top}" if self.method == "mlae"

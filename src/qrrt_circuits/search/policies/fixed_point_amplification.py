@@ -116,6 +116,10 @@ class FixedPointAmplification(IterationPolicy):
     def start(self, num_items: int) -> FixedPointState:
         return FixedPointState(self, num_items)
 
+    def miss_reason(self) -> str:
+        return ("fixed-point amplification guarantees P >= 1 - delta^2 only for m/N >= min_fraction; "
+                "databases with fewer reachable entries miss more")
+
     def describe(self) -> str:
         return (f"fixed-point (delta {self.delta}, min fraction {self.min_fraction}: {self.iterates} "
                 f"generalized iterates, P >= {1 - self.delta ** 2:.3g} for f >= {self.min_fraction})")

@@ -62,6 +62,11 @@ class PaperIterations(IterationPolicy):
     def iterations_bound(self, num_items: int) -> int:
         return max(self.early, self.late)
 
+    def miss_reason(self) -> str:
+        return ("the paper's fixed counts suit a small reachable share m/N and over-rotate past the peak of "
+                "sin^2((2k+1) theta) once the share grows; --policy thompson or adaptive learn k from verified "
+                "outcomes")
+
     def describe(self) -> str:
         return f"paper ({self.early} iterations, {self.late} after {self.switch_nodes} nodes)"
 
@@ -90,6 +95,10 @@ class FixedIterations(IterationPolicy):
     def iterations_bound(self, num_items: int) -> int:
         return int(self.k)
 
+    def miss_reason(self) -> str:
+        return ("a fixed k suits one reachable share m/N and over-rotates past the peak of sin^2((2k+1) theta) "
+                "above it; --policy thompson or adaptive learn k from verified outcomes")
+
     def describe(self) -> str:
         return f"fixed:{self.k}"
 
@@ -117,6 +126,10 @@ class KnownOptimal(IterationPolicy):
 
     def iterations_for(self, problem: DatabaseSearch, tree_nodes: int) -> int:
         return self._iterations(problem.num_items, tree_nodes, problem.marked_count())
+
+    def miss_reason(self) -> str:
+        return ("even the optimal k for the true m misses with probability cos^2((2k+1) theta), and a database "
+                "with no reachable entry always misses")
 
     def describe(self) -> str:
         return "optimal (uses the true m of each database: simulation knowledge)"

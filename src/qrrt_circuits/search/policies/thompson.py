@@ -119,6 +119,10 @@ class ThompsonIterations(IterationPolicy):
         """
         return 8 * (self.iterations_bound(num_items) + 1) * (4 + _PRIOR_GRID)
 
+    def miss_reason(self) -> str:
+        return ("the bandit tries iteration counts to learn which verifies most entries per call, so its misses "
+                "include that exploration")
+
     def describe(self) -> str:
         return (f"thompson (k per database from a bandit over verified outcomes, memory {self.memory}, "
                 f"{self.prior} prior; no access to the true m)")
