@@ -79,7 +79,7 @@ def read_json_file(path: str | Path, what: str, limit: int = MAX_INPUT_BYTES) ->
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise ValueError(f"{what}: {str(path)!r} is not UTF-8 text (byte {exc.start})") from None
+        raise ValueError(f"{what}: {str(path)!r} is not a UTF-8 text file (byte {exc.start})") from None
     try:
         return json.loads(text)
     except RecursionError:
