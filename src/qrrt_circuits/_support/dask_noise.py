@@ -6,7 +6,8 @@ way, Dask's event loops report every cancelled task and every closed connection 
 ``tornado.application`` errors, a worker's "Failed to communicate with scheduler during heartbeat"
 once the scheduler has gone, its state machine's warnings on cancelled tasks): tracebacks that say
 nothing about the run's results. ``ShutdownNoise`` leaves out a record whose exception (or one in
-its chain) is one of ``SHUTDOWN_EXCEPTIONS``, or whose message is one of ``SHUTDOWN_MESSAGES``;
+its chain) is one of ``SHUTDOWN_EXCEPTIONS`` or a result refused for a cancelled task
+(``CANCELLED_STATE``), or whose message is one of ``SHUTDOWN_MESSAGES``;
 ``quiet_workers()`` sets it on the worker loggers (the fork server calls it, so every worker it forks
 has it), and ``execution`` sets it on the client's loggers while its cluster lives.
 """
@@ -17,6 +18,9 @@ import logging
 
 #: exceptions that only say that a task was cancelled or a connection closed
 SHUTDOWN_EXCEPTIONS = frozenset({"CancelledError", "FutureCancelledError", "CommClosedError", "StreamClosedError"})
+#: an exception of this type whose text starts so: a result that came back for a task already
+#: cancelled (``concurrent.futures`` refuses to set it)
+CANCELLED_STATE = ("InvalidStateError", "CANCELLED")
 #: messages a worker logs once its scheduler has gone
 SHUTDOWN_MESSAGES = ("Failed to communicate with scheduler during heartbeat",)
 #: the loggers of a worker process that report a shutdown (its state machine warns of each
@@ -34,7 +38,8 @@ class ShutdownNoise(logging.Filter):
         error = record.exc_info[1] if record.exc_info else None
         seen = 0
         while error is not None and seen < 32:
-            if type(error).__name__ in SHUTDOWN_EXCEPTIONS:
+            name = type(error).__name__
+            if name in SHUTDOWN_EXCEPTIONS or (name, str(error)[:len(CANCELLED_STATE[1])]) == CANCELLED_STATE:
                 return False
             error, seen = error.__cause__ or error.__context__, seen + 1
         return True
