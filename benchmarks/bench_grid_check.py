@@ -7,7 +7,7 @@ Worlds, all 20 x 20 length units:
 
 - ``maze512``: a perfect maze (``qrrt_circuits.world.maze``, seed 0) of 64 x 64 rooms, corridors
   7 pixels wide and walls 1 pixel thick, cropped to 512 x 512 pixels of 20 / 512, written as a PNG
-  and read with ``qc.image_world``; checked by ``GridCheck`` (straight segments, every cell
+  and read with ``qc.image_problem``; checked by ``GridCheck`` (straight segments, every cell
   touched);
 - ``maze512-boxes``: the same walls as boxes (each run of occupied pixels in a row, merged with the
   identical runs of the rows below), checked by ``ExactCheck`` at its default resolution 0.01
@@ -100,11 +100,11 @@ def main() -> None:
     with tempfile.TemporaryDirectory(prefix="qrrt-bench-grid-") as scratch:
         path = Path(scratch) / "maze512.png"
         plt.imsave(path, free.astype(float), cmap="gray", vmin=0.0, vmax=1.0)
-        maze_env, grid_check = qc.image_world(path, pixel, start=[0.5 * pixel + 0.1] * 2, goal=[19.8, 0.2],
-                                              goal_radius=0.1)
+        maze = qc.image_problem(path, pixel, start=[0.5 * pixel + 0.1] * 2, goal=[19.8, 0.2], goal_radius=0.1)
+    maze_env, grid_check = maze.env, maze.predicate
     assert np.array_equal(grid_check.grid.free, free)
     box_env = qc.Environment([[0.0, EXTENT], [0.0, EXTENT]], as_boxes(free, pixel), name="maze512-boxes")
-    clutter = qc.paper_clutter(seed=0)
+    clutter = qc.paper_clutter(seed=0).env
     worlds = {
         "maze512": (maze_env, grid_check, grid_check.is_valid),
         "maze512-boxes": (box_env, qc.ExactCheck(box_env), box_env.is_free),

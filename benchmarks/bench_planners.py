@@ -227,7 +227,7 @@ def predicate_construction(env, repeats: int = 20) -> dict:
             if clear:
                 oracle._CHORD_GRIDS.clear()
             start = time.perf_counter()
-            qc.ExactCheck(env)
+            qc.ExactCheck(env.env)
             times.append((time.perf_counter() - start) * 1e3)
         return float(np.median(times))
 

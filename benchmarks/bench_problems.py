@@ -197,7 +197,7 @@ def main() -> None:
         "open-space", "maze", "narrow-passage-2d", "narrow-passage-4d", "se2-gap")
     runs = 3 if args.quick else 10
     have_ompl = importlib.util.find_spec("ompl") is not None
-    out: dict[str, Any] = {"machine": machine(), "budget": BUDGET, "runs": runs, "ompl": have_ompl, "figures": {}}
+    out: dict[str, Any] = {"machine": machine(), "budget": BUDGET, "runs": runs, "ompl": have_ompl, "families": {}}
     header = ("family", "planner", "us/check", "in check", "own", "us/node", "success")
     print(f"{header[0]:20s} {header[1]:14s} " + " ".join(f"{h:>9s}" for h in header[2:]))
     for family in families:
@@ -228,7 +228,7 @@ def main() -> None:
                                   per_run(raw["rrt_python_check"]), per_run(raw["ompl_rrt_python_check"])),
                               "python_check_rrt_one_by_one_over_ompl_per_run": ratio_of_medians(
                                   per_run(raw["rrt_one_by_one_python_check"]), per_run(raw["ompl_rrt_python_check"]))}
-        out["figures"][family] = rows
+        out["families"][family] = rows
         for planner, row in rows.items():
             if planner != "ratios":
                 print(f"{family:20s} {planner:14s} {row['us_per_check']:9.1f} {row['check_us_per_check']:9.1f} "

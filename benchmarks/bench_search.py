@@ -59,6 +59,7 @@ import numpy as np
 from _common import machine, median_time, write_json
 
 import qrrt_circuits as qc
+from qrrt_circuits.problems.scenarios import SCENARIOS
 from qrrt_circuits.registry import BACKENDS
 from qrrt_circuits.search import circuits
 from qrrt_circuits.search.aer_circuits import aer_grover_program
@@ -363,7 +364,7 @@ def bench_reachability(quick: bool) -> list[dict]:
     rows = []
     count = 20000 if quick else 200000
     for scenario in ("paper_clutter", "annealing_field"):
-        env = qc.by_name(scenario, seed=0)
+        env = SCENARIOS[scenario](seed=0).env
         oracle = qc.ExactCheck(env)
         rng = np.random.default_rng(1)
         parents = env.sample_free(count, rng)

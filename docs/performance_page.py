@@ -210,7 +210,7 @@ def _benchmarks_table(root: Path, run: dict) -> list[str]:
 
 def _families_section(run: dict) -> list[str]:
     problems = (run.get("raw") or {}).get("problems") or {}
-    figures = problems.get("figures")
+    figures = problems.get("families")
     lines = ["### OMPL's RRT on the problem families", ""]
     if not isinstance(figures, dict) or not figures:
         return lines + ["This run holds no problem-family figures (`bench_problems.py`).", ""]

@@ -26,7 +26,7 @@ def _run(commit: str, ms_per_node: float, cpu: str = "Test CPU") -> dict:
                                  "median_ms": {"floor": 0.5, "ours": 1.0, "qiskit_algorithms": 20.0},
                                  "ratio_to_floor": {"floor": 1.0, "ours": 2.0, "qiskit_algorithms": 40.0}}]}
     ratio = {"median": 1.25, "low": 1.0, "high": 1.5}
-    problems = {"runs": 4, "budget": 5000, "figures": {"maze": {
+    problems = {"runs": 4, "budget": 5000, "families": {"maze": {
         "rrt": {"us_per_check": 8.0, "own_us_per_check": 6.0}, "ompl_rrt": {"us_per_check": 6.4},
         "ratios": {"rrt_over_ompl_per_run": ratio, "rrt_one_by_one_over_ompl_per_run": ratio}}}}
     return {"machine": machine, "quick": True, "benchmarks": {"planners": {"returncode": 0, "wall_s": 1.5},
