@@ -8,24 +8,26 @@ is noisy and a positive answer is verified with the true predicate (one more cal
 is added, as the quantum planners' finalizer does.
 
 Rounds tested ahead. The planners run the one round loop of ``Planner._run`` (the termination
-condition checked before each round). A round's candidates depend only on its random streams
-(keyed by round and worker: ``placement.keyed_samples``, the samples ``build_database(tree, 1,
-...)`` draws), so a round that finds no tests made ahead for it draws the candidates of the next B
-rounds at once, finds their nearest nodes in one query and tests all B x p pairs in one call
+condition checked before each round). A round's candidates depend only on its random streams (keyed
+by round and worker: ``placement.keyed_samples``, the samples ``build_database(tree, 1, ...)``
+draws), so a round that finds no tests made ahead for it draws the candidates of the next B rounds
+at once, finds their nearest nodes in one query and tests all B x p pairs in one call
 (``LookAhead``). A test made ahead holds as long as the candidate's nearest node is the one it was
 tested with: a node added since takes that place only if it is at least as near to the raw sample
 as the parent (ties go to the lower index, the older node), which one query of the
 nearest-neighbour structure tells (``nearest_distance_from``). A round whose test no longer holds
-is stale: it and the rest of the batch are tested again, the same candidates with their nearest
-nodes in the new tree. The rounds ready before the first that finds a reachable candidate run as
-one block: they add no node, so their counters and history are written at once, as many as the
-termination condition lets start (``termination.rounds_that_start``). The tree, the counters, the
-history and the status are those of testing each round on its own; tests made ahead and never used
-are counted in ``Metrics.wasted_checks``, never as oracle calls. B is the expected number of rounds
-up to the next stale one, ceil(1 / rate) with the Laplace estimate rate = (stale rounds + 1) /
-(rounds recorded + 2), at most ``MAX_BATCH_ROUNDS`` and at most ``batch_round_limit(workers, d)``
-(a batch's candidates take at most ``MAX_BATCH_BYTES``). On an ``executor``, or with
-``look_ahead=False``, B = 1 (on an executor each worker's test is one task).
+is stale: the batch's stale rounds are tested again, the same candidates with their nearest nodes
+in the new tree, while the others keep their tests. The rounds ready before the first that finds a
+reachable candidate run as one block: they add no node, so their counters and history are written
+at once, as many as the termination condition lets start (``termination.rounds_that_start``). The
+tree, the counters, the history and the status are those of testing each round on its own; tests
+made ahead and never used are counted in ``Metrics.wasted_checks``, never as oracle calls. B is the
+expected number of rounds up to the next stale one, ceil(1 / rate) with the Laplace estimate rate =
+(stale rounds + 1) / (rounds recorded + 2), at most floor(sqrt(r)) + 1 at round r (so the tests a
+plan's end leaves unused are about the square root of its rounds), at most ``MAX_BATCH_ROUNDS`` and
+at most ``batch_round_limit(workers, d)`` (a batch's candidates take at most ``MAX_BATCH_BYTES``).
+On an ``executor``, or with ``look_ahead=False``, B = 1 (on an executor each worker's test is one
+task).
 """
 
 from __future__ import annotations
@@ -122,8 +124,8 @@ class LookAhead:
 
     A test holds while the candidate's nearest node is the one it was tested with: a node added
     since can only take that place by being at least as near to the raw sample as the parent was
-    (``reach``); rounds with such a candidate are stale and are tested again, with the rest of the
-    batch, against the tree as it is. A block is the rounds from the current one up to the first
+    (``reach``); rounds with such a candidate are stale and are tested again against the tree as it
+    is, the others keeping their tests. A block is the rounds from the current one up to the first
     that finds a reachable candidate or the first stale one, at most the rounds the caller allows.
 
     ``RunState.wasted_checks`` counts the tests made ahead and not used: a batch of B rounds adds
@@ -140,7 +142,7 @@ class LookAhead:
 
     def __init__(self, workers: int, most: int, tree: Tree, draw: Draw, extend: Extend) -> None:
         self.workers, self.most, self.draw, self.extend = workers, most, draw, extend
-        self.stale_rounds = 0  # rounds found stale (each tested again in a new batch)
+        self.stale_rounds = 0  # rounds found stale when they came (each tested again)
         self.drawn = np.empty((0, tree.dim))  # the candidates of rounds drawn_from, drawn_from + 1, ...
         self.drawn_from = 0
         self.tested_from = self.tested_rounds = 0  # the rounds of the last batch
@@ -159,10 +161,12 @@ class LookAhead:
         offset = state.rounds - self.tested_from
         if offset < self.tested_rounds and state.tree.size > self.checked_size:
             self._mark_stale(state, offset)
-        if offset >= self.tested_rounds or self.stale[offset]:
-            self.stale_rounds += offset < self.tested_rounds
+        if offset >= self.tested_rounds:
             self._test_ahead(state)
             offset = 0
+        elif self.stale[offset]:
+            self.stale_rounds += 1
+            self._test_stale_again(state, offset)
         stop = offset + 1
         if gate is not None:
             stop = self.tested_rounds
@@ -188,10 +192,30 @@ class LookAhead:
         self.stale[offset:] |= nearer.reshape(-1, self.workers).any(axis=1)
         self.checked_size = state.tree.size
 
+    def _test_stale_again(self, state: RunState, offset: int) -> None:
+        """Test the batch's stale rounds from ``offset`` on again against the tree as it is (their
+        raw samples steered from their new nearest nodes); the other rounds' tests still hold."""
+        workers = self.workers
+        rounds = offset + np.flatnonzero(self.stale[offset:])
+        rows = (rounds[:, None] * workers + np.arange(workers)).reshape(-1)
+        children, parents, truth, reach = self.extend(state, self.drawn[rows])
+        tested_children, tested_parents, tested_truth, in_goal = self.tested
+        tested_children[rows], tested_parents[rows], tested_truth[rows] = children, parents, truth
+        self.reach[rows] = reach
+        in_goal[rows] = False
+        reachable = np.flatnonzero(truth)
+        if reachable.size:
+            in_goal[rows[reachable]] = satisfying(state.goal, children[reachable])
+        self.hits[rounds] = truth.reshape(-1, workers).any(axis=1)
+        self.stale[rounds] = False
+        state.wasted_checks += rows.shape[0]
+
     def _test_ahead(self, state: RunState) -> None:
         """Test rounds r .. r + B - 1 (r the current round) against the tree as it is."""
         workers, first = self.workers, state.rounds
-        ahead = min(batch_rounds(self.stale_rounds, first), self.most)
+        # at most floor(sqrt(r)) + 1 rounds from round r: the tests a plan's end leaves unused are
+        # about the square root of its rounds (a share that vanishes as plans grow)
+        ahead = min(batch_rounds(self.stale_rounds, first), math.isqrt(first) + 1, self.most)
         drawn = self.drawn[(first - self.drawn_from) * workers:]  # (the rounds used are dropped)
         kept = min(drawn.shape[0] // workers, ahead)  # a round's candidates depend on its key only
         if kept < ahead:
