@@ -74,7 +74,7 @@ def test_a_missing_file_inside_a_problem_file_names_its_key(tmp_path, family, ke
     run = subprocess.run([sys.executable, "-m", "qrrt_circuits.cli", "plan", "--problem", str(problem)],
                          capture_output=True, text=True, timeout=120)
     assert run.returncode == 2 and "Traceback" not in run.stderr and "Errno" not in run.stderr
-    assert f'"{key}" names' in run.stderr and "absent" in run.stderr
+    assert f'problem.json: "{key}":' in run.stderr and "no such file" in run.stderr and "absent" in run.stderr
 
 
 def test_a_closed_pipe_ends_the_command_quietly():
