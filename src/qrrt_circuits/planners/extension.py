@@ -20,15 +20,14 @@ import numpy as np
 from .._support.memory import MemoryEstimate, database_bytes, database_resident_bytes
 from ..problems.goals import Goal
 from ..problems.problem import Problem
-from ..search.backends.base import QuantumSearchBackend
 from ..search.policies.base import IterationPolicy, PolicyState
 from ..search.policies.thompson import ThompsonIterations
 from ..world.nearest import NearestNeighbors
-from .base import Planner
 from .candidates import NearestParents
 from .context import RoundView, WorkerContext
 from .quantum import ORACLE_LOOKUP_LABEL
 from .run_state import RunState
+from .searching import SearchingPlanner
 from .tree import Tree
 from .workers import search_database
 
@@ -58,7 +57,7 @@ class GrowingTree:
     add: Callable[[np.ndarray, np.ndarray], int]
 
 
-class SearchPlanner(Planner):
+class SearchPlanner(SearchingPlanner):
     """Base of the quantum planners beyond the paper (q-RRT-Connect, q-RRT*): the backend, the
     database size and the search policy (``QuantumOptions``' meanings and defaults), and one q-RRT
     extension of a tree (``_extend``)."""
@@ -68,38 +67,10 @@ class SearchPlanner(Planner):
         """q-RRT's default policy, ``ThompsonIterations()`` (``QRRT.default_search_policy``)."""
         return ThompsonIterations()
 
-    def _complete(self, options: Any) -> Any:
-        """The options with a new ``AerBackend()`` and ``default_search_policy()`` where none is given."""
-        changes: dict[str, Any] = {}
-        if options.backend is None:
-            from ..search.backends.aer import AerBackend  # qiskit and Aer are imported only when used
-
-            changes["backend"] = AerBackend()
-        if options.search_policy is None:
-            changes["search_policy"] = self.default_search_policy()
-        return options.replace(**changes) if changes else options
-
-    @property
-    def backend(self) -> QuantumSearchBackend:
-        """The search backend."""
-        backend: QuantumSearchBackend = self.options.backend
-        return backend
-
-    @property
-    def num_qubits(self) -> int:
-        """n, the qubits of each extension database."""
-        return int(self.options.num_qubits)
-
     @property
     def database_size(self) -> int:
         """N = 2^n, the entries of each extension database."""
         return 1 << self.num_qubits
-
-    @property
-    def search_policy(self) -> IterationPolicy:
-        """The search policy (the planner's default where none was given)."""
-        policy: IterationPolicy = self.options.search_policy
-        return policy
 
     def memory_estimate(self, num_qubits: int | None = None, *, dim: int) -> MemoryEstimate:
         """Estimated peak memory of one round: one extension database and its search at the

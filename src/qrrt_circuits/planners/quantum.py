@@ -28,16 +28,15 @@ from typing import Any, ClassVar
 
 from .._support.memory import MemoryEstimate, database_bytes, database_resident_bytes
 from ..problems.problem import Problem
-from ..search.backends.base import QuantumSearchBackend
 from ..search.policies.adaptive import Adaptive
 from ..search.policies.base import IterationPolicy
 from ..search.policies.thompson import ThompsonIterations
-from .base import Planner
 from .candidates import Candidates, NearestParents
 from .context import WorkerContext, map_tasks
 from .database import AnnealingSchedule
 from .options import ParallelQuantumOptions, PlannerOptions, QuantumOptions
 from .run_state import RunState
+from .searching import SearchingPlanner
 from .workers import DatabaseOutcome, search_database
 
 #: the paper's database, which annealing draws in bands
@@ -49,7 +48,7 @@ ORACLE_LOOKUP_LABEL = (
 )
 
 
-class PQRRT(Planner):
+class PQRRT(SearchingPlanner):
     """Parallel q-RRT (paper Algorithm 3) with ``workers`` quantum workers on a shared or unshared database.
 
     Each round builds 2^n (sample, nearest parent) databases, marks their reachable entries in a
@@ -79,27 +78,10 @@ class PQRRT(Planner):
     def _complete(self, options: Any) -> Any:
         """The options with the planner's defaults: a new ``AerBackend()``, the planner's
         ``default_search_policy()`` and the paper's database, where none is given."""
-        changes: dict[str, Any] = {}
-        if options.backend is None:
-            from ..search.backends.aer import AerBackend  # qiskit and Aer are imported only when used
-
-            changes["backend"] = AerBackend()
-        if options.search_policy is None:
-            changes["search_policy"] = self.default_search_policy()
+        options = super()._complete(options)
         if options.database is None and options.annealing is None:  # (annealing draws the paper's in bands)
-            changes["database"] = NearestParents()
-        return options.replace(**changes) if changes else options
-
-    @property
-    def backend(self) -> QuantumSearchBackend:
-        """The search backend."""
-        backend: QuantumSearchBackend = self.options.backend
-        return backend
-
-    @property
-    def num_qubits(self) -> int:
-        """n, the qubits of each database."""
-        return int(self.options.num_qubits)
+            options = options.replace(database=NearestParents())
+        return options
 
     @property
     def workers(self) -> int:
@@ -110,12 +92,6 @@ class PQRRT(Planner):
     def shared_database(self) -> bool:
         """Whether the workers search one shared database."""
         return bool(self.options.shared_database)
-
-    @property
-    def search_policy(self) -> IterationPolicy:
-        """The search policy (the planner's default where none was given)."""
-        policy: IterationPolicy = self.options.search_policy
-        return policy
 
     @property
     def annealing(self) -> AnnealingSchedule | None:
