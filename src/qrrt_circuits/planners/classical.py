@@ -102,6 +102,23 @@ Extend = Callable[[RunState, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarr
 NEARER_MARGIN = 1e-9
 
 
+def first_true(flags: np.ndarray, start: int, stop: int) -> int:
+    """The first index in [start, stop) where the bool array ``flags`` holds, else ``stop``.
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits.planners.classical import first_true
+        >>> flags = np.array([False, True, False, True])
+        >>> first_true(flags, 0, 4), first_true(flags, 2, 4), first_true(flags, 2, 3), first_true(flags, 3, 3)
+        (1, 3, 3, 3)
+    """
+    if start >= stop:
+        return stop
+    part = flags[start:stop]
+    index = int(part.argmax())  # (the first True of a bool array, or 0 where none holds)
+    return start + index if part[index] else stop
+
+
 class RoundGate(NamedTuple):
     """Which of the rounds ready may start: ``termination.rounds_that_start`` of the plan's
     condition from the counters now, each round adding ``growth``."""
@@ -149,7 +166,8 @@ class LookAhead:
         self.checked_size = tree.size  # the tree's nodes the batch's candidates were compared with
         empty = np.empty(0, dtype=bool)
         self.tested = (np.empty((0, tree.dim)), np.empty(0, dtype=np.int64), empty, empty)
-        self.reach = np.empty(0)
+        self.reach_limit = np.empty(0)  # per candidate, its parent's distance to its raw sample, widened
+        self.idle_growth = Progress(workers, 1, 0, 1, 1, 0.0)  # what a round that adds no node adds
         self.hits = self.stale = empty  # per round of the batch: a reachable candidate; a stale test
 
     def block(self, state: RunState, gate: RoundGate | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -169,27 +187,25 @@ class LookAhead:
             self._test_stale_again(state, offset)
         stop = offset + 1
         if gate is not None:
-            stop = self.tested_rounds
-            stale = np.flatnonzero(self.stale[offset + 1:stop])
-            if stale.size:
-                stop = offset + 1 + int(stale[0])
-            hits = np.flatnonzero(self.hits[offset:stop])
-            if hits.size:
-                stop = offset + int(hits[0]) + 1
+            stop = first_true(self.stale, offset + 1, self.tested_rounds)
+            stop = min(stop, first_true(self.hits, offset, stop) + 1)
             stop = offset + gate.rounds(stop - offset)
         state.wasted_checks -= (stop - offset) * self.workers
         rows = slice(offset * self.workers, stop * self.workers)
         children, parents, truth, in_goal = self.tested
         return children[rows], parents[rows], truth[rows], in_goal[rows]
 
+    def _per_round(self, flags: np.ndarray) -> np.ndarray:
+        """Per round, whether any of its p workers' ``flags`` (K p,) holds: (K,)."""
+        return flags if self.workers == 1 else flags.reshape(-1, self.workers).any(axis=1)
+
     def _mark_stale(self, state: RunState, offset: int) -> None:
         """Mark the batch's rounds from ``offset`` on whose candidates a node added since may be
         nearer to than their parents."""
         first = offset * self.workers
         samples = self.drawn[first:self.tested_rounds * self.workers]
-        nearer = state.neighbors.nearest_distance_from(samples, self.checked_size) <= self.reach[first:] * (
-            1.0 + NEARER_MARGIN)
-        self.stale[offset:] |= nearer.reshape(-1, self.workers).any(axis=1)
+        nearer = state.neighbors.nearest_distance_from(samples, self.checked_size) <= self.reach_limit[first:]
+        self.stale[offset:] |= self._per_round(nearer)
         self.checked_size = state.tree.size
 
     def _test_stale_again(self, state: RunState, offset: int) -> None:
@@ -201,12 +217,12 @@ class LookAhead:
         children, parents, truth, reach = self.extend(state, self.drawn[rows])
         tested_children, tested_parents, tested_truth, in_goal = self.tested
         tested_children[rows], tested_parents[rows], tested_truth[rows] = children, parents, truth
-        self.reach[rows] = reach
+        self.reach_limit[rows] = reach * (1.0 + NEARER_MARGIN)
         in_goal[rows] = False
         reachable = np.flatnonzero(truth)
         if reachable.size:
             in_goal[rows[reachable]] = satisfying(state.goal, children[reachable])
-        self.hits[rounds] = truth.reshape(-1, workers).any(axis=1)
+        self.hits[rounds] = self._per_round(truth)
         self.stale[rounds] = False
         state.wasted_checks += rows.shape[0]
 
@@ -223,13 +239,14 @@ class LookAhead:
             drawn = np.concatenate((drawn[:kept * workers], self.draw(state, keys)))
         self.drawn, self.drawn_from = drawn, first
         # the raw samples are kept: a round tested again is steered from its new parents
-        children, parents, truth, self.reach = self.extend(state, drawn[:ahead * workers])
+        children, parents, truth, reach = self.extend(state, drawn[:ahead * workers])
+        self.reach_limit = reach * (1.0 + NEARER_MARGIN)
         in_goal = np.zeros(truth.shape[0], dtype=bool)
         reachable = np.flatnonzero(truth)
         if reachable.size:
             in_goal[reachable] = satisfying(state.goal, children[reachable])
         self.tested = children, parents, truth, in_goal
-        self.hits = np.asarray(truth.reshape(ahead, workers).any(axis=1))
+        self.hits = self._per_round(truth)
         self.stale = np.zeros(ahead, dtype=bool)
         self.tested_from, self.tested_rounds, self.checked_size = first, ahead, state.tree.size
         state.wasted_checks += ahead * workers
@@ -271,17 +288,13 @@ class ParallelRRT(Planner):
         once, the last worker by worker. With ``oracle_errors`` (answers drawn round by round) one
         round."""
         workers = self.workers
-        gate = None if self.options.oracle_errors else RoundGate(condition, progress, self._idle_growth)
-        children, parents, truth, in_goal = state.tests_ahead.block(state, gate)
+        ahead = state.tests_ahead
+        gate = None if self.options.oracle_errors else RoundGate(condition, progress, ahead.idle_growth)
+        children, parents, truth, in_goal = ahead.block(state, gate)
         last = children.shape[0] - workers
         state.end_idle_rounds(last // workers, workers)
         self._round_from(state, children[last:], parents[last:], truth[last:], in_goal[last:])
         state.end_round()
-
-    @property
-    def _idle_growth(self) -> Progress:
-        """What a round that finds nothing reachable adds: p calls, one critical-path call, one round."""
-        return Progress(self.workers, 1, 0, 1, 1, 0.0)
 
     def _draw(self, state: RunState, keys: np.ndarray) -> np.ndarray:
         """The candidates of the keys (round, worker, ``Stream.CANDIDATES``) (K, 3): the samples
