@@ -197,7 +197,7 @@ class LookAhead:
 
     def _per_round(self, flags: np.ndarray) -> np.ndarray:
         """Per round, whether any of its p workers' ``flags`` (K p,) holds: (K,)."""
-        return flags if self.workers == 1 else flags.reshape(-1, self.workers).any(axis=1)
+        return flags if self.workers == 1 else np.asarray(flags.reshape(-1, self.workers).any(axis=1))
 
     def _mark_stale(self, state: RunState, offset: int) -> None:
         """Mark the batch's rounds from ``offset`` on whose candidates a node added since may be
