@@ -20,6 +20,7 @@ Also the library's RRT time per motion check in the maze family (``bench_problem
 from __future__ import annotations
 
 import argparse
+import functools
 import os
 import time
 
@@ -57,6 +58,20 @@ def rrt_us_per_check(seeds: int) -> float:
     return 1e6 * elapsed / checks
 
 
+def per_key_costs(streams: RandomStreams, keys: np.ndarray, count: int, repeats: int) -> dict:
+    """Microseconds per key of ``count`` doubles, each way (asserted equal first)."""
+    if not np.array_equal(documented_draws(streams, keys, count), uniform_draws(streams, keys, count)):
+        raise AssertionError("the compiled draws differ from numpy's")
+    one_by_one = [keys[row:row + 1] for row in range(keys.shape[0])]
+    documented = median_time(functools.partial(documented_draws, streams, keys, count), repeats)[0]
+    compiled = median_time(functools.partial(uniform_draws, streams, keys, count), repeats)[0]
+    one = median_time(lambda: [uniform_draws(streams, key, count) for key in one_by_one], repeats)[0]
+    return {"documented": {"us_per_key": 1e6 * documented / keys.shape[0]},
+            "compiled": {"us_per_key": 1e6 * compiled / keys.shape[0]},
+            "compiled_one_key": {"us_per_key": 1e6 * one / keys.shape[0]},
+            "documented_over_compiled": documented / compiled}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true")
@@ -65,22 +80,12 @@ def main() -> None:
     repeats, seeds = (3, 4) if args.quick else (REPEATS, SEEDS)
     streams = RandomStreams.from_seed(2024)
     out: dict = {"machine": machine(), "keys": KEYS, "repeats": repeats, "dims": {}}
+    keys = round_keys(1000, KEYS, 1, int(Stream.CANDIDATES))
     for dim in (2, 6):
-        keys = round_keys(1000, KEYS, 1, int(Stream.CANDIDATES))
-        count = dim + 1
-        if not np.array_equal(documented_draws(streams, keys, count), uniform_draws(streams, keys, count)):
-            raise AssertionError("the compiled draws differ from numpy's")
-        documented = median_time(lambda: documented_draws(streams, keys, count), repeats)[0]
-        compiled = median_time(lambda: uniform_draws(streams, keys, count), repeats)[0]
-        one = median_time(lambda: [uniform_draws(streams, keys[row:row + 1], count) for row in range(KEYS)],
-                          repeats)[0]
-        row = {"documented": {"us_per_key": 1e6 * documented / KEYS},
-               "compiled": {"us_per_key": 1e6 * compiled / KEYS},
-               "compiled_one_key": {"us_per_key": 1e6 * one / KEYS},
-               "documented_over_compiled": documented / compiled}
-        out["dims"][str(dim)] = row
+        out["dims"][str(dim)] = row = per_key_costs(streams, keys, dim + 1, repeats)
         print(f"d = {dim}: documented {row['documented']['us_per_key']:.2f} µs/key, compiled "
-              f"{row['compiled']['us_per_key']:.3f} µs/key (one key a call {row['compiled_one_key']['us_per_key']:.2f})")
+              f"{row['compiled']['us_per_key']:.3f} µs/key "
+              f"(one key a call {row['compiled_one_key']['us_per_key']:.2f})")
     out["rrt_maze"] = {"us_per_check": rrt_us_per_check(seeds)}
     print(f"RRT on the maze: {out['rrt_maze']['us_per_check']:.2f} µs per motion check")
     print(f"wrote {write_json('bench_streams', out, args.out)}")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from qrrt_circuits._support.randomness import RandomStreams, Stream
+from qrrt_circuits._support.randomness import RandomStreams, Stream, seeded_generator
 
 
 @pytest.mark.parametrize("seed", [0, 1, 7, 2**32 + 5, 2**70 + 3, 12345678901234567890123, None])
@@ -31,6 +31,19 @@ def test_generators_draw_what_default_rng_draws():
         assert np.array_equal(single.random(5), expected)
         assert streams.seed(round_index, 3) == int(
             np.random.default_rng(np.random.SeedSequence(42, spawn_key=(round_index, 3, 7))).integers(0, 2**62))
+
+
+@pytest.mark.parametrize("seed", [0, 1, 255, 2**32 - 1, 2**32, 2**62 - 1, 2**64 + 9, 2**128 + 1, 2**200 + 77])
+def test_seeded_generator_is_default_rng(seed):
+    ours, numpys = seeded_generator(seed), np.random.default_rng(seed)
+    assert np.array_equal(ours.random(7), numpys.random(7))
+    assert np.array_equal(ours.integers(0, 2**62, 5), numpys.integers(0, 2**62, 5))
+    assert np.array_equal(ours.normal(size=3), numpys.normal(size=3))
+
+
+def test_seeded_generator_refuses_a_negative_seed():
+    with pytest.raises(ValueError, match="non-negative"):
+        seeded_generator(-1)
 
 
 def test_negative_keys_refused():

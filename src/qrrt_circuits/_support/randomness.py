@@ -365,3 +365,28 @@ def uniform_draws(streams: RandomStreams, keys: np.ndarray, count: int) -> np.nd
         ValueError: A negative key.
     """
     return _pcg64_doubles(streams.seed_words(keys), int(count))
+
+
+def seeded_generator(seed: int) -> np.random.Generator:
+    """``np.random.default_rng(seed)`` for a non-negative integer ``seed``, bit for bit: the seed
+    words of ``SeedSequence(seed)`` (no spawn key) from the compiled ``_seed_words``, handed to
+    ``PCG64`` (a backend builds one per search from its seed).
+
+    Args:
+        seed: A non-negative integer (any size).
+
+    Returns:
+        A ``numpy.random.Generator`` on ``PCG64``.
+
+    Raises:
+        ValueError: A negative seed.
+
+    Example:
+        >>> import numpy as np
+        >>> from qrrt_circuits._support.randomness import seeded_generator
+        >>> bool(seeded_generator(42).random() == np.random.default_rng(42).random())
+        True
+    """
+    words = np.asarray(_uint32_words(int(seed)), dtype=np.uint64)
+    state = _seed_words(words, np.empty((1, 0), dtype=np.int64))[0]
+    return np.random.Generator(np.random.PCG64(_SeedWords(state)))  # type: ignore[arg-type]  # an ISeedSequence
