@@ -234,9 +234,33 @@ def _families_section(run: dict) -> list[str]:
         rows.append([family, _number((row.get("rrt") or {}).get("us_per_check")),
                      _number((row.get("rrt") or {}).get("own_us_per_check")),
                      _number((row.get("ompl_rrt") or {}).get("us_per_check")), interval(per_run),
-                     interval(one_by_one)])
+                     interval(one_by_one), interval(ratios.get("python_check_rrt_over_ompl_per_run") or {})])
     lines += _table(["family", "RRT µs / check", "its own µs", "OMPL µs / check", "RRT / OMPL",
-                     "one by one / OMPL"], rows, "lrrrrr")
+                     "one by one / OMPL", "RRT / OMPL, Python check"], rows, "lrrrrrr")
+    lines += ["The last column asks the same predicate one pair at a time from a Python loop that also does "
+              "fixed Python work per pair, on both sides: a check whose cost dominates the planner's.", ""]
+    return lines
+
+
+def _streams_section(run: dict) -> list[str]:
+    streams = (run.get("raw") or {}).get("streams") or {}
+    dims = streams.get("dims")
+    lines = ["### A keyed random stream: numpy's constructors and the compiled path", ""]
+    if not isinstance(dims, dict) or not dims:
+        return lines + ["This run holds no stream figures (`bench_streams.py`).", ""]
+    lines += [f"The first d + 1 doubles of the generator of each of {streams.get('keys', '—')} keys (round, worker, "
+              "stream), as the classical planners draw one candidate per key: built through numpy's documented "
+              "constructors one key at a time, and by the library's compiled seed words and PCG64 doubles (the "
+              "same doubles, checked before timing), all keys in one call or one call per key. Microseconds per "
+              "key; RRT's time per motion check on the maze family in the same run is the yardstick.", ""]
+    rows = [[dim, _number((row.get("documented") or {}).get("us_per_key")),
+             _number((row.get("compiled") or {}).get("us_per_key")),
+             _number((row.get("compiled_one_key") or {}).get("us_per_key")),
+             _ratio(row.get("documented_over_compiled"))] for dim, row in dims.items()]
+    lines += _table(["d", "numpy's constructors", "compiled, one call", "compiled, a call per key",
+                     "constructors / compiled"], rows, "lrrrr")
+    lines += [f"RRT on the maze: {_number((streams.get('rrt_maze') or {}).get('us_per_check'))} µs per motion "
+              "check.", ""]
     return lines
 
 
@@ -482,6 +506,7 @@ def performance_page(root: Path) -> str:
     lines += ["## Against peers measured in the same run", ""]
     lines += _ompl_section(run)
     lines += _families_section(run)
+    lines += _streams_section(run)
     lines += _floor_section(run)
     lines += _interleaved_section(run)
     baseline, why = _load(root / BASELINE)
