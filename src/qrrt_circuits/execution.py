@@ -19,8 +19,9 @@ the executor is shut down. Where the platform has no fork server, workers are sp
 
 **Interrupts.** Workers never see Ctrl-C (a Ctrl-C from a terminal goes to the whole process
 group, and a worker interrupted mid-trial would print its traceback): the fork server is started
-with SIGINT blocked in the starting thread and ignores it from the first module it preloads
-(``_support.ignore_interrupts``), so every worker it forks ignores it too, and a spawned pool
+with SIGINT blocked in the starting thread (after multiprocessing's resource tracker, whose start
+unblocks it) and ignores it from the first module it preloads (``_support.ignore_interrupts``),
+so every worker it forks ignores it too, and a spawned pool
 worker ignores it from its initializer. The command's own process gets it and shuts
 the workers down as it leaves (``WorkerPool``'s ``with`` block); while a local Dask cluster shuts
 down, Dask's and Tornado's loggers are silenced (its nannies and heartbeats would report the
@@ -146,7 +147,7 @@ def _warm_fork_server(extra_preload: tuple[str, ...] = ()) -> Iterator[str]:
         yield "spawn"
         return
     import multiprocessing
-    from multiprocessing import forkserver
+    from multiprocessing import forkserver, resource_tracker
 
     server = forkserver._forkserver  # the standard library's one per process
     started_here = server._forkserver_pid is None  # type: ignore[attr-defined]  # private, see docstring
@@ -154,6 +155,9 @@ def _warm_fork_server(extra_preload: tuple[str, ...] = ()) -> Iterator[str]:
         multiprocessing.get_context("forkserver").set_forkserver_preload([INTERRUPTS_IGNORED, *extra_preload,
                                                                           *WORKER_PRELOAD])
         _own_scratch_folder()
+        # the resource tracker first: starting it unblocks SIGINT in the starting thread, which
+        # would leave the fork server started after it without the blocked mask
+        resource_tracker.ensure_running()
         with _single_thread_environment(), _interrupts_blocked():
             forkserver.ensure_running()
     try:

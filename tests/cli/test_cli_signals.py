@@ -204,18 +204,20 @@ def test_ctrl_c_to_the_process_group_is_one_line_and_the_workers_are_shut_down(e
     """Ctrl-C from a terminal reaches the whole process group, workers and fork server included:
     they ignore it, the command prints its one line, exits 130 and shuts them down, and the run
     resumes. Sent once the first records are written (the workers mid-trial) and, with the process
-    pool, on a second run while the fork server is still importing its preload (a Dask run
+    pool, on a second run as soon as the fork server exists, importing its preload (a Dask run
     interrupted in its first second, before its processes ignore the signal, is not covered)."""
     if executor == "dask":
         pytest.importorskip("distributed")
     out = tmp_path / "results"
     argv = _reproduce("heatmaps", out, "--executor", executor, "--jobs", "2", "--trials", "100")
-    moments = [lambda: _records(out) >= 2] + ([lambda: True] if executor == "process" else [])
+
+    def pool_started() -> bool:  # the fork server exists, importing its preload
+        return bool(psutil.Process(process.pid).children())
+
+    moments = [lambda: _records(out) >= 2] + ([pool_started] if executor == "process" else [])
     for ready in moments:
         process = _start(argv, tmp_path, start_new_session=True)
         _wait_for(ready, process, "the moment to interrupt", timeout_s=120)
-        if ready() is True:
-            time.sleep(1.0)  # the fork server is importing
         helpers = psutil.Process(process.pid).children(recursive=True)
         os.killpg(process.pid, signal.SIGINT)
         out_text, err = process.communicate(timeout=120)
@@ -241,3 +243,23 @@ def test_stale_scratch_folders_of_dead_runs_are_removed_on_the_next_start(tmp_pa
         (folder / "lock").write_text("")
     assert sorted(remove_stale_scratch(str(tmp_path))) == sorted(map(str, stale))
     assert live.exists() and not any(folder.exists() for folder in stale)
+
+
+@pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="reads the signal mask from /proc")
+def test_the_fork_server_starts_with_sigint_blocked():
+    """Starting multiprocessing's resource tracker unblocks SIGINT in the starting thread; the fork
+    server is started after it, inside the blocked window, so a Ctrl-C while it is still starting
+    (before its first preload ignores the signal) waits instead of interrupting its imports."""
+    from multiprocessing import forkserver
+
+    from qrrt_circuits import execution
+
+    if not execution._fork_server_available():
+        pytest.skip("no fork server on this platform")
+    if forkserver._forkserver._forkserver_pid is not None:
+        pytest.skip("a fork server already runs in this process")
+    with execution._warm_fork_server():
+        pid = forkserver._forkserver._forkserver_pid
+        blocked = next(line for line in Path(f"/proc/{pid}/status").read_text().splitlines()
+                       if line.startswith("SigBlk:"))
+    assert int(blocked.split()[1], 16) & (1 << (signal.SIGINT - 1)), blocked
