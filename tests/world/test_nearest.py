@@ -11,7 +11,13 @@ import numpy as np
 import pytest
 
 import qrrt_circuits as qc
-from qrrt_circuits.world.nearest import GridNearest, LinearNearest, NearestNeighbors, SE2Nearest
+from qrrt_circuits.world.nearest import (
+    BRUTE_FORCE_BELOW_SE2,
+    GridNearest,
+    LinearNearest,
+    NearestNeighbors,
+    SE2Nearest,
+)
 
 
 def _grid(first: np.ndarray, capacity: int = 256) -> GridNearest:
@@ -422,3 +428,41 @@ def test_the_compiled_se2_scan_is_the_space_metric_scan_bit_for_bit(weight):
         first = int(rng.integers(0, count + 1))
         assert np.array_equal(scan.nearest_distance_from(queries, first),
                               compiled.nearest_distance_from(queries, first))
+
+
+@pytest.mark.parametrize("weight", [0.5, 2.0, 0.0])
+def test_the_se2_grid_answers_the_scan_bit_for_bit(weight):
+    """From ``BRUTE_FORCE_BELOW_SE2`` points on, ``SE2Nearest`` searches an (x, y) grid: it answers
+    ``LinearNearest(SE2Space(w))``'s indices exactly, grown point by point across rebuilds, with
+    ties (positions on a coarse grid, repeated points with angles that wrap to the same turn),
+    clusters, points on one line, and queries far outside the points' box."""
+    rng = np.random.default_rng(7 + int(weight * 10))
+    for trial in range(6):
+        scan, compiled = LinearNearest(qc.SE2Space(weight)), SE2Nearest(weight)
+        count = BRUTE_FORCE_BELOW_SE2 + int(rng.integers(0, 1500))
+        points = _se2_points(rng, count)
+        if trial % 3 == 0:  # ties: a coarse lattice of positions, angles a multiple of pi / 2
+            points[:, :2] = np.round(points[:, :2] * 4) / 4
+            points[:, 2] = rng.integers(-2, 2, count) * (math.pi / 2)
+        elif trial % 3 == 1:  # a cluster and a few far points (most cells empty)
+            points[: count // 2, :2] = 0.01 * points[: count // 2, :2]
+        if trial == 5:  # every point on one line, a third of them at one position
+            points[:, 0] = 3.0
+            points[: count // 3, 1] = 5.0
+        queries = _se2_points(rng, 60)
+        queries[:10, :2] *= 25.0  # outside the box
+        if trial % 3 == 0:
+            queries[10:, :2] = np.round(queries[10:, :2] * 4) / 4
+            queries[10:, 2] = rng.integers(-2, 3, 50) * (math.pi / 2)
+        for chunk in np.array_split(np.arange(count), 7):  # through several grid rebuilds
+            scan.add(points[chunk])
+            compiled.add(points[chunk])
+            assert np.array_equal(scan.nearest(queries), compiled.nearest(queries)), (trial, chunk[-1])
+        assert compiled._grid_built_at > 0
+
+
+def test_the_se2_grid_refuses_queries_that_are_not_finite():
+    near = SE2Nearest(0.5)
+    near.add(_se2_points(np.random.default_rng(0), BRUTE_FORCE_BELOW_SE2))
+    with pytest.raises(ValueError, match="finite"):
+        near.nearest(np.array([[0.0, np.nan, 0.0]]))

@@ -6,8 +6,10 @@ A structure holds points in the order they were added (index 0 first) and answer
 query, the index of the nearest point under its metric; among equally near points the lowest
 index. Two are built in:
 
-- ``LinearNearest(space)``: a scan of every point under ``space.distance``; any metric (the
-  ``SE2Space``'s, or a space of your own).
+- ``LinearNearest(space)``: a scan of every point under ``space.distance``; any metric (a space
+  of your own).
+- ``SE2Nearest(w)``: ``SE2Space``'s metric, exact and compiled, a scan below
+  ``BRUTE_FORCE_BELOW_SE2`` points and an (x, y) bucket grid from there.
 - ``GridNearest(dim)``: Euclidean, exact and compiled (``RealVectorSpace``'s). Below
   ``BRUTE_FORCE_BELOW`` points it searches by brute force (every query against every point, one
   pass over the points for all the queries at once, so the inner loop over the queries
@@ -40,13 +42,17 @@ from numba import njit
 if TYPE_CHECKING:
     from .spaces import StateSpace
 
-__all__ = ["BRUTE_FORCE_BELOW", "GridNearest", "LinearNearest", "NearestNeighbors", "SE2Nearest"]
+__all__ = ["BRUTE_FORCE_BELOW", "BRUTE_FORCE_BELOW_SE2", "GridNearest", "LinearNearest", "NearestNeighbors",
+           "SE2Nearest"]
 
 #: cells per point when the grid is (re)built, and the most cells one grid has
 _CELLS_PER_NODE = 1.0
 _MAX_CELLS = 1 << 22
 #: structures with fewer points answer queries by brute force (see the module docstring)
 BRUTE_FORCE_BELOW = 400
+#: ``SE2Nearest`` scans every point below this size, and keeps an (x, y) grid from there (calibrated:
+#: from about this size a batch of queries costs less through the grid)
+BRUTE_FORCE_BELOW_SE2 = 64
 #: the fewest points added since the grid's build that trigger a rebuild (see ``_pending_limit``)
 _PENDING_MIN = 32
 #: relative rounding allowance of the grid's stopping bound (a few units in the last place)
@@ -222,10 +228,103 @@ def _se2_scan(queries: np.ndarray, points: np.ndarray, first: int, stop: int, we
         out[row] = index
 
 
+@njit(cache=True, nogil=True)
+def _se2_grid_search(queries: np.ndarray, start: np.ndarray, order: np.ndarray, ordered: np.ndarray,
+                     origin: np.ndarray, cell: float, shape: np.ndarray, low: np.ndarray, high: np.ndarray,
+                     weight: float, best: np.ndarray, out: np.ndarray) -> None:
+    """Ring search of an (x, y) bucket grid under the SE(2) metric, from the nearest (``best``,
+    ``out``) found so far: for each query, the point with the smallest (distance, index), the
+    distance computed as ``_se2_scan`` computes it (the same bits). The grid files the points by
+    (x, y) (``ordered``: their (x, y, theta) sorted by cell); the metric is at least the (x, y)
+    distance, so the rings stop, as ``_grid_search``'s, once every cell left is farther in (x, y)
+    than the best distance found."""
+    two_pi = 2 * math.pi
+    centre = np.empty(2, dtype=np.int64)
+    here = np.empty(2)
+    outside = np.empty(2)
+    slack = np.empty(2)
+    for row in range(queries.shape[0]):
+        x, y, theta = queries[row, 0], queries[row, 1], queries[row, 2]
+        here[0], here[1] = x, y
+        _cell_of(here, origin, cell, shape, centre)
+        for axis in range(2):
+            outside[axis] = max(low[axis] - here[axis], here[axis] - high[axis], 0.0)
+            slack[axis] = _EDGE_SLACK * (abs(here[axis]) + abs(origin[axis]) + shape[axis] * cell)
+        nearest, nearest_index = best[row], out[row]
+        ring = 1  # the first visit covers rings 0 and 1 (the 3 x 3 cells around the centre)
+        while True:
+            lower_y, upper_y = max(centre[1] - ring, 0), min(centre[1] + ring, shape[1] - 1)
+            for cell_x in range(max(centre[0] - ring, 0), min(centre[0] + ring, shape[0] - 1) + 1):
+                prefix = cell_x * shape[1]
+                on_ring = ring == 1 or abs(cell_x - centre[0]) == ring
+                for end in range(2):  # on the ring: the run of cells along y once; else its two end cells
+                    if on_ring:
+                        if end:
+                            break
+                        first, stop = start[prefix + lower_y], start[prefix + upper_y + 1]
+                    else:
+                        cell_y = centre[1] - ring if end == 0 else centre[1] + ring
+                        if cell_y < 0 or cell_y > shape[1] - 1:
+                            continue
+                        first, stop = start[prefix + cell_y], start[prefix + cell_y + 1]
+                    for slot in range(first, stop):
+                        turn = np.mod(ordered[slot, 2] - theta + math.pi, two_pi) - math.pi
+                        distance = math.hypot(ordered[slot, 0] - x, ordered[slot, 1] - y) + weight * abs(turn)
+                        candidate = order[slot]
+                        if distance < nearest or (distance == nearest and candidate < nearest_index):
+                            nearest, nearest_index = distance, candidate
+            # the (x, y) distance from the query to any cell outside the visited block, less a few
+            # units in the last place (a point is filed by int((x - origin) / cell)), as _grid_search
+            bound = np.inf
+            covers = True
+            for axis in range(2):
+                others = outside[1 - axis] * outside[1 - axis]
+                if centre[axis] - ring - 1 >= 0:
+                    covers = False
+                    gap = max(here[axis] - (origin[axis] + (centre[axis] - ring) * cell) - slack[axis], 0.0)
+                    bound = min(bound, gap * gap + others)
+                if centre[axis] + ring + 1 <= shape[axis] - 1:
+                    covers = False
+                    gap = max(origin[axis] + (centre[axis] + ring + 1) * cell - here[axis] - slack[axis], 0.0)
+                    bound = min(bound, gap * gap + others)
+            reach = nearest * (1.0 + _EDGE_SLACK)
+            if covers or bound > reach * reach:  # every cell visited, or none left nearer
+                break
+            ring += 1
+        best[row] = nearest
+        out[row] = nearest_index
+
+
+@njit(cache=True, nogil=True)
+def _se2_nearest_into(queries: np.ndarray, points: np.ndarray, size: int, built: int, start: np.ndarray,
+                      order: np.ndarray, ordered: np.ndarray, origin: np.ndarray, cell: float, shape: np.ndarray,
+                      low: np.ndarray, high: np.ndarray, weight: float, out: np.ndarray) -> None:
+    """``SE2Nearest.nearest`` compiled: the scan of the points the grid does not hold (all of them
+    without a grid, ``built`` = 0), then the grid's ring search from that best.
+
+    Raises:
+        ValueError: A query that is not finite.
+    """
+    for row in range(queries.shape[0]):
+        for axis in range(3):
+            if not np.isfinite(queries[row, axis]):
+                raise ValueError(_NOT_FINITE)
+    best = np.empty(queries.shape[0])
+    _se2_scan(queries, points, built, size, weight, best, out)
+    if built:
+        _se2_grid_search(queries, start, order, ordered, origin, cell, shape, low, high, weight, best, out)
+
+
 class SE2Nearest(_Points):
-    """Exact nearest points under an ``SE2Space``'s metric, compiled: every query scans every point
-    (OMPL's ``NearestNeighborsLinear``), with the space's own operations, so it answers what
+    """Exact nearest points under an ``SE2Space``'s metric, compiled: it answers what
     ``LinearNearest(space)`` answers, bit for bit, ties to the lowest index.
+
+    Below ``BRUTE_FORCE_BELOW_SE2`` points every query scans every point (OMPL's
+    ``NearestNeighborsLinear``) with the space's own operations. From there it keeps a bucket grid
+    over the points' (x, y), built and rebuilt as ``GridNearest``'s (about one point per cell,
+    rebuilt once the points added since reach ``_pending_limit``): a query scans the points added
+    since the build, then the grid's cells ring by ring, and stops once every cell left is farther
+    in (x, y) than the best SE(2) distance found (the metric is at least the (x, y) distance).
 
     Args:
         angle_weight: w of the metric ``||(dx, dy)|| + w |wrap(dtheta)|`` (``SE2Space.angle_weight``).
@@ -242,6 +341,25 @@ class SE2Nearest(_Points):
     def __init__(self, angle_weight: float) -> None:
         super().__init__(3)
         self.angle_weight = float(angle_weight)
+        self._grid_built_at = 0  # the points the (x, y) grid holds (0: no grid yet)
+        self._rebuild_at = BRUTE_FORCE_BELOW_SE2
+        self._origin, self._low, self._high = np.zeros(2), np.zeros(2), np.zeros(2)
+        self._cell = 1.0
+        self._shape = np.ones(2, dtype=np.int64)
+        self._start = np.zeros(2, dtype=np.int64)
+        self._order = np.empty(0, dtype=np.int64)
+        self._sorted = np.empty((0, 3))
+
+    def add(self, points: np.ndarray) -> None:
+        """Append the rows of ``points`` (m, 3) (the grid is rebuilt, once, when the points added
+        since its build reach ``_pending_limit``).
+
+        Raises:
+            ValueError: ``points`` not of shape (m, 3).
+        """
+        super().add(points)
+        if self.size >= self._rebuild_at:
+            self._build_grid()
 
     def _scan(self, queries: np.ndarray, first: int) -> tuple[np.ndarray, np.ndarray]:
         best = np.empty(queries.shape[0])
@@ -254,14 +372,36 @@ class SE2Nearest(_Points):
         the SE(2) metric; among equally near points the lowest index.
 
         Raises:
-            ValueError: ``queries`` of the wrong shape, or no point added yet.
+            ValueError: ``queries`` of the wrong shape or not finite, or no point added yet.
         """
-        return self._scan(self.queries(queries), 0)[1]
+        queries = self.queries(queries)
+        out = np.empty(queries.shape[0], dtype=np.int64)
+        _se2_nearest_into(queries, self._buffer, self.size, self._grid_built_at, self._start, self._order,
+                          self._sorted, self._origin, self._cell, self._shape, self._low, self._high,
+                          self.angle_weight, out)
+        return out
 
     def nearest_distance_from(self, queries: np.ndarray, first: int) -> np.ndarray:
         """Float (M,): the SE(2) distance from each of ``queries`` to the nearest of the points of
-        index ``first`` on (``inf`` where there are none)."""
+        index ``first`` on (``inf`` where there are none), by the scan."""
         return self._scan(self.queries(queries), first)[0]
+
+    def _build_grid(self) -> None:
+        points = self.points
+        planar = np.ascontiguousarray(points[:, :2])
+        low, high = _bounding_box(planar)
+        extent = np.maximum(high - low, 1e-9)
+        cell = max(math.sqrt(float(extent[0] * extent[1]) / min(self.size, _MAX_CELLS)), 1e-12,
+                   float(extent.max()) / math.sqrt(_MAX_CELLS))
+        shape = np.minimum(np.floor(extent / cell).astype(np.int64) + 1, 1 << 11)
+        start = np.zeros(int(shape[0]) * int(shape[1]) + 1, dtype=np.int64)
+        order = np.empty(self.size, dtype=np.int64)
+        ordered = np.empty_like(planar)
+        _file_by_cell(planar, low, cell, shape, start, order, ordered)
+        self._origin, self._cell, self._shape, self._low, self._high = low.copy(), cell, shape, low, high
+        self._start, self._order, self._sorted = start, order, np.ascontiguousarray(points[order])
+        self._rebuild_at = self.size + _pending_limit(self.size)
+        self._grid_built_at = self.size
 
 
 class GridNearest(_Points):
