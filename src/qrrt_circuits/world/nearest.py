@@ -228,6 +228,34 @@ def _se2_scan(queries: np.ndarray, points: np.ndarray, first: int, stop: int, we
         out[row] = index
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _unvisited_bound(point: np.ndarray, outside: np.ndarray, outside_total: float, slack: np.ndarray,
+                     centre: np.ndarray, ring: int, origin: np.ndarray, cell: float,
+                     shape: np.ndarray) -> tuple[float, bool]:
+    """(a lower bound on the squared distance from ``point`` to any grid cell outside the block of
+    Chebyshev radius ``ring`` around ``centre``, whether that block covers the whole grid).
+
+    Beyond one side of one axis: the gap to that side plus, along the other axes, the point's
+    distance to the grid nodes' bounding box (``outside``, squares summed in ``outside_total``).
+    Each gap is shortened by ``slack``, a few units in the last place of the coordinates involved:
+    a node is filed by int((x - origin) / cell), which can put a node lying a rounding error below
+    a computed edge origin + k * cell into cell k, and the search must not stop before reaching it
+    (a node as near as the best, or a tie with a lower index)."""
+    bound = np.inf
+    covers = True
+    for axis in range(point.shape[0]):
+        others = outside_total - outside[axis] * outside[axis]
+        if centre[axis] - ring - 1 >= 0:
+            covers = False
+            gap = max(point[axis] - (origin[axis] + (centre[axis] - ring) * cell) - slack[axis], 0.0)
+            bound = min(bound, gap * gap + others)
+        if centre[axis] + ring + 1 <= shape[axis] - 1:
+            covers = False
+            gap = max(origin[axis] + (centre[axis] + ring + 1) * cell - point[axis] - slack[axis], 0.0)
+            bound = min(bound, gap * gap + others)
+    return bound, covers
+
+
 @njit(cache=True, nogil=True)
 def _se2_grid_search(queries: np.ndarray, start: np.ndarray, order: np.ndarray, ordered: np.ndarray,
                      origin: np.ndarray, cell: float, shape: np.ndarray, low: np.ndarray, high: np.ndarray,
@@ -247,8 +275,10 @@ def _se2_grid_search(queries: np.ndarray, start: np.ndarray, order: np.ndarray, 
         x, y, theta = queries[row, 0], queries[row, 1], queries[row, 2]
         here[0], here[1] = x, y
         _cell_of(here, origin, cell, shape, centre)
+        outside_total = 0.0
         for axis in range(2):
             outside[axis] = max(low[axis] - here[axis], here[axis] - high[axis], 0.0)
+            outside_total += outside[axis] * outside[axis]
             slack[axis] = _EDGE_SLACK * (abs(here[axis]) + abs(origin[axis]) + shape[axis] * cell)
         nearest, nearest_index = best[row], out[row]
         ring = 1  # the first visit covers rings 0 and 1 (the 3 x 3 cells around the centre)
@@ -273,20 +303,8 @@ def _se2_grid_search(queries: np.ndarray, start: np.ndarray, order: np.ndarray, 
                         candidate = order[slot]
                         if distance < nearest or (distance == nearest and candidate < nearest_index):
                             nearest, nearest_index = distance, candidate
-            # the (x, y) distance from the query to any cell outside the visited block, less a few
-            # units in the last place (a point is filed by int((x - origin) / cell)), as _grid_search
-            bound = np.inf
-            covers = True
-            for axis in range(2):
-                others = outside[1 - axis] * outside[1 - axis]
-                if centre[axis] - ring - 1 >= 0:
-                    covers = False
-                    gap = max(here[axis] - (origin[axis] + (centre[axis] - ring) * cell) - slack[axis], 0.0)
-                    bound = min(bound, gap * gap + others)
-                if centre[axis] + ring + 1 <= shape[axis] - 1:
-                    covers = False
-                    gap = max(origin[axis] + (centre[axis] + ring + 1) * cell - here[axis] - slack[axis], 0.0)
-                    bound = min(bound, gap * gap + others)
+            # the squared (x, y) distance from the query to any cell outside the visited block
+            bound, covers = _unvisited_bound(here, outside, outside_total, slack, centre, ring, origin, cell, shape)
             reach = nearest * (1.0 + _EDGE_SLACK)
             if covers or bound > reach * reach:  # every cell visited, or none left nearer
                 break
@@ -687,25 +705,7 @@ def _grid_search(points: np.ndarray, start: np.ndarray, order: np.ndarray, order
                     axis -= 1
                 if axis < 0:
                     break
-            # a lower bound on the squared distance from the point to any cell outside the visited
-            # block: beyond one side of one axis, the gap to that side plus, along the other axes,
-            # the point's distance to the grid nodes' bounding box.
-            # Each gap is shortened by a few units in the last place of the coordinates involved:
-            # a node is filed by int((x - origin) / cell), which can put a node lying a rounding
-            # error below a computed edge origin + k * cell into cell k, and the search must not
-            # stop before reaching it (a node as near as the best, or a tie with a lower index).
-            bound = np.inf
-            covers = True
-            for axis in range(dim):
-                others = outside_total - outside[axis] * outside[axis]
-                if centre[axis] - ring - 1 >= 0:
-                    covers = False
-                    gap = max(point[axis] - (origin[axis] + (centre[axis] - ring) * cell) - slack[axis], 0.0)
-                    bound = min(bound, gap * gap + others)
-                if centre[axis] + ring + 1 <= shape[axis] - 1:
-                    covers = False
-                    gap = max(origin[axis] + (centre[axis] + ring + 1) * cell - point[axis] - slack[axis], 0.0)
-                    bound = min(bound, gap * gap + others)
+            bound, covers = _unvisited_bound(point, outside, outside_total, slack, centre, ring, origin, cell, shape)
             if covers or bound > nearest * (1.0 + _EDGE_SLACK):  # every cell visited, or none left nearer
                 break
             ring += 1
