@@ -264,6 +264,24 @@ def _streams_section(run: dict) -> list[str]:
     return lines
 
 
+def _profile_section(run: dict) -> list[str]:
+    problems = (run.get("raw") or {}).get("problems") or {}
+    profile = problems.get("profile")
+    lines = ["### Where one round's time goes", ""]
+    if not isinstance(profile, dict) or not profile:
+        return lines + ["This run holds no round profile (`bench_problems.py`).", ""]
+    lines += ["One plan of each of the library's planners on the maze family under `cProfile`: the functions "
+              "with the most own time, in microseconds per round (profiling slows every call, so the shares "
+              "matter, not the totals).", ""]
+    rows = []
+    for planner, entry in profile.items():
+        functions = entry.get("functions") or []
+        top = ", ".join(f"`{item.get('function')}` {_number(item.get('own_us_per_round'))}" for item in functions[:6])
+        rows.append([f"`{planner}`", _number(entry.get("rounds")), _number(entry.get("total_us_per_round")), top])
+    lines += _table(["planner", "rounds", "µs per round", "largest own times (µs per round)"], rows, "lrrl")
+    return lines
+
+
 def _planners_section(run: dict) -> list[str]:
     planners = (run.get("raw") or {}).get("planners")
     if not isinstance(planners, dict) or not isinstance(planners.get("planners"), dict):
@@ -507,6 +525,7 @@ def performance_page(root: Path) -> str:
     lines += _ompl_section(run)
     lines += _families_section(run)
     lines += _streams_section(run)
+    lines += _profile_section(run)
     lines += _floor_section(run)
     lines += _interleaved_section(run)
     baseline, why = _load(root / BASELINE)
