@@ -11,7 +11,9 @@ words with a compiled copy of numpy's ``SeedSequence`` algorithm (``_seed_words`
 mixing, then ``generate_state(4, uint64)``, as numpy's ``bit_generator.pyx``), for many keys in
 one call, and hands them to ``PCG64`` through a fixed-words seed sequence (``_SeedWords``). The
 generators are therefore bit for bit the ones ``np.random.default_rng(SeedSequence(entropy,
-spawn_key=key))`` gives (tested against numpy on many keys).
+spawn_key=key))`` gives (tested against numpy on many keys). ``seeded_generator(seed)`` does the
+same for a plain integer seed (no spawn key): ``np.random.default_rng(seed)``, bit for bit, as the
+backends build one per search from its seed.
 
 Where only a key's first few doubles are wanted (``uniform_draws``: one classical extension per
 key), building a ``Generator`` per key is again the larger cost. ``_pcg64_doubles`` runs numpy's
