@@ -115,14 +115,7 @@ class SearchPlanner(SearchingPlanner):
         """
         view = RoundView(grower.tree, grower.neighbors, grower.goal, state.rounds, 0, grower.policy_state)
         result = search_database(grower.context, view, (worker, 1))
-        quantum, verifications, rejected, longest, _, children, parents = result.tally()
-        state.databases += 1
-        state.simulation_checks += result.entries
-        state.round_entries += result.entries
-        state.round_reachable += result.reachable_entries
-        state.quantum_calls += quantum
-        state.verification_calls += verifications
-        state.rejected += rejected
+        longest, children, parents = state.count_database(result)  # (one worker: no duplicates)
         state.critical_path += longest
         grower.policy_state.learn([result.outcomes])
         if parents.shape[0] == 0:

@@ -187,17 +187,9 @@ class PQRRT(SearchingPlanner):
 
     @staticmethod
     def _integrate(state: RunState, result: DatabaseOutcome) -> int:
-        """Count one database's work and add its verified candidates (``DatabaseResult.tally``);
+        """Count one database's work (``RunState.count_database``) and add its verified candidates;
         returns the largest oracle calls of one of its workers."""
-        quantum, verifications, rejected, longest, duplicates, children, parents = result.tally()
-        state.databases += 1
-        state.simulation_checks += result.entries
-        state.round_entries += result.entries
-        state.round_reachable += result.reachable_entries
-        state.quantum_calls += quantum
-        state.verification_calls += verifications
-        state.rejected += rejected
-        state.duplicates += duplicates
+        longest, children, parents = state.count_database(result)
         state.add_nodes(children, parents)
         return longest
 

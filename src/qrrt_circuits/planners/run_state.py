@@ -17,6 +17,7 @@ if TYPE_CHECKING:  # annotations only (context imports the search modules)
     from ..world.nearest import NearestNeighbors
     from .classical import LookAhead
     from .context import WorkerContext
+    from .workers import DatabaseOutcome
 
 HISTORY_KEYS = ("oracle_calls", "critical_path", "nodes", "entries", "reachable")
 #: history keys a planner may add whose values are floats (q-RRT*'s best path cost after each round)
@@ -114,6 +115,22 @@ class RunState:
             hit = first_satisfying(self.goal, positions)
             if hit >= 0:
                 self.goal_node = first + hit
+
+    def count_database(self, result: DatabaseOutcome) -> tuple[int, np.ndarray, np.ndarray]:
+        """Count one searched database's work as DESIGN §2 counts it (``DatabaseOutcome.tally``:
+        its entries, quantum calls, verifications, rejected and duplicate measurements); returns
+        (the largest oracle calls of one of its workers, the verified children, their parents),
+        the nodes for the caller to add to its tree."""
+        quantum, verifications, rejected, longest, duplicates, children, parents = result.tally()
+        self.databases += 1
+        self.simulation_checks += result.entries
+        self.round_entries += result.entries
+        self.round_reachable += result.reachable_entries
+        self.quantum_calls += quantum
+        self.verification_calls += verifications
+        self.rejected += rejected
+        self.duplicates += duplicates
+        return longest, children, parents
 
     def progress(self, elapsed_s: float) -> Progress:
         return Progress(self.oracle_calls, self.critical_path, self.nodes, self.rounds,
