@@ -69,14 +69,24 @@ def test_statevector_closed_form_equals_iteration():
                 assert np.sum(amps**2) == pytest.approx(1.0)
 
 
-def test_kth_unmarked_ranks():
-    from qrrt_circuits.search.backends.statevector import _kth_unmarked
+def test_ranked_indices_name_each_class_rank():
+    """Every rank of each class maps to that class's entry of that rank, shots in order."""
+    from qrrt_circuits.search.backends.statevector import _ranked_indices
 
     marks = np.zeros(32, dtype=bool)
     marks[[0, 3, 4, 5, 20, 31]] = True
-    unmarked = np.flatnonzero(~marks)
-    ranks = np.arange(len(unmarked))
-    assert np.array_equal(_kth_unmarked(np.flatnonzero(marks), ranks), unmarked)
+    marked, unmarked = np.flatnonzero(marks), np.flatnonzero(~marks)
+    rng = np.random.default_rng(3)
+    good = rng.random(200) < 0.4
+    good_ranks = rng.integers(0, marked.size, int(good.sum()))
+    other_ranks = rng.integers(0, unmarked.size, int((~good).sum()))
+    expected = np.empty(200, dtype=np.int64)
+    expected[good], expected[~good] = marked[good_ranks], unmarked[other_ranks]
+    assert np.array_equal(_ranked_indices(marks, good, good_ranks, other_ranks), expected)
+    every = np.arange(unmarked.size)
+    assert np.array_equal(_ranked_indices(marks, np.zeros(every.size, bool), every[:0], every), unmarked)
+    every = np.arange(marked.size)
+    assert np.array_equal(_ranked_indices(marks, np.ones(every.size, bool), every, every[:0]), marked)
 
 
 @pytest.mark.parametrize("backend_name", ALL_BACKENDS)

@@ -221,7 +221,7 @@ class LookAhead:
         in_goal[rows] = False
         reachable = np.flatnonzero(truth)
         if reachable.size:
-            in_goal[rows[reachable]] = satisfying(state.goal, children[reachable])
+            in_goal[rows[reachable]] = satisfying(state.goal, children.take(reachable, axis=0))
         self.hits[rounds] = self._per_round(truth)
         self.stale[rounds] = False
         state.wasted_checks += rows.shape[0]
@@ -244,7 +244,7 @@ class LookAhead:
         in_goal = np.zeros(truth.shape[0], dtype=bool)
         reachable = np.flatnonzero(truth)
         if reachable.size:
-            in_goal[reachable] = satisfying(state.goal, children[reachable])
+            in_goal[reachable] = satisfying(state.goal, children.take(reachable, axis=0))
         self.tested = children, parents, truth, in_goal
         self.hits = self._per_round(truth)
         self.stale = np.zeros(ahead, dtype=bool)
@@ -306,7 +306,7 @@ class ParallelRRT(Planner):
         """Each sample's nearest node, the sample steered toward it, the predicate's answer on the
         pair and the distance from the node to the sample: (children, parents, truth, reach)."""
         parents = state.neighbors.nearest(samples)
-        origins = state.tree.nodes[parents]
+        origins = state.tree.nodes.take(parents, axis=0)
         context = state.worker_context
         reach = context.space.distance(origins, samples)
         children = steer(context.space, origins, samples, context.max_extension, reach)

@@ -229,7 +229,7 @@ def build_database(
         band = annealing.band(temperature_index)
         samples, parents = PLACEMENTS[annealing.placement].candidates(tree, neighbors, size, env, rng, goal,
                                                                       goal_bias, band)
-    return Database(steer(space, tree.nodes[parents], samples, max_extension), parents, band)
+    return Database(steer(space, tree.nodes.take(parents, axis=0), samples, max_extension), parents, band)
 
 
 #: the smallest positive normal double (a sample on its origin moves nowhere)

@@ -95,7 +95,7 @@ class _Moved(Placement):
                    band: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
         samples = uniform_samples(size, env, rng, goal, goal_bias)
         parents = neighbors.nearest(samples)
-        origin = tree.nodes[parents]
+        origin = tree.nodes.take(parents, axis=0)
         offset = samples - origin
         norm = np.linalg.norm(offset, axis=1)
         zero = norm == 0
@@ -153,9 +153,9 @@ class AdmitPlacement(Placement):
         for _ in range(ADMIT_DRAWS_PER_ENTRY):
             samples = uniform_samples(size, env, rng, goal, goal_bias)
             parents = neighbors.nearest(samples)
-            distance = np.linalg.norm(samples - tree.nodes[parents], axis=1)
+            distance = np.linalg.norm(samples - tree.nodes.take(parents, axis=0), axis=1)
             inside = (distance >= band[0]) & (distance <= band[1])
-            kept_samples.append(samples[inside])
+            kept_samples.append(samples.compress(inside, axis=0))
             kept_parents.append(parents[inside])
             admitted += int(inside.sum())
             if admitted >= size:

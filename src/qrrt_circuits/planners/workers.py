@@ -92,7 +92,7 @@ def make_database(context: WorkerContext, view: RoundView, worker: int) -> tuple
     marks."""
     db = context.candidates.build(context, view, worker)
     size = db.parents.shape[0]
-    truth = check_answers(context.predicate.reachable(view.tree.nodes[db.parents], db.children), size,
+    truth = check_answers(context.predicate.reachable(view.tree.nodes.take(db.parents, axis=0), db.children), size,
                           f"the predicate {context.predicate.name!r}")
     marks = context.candidates.oracle_marks(context, db, truth)
     if context.oracle_errors is not None:

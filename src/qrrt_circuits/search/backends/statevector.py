@@ -16,6 +16,7 @@ import os
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numba import njit
 
 from ..._support.validation import check_bool, check_int
 from ...probability import good_probability
@@ -167,29 +168,53 @@ def _draw(probabilities: np.ndarray, shots: int, rng: np.random.Generator) -> np
     return np.minimum(np.searchsorted(cumulative, draws, side="right"), probabilities.shape[0] - 1)
 
 
+#: no ranks to draw (a class no shot landed in)
+_NO_RANKS = np.empty(0, dtype=np.int64)
+
+
 def _draw_two_level(marks: np.ndarray, p_good: float, shots: int, rng: np.random.Generator) -> np.ndarray:
     """``shots`` indices: marked (uniformly among the marked) with probability ``p_good``, else
-    uniformly among the unmarked (Grover-type states are uniform within each class)."""
+    uniformly among the unmarked (Grover-type states are uniform within each class). The draws:
+    ``shots`` doubles (u < p_good: marked), then the marked shots' ranks among the marked, then
+    the others' ranks among the unmarked; ``_ranked_indices`` turns the ranks into indices."""
     size = marks.shape[0]
-    marked = np.flatnonzero(marks)
-    num_marked = marked.shape[0]
+    num_marked = int(np.count_nonzero(marks))
     if num_marked in (0, size):  # nothing to amplify: the class probabilities are exact
         p_good = float(num_marked == size)
     good = rng.random(shots) < p_good
-    out = np.empty(shots, dtype=np.int64)
     num_good = int(np.count_nonzero(good))
-    if num_good:
-        out[good] = marked[rng.integers(0, num_marked, num_good)]
-    if num_good < shots:
-        unmarked_count = size - num_marked
-        # k-th unmarked index without listing them all: rank among the complement
-        ranks = rng.integers(0, unmarked_count, shots - num_good)
-        out[~good] = _kth_unmarked(marked, ranks)
+    good_ranks = rng.integers(0, num_marked, num_good) if num_good else _NO_RANKS
+    other_ranks = rng.integers(0, size - num_marked, shots - num_good) if num_good < shots else _NO_RANKS
+    return _ranked_indices(marks, good, good_ranks, other_ranks)
+
+
+@njit(cache=True, nogil=True)
+def _ranked_indices(marks: np.ndarray, good: np.ndarray, good_ranks: np.ndarray,
+                    other_ranks: np.ndarray) -> np.ndarray:
+    """Per shot, the index of its rank: the ``good_ranks``-th marked index for the shots where
+    ``good`` holds, the ``other_ranks``-th unmarked one for the rest, each in shot order."""
+    marked = np.flatnonzero(marks)
+    out = np.empty(good.shape[0], dtype=np.int64)
+    taken_good = taken_other = 0
+    for shot in range(good.shape[0]):
+        if good[shot]:
+            out[shot] = marked[good_ranks[taken_good]]
+            taken_good += 1
+        else:
+            out[shot] = _kth_unmarked_one(marked, other_ranks[taken_other])
+            taken_other += 1
     return out
 
 
-def _kth_unmarked(marked_sorted: np.ndarray, ranks: np.ndarray) -> np.ndarray:
-    """The ranks[j]-th index (0-based) not in ``marked_sorted``."""
-    # index = rank + (number of marked indices <= index); solve by searching marked - arange
-    shifted = marked_sorted - np.arange(marked_sorted.shape[0])
-    return ranks + np.searchsorted(shifted, ranks, side="right")
+@njit(cache=True, nogil=True)
+def _kth_unmarked_one(marked_sorted: np.ndarray, rank: int) -> int:
+    """The rank-th index (0-based) not in ``marked_sorted``: rank + the number j of marked
+    indices below it, the count of ``marked_sorted[i] - i <= rank`` (a binary search)."""
+    low, high = 0, marked_sorted.shape[0]
+    while low < high:
+        middle = (low + high) // 2
+        if marked_sorted[middle] - middle <= rank:
+            low = middle + 1
+        else:
+            high = middle
+    return rank + low
