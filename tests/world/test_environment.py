@@ -253,3 +253,14 @@ def test_bad_scenario_arguments():
         qc.lattice(blocked_fraction=1.5)
     with pytest.raises(ValueError, match="unknown scenario"):
         scenarios.by_name("nope")
+
+
+def test_box_points_and_sample_uniform_are_numpys_expression():
+    """low + (high - low) u, bit for bit, for a strided view and in d = 5 (the planners' samples
+    depend on these exact bits: the keyed streams' contract)."""
+    env = Environment(np.array([[-3.5, 2.25], [0.1, 7.0], [-1e3, 1e-3], [5.0, 5.5], [0.0, 1.0]]), np.zeros((0, 2, 5)))
+    low, high = env.bounds[:, 0], env.bounds[:, 1]
+    unit = np.random.default_rng(4).random((40, 6))[:, 1:]  # not contiguous
+    assert np.array_equal(env.box_points(unit), low + (high - low) * unit)
+    drawn = env.sample_uniform(40, np.random.default_rng(8))
+    assert np.array_equal(drawn, low + (high - low) * np.random.default_rng(8).random((40, 5)))

@@ -48,10 +48,11 @@ def keyed_samples(streams: RandomStreams, keys: np.ndarray, env: Environment, go
     draws it, for many keys at once (the classical planners' candidates, one per (round, worker)).
 
     That call takes the key's first d doubles u for the point low + (high - low) u
-    (``Environment.sample_uniform``), then, with goal bias, one more double b, and where
-    b < ``goal_bias`` it draws the point in the goal with the same generator. Here the first d + 1
-    doubles of every key come from one call (``randomness.uniform_draws``), and only the biased
-    keys' generators are built again, their d + 1 doubles skipped, for the goal draws.
+    (``Environment.sample_uniform``, through ``Environment.box_points``), then, with goal bias,
+    one more double b, and where b < ``goal_bias`` it draws the point in the goal with the same
+    generator. Here the first d + 1 doubles of every key come from one call
+    (``randomness.uniform_draws``), and only the biased keys' generators are built again, their
+    d + 1 doubles skipped, for the goal draws.
 
     Args:
         streams: The plan's ``RandomStreams``.
@@ -66,8 +67,7 @@ def keyed_samples(streams: RandomStreams, keys: np.ndarray, env: Environment, go
     dim = env.dim
     biased = goal if goal_bias > 0 else None
     draws = uniform_draws(streams, keys, dim + (biased is not None))
-    low, high = env.bounds[:, 0], env.bounds[:, 1]
-    samples = low + (high - low) * draws[:, :dim]
+    samples = env.box_points(draws[:, :dim])
     if biased is not None:
         for row in np.flatnonzero(draws[:, dim] < goal_bias):
             rng = streams.generator(*keys[row])

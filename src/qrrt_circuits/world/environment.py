@@ -49,13 +49,14 @@ def _as_float_array(value: Any, name: str) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True)
-def _scale_into(unit: np.ndarray, low: np.ndarray, span: np.ndarray) -> None:
-    """Each row u of ``unit`` (M, d) replaced, in place, by low + span u (a uniform point of the
-    box from one in the unit cube; compiled: numpy's broadcast over a short last axis costs more
-    than the arithmetic)."""
+def _box_points(unit: np.ndarray, low: np.ndarray, span: np.ndarray) -> np.ndarray:
+    """low + span u for each row u of ``unit`` (M, d), a new array (compiled: numpy's broadcast
+    over a short last axis costs more than the arithmetic)."""
+    out = np.empty(unit.shape)
     for row in range(unit.shape[0]):
         for axis in range(unit.shape[1]):
-            unit[row, axis] = low[axis] + span[axis] * unit[row, axis]
+            out[row, axis] = low[axis] + span[axis] * unit[row, axis]
+    return out
 
 
 def _metadata(value: Any) -> dict:
@@ -210,9 +211,18 @@ class Environment:
         Returns:
             Float array (count, d).
         """
-        samples = rng.random((count, self.dim))
-        _scale_into(samples, self._low, self._span)
-        return samples
+        return self.box_points(rng.random((count, self.dim)))
+
+    def box_points(self, unit: np.ndarray) -> np.ndarray:
+        """The workspace points low + (high - low) u of points u of the unit cube.
+
+        Args:
+            unit: Float (M, d), each row in [0, 1)^d (unchecked).
+
+        Returns:
+            A new float array (M, d).
+        """
+        return _box_points(unit, self._low, self._span)
 
     def sample_free(
         self, count: int, rng: np.random.Generator, max_attempts: int = 1000
