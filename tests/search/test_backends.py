@@ -372,8 +372,8 @@ def test_a_process_forked_after_aer_searches_searches_too():
 
 def test_aer_threads_follow_the_free_cores_from_14_qubits(monkeypatch):
     """By default a circuit of 14 qubits or more runs on the cores other work leaves free (usable
-    cores less the load beyond this process's own thread, at least 1); below 14 qubits on one
-    thread; an explicit limit (0: all cores) is kept whatever the load."""
+    cores less the load beyond this process's own thread, to the nearest core, at least 1); below
+    14 qubits on one thread; an explicit limit (0: all cores) is kept whatever the load."""
     import os
 
     from qrrt_circuits._support import free_cores
@@ -381,7 +381,7 @@ def test_aer_threads_follow_the_free_cores_from_14_qubits(monkeypatch):
     monkeypatch.setattr(os, "sched_getaffinity", lambda pid: set(range(8)))
     auto, all_cores, two = qc.AerBackend(seed=0), qc.AerBackend(max_parallel_threads=0), qc.AerBackend(
         max_parallel_threads=2)
-    for load, expected in ((0.3, 8), (1.0, 8), (3.5, 5), (7.2, 1), (40.0, 1)):
+    for load, expected in ((0.3, 8), (1.0, 8), (1.49, 8), (1.51, 7), (3.5, 6), (3.6, 5), (7.2, 2), (7.6, 1), (40.0, 1)):
         monkeypatch.setattr(os, "getloadavg", lambda load=load: (load, load, load))
         assert free_cores.free_cores() == expected
         assert auto.threads_for(16) == expected and auto.threads_for(13) == 1

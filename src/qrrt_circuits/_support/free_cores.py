@@ -26,8 +26,14 @@ def usable_cores() -> int:
 
 def free_cores() -> int:
     """The usable cores that other work does not keep busy: ``usable_cores()`` less the one-minute
-    system load beyond this process's own running thread (load - 1), rounded down, at least 1;
-    ``usable_cores()`` where the platform has no system load.
+    system load beyond this process's own running thread (load - 1), rounded to the nearest whole
+    core (a core counts as free when other work keeps it busy less than half the time), at least
+    1; ``usable_cores()`` where the platform has no system load.
+
+    Rounding to the nearest core rather than down keeps the cores when the load is only the tail
+    of this process's own earlier work: a search on all cores raises the one-minute load for a
+    minute after it ends, and a rule that gave up a core for any load beyond 1 would then run the
+    next searches on fewer threads than the idle machine has.
 
     Example:
         >>> from qrrt_circuits._support.free_cores import free_cores, usable_cores
@@ -40,4 +46,4 @@ def free_cores() -> int:
     except (AttributeError, OSError):  # (no system load on this platform)
         return usable
     others = max(0.0, load - 1.0)
-    return max(1, min(usable, math.floor(usable - others)))
+    return max(1, min(usable, math.floor(usable - others + 0.5)))
