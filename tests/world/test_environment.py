@@ -264,3 +264,6 @@ def test_box_points_and_sample_uniform_are_numpys_expression():
     assert np.array_equal(env.box_points(unit), low + (high - low) * unit)
     drawn = env.sample_uniform(40, np.random.default_rng(8))
     assert np.array_equal(drawn, low + (high - low) * np.random.default_rng(8).random((40, 5)))
+    for bad in (np.zeros((3, 4)), np.zeros(5), np.zeros((2, 3, 5))):
+        with pytest.raises(ValueError, match=r"unit must have shape \(M, 5\)"):
+            env.box_points(bad)

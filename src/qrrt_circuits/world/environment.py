@@ -217,11 +217,17 @@ class Environment:
         """The workspace points low + (high - low) u of points u of the unit cube.
 
         Args:
-            unit: Float (M, d), each row in [0, 1)^d (unchecked).
+            unit: Float (M, d), each row in [0, 1)^d (the values are not checked).
 
         Returns:
             A new float array (M, d).
+
+        Raises:
+            ValueError: ``unit`` not of shape (M, d) for the environment's d.
         """
+        unit = np.asarray(unit, dtype=float)
+        if unit.ndim != 2 or unit.shape[1] != self.dim:
+            raise ValueError(f"unit must have shape (M, {self.dim}), got {unit.shape}")
         return _box_points(unit, self._low, self._span)
 
     def sample_free(
