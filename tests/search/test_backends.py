@@ -372,13 +372,15 @@ def test_a_process_forked_after_aer_searches_searches_too():
 
 def test_aer_threads_follow_the_free_cores_from_14_qubits(monkeypatch):
     """By default a circuit of 14 qubits or more runs on the cores other work leaves free (usable
-    cores less the load beyond this process's own thread, to the nearest core, at least 1); below
-    14 qubits on one thread; an explicit limit (0: all cores) is kept whatever the load."""
+    cores less the load beyond this process's own thread where no CPU time has been measured, to
+    the nearest core, at least 1); below 14 qubits on one thread; an explicit limit (0: all cores)
+    is kept whatever the load."""
     import os
 
     from qrrt_circuits._support import free_cores
 
     monkeypatch.setattr(os, "sched_getaffinity", lambda pid: set(range(8)))
+    monkeypatch.setattr(free_cores, "_METER", free_cores.BusyMeter(lambda: None))  # (no counters: the load)
     auto, all_cores, two = qc.AerBackend(seed=0), qc.AerBackend(max_parallel_threads=0), qc.AerBackend(
         max_parallel_threads=2)
     for load, expected in ((0.3, 8), (1.0, 8), (1.49, 8), (1.51, 7), (3.5, 6), (3.6, 5), (7.2, 2), (7.6, 1), (40.0, 1)):

@@ -3,37 +3,179 @@ may run on less what the other work on the machine already keeps busy.
 
 A state update parallelised over more threads than there are idle cores waits on the busy ones
 (``benchmarks/bench_aer_threads.py`` times a search on one thread, on every core and on the free
-cores). ``free_cores()`` reads the one-minute system load
-(``os.getloadavg``: the runnable threads, this process's own included) once per call.
+cores, with and without a competing process).
+
+How busy other work keeps the usable cores is measured where the kernel counts CPU time (Linux:
+``/proc/stat`` per CPU, ``/proc/self/stat`` for this process), by ``BusyMeter``: between two
+readings at least ``MIN_INTERVAL_S`` apart, the busy time of the usable CPUs (user, nice, system,
+irq, softirq and steal, in clock ticks) less this process's own CPU time (all its threads, user and
+system), over the interval. A reading taken sooner keeps the last measured value; the interval
+since a reading spans whatever the process did in between, its own searches included, which the
+subtraction takes out. Before the first interval ends, and where the platform has no such
+counters, the one-minute system load stands in for it (``os.getloadavg``: the runnable threads,
+this process's own running thread included, so the load beyond 1).
 """
 
 from __future__ import annotations
 
 import math
 import os
+import threading
+from collections.abc import Callable, Collection
+from dataclasses import dataclass
 
-__all__ = ["free_cores", "usable_cores"]
+__all__ = ["MIN_INTERVAL_S", "BusyMeter", "CpuTimes", "free_cores", "read_cpu_times", "usable_cores"]
+
+#: the shortest interval a measurement spans (the kernel counts CPU time in ticks of 1 / CLK_TCK s,
+#: 10 ms on most Linux systems: over 0.25 s a tick's rounding is 4 % of a core)
+MIN_INTERVAL_S = 0.25
+
+
+def usable_cpus() -> frozenset[int]:
+    """The CPUs this process may run on: its CPU affinity where the platform has one, else
+    ``0 .. os.cpu_count() - 1``."""
+    try:
+        return frozenset(os.sched_getaffinity(0))
+    except (AttributeError, OSError):  # (no affinity on this platform)
+        return frozenset(range(max(1, os.cpu_count() or 1)))
 
 
 def usable_cores() -> int:
     """The cores this process may run on: its CPU affinity where the platform has one, else
     ``os.cpu_count()`` (at least 1)."""
+    return max(1, len(usable_cpus()))
+
+
+@dataclass(frozen=True)
+class CpuTimes:
+    """One reading of the kernel's CPU time counters, in clock ticks.
+
+    Args:
+        busy: Ticks the usable CPUs spent busy (user, nice, system, irq, softirq, steal), summed.
+        total: Ticks the usable CPUs counted in any state (busy, idle, iowait), summed.
+        own: Ticks this process's threads ran (user and system).
+        cpus: The usable CPUs read.
+        pid: The process the reading belongs to (a forked child starts its own count).
+    """
+
+    busy: int
+    total: int
+    own: int
+    cpus: int
+    pid: int
+
+
+#: ``/proc/stat``'s per-CPU columns (after the name) counted busy, and those counted idle
+_BUSY_COLUMNS = (0, 1, 2, 5, 6, 7)  # user, nice, system, irq, softirq, steal
+_IDLE_COLUMNS = (3, 4)  # idle, iowait
+
+
+def read_cpu_times(cpus: Collection[int] | None = None) -> CpuTimes | None:
+    """The busy and total ticks of ``cpus`` (default: the usable CPUs) from ``/proc/stat`` and this
+    process's own ticks from ``/proc/self/stat``; None where the platform has no such files or a
+    usable CPU has no line (its counters cannot be read).
+
+    Args:
+        cpus: CPU numbers, or None for ``usable_cpus()``.
+
+    Returns:
+        A ``CpuTimes``, or None.
+    """
+    wanted = usable_cpus() if cpus is None else frozenset(cpus)
     try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except (AttributeError, OSError):  # (no affinity on this platform)
-        return max(1, os.cpu_count() or 1)
+        with open("/proc/stat", encoding="ascii") as stat:
+            lines = stat.read().splitlines()
+        with open("/proc/self/stat", encoding="ascii") as own:
+            # fields after the command name (which may hold spaces), from field 3 (state) on
+            fields = own.read().rsplit(")", 1)[1].split()
+    except OSError:
+        return None
+    busy = total = seen = 0
+    for line in lines:
+        name, _, rest = line.partition(" ")
+        if not (name.startswith("cpu") and name[3:].isdigit() and int(name[3:]) in wanted):
+            continue
+        columns = [int(value) for value in rest.split()]
+        if len(columns) < 8:
+            return None
+        cpu_busy = sum(columns[index] for index in _BUSY_COLUMNS)
+        busy += cpu_busy
+        total += cpu_busy + sum(columns[index] for index in _IDLE_COLUMNS)
+        seen += 1
+    if seen != len(wanted) or len(fields) < 13:
+        return None
+    return CpuTimes(busy, total, int(fields[11]) + int(fields[12]), seen, os.getpid())  # utime, stime
+
+
+class BusyMeter:
+    """The cores other work keeps busy, measured between readings of the kernel's CPU time counters
+    (module docstring).
+
+    Args:
+        read: Returns a ``CpuTimes`` reading, or None where none can be taken (default
+            ``read_cpu_times``).
+        min_interval_ticks: The shortest interval, in clock ticks per CPU, a measurement spans
+            (default ``MIN_INTERVAL_S`` in the system's ticks).
+
+    Example:
+        >>> from qrrt_circuits._support.free_cores import BusyMeter, CpuTimes
+        >>> readings = iter([CpuTimes(0, 0, 0, 2, 1), CpuTimes(130, 200, 30, 2, 1)])
+        >>> meter = BusyMeter(lambda: next(readings), min_interval_ticks=25)
+        >>> meter.others() is None, meter.others()  # 100 ticks a CPU; others ran 100 of them
+        (True, 1.0)
+    """
+
+    def __init__(self, read: Callable[[], CpuTimes | None] = read_cpu_times,
+                 min_interval_ticks: float | None = None) -> None:
+        if min_interval_ticks is None:
+            min_interval_ticks = MIN_INTERVAL_S * _clock_ticks_per_second()
+        self.read, self.min_interval_ticks = read, float(min_interval_ticks)
+        self._last: CpuTimes | None = None
+        self._others: float | None = None
+        self._lock = threading.Lock()
+
+    def others(self) -> float | None:
+        """The cores other work kept busy on average over the last interval of at least the minimum
+        length (a fraction, >= 0), or None before one has been measured or without counters."""
+        now = self.read()
+        with self._lock:
+            if now is None:
+                return None
+            last = self._last
+            if last is None or last.pid != now.pid or last.cpus != now.cpus:  # (a new count starts)
+                self._last, self._others = now, None
+                return None
+            elapsed = (now.total - last.total) / now.cpus  # ticks per CPU
+            if elapsed >= self.min_interval_ticks:
+                others = (now.busy - last.busy) - (now.own - last.own)
+                self._others = max(0.0, others / elapsed)
+                self._last = now
+            return self._others
+
+
+def _clock_ticks_per_second() -> float:
+    """The kernel's clock ticks per second (``SC_CLK_TCK``; 100 where it cannot be read)."""
+    try:
+        return float(os.sysconf("SC_CLK_TCK"))
+    except (AttributeError, ValueError, OSError):
+        return 100.0
+
+
+#: the process's meter: how busy other work keeps the cores is one fact for the whole process
+_METER = BusyMeter()
 
 
 def free_cores() -> int:
-    """The usable cores that other work does not keep busy: ``usable_cores()`` less the one-minute
-    system load beyond this process's own running thread (load - 1), rounded to the nearest whole
-    core (a core counts as free when other work keeps it busy less than half the time), at least
-    1; ``usable_cores()`` where the platform has no system load.
+    """The usable cores that other work does not keep busy: ``usable_cores()`` less the cores other
+    work kept busy since a reading at least ``MIN_INTERVAL_S`` ago (``BusyMeter``), rounded to the
+    nearest whole core (a core counts as free when other work keeps it busy less than half the
+    time), at least 1. Until that interval has been measured, or without the kernel's counters,
+    the one-minute system load less this process's own running thread (load - 1) stands for the
+    busy cores; ``usable_cores()`` where the platform has no system load either.
 
-    Rounding to the nearest core rather than down keeps the cores when the load is only the tail
-    of this process's own earlier work: a search on all cores raises the one-minute load for a
-    minute after it ends, and a rule that gave up a core for any load beyond 1 would then run the
-    next searches on fewer threads than the idle machine has.
+    Rounding to the nearest core rather than down keeps the cores when other work only touches
+    them: a core busy a third of the time still runs a share of a parallel state update sooner
+    than the other cores run it alone.
 
     Example:
         >>> from qrrt_circuits._support.free_cores import free_cores, usable_cores
@@ -41,9 +183,11 @@ def free_cores() -> int:
         True
     """
     usable = usable_cores()
-    try:
-        load = os.getloadavg()[0]
-    except (AttributeError, OSError):  # (no system load on this platform)
-        return usable
-    others = max(0.0, load - 1.0)
+    others = _METER.others()
+    if others is None:
+        try:
+            load = os.getloadavg()[0]
+        except (AttributeError, OSError):  # (no system load on this platform)
+            return usable
+        others = max(0.0, load - 1.0)
     return max(1, min(usable, math.floor(usable - others + 0.5)))

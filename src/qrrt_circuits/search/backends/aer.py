@@ -19,9 +19,10 @@ Threads: Aer parallelises a state update only from ``statevector_parallel_thresh
 on; below it, extra OpenMP threads only cost their start-up and synchronisation, so circuits
 narrower than ``SERIAL_BELOW_QUBITS`` run on one thread whatever ``max_parallel_threads`` says.
 From 14 qubits on, the default (``max_parallel_threads=None``) runs each search on the cores free
-when it starts (``_support.free_cores``: the usable cores less the load of other work, to the
-nearest core, at least one), so a search on a busy machine does not wait on threads that have no
-core.
+when it starts (``_support.free_cores``: the usable cores less the cores other work kept busy,
+measured from the kernel's CPU time counters less this process's own time, or the system load
+before a first measurement; to the nearest core, at least one), so a search on a busy machine
+does not wait on threads that have no core.
 """
 
 from __future__ import annotations

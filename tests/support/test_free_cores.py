@@ -1,0 +1,103 @@
+"""The free cores: the busy time other work takes, measured from the kernel's CPU time counters
+between two readings (``BusyMeter``), the one-minute load before the first interval ends."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import time
+
+import pytest
+
+from qrrt_circuits._support import free_cores as fc
+from qrrt_circuits._support.free_cores import BusyMeter, CpuTimes
+
+
+def readings(*values: CpuTimes | None):
+    """A reader handing back ``values`` in turn."""
+    queue = list(values)
+    return lambda: queue.pop(0)
+
+
+def test_the_meter_subtracts_this_process_time_over_the_interval():
+    """Others' cores = (busy ticks - own ticks) / ticks per CPU; nothing until a first interval."""
+    meter = BusyMeter(readings(CpuTimes(1000, 4000, 50, 4, 7), CpuTimes(1250, 4400, 150, 4, 7),
+                               CpuTimes(1250, 4800, 150, 4, 7)), min_interval_ticks=25)
+    assert meter.others() is None  # the first reading starts the count
+    assert meter.others() == pytest.approx((250 - 100) / 100)  # 100 ticks a CPU, 150 of them others'
+    assert meter.others() == 0.0  # an idle interval
+
+
+def test_a_short_interval_keeps_the_last_measurement():
+    """A reading sooner than the minimum interval after the last measured one keeps its value and
+    does not move the interval's start."""
+    meter = BusyMeter(readings(CpuTimes(0, 0, 0, 2, 7), CpuTimes(40, 20, 0, 2, 7), CpuTimes(100, 100, 0, 2, 7),
+                               CpuTimes(110, 120, 0, 2, 7), CpuTimes(110, 160, 0, 2, 7)), min_interval_ticks=25)
+    assert meter.others() is None
+    assert meter.others() is None  # 10 ticks a CPU: too short, nothing measured yet
+    assert meter.others() == pytest.approx(100 / 50)  # from the first reading: 50 ticks a CPU
+    assert meter.others() == pytest.approx(2.0)  # 10 ticks a CPU since: kept
+    assert meter.others() == pytest.approx(10 / 30)  # 30 ticks a CPU since the measured reading
+
+
+def test_the_meter_restarts_in_a_forked_child_and_never_goes_negative():
+    """A reading of another process (a forked child's own count starts at 0) or of another CPU set
+    restarts the count; own ticks beyond the busy ones (the kernel's sampling) give 0, not less."""
+    meter = BusyMeter(readings(CpuTimes(0, 0, 500, 2, 7), CpuTimes(100, 100, 3, 2, 8), CpuTimes(100, 100, 3, 1, 8),
+                               CpuTimes(110, 200, 40, 1, 8)), min_interval_ticks=25)
+    assert meter.others() is None
+    assert meter.others() is None  # pid 8: a new count, not 500 own ticks fewer
+    assert meter.others() is None  # one CPU now: a new count
+    assert meter.others() == 0.0  # 10 busy, 37 own
+
+
+def test_without_counters_the_meter_measures_nothing():
+    meter = BusyMeter(lambda: None, min_interval_ticks=25)
+    assert meter.others() is None and meter.others() is None
+
+
+@pytest.mark.parametrize(("others", "usable", "expected"), [
+    (0.0, 8, 8), (0.49, 8, 8), (0.51, 8, 7), (2.5, 8, 6), (2.6, 8, 5), (6.2, 8, 2), (6.6, 8, 1), (39.0, 8, 1),
+    (0.0, 1, 1), (1.0, 2, 1), (0.3, 2, 2)])
+def test_free_cores_rounds_the_measured_busy_cores(monkeypatch, others, usable, expected):
+    """The usable cores less others' busy cores, to the nearest core, at least 1 (the load average
+    is not read once a measurement exists)."""
+    monkeypatch.setattr(fc, "_METER", BusyMeter(readings(CpuTimes(0, 0, 0, 1, 7), CpuTimes(round(100 * others),
+                                                                                              100, 0, 1, 7)),
+                                                min_interval_ticks=25))
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: set(range(usable)))
+    monkeypatch.setattr(os, "getloadavg", lambda: (99.0, 99.0, 99.0))
+    assert fc.free_cores() == 1 or usable == 1  # first reading: the load (99) stands in
+    assert fc.free_cores() == expected
+
+
+@pytest.mark.skipif(not os.path.exists("/proc/stat"), reason="the kernel's CPU time counters are Linux's")
+def test_the_real_counters_are_read():
+    """On Linux every usable CPU has a line and the counts only grow."""
+    first = fc.read_cpu_times()
+    sum(range(200_000))  # (some CPU time of this process)
+    second = fc.read_cpu_times()
+    assert first is not None and second is not None
+    assert first.cpus == second.cpus == fc.usable_cores() and first.pid == second.pid == os.getpid()
+    assert 0 <= first.busy <= first.total and first.busy <= second.busy and first.total <= second.total
+    assert first.own <= second.own
+    assert fc.read_cpu_times(cpus=[10**6]) is None  # no such CPU: no reading
+
+
+@pytest.mark.skipif(not os.path.exists("/proc/stat") or fc.usable_cores() < 2,
+                    reason="needs the kernel's counters and two usable cores")
+def test_a_busy_process_beside_this_one_is_measured():
+    """A process spinning on one core for the whole interval while this one sleeps keeps most of a
+    core busy (its interpreter's start-up is before the interval)."""
+    meter = BusyMeter(fc.read_cpu_times, min_interval_ticks=1)
+    spin = "import time\nend = time.time() + 1.2\nwhile time.time() < end: pass"
+    spinner = subprocess.Popen([sys.executable, "-c", spin])
+    try:
+        time.sleep(0.2)  # (the child's interpreter starts)
+        assert meter.others() is None
+        time.sleep(0.6)
+        others = meter.others()
+    finally:
+        spinner.wait(timeout=30)
+    assert others is not None and others >= 0.7  # so at least one core counts as busy
