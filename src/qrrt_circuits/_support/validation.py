@@ -50,9 +50,10 @@ def check_int(value: Any, name: str, minimum: int | None = 0, maximum: int | Non
         ...
         ValueError: workers must be an integer >= 1, got 0
     """
-    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Integral):
-        raise TypeError(f"{name} must be an integer {_range_text(minimum, maximum)}, got {value!r}")
-    value = int(value)
+    if type(value) is not int:  # (a plain int, the common case, needs no abstract-class checks)
+        if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Integral):
+            raise TypeError(f"{name} must be an integer {_range_text(minimum, maximum)}, got {value!r}")
+        value = int(value)
     if (minimum is not None and value < minimum) or (maximum is not None and value > maximum):
         raise ValueError(f"{name} must be an integer {_range_text(minimum, maximum)}, got {value!r}")
     return value

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numba import njit
 
 from .._support.randomness import seeded_generator
 from .._support.validation import check_int, check_seed
@@ -101,8 +102,17 @@ def check_measured(indices: np.ndarray, shots: int, size: int, backend: str) -> 
     if not (isinstance(indices, np.ndarray) and indices.shape == (shots,) and indices.dtype.kind in "iu"):
         raise RuntimeError(f"the {backend} backend returned {indices!r} for {shots} shots: expected an integer "
                            f"array of shape ({shots},)")
-    if shots and (int(indices.min()) < 0 or int(indices.max()) >= size):
+    if _any_outside(indices, size):
         raise RuntimeError(f"the {backend} backend measured an index outside [0, {size}): {indices.tolist()}")
+
+
+@njit(cache=True, nogil=True)
+def _any_outside(indices: np.ndarray, size: int) -> bool:
+    """Whether any of the integer ``indices`` lies outside [0, ``size``) (one compiled pass)."""
+    for index in indices:
+        if index < 0 or index >= size:
+            return True
+    return False
 
 
 #: generous upper limits: far beyond any useful search (the optimal k for N = 2^30 and m = 1 is
