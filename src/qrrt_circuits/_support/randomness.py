@@ -96,7 +96,8 @@ def _mix(x: np.uint64, y: np.uint64) -> np.uint64:
 def _seed_words(run_entropy: np.ndarray, keys: np.ndarray) -> np.ndarray:
     """For each row of ``keys`` (K, c) non-negative int64: the 4 uint64 words that
     ``SeedSequence(entropy, spawn_key=tuple(row)).generate_state(4, np.uint64)`` returns, where
-    ``run_entropy`` (uint64 holding 32-bit words) is the entropy's words padded to the pool size."""
+    ``run_entropy`` (uint64 holding 32-bit words) is the entropy's words padded to the pool size.
+    A negative key raises ``ValueError``."""
     mask = np.uint64(_MASK)
     count = keys.shape[0]
     out = np.empty((count, 4), dtype=np.uint64)
@@ -109,6 +110,8 @@ def _seed_words(run_entropy: np.ndarray, keys: np.ndarray) -> np.ndarray:
     for row in range(count):
         size = run_entropy.shape[0]
         for column in range(keys.shape[1]):
+            if keys[row, column] < 0:
+                raise ValueError("spawn keys must be non-negative")
             value = np.uint64(keys[row, column])
             entropy[size] = value & mask
             size += 1
@@ -265,10 +268,7 @@ class RandomStreams:
         Raises:
             ValueError: A negative key.
         """
-        keys = np.ascontiguousarray(keys, dtype=np.int64).reshape(-1, 3)
-        if keys.size and keys.min() < 0:
-            raise ValueError("spawn keys must be non-negative")
-        return _seed_words(self._run_entropy, keys)
+        return _seed_words(self._run_entropy, np.ascontiguousarray(keys, dtype=np.int64).reshape(-1, 3))
 
     def generator(self, round_index: int, worker: int, stream: Stream) -> np.random.Generator:
         """The generator of one (round, worker, stream) key.
