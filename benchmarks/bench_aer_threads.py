@@ -68,7 +68,8 @@ def measure(sizes: tuple[int, ...], repeats: int, duty: float, rng: np.random.Ge
                     backend.search(oracle, 12, shots=8, seed=repeat)
                     times[label].append(time.perf_counter() - began)
             measured = free_cores_module._METER.others()
-            row = {"num_qubits": n, "competitor_duty": duty, "load_average_1min": os.getloadavg()[0],
+            row = {"competitor": "none" if duty == 0 else f"busy{round(100 * duty)}", "num_qubits": n,
+                   "competitor_duty": duty, "load_average_1min": os.getloadavg()[0],
                    "measured_busy_cores": measured, "usable_cores": usable_cores(),
                    "free_cores_now": free_cores(), "default_threads_chosen": chosen,
                    "median_ms": {label: float(np.median(values)) * 1e3 for label, values in times.items()}}
