@@ -381,6 +381,7 @@ def test_aer_threads_follow_the_free_cores_from_14_qubits(monkeypatch):
 
     monkeypatch.setattr(os, "sched_getaffinity", lambda pid: set(range(8)))
     monkeypatch.setattr(free_cores, "_METER", free_cores.BusyMeter(lambda: None))  # (no counters: the load)
+    monkeypatch.setattr(free_cores, "PROC_CGROUP", "/nonexistent/cgroup")  # (no CPU quota)
     auto, all_cores, two = qc.AerBackend(seed=0), qc.AerBackend(max_parallel_threads=0), qc.AerBackend(
         max_parallel_threads=2)
     for load, expected in ((0.3, 8), (1.0, 8), (1.49, 8), (1.51, 7), (3.5, 6), (3.6, 5), (7.2, 2), (7.6, 1), (40.0, 1)):

@@ -14,6 +14,12 @@ from qrrt_circuits._support import free_cores as fc
 from qrrt_circuits._support.free_cores import BusyMeter, CpuTimes
 
 
+@pytest.fixture(autouse=True)
+def _no_cpu_quota(tmp_path, monkeypatch):
+    """The machine's own control groups are not read unless a test makes its own."""
+    monkeypatch.setattr(fc, "PROC_CGROUP", str(tmp_path / "no-cgroup-file"))
+
+
 def readings(*values: CpuTimes | None):
     """A reader handing back ``values`` in turn."""
     queue = list(values)
@@ -101,3 +107,53 @@ def test_a_busy_process_beside_this_one_is_measured():
     finally:
         spinner.wait(timeout=30)
     assert others is not None and others >= 0.7  # so at least one core counts as busy
+
+
+def _cpu_groups(tmp_path, monkeypatch, version: int, own: tuple[str, ...], parent: tuple[str, ...]) -> None:
+    """Fake CPU control groups of ``version`` for a process in group ``/box`` (parent: the mount's
+    root): ``own`` and ``parent`` are the files' contents (v2: ``cpu.max``; v1: quota, period)."""
+    root = tmp_path / "cgroup"
+    mount = root if version == 2 else root / "cpu"
+    names = ("cpu.max",) if version == 2 else ("cpu.cfs_quota_us", "cpu.cfs_period_us")
+    for folder, contents in ((mount / "box", own), (mount, parent)):
+        folder.mkdir(parents=True, exist_ok=True)
+        for name, text in zip(names, contents, strict=True):
+            (folder / name).write_text(text + "\n")
+    proc = tmp_path / "cgroup.txt"
+    proc.write_text("0::/box\n" if version == 2 else "4:memory:/box\n3:cpu,cpuacct:/box\n0::/\n")
+    monkeypatch.setattr(fc, "CGROUP_ROOT", str(root))
+    monkeypatch.setattr(fc, "PROC_CGROUP", str(proc))
+
+
+@pytest.mark.parametrize(("version", "own", "parent", "quota"), [
+    (2, ("150000 100000",), ("max 100000",), 1.5),
+    (2, ("max 100000",), ("300000 100000",), 3.0),  # a parent's quota bounds its children
+    (2, ("max 100000",), ("max 100000",), None),
+    (2, ("garbage",), ("max",), None),
+    (1, ("150000", "100000"), ("-1", "100000"), 1.5),
+    (1, ("-1", "100000"), ("-1", "100000"), None),
+])
+def test_the_cpu_quota_is_read_from_the_control_groups(tmp_path, monkeypatch, version, own, parent, quota):
+    _cpu_groups(tmp_path, monkeypatch, version, own, parent)
+    assert fc.cpu_quota_cores() == quota
+
+
+def test_a_cpu_quota_caps_the_usable_and_the_free_cores(tmp_path, monkeypatch):
+    """8 CPUs under a quota of 1.5 cores: 2 usable (rounded up); other work's busy cores are counted
+    on the 8 CPUs, so 3 busy ones still leave the 2 the quota allows, 7 busy ones leave 1."""
+    _cpu_groups(tmp_path, monkeypatch, 2, ("150000 100000",), ("max 100000",))
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: set(range(8)))
+    assert fc.usable_cores() == 2
+    for others, expected in ((0.0, 2), (3.0, 2), (6.4, 2), (6.6, 1), (7.0, 1)):
+        monkeypatch.setattr(fc, "_METER", BusyMeter(readings(CpuTimes(0, 0, 0, 8, 7), CpuTimes(
+            round(100 * others), 800, 0, 8, 7)), min_interval_ticks=25))
+        fc.free_cores()  # (the first reading)
+        assert fc.free_cores() == expected, others
+    _cpu_groups(tmp_path, monkeypatch, 2, ("max 100000",), ("max 100000",))
+    assert fc.usable_cores() == 8
+
+
+def test_without_control_groups_there_is_no_quota(tmp_path, monkeypatch):
+    monkeypatch.setattr(fc, "PROC_CGROUP", str(tmp_path / "absent"))
+    assert fc.cpu_quota_cores() is None
+    assert fc.usable_cores() == len(fc.usable_cpus())

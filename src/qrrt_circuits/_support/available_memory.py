@@ -22,6 +22,8 @@ import functools
 import os
 from pathlib import Path
 
+from .control_groups import group_folders
+
 MIB = 1 << 20
 
 #: estimates up to this size are accepted without reading the figures (``always_fits_bytes``)
@@ -184,32 +186,8 @@ def always_fits_bytes() -> int:
 
 def _memory_groups() -> list[tuple[Path, _GroupFiles]]:
     """(folder, file names) of the process's memory groups, from its own up to the mount's root."""
-    try:
-        with open(PROC_CGROUP, encoding="utf-8", errors="surrogateescape") as handle:  # any group name
-            lines = handle.read().splitlines()
-    except OSError:
-        return []
-    groups: list[tuple[Path, _GroupFiles]] = []
-    for line in lines:
-        parts = line.split(":", 2)
-        if len(parts) != 3:
-            continue
-        controllers, path = parts[1], parts[2].lstrip("/")
-        mounts: list[tuple[Path, _GroupFiles]]
-        if controllers == "":  # the v2 hierarchy
-            mounts = [(Path(CGROUP_ROOT), _V2_FILES), (Path(CGROUP_ROOT) / "unified", _V2_FILES)]
-        elif "memory" in controllers.split(","):
-            mounts = [(Path(CGROUP_ROOT) / "memory", _V1_FILES)]
-        else:
-            continue
-        for root, files in mounts:
-            folder = root / path
-            while True:
-                groups.append((folder, files))
-                if folder == root or root not in folder.parents:
-                    break
-                folder = folder.parent
-    return groups
+    return [(folder, _V2_FILES if version == 2 else _V1_FILES)
+            for folder, version in group_folders("memory", PROC_CGROUP, CGROUP_ROOT)]
 
 
 def _read_int(path: Path) -> int | None:

@@ -14,6 +14,11 @@ since a reading spans whatever the process did in between, its own searches incl
 subtraction takes out. Before the first interval ends, and where the platform has no such
 counters, the one-minute system load stands in for it (``os.getloadavg``: the runnable threads,
 this process's own running thread included, so the load beyond 1).
+
+A container may run on every CPU of its host with a CPU quota (``docker --cpus``: the control
+group's ``cpu.max`` in v2, ``cpu.cfs_quota_us`` / ``cpu.cfs_period_us`` in v1): the kernel then
+stops its threads once they have used quota / period CPU-seconds a second, so more threads than
+that only wait. ``usable_cores`` counts the smallest quota of the process's groups, rounded up.
 """
 
 from __future__ import annotations
@@ -23,8 +28,12 @@ import os
 import threading
 from collections.abc import Callable, Collection
 from dataclasses import dataclass
+from pathlib import Path
 
-__all__ = ["MIN_INTERVAL_S", "BusyMeter", "CpuTimes", "free_cores", "read_cpu_times", "usable_cores"]
+from .control_groups import group_folders
+
+__all__ = ["MIN_INTERVAL_S", "BusyMeter", "CpuTimes", "cpu_quota_cores", "free_cores", "read_cpu_times",
+           "usable_cores"]
 
 #: the shortest interval a measurement spans (the kernel counts CPU time in ticks of 1 / CLK_TCK s,
 #: 10 ms on most Linux systems: over 0.25 s a tick's rounding is 4 % of a core)
@@ -40,10 +49,44 @@ def usable_cpus() -> frozenset[int]:
         return frozenset(range(max(1, os.cpu_count() or 1)))
 
 
+#: the process's control groups and where their file systems are mounted (``control_groups``)
+PROC_CGROUP = "/proc/self/cgroup"
+CGROUP_ROOT = "/sys/fs/cgroup"
+
+
+def cpu_quota_cores() -> float | None:
+    """The smallest CPU quota of the process's control groups, in cores (quota / period: 1.5 for
+    ``docker --cpus 1.5``); None without a quota (``max`` in v2, -1 in v1) or where the groups
+    cannot be read."""
+    quotas = []
+    for folder, version in group_folders("cpu", PROC_CGROUP, CGROUP_ROOT):
+        if version == 2:
+            fields = _read_fields(folder / "cpu.max")
+        else:
+            fields = _read_fields(folder / "cpu.cfs_quota_us") + _read_fields(folder / "cpu.cfs_period_us")
+        try:
+            quota, period = int(fields[0]), int(fields[1])
+        except (IndexError, ValueError):  # absent, or "max" (v2: no quota)
+            continue
+        if quota > 0 and period > 0:  # (v1 writes -1 for no quota)
+            quotas.append(quota / period)
+    return min(quotas) if quotas else None
+
+
+def _read_fields(path: Path) -> list[str]:
+    try:
+        return path.read_text(encoding="ascii").split()
+    except (OSError, UnicodeDecodeError):
+        return []
+
+
 def usable_cores() -> int:
     """The cores this process may run on: its CPU affinity where the platform has one, else
-    ``os.cpu_count()`` (at least 1)."""
-    return max(1, len(usable_cpus()))
+    ``os.cpu_count()``, and no more than its control groups' CPU quota rounded up
+    (``cpu_quota_cores``); at least 1."""
+    cores = len(usable_cpus())
+    quota = cpu_quota_cores()
+    return max(1, cores if quota is None else min(cores, math.ceil(quota)))
 
 
 @dataclass(frozen=True)
@@ -166,12 +209,13 @@ _METER = BusyMeter()
 
 
 def free_cores() -> int:
-    """The usable cores that other work does not keep busy: ``usable_cores()`` less the cores other
-    work kept busy since a reading at least ``MIN_INTERVAL_S`` ago (``BusyMeter``), rounded to the
-    nearest whole core (a core counts as free when other work keeps it busy less than half the
-    time), at least 1. Until that interval has been measured, or without the kernel's counters,
-    the one-minute system load less this process's own running thread (load - 1) stands for the
-    busy cores; ``usable_cores()`` where the platform has no system load either.
+    """The usable cores that other work does not keep busy: the CPUs this process may run on less
+    the cores other work kept busy on them since a reading at least ``MIN_INTERVAL_S`` ago
+    (``BusyMeter``), rounded to the nearest whole core (a core counts as free when other work keeps
+    it busy less than half the time), at most ``usable_cores()`` (the CPU quota), at least 1.
+    Until that interval has been measured, or without the kernel's counters, the one-minute system
+    load less this process's own running thread (load - 1) stands for the busy cores;
+    ``usable_cores()`` where the platform has no system load either.
 
     Rounding to the nearest core rather than down keeps the cores when other work only touches
     them: a core busy a third of the time still runs a share of a parallel state update sooner
@@ -182,7 +226,7 @@ def free_cores() -> int:
         >>> 1 <= free_cores() <= usable_cores()
         True
     """
-    usable = usable_cores()
+    usable, cpus = usable_cores(), len(usable_cpus())
     others = _METER.others()
     if others is None:
         try:
@@ -190,4 +234,4 @@ def free_cores() -> int:
         except (AttributeError, OSError):  # (no system load on this platform)
             return usable
         others = max(0.0, load - 1.0)
-    return max(1, min(usable, math.floor(usable - others + 0.5)))
+    return max(1, min(usable, math.floor(cpus - others + 0.5)))
