@@ -157,3 +157,19 @@ def test_without_control_groups_there_is_no_quota(tmp_path, monkeypatch):
     monkeypatch.setattr(fc, "PROC_CGROUP", str(tmp_path / "absent"))
     assert fc.cpu_quota_cores() is None
     assert fc.usable_cores() == len(fc.usable_cpus())
+
+
+@pytest.mark.skipif(not os.path.exists("/proc/self/comm"), reason="the process name is Linux's /proc/self/comm")
+def test_a_process_name_with_spaces_and_other_bytes_is_read_past():
+    """``/proc/self/stat`` holds the process name between parentheses as the kernel has it (any
+    bytes, spaces and ')' included): the counters after it are still read."""
+    with open("/proc/self/comm", "rb") as handle:
+        before = handle.read().rstrip(b"\n")
+    try:
+        with open("/proc/self/comm", "wb") as handle:
+            handle.write("q) r\u00e9t x".encode())
+        reading = fc.read_cpu_times()
+    finally:
+        with open("/proc/self/comm", "wb") as handle:
+            handle.write(before)
+    assert reading is not None and reading.own >= 0 and reading.cpus == len(fc.usable_cpus())

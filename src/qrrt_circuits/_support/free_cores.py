@@ -33,7 +33,7 @@ from pathlib import Path
 from .control_groups import group_folders
 
 __all__ = ["MIN_INTERVAL_S", "BusyMeter", "CpuTimes", "cpu_quota_cores", "free_cores", "read_cpu_times",
-           "usable_cores"]
+           "usable_cores", "usable_cpus"]
 
 #: the shortest interval a measurement spans (the kernel counts CPU time in ticks of 1 / CLK_TCK s,
 #: 10 ms on most Linux systems: over 0.25 s a tick's rounding is 4 % of a core)
@@ -128,10 +128,10 @@ def read_cpu_times(cpus: Collection[int] | None = None) -> CpuTimes | None:
     try:
         with open("/proc/stat", encoding="ascii") as stat:
             lines = stat.read().splitlines()
-        with open("/proc/self/stat", encoding="ascii") as own:
-            # fields after the command name (which may hold spaces), from field 3 (state) on
-            fields = own.read().rsplit(")", 1)[1].split()
-    except OSError:
+        with open("/proc/self/stat", encoding="ascii", errors="replace") as own:
+            # fields after the command name (which may hold spaces and any bytes), from field 3 on
+            fields = own.read().rsplit(")", 1)[-1].split()
+    except (OSError, UnicodeDecodeError):
         return None
     busy = total = seen = 0
     for line in lines:
@@ -145,7 +145,7 @@ def read_cpu_times(cpus: Collection[int] | None = None) -> CpuTimes | None:
         busy += cpu_busy
         total += cpu_busy + sum(columns[index] for index in _IDLE_COLUMNS)
         seen += 1
-    if seen != len(wanted) or len(fields) < 13:
+    if seen != len(wanted) or len(fields) < 13 or not (fields[11].isdigit() and fields[12].isdigit()):
         return None
     return CpuTimes(busy, total, int(fields[11]) + int(fields[12]), seen, os.getpid())  # utime, stime
 
