@@ -26,8 +26,7 @@ import numpy as np
 from _common import machine, write_json
 
 import qrrt_circuits as qc
-from qrrt_circuits._support import free_cores as free_cores_module
-from qrrt_circuits._support.free_cores import free_cores, usable_cores
+from qrrt_circuits._support.free_cores import busy_cores, free_cores, usable_cores
 
 SETTINGS = {"one thread": 1, "all cores": 0, "default (free cores)": None}
 
@@ -67,7 +66,7 @@ def measure(sizes: tuple[int, ...], repeats: int, duty: float, rng: np.random.Ge
                     began = time.perf_counter()
                     backend.search(oracle, 12, shots=8, seed=repeat)
                     times[label].append(time.perf_counter() - began)
-            measured = free_cores_module._METER.others()
+            measured = busy_cores()
             row = {"competitor": "none" if duty == 0 else f"busy{round(100 * duty)}", "num_qubits": n,
                    "competitor_duty": duty, "load_average_1min": os.getloadavg()[0],
                    "measured_busy_cores": measured, "usable_cores": usable_cores(),

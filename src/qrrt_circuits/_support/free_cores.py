@@ -32,7 +32,7 @@ from pathlib import Path
 
 from .control_groups import group_folders
 
-__all__ = ["MIN_INTERVAL_S", "BusyMeter", "CpuTimes", "cpu_quota_cores", "free_cores", "read_cpu_times",
+__all__ = ["MIN_INTERVAL_S", "BusyMeter", "CpuTimes", "busy_cores", "cpu_quota_cores", "free_cores", "read_cpu_times",
            "usable_cores", "usable_cpus"]
 
 #: the shortest interval a measurement spans (the kernel counts CPU time in ticks of 1 / CLK_TCK s,
@@ -208,6 +208,13 @@ def _clock_ticks_per_second() -> float:
 _METER = BusyMeter()
 
 
+def busy_cores() -> float | None:
+    """The cores other work kept busy, as the process's meter last measured them (``BusyMeter.others``:
+    a reading now, a new value once ``MIN_INTERVAL_S`` has passed since the last measured one);
+    None before a first interval or without the kernel's counters."""
+    return _METER.others()
+
+
 def free_cores() -> int:
     """The usable cores that other work does not keep busy: the CPUs this process may run on less
     the cores other work kept busy on them since a reading at least ``MIN_INTERVAL_S`` ago
@@ -227,7 +234,7 @@ def free_cores() -> int:
         True
     """
     usable, cpus = usable_cores(), len(usable_cpus())
-    others = _METER.others()
+    others = busy_cores()
     if others is None:
         try:
             load = os.getloadavg()[0]
