@@ -1,20 +1,23 @@
-"""What one keyed random stream costs: the first d + 1 doubles of the generator of a key (round,
-worker, stream), as the classical planners draw one candidate per key.
+"""What a plan's random draws cost: a keyed generator per (round, worker, stream), against the
+sequential stream the classical planners draw their candidates from.
 
     python benchmarks/bench_streams.py [--quick] [--out FILE]
 
-Two ways to the same doubles (asserted equal before timing), per key, for ``KEYS`` consecutive
-rounds of one worker:
+Per candidate, the d + 1 doubles of one classical extension sample (``KEYS`` candidates of
+consecutive rounds of one worker):
 
-- ``documented``: numpy's documented constructors, one per key:
-  ``Generator(PCG64(SeedSequence(entropy, spawn_key=key))).random(d + 1)``;
-- ``compiled``: ``randomness.uniform_draws`` (the library's compiled seed words and PCG64 doubles,
-  all keys in one call), as ``keyed_samples`` draws them;
-- ``compiled_one_key``: the same for a single key (one call per key).
+- ``keyed``: a generator per key (round, worker, stream), built by ``RandomStreams.generator``
+  (numpy's ``SeedSequence(entropy, spawn_key=key)``), then ``random(d + 1)``: what each quantum
+  round pays per generator it builds;
+- ``sequential``: the plan's sequential ``Stream.EXTENSION_SAMPLES`` generator
+  (``RandomStreams.sequence``), all candidates in one ``random((K, d + 1))`` call, as a batch of
+  rounds tested ahead draws them;
+- ``sequential_one_call_each``: the same, one call per candidate (a round drawn on its own).
 
 Also the library's RRT time per motion check in the maze family (``bench_problems``' setting,
-``SEEDS`` plans), the yardstick the per-key cost is read against. Writes
-``benchmarks/results/bench_streams.json``: microseconds per key (``us_per_key``), medians of ``REPEATS`` timings.
+``SEEDS`` plans), the yardstick the per-candidate cost is read against. Writes
+``benchmarks/results/bench_streams.json``: microseconds per candidate (``us_per_key``), medians of
+``REPEATS`` timings.
 """
 
 from __future__ import annotations
@@ -30,7 +33,7 @@ import numpy as np  # noqa: E402
 from _common import machine, median_time, write_json  # noqa: E402
 
 import qrrt_circuits as qc  # noqa: E402
-from qrrt_circuits._support.randomness import RandomStreams, Stream, round_keys, uniform_draws  # noqa: E402
+from qrrt_circuits._support.randomness import RandomStreams, Stream  # noqa: E402
 from qrrt_circuits.experiments.problems import build_problem, ompl_range  # noqa: E402
 
 KEYS = 256
@@ -38,10 +41,9 @@ REPEATS = 15
 SEEDS = 20
 
 
-def documented_draws(streams: RandomStreams, keys: np.ndarray, count: int) -> np.ndarray:
-    """The first ``count`` doubles of each key's generator, built with numpy's documented API."""
-    return np.array([np.random.Generator(np.random.PCG64(np.random.SeedSequence(
-        streams.entropy, spawn_key=tuple(int(part) for part in key)))).random(count) for key in keys])
+def keyed_draws(streams: RandomStreams, rounds: range, count: int) -> np.ndarray:
+    """The first ``count`` doubles of each round's keyed generator (worker 0, candidates' stream)."""
+    return np.array([streams.generator(round_index, 0, Stream.CANDIDATES).random(count) for round_index in rounds])
 
 
 def rrt_us_per_check(seeds: int) -> float:
@@ -58,18 +60,26 @@ def rrt_us_per_check(seeds: int) -> float:
     return 1e6 * elapsed / checks
 
 
-def per_key_costs(streams: RandomStreams, keys: np.ndarray, count: int, repeats: int) -> dict:
-    """Microseconds per key of ``count`` doubles, each way (asserted equal first)."""
-    if not np.array_equal(documented_draws(streams, keys, count), uniform_draws(streams, keys, count)):
-        raise AssertionError("the compiled draws differ from numpy's")
-    one_by_one = [keys[row:row + 1] for row in range(keys.shape[0])]
-    documented = median_time(functools.partial(documented_draws, streams, keys, count), repeats)[0]
-    compiled = median_time(functools.partial(uniform_draws, streams, keys, count), repeats)[0]
-    one = median_time(lambda: [uniform_draws(streams, key, count) for key in one_by_one], repeats)[0]
-    return {"documented": {"us_per_key": 1e6 * documented / keys.shape[0]},
-            "compiled": {"us_per_key": 1e6 * compiled / keys.shape[0]},
-            "compiled_one_key": {"us_per_key": 1e6 * one / keys.shape[0]},
-            "documented_over_compiled": documented / compiled}
+def per_key_costs(streams: RandomStreams, rounds: range, count: int, repeats: int) -> dict:
+    """Microseconds per candidate of ``count`` doubles, each way."""
+    keys = len(rounds)
+
+    def sequential() -> np.ndarray:
+        return streams.sequence(Stream.EXTENSION_SAMPLES).random((keys, count))
+
+    def sequential_one_call_each() -> list[np.ndarray]:
+        generator = streams.sequence(Stream.EXTENSION_SAMPLES)
+        return [generator.random((1, count)) for _ in range(keys)]
+
+    if not np.array_equal(sequential(), np.concatenate(sequential_one_call_each())):
+        raise AssertionError("the sequential stream's batch differs from its draws one by one")
+    keyed = median_time(functools.partial(keyed_draws, streams, rounds, count), repeats)[0]
+    batch = median_time(sequential, repeats)[0]
+    each = median_time(sequential_one_call_each, repeats)[0]
+    return {"keyed": {"us_per_key": 1e6 * keyed / keys},
+            "sequential": {"us_per_key": 1e6 * batch / keys},
+            "sequential_one_call_each": {"us_per_key": 1e6 * each / keys},
+            "keyed_over_sequential": keyed / batch}
 
 
 def main() -> None:
@@ -80,12 +90,12 @@ def main() -> None:
     repeats, seeds = (3, 4) if args.quick else (REPEATS, SEEDS)
     streams = RandomStreams.from_seed(2024)
     out: dict = {"machine": machine(), "keys": KEYS, "repeats": repeats, "dims": {}}
-    keys = round_keys(1000, KEYS, 1, int(Stream.CANDIDATES))
+    rounds = range(1000, 1000 + KEYS)
     for dim in (2, 6):
-        out["dims"][str(dim)] = row = per_key_costs(streams, keys, dim + 1, repeats)
-        print(f"d = {dim}: documented {row['documented']['us_per_key']:.2f} µs/key, compiled "
-              f"{row['compiled']['us_per_key']:.3f} µs/key "
-              f"(one key a call {row['compiled_one_key']['us_per_key']:.2f})")
+        out["dims"][str(dim)] = row = per_key_costs(streams, rounds, dim + 1, repeats)
+        print(f"d = {dim}: keyed {row['keyed']['us_per_key']:.2f} µs/candidate, sequential "
+              f"{row['sequential']['us_per_key']:.3f} µs/candidate "
+              f"(one call each {row['sequential_one_call_each']['us_per_key']:.2f})")
     out["rrt_maze"] = {"us_per_check": rrt_us_per_check(seeds)}
     print(f"RRT on the maze: {out['rrt_maze']['us_per_check']:.2f} µs per motion check")
     print(f"wrote {write_json('bench_streams', out, args.out)}")

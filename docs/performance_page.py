@@ -245,20 +245,21 @@ def _families_section(run: dict) -> list[str]:
 def _streams_section(run: dict) -> list[str]:
     streams = (run.get("raw") or {}).get("streams") or {}
     dims = streams.get("dims")
-    lines = ["### A keyed random stream: numpy's constructors and the compiled path", ""]
+    lines = ["### Random draws: a keyed generator per use, or the plan's sequential stream", ""]
     if not isinstance(dims, dict) or not dims:
         return lines + ["This run holds no stream figures (`bench_streams.py`).", ""]
-    lines += [f"The first d + 1 doubles of the generator of each of {streams.get('keys', '—')} keys (round, worker, "
-              "stream), as the classical planners draw one candidate per key: built through numpy's documented "
-              "constructors one key at a time, and by the library's compiled seed words and PCG64 doubles (the "
-              "same doubles, checked before timing), all keys in one call or one call per key. Microseconds per "
-              "key; RRT's time per motion check on the maze family in the same run is the yardstick.", ""]
-    rows = [[dim, _number((row.get("documented") or {}).get("us_per_key")),
-             _number((row.get("compiled") or {}).get("us_per_key")),
-             _number((row.get("compiled_one_key") or {}).get("us_per_key")),
-             _ratio(row.get("documented_over_compiled"))] for dim, row in dims.items()]
-    lines += _table(["d", "numpy's constructors", "compiled, one call", "compiled, a call per key",
-                     "constructors / compiled"], rows, "lrrrr")
+    lines += [f"The d + 1 doubles of one classical extension sample, for {streams.get('keys', '—')} candidates: "
+              "from a generator built per key (round, worker, stream) through numpy's `SeedSequence`, as each "
+              "quantum round builds its generators; and from the plan's one sequential stream, as the classical "
+              "planners draw their candidates, all in one call (a batch of rounds tested ahead) or one call "
+              "each (a round drawn on its own). Microseconds per candidate; RRT's time per motion check on the "
+              "maze family in the same run is the yardstick.", ""]
+    rows = [[dim, _number((row.get("keyed") or {}).get("us_per_key")),
+             _number((row.get("sequential") or {}).get("us_per_key")),
+             _number((row.get("sequential_one_call_each") or {}).get("us_per_key")),
+             _ratio(row.get("keyed_over_sequential"))] for dim, row in dims.items()]
+    lines += _table(["d", "keyed generator", "sequential, one call", "sequential, a call each",
+                     "keyed / sequential"], rows, "lrrrr")
     lines += [f"RRT on the maze: {_number((streams.get('rrt_maze') or {}).get('us_per_check'))} µs per motion "
               "check.", ""]
     return lines

@@ -2,8 +2,7 @@
 
 ``fingerprint`` hashes everything a plan's numbers depend on except the wall time, so a change that
 makes any planner draw, test or add differently changes the hash. ``CASES`` are the plans the
-reference hashes in ``test_planner_fingerprints.py`` were computed on (with the code before the
-performance work of issue 11: per-round generators, one reachability call per RRT round).
+reference hashes in ``test_planner_fingerprints.py`` were computed on.
 """
 
 from __future__ import annotations
@@ -113,8 +112,7 @@ CASES["pqrrt-shared-bbht-errors"] = (lambda: _clutter(10),
                                                           search_policy=qc.BBHT(), oracle_errors=_errors()),
                                      {"max_oracle_calls": 200})
 
-# trees past tree.BRUTE_FORCE_BELOW (400 since the grid's rewrite), so the grid answers the queries
-# (references computed at 9c3c6d4, before that rewrite)
+# trees past tree.BRUTE_FORCE_BELOW, so the grid answers the queries
 CASES["rrt-large"] = (lambda: _clutter(13), lambda: qc.RRT(seed=13), {"max_nodes": 700, "goal_radius": 1e-9})
 CASES["qrrt-sv-large"] = (lambda: _clutter(11), lambda: qc.QRRT(backend=_sv(), num_qubits=6, seed=11,
                                                                    search_policy=_paper()),

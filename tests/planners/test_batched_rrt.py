@@ -17,7 +17,7 @@ import qrrt_circuits as qc
 from qrrt_circuits._support.randomness import RandomStreams, Stream
 from qrrt_circuits.planners.base import Planner
 from qrrt_circuits.planners.classical import MAX_BATCH_ROUNDS, batch_rounds
-from qrrt_circuits.planners.placement import keyed_samples, uniform_samples
+from qrrt_circuits.planners.extension_samples import ExtensionSamples
 
 
 def _sequential(planner, executor):
@@ -124,19 +124,22 @@ def test_every_planner_runs_the_one_round_loop():
 
 
 @pytest.mark.parametrize("goal_bias", [0.0, 0.3])
-def test_keyed_samples_are_the_samples_of_each_keys_generator(clutter, goal_bias):
-    """``keyed_samples`` (the classical planners' batched draws) is, key by key, what
-    ``uniform_samples(1, ...)`` (``build_database``'s draws) makes of that key's generator."""
-    streams = RandomStreams.from_seed(12)
-    keys = np.array([(round_index, worker, int(Stream.CANDIDATES)) for round_index in (0, 1, 7, 4000)
-                     for worker in range(5)], dtype=np.int64)
+def test_extension_samples_drawn_in_batches_are_those_drawn_one_by_one(clutter, goal_bias):
+    """``ExtensionSamples.next`` (the classical planners' candidates): batches of any sizes give
+    the samples drawn one at a time, the biased ones in the goal from the goal stream."""
     goal = qc.GoalBall(np.array([9.0, 9.0]), 1.5)
-    samples = keyed_samples(streams, keys, clutter.env, goal, goal_bias)
-    for key, sample in zip(keys, samples, strict=True):
-        one = uniform_samples(1, clutter.env, streams.generator(*key), goal, goal_bias)
-        assert np.array_equal(sample, one[0]), key
-    if goal_bias:
-        assert np.any(np.linalg.norm(samples - goal.centre, axis=1) <= 1.5)  # (some were drawn in the goal)
+    batched = ExtensionSamples(RandomStreams.from_seed(12), clutter.env, goal, goal_bias)
+    single = ExtensionSamples(RandomStreams.from_seed(12), clutter.env, goal, goal_bias)
+    samples = np.concatenate([batched.next(size) for size in (1, 7, 0, 30, 2)])
+    one_by_one = np.concatenate([single.next(1) for _ in range(40)])
+    assert samples.shape == (40, 2) and np.array_equal(samples, one_by_one)
+    in_goal = np.linalg.norm(samples - goal.centre, axis=1) <= 1.5
+    points = RandomStreams.from_seed(12).sequence(Stream.EXTENSION_SAMPLES).random((40, 2 + (goal_bias > 0)))
+    uniform = clutter.env.box_points(points[:, :2])
+    biased = points[:, 2] < goal_bias if goal_bias else np.zeros(40, dtype=bool)
+    assert np.array_equal(samples[~biased], uniform[~biased])  # (the unbiased ones: the stream's doubles)
+    assert np.all(in_goal[biased]) and (biased.any() == bool(goal_bias))
+    assert not np.array_equal(RandomStreams.from_seed(13).sequence(Stream.EXTENSION_SAMPLES).random(3), points[0, :3])
 
 
 @pytest.mark.parametrize("family", ["se2-gap", "narrow-passage-4d", "open-space", "maze"])

@@ -8,26 +8,26 @@ is noisy and a positive answer is verified with the true predicate (one more cal
 is added, as the quantum planners' finalizer does.
 
 Rounds tested ahead. The planners run the one round loop of ``Planner._run`` (the termination
-condition checked before each round). A round's candidates depend only on its random streams (keyed
-by round and worker: ``placement.keyed_samples``, the samples ``build_database(tree, 1, ...)``
-draws), so a round that finds no tests made ahead for it draws the candidates of the next B rounds
-at once, finds their nearest nodes in one query and tests all B x p pairs in one call
-(``LookAhead``). A test made ahead holds as long as the candidate's nearest node is the one it was
-tested with: a node added since takes that place only if it is at least as near to the raw sample
-as the parent (ties go to the lower index, the older node), which one query of the
-nearest-neighbour structure tells (``nearest_distance_from``). A round whose test no longer holds
-is stale: the batch's stale rounds are tested again, the same candidates with their nearest nodes
-in the new tree, while the others keep their tests. The rounds ready before the first that finds a
-reachable candidate run as one block: they add no node, so their counters and history are written
-at once, as many as the termination condition lets start (``termination.rounds_that_start``). The
-tree, the counters, the history and the status are those of testing each round on its own; tests
-made ahead and never used are counted in ``Metrics.wasted_checks``, never as oracle calls. B is the
-expected number of rounds up to the next stale one, ceil(1 / rate) with the Laplace estimate rate =
-(stale rounds + 1) / (rounds recorded + 2), at most floor(sqrt(r)) + 1 at round r (so the tests a
-plan's end leaves unused are about the square root of its rounds), at most ``MAX_BATCH_ROUNDS`` and
-at most ``batch_round_limit(workers, d)`` (a batch's candidates take at most ``MAX_BATCH_BYTES``).
-On an ``executor``, or with ``look_ahead=False``, B = 1 (on an executor each worker's test is one
-task).
+condition checked before each round). The candidates are the plan's extension samples, one per
+(round, worker) in round order from its sequential streams (``ExtensionSamples``): they do not
+depend on the tree, and a batch of rounds draws what the rounds drawn one by one would. So a round
+that finds no tests made ahead for it draws the candidates of the next B rounds at once, finds
+their nearest nodes in one query and tests all B x p pairs in one call (``LookAhead``). A test made
+ahead holds as long as the candidate's nearest node is the one it was tested with: a node added
+since takes that place only if it is at least as near to the raw sample as the parent (ties go to
+the lower index, the older node), which one query of the nearest-neighbour structure tells
+(``nearest_distance_from``). A round whose test no longer holds is stale: the batch's stale rounds
+are tested again, the same candidates with their nearest nodes in the new tree, while the others
+keep their tests. The rounds ready before the first that finds a reachable candidate run as one
+block: they add no node, so their counters and history are written at once, as many as the
+termination condition lets start (``termination.rounds_that_start``). The tree, the counters, the
+history and the status are those of testing each round on its own; tests made ahead and never used
+are counted in ``Metrics.wasted_checks``, never as oracle calls. B is the expected number of rounds
+up to the next stale one, ceil(1 / rate) with the Laplace estimate rate = (stale rounds + 1) /
+(rounds recorded + 2), at most floor(sqrt(r)) + 1 at round r (so the tests a plan's end leaves
+unused are about the square root of its rounds), at most ``MAX_BATCH_ROUNDS`` and at most
+``batch_round_limit(workers, d)`` (a batch's candidates take at most ``MAX_BATCH_BYTES``). On an
+``executor``, or with ``look_ahead=False``, B = 1 (on an executor each worker's test is one task).
 """
 
 from __future__ import annotations
@@ -38,14 +38,14 @@ from typing import ClassVar, NamedTuple
 
 import numpy as np
 
-from .._support.randomness import Stream, round_keys
+from .._support.randomness import Stream
 from ..problems.goals import satisfying
 from ..reachability.predicate import check_answers
 from .base import Planner
 from .context import map_tasks
 from .database import steer
+from .extension_samples import ExtensionSamples
 from .options import ParallelOptions, PlannerOptions, RRTOptions
-from .placement import keyed_samples
 from .run_state import RunState
 from .termination import Progress, TerminationCondition, rounds_that_start
 from .tree import Tree
@@ -93,9 +93,9 @@ def batch_rounds(stale_rounds: int, recorded_rounds: int) -> int:
     return max(1, min(MAX_BATCH_ROUNDS, math.ceil(1.0 / rate)))
 
 
-#: what ``LookAhead`` draws and tests with: the candidates of keys (K, 3), and (children, parents,
-#: truth, reach) of samples (K, d) against the plan's tree
-Draw = Callable[[RunState, np.ndarray], np.ndarray]
+#: what ``LookAhead`` draws and tests with: the plan's next K candidates (K, d), and (children,
+#: parents, truth, reach) of samples (K, d) against the plan's tree
+Draw = Callable[[int], np.ndarray]
 Extend = Callable[[RunState, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
 #: a node counts as possibly nearer than a candidate's parent within this relative margin (the
 #: structures round distances their own way; a false alarm only tests a round again)
@@ -152,7 +152,7 @@ class LookAhead:
         workers: p, the extensions of one round.
         most: The most rounds one batch tests (``batch_round_limit``, or 1).
         tree: The plan's tree as the plan starts (its d and its nodes).
-        draw: The candidates of keys (round, worker, stream) (K, 3), (K, d).
+        draw: The plan's next K candidates (K, d), given K (``ExtensionSamples.next``).
         extend: (children, parents, truth, reach) of samples (K, d) against the plan's tree, in
             order; ``reach`` the distance from each parent to its raw sample.
     """
@@ -233,10 +233,9 @@ class LookAhead:
         # about the square root of its rounds (a share that vanishes as plans grow)
         ahead = min(batch_rounds(self.stale_rounds, first), math.isqrt(first) + 1, self.most)
         drawn = self.drawn[(first - self.drawn_from) * workers:]  # (the rounds used are dropped)
-        kept = min(drawn.shape[0] // workers, ahead)  # a round's candidates depend on its key only
+        kept = min(drawn.shape[0] // workers, ahead)  # (the rounds drawn before and not yet used)
         if kept < ahead:
-            keys = round_keys(first + kept, ahead - kept, workers, int(Stream.CANDIDATES))
-            drawn = np.concatenate((drawn[:kept * workers], self.draw(state, keys)))
+            drawn = np.concatenate((drawn[:kept * workers], self.draw((ahead - kept) * workers)))
         self.drawn, self.drawn_from = drawn, first
         # the raw samples are kept: a round tested again is steered from its new parents
         children, parents, truth, reach = self.extend(state, drawn[:ahead * workers])
@@ -280,7 +279,9 @@ class ParallelRRT(Planner):
         without ``look_ahead``."""
         look_ahead = self.executor is None and self.options.look_ahead
         most = batch_round_limit(self.workers, state.tree.dim) if look_ahead else 1
-        state.ahead = LookAhead(self.workers, most, state.tree, self._draw, self._extend)
+        context = state.worker_context
+        samples = ExtensionSamples(self.streams, context.env, state.goal, self.options.goal_bias)
+        state.ahead = LookAhead(self.workers, most, state.tree, samples.next, self._extend)
 
     def _rounds(self, state: RunState, condition: TerminationCondition, progress: Progress) -> None:
         """A block of rounds from the tests made ahead (``LookAhead.block``): the rounds before the
@@ -295,11 +296,6 @@ class ParallelRRT(Planner):
         state.end_idle_rounds(last // workers, workers)
         self._round_from(state, children[last:], parents[last:], truth[last:], in_goal[last:])
         state.end_round()
-
-    def _draw(self, state: RunState, keys: np.ndarray) -> np.ndarray:
-        """The candidates of the keys (round, worker, ``Stream.CANDIDATES``) (K, 3): the samples
-        ``build_database(tree, 1, ...)`` draws from each key's generator (``keyed_samples``)."""
-        return keyed_samples(self.streams, keys, state.worker_context.env, state.goal, self.options.goal_bias)
 
     def _extend(self, state: RunState,
                 samples: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

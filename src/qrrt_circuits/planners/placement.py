@@ -17,13 +17,12 @@ import abc
 
 import numpy as np
 
-from .._support.randomness import RandomStreams, uniform_draws
 from ..problems.goals import Goal, sample_goal
 from ..world.environment import Environment
 from ..world.nearest import NearestNeighbors
 from .tree import Tree
 
-__all__ = ["ADMIT_DRAWS_PER_ENTRY", "PLACEMENTS", "Placement", "keyed_samples", "uniform_samples"]
+__all__ = ["ADMIT_DRAWS_PER_ENTRY", "PLACEMENTS", "Placement", "uniform_samples"]
 
 #: ``AdmitPlacement``: the most samples drawn per database entry before the band is declared empty
 ADMIT_DRAWS_PER_ENTRY = 10_000
@@ -39,40 +38,6 @@ def uniform_samples(size: int, env: Environment, rng: np.random.Generator, goal:
         count = int(biased.sum())
         if count:
             samples[biased] = sample_goal(goal, count, rng)
-    return samples
-
-
-def keyed_samples(streams: RandomStreams, keys: np.ndarray, env: Environment, goal: Goal | None,
-                  goal_bias: float) -> np.ndarray:
-    """One sample per key, as ``uniform_samples(1, env, streams.generator(*key), goal, goal_bias)``
-    draws it, for many keys at once (the classical planners' candidates, one per (round, worker)).
-
-    That call takes the key's first d doubles u for the point low + (high - low) u
-    (``Environment.sample_uniform``, through ``Environment.box_points``), then, with goal bias,
-    one more double b, and where b < ``goal_bias`` it draws the point in the goal with the same
-    generator. Here the first d + 1 doubles of every key come from one call
-    (``randomness.uniform_draws``), and only the biased keys' generators are built again, their
-    d + 1 doubles skipped, for the goal draws.
-
-    Args:
-        streams: The plan's ``RandomStreams``.
-        keys: Int (K, 3), the keys (round, worker, stream).
-        env: The ``Environment`` whose workspace is sampled.
-        goal: The ``Goal`` of the goal-biased samples, or None.
-        goal_bias: Fraction in [0, 1) of samples drawn in the goal.
-
-    Returns:
-        Float (K, d), row k the sample of key k.
-    """
-    dim = env.dim
-    biased = goal if goal_bias > 0 else None
-    draws = uniform_draws(streams, keys, dim + (biased is not None))
-    samples = env.box_points(draws[:, :dim])
-    if biased is not None:
-        for row in np.flatnonzero(draws[:, dim] < goal_bias):
-            rng = streams.generator(*keys[row])
-            rng.random(dim + 1)  # the doubles used above
-            samples[row] = sample_goal(biased, 1, rng)[0]
     return samples
 
 

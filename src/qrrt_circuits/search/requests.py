@@ -14,7 +14,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
-from .._support.randomness import seeded_generator
 from .._support.validation import check_int, check_seed
 
 if TYPE_CHECKING:
@@ -154,8 +153,8 @@ def validate_shots(shots: int) -> int:
 
 
 def seed_stream(seed: int | np.random.Generator | None) -> np.random.Generator:
-    """A numpy Generator from a seed (``np.random.default_rng(seed)``, bit for bit, built by the
-    compiled ``randomness.seeded_generator``), a Generator (used as is) or None (fresh entropy).
+    """A numpy Generator from a seed (``np.random.default_rng(seed)``), a Generator (used as is)
+    or None (fresh entropy).
 
     Args:
         seed: A non-negative integer, a ``numpy.random.Generator`` or None.
@@ -170,4 +169,4 @@ def seed_stream(seed: int | np.random.Generator | None) -> np.random.Generator:
     if isinstance(seed, np.random.Generator):
         return seed
     checked = check_seed(seed)
-    return np.random.default_rng() if checked is None else seeded_generator(checked)
+    return np.random.default_rng(checked)
