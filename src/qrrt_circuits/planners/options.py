@@ -159,9 +159,10 @@ class PlannerOptions:
             wrong answer adds a node: a classical planner verifies a positive answer with the true
             predicate (one more verification call) before it adds the node, and a quantum
             planner's finalizer verifies every measured entry, so an error costs oracle calls only.
-        seed: Non-negative integer seed of the keyed random streams (one generator per (round,
-            worker, stream), so results do not depend on the executor or the order of the calls), or
-            None (default) for fresh entropy.
+        seed: Non-negative integer seed of the plan's random streams (``RandomStreams``: a
+            generator per (round, worker, stream) for what workers draw, and the classical
+            planners' samples drawn in round order, so results do not depend on the executor or
+            the order of the calls), or None (default) for fresh entropy.
 
     Raises:
         TypeError: An option of the wrong type (naming it).
