@@ -11,7 +11,8 @@ fresh interpreters run back to back, one importing ``qrrt_circuits`` from ``--ba
 first on ``PYTHONPATH``), the other from this checkout's ``src``; which one runs first alternates
 from pair to pair. Each interpreter plans on ``paper_clutter`` worlds 0 .. W-1 (planner seed =
 world seed, built through the registry as ``bench_planners.py`` builds them) to ``--nodes`` nodes
-after one warm-up plan, and reports its total wall time over its total nodes. Prints each pair,
+after one warm-up plan (and a full garbage collection, so that the one the imports' heap is due for
+does not land in the timed plans), and reports its total wall time over its total nodes. Prints each pair,
 the medians and their ratio (baseline / ours: above 1 means ours is faster) and the median of
 the pairs' own ratios (less sensitive to a drift between pairs); writes JSON, with the baseline
 checkout's git commit and whether its tree differs from it (``baseline_checkout``), and the same
@@ -50,7 +51,7 @@ OURS = HERE.parent / "src"
 #: what each interpreter runs (argv: planner, backend, worlds, nodes, replay, unreachable goal);
 #: prints one JSON line
 CHILD = """
-import json, sys, time
+import gc, json, sys, time
 import numpy as np
 import qrrt_circuits as qc
 from qrrt_circuits.experiments.planners import make_planner
@@ -80,7 +81,8 @@ def plan(problem, seed, predicate=None, **limits):
 
 
 problems = [world(seed) for seed in range(worlds)]
-plan(problems[0], 0, max_rounds=5)  # compile and warm up
+plan(problems[0], 0, max_nodes=nodes)  # compile and warm up: a whole plan, as timed below
+gc.collect()  # (a full collection of the import-time heap, ~0.1 s, would otherwise land in the timed plans)
 
 
 class Recorded:  # the exact predicate of a world, recording its answers (record) or handing them back
