@@ -93,9 +93,12 @@ LAYERS = (
 )
 #: imports against the layer order that remain, each named: (importing module, imported module)
 LAYER_EXCEPTIONS = {
-    # the process pools' warm-up builds the experiments' default world (and its exact check) once per worker
+    # the process pools' warm-up builds the experiments' default world (and its exact check) once per
+    # worker ...
     ("qrrt_circuits._support.worker_warmup", "qrrt_circuits.experiments"),
     ("qrrt_circuits._support.worker_warmup", "qrrt_circuits.experiments.worlds"),
+    # ... and loads the kernels of the problem families' plans
+    ("qrrt_circuits._support.worker_warmup", "qrrt_circuits.experiments.problems"),
     # the OMPL planner adapter reads the package version for OMPL's planner name
     ("qrrt_circuits.adapters.ompl_planning", "qrrt_circuits"),
 }

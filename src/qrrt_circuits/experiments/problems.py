@@ -132,6 +132,23 @@ def build_problem(family: str, replicate: int) -> Problem:
     return {"open-space": open_space, "se2-gap": se2_gap}[family]()
 
 
+def load_kernels(calls: int = 40) -> None:
+    """Plan ``calls`` oracle calls of RRT (with OMPL's range) and of q-RRT (exact statevector) on
+    each family's first world, which loads the compiled kernels of their checks, nearest-neighbour
+    structures and goals into this process (once per process and argument types; the process
+    pools' warm-up, so that no trial's wall time counts the loading).
+
+    Args:
+        calls: The oracle calls of each plan (default 40).
+    """
+    for family in FAMILIES:
+        problem = build_problem(family, 0)
+        step = ompl_range(problem)
+        make_planner("rrt", 0, goal_bias=GOAL_BIAS, max_extension=step).plan(problem, max_oracle_calls=calls)
+        make_planner("qrrt", 0, "statevector", goal_bias=GOAL_BIAS, max_extension=step).plan(
+            problem, max_oracle_calls=calls)
+
+
 def ompl_range(problem: Problem) -> float:
     """OMPL's default RRT range for the problem's bounds: 0.2 of their diagonal."""
     extent = np.diff(problem.env.bounds, axis=1)[:, 0]

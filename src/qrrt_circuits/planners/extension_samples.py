@@ -45,16 +45,17 @@ class ExtensionSamples:
 
     def __init__(self, streams: RandomStreams, env: Environment, goal: Goal | None, goal_bias: float) -> None:
         self.env, self.goal_bias = env, goal_bias
-        self.goal = goal if goal_bias > 0 else None
         self.points = streams.sequence(Stream.EXTENSION_SAMPLES)
-        self.goal_points = streams.sequence(Stream.GOAL_SAMPLES)
+        #: the goal and the generator of its points, for goal-biased samples only
+        self.biased = None if goal is None or goal_bias <= 0 else (goal, streams.sequence(Stream.GOAL_SAMPLES))
 
     def next(self, count: int) -> np.ndarray:
         """The next ``count`` samples, (count, d)."""
-        dim = self.env.dim
-        draws = self.points.random((count, dim + (self.goal is not None)))
+        dim, biased = self.env.dim, self.biased
+        draws = self.points.random((count, dim + (biased is not None)))
         samples = self.env.box_points(draws[:, :dim])
-        if self.goal is not None:
+        if biased is not None:
+            goal, goal_points = biased
             for row in np.flatnonzero(draws[:, dim] < self.goal_bias):
-                samples[row] = sample_goal(self.goal, 1, self.goal_points)[0]
+                samples[row] = sample_goal(goal, 1, goal_points)[0]
         return samples
