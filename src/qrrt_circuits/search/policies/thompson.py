@@ -192,8 +192,9 @@ class ThompsonState(PolicyState):
         Returns:
             One ``SearchOutcome`` per worker.
         """
-        k = self.sample_iterations(np.random.default_rng([problem.shared_seed(), _DRAW_SALT]))
-        return verified_outcomes(problem, k, problem.search(k, workers, problem.shared_seed()))
+        seed = problem.shared_seed()
+        k = self.sample_iterations(np.random.default_rng([seed, _DRAW_SALT]))
+        return verified_outcomes(problem, k, problem.search(k, workers, seed))
 
     def learn(self, databases: Iterable[Sequence[SearchOutcome]]) -> None:
         """Each database's share of distinct verified entries updates the arm it was searched at,
