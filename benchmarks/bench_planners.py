@@ -85,12 +85,15 @@ class TimedPredicate:
 class PartTimer:
     """Times the main parts of a quantum planner's round by wrapping, for the duration of a
     ``with`` block, the functions that do them: the nearest-node query of the candidates
-    (``GridNearest.nearest``), the candidate draws (``Environment.sample_uniform``) and the backend's
-    searches (``QuantumSearchBackend.search``). The predicate is timed by ``TimedPredicate``; the rest of the round (the
-    policy, verification, bookkeeping, the planner's loop) is the plan's wall time minus these."""
+    (``GridNearest.nearest``), the candidate draws (``Environment.sample_uniform``), the backend's
+    searches as a plan runs them (``QuantumSearchBackend.run`` and ``run_sequence``, each with the
+    generator it builds from its seed) and the keyed generators of the round (``RandomStreams.
+    generator``: the database's, and the one its search seed is drawn from). The predicate is
+    timed by ``TimedPredicate``; the rest of the round (the policy, verification, bookkeeping, the
+    planner's loop) is the plan's wall time minus these."""
 
     def __init__(self) -> None:
-        self.seconds = {"nearest": 0.0, "candidate_draws": 0.0, "search": 0.0}
+        self.seconds = {"nearest": 0.0, "candidate_draws": 0.0, "search": 0.0, "keyed_generators": 0.0}
         self._patched: list[tuple[object, str, object]] = []
 
     def _wrap(self, owner, attribute: str, part: str) -> None:
@@ -108,13 +111,16 @@ class PartTimer:
         setattr(owner, attribute, timed)
 
     def __enter__(self) -> PartTimer:
+        from qrrt_circuits._support.randomness import RandomStreams
         from qrrt_circuits.search.backends.base import QuantumSearchBackend
         from qrrt_circuits.world.environment import Environment
         from qrrt_circuits.world.nearest import GridNearest
 
         self._wrap(GridNearest, "nearest", "nearest")
         self._wrap(Environment, "sample_uniform", "candidate_draws")
-        self._wrap(QuantumSearchBackend, "search", "search")
+        self._wrap(QuantumSearchBackend, "run", "search")
+        self._wrap(QuantumSearchBackend, "run_sequence", "search")
+        self._wrap(RandomStreams, "generator", "keyed_generators")
         return self
 
     def __exit__(self, *exc_info) -> None:
@@ -294,7 +300,7 @@ def main() -> None:
         print("(ompl not importable: OMPL comparison skipped; pip install '.[ompl]')")
     parts = {}
     print(f"\n{'round breakdown, us per round':44s} " + " ".join(f"{k:>15s}" for k in
-          ("predicate", "nearest", "candidate_draws", "search", "rest")))
+          ("predicate", "nearest", "candidate_draws", "search", "keyed_generators", "rest")))
     for name, configuration, big, options in BREAKDOWN:
         make = configurations(**options)[configuration]
         runs = [breakdown(make, env, seed, big_nodes if big else nodes, big)
