@@ -17,6 +17,7 @@ from __future__ import annotations
 import ast
 import json
 import math
+import statistics
 import subprocess
 import sys
 from pathlib import Path
@@ -283,6 +284,33 @@ def _profile_section(run: dict) -> list[str]:
     return lines
 
 
+#: the parts of a quantum round in ``bench_planners.py``'s breakdown, in the page's column order
+ROUND_PARTS = {"predicate": "predicate (2^n entries)", "nearest": "nearest nodes", "candidate_draws": "samples",
+               "search": "backend search", "keyed_generators": "keyed generators", "rest": "rest"}
+
+
+def _round_parts_section(run: dict) -> list[str]:
+    planners = (run.get("raw") or {}).get("planners") or {}
+    breakdown = planners.get("round_breakdown")
+    lines = ["### A quantum round, part by part", ""]
+    if not isinstance(breakdown, dict) or not breakdown:
+        return lines + ["This run holds no round breakdown (`bench_planners.py`).", ""]
+    lines += ["Microseconds per round in each part of the round, medians over the worlds (`bench_planners.py`, "
+              "`round_breakdown`): the predicate on every database entry (the simulation's checks behind the "
+              "phase oracle), the nearest-node query and the samples of the database, the backend's search "
+              "(the generator it builds from its seed included), the round's keyed generators (the database's "
+              "and the one its search seed comes from) and the rest of the round (the policy, the verification, "
+              "the bookkeeping and the planner's loop). A missing part is one this run did not time.", ""]
+    rows = []
+    for name, entry in breakdown.items():
+        runs = [item.get("us_per_round") or {} for item in (entry.get("runs") or [])]
+        medians = [statistics.median(r[part] for r in runs) if runs and all(part in r for r in runs) else None
+                   for part in ROUND_PARTS]
+        rows.append([name, *(_number(value) for value in medians)])
+    lines += _table(["planner", *ROUND_PARTS.values()], rows, "l" + "r" * len(ROUND_PARTS))
+    return lines
+
+
 def _planners_section(run: dict) -> list[str]:
     planners = (run.get("raw") or {}).get("planners")
     if not isinstance(planners, dict) or not isinstance(planners.get("planners"), dict):
@@ -522,6 +550,7 @@ def performance_page(root: Path) -> str:
     lines += _benchmarks_table(root, run)
     lines += ["## Time per node and per oracle call", ""]
     lines += _planners_section(run)
+    lines += _round_parts_section(run)
     lines += ["## Against peers measured in the same run", ""]
     lines += _ompl_section(run)
     lines += _families_section(run)

@@ -21,7 +21,10 @@ def _run(commit: str, ms_per_node: float, cpu: str = "Test CPU") -> dict:
                                      "ms_per_node": {"median": ms_per_node, "p10": 0.1, "p90": 0.9},
                                      "ms_per_call": {"median": 0.0123}, "calls_per_node": {"median": 4.5},
                                      "oracle_share": {"median": 0.25}}},
-                "ompl_rrt": {"ms_per_node": {"median": 0.5}, "ours_over_ompl": ms_per_node / 0.5}}
+                "ompl_rrt": {"ms_per_node": {"median": 0.5}, "ours_over_ompl": ms_per_node / 0.5},
+                "round_breakdown": {"QRRT statevector": {"runs": [
+                    {"us_per_round": {"predicate": 100.0, "nearest": 8.0, "rest": 40.0}},
+                    {"us_per_round": {"predicate": 120.0, "nearest": 10.0, "rest": 60.0}}]}}}
     search = {"against_floor": [{"qubits": 8, "marked": 12, "iterations": 12, "shots": 8, "repeats": 5,
                                  "median_ms": {"floor": 0.5, "ours": 1.0, "qiskit_algorithms": 20.0},
                                  "ratio_to_floor": {"floor": 1.0, "ours": 2.0, "qiskit_algorithms": 40.0}}]}
@@ -57,6 +60,7 @@ def test_the_page_shows_the_runs_figures_provenance_and_peers(root):
     assert "| RRT | — | 10 | 3 | 0.25 (0.1–0.9) | 0.0123 | 4.5 | 25 % |" in page
     assert "| maze | 8 | 6 | 6.4 | 1.25 [1, 1.5] | 1.25 [1, 1.5] |" in page  # RRT against OMPL on a family
     assert "ours over OMPL's: **0.5×**" in page
+    assert "| QRRT statevector | 110 | 9 | — | — | — | 50 |" in page  # medians of the parts; untimed: —
     assert "| 8 | 12 | 12 | 8 | 5 | 0.5 | 1 | 2× | 20 | 40× |" in page
     assert "20× at n = 8" in page  # qiskit-algorithms over ours
     assert "`bbbb`" in page and "different machines" in page
@@ -70,7 +74,7 @@ def test_missing_files_give_a_page_that_says_so(root):
     assert "is not found: no figures to show" in performance_page.performance_page(root)
     (root / "benchmarks" / "results" / "run.json").write_text(json.dumps({"machine": {}, "benchmarks": {}}))
     page = performance_page.performance_page(root)
-    assert "holds no planner figures" in page and "no OMPL figures" in page
+    assert "holds no planner figures" in page and "no OMPL figures" in page and "no round breakdown" in page
     assert "baseline.json` is not found: no comparison" in page
 
 
