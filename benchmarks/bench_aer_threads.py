@@ -31,11 +31,12 @@ from qrrt_circuits._support.free_cores import busy_cores, free_cores, usable_cor
 SETTINGS = {"one thread": 1, "all cores": 0, "default (free cores)": None}
 
 
-#: a process that keeps one core busy ``duty`` of every 100 ms (argv: duty, seconds)
+#: a process that keeps one core busy ``duty`` of every 100 ms (argv: duty, seconds, the benchmark's
+#: pid), until the seconds are over or the benchmark is gone (killed, its ``finally`` never ran)
 COMPETITOR = """
-import sys, time
-duty, end = float(sys.argv[1]), time.time() + float(sys.argv[2])
-while time.time() < end:
+import os, sys, time
+duty, end, parent = float(sys.argv[1]), time.time() + float(sys.argv[2]), int(sys.argv[3])
+while time.time() < end and os.getppid() == parent:
     began = time.time()
     while time.time() - began < 0.1 * duty:
         pass
@@ -46,7 +47,8 @@ while time.time() < end:
 def measure(sizes: tuple[int, ...], repeats: int, duty: float, rng: np.random.Generator) -> list[dict]:
     """The rows of one competitor (``duty`` 0: none)."""
     backends = {label: qc.AerBackend(seed=0, max_parallel_threads=threads) for label, threads in SETTINGS.items()}
-    competitor = None if duty == 0 else subprocess.Popen([sys.executable, "-c", COMPETITOR, str(duty), "600"])
+    competitor = None if duty == 0 else subprocess.Popen([sys.executable, "-c", COMPETITOR, str(duty), "600",
+                                                                str(os.getpid())])
     rows = []
     try:
         time.sleep(0.5)  # (the competitor's interpreter starts; the meter's interval begins)
