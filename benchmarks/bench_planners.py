@@ -138,7 +138,8 @@ def _timed(problem, big: bool):
 
 def breakdown(make, env, seed: int, nodes: int, big: bool) -> dict:
     """Microseconds per round in the predicate, the nearest-node queries, the candidate draws, the
-    backend search and the rest, for one plan (the wrappers add about a microsecond per call)."""
+    backend search, the keyed generators and the rest, for one plan (the wrappers add about a
+    microsecond per call)."""
     problem, predicate = _timed(env, big)
     planner = make(seed)
     with PartTimer() as parts:

@@ -11,9 +11,10 @@
 
 **Warm workers.** Local workers (pool and ``LocalCluster``) are forked from one *fork server*
 (the ``forkserver`` start method) that has imported ``qrrt_circuits._support.worker_warmup`` once: every
-experiment, Qiskit, Aer, numba's compiled kernels and the default world. A worker then starts
+experiment, Qiskit, Aer, numba's compiled kernels, the default world and the kernels of the
+problem families' plans (``experiments.problems.load_kernels``). A worker then starts
 with all of that in memory instead of repeating the same imports in a fresh interpreter. The fork
-server is a fresh single-threaded interpreter that never runs a simulator, so nothing forked holds
+server is a fresh single-threaded interpreter that never runs Aer, so nothing forked holds
 threads or OpenMP state. It is started with the single-thread environment below and stopped when
 the executor is shut down. Where the platform has no fork server, workers are spawned (cold).
 

@@ -5,10 +5,10 @@ start method) that imports this module first: every experiment (and with them Qi
 scipy), the default world ``paper_clutter`` (seed 0), whose construction loads the compiled
 numba kernels of the collision checks from their on-disk cache and is then cached per process
 (``experiments.worlds.world``), and its exact predicate, whose chord grid for the paper's dynamics
-is then cached per process too (``oracle.chord_grid``); then one short RRT and q-RRT plan on each
-family of the problems experiment loads the kernels of their checks, nearest-neighbour structures
-and goals (a kernel loads once per process and argument types, in tens of milliseconds that a
-worker's first trial on a family would otherwise count in its wall time). A worker forked from the
+is then cached per process too (``oracle.chord_grid``); then the problems experiment's
+``load_kernels`` loads the kernels of its families' plans (a kernel loads once per process and
+argument types, in tens of milliseconds that a worker's first trial on a family would otherwise
+count in its wall time). A worker forked from the
 server starts with all of it in memory instead of importing and loading it again; the fork server
 itself is a fresh, single-threaded interpreter (it never runs Aer, whose threads a fork would not
 carry), so forking it is safe.

@@ -22,10 +22,10 @@ interval``) resamples the worlds of a family, then the runs (root seed x replica
 in a family with one world every run is its own group, so the interval is over runs in that world.
 
 **Planners**: RRT; RRT with OMPL's range (``max_extension`` = 0.2 of the bounds' diagonal: the
-algorithm of OMPL's RRT, its rounds tested ahead as the library's RRT tests them by default, which
-changes the checks it throws away and its wall time, never its tree or its calls); manager-worker
-parallel RRT (8 workers); q-RRT under the paper's schedule, ``Adaptive``, ``BBHT`` and
-``ThompsonIterations``; Pq-RRT (8 workers, shared database) under the same four; and, when the
+algorithm of OMPL's RRT, its rounds tested ahead as the library's RRT tests them by default: the
+tree and the oracle calls of testing one round at a time, and checks thrown away besides);
+manager-worker parallel RRT (8 workers); q-RRT under the paper's schedule, ``Adaptive``, ``BBHT``
+and ``ThompsonIterations``; Pq-RRT (8 workers, shared database) under the same four; and, when the
 ``ompl`` extra is installed, OMPL's RRT and RRTConnect (``experiments.ompl_runs``). All with goal
 bias 0.05 (OMPL's default; RRTConnect has none), 2^8-entry databases on the exact statevector.
 
@@ -132,21 +132,33 @@ def build_problem(family: str, replicate: int) -> Problem:
     return {"open-space": open_space, "se2-gap": se2_gap}[family]()
 
 
+#: points ``load_kernels`` puts in each family's nearest-neighbour structure: more than any
+#: structure searches by brute force (``world.nearest.BRUTE_FORCE_BELOW``), so that it builds its grid
+GRID_POINTS = 512
+
+
 def load_kernels(calls: int = 40) -> None:
     """Plan ``calls`` oracle calls of RRT (with OMPL's range) and of q-RRT (exact statevector) on
-    each family's first world, which loads the compiled kernels of their checks, nearest-neighbour
-    structures and goals into this process (once per process and argument types; the process
-    pools' warm-up, so that no trial's wall time counts the loading).
+    each family's first world, and fill the family's nearest-neighbour structure with
+    ``GRID_POINTS`` points and query it: this loads into the process the compiled kernels of the
+    families' checks, goals, statevector draws and nearest-neighbour structures, small and large
+    (once per process and argument types; the process pools' warm-up, so that a worker's first
+    trial on a family does not count their loading in its wall time).
 
     Args:
         calls: The oracle calls of each plan (default 40).
     """
+    rng = np.random.default_rng(0)
     for family in FAMILIES:
         problem = build_problem(family, 0)
         step = ompl_range(problem)
         make_planner("rrt", 0, goal_bias=GOAL_BIAS, max_extension=step).plan(problem, max_oracle_calls=calls)
         make_planner("qrrt", 0, "statevector", goal_bias=GOAL_BIAS, max_extension=step).plan(
             problem, max_oracle_calls=calls)
+        neighbors = problem.space.nearest_neighbors()
+        points = problem.env.sample_uniform(GRID_POINTS, rng)
+        neighbors.add(points)
+        neighbors.nearest(points[:2])
 
 
 def ompl_range(problem: Problem) -> float:
