@@ -19,14 +19,20 @@ Per family, ``RUNS`` seeds of each planner plan until the goal or ``BUDGET`` mot
   additions (``PairByPair``): a checker whose cost is Python's and dominates, the same on both
   sides.
 
-Every planner's predicate is timed (its ``reachable`` wrapped by a timer), so a run's wall time
-splits into the time inside the check and the planner's own time. Figures, per family and planner:
-``us_per_check`` (wall time over motion checks or oracle calls), ``check_us_per_check`` (inside the
-predicate), ``own_us_per_check`` (the rest: sampling, nearest neighbours, tree, for q-RRT the
-database and the search), ``us_per_node``; and the ratios ``rrt_over_ompl_wall`` and
-``rrt_over_ompl_own`` (pooled: total time over total checks), and ``rrt_over_ompl_per_run`` (the
-ratio of the medians of each run's wall time per check, with a 95 % bootstrap interval), all in one
-run on one machine. ``profile``: where one plan's time goes on the maze family, per planner
+A run's wall time is its search, like for like: the library's round loop (``Metrics.wall_time_s``,
+what ``qrrt reproduce problems`` compares) beside OMPL's ``SimpleSetup.solve``. Its whole call is
+timed too: the library's ``plan()`` (its checks of the request, memory estimate, streams, tree and
+result) beside ``ompl_run`` (the OMPL setup built from the problem, ``setup()``, ``solve()`` and the
+path read back). Every planner's predicate is timed (its ``reachable`` wrapped by a timer), so a
+run's wall time splits into the time inside the check and the planner's own time. Figures, per
+family and planner: ``us_per_check`` (wall time over motion checks or oracle calls),
+``check_us_per_check`` (inside the predicate), ``own_us_per_check`` (the rest: sampling, nearest
+neighbours, tree, for q-RRT the database and the search), ``call_us_per_check`` (the whole call
+over the checks), ``setup_us_per_plan`` (a call's time outside its search, per plan),
+``us_per_node``; and the ratios ``rrt_over_ompl_wall`` and ``rrt_over_ompl_own`` (pooled: total
+time over total checks), ``rrt_over_ompl_per_run`` (the ratio of the medians of each run's wall
+time per check, with a 95 % bootstrap interval) and ``*_call_per_run`` (the same of the whole
+calls), all in one run on one machine. ``profile``: where one plan's time goes on the maze family, per planner
 (``cProfile``, the functions with the most own time, microseconds per round). Prints a table and
 writes JSON.
 """
@@ -121,8 +127,9 @@ def run_library(family: str, planner: str, seed: int, python_check: bool = False
     plan = make(planner, problem, seed)
     began = time.perf_counter()
     result = plan.plan(problem, max_oracle_calls=BUDGET)
-    wall = time.perf_counter() - began
-    return {"wall_s": wall, "check_s": spent[0], "checks": result.metrics.oracle_calls,
+    call = time.perf_counter() - began
+    return {"wall_s": result.metrics.wall_time_s, "call_s": call, "check_s": spent[0],
+            "checks": result.metrics.oracle_calls,
             "nodes": result.metrics.nodes, "reached": float(result.reached),
             "wasted": result.metrics.wasted_checks}
 
@@ -133,14 +140,18 @@ def run_ompl(family: str, seed: int, python_check: bool = False) -> dict[str, fl
 
     problem = posed(family, python_check)
     spent = timed(problem)
+    began = time.perf_counter()
     run = ompl_run(problem, "OMPL RRT", BUDGET, seed + 1, 0.05)
-    return {"wall_s": run.wall_time_s, "check_s": spent[0], "checks": run.motion_checks, "nodes": float("nan"),
+    call = time.perf_counter() - began
+    return {"wall_s": run.wall_time_s, "call_s": call, "check_s": spent[0], "checks": run.motion_checks,
+            "nodes": float("nan"),
             "reached": float(run.reached), "wasted": 0}
 
 
-def per_run(runs: list[dict[str, float]]) -> np.ndarray:
-    """Each run's wall time per motion check, in microseconds."""
-    return np.array([1e6 * r["wall_s"] / max(r["checks"], 1) for r in runs])
+def per_run(runs: list[dict[str, float]], key: str = "wall_s") -> np.ndarray:
+    """Each run's time per motion check (its search, ``wall_s``, or its whole call, ``call_s``), in
+    microseconds."""
+    return np.array([1e6 * r[key] / max(r["checks"], 1) for r in runs])
 
 
 def ratio_of_medians(mine: np.ndarray, peer: np.ndarray, seed: int = 0) -> dict[str, float]:
@@ -158,8 +169,10 @@ def figures(runs: list[dict[str, float]]) -> dict[str, float]:
     check = sum(r["check_s"] for r in runs)
     checks = sum(r["checks"] for r in runs)
     nodes = sum(r["nodes"] for r in runs)
+    call = sum(r["call_s"] for r in runs)
     return {"us_per_check": 1e6 * wall / checks, "check_us_per_check": 1e6 * check / checks,
-            "own_us_per_check": 1e6 * (wall - check) / checks,
+            "own_us_per_check": 1e6 * (wall - check) / checks, "call_us_per_check": 1e6 * call / checks,
+            "setup_us_per_plan": 1e6 * (call - wall) / len(runs),
             "us_per_node": 1e6 * wall / nodes if np.isfinite(nodes) and nodes else float("nan"),
             "checks": float(checks), "wasted_per_check": sum(r["wasted"] for r in runs) / checks,
             "success_rate": float(np.mean([r["reached"] for r in runs]))}
@@ -198,7 +211,7 @@ def main() -> None:
     runs = 3 if args.quick else 10
     have_ompl = importlib.util.find_spec("ompl") is not None
     out: dict[str, Any] = {"machine": machine(), "budget": BUDGET, "runs": runs, "ompl": have_ompl, "families": {}}
-    header = ("family", "planner", "us/check", "in check", "own", "us/node", "success")
+    header = ("family", "planner", "us/check", "in check", "own", "call", "us/node", "success")
     print(f"{header[0]:20s} {header[1]:14s} " + " ".join(f"{h:>9s}" for h in header[2:]))
     for family in families:
         planners: dict[str, Callable[[int], dict[str, float]]] = {
@@ -227,12 +240,18 @@ def main() -> None:
                               "python_check_rrt_over_ompl_per_run": ratio_of_medians(
                                   per_run(raw["rrt_python_check"]), per_run(raw["ompl_rrt_python_check"])),
                               "python_check_rrt_one_by_one_over_ompl_per_run": ratio_of_medians(
-                                  per_run(raw["rrt_one_by_one_python_check"]), per_run(raw["ompl_rrt_python_check"]))}
+                                  per_run(raw["rrt_one_by_one_python_check"]), per_run(raw["ompl_rrt_python_check"])),
+                              "rrt_over_ompl_call_per_run": ratio_of_medians(
+                                  per_run(raw["rrt"], "call_s"), per_run(raw["ompl_rrt"], "call_s")),
+                              "python_check_rrt_over_ompl_call_per_run": ratio_of_medians(
+                                  per_run(raw["rrt_python_check"], "call_s"),
+                                  per_run(raw["ompl_rrt_python_check"], "call_s"))}
         out["families"][family] = rows
         for planner, row in rows.items():
             if planner != "ratios":
                 print(f"{family:20s} {planner:14s} {row['us_per_check']:9.1f} {row['check_us_per_check']:9.1f} "
-                      f"{row['own_us_per_check']:9.1f} {row['us_per_node']:9.1f} {row['success_rate']:8.2f}")
+                      f"{row['own_us_per_check']:9.1f} {row['call_us_per_check']:9.1f} {row['us_per_node']:9.1f} "
+                      f"{row['success_rate']:8.2f}")
         if "ratios" in rows:
             print(f"{family:20s} RRT / OMPL RRT: wall per check {rows['ratios']['rrt_over_ompl_wall']:.2f}x, "
                   f"own time per check {rows['ratios']['rrt_over_ompl_own']:.2f}x")

@@ -56,6 +56,6 @@ class ExtensionSamples:
         samples = self.env.box_points(draws[:, :dim])
         if biased is not None:
             goal, goal_points = biased
-            for row in np.flatnonzero(draws[:, dim] < self.goal_bias):
+            for row in (draws[:, dim] < self.goal_bias).nonzero()[0]:
                 samples[row] = sample_goal(goal, 1, goal_points)[0]
         return samples

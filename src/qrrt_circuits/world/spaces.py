@@ -79,7 +79,8 @@ class RealVectorSpace:
         object.__setattr__(self, "dim", check_int(self.dim, "dim", 1))
 
     def distance(self, states: np.ndarray, others: np.ndarray) -> np.ndarray:
-        return np.linalg.norm(np.atleast_2d(states) - others, axis=1)
+        offset = np.atleast_2d(states) - others
+        return np.sqrt(np.add.reduce(offset * offset, axis=1))  # (numpy's 2-norm along an axis, its sum order)
 
     def interpolate(self, origins: np.ndarray, targets: np.ndarray, fraction: np.ndarray) -> np.ndarray:
         return origins + (targets - origins) * np.asarray(fraction)[:, None]
