@@ -14,6 +14,11 @@ Per family, ``RUNS`` seeds of each planner plan until the goal or ``BUDGET`` mot
   predicate as its motion validator (``experiments.ompl_runs``), when the ``ompl`` extra is
   installed;
 - ``qrrt``: q-RRT with ``Adaptive()``, 2^8 databases on the exact statevector;
+- ``one_screen_rrt``: the floor of a round written in Python, RRT on one screen (``one_screen_rrt``):
+  a sample, the nearest node from the space's own nearest-neighbour structure, a step of OMPL's
+  range through the space's ``distance`` and ``interpolate``, the problem's check and goal, one
+  round per motion check, with no counters, history, look-ahead or checks of its input; a
+  measuring device, not a planner of the library (its random draws are its own);
 - ``*_python_check`` (with OMPL): ``rrt``, ``rrt_one_by_one`` and ``ompl_rrt`` with the predicate
   asked one pair at a time from a Python loop, each pair also paying ``PYTHON_WORK`` Python
   additions (``PairByPair``): a checker whose cost is Python's and dominates, the same on both
@@ -31,10 +36,10 @@ neighbours, tree, for q-RRT the database and the search), ``call_us_per_check`` 
 over the checks), ``setup_us_per_plan`` (a call's time outside its search, per plan),
 ``us_per_node``; and the ratios ``rrt_over_ompl_wall`` and ``rrt_over_ompl_own`` (pooled: total
 time over total checks), ``rrt_over_ompl_per_run`` (the ratio of the medians of each run's wall
-time per check, with a 95 % bootstrap interval) and ``*_call_per_run`` (the same of the whole
-calls), all in one run on one machine. ``profile``: where one plan's time goes on the maze family, per planner
-(``cProfile``, the functions with the most own time, microseconds per round). Prints a table and
-writes JSON.
+time per check, with a 95 % bootstrap interval), ``*_call_per_run`` (the same of the whole calls)
+and ``one_screen_rrt_over_ompl_per_run``, all in one run on one machine. ``profile``: where one
+plan's time goes on the maze family, per planner (``cProfile``, the functions with the most own
+time, microseconds per round). Prints a table and writes JSON.
 """
 
 from __future__ import annotations
@@ -56,6 +61,7 @@ from _common import machine, write_json  # noqa: E402
 import qrrt_circuits as qc  # noqa: E402
 from qrrt_circuits.experiments.problems import build_problem, ompl_range  # noqa: E402
 from qrrt_circuits.problems.families import Problem  # noqa: E402
+from qrrt_circuits.problems.goals import sample_goal  # noqa: E402
 
 BUDGET = 5000
 #: the library's planners of the benchmark
@@ -148,6 +154,44 @@ def run_ompl(family: str, seed: int, python_check: bool = False) -> dict[str, fl
             "reached": float(run.reached), "wasted": 0}
 
 
+def one_screen_rrt(problem: Problem, seed: int, budget: int = BUDGET,
+                   goal_bias: float = 0.05) -> tuple[int, int, bool]:
+    """RRT on one screen (OMPL's algorithm, the paper's Alg. 1) on the problem's own parts, until a
+    node satisfies the goal or ``budget`` motion checks: returns (motion checks, nodes, reached)."""
+    rng = np.random.default_rng(seed)
+    space, check, goal, step = problem.space, problem.predicate, problem.goal, ompl_range(problem)
+    low, span = problem.env.bounds[:, 0], problem.env.bounds[:, 1] - problem.env.bounds[:, 0]
+    nodes = np.empty((budget + 1, problem.dim))
+    nodes[0] = problem.start
+    near = space.nearest_neighbors()
+    near.add(nodes[:1])
+    size = 1
+    for checks in range(1, budget + 1):
+        draw = rng.random(problem.dim + 1)
+        sample = sample_goal(goal, 1, rng) if draw[-1] < goal_bias else (low + span * draw[:-1])[None]
+        origin = nodes[near.nearest(sample)]
+        length = space.distance(origin, sample)
+        child = space.interpolate(origin, sample, np.minimum(1.0, step / np.maximum(length, 1e-300)))
+        if check.reachable(origin, child)[0]:
+            nodes[size] = child[0]
+            size += 1
+            near.add(child)
+            if goal.is_satisfied(child)[0]:
+                return checks, size - 1, True
+    return budget, size - 1, False
+
+
+def run_one_screen(family: str, seed: int) -> dict[str, float]:
+    """One run of ``one_screen_rrt`` on a fresh problem."""
+    problem = posed(family, False)
+    spent = timed(problem)
+    began = time.perf_counter()
+    checks, nodes, reached = one_screen_rrt(problem, seed)
+    wall = time.perf_counter() - began
+    return {"wall_s": wall, "call_s": wall, "check_s": spent[0], "checks": checks, "nodes": nodes,
+            "reached": float(reached), "wasted": 0}
+
+
 def per_run(runs: list[dict[str, float]], key: str = "wall_s") -> np.ndarray:
     """Each run's time per motion check (its search, ``wall_s``, or its whole call, ``call_s``), in
     microseconds."""
@@ -216,6 +260,7 @@ def main() -> None:
     for family in families:
         planners: dict[str, Callable[[int], dict[str, float]]] = {
             name: functools.partial(run_library, family, name) for name in LIBRARY}
+        planners["one_screen_rrt"] = functools.partial(run_one_screen, family)
         if have_ompl:
             planners["ompl_rrt"] = functools.partial(run_ompl, family)
             for name in ("rrt", "rrt_one_by_one"):
@@ -241,6 +286,8 @@ def main() -> None:
                                   per_run(raw["rrt_python_check"]), per_run(raw["ompl_rrt_python_check"])),
                               "python_check_rrt_one_by_one_over_ompl_per_run": ratio_of_medians(
                                   per_run(raw["rrt_one_by_one_python_check"]), per_run(raw["ompl_rrt_python_check"])),
+                              "one_screen_rrt_over_ompl_per_run": ratio_of_medians(
+                                  per_run(raw["one_screen_rrt"]), per_run(raw["ompl_rrt"])),
                               "rrt_over_ompl_call_per_run": ratio_of_medians(
                                   per_run(raw["rrt"], "call_s"), per_run(raw["ompl_rrt"], "call_s")),
                               "python_check_rrt_over_ompl_call_per_run": ratio_of_medians(

@@ -30,10 +30,11 @@ def _run(commit: str, ms_per_node: float, cpu: str = "Test CPU") -> dict:
                                  "ratio_to_floor": {"floor": 1.0, "ours": 2.0, "qiskit_algorithms": 40.0}}]}
     ratio = {"median": 1.25, "low": 1.0, "high": 1.5}
     call = {"median": 2.5, "low": 2.0, "high": 3.0}
+    floor = {"median": 1.75, "low": 1.5, "high": 2.0}
     problems = {"runs": 4, "budget": 5000, "families": {"maze": {
         "rrt": {"us_per_check": 8.0, "own_us_per_check": 6.0}, "ompl_rrt": {"us_per_check": 6.4},
         "ratios": {"rrt_over_ompl_per_run": ratio, "rrt_over_ompl_call_per_run": call,
-                   "rrt_one_by_one_over_ompl_per_run": ratio}}}}
+                   "rrt_one_by_one_over_ompl_per_run": ratio, "one_screen_rrt_over_ompl_per_run": floor}}}}
     return {"machine": machine, "quick": True, "benchmarks": {"planners": {"returncode": 0, "wall_s": 1.5},
                                                             "problems": {"returncode": 3, "wall_s": 2.0}},
             "figures": {"planners.RRT.ms_per_node.median": ms_per_node},
@@ -60,8 +61,8 @@ def test_the_page_shows_the_runs_figures_provenance_and_peers(root):
     assert "quick run" in page and "qiskit 9.9" in page and "not installed: ompl" in page
     assert "The run holds 2 benchmarks (`planners`, `problems`" in page and "`problems` failed (exit status 3)" in page
     assert "| RRT | — | 10 | 3 | 0.25 (0.1–0.9) | 0.0123 | 4.5 | 25 % |" in page
-    # RRT against OMPL on a family: the search, the whole call, one by one
-    assert "| maze | 8 | 6 | 6.4 | 1.25 [1, 1.5] | 2.5 [2, 3] | 1.25 [1, 1.5] |" in page
+    # RRT against OMPL on a family: the search, the whole call, one by one, the one-screen floor, —
+    assert "| maze | 8 | 6 | 6.4 | 1.25 [1, 1.5] | 2.5 [2, 3] | 1.25 [1, 1.5] | 1.75 [1.5, 2] | — |" in page
     assert "ours over OMPL's: **0.5×**" in page
     assert "| QRRT statevector | 110 | 9 | — | — | — | 50 |" in page  # medians of the parts; untimed: —
     assert "| 8 | 12 | 12 | 8 | 5 | 0.5 | 1 | 2× | 20 | 40× |" in page
