@@ -26,20 +26,21 @@ Per family, ``RUNS`` seeds of each planner plan until the goal or ``BUDGET`` mot
 
 A run's wall time is its search, like for like: the library's round loop (``Metrics.wall_time_s``,
 what ``qrrt reproduce problems`` compares) beside OMPL's ``SimpleSetup.solve``. Its whole call is
-timed too: the library's ``plan()`` (its checks of the request, memory estimate, streams, tree and
-result) beside ``ompl_run`` (the OMPL setup built from the problem, ``setup()``, ``solve()`` and the
-path read back). Every planner's predicate is timed (its ``reachable`` wrapped by a timer), so a
-run's wall time splits into the time inside the check and the planner's own time. Figures, per
-family and planner: ``us_per_check`` (wall time over motion checks or oracle calls),
-``check_us_per_check`` (inside the predicate), ``own_us_per_check`` (the rest: sampling, nearest
-neighbours, tree, for q-RRT the database and the search), ``call_us_per_check`` (the whole call
-over the checks), ``setup_us_per_plan`` (a call's time outside its search, per plan),
-``us_per_node``; and the ratios ``rrt_over_ompl_wall`` and ``rrt_over_ompl_own`` (pooled: total
-time over total checks), ``rrt_over_ompl_per_run`` (the ratio of the medians of each run's wall
-time per check, with a 95 % bootstrap interval), ``*_call_per_run`` (the same of the whole calls)
-and ``one_screen_rrt_over_ompl_per_run``, all in one run on one machine. ``profile``: where one
-plan's time goes on the maze family, per planner (``cProfile``, the functions with the most own
-time, microseconds per round). Prints a table and writes JSON.
+timed too: the library's ``plan()`` (its checks of the request, memory estimate, run state and tree,
+and result) beside ``ompl_run`` (the OMPL setup and planner built from the problem, ``setup()``,
+``solve()`` and the path read back); OMPL's side is OMPL driven from Python (its motion checks and
+termination condition are Python callbacks). Every planner's predicate is timed (its ``reachable``
+wrapped by a timer), so a run's wall time splits into the time inside the check and the planner's
+own time. Figures, per family and planner: ``us_per_check`` (wall time over motion checks or oracle
+calls), ``check_us_per_check`` (inside the predicate), ``own_us_per_check`` (the rest: sampling,
+nearest neighbours, tree, for q-RRT the database and the search), ``call_us_per_check`` (the whole
+call over the checks), ``outside_search_us_per_plan`` (a call's time outside its search, per plan),
+``us_per_node``; and the ratios ``rrt_over_ompl_wall`` and ``rrt_over_ompl_own`` (pooled: total time
+over total checks), ``rrt_over_ompl_per_run`` (the ratio of the medians of each run's wall time per
+check, with a 95 % bootstrap interval), ``*_call_per_run`` (the same of the whole calls) and
+``one_screen_rrt_over_ompl_per_run``, all in one run on one machine. ``profile``: where one plan's
+time goes on the maze family, per planner (``cProfile``, the functions with the most own time,
+microseconds per round). Prints a table and writes JSON.
 """
 
 from __future__ import annotations
@@ -216,7 +217,7 @@ def figures(runs: list[dict[str, float]]) -> dict[str, float]:
     call = sum(r["call_s"] for r in runs)
     return {"us_per_check": 1e6 * wall / checks, "check_us_per_check": 1e6 * check / checks,
             "own_us_per_check": 1e6 * (wall - check) / checks, "call_us_per_check": 1e6 * call / checks,
-            "setup_us_per_plan": 1e6 * (call - wall) / len(runs),
+            "outside_search_us_per_plan": 1e6 * (call - wall) / len(runs),
             "us_per_node": 1e6 * wall / nodes if np.isfinite(nodes) and nodes else float("nan"),
             "checks": float(checks), "wasted_per_check": sum(r["wasted"] for r in runs) / checks,
             "success_rate": float(np.mean([r["reached"] for r in runs]))}

@@ -222,7 +222,9 @@ def _families_section(run: dict) -> list[str]:
               "predicate as its motion validator. A run's wall time is its search, like for like: the library's "
               "round loop (what `qrrt reproduce problems` compares) beside OMPL's `solve()`; its whole call adds "
               "what each side does around it (the library's `plan()`: its checks of the request, memory "
-              "estimate, streams and result; OMPL's setup from the problem, `setup()` and the path read back). "
+              "estimate, run state and tree, and result; OMPL's setup and planner built from the problem, "
+              "`setup()` and the path read back). OMPL's side is OMPL driven from Python: its motion checks and "
+              "termination condition are Python callbacks. "
               "Wall time per motion check in microseconds (pooled over the seeds), and the ratio of the medians "
               "of each seed's time per check, ours over OMPL's, with its 95 % bootstrap interval over the seeds.",
               ""]
@@ -243,8 +245,8 @@ def _families_section(run: dict) -> list[str]:
                      interval(one_by_one), interval(ratios.get("one_screen_rrt_over_ompl_per_run") or {}),
                      interval(ratios.get("python_check_rrt_over_ompl_per_run") or {})])
     lines += _table(["family", "RRT µs / check", "its own µs", "OMPL µs / check", "RRT / OMPL",
-                     "whole call", "one by one / OMPL", "one screen / OMPL", "RRT / OMPL, Python check"], rows,
-                    "lrrrrrrrr")
+                     "RRT / OMPL, whole call", "one by one / OMPL", "one screen / OMPL",
+                     "RRT / OMPL, Python check"], rows, "lrrrrrrrr")
     lines += ["`one screen` is the floor of a round written in Python: RRT on one screen (`one_screen_rrt` in "
               "the benchmark) on the same parts (the space's nearest-neighbour structure, `distance` and "
               "`interpolate`, the problem's check and goal), one round per motion check, with no counters, "
