@@ -98,6 +98,17 @@ def _records(out, experiment="heatmaps") -> int:
         return 0
 
 
+def _names(processes) -> list[str]:
+    """The names of ``processes`` (psutil), those gone meanwhile as "gone"."""
+    names = []
+    for process in processes:
+        try:
+            names.append(" ".join(process.cmdline()[:3]) or process.name())
+        except psutil.Error:
+            names.append("gone")
+    return names
+
+
 def _terminated_line(signum, out):
     return (f"qrrt reproduce: terminated ({signal.Signals(signum).name}); finished trials are kept in "
             f"{out / 'heatmaps' / 'records.csv'}; run the same command again to resume")
@@ -213,14 +224,15 @@ def test_ctrl_c_to_the_process_group_is_one_line_and_the_workers_are_shut_down(e
     def pool_started() -> bool:  # the fork server exists, importing its preload
         return bool(psutil.Process(process.pid).children())
 
-    moments = [lambda: _records(out) >= 2, pool_started]
-    for ready in moments:
+    moments = {"records written": lambda: _records(out) >= 2, "a child process": pool_started}
+    for moment, ready in moments.items():
         process = _start(argv, tmp_path, start_new_session=True)
         _wait_for(ready, process, "the moment to interrupt", timeout_s=120)
         helpers = psutil.Process(process.pid).children(recursive=True)
+        seen = (moment, _names(helpers), _records(out))  # (what a failure reports: when it was sent)
         os.killpg(process.pid, signal.SIGINT)
         out_text, err = process.communicate(timeout=120)
-        assert process.returncode == 130, (process.returncode, err)
+        assert process.returncode == 130, (*seen, _records(out), process.returncode, out_text[-300:], err)
         assert _error_lines(out_text + err) == [
             f"qrrt reproduce: interrupted; finished trials are kept in {out / 'heatmaps' / 'records.csv'}; run the "
             "same command again to resume"], err
