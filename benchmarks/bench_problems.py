@@ -16,9 +16,9 @@ Per family, ``RUNS`` seeds of each planner plan until the goal or ``BUDGET`` mot
 - ``qrrt``: q-RRT with ``Adaptive()``, 2^8 databases on the exact statevector;
 - ``one_screen_rrt``: the floor of a round written in Python, RRT on one screen (``one_screen_rrt``):
   a sample, the nearest node from the space's own nearest-neighbour structure, a step of OMPL's
-  range through the space's ``distance`` and ``interpolate``, the problem's check and goal, one
-  round per motion check, with no counters, history, look-ahead or checks of its input; a
-  measuring device, not a planner of the library (its random draws are its own);
+  range (the library's ``steer``: the space's ``distance`` and ``interpolate``), the problem's check
+  and goal, one round per motion check, with no counters, history, look-ahead or checks of its
+  input; a measuring device, not a planner of the library (its random draws are its own);
 - ``*_python_check`` (with OMPL): ``rrt``, ``rrt_one_by_one`` and ``ompl_rrt`` with the predicate
   asked one pair at a time from a Python loop, each pair also paying ``PYTHON_WORK`` Python
   additions (``PairByPair``): a checker whose cost is Python's and dominates, the same on both
@@ -61,6 +61,7 @@ from _common import machine, write_json  # noqa: E402
 
 import qrrt_circuits as qc  # noqa: E402
 from qrrt_circuits.experiments.problems import build_problem, ompl_range  # noqa: E402
+from qrrt_circuits.planners.database import steer  # noqa: E402
 from qrrt_circuits.problems.families import Problem  # noqa: E402
 from qrrt_circuits.problems.goals import sample_goal  # noqa: E402
 
@@ -171,8 +172,7 @@ def one_screen_rrt(problem: Problem, seed: int, budget: int = BUDGET,
         draw = rng.random(problem.dim + 1)
         sample = sample_goal(goal, 1, rng) if draw[-1] < goal_bias else (low + span * draw[:-1])[None]
         origin = nodes[near.nearest(sample)]
-        length = space.distance(origin, sample)
-        child = space.interpolate(origin, sample, np.minimum(1.0, step / np.maximum(length, 1e-300)))
+        child = steer(space, origin, sample, step)
         if check.reachable(origin, child)[0]:
             nodes[size] = child[0]
             size += 1

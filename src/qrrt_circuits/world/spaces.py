@@ -79,10 +79,7 @@ class RealVectorSpace:
         object.__setattr__(self, "dim", check_int(self.dim, "dim", 1))
 
     def distance(self, states: np.ndarray, others: np.ndarray) -> np.ndarray:
-        offset = np.atleast_2d(states) - others
-        if not np.issubdtype(offset.dtype, np.inexact):  # (as numpy's norm: integers in float)
-            offset = offset.astype(float)
-        return np.sqrt(np.add.reduce(offset * offset, axis=1))  # (numpy's 2-norm along an axis, its sum order)
+        return np.linalg.norm(np.atleast_2d(states) - others, axis=1)
 
     def interpolate(self, origins: np.ndarray, targets: np.ndarray, fraction: np.ndarray) -> np.ndarray:
         return origins + (targets - origins) * np.asarray(fraction)[:, None]
